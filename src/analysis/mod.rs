@@ -1,0 +1,1 @@
+//! Decomposition of every bone, findings and whole-clip scans.

@@ -1,0 +1,1 @@
+//! Sampling, layering and local→model evaluation.

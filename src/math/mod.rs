@@ -1,0 +1,1 @@
+//! Polar decomposition and quaternion helpers on top of glam.

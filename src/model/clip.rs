@@ -1,0 +1,248 @@
+//! Animation clips: per-bone keyframe tracks for translation, rotation and scale.
+//!
+//! Key values are stored in single precision (what every supported file format holds), times in seconds as `f64`
+//! and shared between tracks that use the same input, so a long clip of a big rig stays small. Evaluation
+//! (`eval::sample`) widens everything to `f64`.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+
+/// How values between keys are computed (glTF's sampler interpolations).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interpolation {
+    Step,
+    Linear,
+    /// Hermite spline; each key stores `[in-tangent, value, out-tangent]`.
+    CubicSpline,
+}
+
+impl Interpolation {
+    /// How many stored values one key has.
+    pub fn values_per_key(self) -> usize {
+        match self {
+            Interpolation::CubicSpline => 3,
+            _ => 1,
+        }
+    }
+}
+
+/// Keyframes of one animated property.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Track<T> {
+    times: Arc<[f64]>,
+    values: Vec<T>,
+    interpolation: Interpolation,
+}
+
+/// Why keyframe data cannot form a track.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrackError {
+    #[error("no keyframes")]
+    Empty,
+    #[error("{values} output values for {keys} keys with {interpolation:?} interpolation (expected {expected})")]
+    CountMismatch { keys: usize, values: usize, expected: usize, interpolation: Interpolation },
+    #[error("key time {index} ({time}) is not finite, negative, or not after the previous key")]
+    BadTime { index: usize, time: f64 },
+    #[error("output value {index} is not finite")]
+    NonFinite { index: usize },
+    #[error("cubic-spline interpolation needs at least 2 keys")]
+    TooFewCubicKeys,
+}
+
+/// A key value in single precision whose components can be checked for finiteness.
+pub trait KeyValue: Copy {
+    fn is_finite(&self) -> bool;
+}
+
+impl KeyValue for Vec3 {
+    fn is_finite(&self) -> bool {
+        Vec3::is_finite(*self)
+    }
+}
+
+impl KeyValue for Quat {
+    fn is_finite(&self) -> bool {
+        Quat::is_finite(*self)
+    }
+}
+
+impl<T: KeyValue> Track<T> {
+    /// Checks the glTF rules: times finite, non-negative and strictly increasing; one value per key
+    /// (three for cubic splines, at least two keys); every value finite.
+    pub fn new(times: Arc<[f64]>, values: Vec<T>, interpolation: Interpolation) -> Result<Self, TrackError> {
+        if times.is_empty() {
+            return Err(TrackError::Empty);
+        }
+        let expected = times.len() * interpolation.values_per_key();
+        if values.len() != expected {
+            return Err(TrackError::CountMismatch { keys: times.len(), values: values.len(), expected, interpolation });
+        }
+        if interpolation == Interpolation::CubicSpline && times.len() < 2 {
+            return Err(TrackError::TooFewCubicKeys);
+        }
+        let mut previous = f64::NEG_INFINITY;
+        for (index, &time) in times.iter().enumerate() {
+            if !time.is_finite() || time < 0.0 || time <= previous {
+                return Err(TrackError::BadTime { index, time });
+            }
+            previous = time;
+        }
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(TrackError::NonFinite { index });
+        }
+        Ok(Track { times, values, interpolation })
+    }
+}
+
+impl<T> Track<T> {
+    pub fn times(&self) -> &[f64] {
+        &self.times
+    }
+
+    /// The stored values (`3 × keys` for cubic splines: in-tangent, value, out-tangent per key).
+    pub fn values(&self) -> &[T] {
+        &self.values
+    }
+
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
+    }
+
+    pub fn last_time(&self) -> f64 {
+        self.times[self.times.len() - 1]
+    }
+}
+
+/// The animated properties of one bone in a clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoneTracks {
+    pub bone: usize,
+    pub translation: Option<Track<Vec3>>,
+    pub rotation: Option<Track<Quat>>,
+    pub scale: Option<Track<Vec3>>,
+}
+
+impl BoneTracks {
+    pub fn new(bone: usize) -> Self {
+        BoneTracks { bone, translation: None, rotation: None, scale: None }
+    }
+
+    /// Key times of all three properties (unsorted, with repeats).
+    fn all_times(&self) -> impl Iterator<Item = f64> + '_ {
+        let t = self.translation.iter().flat_map(|t| t.times().iter());
+        let r = self.rotation.iter().flat_map(|t| t.times().iter());
+        let s = self.scale.iter().flat_map(|t| t.times().iter());
+        t.chain(r).chain(s).copied()
+    }
+}
+
+/// A morph-weight channel: listed so a user knows it is there, not evaluated.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MorphChannel {
+    pub bone: usize,
+    pub keys: usize,
+    pub interpolation: Interpolation,
+    /// The last key time, which counts towards the clip's duration.
+    pub last_time: f64,
+}
+
+/// One animation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clip {
+    /// Index among the file's animations.
+    pub index: usize,
+    pub name: Option<String>,
+    /// Tracks sorted by bone, at most one entry per bone.
+    tracks: Vec<BoneTracks>,
+    pub morph_channels: Vec<MorphChannel>,
+    duration: f64,
+}
+
+impl Clip {
+    /// Sorts the tracks by bone; the duration is the last key time of any track (glTF clips start at t = 0).
+    pub fn new(index: usize, name: Option<String>, mut tracks: Vec<BoneTracks>, morph_channels: Vec<MorphChannel>) -> Self {
+        tracks.sort_by_key(|t| t.bone);
+        let duration = tracks.iter().flat_map(BoneTracks::all_times).fold(0.0, f64::max);
+        let duration = morph_channels.iter().map(|m| m.last_time).fold(duration, f64::max);
+        Clip { index, name, tracks, morph_channels, duration }
+    }
+
+    pub fn tracks(&self) -> &[BoneTracks] {
+        &self.tracks
+    }
+
+    /// Seconds from t = 0 to the last key.
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// A name for people: the clip's name, or `animation <index>`.
+    pub fn label(&self) -> String {
+        self.name.clone().unwrap_or_else(|| format!("animation {}", self.index))
+    }
+
+    /// Every key time of every track, sorted, without duplicates.
+    pub fn key_times(&self) -> Vec<f64> {
+        let mut times: Vec<f64> = self.tracks.iter().flat_map(BoneTracks::all_times).collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
+    /// The tracks of one bone, if the clip animates it.
+    pub fn tracks_of(&self, bone: usize) -> Option<&BoneTracks> {
+        self.tracks.binary_search_by_key(&bone, |t| t.bone).ok().map(|i| &self.tracks[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn times(t: &[f64]) -> Arc<[f64]> {
+        t.into()
+    }
+
+    #[test]
+    fn track_validation() {
+        let v = vec![Vec3::ZERO; 2];
+        assert!(Track::new(times(&[0.0, 1.0]), v.clone(), Interpolation::Linear).is_ok());
+        assert_eq!(Track::<Vec3>::new(times(&[]), vec![], Interpolation::Step), Err(TrackError::Empty));
+        assert!(matches!(
+            Track::new(times(&[0.0, 1.0]), v.clone(), Interpolation::CubicSpline),
+            Err(TrackError::CountMismatch { expected: 6, .. })
+        ));
+        assert!(matches!(
+            Track::new(times(&[1.0, 1.0]), v.clone(), Interpolation::Linear),
+            Err(TrackError::BadTime { index: 1, .. })
+        ));
+        assert!(matches!(
+            Track::new(times(&[0.0, f64::NAN]), v.clone(), Interpolation::Linear),
+            Err(TrackError::BadTime { index: 1, .. })
+        ));
+        assert_eq!(
+            Track::new(times(&[0.0, 1.0]), vec![Vec3::ZERO, Vec3::NAN], Interpolation::Linear),
+            Err(TrackError::NonFinite { index: 1 })
+        );
+        assert_eq!(
+            Track::new(times(&[0.0]), vec![Vec3::ZERO; 3], Interpolation::CubicSpline),
+            Err(TrackError::TooFewCubicKeys)
+        );
+    }
+
+    #[test]
+    fn duration_and_key_times_cover_all_tracks() {
+        let mut a = BoneTracks::new(3);
+        a.translation = Some(Track::new(times(&[0.5, 2.0]), vec![Vec3::ZERO; 2], Interpolation::Linear).unwrap());
+        let mut b = BoneTracks::new(1);
+        b.rotation = Some(Track::new(times(&[0.0, 0.5, 1.0]), vec![Quat::IDENTITY; 3], Interpolation::Step).unwrap());
+        let clip = Clip::new(0, None, vec![a, b], vec![]);
+        assert_eq!(clip.duration(), 2.0);
+        assert_eq!(clip.key_times(), vec![0.0, 0.5, 1.0, 2.0]);
+        assert_eq!(clip.tracks()[0].bone, 1, "tracks are sorted by bone");
+        assert!(clip.tracks_of(3).is_some() && clip.tracks_of(2).is_none());
+        assert_eq!(clip.label(), "animation 0");
+    }
+}

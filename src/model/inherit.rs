@@ -1,0 +1,124 @@
+//! How a bone combines its parent's model matrix with its own local transform.
+//!
+//! The ids are the ones of `docs/inheritance-modes.md` and are what the command line and the JSON reports use.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A bone's scale-inheritance mode. Roots behave the same in every mode (`W = L`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InheritMode {
+    /// `W = W_p·L`: glTF, FBX RSrs, Blender Full, Unity, Godot, ozz. Shears under a rotated child.
+    #[default]
+    Full,
+    /// The seed's two-pass "don't inherit scale": `W = G_p·L` with `G` the rigid (T·R only) chain.
+    UnscaledParent,
+    /// Maya segment scale compensate / FBX Rrs: `W = U_p·T(s_p⊙t)·R·S`.
+    SegmentCompensate,
+    /// FBX RrSs as ufbx reads it, Unreal's FTransform: parent scale applied along the child's axes.
+    Componentwise,
+    /// Blender Inherit Scale: Fix Shear.
+    BlenderFixShear,
+    /// Blender Inherit Scale: Aligned.
+    BlenderAligned,
+    /// Blender Inherit Scale: Average.
+    BlenderAverage,
+    /// Blender Inherit Scale: None.
+    BlenderNone,
+    /// Blender Inherit Scale: None (Legacy).
+    BlenderNoneLegacy,
+}
+
+impl InheritMode {
+    /// Every mode, in the order of the reference table.
+    pub const ALL: [InheritMode; 9] = [
+        InheritMode::Full,
+        InheritMode::UnscaledParent,
+        InheritMode::SegmentCompensate,
+        InheritMode::Componentwise,
+        InheritMode::BlenderFixShear,
+        InheritMode::BlenderAligned,
+        InheritMode::BlenderAverage,
+        InheritMode::BlenderNone,
+        InheritMode::BlenderNoneLegacy,
+    ];
+
+    /// The stable id used on the command line and in reports.
+    pub fn id(self) -> &'static str {
+        match self {
+            InheritMode::Full => "full",
+            InheritMode::UnscaledParent => "unscaled-parent",
+            InheritMode::SegmentCompensate => "segment-compensate",
+            InheritMode::Componentwise => "componentwise",
+            InheritMode::BlenderFixShear => "blender-fix-shear",
+            InheritMode::BlenderAligned => "blender-aligned",
+            InheritMode::BlenderAverage => "blender-average",
+            InheritMode::BlenderNone => "blender-none",
+            InheritMode::BlenderNoneLegacy => "blender-none-legacy",
+        }
+    }
+
+    /// One line on what the mode models, for help texts and tooltips.
+    pub fn description(self) -> &'static str {
+        match self {
+            InheritMode::Full => "full matrix inheritance (glTF, FBX RSrs, Unity, Godot, ozz)",
+            InheritMode::UnscaledParent => "parent matrix from the rigid T·R chain (the two-pass \"don't inherit scale\")",
+            InheritMode::SegmentCompensate => "Maya segment scale compensate, FBX Rrs",
+            InheritMode::Componentwise => "parent scale along the child's axes (FBX RrSs, Unreal FTransform)",
+            InheritMode::BlenderFixShear => "Blender Inherit Scale: Fix Shear",
+            InheritMode::BlenderAligned => "Blender Inherit Scale: Aligned",
+            InheritMode::BlenderAverage => "Blender Inherit Scale: Average",
+            InheritMode::BlenderNone => "Blender Inherit Scale: None",
+            InheritMode::BlenderNoneLegacy => "Blender Inherit Scale: None (Legacy)",
+        }
+    }
+
+    /// Whether the mode follows Blender's bone model (rest offset `O` and channel `C`).
+    pub fn is_blender(self) -> bool {
+        matches!(
+            self,
+            InheritMode::BlenderFixShear
+                | InheritMode::BlenderAligned
+                | InheritMode::BlenderAverage
+                | InheritMode::BlenderNone
+                | InheritMode::BlenderNoneLegacy
+        )
+    }
+}
+
+impl fmt::Display for InheritMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.id())
+    }
+}
+
+/// The error of parsing an unknown mode id.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown inheritance mode `{0}` (expected one of: {ids})", ids = InheritMode::ALL.map(InheritMode::id).join(", "))]
+pub struct UnknownInheritMode(pub String);
+
+impl FromStr for InheritMode {
+    type Err = UnknownInheritMode;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        InheritMode::ALL
+            .into_iter()
+            .find(|m| m.id() == s)
+            .ok_or_else(|| UnknownInheritMode(s.to_owned()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_round_trip() {
+        for mode in InheritMode::ALL {
+            assert_eq!(mode.id().parse::<InheritMode>(), Ok(mode));
+            assert_eq!(serde_json::to_string(&mode).unwrap(), format!("\"{}\"", mode.id()));
+        }
+        assert!("fulll".parse::<InheritMode>().is_err());
+    }
+}

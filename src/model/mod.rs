@@ -1,0 +1,34 @@
+//! The loaded document: skeleton, clips, skins and meshes, independent of the file format they came from.
+
+mod clip;
+mod inherit;
+mod skeleton;
+mod skin;
+mod transform;
+
+pub use clip::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Track, TrackError};
+pub use inherit::{InheritMode, UnknownInheritMode};
+pub use skeleton::{Bone, ParentOrderError, Skeleton};
+pub use skin::{Mesh, Skin};
+pub use transform::{Transform, affine};
+
+/// Everything bonescope knows about one file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Rig {
+    pub skeleton: Skeleton,
+    pub clips: Vec<Clip>,
+    pub skins: Vec<Skin>,
+    pub meshes: Vec<Mesh>,
+    /// Facts about the import a user should know (units, axes, what was listed but not evaluated).
+    pub notes: Vec<String>,
+}
+
+impl Rig {
+    /// The clip named `name`, or with index `name` when it parses as a number.
+    pub fn find_clip(&self, name: &str) -> Option<&Clip> {
+        self.clips
+            .iter()
+            .find(|c| c.name.as_deref() == Some(name))
+            .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
+    }
+}

@@ -1,0 +1,130 @@
+//! The bone hierarchy: flat arrays ordered parents-first, addressed by index.
+
+use super::{InheritMode, Transform};
+
+/// One bone (every node of the source scene becomes one).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bone {
+    pub name: String,
+    /// The node's index in the source file.
+    pub node: usize,
+    /// Index of the parent bone; always smaller than this bone's own index.
+    pub parent: Option<usize>,
+    /// The local transform when no clip animates the bone.
+    pub rest: Transform,
+    /// The mode the file declares (`full` where the format has no such notion).
+    pub inherit: InheritMode,
+}
+
+/// Bones in parents-first order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Skeleton {
+    bones: Vec<Bone>,
+}
+
+/// A bone list that is not in parents-first order.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("bone {bone} (`{name}`) has parent {parent}, which does not come before it")]
+pub struct ParentOrderError {
+    pub bone: usize,
+    pub name: String,
+    pub parent: usize,
+}
+
+impl Skeleton {
+    /// Builds a skeleton, checking that every parent comes before its children.
+    pub fn new(bones: Vec<Bone>) -> Result<Self, ParentOrderError> {
+        for (index, bone) in bones.iter().enumerate() {
+            if let Some(parent) = bone.parent.filter(|&p| p >= index) {
+                return Err(ParentOrderError { bone: index, name: bone.name.clone(), parent });
+            }
+        }
+        Ok(Skeleton { bones })
+    }
+
+    pub fn len(&self) -> usize {
+        self.bones.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bones.is_empty()
+    }
+
+    pub fn bones(&self) -> &[Bone] {
+        &self.bones
+    }
+
+    pub fn bone(&self, index: usize) -> &Bone {
+        &self.bones[index]
+    }
+
+    pub fn parent(&self, index: usize) -> Option<usize> {
+        self.bones[index].parent
+    }
+
+    /// The first bone with this exact name.
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.bones.iter().position(|b| b.name == name)
+    }
+
+    /// The bone that came from source node `node`.
+    pub fn find_node(&self, node: usize) -> Option<usize> {
+        self.bones.iter().position(|b| b.node == node)
+    }
+
+    /// The modes the file declares, one per bone.
+    pub fn declared_modes(&self) -> Vec<InheritMode> {
+        self.bones.iter().map(|b| b.inherit).collect()
+    }
+
+    /// The rest pose, one local transform per bone.
+    pub fn rest_pose(&self) -> Vec<Transform> {
+        self.bones.iter().map(|b| b.rest).collect()
+    }
+
+    /// Number of ancestors of each bone (0 for roots).
+    pub fn depths(&self) -> Vec<usize> {
+        let mut depths = Vec::with_capacity(self.bones.len());
+        for bone in &self.bones {
+            depths.push(bone.parent.map_or(0, |p| depths[p] + 1));
+        }
+        depths
+    }
+
+    /// Whether `bone` is `ancestor` or lies below it.
+    pub fn is_in_subtree(&self, bone: usize, ancestor: usize) -> bool {
+        let mut current = Some(bone);
+        while let Some(b) = current {
+            if b == ancestor {
+                return true;
+            }
+            current = self.bones[b].parent;
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bone(name: &str, parent: Option<usize>) -> Bone {
+        Bone { name: name.into(), node: 0, parent, rest: Transform::IDENTITY, inherit: InheritMode::Full }
+    }
+
+    #[test]
+    fn rejects_children_before_parents() {
+        let err = Skeleton::new(vec![bone("a", Some(1)), bone("b", None)]).unwrap_err();
+        assert_eq!(err.bone, 0);
+        assert!(Skeleton::new(vec![bone("a", Some(0))]).is_err(), "a bone cannot be its own parent");
+    }
+
+    #[test]
+    fn depths_and_subtrees() {
+        let s = Skeleton::new(vec![bone("root", None), bone("a", Some(0)), bone("b", Some(1)), bone("c", Some(0))])
+            .unwrap();
+        assert_eq!(s.depths(), vec![0, 1, 2, 1]);
+        assert!(s.is_in_subtree(2, 1) && s.is_in_subtree(2, 0) && !s.is_in_subtree(3, 1));
+        assert_eq!(s.find("c"), Some(3));
+    }
+}
