@@ -1,1 +1,7 @@
-//! Polar decomposition and quaternion helpers on top of glam.
+//! Polar decomposition and quaternion helpers on top of glam, in `f64`.
+
+mod polar;
+mod quat;
+
+pub use polar::{AffineParts, EQUAL_SCALE_TOLERANCE, decompose, quat_angle, shear_deg};
+pub use quat::{nlerp, slerp};

@@ -6,7 +6,9 @@ use std::fmt;
 use std::str::FromStr;
 
 /// A bone's scale-inheritance mode. Roots behave the same in every mode (`W = L`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum InheritMode {
     /// `W = W_p·L`: glTF, FBX RSrs, Blender Full, Unity, Godot, ozz. Shears under a rotated child.
@@ -63,9 +65,13 @@ impl InheritMode {
     pub fn description(self) -> &'static str {
         match self {
             InheritMode::Full => "full matrix inheritance (glTF, FBX RSrs, Unity, Godot, ozz)",
-            InheritMode::UnscaledParent => "parent matrix from the rigid T·R chain (the two-pass \"don't inherit scale\")",
+            InheritMode::UnscaledParent => {
+                "parent matrix from the rigid T·R chain (the two-pass \"don't inherit scale\")"
+            }
             InheritMode::SegmentCompensate => "Maya segment scale compensate, FBX Rrs",
-            InheritMode::Componentwise => "parent scale along the child's axes (FBX RrSs, Unreal FTransform)",
+            InheritMode::Componentwise => {
+                "parent scale along the child's axes (FBX RrSs, Unreal FTransform)"
+            }
             InheritMode::BlenderFixShear => "Blender Inherit Scale: Fix Shear",
             InheritMode::BlenderAligned => "Blender Inherit Scale: Aligned",
             InheritMode::BlenderAverage => "Blender Inherit Scale: Average",
@@ -117,7 +123,10 @@ mod tests {
     fn ids_round_trip() {
         for mode in InheritMode::ALL {
             assert_eq!(mode.id().parse::<InheritMode>(), Ok(mode));
-            assert_eq!(serde_json::to_string(&mode).unwrap(), format!("\"{}\"", mode.id()));
+            assert_eq!(
+                serde_json::to_string(&mode).unwrap(),
+                format!("\"{}\"", mode.id())
+            );
         }
         assert!("fulll".parse::<InheritMode>().is_err());
     }

@@ -29,7 +29,12 @@ impl Transform {
     };
 
     pub fn from_trs(translation: DVec3, rotation: DQuat, scale: DVec3) -> Self {
-        Transform { translation, rotation, scale, stretch: DQuat::IDENTITY }
+        Transform {
+            translation,
+            rotation,
+            scale,
+            stretch: DQuat::IDENTITY,
+        }
     }
 
     /// Whether the scale part is diagonal in the bone's frame (no stretch rotation).
@@ -65,7 +70,12 @@ impl Transform {
 
 /// The affine matrix with linear part `m` and translation `t`.
 pub fn affine(m: DMat3, t: DVec3) -> DMat4 {
-    DMat4::from_cols(m.x_axis.extend(0.0), m.y_axis.extend(0.0), m.z_axis.extend(0.0), t.extend(1.0))
+    DMat4::from_cols(
+        m.x_axis.extend(0.0),
+        m.y_axis.extend(0.0),
+        m.z_axis.extend(0.0),
+        t.extend(1.0),
+    )
 }
 
 #[cfg(test)]
@@ -92,6 +102,9 @@ mod tests {
             scale: DVec3::new(2.0, 1.0, 1.0),
             ..Transform::IDENTITY
         };
-        assert!(t.scale_matrix().abs_diff_eq(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), 1e-12));
+        assert!(
+            t.scale_matrix()
+                .abs_diff_eq(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), 1e-12)
+        );
     }
 }
