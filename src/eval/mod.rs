@@ -1,1 +1,9 @@
-//! Sampling, layering and local→model evaluation.
+//! Pure evaluation: sample a clip at a time into local transforms, then combine them into model matrices with
+//! each bone's scale-inheritance mode.
+
+pub mod blender;
+mod hierarchy;
+mod sample;
+
+pub use hierarchy::{Hierarchy, ModelPose};
+pub use sample::{Interpolate, sample_clip, sample_track};

@@ -1,0 +1,151 @@
+//! Local → model matrices, with each bone's scale-inheritance mode (`docs/inheritance-modes.md`).
+//!
+//! Besides its model matrix `W`, every bone gets the matrices its children may need: `U`, the model matrix
+//! without the bone's own scale (ufbx's `unscaled_node_to_world`), `G`, the rigid chain of translations and
+//! rotations only (the seed's first pass), and the scale vectors ufbx carries for componentwise inheritance.
+//! They are computed only where some bone needs them, so an all-`full` rig costs one matrix product per bone.
+
+use glam::{DMat4, DVec3};
+
+use super::blender;
+use crate::model::{InheritMode, Skeleton, Transform};
+
+/// The model-space result of one evaluation.
+#[derive(Clone, Debug, Default)]
+pub struct ModelPose {
+    /// `W`, one per bone.
+    pub model: Vec<DMat4>,
+    unscaled: Vec<DMat4>,
+    rigid: Vec<DMat4>,
+    /// ufbx's `inherit_scale`: the scale a componentwise or compensating child multiplies its offset by.
+    inherit_scale: Vec<DVec3>,
+    /// The `inherit_scale` of ufbx's `inherit_scale_node`: what a compensating child multiplies its scale by.
+    carried_scale: Vec<DVec3>,
+}
+
+/// A skeleton's parent links and modes, prepared once and evaluated for any number of poses.
+#[derive(Clone, Debug)]
+pub struct Hierarchy {
+    parents: Vec<Option<usize>>,
+    modes: Vec<InheritMode>,
+    /// For Blender modes: the rest offset `O = T·R` of the bone and its inverse.
+    offsets: Vec<Option<(DMat4, DMat4)>>,
+    needs_unscaled: Vec<bool>,
+    needs_rigid: bool,
+}
+
+impl Hierarchy {
+    /// `modes` holds one mode per bone.
+    pub fn new(skeleton: &Skeleton, modes: &[InheritMode]) -> Self {
+        assert_eq!(modes.len(), skeleton.len(), "one inheritance mode per bone");
+        let parents: Vec<Option<usize>> = skeleton.bones().iter().map(|b| b.parent).collect();
+        let offsets = skeleton
+            .bones()
+            .iter()
+            .zip(modes)
+            .map(|(bone, mode)| {
+                mode.is_blender().then(|| {
+                    let offset = bone.rest.rigid_matrix();
+                    (offset, offset.inverse())
+                })
+            })
+            .collect();
+        let mut needs_unscaled = vec![false; parents.len()];
+        for (parent, mode) in parents.iter().zip(modes) {
+            if let Some(p) = parent
+                && matches!(
+                    mode,
+                    InheritMode::SegmentCompensate | InheritMode::Componentwise
+                )
+            {
+                needs_unscaled[*p] = true;
+            }
+        }
+        let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
+        Hierarchy {
+            parents,
+            modes: modes.to_vec(),
+            offsets,
+            needs_unscaled,
+            needs_rigid,
+        }
+    }
+
+    pub fn modes(&self) -> &[InheritMode] {
+        &self.modes
+    }
+
+    /// Model matrices of the local pose `local` (one transform per bone, parents first).
+    pub fn evaluate(&self, local: &[Transform], out: &mut ModelPose) {
+        let n = self.parents.len();
+        assert_eq!(local.len(), n, "one local transform per bone");
+        for v in [&mut out.model, &mut out.unscaled, &mut out.rigid] {
+            v.resize(n, DMat4::IDENTITY);
+        }
+        out.inherit_scale.resize(n, DVec3::ONE);
+        out.carried_scale.resize(n, DVec3::ONE);
+        for i in 0..n {
+            self.evaluate_bone(i, &local[i], out);
+        }
+    }
+
+    fn evaluate_bone(&self, i: usize, local: &Transform, out: &mut ModelPose) {
+        let Some(p) = self.parents[i] else {
+            out.model[i] = local.matrix();
+            out.unscaled[i] = local.rigid_matrix();
+            out.rigid[i] = out.unscaled[i];
+            out.inherit_scale[i] = local.scale;
+            out.carried_scale[i] = DVec3::ONE;
+            return;
+        };
+        if self.needs_rigid {
+            out.rigid[i] = out.rigid[p] * local.rigid_matrix();
+        }
+        let (mut inherit_scale, mut carried_scale) = (local.scale, DVec3::ONE);
+        match self.modes[i] {
+            InheritMode::Full => {
+                out.model[i] = out.model[p] * local.matrix();
+                if self.needs_unscaled[i] {
+                    out.unscaled[i] = out.model[p] * local.rigid_matrix();
+                }
+            }
+            InheritMode::UnscaledParent => {
+                out.model[i] = out.rigid[p] * local.matrix();
+                out.unscaled[i] = out.rigid[i];
+            }
+            mode @ (InheritMode::SegmentCompensate | InheritMode::Componentwise) => {
+                // ufbx: t' = t ⊙ inherit_scale(parent); s' = s ⊙ inherit_scale(inherit_scale_node), where that
+                // node is the parent for componentwise bones and, for compensating ones, the parent's own (none
+                // below a plain parent, so only the offset is scaled: Maya's segment scale compensate).
+                let scale_factor = match mode {
+                    InheritMode::Componentwise => out.inherit_scale[p],
+                    _ => out.carried_scale[p],
+                };
+                carried_scale = scale_factor;
+                let offset = local.translation * out.inherit_scale[p];
+                let scaled = Transform {
+                    translation: offset,
+                    scale: local.scale * scale_factor,
+                    ..*local
+                };
+                out.unscaled[i] = out.unscaled[p] * scaled.rigid_matrix();
+                out.model[i] = out.unscaled[p] * scaled.matrix();
+                inherit_scale = scaled.scale;
+            }
+            mode => {
+                let (offset, offset_inverse) =
+                    self.offsets[i].expect("offsets are prepared for Blender modes");
+                let mode = blender::BlenderInherit::from_mode(mode).expect("a Blender mode");
+                let parent = out.model[p];
+                out.model[i] =
+                    blender::child_pose(mode, &parent, &offset, &(offset_inverse * local.matrix()));
+                if self.needs_unscaled[i] {
+                    let channel = offset_inverse * local.rigid_matrix();
+                    out.unscaled[i] = blender::child_pose(mode, &parent, &offset, &channel);
+                }
+            }
+        }
+        out.inherit_scale[i] = inherit_scale;
+        out.carried_scale[i] = carried_scale;
+    }
+}

@@ -1,0 +1,216 @@
+//! Sampling a clip at a time, exactly as glTF's Appendix C writes it.
+//!
+//! Outside a track's key range the value is clamped to the nearest end; at a key time the key value is used as is;
+//! between keys `t = (t_c − t_k)/(t_{k+1} − t_k)` and STEP takes `v_k`, LINEAR interpolates linearly (rotations by
+//! shortest-path slerp), CUBICSPLINE evaluates the Hermite spline with tangents scaled by the key interval
+//! (rotations then normalised). Bones the clip does not animate keep their rest transform.
+
+use glam::{DQuat, DVec3, Quat, Vec3};
+
+use crate::math::slerp;
+use crate::model::{Clip, Interpolation, Skeleton, Track, Transform};
+
+/// A key value type and how it interpolates, in double precision.
+pub trait Interpolate: Copy {
+    type Wide: Copy;
+    fn widen(self) -> Self::Wide;
+    fn linear(a: Self::Wide, b: Self::Wide, t: f64) -> Self::Wide;
+    /// Hermite basis weights `(h00, h10, h01, h11)` applied to `(v0, b0, v1, a1)`, tangents already scaled.
+    fn hermite(
+        v0: Self::Wide,
+        b0: Self::Wide,
+        v1: Self::Wide,
+        a1: Self::Wide,
+        h: [f64; 4],
+    ) -> Self::Wide;
+}
+
+impl Interpolate for Vec3 {
+    type Wide = DVec3;
+
+    fn widen(self) -> DVec3 {
+        self.as_dvec3()
+    }
+
+    fn linear(a: DVec3, b: DVec3, t: f64) -> DVec3 {
+        a * (1.0 - t) + b * t
+    }
+
+    fn hermite(v0: DVec3, b0: DVec3, v1: DVec3, a1: DVec3, h: [f64; 4]) -> DVec3 {
+        v0 * h[0] + b0 * h[1] + v1 * h[2] + a1 * h[3]
+    }
+}
+
+impl Interpolate for Quat {
+    type Wide = DQuat;
+
+    fn widen(self) -> DQuat {
+        self.as_dquat()
+    }
+
+    fn linear(a: DQuat, b: DQuat, t: f64) -> DQuat {
+        slerp(a, b, t)
+    }
+
+    fn hermite(v0: DQuat, b0: DQuat, v1: DQuat, a1: DQuat, h: [f64; 4]) -> DQuat {
+        let q = v0 * h[0] + b0 * h[1] + v1 * h[2] + a1 * h[3];
+        // The spec requires the result normalised; a zero result (v1 = −v0 at the midpoint) keeps v0.
+        if q.length_squared() > 0.0 {
+            q.normalize()
+        } else {
+            v0
+        }
+    }
+}
+
+/// The track's value at `time` (seconds).
+pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
+    let times = track.times();
+    let per_key = track.interpolation().values_per_key();
+    // For cubic splines, key k stores [a_k, v_k, b_k].
+    let value = |k: usize| track.values()[k * per_key + per_key / 2].widen();
+    let last = times.len() - 1;
+    if !(time > times[0]) {
+        return value(0);
+    }
+    if time >= times[last] {
+        return value(last);
+    }
+    // times[k] ≤ time < times[k + 1]
+    let k = times.partition_point(|&t| t <= time) - 1;
+    if times[k] == time {
+        return value(k);
+    }
+    let span = times[k + 1] - times[k];
+    let t = (time - times[k]) / span;
+    match track.interpolation() {
+        Interpolation::Step => value(k),
+        Interpolation::Linear => T::linear(value(k), value(k + 1), t),
+        Interpolation::CubicSpline => {
+            let out_tangent = track.values()[3 * k + 2].widen();
+            let in_tangent = track.values()[3 * (k + 1)].widen();
+            let (t2, t3) = (t * t, t * t * t);
+            let h = [
+                2.0 * t3 - 3.0 * t2 + 1.0,
+                span * (t3 - 2.0 * t2 + t),
+                -2.0 * t3 + 3.0 * t2,
+                span * (t3 - t2),
+            ];
+            T::hermite(value(k), out_tangent, value(k + 1), in_tangent, h)
+        }
+    }
+}
+
+/// Writes the local pose of every bone at `time` into `pose` (resized to the skeleton).
+pub fn sample_clip(skeleton: &Skeleton, clip: &Clip, time: f64, pose: &mut Vec<Transform>) {
+    pose.clear();
+    pose.extend(skeleton.bones().iter().map(|b| b.rest));
+    for tracks in clip.tracks() {
+        let Some(local) = pose.get_mut(tracks.bone) else {
+            continue;
+        };
+        if let Some(track) = &tracks.translation {
+            local.translation = sample_track(track, time);
+        }
+        if let Some(track) = &tracks.rotation {
+            local.rotation = sample_track(track, time);
+        }
+        if let Some(track) = &tracks.scale {
+            local.scale = sample_track(track, time);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+
+    fn vec_track(times: &[f64], values: &[[f32; 3]], interpolation: Interpolation) -> Track<Vec3> {
+        Track::new(
+            Arc::from(times),
+            values.iter().map(|&v| Vec3::from(v)).collect(),
+            interpolation,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn step_and_linear_at_keys_between_and_outside() {
+        let values = [[0.0, 0.0, 0.0], [2.0, 4.0, -2.0], [2.0, 0.0, 0.0]];
+        let step = vec_track(&[1.0, 2.0, 4.0], &values, Interpolation::Step);
+        let linear = vec_track(&[1.0, 2.0, 4.0], &values, Interpolation::Linear);
+        // Before the first key and after the last: clamped.
+        assert_eq!(sample_track(&linear, 0.0), DVec3::ZERO);
+        assert_eq!(sample_track(&linear, 9.0), DVec3::new(2.0, 0.0, 0.0));
+        // At a key: the key value.
+        assert_eq!(sample_track(&linear, 2.0), DVec3::new(2.0, 4.0, -2.0));
+        assert_eq!(sample_track(&step, 2.0), DVec3::new(2.0, 4.0, -2.0));
+        // Between keys: t = (1.25 − 1)/1 = 0.25 → 0.25·v1; t = (3 − 2)/2 = 0.5 → midpoint.
+        assert_eq!(sample_track(&linear, 1.25), DVec3::new(0.5, 1.0, -0.5));
+        assert_eq!(sample_track(&linear, 3.0), DVec3::new(2.0, 2.0, -1.0));
+        assert_eq!(sample_track(&step, 3.99), DVec3::new(2.0, 4.0, -2.0));
+    }
+
+    #[test]
+    fn cubic_spline_matches_the_hermite_formula() {
+        // Keys at 0 and 2 (t_d = 2), stored [a, v, b] per key. At t_c = 0.5: t = 0.25,
+        // h00 = 2t³−3t²+1 = 0.84375, h10 = t³−2t²+t = 0.140625, h01 = −2t³+3t² = 0.15625, h11 = t³−t² = −0.046875.
+        // v = h00·v0 + t_d·h10·b0 + h01·v1 + t_d·h11·a1 with v0 = 1, b0 = 3, v1 = 5, a1 = −1 (x component):
+        // 0.84375 + 2·0.140625·3 + 0.15625·5 + 2·(−0.046875)·(−1) = 2.5625.
+        let track = vec_track(
+            &[0.0, 2.0],
+            &[
+                [9.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [3.0, 0.0, 0.0],
+                [-1.0, 0.0, 0.0],
+                [5.0, 0.0, 0.0],
+                [9.0, 0.0, 0.0],
+            ],
+            Interpolation::CubicSpline,
+        );
+        assert!((sample_track(&track, 0.5).x - 2.5625).abs() < 1e-15);
+        // Keys and clamping use the value, never the tangents.
+        assert_eq!(sample_track(&track, 0.0).x, 1.0);
+        assert_eq!(sample_track(&track, 2.0).x, 5.0);
+        assert_eq!(sample_track(&track, -1.0).x, 1.0);
+        assert_eq!(sample_track(&track, 3.0).x, 5.0);
+    }
+
+    #[test]
+    fn linear_rotation_is_shortest_path_slerp() {
+        // 10° and 350° about Y stored with opposite signs: the short way passes through 0°, not 180°.
+        let a = Quat::from_rotation_y(10f32.to_radians());
+        let b = -Quat::from_rotation_y(-10f32.to_radians());
+        let track = Track::new(
+            Arc::from([0.0, 1.0].as_slice()),
+            vec![a, b],
+            Interpolation::Linear,
+        )
+        .unwrap();
+        let mid = sample_track(&track, 0.5);
+        assert!(mid.angle_between(DQuat::IDENTITY) < 1e-6, "{mid:?}");
+        // A quarter of the way: 5°.
+        let quarter = sample_track(&track, 0.25);
+        assert!(quarter.angle_between(DQuat::from_rotation_y(5f64.to_radians())) < 1e-6);
+    }
+
+    #[test]
+    fn cubic_rotation_is_normalised() {
+        let q0 = Quat::from_rotation_x(0.0);
+        let q1 = Quat::from_rotation_x(1.0);
+        let zero = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+        let track = Track::new(
+            Arc::from([0.0, 1.0].as_slice()),
+            vec![zero, q0, zero, zero, q1, zero],
+            Interpolation::CubicSpline,
+        )
+        .unwrap();
+        // h00 = h01 = 0.5 at t = 0.5: the normalised sum of q0 and q1 is the half-way rotation.
+        let mid = sample_track(&track, 0.5);
+        assert!((mid.length() - 1.0).abs() < 1e-15);
+        assert!(mid.angle_between(DQuat::from_rotation_x(0.5)) < 1e-6);
+    }
+}
