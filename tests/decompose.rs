@@ -7,27 +7,13 @@ use proptest::prelude::*;
 
 /// Relative difference of two matrices in the max norm, against the larger of their sizes (or 1).
 fn relative_error(a: &DMat4, b: &DMat4) -> f64 {
-    let diff = (*a - *b)
-        .to_cols_array()
-        .iter()
-        .map(|x| x.abs())
-        .fold(0.0, f64::max);
-    let size = a
-        .to_cols_array()
-        .iter()
-        .chain(b.to_cols_array().iter())
-        .map(|x| x.abs())
-        .fold(1e-300, f64::max);
+    let diff = (*a - *b).to_cols_array().iter().map(|x| x.abs()).fold(0.0, f64::max);
+    let size = a.to_cols_array().iter().chain(b.to_cols_array().iter()).map(|x| x.abs()).fold(1e-300, f64::max);
     diff / size
 }
 
 fn assert_parts_finite(p: &AffineParts) {
-    assert!(
-        p.translation.is_finite()
-            && p.rotation.is_finite()
-            && p.stretch.is_finite()
-            && p.scale.is_finite()
-    );
+    assert!(p.translation.is_finite() && p.rotation.is_finite() && p.stretch.is_finite() && p.scale.is_finite());
     assert!((p.rotation.length() - 1.0).abs() < 1e-12 && (p.stretch.length() - 1.0).abs() < 1e-12);
     assert!(p.sign == 1.0 || p.sign == -1.0);
     assert!(p.scale.min_element() >= 0.0);
@@ -40,11 +26,7 @@ fn rot_z_matrix(m: DMat3) -> DMat4 {
 #[test]
 fn rotation_times_axis_aligned_scale() {
     let r = DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0);
-    let m = DMat4::from_scale_rotation_translation(
-        DVec3::new(2.0, 3.0, 4.0),
-        r,
-        DVec3::new(1.0, -2.0, 5.0),
-    );
+    let m = DMat4::from_scale_rotation_translation(DVec3::new(2.0, 3.0, 4.0), r, DVec3::new(1.0, -2.0, 5.0));
     let p = decompose(&m);
     assert!(p.rotation.abs_diff_eq(r, 1e-14) || p.rotation.abs_diff_eq(-r, 1e-14));
     assert_eq!(p.stretch, DQuat::IDENTITY);
@@ -73,30 +55,12 @@ fn planar_shear_closed_form() {
     // φ = (1+√5)/2 and 1/φ; Q = [[2,1],[−1,2]]/√5 (a rotation by −atan(1/2)); the eigenvector of 1/φ lies at
     // −atan(1/φ) from X, so the canonical U turns by −atan(1/φ) = −31.7175° with K = (1/φ, φ, 1). The columns
     // (1,0) and (1,1) are 45° apart: shear 45°.
-    let m = rot_z_matrix(DMat3::from_cols(
-        DVec3::X,
-        DVec3::new(1.0, 1.0, 0.0),
-        DVec3::Z,
-    ));
+    let m = rot_z_matrix(DMat3::from_cols(DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Z));
     let p = decompose(&m);
     let phi = (1.0 + 5f64.sqrt()) / 2.0;
-    assert!(
-        p.scale.abs_diff_eq(DVec3::new(1.0 / phi, phi, 1.0), 1e-14),
-        "{:?}",
-        p.scale
-    );
-    assert!(
-        p.stretch
-            .abs_diff_eq(DQuat::from_rotation_z(-(1.0 / phi).atan()), 1e-14),
-        "{:?}",
-        p.stretch
-    );
-    assert!(
-        p.rotation
-            .abs_diff_eq(DQuat::from_rotation_z(-(0.5f64).atan()), 1e-14),
-        "{:?}",
-        p.rotation
-    );
+    assert!(p.scale.abs_diff_eq(DVec3::new(1.0 / phi, phi, 1.0), 1e-14), "{:?}", p.scale);
+    assert!(p.stretch.abs_diff_eq(DQuat::from_rotation_z(-(1.0 / phi).atan()), 1e-14), "{:?}", p.stretch);
+    assert!(p.rotation.abs_diff_eq(DQuat::from_rotation_z(-(0.5f64).atan()), 1e-14), "{:?}", p.rotation);
     assert!((p.stretch_angle_deg() - 31.717474411461005).abs() < 1e-10);
     assert!((shear_deg(&DMat3::from_mat4(m)) - 45.0).abs() < 1e-12);
     assert!(relative_error(&p.matrix(), &m) < 1e-15);
@@ -115,12 +79,7 @@ fn two_equal_factors_turn_the_distinct_axis_onto_the_nearest_local_axis() {
         sign: 1.0,
     };
     let p = decompose(&parts.matrix());
-    assert!(
-        p.stretch
-            .abs_diff_eq(DQuat::from_rotation_z(20f64.to_radians()), 1e-13),
-        "{:?}",
-        p.stretch
-    );
+    assert!(p.stretch.abs_diff_eq(DQuat::from_rotation_z(20f64.to_radians()), 1e-13), "{:?}", p.stretch);
     assert!(p.scale.abs_diff_eq(DVec3::new(3.0, 1.0, 1.0), 1e-13));
 }
 
@@ -129,12 +88,7 @@ fn uniform_scale_reports_identity_stretch_despite_rounding() {
     // A long product of rotations and a uniform scale carries rounding noise in every entry.
     let mut m = DMat4::from_scale(DVec3::splat(1.7));
     for i in 0..50 {
-        m = m * DMat4::from_quat(DQuat::from_euler(
-            glam::EulerRot::ZXY,
-            0.1 * i as f64,
-            0.37,
-            -0.2,
-        ));
+        m = m * DMat4::from_quat(DQuat::from_euler(glam::EulerRot::ZXY, 0.1 * i as f64, 0.37, -0.2));
     }
     let p = decompose(&m);
     assert_eq!(p.stretch, DQuat::IDENTITY);
@@ -148,31 +102,13 @@ fn uniform_scale_reports_identity_stretch_despite_rounding() {
 #[test]
 fn extreme_scales_from_1e_minus_6_to_1e6() {
     let r = DQuat::from_euler(glam::EulerRot::XYZ, 0.5, 0.25, -0.75);
-    for scale in [
-        DVec3::new(1e-6, 1.0, 1e6),
-        DVec3::new(1e6, 1e6, 1e-6),
-        DVec3::splat(1e-6),
-        DVec3::splat(1e6),
-    ] {
-        for stretch in [
-            DQuat::IDENTITY,
-            DQuat::from_euler(glam::EulerRot::YXZ, 0.2, 0.4, 0.1),
-        ] {
-            let parts = AffineParts {
-                translation: DVec3::new(3.0, 2.0, 1.0),
-                rotation: r,
-                stretch,
-                scale,
-                sign: 1.0,
-            };
+    for scale in [DVec3::new(1e-6, 1.0, 1e6), DVec3::new(1e6, 1e6, 1e-6), DVec3::splat(1e-6), DVec3::splat(1e6)] {
+        for stretch in [DQuat::IDENTITY, DQuat::from_euler(glam::EulerRot::YXZ, 0.2, 0.4, 0.1)] {
+            let parts = AffineParts { translation: DVec3::new(3.0, 2.0, 1.0), rotation: r, stretch, scale, sign: 1.0 };
             let m = parts.matrix();
             let p = decompose(&m);
             assert_parts_finite(&p);
-            assert!(
-                relative_error(&p.matrix(), &m) < 1e-9,
-                "scale {scale}: {}",
-                relative_error(&p.matrix(), &m)
-            );
+            assert!(relative_error(&p.matrix(), &m) < 1e-9, "scale {scale}: {}", relative_error(&p.matrix(), &m));
         }
     }
 }
@@ -185,11 +121,7 @@ fn degenerate_matrices_give_finite_parts() {
         r * DMat3::from_diagonal(DVec3::new(1.0, 0.0, 0.0)),
         r * DMat3::from_diagonal(DVec3::new(2.0, 3.0, 0.0)),
         // Rank 2 with shear: the third column is the sum of the first two.
-        DMat3::from_cols(
-            DVec3::new(1.0, 2.0, 0.5),
-            DVec3::new(-1.0, 0.5, 2.0),
-            DVec3::new(0.0, 2.5, 2.5),
-        ),
+        DMat3::from_cols(DVec3::new(1.0, 2.0, 0.5), DVec3::new(-1.0, 0.5, 2.0), DVec3::new(0.0, 2.5, 2.5)),
         DMat3::from_cols(DVec3::ONE, DVec3::ONE, DVec3::ONE),
         DMat3::from_cols(DVec3::X, DVec3::X * 1e-300, DVec3::Z),
     ];
@@ -198,14 +130,8 @@ fn degenerate_matrices_give_finite_parts() {
         let p = decompose(&m);
         assert_parts_finite(&p);
         // A polar decomposition exists for singular matrices too, so recomposition stays exact.
-        assert!(
-            relative_error(&p.matrix(), &m) < 1e-12,
-            "{a}: {}",
-            relative_error(&p.matrix(), &m)
-        );
-        assert!(
-            p.scale.min_element() < 1e-12 * p.scale.max_element().max(1e-300) || a == DMat3::ZERO
-        );
+        assert!(relative_error(&p.matrix(), &m) < 1e-12, "{a}: {}", relative_error(&p.matrix(), &m));
+        assert!(p.scale.min_element() < 1e-12 * p.scale.max_element().max(1e-300) || a == DMat3::ZERO);
     }
     let nan = DMat4::from_cols_array(&[f64::NAN; 16]);
     let p = decompose(&nan);
@@ -216,9 +142,7 @@ fn degenerate_matrices_give_finite_parts() {
 
 fn unit_quat() -> impl Strategy<Value = DQuat> {
     (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
-        .prop_filter("non-zero", |(x, y, z, w)| {
-            x * x + y * y + z * z + w * w > 1e-3
-        })
+        .prop_filter("non-zero", |(x, y, z, w)| x * x + y * y + z * z + w * w > 1e-3)
         .prop_map(|(x, y, z, w)| DQuat::from_xyzw(x, y, z, w).normalize())
 }
 
@@ -230,9 +154,7 @@ fn random_parts() -> impl Strategy<Value = AffineParts> {
     parts_with_scales(log_scale())
 }
 
-fn parts_with_scales(
-    scale: impl Strategy<Value = f64> + Clone,
-) -> impl Strategy<Value = AffineParts> {
+fn parts_with_scales(scale: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value = AffineParts> {
     (
         (-100.0..100.0f64, -100.0..100.0f64, -100.0..100.0f64),
         unit_quat(),
@@ -240,15 +162,13 @@ fn parts_with_scales(
         (scale.clone(), scale.clone(), scale),
         prop::bool::ANY,
     )
-        .prop_map(
-            |((tx, ty, tz), rotation, stretch, (kx, ky, kz), mirrored)| AffineParts {
-                translation: DVec3::new(tx, ty, tz),
-                rotation,
-                stretch,
-                scale: DVec3::new(kx, ky, kz),
-                sign: if mirrored { -1.0 } else { 1.0 },
-            },
-        )
+        .prop_map(|((tx, ty, tz), rotation, stretch, (kx, ky, kz), mirrored)| AffineParts {
+            translation: DVec3::new(tx, ty, tz),
+            rotation,
+            stretch,
+            scale: DVec3::new(kx, ky, kz),
+            sign: if mirrored { -1.0 } else { 1.0 },
+        })
 }
 
 proptest! {

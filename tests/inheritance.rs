@@ -38,11 +38,7 @@ fn linear(m: &DMat4) -> DMat3 {
 fn parent_and_rotated_child() -> [Transform; 2] {
     [
         Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0)),
-        Transform::from_trs(
-            DVec3::X,
-            DQuat::from_rotation_z(45f64.to_radians()),
-            DVec3::ONE,
-        ),
+        Transform::from_trs(DVec3::X, DQuat::from_rotation_z(45f64.to_radians()), DVec3::ONE),
     ]
 }
 
@@ -57,16 +53,8 @@ fn full_scales_the_offset_and_shears_the_rotated_child() {
     // W = diag(2,1,1)·T(1,0,0)·Rz(45°): translation (2,0,0); columns diag(2,1,1)·(c, c, 0) and ·(−c, c, 0).
     // Their dot product is −4c² + c² = −1.5 over lengths² 2.5: 126.87°, a shear of 36.87°.
     let w = child_under(InheritMode::Full);
-    assert!(
-        w.w_axis
-            .truncate()
-            .abs_diff_eq(DVec3::new(2.0, 0.0, 0.0), EPS)
-    );
-    let expected = DMat3::from_cols(
-        DVec3::new(2.0 * C, C, 0.0),
-        DVec3::new(-2.0 * C, C, 0.0),
-        DVec3::Z,
-    );
+    assert!(w.w_axis.truncate().abs_diff_eq(DVec3::new(2.0, 0.0, 0.0), EPS));
+    let expected = DMat3::from_cols(DVec3::new(2.0 * C, C, 0.0), DVec3::new(-2.0 * C, C, 0.0), DVec3::Z);
     assert!(linear(&w).abs_diff_eq(expected, EPS));
     assert!((shear_deg(&linear(&w)) - ((-0.6f64).acos().to_degrees() - 90.0)).abs() < 1e-9);
 }
@@ -75,20 +63,15 @@ fn full_scales_the_offset_and_shears_the_rotated_child() {
 fn unscaled_parent_drops_the_parent_scale_entirely() {
     // W = G_p·L with G_p = I: the offset is not scaled and the child is a pure rotation.
     let w = child_under(InheritMode::UnscaledParent);
-    assert!(w.abs_diff_eq(
-        DMat4::from_rotation_translation(DQuat::from_rotation_z(45f64.to_radians()), DVec3::X),
-        EPS
-    ));
+    assert!(w.abs_diff_eq(DMat4::from_rotation_translation(DQuat::from_rotation_z(45f64.to_radians()), DVec3::X), EPS));
 }
 
 #[test]
 fn segment_compensate_scales_the_offset_only() {
     // W = U_p·T(s_p ⊙ t)·R·S = T(2,0,0)·Rz(45°).
     let w = child_under(InheritMode::SegmentCompensate);
-    let expected = DMat4::from_rotation_translation(
-        DQuat::from_rotation_z(45f64.to_radians()),
-        DVec3::new(2.0, 0.0, 0.0),
-    );
+    let expected =
+        DMat4::from_rotation_translation(DQuat::from_rotation_z(45f64.to_radians()), DVec3::new(2.0, 0.0, 0.0));
     assert!(w.abs_diff_eq(expected, EPS));
 }
 
@@ -96,32 +79,17 @@ fn segment_compensate_scales_the_offset_only() {
 fn componentwise_applies_parent_scale_along_the_child_axes() {
     // W = U_p·T(s_p ⊙ t)·R·S(s_p ⊙ s) = T(2,0,0)·Rz(45°)·diag(2,1,1): columns (2c, 2c, 0) and (−c, c, 0).
     let w = child_under(InheritMode::Componentwise);
-    let expected = DMat3::from_cols(
-        DVec3::new(2.0 * C, 2.0 * C, 0.0),
-        DVec3::new(-C, C, 0.0),
-        DVec3::Z,
-    );
+    let expected = DMat3::from_cols(DVec3::new(2.0 * C, 2.0 * C, 0.0), DVec3::new(-C, C, 0.0), DVec3::Z);
     assert!(linear(&w).abs_diff_eq(expected, EPS));
-    assert!(
-        w.w_axis
-            .truncate()
-            .abs_diff_eq(DVec3::new(2.0, 0.0, 0.0), EPS)
-    );
+    assert!(w.w_axis.truncate().abs_diff_eq(DVec3::new(2.0, 0.0, 0.0), EPS));
     assert!(shear_deg(&linear(&w)) < 1e-9);
 }
 
 #[test]
 fn roots_are_their_local_matrix_in_every_mode() {
-    let local = Transform::from_trs(
-        DVec3::new(1.0, 2.0, 3.0),
-        DQuat::from_rotation_x(0.3),
-        DVec3::new(2.0, 0.5, 1.0),
-    );
+    let local = Transform::from_trs(DVec3::new(1.0, 2.0, 3.0), DQuat::from_rotation_x(0.3), DVec3::new(2.0, 0.5, 1.0));
     for mode in InheritMode::ALL {
-        assert!(
-            evaluate(&[local], &[mode])[0].abs_diff_eq(local.matrix(), EPS),
-            "{mode}"
-        );
+        assert!(evaluate(&[local], &[mode])[0].abs_diff_eq(local.matrix(), EPS), "{mode}");
     }
 }
 
@@ -134,34 +102,16 @@ fn compensating_child_of_a_componentwise_bone_keeps_the_grandparent_scale() {
     // B's own (×3 along Y) does not. B sits at (1,1,0)⊙(2,1,1) = (2,1,0).
     let locals = [
         Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0)),
-        Transform::from_trs(
-            DVec3::new(1.0, 1.0, 0.0),
-            DQuat::IDENTITY,
-            DVec3::new(1.0, 3.0, 1.0),
-        ),
+        Transform::from_trs(DVec3::new(1.0, 1.0, 0.0), DQuat::IDENTITY, DVec3::new(1.0, 3.0, 1.0)),
         Transform::from_trs(DVec3::new(1.0, 1.0, 0.0), DQuat::IDENTITY, DVec3::ONE),
     ];
-    let w = evaluate(
-        &locals,
-        &[
-            InheritMode::Full,
-            InheritMode::Componentwise,
-            InheritMode::SegmentCompensate,
-        ],
-    );
+    let w = evaluate(&locals, &[InheritMode::Full, InheritMode::Componentwise, InheritMode::SegmentCompensate]);
     assert!(w[1].abs_diff_eq(
-        DMat4::from_scale_rotation_translation(
-            DVec3::new(2.0, 3.0, 1.0),
-            DQuat::IDENTITY,
-            DVec3::new(2.0, 1.0, 0.0)
-        ),
+        DMat4::from_scale_rotation_translation(DVec3::new(2.0, 3.0, 1.0), DQuat::IDENTITY, DVec3::new(2.0, 1.0, 0.0)),
         EPS
     ));
-    let expected = DMat4::from_scale_rotation_translation(
-        DVec3::new(2.0, 1.0, 1.0),
-        DQuat::IDENTITY,
-        DVec3::new(4.0, 4.0, 0.0),
-    );
+    let expected =
+        DMat4::from_scale_rotation_translation(DVec3::new(2.0, 1.0, 1.0), DQuat::IDENTITY, DVec3::new(4.0, 4.0, 0.0));
     assert!(w[2].abs_diff_eq(expected, EPS), "{}", w[2]);
 }
 
@@ -170,17 +120,10 @@ fn random_local() -> impl Strategy<Value = Transform> {
     let scale = 0.2..3.0f64;
     (
         (component.clone(), component.clone(), component.clone()),
-        (
-            component.clone(),
-            component.clone(),
-            component.clone(),
-            component,
-        ),
+        (component.clone(), component.clone(), component.clone(), component),
         (scale.clone(), scale.clone(), scale),
     )
-        .prop_filter("rotation", |(_, (x, y, z, w), _)| {
-            x * x + y * y + z * z + w * w > 1e-2
-        })
+        .prop_filter("rotation", |(_, (x, y, z, w), _)| x * x + y * y + z * z + w * w > 1e-2)
         .prop_map(|((tx, ty, tz), (x, y, z, w), (sx, sy, sz))| {
             Transform::from_trs(
                 DVec3::new(tx, ty, tz),
@@ -191,10 +134,7 @@ fn random_local() -> impl Strategy<Value = Transform> {
 }
 
 fn worst_shear(models: &[DMat4]) -> f64 {
-    models
-        .iter()
-        .map(|m| shear_deg(&linear(m)))
-        .fold(0.0, f64::max)
+    models.iter().map(|m| shear_deg(&linear(m))).fold(0.0, f64::max)
 }
 
 proptest! {
@@ -223,10 +163,5 @@ proptest! {
 
 #[test]
 fn full_inheritance_does_shear() {
-    assert!(
-        worst_shear(&evaluate(
-            &parent_and_rotated_child(),
-            &[InheritMode::Full; 2]
-        )) > 30.0
-    );
+    assert!(worst_shear(&evaluate(&parent_and_rotated_child(), &[InheritMode::Full; 2])) > 30.0);
 }

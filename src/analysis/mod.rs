@@ -1,1 +1,9 @@
-//! Decomposition of every bone, findings and whole-clip scans.
+//! Decomposition of every bone, findings (stretched, non-uniform, mirrored, degenerate), whole-clip scans and the
+//! reports built from them.
+
+mod findings;
+pub mod report;
+mod scan;
+
+pub use findings::{Assessment, Findings, Tolerances};
+pub use scan::{BoneSummary, ClipScan, ScanOptions, sample_times, scan};

@@ -1,1 +1,48 @@
-//! The command line.
+//! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips.
+//!
+//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone; 2 bad usage or a file that cannot be
+//! loaded (after reporting every file that could).
+
+mod inspect;
+mod options;
+mod scan;
+mod table;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub use options::{EvalArgs, Format, ToleranceArgs};
+
+/// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
+/// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.
+#[derive(Debug, Parser)]
+#[command(name = "bonescope", version, about, long_about = None, arg_required_else_help = true)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Print every bone's local and model matrix, their decomposition and findings at chosen times.
+    Inspect(inspect::InspectArgs),
+    /// Scan whole clips of one or more files and report the stretched bones.
+    Scan(scan::ScanArgs),
+}
+
+/// Parses the process arguments and runs the command.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Inspect(args) => inspect::run(&args),
+        Command::Scan(args) => scan::run(&args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -53,22 +53,13 @@ impl Hierarchy {
         let mut needs_unscaled = vec![false; parents.len()];
         for (parent, mode) in parents.iter().zip(modes) {
             if let Some(p) = parent
-                && matches!(
-                    mode,
-                    InheritMode::SegmentCompensate | InheritMode::Componentwise
-                )
+                && matches!(mode, InheritMode::SegmentCompensate | InheritMode::Componentwise)
             {
                 needs_unscaled[*p] = true;
             }
         }
         let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
-        Hierarchy {
-            parents,
-            modes: modes.to_vec(),
-            offsets,
-            needs_unscaled,
-            needs_rigid,
-        }
+        Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid }
     }
 
     pub fn modes(&self) -> &[InheritMode] {
@@ -123,22 +114,16 @@ impl Hierarchy {
                 };
                 carried_scale = scale_factor;
                 let offset = local.translation * out.inherit_scale[p];
-                let scaled = Transform {
-                    translation: offset,
-                    scale: local.scale * scale_factor,
-                    ..*local
-                };
+                let scaled = Transform { translation: offset, scale: local.scale * scale_factor, ..*local };
                 out.unscaled[i] = out.unscaled[p] * scaled.rigid_matrix();
                 out.model[i] = out.unscaled[p] * scaled.matrix();
                 inherit_scale = scaled.scale;
             }
             mode => {
-                let (offset, offset_inverse) =
-                    self.offsets[i].expect("offsets are prepared for Blender modes");
+                let (offset, offset_inverse) = self.offsets[i].expect("offsets are prepared for Blender modes");
                 let mode = blender::BlenderInherit::from_mode(mode).expect("a Blender mode");
                 let parent = out.model[p];
-                out.model[i] =
-                    blender::child_pose(mode, &parent, &offset, &(offset_inverse * local.matrix()));
+                out.model[i] = blender::child_pose(mode, &parent, &offset, &(offset_inverse * local.matrix()));
                 if self.needs_unscaled[i] {
                     let channel = offset_inverse * local.rigid_matrix();
                     out.unscaled[i] = blender::child_pose(mode, &parent, &offset, &channel);

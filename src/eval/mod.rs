@@ -3,7 +3,9 @@
 
 pub mod blender;
 mod hierarchy;
+mod pose;
 mod sample;
 
 pub use hierarchy::{Hierarchy, ModelPose};
+pub use pose::Pose;
 pub use sample::{Interpolate, sample_clip, sample_track};

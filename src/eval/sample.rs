@@ -16,13 +16,7 @@ pub trait Interpolate: Copy {
     fn widen(self) -> Self::Wide;
     fn linear(a: Self::Wide, b: Self::Wide, t: f64) -> Self::Wide;
     /// Hermite basis weights `(h00, h10, h01, h11)` applied to `(v0, b0, v1, a1)`, tangents already scaled.
-    fn hermite(
-        v0: Self::Wide,
-        b0: Self::Wide,
-        v1: Self::Wide,
-        a1: Self::Wide,
-        h: [f64; 4],
-    ) -> Self::Wide;
+    fn hermite(v0: Self::Wide, b0: Self::Wide, v1: Self::Wide, a1: Self::Wide, h: [f64; 4]) -> Self::Wide;
 }
 
 impl Interpolate for Vec3 {
@@ -55,11 +49,7 @@ impl Interpolate for Quat {
     fn hermite(v0: DQuat, b0: DQuat, v1: DQuat, a1: DQuat, h: [f64; 4]) -> DQuat {
         let q = v0 * h[0] + b0 * h[1] + v1 * h[2] + a1 * h[3];
         // The spec requires the result normalised; a zero result (v1 = −v0 at the midpoint) keeps v0.
-        if q.length_squared() > 0.0 {
-            q.normalize()
-        } else {
-            v0
-        }
+        if q.length_squared() > 0.0 { q.normalize() } else { v0 }
     }
 }
 
@@ -90,12 +80,7 @@ pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
             let out_tangent = track.values()[3 * k + 2].widen();
             let in_tangent = track.values()[3 * (k + 1)].widen();
             let (t2, t3) = (t * t, t * t * t);
-            let h = [
-                2.0 * t3 - 3.0 * t2 + 1.0,
-                span * (t3 - 2.0 * t2 + t),
-                -2.0 * t3 + 3.0 * t2,
-                span * (t3 - t2),
-            ];
+            let h = [2.0 * t3 - 3.0 * t2 + 1.0, span * (t3 - 2.0 * t2 + t), -2.0 * t3 + 3.0 * t2, span * (t3 - t2)];
             T::hermite(value(k), out_tangent, value(k + 1), in_tangent, h)
         }
     }
@@ -128,12 +113,7 @@ mod tests {
     use super::*;
 
     fn vec_track(times: &[f64], values: &[[f32; 3]], interpolation: Interpolation) -> Track<Vec3> {
-        Track::new(
-            Arc::from(times),
-            values.iter().map(|&v| Vec3::from(v)).collect(),
-            interpolation,
-        )
-        .unwrap()
+        Track::new(Arc::from(times), values.iter().map(|&v| Vec3::from(v)).collect(), interpolation).unwrap()
     }
 
     #[test]
@@ -161,14 +141,7 @@ mod tests {
         // 0.84375 + 2·0.140625·3 + 0.15625·5 + 2·(−0.046875)·(−1) = 2.5625.
         let track = vec_track(
             &[0.0, 2.0],
-            &[
-                [9.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [3.0, 0.0, 0.0],
-                [-1.0, 0.0, 0.0],
-                [5.0, 0.0, 0.0],
-                [9.0, 0.0, 0.0],
-            ],
+            &[[9.0, 0.0, 0.0], [1.0, 0.0, 0.0], [3.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [5.0, 0.0, 0.0], [9.0, 0.0, 0.0]],
             Interpolation::CubicSpline,
         );
         assert!((sample_track(&track, 0.5).x - 2.5625).abs() < 1e-15);
@@ -184,12 +157,7 @@ mod tests {
         // 10° and 350° about Y stored with opposite signs: the short way passes through 0°, not 180°.
         let a = Quat::from_rotation_y(10f32.to_radians());
         let b = -Quat::from_rotation_y(-10f32.to_radians());
-        let track = Track::new(
-            Arc::from([0.0, 1.0].as_slice()),
-            vec![a, b],
-            Interpolation::Linear,
-        )
-        .unwrap();
+        let track = Track::new(Arc::from([0.0, 1.0].as_slice()), vec![a, b], Interpolation::Linear).unwrap();
         let mid = sample_track(&track, 0.5);
         assert!(mid.angle_between(DQuat::IDENTITY) < 1e-6, "{mid:?}");
         // A quarter of the way: 5°.

@@ -6,9 +6,5 @@ use super::ImportError;
 use crate::model::Rig;
 
 pub fn load(path: &Path, _bytes: &[u8]) -> Result<Rig, ImportError> {
-    Err(ImportError::new(
-        path,
-        None,
-        "glTF import is not written yet",
-    ))
+    Err(ImportError::new(path, None, "glTF import is not written yet"))
 }

@@ -28,11 +28,7 @@ impl fmt::Display for ImportError {
 
 impl ImportError {
     pub fn new(path: &Path, place: Option<String>, message: impl Into<String>) -> Self {
-        ImportError {
-            path: path.to_owned(),
-            place,
-            message: message.into(),
-        }
+        ImportError { path: path.to_owned(), place, message: message.into() }
     }
 }
 
@@ -47,23 +43,14 @@ pub enum Format {
 pub fn detect(bytes: &[u8]) -> Option<Format> {
     let text_start = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let first = text_start.iter().find(|b| !b.is_ascii_whitespace());
-    if bytes.starts_with(b"glTF") || first == Some(&b'{') {
-        Some(Format::Gltf)
-    } else {
-        None
-    }
+    if bytes.starts_with(b"glTF") || first == Some(&b'{') { Some(Format::Gltf) } else { None }
 }
 
 /// Reads and parses the file at `path`, whatever its format.
 pub fn load(path: &Path) -> Result<Rig, ImportError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?;
     match detect(&bytes) {
         Some(Format::Gltf) => gltf::load(path, &bytes),
-        None => Err(ImportError::new(
-            path,
-            None,
-            "not a recognised animation file (expected glTF 2.0: .gltf or .glb)",
-        )),
+        None => Err(ImportError::new(path, None, "not a recognised animation file (expected glTF 2.0: .gltf or .glb)")),
     }
 }

@@ -90,13 +90,7 @@ pub fn decompose(m: &DMat4) -> AffineParts {
         };
     }
     let (rotation, stretch, scale, sign) = orthogonal_shortcut(&a).unwrap_or_else(|| general(&a));
-    AffineParts {
-        translation,
-        rotation,
-        stretch,
-        scale,
-        sign,
-    }
+    AffineParts { translation, rotation, stretch, scale, sign }
 }
 
 type Parts3 = (DQuat, DQuat, DVec3, f64);
@@ -109,8 +103,7 @@ fn orthogonal_shortcut(a: &DMat3) -> Option<Parts3> {
     if !(min_length > 0.0) || min_length < lengths.max_element() * 1e-6 {
         return None;
     }
-    let orthogonal =
-        |a: DVec3, b: DVec3, la: f64, lb: f64| a.dot(b).abs() <= ORTHOGONAL_COSINE * la * lb;
+    let orthogonal = |a: DVec3, b: DVec3, la: f64, lb: f64| a.dot(b).abs() <= ORTHOGONAL_COSINE * la * lb;
     if !(orthogonal(x, y, lengths.x, lengths.y)
         && orthogonal(y, z, lengths.y, lengths.z)
         && orthogonal(x, z, lengths.x, lengths.z))
@@ -119,12 +112,7 @@ fn orthogonal_shortcut(a: &DMat3) -> Option<Parts3> {
     }
     let sign = if a.determinant() < 0.0 { -1.0 } else { 1.0 };
     let q = DMat3::from_cols(x / lengths.x, y / lengths.y, z / lengths.z) * sign;
-    Some((
-        rotation_from_orthonormal(&q),
-        DQuat::IDENTITY,
-        lengths,
-        sign,
-    ))
+    Some((rotation_from_orthonormal(&q), DQuat::IDENTITY, lengths, sign))
 }
 
 /// The full decomposition: polar factor, sign, spectral decomposition, canonical stretch frame.
@@ -144,8 +132,7 @@ fn polar_newton(a: &DMat3) -> Option<(DMat3, DMat3)> {
     for _ in 0..NEWTON_MAX_ITERATIONS {
         let cof = cofactor(&x);
         let det = x.x_axis.dot(cof.x_axis);
-        if !det.is_finite() || det.abs() <= f64::MIN_POSITIVE * norm_frobenius(&x).powi(3).max(1.0)
-        {
+        if !det.is_finite() || det.abs() <= f64::MIN_POSITIVE * norm_frobenius(&x).powi(3).max(1.0) {
             return None;
         }
         let ratio = (norm_one(&cof) * norm_inf(&cof)) / (norm_one(&x) * norm_inf(&x));
@@ -177,15 +164,8 @@ fn polar_degenerate(a: &DMat3) -> (DMat3, DMat3) {
     let significant = sigma[order[0]] * 1e-12;
     let mut w = [DVec3::ZERO; 3];
     for (rank, &i) in order.iter().enumerate() {
-        let image = if sigma[i] > significant {
-            *a * v.col(i)
-        } else {
-            DVec3::ZERO
-        };
-        w[i] = orthonormal_completion(
-            image,
-            &order[..rank].iter().map(|&j| w[j]).collect::<Vec<_>>(),
-        );
+        let image = if sigma[i] > significant { *a * v.col(i) } else { DVec3::ZERO };
+        w[i] = orthonormal_completion(image, &order[..rank].iter().map(|&j| w[j]).collect::<Vec<_>>());
     }
     let mut w = DMat3::from_cols(w[0], w[1], w[2]);
     if w.determinant() < 0.0 {
@@ -225,10 +205,7 @@ fn symmetric_eigen(s: &DMat3) -> (DMat3, DVec3) {
             jacobi_rotate(&mut m, &mut u, p, q);
         }
     }
-    (
-        DMat3::from_cols_array_2d(&u),
-        DVec3::new(m[0][0], m[1][1], m[2][2]),
-    )
+    (DMat3::from_cols_array_2d(&u), DVec3::new(m[0][0], m[1][1], m[2][2]))
 }
 
 /// One Jacobi rotation in the (p, q) plane zeroing `m[p][q]` (Golub & Van Loan, symmetric Schur).
@@ -326,11 +303,7 @@ fn rotation_from_orthonormal(m: &DMat3) -> DQuat {
 
 /// Columns `x1×x2, x2×x0, x0×x1`: `det(X)·X⁻ᵀ`.
 fn cofactor(x: &DMat3) -> DMat3 {
-    DMat3::from_cols(
-        x.y_axis.cross(x.z_axis),
-        x.z_axis.cross(x.x_axis),
-        x.x_axis.cross(x.y_axis),
-    )
+    DMat3::from_cols(x.y_axis.cross(x.z_axis), x.z_axis.cross(x.x_axis), x.x_axis.cross(x.y_axis))
 }
 
 fn symmetric_part(m: &DMat3) -> DMat3 {
@@ -339,10 +312,7 @@ fn symmetric_part(m: &DMat3) -> DMat3 {
 
 /// Largest column sum of absolute values.
 fn norm_one(m: &DMat3) -> f64 {
-    [m.x_axis, m.y_axis, m.z_axis]
-        .iter()
-        .map(|c| c.abs().element_sum())
-        .fold(0.0, f64::max)
+    [m.x_axis, m.y_axis, m.z_axis].iter().map(|c| c.abs().element_sum()).fold(0.0, f64::max)
 }
 
 /// Largest row sum of absolute values.

@@ -41,15 +41,8 @@ pub struct Track<T> {
 pub enum TrackError {
     #[error("no keyframes")]
     Empty,
-    #[error(
-        "{values} output values for {keys} keys with {interpolation:?} interpolation (expected {expected})"
-    )]
-    CountMismatch {
-        keys: usize,
-        values: usize,
-        expected: usize,
-        interpolation: Interpolation,
-    },
+    #[error("{values} output values for {keys} keys with {interpolation:?} interpolation (expected {expected})")]
+    CountMismatch { keys: usize, values: usize, expected: usize, interpolation: Interpolation },
     #[error("key time {index} ({time}) is not finite, negative, or not after the previous key")]
     BadTime { index: usize, time: f64 },
     #[error("output value {index} is not finite")]
@@ -78,22 +71,13 @@ impl KeyValue for Quat {
 impl<T: KeyValue> Track<T> {
     /// Checks the glTF rules: times finite, non-negative and strictly increasing; one value per key
     /// (three for cubic splines, at least two keys); every value finite.
-    pub fn new(
-        times: Arc<[f64]>,
-        values: Vec<T>,
-        interpolation: Interpolation,
-    ) -> Result<Self, TrackError> {
+    pub fn new(times: Arc<[f64]>, values: Vec<T>, interpolation: Interpolation) -> Result<Self, TrackError> {
         if times.is_empty() {
             return Err(TrackError::Empty);
         }
         let expected = times.len() * interpolation.values_per_key();
         if values.len() != expected {
-            return Err(TrackError::CountMismatch {
-                keys: times.len(),
-                values: values.len(),
-                expected,
-                interpolation,
-            });
+            return Err(TrackError::CountMismatch { keys: times.len(), values: values.len(), expected, interpolation });
         }
         if interpolation == Interpolation::CubicSpline && times.len() < 2 {
             return Err(TrackError::TooFewCubicKeys);
@@ -108,11 +92,7 @@ impl<T: KeyValue> Track<T> {
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             return Err(TrackError::NonFinite { index });
         }
-        Ok(Track {
-            times,
-            values,
-            interpolation,
-        })
+        Ok(Track { times, values, interpolation })
     }
 }
 
@@ -146,12 +126,7 @@ pub struct BoneTracks {
 
 impl BoneTracks {
     pub fn new(bone: usize) -> Self {
-        BoneTracks {
-            bone,
-            translation: None,
-            rotation: None,
-            scale: None,
-        }
+        BoneTracks { bone, translation: None, rotation: None, scale: None }
     }
 
     /// Key times of all three properties (unsorted, with repeats).
@@ -194,21 +169,9 @@ impl Clip {
         morph_channels: Vec<MorphChannel>,
     ) -> Self {
         tracks.sort_by_key(|t| t.bone);
-        let duration = tracks
-            .iter()
-            .flat_map(BoneTracks::all_times)
-            .fold(0.0, f64::max);
-        let duration = morph_channels
-            .iter()
-            .map(|m| m.last_time)
-            .fold(duration, f64::max);
-        Clip {
-            index,
-            name,
-            tracks,
-            morph_channels,
-            duration,
-        }
+        let duration = tracks.iter().flat_map(BoneTracks::all_times).fold(0.0, f64::max);
+        let duration = morph_channels.iter().map(|m| m.last_time).fold(duration, f64::max);
+        Clip { index, name, tracks, morph_channels, duration }
     }
 
     pub fn tracks(&self) -> &[BoneTracks] {
@@ -222,9 +185,7 @@ impl Clip {
 
     /// A name for people: the clip's name, or `animation <index>`.
     pub fn label(&self) -> String {
-        self.name
-            .clone()
-            .unwrap_or_else(|| format!("animation {}", self.index))
+        self.name.clone().unwrap_or_else(|| format!("animation {}", self.index))
     }
 
     /// Every key time of every track, sorted, without duplicates.
@@ -237,10 +198,7 @@ impl Clip {
 
     /// The tracks of one bone, if the clip animates it.
     pub fn tracks_of(&self, bone: usize) -> Option<&BoneTracks> {
-        self.tracks
-            .binary_search_by_key(&bone, |t| t.bone)
-            .ok()
-            .map(|i| &self.tracks[i])
+        self.tracks.binary_search_by_key(&bone, |t| t.bone).ok().map(|i| &self.tracks[i])
     }
 }
 
@@ -256,10 +214,7 @@ mod tests {
     fn track_validation() {
         let v = vec![Vec3::ZERO; 2];
         assert!(Track::new(times(&[0.0, 1.0]), v.clone(), Interpolation::Linear).is_ok());
-        assert_eq!(
-            Track::<Vec3>::new(times(&[]), vec![], Interpolation::Step),
-            Err(TrackError::Empty)
-        );
+        assert_eq!(Track::<Vec3>::new(times(&[]), vec![], Interpolation::Step), Err(TrackError::Empty));
         assert!(matches!(
             Track::new(times(&[0.0, 1.0]), v.clone(), Interpolation::CubicSpline),
             Err(TrackError::CountMismatch { expected: 6, .. })
@@ -273,19 +228,11 @@ mod tests {
             Err(TrackError::BadTime { index: 1, .. })
         ));
         assert_eq!(
-            Track::new(
-                times(&[0.0, 1.0]),
-                vec![Vec3::ZERO, Vec3::NAN],
-                Interpolation::Linear
-            ),
+            Track::new(times(&[0.0, 1.0]), vec![Vec3::ZERO, Vec3::NAN], Interpolation::Linear),
             Err(TrackError::NonFinite { index: 1 })
         );
         assert_eq!(
-            Track::new(
-                times(&[0.0]),
-                vec![Vec3::ZERO; 3],
-                Interpolation::CubicSpline
-            ),
+            Track::new(times(&[0.0]), vec![Vec3::ZERO; 3], Interpolation::CubicSpline),
             Err(TrackError::TooFewCubicKeys)
         );
     }
@@ -293,23 +240,9 @@ mod tests {
     #[test]
     fn duration_and_key_times_cover_all_tracks() {
         let mut a = BoneTracks::new(3);
-        a.translation = Some(
-            Track::new(
-                times(&[0.5, 2.0]),
-                vec![Vec3::ZERO; 2],
-                Interpolation::Linear,
-            )
-            .unwrap(),
-        );
+        a.translation = Some(Track::new(times(&[0.5, 2.0]), vec![Vec3::ZERO; 2], Interpolation::Linear).unwrap());
         let mut b = BoneTracks::new(1);
-        b.rotation = Some(
-            Track::new(
-                times(&[0.0, 0.5, 1.0]),
-                vec![Quat::IDENTITY; 3],
-                Interpolation::Step,
-            )
-            .unwrap(),
-        );
+        b.rotation = Some(Track::new(times(&[0.0, 0.5, 1.0]), vec![Quat::IDENTITY; 3], Interpolation::Step).unwrap());
         let clip = Clip::new(0, None, vec![a, b], vec![]);
         assert_eq!(clip.duration(), 2.0);
         assert_eq!(clip.key_times(), vec![0.0, 0.5, 1.0, 2.0]);

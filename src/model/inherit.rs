@@ -6,9 +6,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// A bone's scale-inheritance mode. Roots behave the same in every mode (`W = L`).
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum InheritMode {
     /// `W = W_p·L`: glTF, FBX RSrs, Blender Full, Unity, Godot, ozz. Shears under a rotated child.
@@ -69,9 +67,7 @@ impl InheritMode {
                 "parent matrix from the rigid T·R chain (the two-pass \"don't inherit scale\")"
             }
             InheritMode::SegmentCompensate => "Maya segment scale compensate, FBX Rrs",
-            InheritMode::Componentwise => {
-                "parent scale along the child's axes (FBX RrSs, Unreal FTransform)"
-            }
+            InheritMode::Componentwise => "parent scale along the child's axes (FBX RrSs, Unreal FTransform)",
             InheritMode::BlenderFixShear => "Blender Inherit Scale: Fix Shear",
             InheritMode::BlenderAligned => "Blender Inherit Scale: Aligned",
             InheritMode::BlenderAverage => "Blender Inherit Scale: Average",
@@ -108,10 +104,7 @@ impl FromStr for InheritMode {
     type Err = UnknownInheritMode;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        InheritMode::ALL
-            .into_iter()
-            .find(|m| m.id() == s)
-            .ok_or_else(|| UnknownInheritMode(s.to_owned()))
+        InheritMode::ALL.into_iter().find(|m| m.id() == s).ok_or_else(|| UnknownInheritMode(s.to_owned()))
     }
 }
 
@@ -123,10 +116,7 @@ mod tests {
     fn ids_round_trip() {
         for mode in InheritMode::ALL {
             assert_eq!(mode.id().parse::<InheritMode>(), Ok(mode));
-            assert_eq!(
-                serde_json::to_string(&mode).unwrap(),
-                format!("\"{}\"", mode.id())
-            );
+            assert_eq!(serde_json::to_string(&mode).unwrap(), format!("\"{}\"", mode.id()));
         }
         assert!("fulll".parse::<InheritMode>().is_err());
     }

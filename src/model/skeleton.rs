@@ -36,11 +36,7 @@ impl Skeleton {
     pub fn new(bones: Vec<Bone>) -> Result<Self, ParentOrderError> {
         for (index, bone) in bones.iter().enumerate() {
             if let Some(parent) = bone.parent.filter(|&p| p >= index) {
-                return Err(ParentOrderError {
-                    bone: index,
-                    name: bone.name.clone(),
-                    parent,
-                });
+                return Err(ParentOrderError { bone: index, name: bone.name.clone(), parent });
             }
         }
         Ok(Skeleton { bones })
@@ -113,34 +109,20 @@ mod tests {
     use super::*;
 
     fn bone(name: &str, parent: Option<usize>) -> Bone {
-        Bone {
-            name: name.into(),
-            node: 0,
-            parent,
-            rest: Transform::IDENTITY,
-            inherit: InheritMode::Full,
-        }
+        Bone { name: name.into(), node: 0, parent, rest: Transform::IDENTITY, inherit: InheritMode::Full }
     }
 
     #[test]
     fn rejects_children_before_parents() {
         let err = Skeleton::new(vec![bone("a", Some(1)), bone("b", None)]).unwrap_err();
         assert_eq!(err.bone, 0);
-        assert!(
-            Skeleton::new(vec![bone("a", Some(0))]).is_err(),
-            "a bone cannot be its own parent"
-        );
+        assert!(Skeleton::new(vec![bone("a", Some(0))]).is_err(), "a bone cannot be its own parent");
     }
 
     #[test]
     fn depths_and_subtrees() {
-        let s = Skeleton::new(vec![
-            bone("root", None),
-            bone("a", Some(0)),
-            bone("b", Some(1)),
-            bone("c", Some(0)),
-        ])
-        .unwrap();
+        let s = Skeleton::new(vec![bone("root", None), bone("a", Some(0)), bone("b", Some(1)), bone("c", Some(0))])
+            .unwrap();
         assert_eq!(s.depths(), vec![0, 1, 2, 1]);
         assert!(s.is_in_subtree(2, 1) && s.is_in_subtree(2, 0) && !s.is_in_subtree(3, 1));
         assert_eq!(s.find("c"), Some(3));

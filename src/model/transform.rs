@@ -21,20 +21,11 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub const IDENTITY: Transform = Transform {
-        translation: DVec3::ZERO,
-        rotation: DQuat::IDENTITY,
-        scale: DVec3::ONE,
-        stretch: DQuat::IDENTITY,
-    };
+    pub const IDENTITY: Transform =
+        Transform { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
 
     pub fn from_trs(translation: DVec3, rotation: DQuat, scale: DVec3) -> Self {
-        Transform {
-            translation,
-            rotation,
-            scale,
-            stretch: DQuat::IDENTITY,
-        }
+        Transform { translation, rotation, scale, stretch: DQuat::IDENTITY }
     }
 
     /// Whether the scale part is diagonal in the bone's frame (no stretch rotation).
@@ -70,12 +61,7 @@ impl Transform {
 
 /// The affine matrix with linear part `m` and translation `t`.
 pub fn affine(m: DMat3, t: DVec3) -> DMat4 {
-    DMat4::from_cols(
-        m.x_axis.extend(0.0),
-        m.y_axis.extend(0.0),
-        m.z_axis.extend(0.0),
-        t.extend(1.0),
-    )
+    DMat4::from_cols(m.x_axis.extend(0.0), m.y_axis.extend(0.0), m.z_axis.extend(0.0), t.extend(1.0))
 }
 
 #[cfg(test)]
@@ -84,11 +70,7 @@ mod tests {
 
     #[test]
     fn stretched_matrix_matches_trs_when_stretch_is_identity() {
-        let t = Transform::from_trs(
-            DVec3::new(1.0, 2.0, 3.0),
-            DQuat::from_rotation_y(0.7),
-            DVec3::new(2.0, 0.5, -1.0),
-        );
+        let t = Transform::from_trs(DVec3::new(1.0, 2.0, 3.0), DQuat::from_rotation_y(0.7), DVec3::new(2.0, 0.5, -1.0));
         let mut stretched = t;
         stretched.stretch = DQuat::from_rotation_z(1e-300); // not bit-identical to IDENTITY: takes the other path
         assert!(t.matrix().abs_diff_eq(stretched.matrix(), 1e-12));
@@ -102,9 +84,6 @@ mod tests {
             scale: DVec3::new(2.0, 1.0, 1.0),
             ..Transform::IDENTITY
         };
-        assert!(
-            t.scale_matrix()
-                .abs_diff_eq(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), 1e-12)
-        );
+        assert!(t.scale_matrix().abs_diff_eq(DMat3::from_diagonal(DVec3::new(1.0, 2.0, 1.0)), 1e-12));
     }
 }

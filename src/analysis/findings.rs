@@ -1,0 +1,96 @@
+//! What is wrong with one matrix: stretched (sheared), non-uniformly scaled, mirrored, degenerate.
+
+use glam::{DMat3, DMat4, DQuat};
+
+use crate::math::{AffineParts, decompose, shear_deg};
+
+/// The tolerances behind the verdicts.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Tolerances {
+    /// Scale factors count as unequal when `max/min − 1` exceeds this (default 1e-4, i.e. 0.01 %).
+    pub min_anisotropy: f64,
+    /// A stretch rotation counts as not the identity when its angle exceeds this many degrees (default 0.01°).
+    pub min_stretch_deg: f64,
+    /// A matrix is degenerate when its smallest scale factor is below this fraction of its largest (default 1e-9).
+    pub degenerate_ratio: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances { min_anisotropy: 1e-4, min_stretch_deg: 0.01, degenerate_ratio: 1e-9 }
+    }
+}
+
+/// The verdicts on one matrix. `stretched` and `non_uniform` exclude each other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Findings {
+    /// Unequal scale along axes that are not the bone's own (`U ≠ I`): shear a TRS runtime cannot represent.
+    pub stretched: bool,
+    /// Unequal scale along the bone's own axes: representable as TRS.
+    pub non_uniform: bool,
+    /// Negative determinant.
+    pub mirrored: bool,
+    /// A (nearly) zero scale factor: the bone collapses a direction.
+    pub degenerate: bool,
+}
+
+impl Findings {
+    pub fn any(&self) -> bool {
+        self.stretched || self.non_uniform || self.mirrored || self.degenerate
+    }
+}
+
+/// A matrix decomposed and judged.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Assessment {
+    pub parts: AffineParts,
+    /// Largest deviation from 90° between two columns, in degrees.
+    pub shear_deg: f64,
+    pub findings: Findings,
+}
+
+impl Assessment {
+    pub fn of(m: &DMat4, tolerances: &Tolerances) -> Self {
+        let parts = decompose(m);
+        // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
+        let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
+        let anisotropic = parts.anisotropy() > tolerances.min_anisotropy;
+        let stretched = anisotropic && parts.stretch_angle_deg() > tolerances.min_stretch_deg;
+        let (min, max) = (parts.scale.min_element(), parts.scale.max_element());
+        let findings = Findings {
+            stretched,
+            non_uniform: anisotropic && !stretched,
+            mirrored: parts.sign < 0.0,
+            degenerate: !(min > tolerances.degenerate_ratio * max),
+        };
+        Assessment { parts, shear_deg, findings }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+
+    fn assess(m: DMat4) -> Findings {
+        Assessment::of(&m, &Tolerances::default()).findings
+    }
+
+    #[test]
+    fn verdicts() {
+        let r = DQuat::from_rotation_y(0.8);
+        let aligned = DMat4::from_scale_rotation_translation(DVec3::new(2.0, 1.0, 1.0), r, DVec3::ZERO);
+        assert_eq!(assess(aligned), Findings { non_uniform: true, ..Findings::default() });
+        let sheared =
+            DMat4::from_cols(glam::DVec4::X, glam::DVec4::new(0.5, 1.0, 0.0, 0.0), glam::DVec4::Z, glam::DVec4::W);
+        assert_eq!(assess(sheared), Findings { stretched: true, ..Findings::default() });
+        let mirrored = DMat4::from_scale(DVec3::new(1.0, -1.0, 1.0));
+        assert_eq!(assess(mirrored), Findings { mirrored: true, ..Findings::default() });
+        assert!(assess(DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0))).degenerate);
+        assert!(assess(DMat4::ZERO).degenerate);
+        assert!(!assess(DMat4::from_quat(r)).any());
+        // Within tolerance: 0.001 % anisotropy is not reported.
+        assert!(!assess(DMat4::from_scale(DVec3::new(1.0, 1.00001, 1.0))).any());
+    }
+}

@@ -1,0 +1,175 @@
+//! The machine-readable reports (`inspect --format json`, `scan --format json`), shared by the CLI and the app.
+
+use glam::DMat4;
+use serde::Serialize;
+
+use super::{Assessment, ClipScan, Tolerances};
+use crate::eval::Pose;
+use crate::math::{AffineParts, decompose};
+use crate::model::{Clip, InheritMode, Skeleton};
+
+/// A matrix and its decomposition `T·F·R·U·K·Uᵀ`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Parts {
+    /// Column-major.
+    pub matrix: [f64; 16],
+    pub translation: [f64; 3],
+    /// `[x, y, z, w]`.
+    pub rotation: [f64; 4],
+    /// The stretch rotation `U`, `[x, y, z, w]`.
+    pub stretch: [f64; 4],
+    pub scale: [f64; 3],
+    /// 1, or −1 for a mirroring matrix.
+    pub sign: i32,
+}
+
+impl Parts {
+    pub fn new(matrix: &DMat4, parts: &AffineParts) -> Self {
+        Parts {
+            matrix: matrix.to_cols_array(),
+            translation: parts.translation.to_array(),
+            rotation: parts.rotation.to_array(),
+            stretch: parts.stretch.to_array(),
+            scale: parts.scale.to_array(),
+            sign: if parts.sign < 0.0 { -1 } else { 1 },
+        }
+    }
+}
+
+/// Which clip a report is about.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AnimationInfo {
+    pub index: usize,
+    pub name: Option<String>,
+    pub duration: f64,
+}
+
+impl AnimationInfo {
+    pub fn of(clip: &Clip) -> Self {
+        AnimationInfo { index: clip.index, name: clip.name.clone(), duration: clip.duration() }
+    }
+}
+
+/// One bone at one time. `stretched`, `shear_deg` and `mirrored` describe the model matrix.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoneReport {
+    pub index: usize,
+    pub node: usize,
+    pub name: String,
+    pub parent: Option<usize>,
+    pub inherit: InheritMode,
+    pub local: Parts,
+    pub model: Parts,
+    pub stretched: bool,
+    pub shear_deg: f64,
+    pub mirrored: bool,
+    /// Everything found about the model matrix (not part of the JSON: `stretched` and `mirrored` say it there).
+    #[serde(skip)]
+    pub assessment: Assessment,
+}
+
+impl BoneReport {
+    /// Every bone of an evaluated pose.
+    pub fn all(skeleton: &Skeleton, modes: &[InheritMode], pose: &Pose, tolerances: &Tolerances) -> Vec<BoneReport> {
+        skeleton
+            .bones()
+            .iter()
+            .enumerate()
+            .map(|(index, bone)| {
+                let local = pose.local[index].matrix();
+                let model = pose.model.model[index];
+                let assessment = Assessment::of(&model, tolerances);
+                BoneReport {
+                    index,
+                    node: bone.node,
+                    name: bone.name.clone(),
+                    parent: bone.parent,
+                    inherit: modes[index],
+                    local: Parts::new(&local, &decompose(&local)),
+                    model: Parts::new(&model, &assessment.parts),
+                    stretched: assessment.findings.stretched,
+                    shear_deg: assessment.shear_deg,
+                    mirrored: assessment.findings.mirrored,
+                    assessment,
+                }
+            })
+            .collect()
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SampleReport {
+    pub time: f64,
+    pub bones: Vec<BoneReport>,
+}
+
+/// `bonescope inspect --format json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InspectReport {
+    pub file: String,
+    pub animation: Option<AnimationInfo>,
+    /// The mode given for every bone, or `declared` when each bone keeps the file's.
+    pub inherit: String,
+    pub samples: Vec<SampleReport>,
+}
+
+/// One bone's whole-clip summary, with its name.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoneScanReport {
+    pub name: String,
+    #[serde(flatten)]
+    pub summary: super::BoneSummary,
+}
+
+/// One clip of one file, scanned.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AnimationScan {
+    /// `null` for a file without animations, whose rest pose is scanned instead.
+    pub animation: Option<AnimationInfo>,
+    pub inherit: String,
+    pub rate: f64,
+    pub samples: usize,
+    /// Bones stretched in at least one sample, worst shear first.
+    pub stretched: Vec<BoneScanReport>,
+    /// Bones with other findings in at least one sample.
+    pub non_uniform: Vec<String>,
+    pub mirrored: Vec<String>,
+    pub degenerate: Vec<String>,
+}
+
+impl AnimationScan {
+    pub fn new(skeleton: &Skeleton, clip: Option<&Clip>, inherit: String, rate: f64, scan: ClipScan) -> Self {
+        let name = |i: usize| skeleton.bone(i).name.clone();
+        let names_where = |count: fn(&super::BoneSummary) -> usize| {
+            scan.bones.iter().filter(|b| count(b) > 0).map(|b| name(b.index)).collect::<Vec<_>>()
+        };
+        let non_uniform = names_where(|b| b.non_uniform_samples);
+        let mirrored = names_where(|b| b.mirrored_samples);
+        let degenerate = names_where(|b| b.degenerate_samples);
+        let mut stretched: Vec<BoneScanReport> = scan
+            .bones
+            .into_iter()
+            .filter(|b| b.stretched())
+            .map(|summary| BoneScanReport { name: name(summary.index), summary })
+            .collect();
+        stretched.sort_by(|a, b| b.summary.worst_shear_deg.total_cmp(&a.summary.worst_shear_deg));
+        AnimationScan {
+            animation: clip.map(AnimationInfo::of),
+            inherit,
+            rate,
+            samples: scan.samples,
+            stretched,
+            non_uniform,
+            mirrored,
+            degenerate,
+        }
+    }
+}
+
+/// One file of `bonescope scan`: its clips, or why it could not be loaded.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FileScan {
+    pub file: String,
+    pub error: Option<String>,
+    pub animations: Vec<AnimationScan>,
+}

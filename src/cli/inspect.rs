@@ -1,0 +1,118 @@
+//! `bonescope inspect`: every bone's matrices, decomposition and findings at chosen times.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+
+use super::table::{Table, vector};
+use super::{EvalArgs, Format, ToleranceArgs};
+use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, SampleReport};
+use crate::eval::{Hierarchy, Pose};
+use crate::import;
+
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The animation file (glTF .gltf/.glb).
+    pub file: PathBuf,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// A time in seconds to evaluate (repeatable; default 0). Outside the clip the first or last key holds.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub time: Vec<f64>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    #[command(flatten)]
+    pub tolerances: ToleranceArgs,
+}
+
+pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    let rig = import::load(&args.file)?;
+    let clip = args.eval.clip(&rig)?;
+    let modes = args.eval.modes(&rig)?;
+    let tolerances = args.tolerances.tolerances()?;
+    if let Some(bad) = args.time.iter().find(|t| !t.is_finite()) {
+        anyhow::bail!("--time must be a finite number of seconds, got {bad}");
+    }
+    let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
+    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
+    let mut pose = Pose::default();
+    let samples = times
+        .iter()
+        .map(|&time| {
+            pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
+            SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, &pose, &tolerances) }
+        })
+        .collect();
+    let report = InspectReport {
+        file: args.file.display().to_string(),
+        animation: clip.map(AnimationInfo::of),
+        inherit: args.eval.inherit_label(),
+        samples,
+    };
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        Format::Table => print!("{}", render_table(&report)),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn render_table(report: &InspectReport) -> String {
+    let animation = match &report.animation {
+        Some(a) => format!(
+            "animation {} {} ({:.3} s)",
+            a.index,
+            a.name.as_deref().map_or_else(String::new, |n| format!("`{n}`")),
+            a.duration
+        ),
+        None => "no animation (rest pose)".to_owned(),
+    };
+    let mut out = format!("{}  {}  inherit: {}\n", report.file, animation, report.inherit);
+    for sample in &report.samples {
+        out.push_str(&format!(
+            "\nt = {:.4} s   (model space; * = stretched: scale along axes that shear)\n",
+            sample.time
+        ));
+        let mut table = Table::new(&[
+            ("", false),
+            ("#", true),
+            ("bone", false),
+            ("parent", false),
+            ("inherit", false),
+            ("translation", false),
+            ("scale k", false),
+            ("stretch°", true),
+            ("shear°", true),
+            ("findings", false),
+        ]);
+        for bone in &sample.bones {
+            let parent = bone.parent.map_or_else(|| "-".to_owned(), |p| sample.bones[p].name.clone());
+            let parts = &bone.assessment.parts;
+            table.row(vec![
+                if bone.stretched { "*" } else { "" }.to_owned(),
+                bone.index.to_string(),
+                bone.name.clone(),
+                parent,
+                bone.inherit.id().to_owned(),
+                vector(&bone.model.translation),
+                vector(&bone.model.scale),
+                format!("{:.3}", parts.stretch_angle_deg()),
+                format!("{:.3}", bone.shear_deg),
+                findings_text(bone),
+            ]);
+        }
+        out.push_str(&table.to_string());
+    }
+    out
+}
+
+fn findings_text(bone: &BoneReport) -> String {
+    let f = bone.assessment.findings;
+    let words = [
+        (f.stretched, "stretched"),
+        (f.non_uniform, "non-uniform"),
+        (f.mirrored, "mirrored"),
+        (f.degenerate, "degenerate"),
+    ];
+    words.iter().filter(|(on, _)| *on).map(|(_, w)| *w).collect::<Vec<_>>().join(", ")
+}

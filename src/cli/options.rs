@@ -1,0 +1,96 @@
+//! Options shared by several commands, defined once.
+
+use anyhow::{Context, anyhow, bail};
+use clap::{Args, ValueEnum};
+
+use crate::analysis::Tolerances;
+use crate::model::{Clip, InheritMode, Rig};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Aligned columns for people; flagged bones marked.
+    #[default]
+    Table,
+    /// One JSON document on standard output.
+    Json,
+}
+
+/// Which clip, and which inheritance modes.
+#[derive(Clone, Debug, Default, Args)]
+pub struct EvalArgs {
+    /// The animation, by name or index (default: `inspect` the first, `scan` every one).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub anim: Option<String>,
+    /// Evaluate every bone with this mode instead of the one the file declares: full, unscaled-parent,
+    /// segment-compensate, componentwise, blender-fix-shear, blender-aligned, blender-average, blender-none,
+    /// blender-none-legacy.
+    #[arg(long, value_name = "MODE")]
+    pub inherit: Option<InheritMode>,
+    /// Then give one bone its own mode (repeatable).
+    #[arg(long = "inherit-bone", value_name = "NAME=MODE", value_parser = parse_bone_mode)]
+    pub inherit_bone: Vec<(String, InheritMode)>,
+}
+
+fn parse_bone_mode(s: &str) -> Result<(String, InheritMode), String> {
+    let (name, mode) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=MODE, got `{s}`"))?;
+    Ok((name.to_owned(), mode.parse().map_err(|e| format!("{e}"))?))
+}
+
+impl EvalArgs {
+    /// The clip `--anim` names, or the first; `None` for a file without animations.
+    pub fn clip<'a>(&self, rig: &'a Rig) -> anyhow::Result<Option<&'a Clip>> {
+        match &self.anim {
+            None => Ok(rig.clips.first()),
+            Some(name) => rig.find_clip(name).map(Some).ok_or_else(|| {
+                let available: Vec<String> = rig.clips.iter().map(|c| format!("{} ({})", c.index, c.label())).collect();
+                let available = if available.is_empty() { "none".to_owned() } else { available.join(", ") };
+                anyhow!("no animation `{name}` (available: {available})")
+            }),
+        }
+    }
+
+    /// One mode per bone: the file's, or `--inherit`'s, then the `--inherit-bone` overrides.
+    pub fn modes(&self, rig: &Rig) -> anyhow::Result<Vec<InheritMode>> {
+        let skeleton = &rig.skeleton;
+        let mut modes = match self.inherit {
+            Some(mode) => vec![mode; skeleton.len()],
+            None => skeleton.declared_modes(),
+        };
+        for (name, mode) in &self.inherit_bone {
+            let bone = skeleton.find(name).with_context(|| format!("--inherit-bone: no bone named `{name}`"))?;
+            modes[bone] = *mode;
+        }
+        Ok(modes)
+    }
+
+    /// What the reports say under `inherit`: the global mode, or `declared`.
+    pub fn inherit_label(&self) -> String {
+        self.inherit.map_or_else(|| "declared".to_owned(), |m| m.id().to_owned())
+    }
+}
+
+/// The thresholds of the verdicts.
+#[derive(Clone, Debug, Args)]
+pub struct ToleranceArgs {
+    /// A bone counts as stretched only when max/min of its scale factors exceeds 1 + this.
+    #[arg(long, value_name = "RATIO", default_value_t = Tolerances::default().min_anisotropy)]
+    pub min_anisotropy: f64,
+    /// ...and its stretch rotation U turns by more than this many degrees.
+    #[arg(long, value_name = "DEGREES", default_value_t = Tolerances::default().min_stretch_deg)]
+    pub min_stretch_deg: f64,
+}
+
+impl ToleranceArgs {
+    pub fn tolerances(&self) -> anyhow::Result<Tolerances> {
+        for (name, value) in [("--min-anisotropy", self.min_anisotropy), ("--min-stretch-deg", self.min_stretch_deg)] {
+            if !(value >= 0.0 && value.is_finite()) {
+                bail!("{name} must be a finite number ≥ 0, got {value}");
+            }
+        }
+        Ok(Tolerances {
+            min_anisotropy: self.min_anisotropy,
+            min_stretch_deg: self.min_stretch_deg,
+            ..Tolerances::default()
+        })
+    }
+}

@@ -1,0 +1,25 @@
+//! One evaluation step from a clip and a time to local and model matrices, with reusable buffers.
+
+use super::{Hierarchy, ModelPose, sample_clip};
+use crate::model::{Clip, Skeleton, Transform};
+
+/// The local transforms and model matrices of every bone at one time. Reuse it across times to avoid allocating.
+#[derive(Clone, Debug, Default)]
+pub struct Pose {
+    pub local: Vec<Transform>,
+    pub model: ModelPose,
+}
+
+impl Pose {
+    /// Samples `clip` at `time` (the rest pose when there is no clip) and evaluates the hierarchy.
+    pub fn evaluate(&mut self, skeleton: &Skeleton, clip: Option<&Clip>, hierarchy: &Hierarchy, time: f64) {
+        match clip {
+            Some(clip) => sample_clip(skeleton, clip, time, &mut self.local),
+            None => {
+                self.local.clear();
+                self.local.extend(skeleton.bones().iter().map(|b| b.rest));
+            }
+        }
+        hierarchy.evaluate(&self.local, &mut self.model);
+    }
+}
