@@ -1,0 +1,216 @@
+//! Buffer bytes: the GLB `BIN` chunk, base64 `data:` URIs, or files beside the glTF file.
+//!
+//! A URI may name a file in the glTF file's folder or below it, percent-encoded or not; absolute paths, `..`
+//! and every scheme but `data:` are refused, so a downloaded file cannot make bonescope read elsewhere on disk or
+//! reach the network. Each buffer is cut to its declared `byteLength` (a GLB chunk may carry padding), and an
+//! external file is read no further than that, so memory stays bounded by what the files actually hold.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use base64::Engine as _;
+use base64::engine::DecodePaddingMode;
+use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
+use gltf::buffer::Source;
+
+use super::{Failure, Result};
+
+/// Base64 as glTF writers produce it; some leave out the `=` padding.
+const BASE64: GeneralPurpose = GeneralPurpose::new(
+    &base64::alphabet::STANDARD,
+    GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
+);
+
+/// One byte vector per buffer of the document, each exactly `byteLength` long.
+pub(super) fn load(
+    doc: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+    folder: &Path,
+) -> Result<Vec<Vec<u8>>> {
+    doc.buffers()
+        .map(|buffer| {
+            let place = format!("buffers[{}]", buffer.index());
+            let mut data = match buffer.source() {
+                Source::Bin if buffer.index() == 0 => blob.take().ok_or_else(|| {
+                    Failure::at(&place, "has no uri, and the file has no GLB BIN chunk")
+                })?,
+                Source::Bin => {
+                    return Err(Failure::at(
+                        &place,
+                        "has no uri (only buffers[0] can be the GLB BIN chunk)",
+                    ));
+                }
+                Source::Uri(uri) => {
+                    read_uri(uri, folder, buffer.length()).map_err(|m| Failure::at(&place, m))?
+                }
+            };
+            if data.len() < buffer.length() {
+                let message = format!(
+                    "byteLength is {} but the data holds {} bytes",
+                    buffer.length(),
+                    data.len()
+                );
+                return Err(Failure::at(place, message));
+            }
+            data.truncate(buffer.length());
+            Ok(data)
+        })
+        .collect()
+}
+
+/// The bytes a buffer URI names (at most `length` of them for a file).
+fn read_uri(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
+    if let Some(data) = strip_prefix_ignore_case(uri, "data:") {
+        return decode_data_uri(data);
+    }
+    let path = folder.join(relative_path(uri)?);
+    let file = std::fs::File::open(&path)
+        .map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
+    let mut data = Vec::new();
+    file.take(length as u64)
+        .read_to_end(&mut data)
+        .map_err(|e| format!("cannot read `{uri}` ({}): {e}", path.display()))?;
+    Ok(data)
+}
+
+/// The payload of `data:[<media type>];base64,<payload>` (glTF buffers are always base64).
+fn decode_data_uri(after_scheme: &str) -> std::result::Result<Vec<u8>, String> {
+    let Some((header, payload)) = after_scheme.split_once(',') else {
+        return Err("malformed data URI (no comma)".into());
+    };
+    if !header.to_ascii_lowercase().ends_with(";base64") {
+        return Err(format!("data URI `data:{header},…` is not base64"));
+    }
+    BASE64
+        .decode(payload)
+        .map_err(|e| format!("bad base64 in data URI: {e}"))
+}
+
+/// A URI reference as a relative path inside the glTF file's folder.
+pub(super) fn relative_path(uri: &str) -> std::result::Result<PathBuf, String> {
+    if let Some(scheme) = scheme(uri) {
+        return Err(format!(
+            "unsupported URI scheme `{scheme}:` in `{uri}` (only data: URIs and relative paths)"
+        ));
+    }
+    let decoded =
+        percent_decode(uri).ok_or_else(|| format!("malformed percent-encoding in `{uri}`"))?;
+    if decoded.starts_with(['/', '\\']) {
+        return Err(format!(
+            "`{uri}` is an absolute path (only paths relative to the glTF file are read)"
+        ));
+    }
+    let mut path = PathBuf::new();
+    for part in decoded
+        .split(['/', '\\'])
+        .filter(|p| !p.is_empty() && *p != ".")
+    {
+        if part == ".." || part.contains(':') {
+            return Err(format!(
+                "`{uri}` is not a path inside the glTF file's folder"
+            ));
+        }
+        path.push(part);
+    }
+    if path.as_os_str().is_empty() {
+        return Err(format!("`{uri}` names no file"));
+    }
+    Ok(path)
+}
+
+/// The URI's scheme (RFC 3986: a letter, then letters, digits, `+`, `-`, `.`, then `:`), if it has one.
+fn scheme(uri: &str) -> Option<&str> {
+    let (scheme, _) = uri.split_once(':')?;
+    let mut chars = scheme.chars();
+    let valid = chars.next().is_some_and(|c| c.is_ascii_alphabetic())
+        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
+    valid.then_some(scheme)
+}
+
+/// `%XX` escapes decoded; `None` for a broken escape or a result that is not UTF-8.
+fn percent_decode(s: &str) -> Option<String> {
+    let mut bytes = Vec::with_capacity(s.len());
+    let mut rest = s.as_bytes();
+    while let Some((&byte, tail)) = rest.split_first() {
+        if byte == b'%' {
+            let hex = std::str::from_utf8(tail.get(..2)?).ok()?;
+            bytes.push(u8::from_str_radix(hex, 16).ok()?);
+            rest = &tail[2..];
+        } else {
+            bytes.push(byte);
+            rest = tail;
+        }
+    }
+    String::from_utf8(bytes).ok()
+}
+
+fn strip_prefix_ignore_case<'a>(s: &'a str, prefix: &str) -> Option<&'a str> {
+    let head = s.get(..prefix.len())?;
+    head.eq_ignore_ascii_case(prefix)
+        .then(|| &s[prefix.len()..])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use base64::engine::general_purpose;
+
+    #[test]
+    fn relative_paths_are_percent_decoded() {
+        assert_eq!(
+            relative_path("my%20model.bin"),
+            Ok(PathBuf::from("my model.bin"))
+        );
+        assert_eq!(
+            relative_path("./sub/a.bin"),
+            Ok(Path::new("sub").join("a.bin"))
+        );
+    }
+
+    #[test]
+    fn escapes_absolute_paths_and_schemes_are_refused() {
+        for uri in [
+            "../x.bin",
+            "a/../../x.bin",
+            "%2E%2E/x.bin",
+            "..%2Fx.bin",
+            "a\\..\\..\\x",
+            "/etc/passwd",
+        ] {
+            assert!(relative_path(uri).is_err(), "{uri}");
+        }
+        for uri in [
+            "http://example.com/x.bin",
+            "file:///x.bin",
+            "C:/x.bin",
+            "https:x",
+        ] {
+            let err = relative_path(uri).unwrap_err();
+            assert!(err.contains("scheme"), "{uri}: {err}");
+        }
+        assert!(
+            relative_path("bad%zz").is_err()
+                && relative_path("bad%4").is_err()
+                && relative_path("%ff").is_err()
+        );
+    }
+
+    #[test]
+    fn data_uris_decode_with_or_without_padding() {
+        assert_eq!(
+            decode_data_uri("application/octet-stream;base64,AQID"),
+            Ok(vec![1, 2, 3])
+        );
+        assert_eq!(
+            decode_data_uri("application/gltf-buffer;base64,AQI"),
+            Ok(vec![1, 2])
+        );
+        assert!(decode_data_uri("text/plain,hello").is_err());
+        assert!(decode_data_uri("application/octet-stream;base64,@@@@").is_err());
+        let encoded = general_purpose::STANDARD.encode([9u8; 10]);
+        assert_eq!(
+            decode_data_uri(&format!(";base64,{encoded}")),
+            Ok(vec![9; 10])
+        );
+    }
+}
