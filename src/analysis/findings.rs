@@ -46,6 +46,9 @@ pub struct Assessment {
     pub parts: AffineParts,
     /// Largest deviation from 90° between two columns, in degrees.
     pub shear_deg: f64,
+    /// The angle of the stretch rotation with scale factors within `min_anisotropy` of each other merged
+    /// ([`AffineParts::stretch_angle_deg_within`]), in degrees.
+    pub stretch_deg: f64,
     pub findings: Findings,
 }
 
@@ -55,7 +58,8 @@ impl Assessment {
         // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
         let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
         let anisotropic = parts.anisotropy() > tolerances.min_anisotropy;
-        let stretched = anisotropic && parts.stretch_angle_deg() > tolerances.min_stretch_deg;
+        let stretch_deg = if anisotropic { parts.stretch_angle_deg_within(tolerances.min_anisotropy) } else { 0.0 };
+        let stretched = stretch_deg > tolerances.min_stretch_deg;
         let (min, max) = (parts.scale.min_element(), parts.scale.max_element());
         let findings = Findings {
             stretched,
@@ -63,7 +67,7 @@ impl Assessment {
             mirrored: parts.sign < 0.0,
             degenerate: !(min > tolerances.degenerate_ratio * max),
         };
-        Assessment { parts, shear_deg, findings }
+        Assessment { parts, shear_deg, stretch_deg, findings }
     }
 }
 
@@ -92,5 +96,11 @@ mod tests {
         assert!(!assess(DMat4::from_quat(r)).any());
         // Within tolerance: 0.001 % anisotropy is not reported.
         assert!(!assess(DMat4::from_scale(DVec3::new(1.0, 1.00001, 1.0))).any());
+        // Two factors 1e-6 apart and a third distinct, the nearly equal pair turned 30° in its plane: the turn
+        // changes the matrix by about 1e-6 only, so the bone is aligned, not stretched.
+        let twisted = DMat4::from_quat(DQuat::from_rotation_z(0.5))
+            * DMat4::from_scale(DVec3::new(1.0, 1.000001, 0.5))
+            * DMat4::from_quat(DQuat::from_rotation_z(-0.5));
+        assert_eq!(assess(twisted), Findings { non_uniform: true, ..Findings::default() });
     }
 }

@@ -29,7 +29,7 @@ pub struct BoneSummary {
     pub worst_shear_deg: f64,
     /// When the worst shear happens (the first such time).
     pub worst_shear_time: f64,
-    /// The largest angle of the stretch rotation among stretched samples.
+    /// The largest angle of the stretch rotation among stretched samples (see [`Assessment::stretch_deg`]).
     pub worst_stretch_deg: f64,
     /// Samples where the bone is stretched.
     pub flagged_samples: usize,
@@ -52,7 +52,7 @@ impl BoneSummary {
         }
         let f = a.findings;
         if f.stretched {
-            self.worst_stretch_deg = self.worst_stretch_deg.max(a.parts.stretch_angle_deg());
+            self.worst_stretch_deg = self.worst_stretch_deg.max(a.stretch_deg);
             self.flagged_samples += 1;
             self.first_flagged_time.get_or_insert(time);
         }

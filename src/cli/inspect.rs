@@ -87,7 +87,6 @@ fn render_table(report: &InspectReport) -> String {
         ]);
         for bone in &sample.bones {
             let parent = bone.parent.map_or_else(|| "-".to_owned(), |p| sample.bones[p].name.clone());
-            let parts = &bone.assessment.parts;
             table.row(vec![
                 if bone.stretched { "*" } else { "" }.to_owned(),
                 bone.index.to_string(),
@@ -96,7 +95,7 @@ fn render_table(report: &InspectReport) -> String {
                 bone.inherit.id().to_owned(),
                 vector(&bone.model.translation),
                 vector(&bone.model.scale),
-                format!("{:.3}", parts.stretch_angle_deg()),
+                format!("{:.3}", bone.assessment.stretch_deg),
                 format!("{:.3}", bone.shear_deg),
                 findings_text(bone),
             ]);

@@ -35,10 +35,10 @@ impl fmt::Display for Table {
         }
         let headers = self.headers.iter().map(|h| h.to_string()).collect::<Vec<_>>();
         for row in std::iter::once(&headers).chain(&self.rows) {
-            let mut line = String::from(" ");
+            let mut line = String::new();
             for ((cell, &width), &right) in row.iter().zip(&widths).zip(&self.right) {
                 let pad = width - cell.chars().count();
-                line.push(' ');
+                line.push_str("  ");
                 if right {
                     line.extend(std::iter::repeat_n(' ', pad));
                     line.push_str(cell);

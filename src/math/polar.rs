@@ -64,6 +64,14 @@ impl AffineParts {
         quat_angle(self.stretch).to_degrees()
     }
 
+    /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees.
+    ///
+    /// Between nearly equal factors `U` may turn freely without changing the matrix by more than their difference,
+    /// so this is the angle that matters when asking whether a bone is stretched.
+    pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
+        quat_angle(canonical_stretch(self.stretch, self.scale, relative_tolerance).0).to_degrees()
+    }
+
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
     pub fn anisotropy(&self) -> f64 {
         let (min, max) = (self.scale.min_element(), self.scale.max_element());
@@ -121,7 +129,7 @@ fn general(a: &DMat3) -> Parts3 {
     let sign = if q.determinant() < 0.0 { -1.0 } else { 1.0 };
     q *= sign;
     let (u, k) = symmetric_eigen(&s);
-    let (stretch, scale) = canonical_stretch(rotation_from_orthonormal(&u), k.max(DVec3::ZERO));
+    let (stretch, scale) = canonical_stretch(rotation_from_orthonormal(&u), k.max(DVec3::ZERO), EQUAL_SCALE_TOLERANCE);
     (rotation_from_orthonormal(&q), stretch, scale, sign)
 }
 
@@ -239,9 +247,10 @@ fn jacobi_rotate(m: &mut [[f64; 3]; 3], u: &mut [[f64; 3]; 3], p: usize, q: usiz
     }
 }
 
-/// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match.
-fn canonical_stretch(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
-    let tolerance = EQUAL_SCALE_TOLERANCE * k.max_element();
+/// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match; factors
+/// within `relative_tolerance` of the largest count as equal.
+fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVec3) {
+    let tolerance = relative_tolerance * k.max_element();
     let equal = |i: usize, j: usize| (k[i] - k[j]).abs() <= tolerance;
     let distinct = match (equal(0, 1), equal(0, 2), equal(1, 2)) {
         (false, false, false) => return closest_axis_permutation(u, k),

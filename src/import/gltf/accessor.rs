@@ -15,25 +15,12 @@ type Component = (DataType, bool);
 
 const FLOAT: &[Component] = &[(DataType::F32, false)];
 /// Rotation and morph-weight outputs: float, or signed or unsigned normalized bytes and shorts.
-const FLOAT_OR_NORMALIZED: &[Component] = &[
-    (DataType::F32, false),
-    (DataType::I8, true),
-    (DataType::U8, true),
-    (DataType::I16, true),
-    (DataType::U16, true),
-];
+const FLOAT_OR_NORMALIZED: &[Component] =
+    &[(DataType::F32, false), (DataType::I8, true), (DataType::U8, true), (DataType::I16, true), (DataType::U16, true)];
 /// `WEIGHTS_0`: float, or unsigned normalized bytes and shorts.
-const FLOAT_OR_UNORM: &[Component] = &[
-    (DataType::F32, false),
-    (DataType::U8, true),
-    (DataType::U16, true),
-];
+const FLOAT_OR_UNORM: &[Component] = &[(DataType::F32, false), (DataType::U8, true), (DataType::U16, true)];
 const JOINT_INDEX: &[Component] = &[(DataType::U8, false), (DataType::U16, false)];
-const VERTEX_INDEX: &[Component] = &[
-    (DataType::U8, false),
-    (DataType::U16, false),
-    (DataType::U32, false),
-];
+const VERTEX_INDEX: &[Component] = &[(DataType::U8, false), (DataType::U16, false), (DataType::U32, false)];
 
 /// The checked bytes of an accessor: `count` elements, `stride` apart, the last one ending the slice.
 struct Elements<'a> {
@@ -45,63 +32,31 @@ struct Elements<'a> {
 
 /// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
 pub(super) fn times(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f64>> {
-    let elements = checked(
-        accessor,
-        buffers,
-        Dimensions::Scalar,
-        FLOAT,
-        "keyframe times",
-    )?;
+    let elements = checked(accessor, buffers, Dimensions::Scalar, FLOAT, "keyframe times")?;
     Ok(elements.floats::<1>().map(|[t]| f64::from(t)).collect())
 }
 
 /// `VEC3` float: translations, scales, positions.
-pub(super) fn vec3s(
-    accessor: &gltf::Accessor,
-    buffers: &[Vec<u8>],
-    what: &str,
-) -> Result<Vec<Vec3>> {
+pub(super) fn vec3s(accessor: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<Vec3>> {
     let elements = checked(accessor, buffers, Dimensions::Vec3, FLOAT, what)?;
     Ok(elements.floats::<3>().map(Vec3::from_array).collect())
 }
 
 /// `VEC4` quaternions `[x, y, z, w]`, float or normalized integers (decoded, not renormalized).
 pub(super) fn rotations(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<Quat>> {
-    let elements = checked(
-        accessor,
-        buffers,
-        Dimensions::Vec4,
-        FLOAT_OR_NORMALIZED,
-        "rotation output",
-    )?;
+    let elements = checked(accessor, buffers, Dimensions::Vec4, FLOAT_OR_NORMALIZED, "rotation output")?;
     Ok(elements.floats::<4>().map(Quat::from_array).collect())
 }
 
 /// Checks a morph-weight output accessor without reading it (the weights are not evaluated).
 pub(super) fn check_morph_weights(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<()> {
-    checked(
-        accessor,
-        buffers,
-        Dimensions::Scalar,
-        FLOAT_OR_NORMALIZED,
-        "morph-weight output",
-    )
-    .map(drop)
+    checked(accessor, buffers, Dimensions::Scalar, FLOAT_OR_NORMALIZED, "morph-weight output").map(drop)
 }
 
 /// `MAT4` float, column-major as glTF stores it.
 pub(super) fn matrices(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<DMat4>> {
-    let elements = checked(
-        accessor,
-        buffers,
-        Dimensions::Mat4,
-        FLOAT,
-        "inverse bind matrices",
-    )?;
-    Ok(elements
-        .floats::<16>()
-        .map(|m| DMat4::from_cols_array(&m.map(f64::from)))
-        .collect())
+    let elements = checked(accessor, buffers, Dimensions::Mat4, FLOAT, "inverse bind matrices")?;
+    Ok(elements.floats::<16>().map(|m| DMat4::from_cols_array(&m.map(f64::from))).collect())
 }
 
 /// `JOINTS_0`: four unsigned byte or short joint indices per vertex.
@@ -113,25 +68,13 @@ pub(super) fn joints(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<V
 
 /// `WEIGHTS_0`: four weights per vertex, float or unsigned normalized.
 pub(super) fn weights(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<[f32; 4]>> {
-    let elements = checked(
-        accessor,
-        buffers,
-        Dimensions::Vec4,
-        FLOAT_OR_UNORM,
-        "WEIGHTS_0",
-    )?;
+    let elements = checked(accessor, buffers, Dimensions::Vec4, FLOAT_OR_UNORM, "WEIGHTS_0")?;
     Ok(elements.floats::<4>().collect())
 }
 
 /// Vertex indices (`SCALAR` unsigned byte, short or int).
 pub(super) fn indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>> {
-    let elements = checked(
-        accessor,
-        buffers,
-        Dimensions::Scalar,
-        VERTEX_INDEX,
-        "indices",
-    )?;
+    let elements = checked(accessor, buffers, Dimensions::Scalar, VERTEX_INDEX, "indices")?;
     Ok(elements.uints::<1>().map(|[i]| i).collect())
 }
 
@@ -146,20 +89,9 @@ fn checked<'a>(
     let place = format!("accessors[{}]", accessor.index());
     let component = (accessor.data_type(), accessor.normalized());
     if accessor.dimensions() != dimensions || !allowed.contains(&component) {
-        let expected = allowed
-            .iter()
-            .map(|&c| component_name(c))
-            .collect::<Vec<_>>()
-            .join(" or ");
-        let found = format!(
-            "{} of {}",
-            type_name(accessor.dimensions()),
-            component_name(component)
-        );
-        let message = format!(
-            "{what} must be {} of {expected}, found {found}",
-            type_name(dimensions)
-        );
+        let expected = allowed.iter().map(|&c| component_name(c)).collect::<Vec<_>>().join(" or ");
+        let found = format!("{} of {}", type_name(accessor.dimensions()), component_name(component));
+        let message = format!("{what} must be {} of {expected}, found {found}", type_name(dimensions));
         return Err(Failure::at(place, message));
     }
     if accessor.sparse().is_some() {
@@ -172,10 +104,8 @@ fn checked<'a>(
     let element_size = accessor.size();
     let stride = view.stride().unwrap_or(element_size);
     if stride < element_size {
-        let message = format!(
-            "bufferViews[{}] has byteStride {stride}, less than the element size {element_size}",
-            view.index()
-        );
+        let message =
+            format!("bufferViews[{}] has byteStride {stride}, less than the element size {element_size}", view.index());
         return Err(Failure::at(place, message));
     }
     let count = accessor.count();
@@ -194,44 +124,34 @@ fn checked<'a>(
         );
         return Err(Failure::at(place, message));
     };
-    Ok(Elements {
-        bytes,
-        stride,
-        data_type: component.0,
-        normalized: component.1,
-    })
+    Ok(Elements { bytes, stride, data_type: component.0, normalized: component.1 })
 }
 
 /// The bytes of a buffer view, checked to lie inside its buffer.
 fn view_bytes<'a>(view: &gltf::buffer::View, buffers: &'a [Vec<u8>]) -> Result<&'a [u8]> {
-    let buffer = buffers
-        .get(view.buffer().index())
-        .map_or(&[][..], Vec::as_slice);
+    let buffer = buffers.get(view.buffer().index()).map_or(&[][..], Vec::as_slice);
     let end = view.offset().checked_add(view.length());
-    end.and_then(|end| buffer.get(view.offset()..end))
-        .ok_or_else(|| {
-            let message = format!(
-                "bytes {}..{} lie outside buffers[{}] ({} bytes)",
-                view.offset(),
-                view.offset().saturating_add(view.length()),
-                view.buffer().index(),
-                buffer.len()
-            );
-            Failure::at(format!("bufferViews[{}]", view.index()), message)
-        })
+    end.and_then(|end| buffer.get(view.offset()..end)).ok_or_else(|| {
+        let message = format!(
+            "bytes {}..{} lie outside buffers[{}] ({} bytes)",
+            view.offset(),
+            view.offset().saturating_add(view.length()),
+            view.buffer().index(),
+            buffer.len()
+        );
+        Failure::at(format!("bufferViews[{}]", view.index()), message)
+    })
 }
 
 impl Elements<'_> {
     /// Each element's first `N` components, as the spec decodes them into floats.
     fn floats<const N: usize>(&self) -> impl Iterator<Item = [f32; N]> + '_ {
-        self.components::<N>()
-            .map(|components| components.map(|c| decode_float(self.data_type, self.normalized, c)))
+        self.components::<N>().map(|components| components.map(|c| decode_float(self.data_type, self.normalized, c)))
     }
 
     /// Each element's first `N` components as unsigned integers.
     fn uints<const N: usize>(&self) -> impl Iterator<Item = [u32; N]> + '_ {
-        self.components::<N>()
-            .map(|components| components.map(|c| decode_uint(self.data_type, c)))
+        self.components::<N>().map(|components| components.map(|c| decode_uint(self.data_type, c)))
     }
 
     /// The bytes of each element's first `N` components.
@@ -256,11 +176,7 @@ fn decode_float(data_type: DataType, normalized: bool, bytes: &[u8]) -> f32 {
         DataType::U16 => (f32::from(u16::from_le_bytes(array(bytes))), 65535.0),
         DataType::U32 => return decode_uint(data_type, bytes) as f32,
     };
-    if normalized {
-        (value / scale).max(-1.0)
-    } else {
-        value
-    }
+    if normalized { (value / scale).max(-1.0) } else { value }
 }
 
 fn decode_uint(data_type: DataType, bytes: &[u8]) -> u32 {
@@ -299,11 +215,7 @@ fn component_name((data_type, normalized): Component) -> String {
         DataType::U32 => "UNSIGNED_INT",
         DataType::F32 => "FLOAT",
     };
-    if normalized {
-        format!("normalized {name}")
-    } else {
-        name.to_owned()
-    }
+    if normalized { format!("normalized {name}") } else { name.to_owned() }
 }
 
 #[cfg(test)]
@@ -321,33 +233,16 @@ mod tests {
         assert_eq!((i8s(127), i8s(-128), i8s(64)), (1.0, -1.0, 64.0 / 127.0));
         assert_eq!(decode_float(DataType::U8, true, &[255]), 1.0);
         assert_eq!(decode_float(DataType::U8, true, &[51]), 0.2);
-        assert_eq!(
-            decode_float(DataType::U16, true, &65535u16.to_le_bytes()),
-            1.0
-        );
-        assert_eq!(
-            decode_float(DataType::F32, false, &1.5f32.to_le_bytes()),
-            1.5
-        );
-        assert_eq!(
-            decode_float(DataType::U16, false, &300u16.to_le_bytes()),
-            300.0
-        );
+        assert_eq!(decode_float(DataType::U16, true, &65535u16.to_le_bytes()), 1.0);
+        assert_eq!(decode_float(DataType::F32, false, &1.5f32.to_le_bytes()), 1.5);
+        assert_eq!(decode_float(DataType::U16, false, &300u16.to_le_bytes()), 300.0);
     }
 
     #[test]
     fn strided_elements_read_only_their_components() {
         // Two VEC2 u16 elements with stride 6: [1, 2, pad], [3, 4].
         let bytes = [1, 0, 2, 0, 0xEE, 0xEE, 3, 0, 4, 0];
-        let elements = Elements {
-            bytes: &bytes,
-            stride: 6,
-            data_type: DataType::U16,
-            normalized: false,
-        };
-        assert_eq!(
-            elements.uints::<2>().collect::<Vec<_>>(),
-            vec![[1, 2], [3, 4]]
-        );
+        let elements = Elements { bytes: &bytes, stride: 6, data_type: DataType::U16, normalized: false };
+        assert_eq!(elements.uints::<2>().collect::<Vec<_>>(), vec![[1, 2], [3, 4]]);
     }
 }

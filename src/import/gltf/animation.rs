@@ -26,27 +26,14 @@ pub(super) fn read_clips(
     bone_of_node: &[Option<usize>],
     notes: &mut Vec<String>,
 ) -> Result<Vec<Clip>> {
-    let mut reader = Reader {
-        buffers,
-        bone_of_node,
-        times: HashMap::new(),
-        tally: Tally::default(),
-    };
-    let clips = doc
-        .animations()
-        .map(|a| reader.clip(&a))
-        .collect::<Result<Vec<_>>>()?;
+    let mut reader = Reader { buffers, bone_of_node, times: HashMap::new(), tally: Tally::default() };
+    let clips = doc.animations().map(|a| reader.clip(&a)).collect::<Result<Vec<_>>>()?;
     if reader.tally.morph_channels > 0 {
-        notes.push(format!(
-            "{} morph-weight channels listed, not evaluated",
-            reader.tally.morph_channels
-        ));
+        notes.push(format!("{} morph-weight channels listed, not evaluated", reader.tally.morph_channels));
     }
     if reader.tally.outside_scene > 0 {
-        notes.push(format!(
-            "{} animation channels target nodes outside the scene, ignored",
-            reader.tally.outside_scene
-        ));
+        notes
+            .push(format!("{} animation channels target nodes outside the scene, ignored", reader.tally.outside_scene));
     }
     Ok(clips)
 }
@@ -68,15 +55,8 @@ impl Reader<'_> {
             let node = channel.target().node().index();
             let property = channel.target().property();
             if !targets.insert((node, property as u8)) {
-                let place = format!(
-                    "animations[{}].channels[{}]",
-                    animation.index(),
-                    channel.index()
-                );
-                let message = format!(
-                    "a second channel for the {} of nodes[{node}]",
-                    property_name(property)
-                );
+                let place = format!("animations[{}].channels[{}]", animation.index(), channel.index());
+                let message = format!("a second channel for the {} of nodes[{node}]", property_name(property));
                 return Err(Failure::at(place, message));
             }
             let Some(bone) = self.bone_of_node[node] else {
@@ -84,11 +64,7 @@ impl Reader<'_> {
                 continue;
             };
             let sampler = channel.sampler();
-            let place = format!(
-                "animations[{}].samplers[{}]",
-                animation.index(),
-                sampler.index()
-            );
+            let place = format!("animations[{}].samplers[{}]", animation.index(), sampler.index());
             let times = self.times(&sampler.input())?;
             let interpolation = interpolation(sampler.interpolation());
             let output = sampler.output();
@@ -97,28 +73,19 @@ impl Reader<'_> {
             match property {
                 Property::Translation => {
                     let values = accessor::vec3s(&output, self.buffers, "translation output")?;
-                    bone_tracks.translation =
-                        Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.translation = Some(Track::new(times, values, interpolation).map_err(track_error)?);
                 }
                 Property::Scale => {
                     let values = accessor::vec3s(&output, self.buffers, "scale output")?;
-                    bone_tracks.scale =
-                        Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.scale = Some(Track::new(times, values, interpolation).map_err(track_error)?);
                 }
                 Property::Rotation => {
                     let values = accessor::rotations(&output, self.buffers)?;
-                    bone_tracks.rotation =
-                        Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.rotation = Some(Track::new(times, values, interpolation).map_err(track_error)?);
                 }
                 Property::MorphTargetWeights => {
                     accessor::check_morph_weights(&output, self.buffers)?;
-                    morph_channels.push(morph_channel(
-                        bone,
-                        &times,
-                        interpolation,
-                        output.count(),
-                        &place,
-                    )?);
+                    morph_channels.push(morph_channel(bone, &times, interpolation, output.count(), &place)?);
                     self.tally.morph_channels += 1;
                 }
             }
@@ -128,21 +95,14 @@ impl Reader<'_> {
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
             .collect();
-        Ok(Clip::new(
-            animation.index(),
-            animation.name().map(str::to_owned),
-            tracks,
-            morph_channels,
-        ))
+        Ok(Clip::new(animation.index(), animation.name().map(str::to_owned), tracks, morph_channels))
     }
 
     /// The key times of an input accessor, read on first use.
     fn times(&mut self, input: &gltf::Accessor) -> Result<Arc<[f64]>> {
         match self.times.entry(input.index()) {
             Entry::Occupied(entry) => Ok(entry.get().clone()),
-            Entry::Vacant(entry) => Ok(entry
-                .insert(accessor::times(input, self.buffers)?.into())
-                .clone()),
+            Entry::Vacant(entry) => Ok(entry.insert(accessor::times(input, self.buffers)?.into()).clone()),
         }
     }
 }
@@ -160,25 +120,15 @@ fn morph_channel(
         && times.windows(2).all(|w| w[0] < w[1])
         && times.iter().all(|t| t.is_finite());
     if !valid_times {
-        return Err(Failure::at(
-            place,
-            "key times are not finite, non-negative and increasing",
-        ));
+        return Err(Failure::at(place, "key times are not finite, non-negative and increasing"));
     }
     let stored = times.len() * interpolation.values_per_key();
     if !outputs.is_multiple_of(stored) {
-        let message = format!(
-            "{outputs} morph-weight outputs are not a whole number per key ({stored} stored keys)"
-        );
+        let message = format!("{outputs} morph-weight outputs are not a whole number per key ({stored} stored keys)");
         return Err(Failure::at(place, message));
     }
     let last_time = times.last().copied().unwrap_or_default();
-    Ok(MorphChannel {
-        bone,
-        keys: times.len(),
-        interpolation,
-        last_time,
-    })
+    Ok(MorphChannel { bone, keys: times.len(), interpolation, last_time })
 }
 
 fn interpolation(interpolation: GltfInterpolation) -> Interpolation {

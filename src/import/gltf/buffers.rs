@@ -22,34 +22,21 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
 );
 
 /// One byte vector per buffer of the document, each exactly `byteLength` long.
-pub(super) fn load(
-    doc: &gltf::Document,
-    mut blob: Option<Vec<u8>>,
-    folder: &Path,
-) -> Result<Vec<Vec<u8>>> {
+pub(super) fn load(doc: &gltf::Document, mut blob: Option<Vec<u8>>, folder: &Path) -> Result<Vec<Vec<u8>>> {
     doc.buffers()
         .map(|buffer| {
             let place = format!("buffers[{}]", buffer.index());
             let mut data = match buffer.source() {
-                Source::Bin if buffer.index() == 0 => blob.take().ok_or_else(|| {
-                    Failure::at(&place, "has no uri, and the file has no GLB BIN chunk")
-                })?,
+                Source::Bin if buffer.index() == 0 => {
+                    blob.take().ok_or_else(|| Failure::at(&place, "has no uri, and the file has no GLB BIN chunk"))?
+                }
                 Source::Bin => {
-                    return Err(Failure::at(
-                        &place,
-                        "has no uri (only buffers[0] can be the GLB BIN chunk)",
-                    ));
+                    return Err(Failure::at(&place, "has no uri (only buffers[0] can be the GLB BIN chunk)"));
                 }
-                Source::Uri(uri) => {
-                    read_uri(uri, folder, buffer.length()).map_err(|m| Failure::at(&place, m))?
-                }
+                Source::Uri(uri) => read_uri(uri, folder, buffer.length()).map_err(|m| Failure::at(&place, m))?,
             };
             if data.len() < buffer.length() {
-                let message = format!(
-                    "byteLength is {} but the data holds {} bytes",
-                    buffer.length(),
-                    data.len()
-                );
+                let message = format!("byteLength is {} but the data holds {} bytes", buffer.length(), data.len());
                 return Err(Failure::at(place, message));
             }
             data.truncate(buffer.length());
@@ -64,8 +51,7 @@ fn read_uri(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<
         return decode_data_uri(data);
     }
     let path = folder.join(relative_path(uri)?);
-    let file = std::fs::File::open(&path)
-        .map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
+    let file = std::fs::File::open(&path).map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
     let mut data = Vec::new();
     file.take(length as u64)
         .read_to_end(&mut data)
@@ -81,34 +67,22 @@ fn decode_data_uri(after_scheme: &str) -> std::result::Result<Vec<u8>, String> {
     if !header.to_ascii_lowercase().ends_with(";base64") {
         return Err(format!("data URI `data:{header},…` is not base64"));
     }
-    BASE64
-        .decode(payload)
-        .map_err(|e| format!("bad base64 in data URI: {e}"))
+    BASE64.decode(payload).map_err(|e| format!("bad base64 in data URI: {e}"))
 }
 
 /// A URI reference as a relative path inside the glTF file's folder.
 pub(super) fn relative_path(uri: &str) -> std::result::Result<PathBuf, String> {
     if let Some(scheme) = scheme(uri) {
-        return Err(format!(
-            "unsupported URI scheme `{scheme}:` in `{uri}` (only data: URIs and relative paths)"
-        ));
+        return Err(format!("unsupported URI scheme `{scheme}:` in `{uri}` (only data: URIs and relative paths)"));
     }
-    let decoded =
-        percent_decode(uri).ok_or_else(|| format!("malformed percent-encoding in `{uri}`"))?;
+    let decoded = percent_decode(uri).ok_or_else(|| format!("malformed percent-encoding in `{uri}`"))?;
     if decoded.starts_with(['/', '\\']) {
-        return Err(format!(
-            "`{uri}` is an absolute path (only paths relative to the glTF file are read)"
-        ));
+        return Err(format!("`{uri}` is an absolute path (only paths relative to the glTF file are read)"));
     }
     let mut path = PathBuf::new();
-    for part in decoded
-        .split(['/', '\\'])
-        .filter(|p| !p.is_empty() && *p != ".")
-    {
+    for part in decoded.split(['/', '\\']).filter(|p| !p.is_empty() && *p != ".") {
         if part == ".." || part.contains(':') {
-            return Err(format!(
-                "`{uri}` is not a path inside the glTF file's folder"
-            ));
+            return Err(format!("`{uri}` is not a path inside the glTF file's folder"));
         }
         path.push(part);
     }
@@ -146,8 +120,7 @@ fn percent_decode(s: &str) -> Option<String> {
 
 fn strip_prefix_ignore_case<'a>(s: &'a str, prefix: &str) -> Option<&'a str> {
     let head = s.get(..prefix.len())?;
-    head.eq_ignore_ascii_case(prefix)
-        .then(|| &s[prefix.len()..])
+    head.eq_ignore_ascii_case(prefix).then(|| &s[prefix.len()..])
 }
 
 #[cfg(test)]
@@ -157,60 +130,29 @@ mod tests {
 
     #[test]
     fn relative_paths_are_percent_decoded() {
-        assert_eq!(
-            relative_path("my%20model.bin"),
-            Ok(PathBuf::from("my model.bin"))
-        );
-        assert_eq!(
-            relative_path("./sub/a.bin"),
-            Ok(Path::new("sub").join("a.bin"))
-        );
+        assert_eq!(relative_path("my%20model.bin"), Ok(PathBuf::from("my model.bin")));
+        assert_eq!(relative_path("./sub/a.bin"), Ok(Path::new("sub").join("a.bin")));
     }
 
     #[test]
     fn escapes_absolute_paths_and_schemes_are_refused() {
-        for uri in [
-            "../x.bin",
-            "a/../../x.bin",
-            "%2E%2E/x.bin",
-            "..%2Fx.bin",
-            "a\\..\\..\\x",
-            "/etc/passwd",
-        ] {
+        for uri in ["../x.bin", "a/../../x.bin", "%2E%2E/x.bin", "..%2Fx.bin", "a\\..\\..\\x", "/etc/passwd"] {
             assert!(relative_path(uri).is_err(), "{uri}");
         }
-        for uri in [
-            "http://example.com/x.bin",
-            "file:///x.bin",
-            "C:/x.bin",
-            "https:x",
-        ] {
+        for uri in ["http://example.com/x.bin", "file:///x.bin", "C:/x.bin", "https:x"] {
             let err = relative_path(uri).unwrap_err();
             assert!(err.contains("scheme"), "{uri}: {err}");
         }
-        assert!(
-            relative_path("bad%zz").is_err()
-                && relative_path("bad%4").is_err()
-                && relative_path("%ff").is_err()
-        );
+        assert!(relative_path("bad%zz").is_err() && relative_path("bad%4").is_err() && relative_path("%ff").is_err());
     }
 
     #[test]
     fn data_uris_decode_with_or_without_padding() {
-        assert_eq!(
-            decode_data_uri("application/octet-stream;base64,AQID"),
-            Ok(vec![1, 2, 3])
-        );
-        assert_eq!(
-            decode_data_uri("application/gltf-buffer;base64,AQI"),
-            Ok(vec![1, 2])
-        );
+        assert_eq!(decode_data_uri("application/octet-stream;base64,AQID"), Ok(vec![1, 2, 3]));
+        assert_eq!(decode_data_uri("application/gltf-buffer;base64,AQI"), Ok(vec![1, 2]));
         assert!(decode_data_uri("text/plain,hello").is_err());
         assert!(decode_data_uri("application/octet-stream;base64,@@@@").is_err());
         let encoded = general_purpose::STANDARD.encode([9u8; 10]);
-        assert_eq!(
-            decode_data_uri(&format!(";base64,{encoded}")),
-            Ok(vec![9; 10])
-        );
+        assert_eq!(decode_data_uri(&format!(";base64,{encoded}")), Ok(vec![9; 10]));
     }
 }

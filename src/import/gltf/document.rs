@@ -33,45 +33,25 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Parsed> {
     check_version(root)?;
     check_position_indices(root)?;
     let notes = validate(root)?;
-    Ok(Parsed {
-        document: gltf.document,
-        blob: gltf.blob,
-        notes,
-    })
+    Ok(Parsed { document: gltf.document, blob: gltf.blob, notes })
 }
 
 /// Checks the 12-byte GLB header and returns the bytes it declares (trailing bytes are ignored).
 fn check_glb_header(bytes: &[u8]) -> Result<&[u8]> {
     let header = Failure::at;
     let Some(fields) = bytes.get(4..GLB_HEADER_LEN) else {
-        return Err(header(
-            "GLB header",
-            format!("truncated: {} of 12 bytes", bytes.len()),
-        ));
+        return Err(header("GLB header", format!("truncated: {} of 12 bytes", bytes.len())));
     };
-    let word =
-        |i: usize| u32::from_le_bytes([fields[i], fields[i + 1], fields[i + 2], fields[i + 3]]);
+    let word = |i: usize| u32::from_le_bytes([fields[i], fields[i + 1], fields[i + 2], fields[i + 3]]);
     let (version, length) = (word(0), word(4) as usize);
     if version != 2 {
-        return Err(header(
-            "GLB header",
-            format!("version {version}, expected 2"),
-        ));
+        return Err(header("GLB header", format!("version {version}, expected 2")));
     }
     if length < GLB_HEADER_LEN {
-        return Err(header(
-            "GLB header",
-            format!("declares a total length of {length} bytes"),
-        ));
+        return Err(header("GLB header", format!("declares a total length of {length} bytes")));
     }
     bytes.get(..length).ok_or_else(|| {
-        header(
-            "GLB header",
-            format!(
-                "declares {length} bytes but the file has {} (truncated?)",
-                bytes.len()
-            ),
-        )
+        header("GLB header", format!("declares {length} bytes but the file has {} (truncated?)", bytes.len()))
     })
 }
 
@@ -102,18 +82,10 @@ fn glb_failure(e: GlbError) -> Failure {
         ChunkType::Bin => "GLB BIN chunk",
     };
     match e {
-        GlbError::ChunkLength {
-            ty,
-            length,
-            length_read,
-        } => Failure::at(
-            chunk(ty),
-            format!("declares {length} bytes but only {length_read} remain (truncated?)"),
-        ),
-        GlbError::ChunkType(ty) => Failure::at(
-            chunk(ty),
-            "unexpected chunk (JSON must come first, then BIN)",
-        ),
+        GlbError::ChunkLength { ty, length, length_read } => {
+            Failure::at(chunk(ty), format!("declares {length} bytes but only {length_read} remain (truncated?)"))
+        }
+        GlbError::ChunkType(ty) => Failure::at(chunk(ty), "unexpected chunk (JSON must come first, then BIN)"),
         GlbError::Io(e) => Failure::at("GLB chunks", format!("truncated chunk header ({e})")),
         other => Failure::at("GLB chunks", other.to_string()),
     }
@@ -124,10 +96,7 @@ fn check_version(root: &Root) -> Result<()> {
     if version.split('.').next() == Some("2") {
         Ok(())
     } else {
-        Err(Failure::at(
-            "asset.version",
-            format!("glTF {version} is not supported (expected 2.x)"),
-        ))
+        Err(Failure::at("asset.version", format!("glTF {version} is not supported (expected 2.x)")))
     }
 }
 
@@ -135,17 +104,11 @@ fn check_version(root: &Root) -> Result<()> {
 fn check_position_indices(root: &Root) -> Result<()> {
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
-            let position = primitive
-                .attributes
-                .get(&json::validation::Checked::Valid(Semantic::Positions));
+            let position = primitive.attributes.get(&json::validation::Checked::Valid(Semantic::Positions));
             if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
                 return Err(Failure::at(
                     format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
-                    format!(
-                        "accessor {} does not exist ({} accessors)",
-                        index.value(),
-                        root.accessors.len()
-                    ),
+                    format!("accessor {} does not exist ({} accessors)", index.value(), root.accessors.len()),
                 ));
             }
         }
@@ -158,34 +121,21 @@ fn check_position_indices(root: &Root) -> Result<()> {
 /// does (mesh compression, quantization) fails later with an accessor error.
 fn validate(root: &Root) -> Result<Vec<String>> {
     let mut problems: Vec<(JsonPath, ValidationError)> = Vec::new();
-    root.validate(root, JsonPath::new, &mut |path, error| {
-        problems.push((path(), error))
-    });
-    let (unsupported, problems): (Vec<_>, Vec<_>) = problems
-        .into_iter()
-        .partition(|(_, e)| *e == ValidationError::Unsupported);
+    root.validate(root, JsonPath::new, &mut |path, error| problems.push((path(), error)));
+    let (unsupported, problems): (Vec<_>, Vec<_>) =
+        problems.into_iter().partition(|(_, e)| *e == ValidationError::Unsupported);
     if let Some((path, error)) = problems.first() {
         let more = match problems.len() {
             1 => String::new(),
             n => format!(" (and {} more problems)", n - 1),
         };
-        return Err(Failure::at(
-            path.as_str(),
-            format!("{}{more}", describe(*error)),
-        ));
+        return Err(Failure::at(path.as_str(), format!("{}{more}", describe(*error))));
     }
     let notes = if unsupported.is_empty() {
         vec![]
     } else {
-        let names = root
-            .extensions_required
-            .iter()
-            .map(|e| format!("`{e}`"))
-            .collect::<Vec<_>>();
-        vec![format!(
-            "the file requires extensions bonescope ignores: {}",
-            names.join(", ")
-        )]
+        let names = root.extensions_required.iter().map(|e| format!("`{e}`")).collect::<Vec<_>>();
+        vec![format!("the file requires extensions bonescope ignores: {}", names.join(", "))]
     };
     Ok(notes)
 }

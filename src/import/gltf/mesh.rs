@@ -13,26 +13,16 @@ pub(super) fn read_skins(
     buffers: &[Vec<u8>],
     bone_of_node: &[Option<usize>],
 ) -> Result<Vec<Skin>> {
-    doc.skins()
-        .map(|skin| read_skin(&skin, buffers, bone_of_node))
-        .collect()
+    doc.skins().map(|skin| read_skin(&skin, buffers, bone_of_node)).collect()
 }
 
-fn read_skin(
-    skin: &gltf::Skin,
-    buffers: &[Vec<u8>],
-    bone_of_node: &[Option<usize>],
-) -> Result<Skin> {
+fn read_skin(skin: &gltf::Skin, buffers: &[Vec<u8>], bone_of_node: &[Option<usize>]) -> Result<Skin> {
     let place = format!("skins[{}]", skin.index());
     let joints = skin
         .joints()
         .map(|node| {
-            bone_of_node[node.index()].ok_or_else(|| {
-                Failure::at(
-                    &place,
-                    format!("joint nodes[{}] is not in the scene", node.index()),
-                )
-            })
+            bone_of_node[node.index()]
+                .ok_or_else(|| Failure::at(&place, format!("joint nodes[{}] is not in the scene", node.index())))
         })
         .collect::<Result<Vec<usize>>>()?;
     let inverse_bind = match skin.inverse_bind_matrices() {
@@ -41,28 +31,17 @@ fn read_skin(
             let mut matrices = accessor::matrices(&accessor, buffers)?;
             // The spec allows more matrices than joints; the extra ones belong to no joint.
             if matrices.len() < joints.len() {
-                let message = format!(
-                    "{} inverse bind matrices for {} joints",
-                    matrices.len(),
-                    joints.len()
-                );
+                let message = format!("{} inverse bind matrices for {} joints", matrices.len(), joints.len());
                 return Err(Failure::at(place, message));
             }
             matrices.truncate(joints.len());
             if let Some(k) = matrices.iter().position(|m| !m.is_finite()) {
-                return Err(Failure::at(
-                    place,
-                    format!("inverse bind matrix {k} is not finite"),
-                ));
+                return Err(Failure::at(place, format!("inverse bind matrix {k} is not finite")));
             }
             matrices
         }
     };
-    Ok(Skin {
-        name: skin.name().map(str::to_owned),
-        joints,
-        inverse_bind,
-    })
+    Ok(Skin { name: skin.name().map(str::to_owned), joints, inverse_bind })
 }
 
 /// One [`Mesh`] per triangle primitive of each scene node with a mesh, named after the mesh (or the node).
@@ -76,13 +55,7 @@ pub(super) fn read_meshes(
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut meshes = Vec::new();
     let (mut other_modes, mut unweighted) = (0, 0);
-    for (bone, node) in scene
-        .skeleton
-        .bones()
-        .iter()
-        .enumerate()
-        .map(|(b, bone)| (b, &nodes[bone.node]))
-    {
+    for (bone, node) in scene.skeleton.bones().iter().enumerate().map(|(b, bone)| (b, &nodes[bone.node])) {
         let Some(mesh) = node.mesh() else { continue };
         let skin = node.skin().map(|s| s.index());
         for primitive in mesh.primitives() {
@@ -96,11 +69,7 @@ pub(super) fn read_meshes(
                 1 => base.to_owned(),
                 _ => format!("{base}[{}]", primitive.index()),
             };
-            let mut read = Mesh {
-                name,
-                bone,
-                ..Mesh::default()
-            };
+            let mut read = Mesh { name, bone, ..Mesh::default() };
             read.positions = positions(&primitive, buffers, &place)?;
             if let Some(skin) = skin {
                 if read_skinning(&mut read, &primitive, buffers, &skins[skin], &place)? {
@@ -114,27 +83,17 @@ pub(super) fn read_meshes(
         }
     }
     if other_modes > 0 {
-        notes.push(format!(
-            "{other_modes} mesh primitives that are not triangle lists were skipped"
-        ));
+        notes.push(format!("{other_modes} mesh primitives that are not triangle lists were skipped"));
     }
     if unweighted > 0 {
-        notes.push(format!(
-            "{unweighted} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned"
-        ));
+        notes.push(format!("{unweighted} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned"));
     }
     Ok(meshes)
 }
 
-fn positions(
-    primitive: &gltf::Primitive,
-    buffers: &[Vec<u8>],
-    place: &str,
-) -> Result<Vec<glam::Vec3>> {
+fn positions(primitive: &gltf::Primitive, buffers: &[Vec<u8>], place: &str) -> Result<Vec<glam::Vec3>> {
     // Validation has made sure that every primitive has a POSITION attribute.
-    let accessor = primitive
-        .get(&Semantic::Positions)
-        .ok_or_else(|| Failure::at(place, "has no POSITION"))?;
+    let accessor = primitive.get(&Semantic::Positions).ok_or_else(|| Failure::at(place, "has no POSITION"))?;
     accessor::vec3s(&accessor, buffers, "POSITION")
 }
 
@@ -146,33 +105,21 @@ fn read_skinning(
     skin: &Skin,
     place: &str,
 ) -> Result<bool> {
-    let (Some(joints), Some(weights)) = (
-        primitive.get(&Semantic::Joints(0)),
-        primitive.get(&Semantic::Weights(0)),
-    ) else {
+    let (Some(joints), Some(weights)) = (primitive.get(&Semantic::Joints(0)), primitive.get(&Semantic::Weights(0)))
+    else {
         return Ok(false);
     };
     mesh.joints = accessor::joints(&joints, buffers)?;
     mesh.weights = accessor::weights(&weights, buffers)?;
     let vertices = mesh.positions.len();
     if mesh.joints.len() != vertices || mesh.weights.len() != vertices {
-        let message = format!(
-            "{vertices} positions but {} JOINTS_0 and {} WEIGHTS_0",
-            mesh.joints.len(),
-            mesh.weights.len()
-        );
+        let message =
+            format!("{vertices} positions but {} JOINTS_0 and {} WEIGHTS_0", mesh.joints.len(), mesh.weights.len());
         return Err(Failure::at(place, message));
     }
     let limit = skin.joints.len();
-    if let Some(v) = mesh
-        .joints
-        .iter()
-        .position(|j| j.iter().any(|&i| usize::from(i) >= limit))
-    {
-        let message = format!(
-            "vertex {v} has joint indices {:?}, but the skin has {limit} joints",
-            mesh.joints[v]
-        );
+    if let Some(v) = mesh.joints.iter().position(|j| j.iter().any(|&i| usize::from(i) >= limit)) {
+        let message = format!("vertex {v} has joint indices {:?}, but the skin has {limit} joints", mesh.joints[v]);
         return Err(Failure::at(place, message));
     }
     Ok(true)
@@ -193,16 +140,10 @@ fn triangle_indices(
         }
     };
     if !indices.len().is_multiple_of(3) {
-        return Err(Failure::at(
-            place,
-            format!("{} indices do not make whole triangles", indices.len()),
-        ));
+        return Err(Failure::at(place, format!("{} indices do not make whole triangles", indices.len())));
     }
     if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertices) {
-        return Err(Failure::at(
-            place,
-            format!("index {bad} is out of range ({vertices} vertices)"),
-        ));
+        return Err(Failure::at(place, format!("index {bad} is out of range ({vertices} vertices)")));
     }
     Ok(indices)
 }

@@ -27,18 +27,12 @@ struct Failure {
 impl Failure {
     /// A problem with a named part of the document.
     fn at(place: impl Into<String>, message: impl Into<String>) -> Self {
-        Failure {
-            place: Some(place.into()),
-            message: message.into(),
-        }
+        Failure { place: Some(place.into()), message: message.into() }
     }
 
     /// A problem with the file as a whole.
     fn whole(message: impl Into<String>) -> Self {
-        Failure {
-            place: None,
-            message: message.into(),
-        }
+        Failure { place: None, message: message.into() }
     }
 }
 
@@ -60,11 +54,5 @@ fn read(path: &Path, bytes: &[u8]) -> Result<Rig> {
     let skins = mesh::read_skins(doc, &buffers, &scene.bone_of_node)?;
     let meshes = mesh::read_meshes(doc, &buffers, &scene, &skins, &mut notes)?;
     let clips = animation::read_clips(doc, &buffers, &scene.bone_of_node, &mut notes)?;
-    Ok(Rig {
-        skeleton: scene.skeleton,
-        clips,
-        skins,
-        meshes,
-        notes,
-    })
+    Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, notes })
 }

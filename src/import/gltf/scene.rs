@@ -29,17 +29,9 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
     while let Some((index, parent)) = stack.pop() {
         let node = &nodes[index];
         bone_of_node[index] = Some(bones.len());
-        stack.extend(
-            node.children()
-                .map(|c| (c.index(), Some(bones.len())))
-                .collect::<Vec<_>>()
-                .into_iter()
-                .rev(),
-        );
+        stack.extend(node.children().map(|c| (c.index(), Some(bones.len()))).collect::<Vec<_>>().into_iter().rev());
         bones.push(Bone {
-            name: node
-                .name()
-                .map_or_else(|| format!("node{index}"), str::to_owned),
+            name: node.name().map_or_else(|| format!("node{index}"), str::to_owned),
             node: index,
             parent,
             rest: rest_transform(node)?,
@@ -52,10 +44,7 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
     }
     // Depth-first order puts every parent first, so this cannot fail; the error is kept for the message's sake.
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
-    Ok(SceneBones {
-        skeleton,
-        bone_of_node,
-    })
+    Ok(SceneBones { skeleton, bone_of_node })
 }
 
 /// Each node's parent; a node listed as a child twice is an error.
@@ -64,10 +53,7 @@ fn parents(doc: &gltf::Document) -> Result<Vec<Option<usize>>> {
     for node in doc.nodes() {
         for child in node.children() {
             if let Some(first) = parents[child.index()].replace(node.index()) {
-                let message = format!(
-                    "has two parents: nodes[{first}] and nodes[{}]",
-                    node.index()
-                );
+                let message = format!("has two parents: nodes[{first}] and nodes[{}]", node.index());
                 return Err(Failure::at(format!("nodes[{}]", child.index()), message));
             }
         }
@@ -91,10 +77,7 @@ fn check_acyclic(parents: &[Option<usize>]) -> Result<()> {
             match state[node] {
                 State::Done => break,
                 State::OnPath => {
-                    return Err(Failure::at(
-                        format!("nodes[{node}]"),
-                        "is its own ancestor (node cycle)",
-                    ));
+                    return Err(Failure::at(format!("nodes[{node}]"), "is its own ancestor (node cycle)"));
                 }
                 State::Unseen => {
                     state[node] = State::OnPath;
@@ -111,32 +94,19 @@ fn check_acyclic(parents: &[Option<usize>]) -> Result<()> {
 }
 
 /// The root nodes of the default scene, else of scene 0, else every node without a parent.
-fn scene_roots(
-    doc: &gltf::Document,
-    parents: &[Option<usize>],
-    notes: &mut Vec<String>,
-) -> Result<Vec<usize>> {
+fn scene_roots(doc: &gltf::Document, parents: &[Option<usize>], notes: &mut Vec<String>) -> Result<Vec<usize>> {
     let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
-        return Ok((0..parents.len())
-            .filter(|&n| parents[n].is_none())
-            .collect());
+        return Ok((0..parents.len()).filter(|&n| parents[n].is_none()).collect());
     };
     if doc.scenes().len() > 1 {
-        notes.push(format!(
-            "{} scenes; bones come from scene {}",
-            doc.scenes().len(),
-            scene.index()
-        ));
+        notes.push(format!("{} scenes; bones come from scene {}", doc.scenes().len(), scene.index()));
     }
     let place = || format!("scenes[{}]", scene.index());
     let mut roots: Vec<usize> = Vec::new();
     for node in scene.nodes() {
         let index = node.index();
         if let Some(parent) = parents[index] {
-            return Err(Failure::at(
-                place(),
-                format!("lists nodes[{index}], a child of nodes[{parent}]"),
-            ));
+            return Err(Failure::at(place(), format!("lists nodes[{index}], a child of nodes[{parent}]")));
         }
         if roots.contains(&index) {
             return Err(Failure::at(place(), format!("lists nodes[{index}] twice")));
@@ -150,11 +120,7 @@ fn scene_roots(
 fn rest_transform(node: &gltf::Node) -> Result<Transform> {
     let place = || format!("nodes[{}]", node.index());
     let rest = match node.transform() {
-        NodeTransform::Decomposed {
-            translation,
-            rotation,
-            scale,
-        } => Transform::from_trs(
+        NodeTransform::Decomposed { translation, rotation, scale } => Transform::from_trs(
             DVec3::from_array(translation.map(f64::from)),
             DQuat::from_array(rotation.map(f64::from)),
             DVec3::from_array(scale.map(f64::from)),
@@ -162,10 +128,7 @@ fn rest_transform(node: &gltf::Node) -> Result<Transform> {
         NodeTransform::Matrix { matrix } => {
             let m = DMat4::from_cols_array_2d(&matrix.map(|column| column.map(f64::from)));
             if m.row(3) != DVec4::W {
-                return Err(Failure::at(
-                    place(),
-                    "matrix is not affine (its last row is not 0, 0, 0, 1)",
-                ));
+                return Err(Failure::at(place(), "matrix is not affine (its last row is not 0, 0, 0, 1)"));
             }
             if !m.is_finite() {
                 return Err(Failure::at(place(), "matrix is not finite"));
@@ -173,18 +136,9 @@ fn rest_transform(node: &gltf::Node) -> Result<Transform> {
             matrix_to_transform(&m)
         }
     };
-    let finite = rest.translation.is_finite()
-        && rest.rotation.is_finite()
-        && rest.scale.is_finite()
-        && rest.stretch.is_finite();
-    if finite {
-        Ok(rest)
-    } else {
-        Err(Failure::at(
-            place(),
-            "transform is not finite (or the matrix is singular)",
-        ))
-    }
+    let finite =
+        rest.translation.is_finite() && rest.rotation.is_finite() && rest.scale.is_finite() && rest.stretch.is_finite();
+    if finite { Ok(rest) } else { Err(Failure::at(place(), "transform is not finite (or the matrix is singular)")) }
 }
 
 /// `M = T·(sign·I)·R·S`, the sign of a mirroring matrix carried by all three scale factors (`−I` commutes).
@@ -215,10 +169,7 @@ mod tests {
             assert!(t.matrix().abs_diff_eq(m, 1e-12), "{m:?} → {t:?}");
         }
         let t = matrix_to_transform(&mirrored);
-        assert!(
-            t.scale.cmplt(DVec3::ZERO).all(),
-            "the mirror sign goes into every scale factor: {t:?}"
-        );
+        assert!(t.scale.cmplt(DVec3::ZERO).all(), "the mirror sign goes into every scale factor: {t:?}");
     }
 
     #[test]
@@ -226,9 +177,6 @@ mod tests {
         assert!(check_acyclic(&[None, Some(0), Some(1)]).is_ok());
         let err = check_acyclic(&[None, Some(2), Some(1)]).unwrap_err();
         assert_eq!(err.place.as_deref(), Some("nodes[1]"));
-        assert!(
-            check_acyclic(&[Some(0)]).is_err(),
-            "a node that is its own child"
-        );
+        assert!(check_acyclic(&[Some(0)]).is_err(), "a node that is its own child");
     }
 }
