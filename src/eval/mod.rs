@@ -1,1 +1,2 @@
 //! Sampling, layering and local→model evaluation.
+pub mod blender;
