@@ -88,7 +88,7 @@ fn uniform_scale_reports_identity_stretch_despite_rounding() {
     // A long product of rotations and a uniform scale carries rounding noise in every entry.
     let mut m = DMat4::from_scale(DVec3::splat(1.7));
     for i in 0..50 {
-        m = m * DMat4::from_quat(DQuat::from_euler(glam::EulerRot::ZXY, 0.1 * i as f64, 0.37, -0.2));
+        m *= DMat4::from_quat(DQuat::from_euler(glam::EulerRot::ZXY, 0.1 * i as f64, 0.37, -0.2));
     }
     let p = decompose(&m);
     assert_eq!(p.stretch, DQuat::IDENTITY);

@@ -65,7 +65,7 @@ impl Assessment {
             stretched,
             non_uniform: anisotropic && !stretched,
             mirrored: parts.sign < 0.0,
-            degenerate: !(min > tolerances.degenerate_ratio * max),
+            degenerate: min <= tolerances.degenerate_ratio * max,
         };
         Assessment { parts, shear_deg, stretch_deg, findings }
     }

@@ -75,8 +75,8 @@ impl Hierarchy {
         }
         out.inherit_scale.resize(n, DVec3::ONE);
         out.carried_scale.resize(n, DVec3::ONE);
-        for i in 0..n {
-            self.evaluate_bone(i, &local[i], out);
+        for (i, bone_local) in local.iter().enumerate() {
+            self.evaluate_bone(i, bone_local, out);
         }
     }
 

@@ -60,7 +60,7 @@ pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
     // For cubic splines, key k stores [a_k, v_k, b_k].
     let value = |k: usize| track.values()[k * per_key + per_key / 2].widen();
     let last = times.len() - 1;
-    if !(time > times[0]) {
+    if time.is_nan() || time <= times[0] {
         return value(0);
     }
     if time >= times[last] {

@@ -108,7 +108,7 @@ fn orthogonal_shortcut(a: &DMat3) -> Option<Parts3> {
     let (x, y, z) = (a.x_axis, a.y_axis, a.z_axis);
     let lengths = DVec3::new(x.length(), y.length(), z.length());
     let min_length = lengths.min_element();
-    if !(min_length > 0.0) || min_length < lengths.max_element() * 1e-6 {
+    if min_length <= 0.0 || min_length < lengths.max_element() * 1e-6 {
         return None;
     }
     let orthogonal = |a: DVec3, b: DVec3, la: f64, lb: f64| a.dot(b).abs() <= ORTHOGONAL_COSINE * la * lb;
@@ -228,23 +228,22 @@ fn jacobi_rotate(m: &mut [[f64; 3]; 3], u: &mut [[f64; 3]; 3], p: usize, q: usiz
     let c = 1.0 / (t * t + 1.0).sqrt();
     let s = t * c;
     // m ← Jᵀ·m·J with J the rotation by (c, s) in the (p, q) plane; u ← u·J. Arrays are [column][row].
-    for k in 0..3 {
-        let (mkp, mkq) = (m[k][p], m[k][q]);
-        m[k][p] = c * mkp - s * mkq;
-        m[k][q] = s * mkp + c * mkq;
+    for column in m.iter_mut() {
+        let (row_p, row_q) = (column[p], column[q]);
+        column[p] = c * row_p - s * row_q;
+        column[q] = s * row_p + c * row_q;
     }
-    for k in 0..3 {
-        let (mpk, mqk) = (m[p][k], m[q][k]);
-        m[p][k] = c * mpk - s * mqk;
-        m[q][k] = s * mpk + c * mqk;
-    }
+    turn_columns(m, p, q, c, s);
     m[p][q] = 0.0;
     m[q][p] = 0.0;
-    for row in 0..3 {
-        let (up, uq) = (u[p][row], u[q][row]);
-        u[p][row] = c * up - s * uq;
-        u[q][row] = s * up + c * uq;
-    }
+    turn_columns(u, p, q, c, s);
+}
+
+/// Columns p and q of `m` (stored [column][row]) turned by the plane rotation (c, s): `m ← m·J`.
+fn turn_columns(m: &mut [[f64; 3]; 3], p: usize, q: usize, c: f64, s: f64) {
+    let (column_p, column_q) = (m[p], m[q]);
+    m[p] = std::array::from_fn(|k| c * column_p[k] - s * column_q[k]);
+    m[q] = std::array::from_fn(|k| s * column_p[k] + c * column_q[k]);
 }
 
 /// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match; factors
