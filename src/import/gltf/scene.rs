@@ -28,14 +28,8 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
     let mut stack: Vec<(usize, Option<usize>)> = roots.iter().rev().map(|&r| (r, None)).collect();
     while let Some((index, parent)) = stack.pop() {
         let node = &nodes[index];
-        bone_of_node[index] = Some(bones.len());
-        stack.extend(
-            node.children()
-                .map(|c| (c.index(), Some(bones.len())))
-                .collect::<Vec<_>>()
-                .into_iter()
-                .rev(),
-        );
+        let bone = bones.len();
+        bone_of_node[index] = Some(bone);
         bones.push(Bone {
             name: node
                 .name()
@@ -45,12 +39,14 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
             rest: rest_transform(node)?,
             inherit: InheritMode::Full,
         });
+        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, Some(bone))));
     }
     let outside = nodes.len() - bones.len();
     if outside > 0 {
         notes.push(format!("{outside} nodes outside the scene are not bones"));
     }
-    // Depth-first order puts every parent first, so this cannot fail; the error is kept for the message's sake.
+    // Cannot fail: depth-first order puts every parent before its children.
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
     Ok(SceneBones {
         skeleton,
