@@ -117,7 +117,8 @@ fn checked<'a>(
         .and_then(|n| n.checked_add(element_size));
     let Some(bytes) = end.and_then(|end| view_bytes.get(accessor.offset()..end)) else {
         let message = format!(
-            "{count} elements of {element_size} bytes (stride {stride}) from byteOffset {} do not fit in bufferViews[{}] ({} bytes)",
+            "{count} elements of {element_size} bytes (stride {stride}) from byteOffset {} \
+             do not fit in bufferViews[{}] ({} bytes)",
             accessor.offset(),
             view.index(),
             view_bytes.len()

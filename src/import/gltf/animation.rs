@@ -11,7 +11,7 @@ use std::sync::Arc;
 use gltf::animation::{Interpolation as GltfInterpolation, Property};
 
 use super::{Failure, Result, accessor};
-use crate::model::{BoneTracks, Clip, Interpolation, MorphChannel, Track};
+use crate::model::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Track};
 
 /// What the channels of all clips add up to, for the notes.
 #[derive(Default)]
@@ -54,7 +54,7 @@ impl Reader<'_> {
         for channel in animation.channels() {
             let node = channel.target().node().index();
             let property = channel.target().property();
-            if !targets.insert((node, property as u8)) {
+            if !targets.insert((node, property_name(property))) {
                 let place = format!("animations[{}].channels[{}]", animation.index(), channel.index());
                 let message = format!("a second channel for the {} of nodes[{node}]", property_name(property));
                 return Err(Failure::at(place, message));
@@ -69,19 +69,18 @@ impl Reader<'_> {
             let interpolation = interpolation(sampler.interpolation());
             let output = sampler.output();
             let bone_tracks = tracks.entry(bone).or_insert_with(|| BoneTracks::new(bone));
-            let track_error = |e: crate::model::TrackError| Failure::at(&place, e.to_string());
             match property {
                 Property::Translation => {
                     let values = accessor::vec3s(&output, self.buffers, "translation output")?;
-                    bone_tracks.translation = Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.translation = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Scale => {
                     let values = accessor::vec3s(&output, self.buffers, "scale output")?;
-                    bone_tracks.scale = Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.scale = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Rotation => {
                     let values = accessor::rotations(&output, self.buffers)?;
-                    bone_tracks.rotation = Some(Track::new(times, values, interpolation).map_err(track_error)?);
+                    bone_tracks.rotation = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::MorphTargetWeights => {
                     accessor::check_morph_weights(&output, self.buffers)?;
@@ -105,6 +104,16 @@ impl Reader<'_> {
             Entry::Vacant(entry) => Ok(entry.insert(accessor::times(input, self.buffers)?.into()).clone()),
         }
     }
+}
+
+/// A checked track; what [`Track::new`] finds wrong is placed at the sampler.
+fn track<T: KeyValue>(
+    times: Arc<[f64]>,
+    values: Vec<T>,
+    interpolation: Interpolation,
+    place: &str,
+) -> Result<Track<T>> {
+    Track::new(times, values, interpolation).map_err(|e| Failure::at(place, e.to_string()))
 }
 
 /// A morph-weight channel, with the checks [`Track::new`] does for the others: valid times, and an output

@@ -3,7 +3,8 @@
 //! Two guards come first because the crate panics without them: a GLB header whose length field is below 12
 //! (it subtracts the header size unchecked), and a primitive whose `POSITION` index is out of range (its
 //! validation indexes the accessor list before checking). The crate's validation then checks every index and
-//! enum, so the `gltf::Document` wrappers used afterwards cannot panic either.
+//! enum (and, added here, animation channel targets, which it skips), so the `gltf::Document` wrappers used
+//! afterwards cannot panic either.
 
 use gltf::binary::{ChunkType, Error as GlbError};
 use gltf::json::validation::{Error as ValidationError, Validate};
@@ -121,7 +122,15 @@ fn check_position_indices(root: &Root) -> Result<()> {
 /// does (mesh compression, quantization) fails later with an accessor error.
 fn validate(root: &Root) -> Result<Vec<String>> {
     let mut problems: Vec<(JsonPath, ValidationError)> = Vec::new();
-    root.validate(root, JsonPath::new, &mut |path, error| problems.push((path(), error)));
+    let mut report = |path: &dyn Fn() -> JsonPath, error| problems.push((path(), error));
+    root.validate(root, JsonPath::new, &mut report);
+    // gltf-json 1.4 validates an animation's samplers but not its channels' targets.
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let path = || JsonPath::new().field("animations").index(a).field("channels").index(c).field("target");
+            channel.target.validate(root, path, &mut report);
+        }
+    }
     let (unsupported, problems): (Vec<_>, Vec<_>) =
         problems.into_iter().partition(|(_, e)| *e == ValidationError::Unsupported);
     if let Some((path, error)) = problems.first() {

@@ -55,7 +55,8 @@ pub(super) fn read_meshes(
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut meshes = Vec::new();
     let (mut other_modes, mut unweighted) = (0, 0);
-    for (bone, node) in scene.skeleton.bones().iter().enumerate().map(|(b, bone)| (b, &nodes[bone.node])) {
+    for (bone, node) in scene.skeleton.bones().iter().enumerate() {
+        let node = &nodes[node.node];
         let Some(mesh) = node.mesh() else { continue };
         let skin = node.skin().map(|s| s.index());
         for primitive in mesh.primitives() {
@@ -97,7 +98,7 @@ fn positions(primitive: &gltf::Primitive, buffers: &[Vec<u8>], place: &str) -> R
     accessor::vec3s(&accessor, buffers, "POSITION")
 }
 
-/// Reads `JOINTS_0` and `WEIGHTS_0` into `mesh`; `false` when the primitive has neither.
+/// Reads `JOINTS_0` and `WEIGHTS_0` into `mesh`; `false` when the primitive lacks either.
 fn read_skinning(
     mesh: &mut Mesh,
     primitive: &gltf::Primitive,

@@ -28,8 +28,8 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
     let mut stack: Vec<(usize, Option<usize>)> = roots.iter().rev().map(|&r| (r, None)).collect();
     while let Some((index, parent)) = stack.pop() {
         let node = &nodes[index];
-        bone_of_node[index] = Some(bones.len());
-        stack.extend(node.children().map(|c| (c.index(), Some(bones.len()))).collect::<Vec<_>>().into_iter().rev());
+        let bone = bones.len();
+        bone_of_node[index] = Some(bone);
         bones.push(Bone {
             name: node.name().map_or_else(|| format!("node{index}"), str::to_owned),
             node: index,
@@ -37,12 +37,14 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
             rest: rest_transform(node)?,
             inherit: InheritMode::Full,
         });
+        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, Some(bone))));
     }
     let outside = nodes.len() - bones.len();
     if outside > 0 {
         notes.push(format!("{outside} nodes outside the scene are not bones"));
     }
-    // Depth-first order puts every parent first, so this cannot fail; the error is kept for the message's sake.
+    // Cannot fail: depth-first order puts every parent before its children.
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
     Ok(SceneBones { skeleton, bone_of_node })
 }
@@ -122,7 +124,9 @@ fn rest_transform(node: &gltf::Node) -> Result<Transform> {
     let rest = match node.transform() {
         NodeTransform::Decomposed { translation, rotation, scale } => Transform::from_trs(
             DVec3::from_array(translation.map(f64::from)),
-            DQuat::from_array(rotation.map(f64::from)),
+            // Exporters write unit quaternions in single precision; renormalise in double (zero stays zero and
+            // is rejected below as not finite).
+            DQuat::from_array(rotation.map(f64::from)).normalize(),
             DVec3::from_array(scale.map(f64::from)),
         ),
         NodeTransform::Matrix { matrix } => {
@@ -138,18 +142,14 @@ fn rest_transform(node: &gltf::Node) -> Result<Transform> {
     };
     let finite =
         rest.translation.is_finite() && rest.rotation.is_finite() && rest.scale.is_finite() && rest.stretch.is_finite();
-    if finite { Ok(rest) } else { Err(Failure::at(place(), "transform is not finite (or the matrix is singular)")) }
+    if finite { Ok(rest) } else { Err(Failure::at(place(), "transform is not finite")) }
 }
 
-/// `M = T·(sign·I)·R·S`, the sign of a mirroring matrix carried by all three scale factors (`−I` commutes).
-// TODO(lead): use math::decompose — keeps shear:
-//     let p = crate::math::decompose(m);
-//     Transform { translation: p.translation, rotation: p.rotation, scale: p.sign * p.scale, stretch: p.stretch }
+/// A node `matrix` as a transform, keeping any shear in the stretch rotation and a mirror in the scale's sign
+/// (`−I` commutes, so `F·R·U·K·Uᵀ = R·U·(−K)·Uᵀ`).
 fn matrix_to_transform(m: &DMat4) -> Transform {
-    let sign = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let unmirrored = DMat4::from_cols(m.x_axis * sign, m.y_axis * sign, m.z_axis * sign, m.w_axis);
-    let (scale, rotation, translation) = unmirrored.to_scale_rotation_translation();
-    Transform::from_trs(translation, rotation, sign * scale)
+    let p = crate::math::decompose(m);
+    Transform { translation: p.translation, rotation: p.rotation, scale: p.sign * p.scale, stretch: p.stretch }
 }
 
 #[cfg(test)]
@@ -170,6 +170,19 @@ mod tests {
         }
         let t = matrix_to_transform(&mirrored);
         assert!(t.scale.cmplt(DVec3::ZERO).all(), "the mirror sign goes into every scale factor: {t:?}");
+    }
+
+    #[test]
+    fn a_sheared_matrix_keeps_its_shear() {
+        // Columns (1,0,0), (1,1,0), (0,0,1): a 45° shear no TRS can hold.
+        let sheared =
+            DMat4::from_cols(DVec4::X, DVec4::new(1.0, 1.0, 0.0, 0.0), DVec4::Z, DVec4::new(1.0, 2.0, 3.0, 1.0));
+        let t = matrix_to_transform(&sheared);
+        assert!(!t.is_trs());
+        assert!(t.matrix().abs_diff_eq(sheared, 1e-14));
+        // A singular matrix is kept too, with a zero scale factor.
+        let flat = DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        assert!(matrix_to_transform(&flat).matrix().abs_diff_eq(flat, 1e-15));
     }
 
     #[test]
