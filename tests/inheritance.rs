@@ -165,3 +165,68 @@ proptest! {
 fn full_inheritance_does_shear() {
     assert!(worst_shear(&evaluate(&parent_and_rotated_child(), &[InheritMode::Full; 2])) > 30.0);
 }
+
+/// A parent scaled (2, 1, 0.5) and turned, a child whose rest is turned 50° about Z and which animates a further
+/// rotation about X: under full inheritance the child shears.
+fn blender_case(child_animated: bool) -> [Transform; 2] {
+    let rest = DQuat::from_rotation_z(50f64.to_radians());
+    let rotation = if child_animated { rest * DQuat::from_rotation_x(0.7) } else { rest };
+    [
+        Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_y(0.3), DVec3::new(2.0, 1.0, 0.5)),
+        Transform::from_trs(DVec3::new(0.0, 1.0, 0.0), rotation, DVec3::ONE),
+    ]
+}
+
+fn blender_child(mode: InheritMode, child_animated: bool) -> DMat4 {
+    // The rest pose (Blender's offset O) is the unanimated case; the animation adds the channel C.
+    let skeleton = chain(&blender_case(false));
+    let mut pose = ModelPose::default();
+    Hierarchy::new(&skeleton, &[InheritMode::Full, mode]).evaluate(&blender_case(child_animated), &mut pose);
+    pose.model[1]
+}
+
+#[test]
+fn blender_modes_that_drop_parent_shear_never_shear() {
+    for mode in [InheritMode::BlenderAligned, InheritMode::BlenderAverage, InheritMode::BlenderNone] {
+        for animated in [false, true] {
+            assert!(shear_deg(&linear(&blender_child(mode, animated))) < 1e-9, "{mode} animated: {animated}");
+        }
+    }
+    assert!(shear_deg(&linear(&blender_child(InheritMode::Full, true))) > 1.0, "the case does shear under full");
+}
+
+#[test]
+fn blender_fix_shear_removes_rest_shear_only() {
+    // Fix Shear orthogonalises P·O, the child's rest orientation: no shear at rest, but the child's own
+    // rotation re-creates it (Blender D5588).
+    assert!(shear_deg(&linear(&blender_child(InheritMode::BlenderFixShear, false))) < 1e-9);
+    assert!(shear_deg(&linear(&blender_child(InheritMode::BlenderFixShear, true))) > 1.0);
+    // Volume is kept: the determinant equals full inheritance's.
+    let (fixed, full) = (blender_child(InheritMode::BlenderFixShear, true), blender_child(InheritMode::Full, true));
+    assert!((fixed.determinant() - full.determinant()).abs() < 1e-12);
+}
+
+#[test]
+fn blender_heads_follow_the_full_parent_matrix() {
+    // In every Blender mode the bone's head is P·O·c: here the parent's matrix applied to the offset (0, 1, 0).
+    let head = blender_child(InheritMode::Full, true).w_axis;
+    for mode in InheritMode::ALL.into_iter().filter(|m| m.is_blender()) {
+        assert!(blender_child(mode, true).w_axis.abs_diff_eq(head, 1e-12), "{mode}");
+    }
+}
+
+#[test]
+fn blender_none_legacy_keeps_the_parent_shear_and_drops_its_scale() {
+    // A sheared grandparent chain: root scaled, middle turned (so it shears), child under None (Legacy).
+    let locals = [
+        Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0)),
+        Transform::from_trs(DVec3::Y, DQuat::from_rotation_z(0.6), DVec3::ONE),
+        Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE),
+    ];
+    let w = evaluate(&locals, &[InheritMode::Full, InheritMode::Full, InheritMode::BlenderNoneLegacy]);
+    // The parent's columns are normalised but not orthogonalised: same angles, unit lengths.
+    assert!((shear_deg(&linear(&w[2])) - shear_deg(&linear(&w[1]))).abs() < 1e-9);
+    for column in [w[2].x_axis, w[2].y_axis, w[2].z_axis] {
+        assert!((column.truncate().length() - 1.0).abs() < 1e-12);
+    }
+}
