@@ -48,6 +48,17 @@ impl AnimationInfo {
     pub fn of(clip: &Clip) -> Self {
         AnimationInfo { index: clip.index, name: clip.name.clone(), duration: clip.duration() }
     }
+
+    /// `animation 0 `walk` (1.333 s)`, or the rest pose when there is no animation.
+    pub fn describe(animation: Option<&AnimationInfo>) -> String {
+        match animation {
+            Some(a) => match &a.name {
+                Some(name) => format!("animation {} `{name}` ({:.3} s)", a.index, a.duration),
+                None => format!("animation {} ({:.3} s)", a.index, a.duration),
+            },
+            None => "rest pose (no animations)".to_owned(),
+        }
+    }
 }
 
 /// One bone at one time. `stretched`, `shear_deg` and `mirrored` describe the model matrix.

@@ -58,15 +58,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn render_table(report: &InspectReport) -> String {
-    let animation = match &report.animation {
-        Some(a) => format!(
-            "animation {} {} ({:.3} s)",
-            a.index,
-            a.name.as_deref().map_or_else(String::new, |n| format!("`{n}`")),
-            a.duration
-        ),
-        None => "no animation (rest pose)".to_owned(),
-    };
+    let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {}  inherit: {}\n", report.file, animation, report.inherit);
     for sample in &report.samples {
         out.push_str(&format!(

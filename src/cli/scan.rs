@@ -7,7 +7,7 @@ use clap::Args;
 
 use super::table::Table;
 use super::{EvalArgs, Format, ToleranceArgs};
-use crate::analysis::report::{AnimationScan, FileScan};
+use crate::analysis::report::{AnimationInfo, AnimationScan, FileScan};
 use crate::analysis::{ScanOptions, scan};
 use crate::eval::Hierarchy;
 use crate::import;
@@ -100,15 +100,7 @@ fn render(files: &[FileScan]) -> String {
 }
 
 fn render_animation(file: &str, scan: &AnimationScan) -> String {
-    let what = match &scan.animation {
-        Some(a) => format!(
-            "animation {} {}({:.3} s)",
-            a.index,
-            a.name.as_deref().map_or_else(String::new, |n| format!("`{n}` ")),
-            a.duration
-        ),
-        None => "rest pose (no animations)".to_owned(),
-    };
+    let what = AnimationInfo::describe(scan.animation.as_ref());
     let mut out = format!("{file}  {what}  {} samples, inherit: {}\n", scan.samples, scan.inherit);
     if scan.stretched.is_empty() {
         out.push_str("  no stretched bones\n");
