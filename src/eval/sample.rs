@@ -13,7 +13,12 @@ use crate::model::{Clip, Interpolation, Skeleton, Track, Transform};
 /// A key value type and how it interpolates, in double precision.
 pub trait Interpolate: Copy {
     type Wide: Copy;
+    /// The stored number in double precision (tangents are used as they are).
     fn widen(self) -> Self::Wide;
+    /// A key's value in double precision, made valid for its kind.
+    fn value(self) -> Self::Wide {
+        self.widen()
+    }
     fn linear(a: Self::Wide, b: Self::Wide, t: f64) -> Self::Wide;
     /// Hermite basis weights `(h00, h10, h01, h11)` applied to `(v0, b0, v1, a1)`, tangents already scaled.
     fn hermite(v0: Self::Wide, b0: Self::Wide, v1: Self::Wide, a1: Self::Wide, h: [f64; 4]) -> Self::Wide;
@@ -42,6 +47,14 @@ impl Interpolate for Quat {
         self.as_dquat()
     }
 
+    /// Normalised, as engines do: exporters often write rotation keys with few digits (SimpleSkin's
+    /// `0.707, 0.707` is 0.03 % too long), and a non-unit quaternion would read as scale. Zero stays the identity.
+    fn value(self) -> DQuat {
+        let q = self.as_dquat();
+        let length = q.length();
+        if length > 0.0 { q / length } else { DQuat::IDENTITY }
+    }
+
     fn linear(a: DQuat, b: DQuat, t: f64) -> DQuat {
         slerp(a, b, t)
     }
@@ -58,7 +71,7 @@ pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
     let times = track.times();
     let per_key = track.interpolation().values_per_key();
     // For cubic splines, key k stores [a_k, v_k, b_k].
-    let value = |k: usize| track.values()[k * per_key + per_key / 2].widen();
+    let value = |k: usize| track.values()[k * per_key + per_key / 2].value();
     let last = times.len() - 1;
     if time.is_nan() || time <= times[0] {
         return value(0);
@@ -163,6 +176,15 @@ mod tests {
         // A quarter of the way: 5°.
         let quarter = sample_track(&track, 0.25);
         assert!(quarter.angle_between(DQuat::from_rotation_y(5f64.to_radians())) < 1e-6);
+    }
+
+    #[test]
+    fn rotation_keys_are_normalised() {
+        let short = Quat::from_xyzw(0.0, 0.0, 0.707, 0.707);
+        let track = Track::new(Arc::from([0.0, 1.0].as_slice()), vec![short, short], Interpolation::Step).unwrap();
+        let q = sample_track(&track, 0.0);
+        assert!((q.length() - 1.0).abs() < 1e-15);
+        assert!(q.angle_between(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2)) < 1e-6);
     }
 
     #[test]
