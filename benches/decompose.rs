@@ -1,1 +1,245 @@
-fn main() {}
+//! Per-matrix cost and accuracy of `bonescope::math::decompose` beside nalgebra's SVD-based polar decomposition.
+//!
+//! Three sets of 1024 matrices, all from one fixed seed:
+//! - `shear_free`: `T·R·diag(s)` with scale factors in [0.25, 4] (the common case; `decompose` takes its shortcut);
+//! - `sheared`: `T·R·U·K·Uᵀ` with random `R`, `U` and factors in [0.25, 4] (shear from non-uniform scale under a
+//!   rotated child, the case the tool exists for);
+//! - `sheared_extreme`: as `sheared`, the largest/smallest factor ratio 10^e with e uniform in [0, 6] and an overall
+//!   magnitude in [1e-2, 1e2].
+//!
+//! nalgebra gets the same matrices, already converted to `Matrix3<f64>` outside the timed loop. Accuracy is measured
+//! once in the setup and printed to stderr (see `BENCHMARKS.md`).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use bonescope::math::{AffineParts, decompose};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DMat3, DMat4, DQuat, DVec3};
+use nalgebra::Matrix3;
+
+const BATCH: usize = 1024;
+const SEED: u64 = 0x5EED_B0E5_C0DE_2026;
+
+/// xorshift64*: small, fast, deterministic; plenty for test inputs.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    /// Uniform on the rotation group (Shoemake's subgroup algorithm).
+    fn rotation(&mut self) -> DQuat {
+        let (u1, u2, u3) = (self.unit(), self.unit() * std::f64::consts::TAU, self.unit() * std::f64::consts::TAU);
+        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+        DQuat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()).normalize()
+    }
+
+    fn vec3(&mut self, lo: f64, hi: f64) -> DVec3 {
+        DVec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
+    }
+}
+
+/// `T·R·U·K·Uᵀ`.
+fn sheared_matrix(rng: &mut Rng, k: DVec3) -> DMat4 {
+    let (r, u) = (DMat3::from_quat(rng.rotation()), DMat3::from_quat(rng.rotation()));
+    let m = r * u * DMat3::from_diagonal(k) * u.transpose();
+    let t = rng.vec3(-1.0, 1.0);
+    DMat4::from_cols(m.x_axis.extend(0.0), m.y_axis.extend(0.0), m.z_axis.extend(0.0), t.extend(1.0))
+}
+
+fn shear_free_set(rng: &mut Rng) -> Vec<DMat4> {
+    (0..BATCH)
+        .map(|_| {
+            let s = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            DMat4::from_scale_rotation_translation(s, rng.rotation(), rng.vec3(-1.0, 1.0))
+        })
+        .collect()
+}
+
+fn sheared_set(rng: &mut Rng) -> Vec<DMat4> {
+    (0..BATCH)
+        .map(|_| {
+            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            sheared_matrix(rng, k)
+        })
+        .collect()
+}
+
+/// Factors `c·[1, ratio^-a, ratio^-1]` in a random order (the order is irrelevant under a random `U`).
+fn factors_with_ratio(rng: &mut Rng, ratio: f64) -> DVec3 {
+    let c = 10f64.powf(rng.range(-2.0, 2.0));
+    c * DVec3::new(1.0, ratio.powf(-rng.unit()), 1.0 / ratio)
+}
+
+fn extreme_set(rng: &mut Rng) -> Vec<DMat4> {
+    (0..BATCH)
+        .map(|_| {
+            let ratio = 10f64.powf(rng.range(0.0, 6.0));
+            let k = factors_with_ratio(rng, ratio);
+            sheared_matrix(rng, k)
+        })
+        .collect()
+}
+
+fn to_nalgebra(m: &DMat4) -> Matrix3<f64> {
+    Matrix3::from_column_slice(&DMat3::from_mat4(*m).to_cols_array())
+}
+
+fn from_nalgebra(m: &Matrix3<f64>) -> DMat3 {
+    DMat3::from_cols_slice(m.as_slice())
+}
+
+fn frobenius(m: &DMat3) -> f64 {
+    (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt()
+}
+
+/// The worst errors over a set of matrices.
+#[derive(Default)]
+struct Errors {
+    /// `‖A − recomposed‖_F / ‖A‖_F`.
+    recompose: f64,
+    /// `‖QᵀQ − I‖_F` of the orthogonal factor.
+    orthogonality: f64,
+    /// `|k_min − k_min,true| / k_min,true`: the smallest stretch factor against the one the matrix was built from.
+    smallest_factor: f64,
+    /// Matrices whose recomposition error exceeds 1e-12.
+    bad: usize,
+}
+
+impl Errors {
+    fn add(&mut self, a: &DMat3, recomposed: &DMat3, q: &DMat3, smallest: f64, smallest_true: f64) {
+        let recompose = frobenius(&(*a - *recomposed)) / frobenius(a);
+        self.recompose = self.recompose.max(recompose);
+        self.orthogonality = self.orthogonality.max(frobenius(&(q.transpose() * *q - DMat3::IDENTITY)));
+        self.smallest_factor = self.smallest_factor.max((smallest - smallest_true).abs() / smallest_true);
+        self.bad += usize::from(recompose > 1e-12 || recompose.is_nan());
+    }
+}
+
+fn ours(m: &DMat4) -> (DMat3, DMat3, f64) {
+    let parts: AffineParts = decompose(m);
+    assert_eq!(parts.translation, m.w_axis.truncate());
+    let q = DMat3::from_quat(parts.rotation) * parts.sign;
+    (DMat3::from_mat4(parts.matrix()), q, parts.scale.min_element())
+}
+
+/// nalgebra's `polar()` is the left form `A = P·U` with `P = U_svd·Σ·U_svdᵀ` and `U = U_svd·V_svdᵀ`.
+fn theirs(m: &DMat4) -> (DMat3, DMat3, f64) {
+    let a = to_nalgebra(m);
+    let (p, u) = a.polar();
+    let smallest = a.singular_values().min();
+    (from_nalgebra(&(p * u)), from_nalgebra(&u), smallest)
+}
+
+/// Accuracy of both on matrices of one largest/smallest ratio, printed as one table row.
+fn accuracy_row(label: &str, set: &[(DMat4, f64)]) {
+    let (mut a, mut b) = (Errors::default(), Errors::default());
+    for (m, smallest_true) in set {
+        let m3 = DMat3::from_mat4(*m);
+        let (r, q, s) = ours(m);
+        a.add(&m3, &r, &q, s, *smallest_true);
+        let (r, q, s) = theirs(m);
+        b.add(&m3, &r, &q, s, *smallest_true);
+    }
+    eprintln!(
+        "{label:<22} | {:>9.2e} {:>9.2e} {:>9.2e} {:>4} | {:>9.2e} {:>9.2e} {:>9.2e} {:>4}",
+        a.recompose, a.orthogonality, a.smallest_factor, a.bad, b.recompose, b.orthogonality, b.smallest_factor, b.bad
+    );
+}
+
+fn print_accuracy() {
+    let mut rng = Rng(SEED ^ 0xACC);
+    eprintln!("accuracy over {BATCH} matrices per row (worst case; `bad` = recomposition error > 1e-12)");
+    eprintln!(
+        "{:<22} | {:>9} {:>9} {:>9} {:>4} | {:>9} {:>9} {:>9} {:>4}",
+        "set", "recompose", "orthog", "k_min", "bad", "recompose", "orthog", "k_min", "bad"
+    );
+    eprintln!("{:<22} | {:<34} | {:<34}", "", "bonescope decompose", "nalgebra polar (SVD)");
+    let shear_free: Vec<(DMat4, f64)> = (0..BATCH)
+        .map(|_| {
+            let s = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            (DMat4::from_scale_rotation_translation(s, rng.rotation(), rng.vec3(-1.0, 1.0)), s.min_element())
+        })
+        .collect();
+    accuracy_row("shear-free", &shear_free);
+    let sheared: Vec<(DMat4, f64)> = (0..BATCH)
+        .map(|_| {
+            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            (sheared_matrix(&mut rng, k), k.min_element())
+        })
+        .collect();
+    accuracy_row("sheared, ratio <= 16", &sheared);
+    for decade in 1..=6 {
+        let ratio = 10f64.powi(decade);
+        let set: Vec<(DMat4, f64)> = (0..BATCH)
+            .map(|_| {
+                let k = factors_with_ratio(&mut rng, ratio);
+                (sheared_matrix(&mut rng, k), k.min_element())
+            })
+            .collect();
+        accuracy_row(&format!("sheared, ratio 1e{decade}"), &set);
+    }
+    let mirrored: Vec<(DMat4, f64)> = (0..BATCH)
+        .map(|_| {
+            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            (sheared_matrix(&mut rng, k) * DMat4::from_scale(DVec3::new(1.0, 1.0, -1.0)), k.min_element())
+        })
+        .collect();
+    accuracy_row("sheared, mirrored", &mirrored);
+}
+
+fn bench_set(c: &mut Criterion, name: &str, set: &[DMat4]) {
+    let converted: Vec<Matrix3<f64>> = set.iter().map(to_nalgebra).collect();
+    let mut group = c.benchmark_group(name);
+    group.throughput(Throughput::Elements(set.len() as u64));
+    group.bench_function("bonescope", |b| {
+        b.iter(|| {
+            for m in set {
+                black_box(decompose(black_box(m)));
+            }
+        })
+    });
+    group.bench_function("nalgebra_polar", |b| {
+        b.iter(|| {
+            for m in &converted {
+                black_box(black_box(*m).polar());
+            }
+        })
+    });
+    group.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    print_accuracy();
+    let mut rng = Rng(SEED);
+    let shear_free = shear_free_set(&mut rng);
+    let sheared = sheared_set(&mut rng);
+    let extreme = extreme_set(&mut rng);
+    // The sets must exercise the paths they are named after.
+    assert!(shear_free.iter().all(|m| decompose(m).stretch == DQuat::IDENTITY), "shear-free set took the full path");
+    assert!(sheared.iter().all(|m| decompose(m).stretch != DQuat::IDENTITY), "sheared set took the shortcut");
+    bench_set(c, "decompose/shear_free", &shear_free);
+    bench_set(c, "decompose/sheared", &sheared);
+    bench_set(c, "decompose/sheared_extreme", &extreme);
+}
+
+criterion_group! {
+    name = decompose_benches;
+    config = Criterion::default().warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
+    targets = benches
+}
+criterion_main!(decompose_benches);

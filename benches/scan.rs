@@ -1,1 +1,346 @@
-fn main() {}
+//! Whole-clip `scan` throughput in bone-samples per second, beside a bare local→model pass over the same clip.
+//!
+//! Both visit the same sample times (`sample_times(Some(&clip), 60.0)`, what `scan` uses by default). The bare pass
+//! is `Pose::evaluate` in a loop, single-threaded; `scan` runs once inside a 1-thread rayon pool (the like-for-like
+//! comparison) and once on the default pool. Sub-benchmarks split the cost into sampling, hierarchy, and the
+//! per-matrix assessment (decomposition plus verdicts).
+//!
+//! Rigs: a generated 100-bone rig (chains with branching, every bone animated, every tenth bone with a non-uniform
+//! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
+//! `stretchy_full.glb` from the shared assets when it is there and loads.
+
+use std::f64::consts::TAU;
+use std::hint::black_box;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+use bonescope::analysis::{Assessment, ScanOptions, Tolerances, sample_times, scan};
+use bonescope::eval::{Hierarchy, Pose, sample_clip};
+use bonescope::math::decompose;
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DMat4, DQuat, DVec3, Vec3};
+
+const BONES: usize = 100;
+const SPINE: usize = 10;
+const KEYS_PER_SECOND: usize = 30;
+const SECONDS: usize = 10;
+const RATE: f64 = 60.0;
+
+/// xorshift64*: small, fast, deterministic.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.unit() * n as f64) as usize
+    }
+
+    fn axis(&mut self) -> DVec3 {
+        loop {
+            let v = DVec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
+            if (0.01..=1.0).contains(&v.length_squared()) {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+/// Parents-first bones: a spine of 10 from the root, then chains of 5–12 bones, each hanging off a random spine bone
+/// (60 %) or a random bone already placed (40 %), like limbs, fingers, tails and props on a character.
+fn generated_skeleton(rng: &mut Rng) -> Skeleton {
+    let mut bones: Vec<Bone> = Vec::with_capacity(BONES);
+    let add = |bones: &mut Vec<Bone>, rng: &mut Rng, parent: Option<usize>| {
+        let index = bones.len();
+        let rest = Transform::from_trs(
+            DVec3::new(rng.range(-0.05, 0.05), rng.range(0.1, 0.4), rng.range(-0.05, 0.05)),
+            DQuat::from_axis_angle(rng.axis(), rng.range(0.0, 0.5)),
+            DVec3::ONE,
+        );
+        bones.push(Bone { name: format!("bone{index}"), node: index, parent, rest, inherit: InheritMode::Full });
+        index
+    };
+    let mut parent = None;
+    for _ in 0..SPINE {
+        parent = Some(add(&mut bones, rng, parent));
+    }
+    while bones.len() < BONES {
+        let length = 5 + rng.below(8);
+        let mut parent = if rng.unit() < 0.6 { rng.below(SPINE) } else { rng.below(bones.len()) };
+        for _ in 0..length.min(BONES - bones.len()) {
+            parent = add(&mut bones, rng, Some(parent));
+        }
+    }
+    Skeleton::new(bones).expect("parents come first")
+}
+
+/// Which bones get a non-uniform scale track.
+#[derive(Clone, Copy, Debug)]
+enum Squash {
+    /// Ten bones drawn at random outside the spine: some limbs shear below them.
+    Limbs,
+    /// The same ten, plus the first spine bone: everything above the pelvis shears (the worst case).
+    Spine,
+    /// No scale tracks: nothing shears (the best case).
+    None,
+}
+
+impl Squash {
+    fn scaled_bones(self, rng: &mut Rng) -> Vec<usize> {
+        let mut bones = Vec::new();
+        while bones.len() < BONES / 10 {
+            let bone = SPINE + rng.below(BONES - SPINE);
+            if !bones.contains(&bone) {
+                bones.push(bone);
+            }
+        }
+        match self {
+            Squash::Limbs => bones,
+            Squash::Spine => {
+                bones.push(1);
+                bones
+            }
+            Squash::None => vec![],
+        }
+    }
+}
+
+/// Every bone: linear rotation (a swing of up to ±0.8 rad about a random axis) and translation tracks; the bones in
+/// `scaled` also a non-uniform scale track (squash and stretch along their own X/Y axes).
+fn generated_clip(rng: &mut Rng, skeleton: &Skeleton, scaled: &[usize]) -> Clip {
+    let keys = KEYS_PER_SECOND * SECONDS + 1;
+    let times: Arc<[f64]> = (0..keys).map(|i| i as f64 / KEYS_PER_SECOND as f64).collect();
+    let tracks = skeleton
+        .bones()
+        .iter()
+        .enumerate()
+        .map(|(index, bone)| {
+            let (axis, amplitude) = (rng.axis(), rng.range(0.2, 0.8));
+            let (frequency, phase) = (rng.range(0.2, 1.5), rng.range(0.0, TAU));
+            let wave = |t: f64| (TAU * frequency * t + phase).sin();
+            let rotation = times
+                .iter()
+                .map(|&t| (bone.rest.rotation * DQuat::from_axis_angle(axis, amplitude * wave(t))).as_quat())
+                .collect();
+            let offset = DVec3::new(rng.range(-0.05, 0.05), rng.range(-0.05, 0.05), rng.range(-0.05, 0.05));
+            let translation = times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
+            let mut tracks = BoneTracks::new(index);
+            tracks.rotation = Some(Track::new(times.clone(), rotation, Interpolation::Linear).unwrap());
+            tracks.translation = Some(Track::new(times.clone(), translation, Interpolation::Linear).unwrap());
+            if scaled.contains(&index) {
+                let scale = times
+                    .iter()
+                    .map(|&t| Vec3::new(1.0 + 0.4 * wave(t) as f32, 1.0 - 0.25 * wave(t) as f32, 1.0))
+                    .collect();
+                tracks.scale = Some(Track::new(times.clone(), scale, Interpolation::Linear).unwrap());
+            }
+            tracks
+        })
+        .collect();
+    Clip::new(0, Some("generated".into()), tracks, vec![])
+}
+
+struct Case {
+    name: String,
+    skeleton: Skeleton,
+    clip: Clip,
+    hierarchy: Hierarchy,
+}
+
+fn generated_case(squash: Squash) -> Case {
+    let mut rng = Rng(0x5CA7_2026_1122_0001);
+    let skeleton = generated_skeleton(&mut rng);
+    let scaled = squash.scaled_bones(&mut rng);
+    let clip = generated_clip(&mut rng, &skeleton, &scaled);
+    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
+    let name = match squash {
+        Squash::Limbs => "generated_100".into(),
+        Squash::Spine => "generated_100_spine_squash".into(),
+        Squash::None => "generated_100_no_scale".into(),
+    };
+    Case { name, skeleton, clip, hierarchy }
+}
+
+fn blender_case() -> Option<Case> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    if !path.exists() {
+        eprintln!("skipping the Blender rig: {} is missing", path.display());
+        return None;
+    }
+    let rig = match bonescope::import::load(&path) {
+        Ok(rig) => rig,
+        Err(e) => {
+            eprintln!("skipping the Blender rig: {e}");
+            return None;
+        }
+    };
+    let clip = rig.find_clip("squash_stretch").or(rig.clips.first())?.clone();
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    Some(Case { name: "stretchy_full".into(), skeleton: rig.skeleton, clip, hierarchy })
+}
+
+/// Model matrices of every bone at every time, concatenated. With `unit_quaternions`, each sampled rotation is
+/// normalised in `f64` first (a what-if: the library does not do that; see `describe`).
+fn all_model_matrices(case: &Case, times: &[f64], unit_quaternions: bool) -> Vec<DMat4> {
+    let mut pose = Pose::default();
+    let mut out = Vec::with_capacity(times.len() * case.skeleton.len());
+    for &t in times {
+        sample_clip(&case.skeleton, &case.clip, t, &mut pose.local);
+        if unit_quaternions {
+            pose.local.iter_mut().for_each(|l| l.rotation = l.rotation.normalize());
+        }
+        case.hierarchy.evaluate(&pose.local, &mut pose.model);
+        out.extend_from_slice(&pose.model.model);
+    }
+    out
+}
+
+/// Whether `decompose` can take its shear-free shortcut: a copy of the test in `math::polar::orthogonal_shortcut`
+/// (columns non-zero, within a ratio of 1e6, pairwise cosines at most 2e-13).
+fn shortcut_eligible(m: &DMat4) -> bool {
+    let cols = [m.x_axis.truncate(), m.y_axis.truncate(), m.z_axis.truncate()];
+    let lengths = cols.map(|c| c.length());
+    let (min, max) =
+        (lengths.iter().copied().fold(f64::INFINITY, f64::min), lengths.iter().copied().fold(0.0, f64::max));
+    min > 0.0
+        && min >= max * 1e-6
+        && [(0, 1), (1, 2), (0, 2)].iter().all(|&(i, j)| cols[i].dot(cols[j]).abs() <= 2e-13 * lengths[i] * lengths[j])
+}
+
+fn percent(part: usize, whole: usize) -> f64 {
+    100.0 * part as f64 / whole as f64
+}
+
+/// One line on the workload: how many bone-samples are sheared for real and how many can take the shortcut.
+fn describe(case: &Case, times: &[f64], models: &[DMat4], unit_models: &[DMat4]) {
+    let summary = scan(&case.skeleton, Some(&case.clip), &case.hierarchy, &ScanOptions::default(), &|_, _| {});
+    let stretched_bones = summary.bones.iter().filter(|b| b.stretched()).count();
+    let stretched_samples: usize = summary.bones.iter().map(|b| b.flagged_samples).sum();
+    let n = models.len();
+    eprintln!(
+        "{}: {} bones, clip {:.3} s, {} sample times, {n} bone-samples; {stretched_bones} bones / {:.1}% of bone-samples \
+         flagged stretched; {:.1}% of bone-samples take the decompose shortcut ({:.1}% if sampled rotations were \
+         normalised in f64)",
+        case.name,
+        case.skeleton.len(),
+        case.clip.duration(),
+        times.len(),
+        percent(stretched_samples, n),
+        percent(models.iter().filter(|m| shortcut_eligible(m)).count(), n),
+        percent(unit_models.iter().filter(|m| shortcut_eligible(m)).count(), n),
+    );
+}
+
+/// `parts`: also the sub-benchmarks that split the cost.
+fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
+    let times = sample_times(Some(&case.clip), RATE);
+    let models = all_model_matrices(case, &times, false);
+    let unit_models = all_model_matrices(case, &times, true);
+    describe(case, &times, &models, &unit_models);
+    let locals: Vec<Vec<Transform>> = times
+        .iter()
+        .map(|&t| {
+            let mut local = Vec::new();
+            sample_clip(&case.skeleton, &case.clip, t, &mut local);
+            local
+        })
+        .collect();
+    let options = ScanOptions::default();
+    let tolerances = Tolerances::default();
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a 1-thread pool");
+    let (skeleton, clip, hierarchy) = (&case.skeleton, Some(&case.clip), &case.hierarchy);
+
+    let mut group = c.benchmark_group(format!("scan/{}", case.name));
+    group.throughput(Throughput::Elements(models.len() as u64));
+    group.bench_function("bare_pose_evaluate", |b| {
+        let mut pose = Pose::default();
+        b.iter(|| {
+            for &t in &times {
+                pose.evaluate(skeleton, clip, hierarchy, black_box(t));
+                black_box(&pose.model.model);
+            }
+        })
+    });
+    group.bench_function("scan_1_thread", |b| {
+        b.iter(|| one_thread.install(|| black_box(scan(skeleton, clip, hierarchy, &options, &|_, _| {}))))
+    });
+    group.bench_function("scan_parallel", |b| {
+        b.iter(|| black_box(scan(skeleton, clip, hierarchy, &options, &|_, _| {})))
+    });
+    if !parts {
+        return group.finish();
+    }
+    // Where the time goes.
+    group.bench_function("part_sample_times", |b| b.iter(|| black_box(sample_times(black_box(clip), RATE))));
+    group.bench_function("part_sample_clip", |b| {
+        let mut local = Vec::new();
+        b.iter(|| {
+            for &t in &times {
+                sample_clip(skeleton, &case.clip, black_box(t), &mut local);
+                black_box(&local);
+            }
+        })
+    });
+    group.bench_function("part_hierarchy", |b| {
+        let mut pose = Pose::default();
+        b.iter(|| {
+            for local in &locals {
+                hierarchy.evaluate(black_box(local), &mut pose.model);
+                black_box(&pose.model.model);
+            }
+        })
+    });
+    group.bench_function("part_decompose", |b| {
+        b.iter(|| {
+            for m in &models {
+                black_box(decompose(black_box(m)));
+            }
+        })
+    });
+    group.bench_function("whatif_decompose_unit_quaternions", |b| {
+        b.iter(|| {
+            for m in &unit_models {
+                black_box(decompose(black_box(m)));
+            }
+        })
+    });
+    group.bench_function("part_assess", |b| {
+        b.iter(|| {
+            for m in &models {
+                black_box(Assessment::of(black_box(m), &tolerances));
+            }
+        })
+    });
+    group.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    bench_case(c, &generated_case(Squash::Limbs), true);
+    bench_case(c, &generated_case(Squash::Spine), false);
+    bench_case(c, &generated_case(Squash::None), false);
+    if let Some(case) = blender_case() {
+        bench_case(c, &case, true);
+    }
+}
+
+criterion_group! {
+    name = scan_benches;
+    config = Criterion::default().warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
+    targets = benches
+}
+criterion_main!(scan_benches);
