@@ -8,8 +8,10 @@
 //! seconds inside the library, right-handed Y-up.
 
 pub mod analysis;
+pub mod app;
 pub mod cli;
 pub mod eval;
 pub mod import;
 pub mod math;
 pub mod model;
+pub mod view;

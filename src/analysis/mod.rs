@@ -1,9 +1,11 @@
-//! Decomposition of every bone, findings (stretched, non-uniform, mirrored, degenerate), whole-clip scans and the
-//! reports built from them.
+//! Decomposition of every bone, findings (stretched, non-uniform, mirrored, degenerate), whole-clip analysis and
+//! the reports built from them.
 
 mod findings;
 pub mod report;
 mod scan;
 
 pub use findings::{Assessment, Findings, Tolerances};
-pub use scan::{BoneSummary, ClipScan, ScanOptions, sample_times, scan};
+pub use scan::{
+    BoneSummary, ClipAnalysis, ClipScan, Components, CurveRequest, Curves, ScanOptions, analyze, sample_times, scan,
+};

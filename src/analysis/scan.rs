@@ -1,7 +1,9 @@
-//! Whole-clip scans: every key time plus a fixed rate, every bone, in parallel, summarised per bone.
+//! Whole-clip analysis: every key time plus a fixed rate, every bone, in parallel. Summarised per bone for the
+//! whole rig (cheap to keep for any rig); full component curves only for the bones asked for (plotted ones).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+use glam::{DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::{Assessment, Tolerances};
@@ -62,7 +64,7 @@ impl BoneSummary {
     }
 
     /// Combines the summary of an earlier stretch of time with that of a later one.
-    fn merge(mut self, later: BoneSummary) -> BoneSummary {
+    fn merge(&mut self, later: &BoneSummary) {
         if later.worst_shear_deg > self.worst_shear_deg {
             self.worst_shear_deg = later.worst_shear_deg;
             self.worst_shear_time = later.worst_shear_time;
@@ -73,7 +75,6 @@ impl BoneSummary {
         self.non_uniform_samples += later.non_uniform_samples;
         self.mirrored_samples += later.mirrored_samples;
         self.degenerate_samples += later.degenerate_samples;
-        self
     }
 
     pub fn stretched(&self) -> bool {
@@ -87,6 +88,86 @@ pub struct ClipScan {
     pub samples: usize,
     /// One per bone, in bone order.
     pub bones: Vec<BoneSummary>,
+}
+
+/// The decomposed parts of one matrix at one sample, in single precision (plots need no more, and long clips
+/// stay small).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Components {
+    pub translation: Vec3,
+    pub rotation: Quat,
+    pub scale: Vec3,
+    pub stretch: Quat,
+    pub sign: f32,
+    pub shear_deg: f32,
+}
+
+impl Components {
+    fn of(assessment: &Assessment) -> Self {
+        let p = &assessment.parts;
+        Components {
+            translation: p.translation.as_vec3(),
+            rotation: p.rotation.as_quat(),
+            scale: p.scale.as_vec3(),
+            stretch: p.stretch.as_quat(),
+            sign: p.sign as f32,
+            shear_deg: assessment.shear_deg as f32,
+        }
+    }
+
+    /// The translation in double precision, for callers that compare positions.
+    pub fn position(&self) -> DVec3 {
+        self.translation.as_dvec3()
+    }
+}
+
+/// One bone's components at every sample time.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Curves {
+    pub local: Vec<Components>,
+    pub model: Vec<Components>,
+    /// The model-space components under the ghost modes, when asked for.
+    pub ghost_model: Vec<Components>,
+}
+
+/// What a whole-clip analysis computes besides the per-bone summaries.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CurveRequest<'a> {
+    /// Bones whose full curves are kept.
+    pub bones: &'a [usize],
+    /// A second hierarchy (other modes) evaluated for those bones.
+    pub ghost: Option<&'a Hierarchy>,
+}
+
+/// A whole clip analysed: per-bone summaries, per-bone per-sample stretched flags, and curves of chosen bones.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipAnalysis {
+    pub times: Vec<f64>,
+    pub scan: ClipScan,
+    /// Bit `s` of bone `b`'s row: stretched at sample `s`. Rows of `words_per_bone` words.
+    stretched_bits: Vec<u64>,
+    words_per_bone: usize,
+    /// Bit `s`: some bone is stretched at sample `s`.
+    any_stretched_bits: Vec<u64>,
+    /// `(bone, curves)` for the requested bones, in request order.
+    pub curves: Vec<(usize, Curves)>,
+}
+
+impl ClipAnalysis {
+    /// Whether `bone` is stretched at sample `sample`.
+    pub fn stretched_at(&self, bone: usize, sample: usize) -> bool {
+        let word = self.stretched_bits.get(bone * self.words_per_bone + sample / 64).copied().unwrap_or(0);
+        word >> (sample % 64) & 1 == 1
+    }
+
+    /// Whether any bone is stretched at sample `sample`.
+    pub fn any_stretched_at(&self, sample: usize) -> bool {
+        self.any_stretched_bits.get(sample / 64).is_some_and(|word| word >> (sample % 64) & 1 == 1)
+    }
+
+    pub fn curves_of(&self, bone: usize) -> Option<&Curves> {
+        self.curves.iter().find(|(b, _)| *b == bone).map(|(_, c)| c)
+    }
 }
 
 /// The times a scan visits: every key time, plus `0, 1/rate, 2/rate, …` up to the duration, plus the duration;
@@ -106,8 +187,16 @@ pub fn sample_times(clip: Option<&Clip>, rate: f64) -> Vec<f64> {
     times
 }
 
-/// Samples per parallel work item: big enough to amortise the buffers, small enough to balance two cores.
+/// Samples per parallel work item: one 64-bit word of flags per bone, big enough to amortise the buffers.
 const CHUNK: usize = 64;
+
+/// What one chunk of samples produced.
+struct ChunkResult {
+    summaries: Vec<BoneSummary>,
+    /// One word per bone.
+    bits: Vec<u64>,
+    curves: Vec<Curves>,
+}
 
 /// Scans `clip` (or the rest pose) under `hierarchy`'s modes. `progress(done, total)` is called from worker
 /// threads as samples complete.
@@ -118,23 +207,101 @@ pub fn scan(
     options: &ScanOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> ClipScan {
+    let never = AtomicBool::new(false);
+    analyze(skeleton, clip, hierarchy, CurveRequest::default(), options, progress, &never)
+        .expect("an analysis that is never cancelled completes")
+        .scan
+}
+
+/// The whole-clip analysis behind [`scan`] and the app's plots. Returns `None` when `cancel` was set.
+pub fn analyze(
+    skeleton: &Skeleton,
+    clip: Option<&Clip>,
+    hierarchy: &Hierarchy,
+    request: CurveRequest,
+    options: &ScanOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Option<ClipAnalysis> {
     let times = sample_times(clip, options.rate);
     let done = AtomicUsize::new(0);
-    let empty = || (0..skeleton.len()).map(BoneSummary::new).collect::<Vec<_>>();
-    let bones = times
+    let chunks: Vec<Option<ChunkResult>> = times
         .par_chunks(CHUNK)
         .map(|chunk| {
-            let mut pose = Pose::default();
-            let mut summaries = empty();
-            for &time in chunk {
-                pose.evaluate(skeleton, clip, hierarchy, time);
-                for (summary, model) in summaries.iter_mut().zip(&pose.model.model) {
-                    summary.add(time, &Assessment::of(model, &options.tolerances));
-                }
+            if cancel.load(Ordering::Relaxed) {
+                return None;
             }
+            let result = analyze_chunk(skeleton, clip, hierarchy, request, options, chunk);
             progress(done.fetch_add(chunk.len(), Ordering::Relaxed) + chunk.len(), times.len());
-            summaries
+            Some(result)
         })
-        .reduce(empty, |earlier, later| earlier.into_iter().zip(later).map(|(a, b)| a.merge(b)).collect());
-    ClipScan { samples: times.len(), bones }
+        .collect();
+    let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
+    Some(assemble(skeleton.len(), times, request, chunks))
+}
+
+fn analyze_chunk(
+    skeleton: &Skeleton,
+    clip: Option<&Clip>,
+    hierarchy: &Hierarchy,
+    request: CurveRequest,
+    options: &ScanOptions,
+    chunk: &[f64],
+) -> ChunkResult {
+    let mut pose = Pose::default();
+    let mut ghost_pose = Pose::default();
+    let mut result = ChunkResult {
+        summaries: (0..skeleton.len()).map(BoneSummary::new).collect(),
+        bits: vec![0; skeleton.len()],
+        curves: vec![Curves::default(); request.bones.len()],
+    };
+    for (sample, &time) in chunk.iter().enumerate() {
+        pose.evaluate(skeleton, clip, hierarchy, time);
+        for (bone, model) in pose.model.model.iter().enumerate() {
+            let assessment = Assessment::of(model, &options.tolerances);
+            result.summaries[bone].add(time, &assessment);
+            result.bits[bone] |= u64::from(assessment.findings.stretched) << sample;
+            if let Some(slot) = request.bones.iter().position(|&b| b == bone) {
+                let curves = &mut result.curves[slot];
+                curves.model.push(Components::of(&assessment));
+                curves.local.push(Components::of(&Assessment::of(&pose.local[bone].matrix(), &options.tolerances)));
+            }
+        }
+        if let Some(ghost) = request.ghost {
+            ghost_pose.evaluate(skeleton, clip, ghost, time);
+            for (slot, &bone) in request.bones.iter().enumerate() {
+                let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
+                result.curves[slot].ghost_model.push(Components::of(&assessment));
+            }
+        }
+    }
+    result
+}
+
+fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<ChunkResult>) -> ClipAnalysis {
+    let words_per_bone = chunks.len();
+    let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();
+    let mut stretched_bits = vec![0u64; bones * words_per_bone];
+    let mut any_stretched_bits = vec![0u64; words_per_bone];
+    let mut curves: Vec<(usize, Curves)> = request.bones.iter().map(|&b| (b, Curves::default())).collect();
+    for (word, chunk) in chunks.into_iter().enumerate() {
+        for (bone, (summary, bits)) in chunk.summaries.iter().zip(&chunk.bits).enumerate() {
+            summaries[bone].merge(summary);
+            stretched_bits[bone * words_per_bone + word] = *bits;
+            any_stretched_bits[word] |= *bits;
+        }
+        for ((_, all), part) in curves.iter_mut().zip(chunk.curves) {
+            all.local.extend(part.local);
+            all.model.extend(part.model);
+            all.ghost_model.extend(part.ghost_model);
+        }
+    }
+    ClipAnalysis {
+        scan: ClipScan { samples: times.len(), bones: summaries },
+        times,
+        stretched_bits,
+        words_per_bone,
+        any_stretched_bits,
+        curves,
+    }
 }

@@ -16,11 +16,15 @@ pub use options::{EvalArgs, Format, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
 /// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.
+///
+/// Without a command, opens the desktop app on FILE (or on a built-in demo rig).
 #[derive(Debug, Parser)]
-#[command(name = "bonescope", version, about, long_about = None, arg_required_else_help = true)]
+#[command(name = "bonescope", version, about, long_about = None, args_conflicts_with_subcommands = true)]
 pub struct Cli {
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
+    /// The animation file to open in the app (glTF .gltf/.glb).
+    pub file: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -35,8 +39,9 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Inspect(args) => inspect::run(&args),
-        Command::Scan(args) => scan::run(&args),
+        Some(Command::Inspect(args)) => inspect::run(&args),
+        Some(Command::Scan(args)) => scan::run(&args),
+        None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
     };
     match result {
         Ok(code) => code,

@@ -5,7 +5,9 @@ pub mod blender;
 mod hierarchy;
 mod pose;
 mod sample;
+mod skinning;
 
 pub use hierarchy::{Hierarchy, ModelPose};
 pub use pose::Pose;
 pub use sample::{Interpolate, sample_clip, sample_track};
+pub use skinning::{skin_mesh, skin_meshes};

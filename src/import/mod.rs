@@ -1,6 +1,9 @@
 //! Turning files into a [`Rig`]: one module per format and one [`load`] entry that picks the format by content.
 
+mod demo;
 mod gltf;
+
+pub use demo::demo_rig;
 
 use std::fmt;
 use std::path::{Path, PathBuf};

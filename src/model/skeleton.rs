@@ -82,6 +82,16 @@ impl Skeleton {
         self.bones.iter().map(|b| b.rest).collect()
     }
 
+    /// Model matrices of the rest pose with plain (full) inheritance.
+    pub fn rest_model_matrices(&self) -> Vec<glam::DMat4> {
+        let mut model: Vec<glam::DMat4> = Vec::with_capacity(self.bones.len());
+        for bone in &self.bones {
+            let local = bone.rest.matrix();
+            model.push(bone.parent.map_or(local, |p| model[p] * local));
+        }
+        model
+    }
+
     /// Number of ancestors of each bone (0 for roots).
     pub fn depths(&self) -> Vec<usize> {
         let mut depths = Vec::with_capacity(self.bones.len());

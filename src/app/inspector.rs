@@ -1,0 +1,80 @@
+//! The selected bone at the current time: local and model matrices, every decomposed part, the findings, and a
+//! button that copies the same JSON `bonescope inspect` prints.
+
+use egui::{Grid, RichText, Ui};
+use glam::DMat4;
+
+use super::Shared;
+use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, SampleReport};
+use crate::math::AffineParts;
+use crate::view::Badge;
+
+pub fn ui(ui: &mut Ui, shared: &mut Shared) {
+    ui.heading("Inspector");
+    let Some(bone) = shared.inspected() else {
+        ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
+        return;
+    };
+    let reports = BoneReport::all(&shared.doc.rig.skeleton, &shared.doc.modes, &shared.frame.pose, shared.tolerances);
+    let report = &reports[bone];
+    ui.label(RichText::new(&report.name).strong().size(16.0));
+    ui.label(format!("bone {} · node {} · inherit {}", report.index, report.node, report.inherit.id()));
+    let assessment = &report.assessment;
+    let badges: Vec<Badge> = Badge::of(&assessment.findings).collect();
+    let text = if badges.is_empty() {
+        "findings: none".to_owned()
+    } else {
+        format!("findings: {}", badges.iter().map(|b| b.label()).collect::<Vec<_>>().join(", "))
+    };
+    let color = badges.first().map_or(ui.visuals().text_color(), |b| b.color());
+    let explanation = badges.iter().map(|b| b.explanation()).collect::<Vec<_>>().join("; ");
+    ui.label(RichText::new(text).color(color).strong()).on_hover_text(explanation);
+    ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
+    if ui.button("Copy as JSON").on_hover_text("the same JSON as `bonescope inspect --format json`").clicked() {
+        let inspect = InspectReport {
+            file: shared.doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string()),
+            animation: shared.doc.clip().map(AnimationInfo::of),
+            inherit: shared.doc.common_mode().map_or_else(|| "declared".to_owned(), |m| m.id().to_owned()),
+            samples: vec![SampleReport { time: *shared.time, bones: vec![report.clone()] }],
+        };
+        if let Ok(json) = serde_json::to_string_pretty(&inspect) {
+            ui.ctx().copy_text(json);
+        }
+    }
+    egui::ScrollArea::vertical().show(ui, |ui| {
+        let local = shared.frame.pose.local[bone].matrix();
+        section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts);
+        section(ui, "Local", &local, &crate::math::decompose(&local));
+    });
+}
+
+fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts) {
+    ui.separator();
+    ui.label(RichText::new(title).strong());
+    Grid::new(format!("{title}-matrix")).striped(true).show(ui, |ui| {
+        for row in 0..4 {
+            for col in 0..4 {
+                ui.label(RichText::new(format!("{:>9.4}", matrix.col(col)[row])).monospace());
+            }
+            ui.end_row();
+        }
+    });
+    Grid::new(format!("{title}-parts")).show(ui, |ui| {
+        let v = |values: &[f64]| values.iter().map(|x| format!("{:.4}", x + 0.0)).collect::<Vec<_>>().join(", ");
+        ui.label("translation");
+        ui.label(v(&parts.translation.to_array()));
+        ui.end_row();
+        ui.label("rotation q");
+        ui.label(v(&parts.rotation.to_array()));
+        ui.end_row();
+        ui.label("stretch U");
+        ui.label(format!("{}  ({:.3}°)", v(&parts.stretch.to_array()), parts.stretch_angle_deg()));
+        ui.end_row();
+        ui.label("scale k");
+        ui.label(v(&parts.scale.to_array()));
+        ui.end_row();
+        ui.label("sign f");
+        ui.label(format!("{}", parts.sign));
+        ui.end_row();
+    });
+}

@@ -1,0 +1,384 @@
+//! The desktop app: one struct per panel, a shared context they work on, and the eframe glue.
+//!
+//! Layout: menu and toolbar on top, the outliner left, the inspector right, plots and timeline at the bottom,
+//! the viewport in the middle. Loading never replaces the document unless it succeeded; errors become
+//! notifications.
+
+mod document;
+mod inspector;
+mod job;
+mod notifications;
+mod outliner;
+mod plots;
+mod settings;
+mod timeline;
+mod toolbar;
+mod viewport;
+mod watch;
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+
+pub use document::{Document, ModeScope};
+pub use settings::{RotationFormat, Settings, TimeUnit};
+
+use crate::analysis::{ClipAnalysis, Tolerances};
+use crate::eval::Pose;
+use crate::view::Layer;
+use job::{AnalysisJob, JobKey};
+use notifications::Notifications;
+
+/// At most this many bones are plotted at once (the most recently selected).
+pub const MAX_PLOTTED: usize = 8;
+
+/// The pose at the current time under the document's modes, and under the ghost mode.
+pub struct Frame {
+    pub pose: Pose,
+    pub primary: Layer,
+    pub ghost: Option<Layer>,
+}
+
+impl Frame {
+    fn evaluate(doc: &Document, time: f64, tolerances: &Tolerances) -> Frame {
+        let rig = &doc.rig;
+        let mut pose = Pose::default();
+        pose.evaluate(&rig.skeleton, doc.clip(), &crate::eval::Hierarchy::new(&rig.skeleton, &doc.modes), time);
+        let primary = Layer::from_model(rig, pose.model.model.clone(), tolerances);
+        let ghost = doc.ghost_modes().map(|modes| Layer::evaluate(rig, doc.clip(), &modes, time, tolerances));
+        Frame { pose, primary, ghost }
+    }
+}
+
+/// What every panel works on.
+pub struct Shared<'a> {
+    pub doc: &'a mut Document,
+    pub settings: &'a mut Settings,
+    pub time: &'a mut f64,
+    pub playing: &'a mut bool,
+    /// Selected bones; the last one is the inspected one.
+    pub selection: &'a mut Vec<usize>,
+    pub frame: &'a Frame,
+    pub analysis: Option<&'a ClipAnalysis>,
+    /// `(done, total)` samples while the whole-clip analysis runs.
+    pub progress: Option<(usize, usize)>,
+    pub tolerances: &'a Tolerances,
+}
+
+impl Shared<'_> {
+    /// Selects one bone, or with `extend` adds/removes it from the selection.
+    pub fn select(&mut self, bone: usize, extend: bool) {
+        if extend {
+            if let Some(i) = self.selection.iter().position(|&b| b == bone) {
+                self.selection.remove(i);
+            } else {
+                self.selection.push(bone);
+            }
+        } else {
+            self.selection.clear();
+            self.selection.push(bone);
+        }
+    }
+
+    pub fn inspected(&self) -> Option<usize> {
+        self.selection.last().copied()
+    }
+}
+
+/// The bonescope app.
+pub struct BonescopeApp {
+    pub settings: Settings,
+    pub doc: Document,
+    pub time: f64,
+    pub playing: bool,
+    pub selection: Vec<usize>,
+    pub tolerances: Tolerances,
+    generation: u64,
+    job: AnalysisJob,
+    notifications: Notifications,
+    watcher: Option<watch::FileWatcher>,
+    open_dialog: Option<Receiver<Option<PathBuf>>>,
+    /// For waking the UI from background threads (the file watcher).
+    repaint: Option<egui::Context>,
+    outliner: outliner::Outliner,
+    plots: plots::Plots,
+    viewport: viewport::Viewport,
+}
+
+impl BonescopeApp {
+    /// The app on `doc` with `settings`; the view is framed on the document.
+    pub fn new(settings: Settings, doc: Document) -> Self {
+        let mut app = BonescopeApp {
+            settings,
+            doc,
+            time: 0.0,
+            playing: false,
+            selection: Vec::new(),
+            tolerances: Tolerances::default(),
+            generation: 0,
+            job: AnalysisJob::default(),
+            notifications: Notifications::default(),
+            watcher: None,
+            open_dialog: None,
+            repaint: None,
+            outliner: outliner::Outliner::default(),
+            plots: plots::Plots::default(),
+            viewport: viewport::Viewport,
+        };
+        app.document_replaced(true);
+        app
+    }
+
+    /// Starts the app as `bonescope [FILE]` does: settings from eframe's storage, the file or the demo rig.
+    pub fn start(cc: &eframe::CreationContext<'_>, file: Option<PathBuf>) -> Self {
+        let settings: Settings =
+            cc.storage.and_then(|s| eframe::get_value(s, Settings::STORAGE_KEY)).unwrap_or_default();
+        let mut app = BonescopeApp::new(settings, Document::demo());
+        app.repaint = Some(cc.egui_ctx.clone());
+        if let Some(path) = file {
+            app.open(&path);
+        }
+        app
+    }
+
+    /// Loads `path`; on failure the current document stays and the error becomes a notification.
+    pub fn open(&mut self, path: &Path) {
+        match Document::load(path) {
+            Ok(doc) => {
+                self.settings.remember(path.to_owned());
+                self.doc = doc;
+                self.selection.clear();
+                self.time = 0.0;
+                self.document_replaced(true);
+                self.notifications.info(format!("opened {}", path.display()));
+            }
+            Err(error) => self.notifications.error(error.to_string()),
+        }
+    }
+
+    pub fn open_demo(&mut self) {
+        self.doc = Document::demo();
+        self.selection.clear();
+        self.document_replaced(true);
+    }
+
+    /// Re-reads the open file after it changed on disk, keeping time, selection, camera and modes.
+    fn reload(&mut self) {
+        let Some(path) = self.doc.path.clone() else { return };
+        match crate::import::load(&path) {
+            Ok(rig) => {
+                self.doc = self.doc.reloaded(rig);
+                let bones = self.doc.rig.skeleton.len();
+                self.selection.retain(|&b| b < bones);
+                self.document_replaced(false);
+                self.notifications.info(format!("reloaded {}", path.display()));
+            }
+            Err(error) => self.notifications.error(format!("not reloaded: {error}")),
+        }
+    }
+
+    fn document_replaced(&mut self, frame_camera: bool) {
+        self.generation += 1;
+        self.watcher = self.doc.path.as_deref().and_then(|path| {
+            let ctx = self.repaint.clone();
+            watch::FileWatcher::new(path, move |after| {
+                if let Some(ctx) = &ctx {
+                    ctx.request_repaint_after(after);
+                }
+            })
+        });
+        if frame_camera {
+            self.viewport.frame_all(&self.doc, &mut self.settings.camera);
+        }
+        self.time = self.time.clamp(0.0, self.doc.duration());
+    }
+
+    /// The whole-clip analysis the UI wants now.
+    fn job_key(&self) -> JobKey {
+        JobKey {
+            generation: self.generation,
+            clip: self.doc.clip,
+            modes: self.doc.modes.clone(),
+            ghost: self.doc.ghost,
+            plotted: self.plotted(),
+            rate: self.settings.frame_rate,
+        }
+    }
+
+    /// The bones whose curves are plotted: the most recently selected ones.
+    pub fn plotted(&self) -> Vec<usize> {
+        let skip = self.selection.len().saturating_sub(MAX_PLOTTED);
+        let mut bones: Vec<usize> = self.selection[skip..].to_vec();
+        bones.sort_unstable();
+        bones
+    }
+
+    /// Waits for the background analysis to finish (for tests and headless renders).
+    pub fn settle(&mut self, ctx: &egui::Context) {
+        let key = self.job_key();
+        let waker = ctx.clone();
+        self.job.update(key, &self.doc.rig, move || waker.request_repaint());
+        self.job.wait();
+    }
+
+    /// The latest whole-clip analysis, if it matches the current state.
+    pub fn analysis(&self) -> Option<&ClipAnalysis> {
+        let key = self.job_key();
+        self.job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
+    }
+
+    /// The whole window.
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        ctx.set_theme(if self.settings.dark { egui::Theme::Dark } else { egui::Theme::Light });
+        self.poll_background(&ctx);
+        self.handle_input(&ctx);
+        self.advance_playback(&ctx);
+        let frame = Frame::evaluate(&self.doc, self.time, &self.tolerances);
+        let latest = self.job.latest().map(|(_, a)| a.clone());
+        let progress = self.job.progress();
+        let mut actions = toolbar::Actions::default();
+        {
+            let mut shared = Shared {
+                doc: &mut self.doc,
+                settings: &mut self.settings,
+                time: &mut self.time,
+                playing: &mut self.playing,
+                selection: &mut self.selection,
+                frame: &frame,
+                analysis: latest.as_deref(),
+                progress,
+                tolerances: &self.tolerances,
+            };
+            egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
+            egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));
+            if shared.settings.show_plots {
+                egui::Panel::bottom("plots")
+                    .resizable(true)
+                    .default_size(230.0)
+                    .min_size(160.0)
+                    .show(ui, |ui| self.plots.ui(ui, &mut shared));
+            }
+            egui::Panel::left("outliner").resizable(true).default_size(250.0).show(ui, |ui| {
+                self.outliner.ui(ui, &mut shared);
+            });
+            if shared.settings.show_inspector {
+                egui::Panel::right("inspector").resizable(true).default_size(300.0).show(ui, |ui| {
+                    inspector::ui(ui, &mut shared);
+                });
+            }
+            egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));
+        }
+        self.notifications.ui(&ctx);
+        self.apply(actions, &ctx);
+    }
+
+    fn apply(&mut self, actions: toolbar::Actions, ctx: &egui::Context) {
+        if actions.open_dialog {
+            self.open_dialog = Some(spawn_open_dialog(ctx.clone()));
+        }
+        if let Some(path) = actions.open {
+            self.open(&path);
+        }
+        if actions.open_demo {
+            self.open_demo();
+        }
+        if actions.frame_all {
+            self.viewport.frame_all(&self.doc, &mut self.settings.camera);
+        }
+        if actions.clip_changed {
+            self.time = 0.0;
+        }
+    }
+
+    fn poll_background(&mut self, ctx: &egui::Context) {
+        if let Some(dialog) = &self.open_dialog
+            && let Ok(choice) = dialog.try_recv()
+        {
+            self.open_dialog = None;
+            if let Some(path) = choice {
+                self.open(&path);
+            }
+        }
+        if self.watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
+            self.reload();
+        }
+        let waker = ctx.clone();
+        self.job.update(self.job_key(), &self.doc.rig, move || waker.request_repaint());
+        if self.job.progress().is_some() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+    }
+
+    fn handle_input(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_owned()).collect());
+        if let Some(path) = dropped.first() {
+            self.open(path);
+        }
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let step = 1.0 / self.settings.frame_rate.max(1.0);
+        let (space, left, right) = ctx.input(|i| {
+            (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::ArrowLeft), i.key_pressed(egui::Key::ArrowRight))
+        });
+        if space {
+            self.playing = !self.playing;
+        }
+        if left || right {
+            self.playing = false;
+            let delta = if right { step } else { -step };
+            self.time = (self.time + delta).clamp(0.0, self.doc.duration());
+        }
+    }
+
+    fn advance_playback(&mut self, ctx: &egui::Context) {
+        if !self.playing {
+            return;
+        }
+        let duration = self.doc.duration();
+        let dt = f64::from(ctx.input(|i| i.stable_dt).min(0.1)) * self.settings.speed;
+        self.time += dt;
+        if self.time > duration {
+            if self.settings.looping && duration > 0.0 {
+                self.time %= duration;
+            } else {
+                self.time = duration;
+                self.playing = false;
+            }
+        }
+        ctx.request_repaint();
+    }
+}
+
+/// Runs the native file dialog on its own thread so the UI keeps drawing.
+fn spawn_open_dialog(ctx: egui::Context) -> Receiver<Option<PathBuf>> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let choice = rfd::FileDialog::new()
+            .add_filter("animation", &["glb", "gltf", "fbx", "bvh"])
+            .add_filter("any file", &["*"])
+            .pick_file();
+        let _ = sender.send(choice);
+        ctx.request_repaint();
+    });
+    receiver
+}
+
+impl eframe::App for BonescopeApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        BonescopeApp::ui(self, ui);
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, Settings::STORAGE_KEY, &self.settings);
+    }
+}
+
+/// Opens the desktop window: `bonescope [FILE]`.
+pub fn run(file: Option<PathBuf>) -> eframe::Result {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default().with_inner_size([1400.0, 900.0]).with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native("bonescope", options, Box::new(|cc| Ok(Box::new(BonescopeApp::start(cc, file)))))
+}

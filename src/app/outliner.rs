@@ -1,0 +1,159 @@
+//! The bone hierarchy as a tree with finding badges, a name filter, "only flagged", and each bone's inheritance
+//! mode (right-click a bone to set it for the bone, its subtree or all bones).
+
+use std::collections::HashSet;
+
+use egui::{RichText, Sense, vec2};
+
+use super::{ModeScope, Shared};
+use crate::analysis::Findings;
+use crate::model::InheritMode;
+use crate::view::Badge;
+
+#[derive(Default)]
+pub struct Outliner {
+    pub filter: String,
+    pub only_flagged: bool,
+    collapsed: HashSet<usize>,
+}
+
+const ROW_HEIGHT: f32 = 20.0;
+const INDENT: f32 = 12.0;
+
+impl Outliner {
+    pub fn ui(&mut self, ui: &mut egui::Ui, shared: &mut Shared) {
+        ui.heading("Skeleton");
+        ui.horizontal(|ui| {
+            let label = ui.label("Filter");
+            ui.add(egui::TextEdit::singleline(&mut self.filter).hint_text("bone name").desired_width(120.0))
+                .labelled_by(label.id);
+            ui.checkbox(&mut self.only_flagged, "Only flagged");
+        });
+        legend(ui);
+        ui.separator();
+        let rows = self.visible_rows(shared);
+        if rows.is_empty() {
+            ui.label(RichText::new("no bone matches").weak());
+        }
+        let depths = shared.doc.rig.skeleton.depths();
+        egui::ScrollArea::vertical().auto_shrink([false, false]).show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
+            for &bone in &rows[range] {
+                self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 });
+            }
+        });
+    }
+
+    /// Findings now, or at any time of the clip when the analysis is there.
+    fn flagged(shared: &Shared, bone: usize) -> bool {
+        let now = shared.frame.primary.findings[bone].any();
+        let ever = shared.analysis.and_then(|a| a.scan.bones.get(bone)).is_some_and(|s| {
+            s.stretched() || s.non_uniform_samples > 0 || s.mirrored_samples > 0 || s.degenerate_samples > 0
+        });
+        now || ever
+    }
+
+    fn visible_rows(&self, shared: &Shared) -> Vec<usize> {
+        let skeleton = &shared.doc.rig.skeleton;
+        let filter = self.filter.to_lowercase();
+        let mut hidden = vec![false; skeleton.len()];
+        let mut rows = Vec::new();
+        for (bone, b) in skeleton.bones().iter().enumerate() {
+            // Without a filter, collapsed bones hide their subtree.
+            hidden[bone] = b.parent.is_some_and(|p| hidden[p] || self.collapsed.contains(&p));
+            let matches = if filter.is_empty() { !hidden[bone] } else { b.name.to_lowercase().contains(&filter) };
+            if matches && (!self.only_flagged || Self::flagged(shared, bone)) {
+                rows.push(bone);
+            }
+        }
+        rows
+    }
+
+    fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, depth: usize) {
+        let skeleton = &shared.doc.rig.skeleton;
+        let has_children = (bone + 1..skeleton.len()).any(|c| skeleton.parent(c) == Some(bone));
+        let name = skeleton.bone(bone).name.clone();
+        let findings = shared.frame.primary.findings[bone];
+        ui.horizontal(|ui| {
+            ui.set_height(ROW_HEIGHT);
+            ui.add_space(depth as f32 * INDENT);
+            if has_children {
+                let collapsed = self.collapsed.contains(&bone);
+                let toggle = ui.add(egui::Button::new(if collapsed { "+" } else { "−" }).small().frame(false));
+                if toggle.on_hover_text(format!("expand or collapse {name}")).clicked() && !self.collapsed.remove(&bone)
+                {
+                    self.collapsed.insert(bone);
+                }
+            } else {
+                ui.add_space(14.0);
+            }
+            badges(ui, &findings);
+            let selected = shared.selection.contains(&bone);
+            let label = ui.selectable_label(selected, &name);
+            if label.clicked() {
+                let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
+                shared.select(bone, extend);
+            }
+            label.context_menu(|ui| mode_menu(ui, shared, bone));
+            ui.label(RichText::new(shared.doc.modes[bone].id()).weak().small());
+            if let Some(summary) = shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched()) {
+                ui.label(
+                    RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
+                        .small()
+                        .color(Badge::Stretched.color()),
+                )
+                .on_hover_text(format!(
+                    "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s",
+                    summary.flagged_samples,
+                    shared.analysis.map_or(0, |a| a.scan.samples),
+                    summary.first_flagged_time.unwrap_or_default(),
+                    summary.worst_shear_deg,
+                    summary.worst_shear_time
+                ));
+            }
+        });
+    }
+}
+
+/// The icons of a bone's findings, painted in a fixed-width slot so names line up.
+fn badges(ui: &mut egui::Ui, findings: &Findings) {
+    let (rect, response) = ui.allocate_exact_size(vec2(34.0, ROW_HEIGHT), Sense::hover());
+    let mut x = rect.left() + 6.0;
+    let mut names = Vec::new();
+    for badge in Badge::of(findings) {
+        badge.paint_icon(ui.painter(), egui::pos2(x, rect.center().y), 4.5);
+        names.push(badge.label());
+        x += 11.0;
+    }
+    if !names.is_empty() {
+        response.on_hover_text(names.join(", "));
+    }
+}
+
+/// Colours and icons, explained once at the top of the list.
+fn legend(ui: &mut egui::Ui) {
+    ui.horizontal_wrapped(|ui| {
+        for badge in Badge::ALL {
+            let (rect, _) = ui.allocate_exact_size(vec2(12.0, 14.0), Sense::hover());
+            badge.paint_icon(ui.painter(), rect.center(), 4.5);
+            ui.label(RichText::new(badge.label()).small()).on_hover_text(badge.explanation());
+        }
+    });
+}
+
+/// Sets a mode for the bone, its subtree or all bones.
+fn mode_menu(ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
+    for (scope, title) in [
+        (ModeScope::Bone, "Set mode of this bone"),
+        (ModeScope::Subtree, "Set mode of its subtree"),
+        (ModeScope::All, "Set mode of all bones"),
+    ] {
+        ui.menu_button(title, |ui| {
+            for mode in InheritMode::ALL {
+                if ui.button(mode.id()).on_hover_text(mode.description()).clicked() {
+                    shared.doc.set_mode(bone, scope, mode);
+                    ui.close();
+                }
+            }
+        });
+    }
+}

@@ -1,0 +1,294 @@
+//! Each decomposed component of the selected bones over the whole clip, in local or model space, under the
+//! current modes and optionally the ghost mode. A cursor marks the current time; a click seeks.
+//!
+//! Long clips stay smooth: curves are reduced to the minimum and maximum of each pixel column of the visible
+//! range before drawing (as Rerun's time-series view does).
+
+use egui::{Color32, RichText, Ui};
+use egui_plot::{Line, Plot, PlotPoints, VLine};
+use glam::{EulerRot, Quat};
+
+use super::{RotationFormat, Shared};
+use crate::analysis::{ClipAnalysis, Components};
+
+/// A curve's name and how to read it from a sample.
+type Channel = (&'static str, fn(&Components) -> f64);
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Component {
+    Translation,
+    #[default]
+    Rotation,
+    Scale,
+    Stretch,
+    Sign,
+    Shear,
+}
+
+impl Component {
+    const ALL: [Component; 6] = [
+        Component::Translation,
+        Component::Rotation,
+        Component::Scale,
+        Component::Stretch,
+        Component::Sign,
+        Component::Shear,
+    ];
+
+    fn label(self) -> &'static str {
+        match self {
+            Component::Translation => "translation",
+            Component::Rotation => "rotation",
+            Component::Scale => "scale k",
+            Component::Stretch => "stretch U",
+            Component::Sign => "sign f",
+            Component::Shear => "shear°",
+        }
+    }
+
+    /// Channel names and how to read each from a sample.
+    fn channels(self, format: RotationFormat) -> Vec<Channel> {
+        match self {
+            Component::Translation => vec![
+                ("x", |c| c.translation.x.into()),
+                ("y", |c| c.translation.y.into()),
+                ("z", |c| c.translation.z.into()),
+            ],
+            Component::Rotation => match format {
+                RotationFormat::Quaternion => vec![
+                    ("x", |c| c.rotation.x.into()),
+                    ("y", |c| c.rotation.y.into()),
+                    ("z", |c| c.rotation.z.into()),
+                    ("w", |c| c.rotation.w.into()),
+                ],
+                RotationFormat::Euler => vec![
+                    ("X°", |c| euler(c.rotation).0),
+                    ("Y°", |c| euler(c.rotation).1),
+                    ("Z°", |c| euler(c.rotation).2),
+                ],
+                RotationFormat::AxisAngle => vec![
+                    ("angle°", |c| axis_angle(c.rotation).0),
+                    ("axis x", |c| axis_angle(c.rotation).1[0]),
+                    ("axis y", |c| axis_angle(c.rotation).1[1]),
+                    ("axis z", |c| axis_angle(c.rotation).1[2]),
+                ],
+            },
+            Component::Scale => {
+                vec![("x", |c| c.scale.x.into()), ("y", |c| c.scale.y.into()), ("z", |c| c.scale.z.into())]
+            }
+            Component::Stretch => vec![
+                ("angle°", |c| axis_angle(c.stretch).0),
+                ("axis x", |c| axis_angle(c.stretch).1[0]),
+                ("axis y", |c| axis_angle(c.stretch).1[1]),
+                ("axis z", |c| axis_angle(c.stretch).1[2]),
+            ],
+            Component::Sign => vec![("f", |c| c.sign.into())],
+            Component::Shear => vec![("shear°", |c| c.shear_deg.into())],
+        }
+    }
+}
+
+fn euler(q: Quat) -> (f64, f64, f64) {
+    let (x, y, z) = q.to_euler(EulerRot::XYZ);
+    (f64::from(x.to_degrees()), f64::from(y.to_degrees()), f64::from(z.to_degrees()))
+}
+
+/// Angle in degrees and unit axis (the X axis for no rotation).
+fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
+    let (axis, angle) = q.to_axis_angle();
+    let axis = if axis.is_finite() && axis.length_squared() > 0.0 { axis } else { glam::Vec3::X };
+    (f64::from(angle.to_degrees()), axis.as_dvec3().to_array())
+}
+
+#[derive(Default)]
+pub struct Plots {
+    pub component: Component,
+    pub show_ghost: bool,
+}
+
+impl Plots {
+    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        ui.horizontal_wrapped(|ui| {
+            for c in Component::ALL {
+                ui.selectable_value(&mut self.component, c, c.label());
+            }
+            ui.separator();
+            ui.selectable_value(&mut shared.settings.plot_model_space, true, "model");
+            ui.selectable_value(&mut shared.settings.plot_model_space, false, "local");
+            if self.component == Component::Rotation {
+                ui.separator();
+                let f = &mut shared.settings.rotation_format;
+                ui.selectable_value(f, RotationFormat::Quaternion, "quaternion");
+                ui.selectable_value(f, RotationFormat::Euler, "Euler XYZ");
+                ui.selectable_value(f, RotationFormat::AxisAngle, "axis-angle");
+            }
+            if shared.doc.ghost.is_some() {
+                ui.separator();
+                ui.checkbox(&mut self.show_ghost, "ghost");
+            }
+        });
+        let plotted = plotted_bones(shared);
+        if plotted.is_empty() {
+            ui.label(RichText::new("Select bones to plot their components over the clip.").weak());
+            return;
+        }
+        let Some(analysis) = shared.analysis.filter(|a| plotted.iter().all(|b| a.curves_of(*b).is_some())) else {
+            ui.label(RichText::new("analysing the clip…").weak());
+            return;
+        };
+        self.plot(ui, shared, analysis, &plotted);
+    }
+
+    fn plot(&self, ui: &mut Ui, shared: &mut Shared, analysis: &ClipAnalysis, plotted: &[usize]) {
+        let channels = self.component.channels(shared.settings.rotation_format);
+        let model_space = shared.settings.plot_model_space;
+        let ghost = self.show_ghost && shared.doc.ghost.is_some() && model_space;
+        let time = *shared.time;
+        let names: Vec<String> = plotted.iter().map(|&b| shared.doc.rig.skeleton.bone(b).name.clone()).collect();
+        let response = Plot::new("components")
+            .height(ui.available_height().max(120.0))
+            // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
+            .include_x(0.0)
+            .include_x(shared.doc.duration())
+            .legend(egui_plot::Legend::default())
+            .x_axis_label("time (s)")
+            .allow_double_click_reset(true)
+            .show(ui, |plot_ui| {
+                let bounds = plot_ui.plot_bounds();
+                let x_range = bounds.min()[0]..=bounds.max()[0];
+                let columns = plot_ui.response().rect.width().max(1.0) as usize;
+                for (i, (&bone, name)) in plotted.iter().zip(&names).enumerate() {
+                    let Some(curves) = analysis.curves_of(bone) else { continue };
+                    let series = continuous(if model_space { &curves.model } else { &curves.local });
+                    let ghost_series = if ghost { continuous(&curves.ghost_model) } else { Vec::new() };
+                    for (c, (channel, read)) in channels.iter().enumerate() {
+                        let color = channel_color(i * channels.len() + c);
+                        let points = aggregate(&analysis.times, |s| read(&series[s]), x_range.clone(), columns);
+                        plot_ui.line(Line::new(format!("{name} {channel}"), PlotPoints::from(points)).color(color));
+                        if ghost {
+                            let points =
+                                aggregate(&analysis.times, |s| read(&ghost_series[s]), x_range.clone(), columns);
+                            let label = format!("{name} {channel} (ghost)");
+                            plot_ui.line(
+                                Line::new(label, PlotPoints::from(points))
+                                    .color(color.gamma_multiply(0.45))
+                                    .style(egui_plot::LineStyle::dashed_loose()),
+                            );
+                        }
+                    }
+                }
+                plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
+                plot_ui.pointer_coordinate()
+            });
+        if response.response.clicked()
+            && let Some(at) = response.inner
+        {
+            *shared.playing = false;
+            *shared.time = at.x.clamp(0.0, shared.doc.duration());
+        }
+    }
+}
+
+fn ui_cursor_color() -> Color32 {
+    Color32::from_rgb(255, 200, 60)
+}
+
+fn plotted_bones(shared: &Shared) -> Vec<usize> {
+    let skip = shared.selection.len().saturating_sub(super::MAX_PLOTTED);
+    let mut bones = shared.selection[skip..].to_vec();
+    bones.sort_unstable();
+    bones
+}
+
+/// Quaternions flipped where needed so consecutive samples stay in one hemisphere: `q` and `−q` are the same
+/// rotation, and the canonical `w ≥ 0` form would jump.
+fn continuous(series: &[Components]) -> Vec<Components> {
+    let mut out = series.to_vec();
+    for i in 1..out.len() {
+        if out[i].rotation.dot(out[i - 1].rotation) < 0.0 {
+            out[i].rotation = -out[i].rotation;
+        }
+        if out[i].stretch.dot(out[i - 1].stretch) < 0.0 {
+            out[i].stretch = -out[i].stretch;
+        }
+    }
+    out
+}
+
+/// Distinct colours for the curves, in order (bone by bone, channel by channel).
+fn channel_color(index: usize) -> Color32 {
+    const COLORS: [Color32; 8] = [
+        Color32::from_rgb(230, 80, 80),
+        Color32::from_rgb(80, 190, 90),
+        Color32::from_rgb(80, 140, 240),
+        Color32::from_rgb(230, 170, 50),
+        Color32::from_rgb(170, 100, 230),
+        Color32::from_rgb(50, 200, 200),
+        Color32::from_rgb(230, 110, 180),
+        Color32::from_rgb(160, 160, 160),
+    ];
+    COLORS[index % COLORS.len()]
+}
+
+/// The samples inside `x_range` reduced to at most two points (minimum and maximum, in time order) per pixel
+/// column, plus one sample either side so lines reach the edges. Short series pass through unchanged.
+pub fn aggregate(
+    times: &[f64],
+    value: impl Fn(usize) -> f64,
+    x_range: std::ops::RangeInclusive<f64>,
+    columns: usize,
+) -> Vec<[f64; 2]> {
+    let start = times.partition_point(|&t| t < *x_range.start()).saturating_sub(1);
+    let end = (times.partition_point(|&t| t <= *x_range.end()) + 1).min(times.len());
+    if start >= end {
+        return Vec::new();
+    }
+    if end - start <= 2 * columns.max(1) {
+        return (start..end).map(|s| [times[s], value(s)]).collect();
+    }
+    let (t0, t1) = (times[start], times[end - 1]);
+    let width = (t1 - t0).max(f64::MIN_POSITIVE) / columns as f64;
+    let mut points = Vec::with_capacity(2 * columns + 2);
+    let mut s = start;
+    while s < end {
+        let column = ((times[s] - t0) / width).floor();
+        let (mut lo, mut hi) = (s, s);
+        let mut next = s + 1;
+        while next < end && ((times[next] - t0) / width).floor() == column {
+            if value(next) < value(lo) {
+                lo = next;
+            }
+            if value(next) > value(hi) {
+                hi = next;
+            }
+            next += 1;
+        }
+        let (first, second) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+        points.push([times[first], value(first)]);
+        if second != first {
+            points.push([times[second], value(second)]);
+        }
+        s = next;
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aggregation_keeps_extremes_and_bounds_the_point_count() {
+        let times: Vec<f64> = (0..100_000).map(|i| i as f64 * 0.001).collect();
+        // A spike at one sample must survive the reduction.
+        let value = |s: usize| if s == 54_321 { 10.0 } else { (s as f64 * 0.01).sin() };
+        let points = aggregate(&times, value, 0.0..=100.0, 500);
+        assert!(points.len() <= 2 * 500 + 2, "{}", points.len());
+        assert!(points.iter().any(|p| p[1] == 10.0));
+        assert!(points.windows(2).all(|w| w[0][0] <= w[1][0]), "in time order");
+        // A visible range with few samples passes through, with a neighbour either side.
+        let few = aggregate(&times, value, 1.0..=1.0045, 500);
+        assert_eq!(few.len(), 7, "samples 1.000 to 1.004 and one either side");
+        assert!(aggregate(&[], value, 0.0..=1.0, 10).is_empty());
+    }
+}

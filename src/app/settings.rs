@@ -1,0 +1,127 @@
+//! What persists across restarts (eframe storage): theme, recent files, camera, view toggles, time display.
+
+use std::path::PathBuf;
+
+use crate::view::{Camera, SceneOptions};
+
+/// How times are shown. The library always works in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum TimeUnit {
+    #[default]
+    Seconds,
+    /// Frames at `Settings::frame_rate`.
+    Frames,
+    /// 3ds Max ticks, 4800 per second.
+    Ticks,
+}
+
+impl TimeUnit {
+    pub const ALL: [TimeUnit; 3] = [TimeUnit::Seconds, TimeUnit::Frames, TimeUnit::Ticks];
+    pub const TICKS_PER_SECOND: f64 = 4800.0;
+
+    pub fn label(self) -> &'static str {
+        match self {
+            TimeUnit::Seconds => "seconds",
+            TimeUnit::Frames => "frames",
+            TimeUnit::Ticks => "ticks",
+        }
+    }
+
+    /// `seconds` in this unit, as text.
+    pub fn format(self, seconds: f64, frame_rate: f64) -> String {
+        match self {
+            TimeUnit::Seconds => format!("{seconds:.3} s"),
+            TimeUnit::Frames => format!("frame {:.1}", seconds * frame_rate),
+            TimeUnit::Ticks => format!("{:.0} ticks", seconds * Self::TICKS_PER_SECOND),
+        }
+    }
+}
+
+/// Which plotted quantity, and how rotations are shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum RotationFormat {
+    #[default]
+    Quaternion,
+    /// XYZ Euler angles in degrees.
+    Euler,
+    /// Angle in degrees and unit axis.
+    AxisAngle,
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct Settings {
+    pub dark: bool,
+    /// Most recent first.
+    pub recent: Vec<PathBuf>,
+    pub camera: Camera,
+    pub scene: SceneOptions,
+    pub time_unit: TimeUnit,
+    pub frame_rate: f64,
+    pub speed: f64,
+    pub looping: bool,
+    pub rotation_format: RotationFormat,
+    /// Plot model-space components (else local).
+    pub plot_model_space: bool,
+    pub show_plots: bool,
+    pub show_inspector: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            dark: true,
+            recent: Vec::new(),
+            camera: Camera::default(),
+            scene: SceneOptions::default(),
+            time_unit: TimeUnit::Seconds,
+            frame_rate: 30.0,
+            speed: 1.0,
+            looping: true,
+            rotation_format: RotationFormat::Quaternion,
+            plot_model_space: true,
+            show_plots: true,
+            show_inspector: true,
+        }
+    }
+}
+
+/// How many recent files are kept.
+const RECENT_FILES: usize = 10;
+
+impl Settings {
+    pub const STORAGE_KEY: &'static str = "bonescope-settings";
+
+    /// Puts `path` first in the recent files.
+    pub fn remember(&mut self, path: PathBuf) {
+        self.recent.retain(|p| p != &path);
+        self.recent.insert(0, path);
+        self.recent.truncate(RECENT_FILES);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_units() {
+        assert_eq!(TimeUnit::Seconds.format(1.5, 30.0), "1.500 s");
+        assert_eq!(TimeUnit::Frames.format(1.5, 30.0), "frame 45.0");
+        assert_eq!(TimeUnit::Ticks.format(1.5, 30.0), "7200 ticks");
+    }
+
+    #[test]
+    fn recent_files_are_unique_most_recent_first_and_bounded() {
+        let mut s = Settings::default();
+        for i in 0..12 {
+            s.remember(PathBuf::from(format!("{i}.glb")));
+        }
+        s.remember(PathBuf::from("5.glb"));
+        assert_eq!(s.recent.len(), 10);
+        assert_eq!(s.recent[0], PathBuf::from("5.glb"));
+        assert_eq!(s.recent.iter().filter(|p| p.as_path() == std::path::Path::new("5.glb")).count(), 1);
+        let json = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<Settings>(&json).unwrap(), s);
+    }
+}

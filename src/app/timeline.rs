@@ -1,0 +1,164 @@
+//! Play, pause, loop, speed, frame step, and the time bar: keyframe ticks of the selected bones and a strip that
+//! marks when the selected bone (or, with nothing selected, any bone) is stretched.
+
+use egui::{Color32, Rect, Sense, Stroke, pos2, vec2};
+
+use super::{Shared, TimeUnit};
+use crate::model::Clip;
+use crate::view::Badge;
+
+pub fn ui(ui: &mut egui::Ui, shared: &mut Shared) {
+    ui.add_space(4.0);
+    ui.horizontal(|ui| controls(ui, shared));
+    time_bar(ui, shared);
+    ui.add_space(4.0);
+}
+
+fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
+    let duration = shared.doc.duration();
+    let step = 1.0 / shared.settings.frame_rate.max(1.0);
+    if ui.button("Previous frame").on_hover_text("← key").clicked() {
+        *shared.playing = false;
+        *shared.time = (*shared.time - step).max(0.0);
+    }
+    let play_label = if *shared.playing { "Pause" } else { "Play" };
+    if ui.button(play_label).on_hover_text("Space").clicked() {
+        *shared.playing = !*shared.playing;
+    }
+    if ui.button("Next frame").on_hover_text("→ key").clicked() {
+        *shared.playing = false;
+        *shared.time = (*shared.time + step).min(duration);
+    }
+    ui.checkbox(&mut shared.settings.looping, "Loop");
+    ui.add(egui::DragValue::new(&mut shared.settings.speed).range(0.01..=10.0).speed(0.01).prefix("speed ×"));
+    ui.separator();
+    let (unit, rate) = (shared.settings.time_unit, shared.settings.frame_rate);
+    ui.label(egui::RichText::new(unit.format(*shared.time, rate)).monospace().strong());
+    ui.label(format!("of {}", unit.format(duration, rate)));
+    let label = ui.label("in");
+    egui::ComboBox::from_id_salt("time-unit")
+        .selected_text(unit.label())
+        .show_ui(ui, |ui| {
+            for u in TimeUnit::ALL {
+                ui.selectable_value(&mut shared.settings.time_unit, u, u.label());
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    ui.add(egui::DragValue::new(&mut shared.settings.frame_rate).range(1.0..=1000.0).suffix(" fps"));
+    if let Some((done, total)) = shared.progress {
+        ui.separator();
+        let fraction = if total > 0 { done as f32 / total as f32 } else { 0.0 };
+        ui.add(egui::ProgressBar::new(fraction).desired_width(140.0).text("analysing clip"));
+    }
+}
+
+const BAR_HEIGHT: f32 = 34.0;
+const STRIP_HEIGHT: f32 = 6.0;
+
+fn time_bar(ui: &mut egui::Ui, shared: &mut Shared) {
+    let duration = shared.doc.duration();
+    let (rect, response) = ui.allocate_exact_size(vec2(ui.available_width(), BAR_HEIGHT), Sense::click_and_drag());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "time bar"));
+    let x_of = |t: f64| rect.left() + (if duration > 0.0 { (t / duration) as f32 } else { 0.0 }) * rect.width();
+    if (response.clicked() || response.dragged())
+        && let Some(p) = response.interact_pointer_pos()
+    {
+        *shared.playing = false;
+        *shared.time = (f64::from((p.x - rect.left()) / rect.width().max(1.0)) * duration).clamp(0.0, duration);
+    }
+    let painter = ui.painter_at(rect);
+    let visuals = ui.visuals();
+    painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
+    seconds_grid(&painter, rect, duration, visuals.weak_text_color(), x_of);
+    if let Some(clip) = shared.doc.clip() {
+        key_ticks(&painter, rect, clip, shared.selection, visuals.text_color(), x_of);
+    }
+    stretch_strip(&painter, rect, shared, x_of);
+    let x = x_of(*shared.time);
+    painter.line_segment([pos2(x, rect.top()), pos2(x, rect.bottom())], Stroke::new(2.0, visuals.selection.bg_fill));
+}
+
+fn seconds_grid(painter: &egui::Painter, rect: Rect, duration: f64, color: Color32, x_of: impl Fn(f64) -> f32) {
+    if duration <= 0.0 {
+        return;
+    }
+    let step = [0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 60.0, 300.0, 600.0]
+        .into_iter()
+        .find(|s| duration / s <= 20.0)
+        .unwrap_or(duration / 10.0);
+    let mut t = 0.0;
+    while t <= duration + 1e-9 {
+        let x = x_of(t);
+        painter.line_segment([pos2(x, rect.bottom() - 8.0), pos2(x, rect.bottom())], Stroke::new(1.0, color));
+        painter.text(
+            pos2(x + 2.0, rect.bottom() - 9.0),
+            egui::Align2::LEFT_BOTTOM,
+            format!("{t:.2}"),
+            egui::FontId::proportional(9.0),
+            color,
+        );
+        t += step;
+    }
+}
+
+/// Key times of the selected bones' tracks as short ticks at the top.
+fn key_ticks(
+    painter: &egui::Painter,
+    rect: Rect,
+    clip: &Clip,
+    selection: &[usize],
+    color: Color32,
+    x_of: impl Fn(f64) -> f32,
+) {
+    let mut last_x = f32::NEG_INFINITY;
+    for &bone in selection {
+        let Some(tracks) = clip.tracks_of(bone) else { continue };
+        let times = [
+            tracks.translation.as_ref().map(|t| t.times()),
+            tracks.rotation.as_ref().map(|t| t.times()),
+            tracks.scale.as_ref().map(|t| t.times()),
+        ];
+        for &t in times.into_iter().flatten().flatten() {
+            let x = x_of(t);
+            // Thousands of keys collapse to one tick per pixel.
+            if (x - last_x).abs() >= 1.0 {
+                painter.line_segment([pos2(x, rect.top() + 2.0), pos2(x, rect.top() + 9.0)], Stroke::new(1.0, color));
+                last_x = x;
+            }
+        }
+    }
+}
+
+/// Stretched spans of the inspected bone (or of any bone) as a coloured strip, one test per pixel column.
+fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: impl Fn(f64) -> f32) {
+    let Some(analysis) = shared.analysis else { return };
+    let bone = shared.inspected();
+    let strip =
+        Rect::from_min_size(pos2(rect.left(), rect.center().y - STRIP_HEIGHT / 2.0), vec2(rect.width(), STRIP_HEIGHT));
+    let flagged = |sample: usize| match bone {
+        Some(b) => analysis.stretched_at(b, sample),
+        None => analysis.any_stretched_at(sample),
+    };
+    let color = Badge::Stretched.color();
+    let mut span_start: Option<f64> = None;
+    for (sample, &time) in analysis.times.iter().enumerate() {
+        let on = flagged(sample);
+        let last = sample + 1 == analysis.times.len();
+        match (span_start, on) {
+            (None, true) => span_start = Some(time),
+            (Some(start), false) => {
+                paint_span(painter, strip, x_of(start), x_of(time), color);
+                span_start = None;
+            }
+            _ => {}
+        }
+        if last && let Some(start) = span_start {
+            paint_span(painter, strip, x_of(start), x_of(time), color);
+        }
+    }
+}
+
+fn paint_span(painter: &egui::Painter, strip: Rect, x0: f32, x1: f32, color: Color32) {
+    painter.rect_filled(Rect::from_x_y_ranges(x0..=x1.max(x0 + 1.0), strip.y_range()), 0.0, color);
+}

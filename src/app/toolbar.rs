@@ -1,0 +1,133 @@
+//! The menu bar and the toolbar: files, the animation, the inheritance mode of every bone, the ghost mode.
+
+use std::path::PathBuf;
+
+use egui::RichText;
+
+use super::{ModeScope, Shared};
+use crate::model::InheritMode;
+
+/// What the toolbar asks the app to do after the frame (things that replace the document).
+#[derive(Default)]
+pub struct Actions {
+    pub open_dialog: bool,
+    pub open: Option<PathBuf>,
+    pub open_demo: bool,
+    pub frame_all: bool,
+    pub clip_changed: bool,
+}
+
+pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+    egui::MenuBar::new().ui(ui, |ui| {
+        ui.menu_button("File", |ui| file_menu(ui, shared, actions));
+        ui.menu_button("View", |ui| view_menu(ui, shared, actions));
+        ui.separator();
+        ui.label(RichText::new(shared.doc.title()).strong());
+    });
+    ui.horizontal(|ui| {
+        clip_picker(ui, shared, actions);
+        ui.separator();
+        mode_picker(ui, shared);
+        ui.separator();
+        ghost_picker(ui, shared);
+    });
+}
+
+fn file_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+    if ui.button("Open…").clicked() {
+        actions.open_dialog = true;
+    }
+    if ui.button("Open demo rig").clicked() {
+        actions.open_demo = true;
+    }
+    ui.menu_button("Open recent", |ui| {
+        if shared.settings.recent.is_empty() {
+            ui.label("no recent files");
+        }
+        for path in &shared.settings.recent {
+            if ui.button(path.display().to_string()).clicked() {
+                actions.open = Some(path.clone());
+            }
+        }
+    });
+    ui.separator();
+    if ui.button("Quit").clicked() {
+        ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+}
+
+fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+    ui.checkbox(&mut shared.settings.dark, "Dark theme");
+    ui.checkbox(&mut shared.settings.show_plots, "Plots");
+    ui.checkbox(&mut shared.settings.show_inspector, "Inspector");
+    if ui.button("Frame all").clicked() {
+        actions.frame_all = true;
+    }
+}
+
+fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+    let label = ui.label("Animation");
+    let clips = &shared.doc.rig.clips;
+    let current = shared.doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
+    let mut chosen = shared.doc.clip;
+    egui::ComboBox::from_id_salt("animation")
+        .selected_text(current)
+        .show_ui(ui, |ui| {
+            for clip in clips {
+                ui.selectable_value(
+                    &mut chosen,
+                    Some(clip.index),
+                    format!("{} ({:.2} s)", clip.label(), clip.duration()),
+                );
+            }
+            ui.selectable_value(&mut chosen, None, "rest pose");
+        })
+        .response
+        .labelled_by(label.id);
+    if chosen != shared.doc.clip {
+        shared.doc.clip = chosen;
+        actions.clip_changed = true;
+    }
+}
+
+/// The mode of every bone at once (per-bone edits live in the outliner).
+fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
+    let label = ui.label("Inherit scale");
+    let text = shared.doc.common_mode().map_or("mixed", InheritMode::id);
+    let mut chosen = None;
+    egui::ComboBox::from_id_salt("inherit-all")
+        .selected_text(text)
+        .width(170.0)
+        .show_ui(ui, |ui| {
+            for mode in InheritMode::ALL {
+                if ui
+                    .selectable_label(shared.doc.common_mode() == Some(mode), mode.id())
+                    .on_hover_text(mode.description())
+                    .clicked()
+                {
+                    chosen = Some(mode);
+                }
+            }
+        })
+        .response
+        .labelled_by(label.id);
+    if let Some(mode) = chosen {
+        shared.doc.set_mode(0, ModeScope::All, mode);
+    }
+}
+
+fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
+    let label = ui.label("Ghost");
+    let text = shared.doc.ghost.map_or("off", InheritMode::id);
+    egui::ComboBox::from_id_salt("ghost")
+        .selected_text(text)
+        .width(170.0)
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut shared.doc.ghost, None, "off");
+            for mode in InheritMode::ALL {
+                ui.selectable_value(&mut shared.doc.ghost, Some(mode), mode.id()).on_hover_text(mode.description());
+            }
+        })
+        .response
+        .labelled_by(label.id);
+}

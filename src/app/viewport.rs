@@ -1,0 +1,99 @@
+//! The viewport panel: view toggles and the camera controls around the shared painting code of `view`.
+//!
+//! Left drag orbits (a 2D view turns into the 3D one), right or middle drag pans, the wheel zooms, a click
+//! selects the bone under the pointer, F frames the selection (or everything).
+
+use egui::{Sense, Ui};
+use glam::DVec2;
+
+use super::{Document, Shared};
+use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, bind_pose, motion_bounds, paint};
+
+/// Poses sampled to find the bounds of a clip's motion.
+const MOTION_SAMPLES: usize = 24;
+
+#[derive(Default)]
+pub struct Viewport;
+
+impl Viewport {
+    /// Frames the whole motion of the current clip.
+    pub fn frame_all(&self, doc: &Document, camera: &mut Camera) {
+        if let Some(bounds) = motion_bounds(&doc.rig, doc.clip(), &doc.modes, MOTION_SAMPLES) {
+            camera.frame(&bounds);
+        }
+    }
+
+    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        toolbar(ui, shared);
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
+        let rig = shared.doc.rig.clone();
+        let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
+        scene.ghost = shared.frame.ghost.clone();
+        scene.selected = shared.selection.clone();
+        if shared.settings.scene.bind_pose {
+            scene.bind_pose = Some(bind_pose(&rig));
+        }
+        navigate(ui, &response, rect, &mut shared.settings.camera);
+        if response.clicked()
+            && let Some(at) = response.interact_pointer_pos()
+        {
+            let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
+            match paint::pick(&scene, &shared.settings.camera, rect, at) {
+                Some(bone) => shared.select(bone, extend),
+                None if !extend => shared.selection.clear(),
+                None => {}
+            }
+        }
+        if response.hovered() && ui.input(|i| i.key_pressed(egui::Key::F)) {
+            frame_selection(&scene, shared.selection, &mut shared.settings.camera);
+        }
+        let camera = &shared.settings.camera;
+        let palette = Palette::new(ui.visuals().dark_mode);
+        paint::paint(ui.painter(), rect, camera, &scene, &palette);
+    }
+}
+
+/// Orbit, pan and zoom from the pointer.
+fn navigate(ui: &Ui, response: &egui::Response, rect: egui::Rect, camera: &mut Camera) {
+    if response.dragged_by(egui::PointerButton::Primary) {
+        let d = response.drag_delta();
+        camera.orbit(DVec2::new(f64::from(d.x), f64::from(d.y)) * 0.008);
+    }
+    if response.dragged_by(egui::PointerButton::Secondary) || response.dragged_by(egui::PointerButton::Middle) {
+        let d = response.drag_delta() / rect.height().max(1.0);
+        camera.pan(DVec2::new(f64::from(d.x), f64::from(d.y)));
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            camera.zoom((f64::from(scroll) * 0.003).exp());
+        }
+    }
+}
+
+fn frame_selection(scene: &Scene, selection: &[usize], camera: &mut Camera) {
+    let selected = Bounds::of(selection.iter().map(|&b| scene.primary.head(b)));
+    if let Some(bounds) = selected.filter(|_| !selection.is_empty()).or_else(|| scene.bounds()) {
+        camera.frame(&bounds);
+    }
+}
+
+fn toolbar(ui: &mut Ui, shared: &mut Shared) {
+    ui.horizontal_wrapped(|ui| {
+        for view in ViewKind::ALL {
+            ui.selectable_value(&mut shared.settings.camera.view, view, view.label());
+        }
+        ui.separator();
+        let o = &mut shared.settings.scene;
+        ui.toggle_value(&mut o.bones, "Bones");
+        ui.toggle_value(&mut o.axes, "Axes");
+        ui.toggle_value(&mut o.boxes, "Boxes").on_hover_text("a unit box per bone: shear slants it");
+        ui.toggle_value(&mut o.mesh, "Mesh");
+        ui.toggle_value(&mut o.wireframe, "Wireframe");
+        ui.toggle_value(&mut o.bind_pose, "Bind pose");
+        ui.toggle_value(&mut o.names, "Names");
+        ui.toggle_value(&mut o.grid, "Grid");
+        ui.toggle_value(&mut o.legend, "Legend");
+    });
+}

@@ -1,0 +1,233 @@
+//! The viewport's camera: an orbit camera for the 3D view and orthographic front, side and top views.
+
+use glam::dcamera::rh::{proj::opengl, view::look_at_mat4};
+use glam::{DMat4, DVec2, DVec3, DVec4};
+
+/// Which view the viewport shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ViewKind {
+    /// 3D perspective with orbit.
+    #[default]
+    Persp,
+    /// Orthographic, looking down −Z (X right, Y up).
+    Front,
+    /// Orthographic, looking down −X (Z right... from +X: −Z right, Y up).
+    Side,
+    /// Orthographic, looking down −Y (X right, −Z up).
+    Top,
+}
+
+impl ViewKind {
+    pub const ALL: [ViewKind; 4] = [ViewKind::Persp, ViewKind::Front, ViewKind::Side, ViewKind::Top];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ViewKind::Persp => "Persp",
+            ViewKind::Front => "Front",
+            ViewKind::Side => "Side",
+            ViewKind::Top => "Top",
+        }
+    }
+
+    /// Direction from the target to the eye, and the screen's up, for the orthographic views.
+    fn fixed_direction(self) -> Option<(DVec3, DVec3)> {
+        match self {
+            ViewKind::Persp => None,
+            ViewKind::Front => Some((DVec3::Z, DVec3::Y)),
+            ViewKind::Side => Some((DVec3::X, DVec3::Y)),
+            ViewKind::Top => Some((DVec3::Y, -DVec3::Z)),
+        }
+    }
+}
+
+/// Axis-aligned bounds of what should be in view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Bounds {
+    /// The bounds of some points; `None` when there are none (or none finite).
+    pub fn of(points: impl IntoIterator<Item = DVec3>) -> Option<Self> {
+        points.into_iter().filter(|p| p.is_finite()).fold(None, |b: Option<Bounds>, p| {
+            Some(b.map_or(Bounds { min: p, max: p }, |b| Bounds { min: b.min.min(p), max: b.max.max(p) }))
+        })
+    }
+
+    pub fn union(self, other: Bounds) -> Bounds {
+        Bounds { min: self.min.min(other.min), max: self.max.max(other.max) }
+    }
+
+    pub fn center(&self) -> DVec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Half the diagonal, at least a centimetre so a single point still frames.
+    pub fn radius(&self) -> f64 {
+        ((self.max - self.min).length() * 0.5).max(0.01)
+    }
+}
+
+/// Where the camera looks from. Angles in radians; `distance` in model units.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Camera {
+    pub view: ViewKind,
+    /// Turn about +Y; 0 looks down −Z (from the front).
+    pub yaw: f64,
+    /// Elevation above the horizon.
+    pub pitch: f64,
+    pub distance: f64,
+    pub target: DVec3,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera { view: ViewKind::Persp, yaw: 0.6, pitch: 0.35, distance: 5.0, target: DVec3::new(1.0, 1.0, 0.0) }
+    }
+}
+
+/// Vertical field of view of the perspective view.
+const FOV_Y: f64 = 0.8;
+
+impl Camera {
+    /// A camera with this view and angles that frames `bounds`.
+    pub fn framing(view: ViewKind, yaw: f64, pitch: f64, bounds: &Bounds) -> Self {
+        let mut camera = Camera { view, yaw, pitch, ..Camera::default() };
+        camera.frame(bounds);
+        camera
+    }
+
+    /// Moves the target to the centre of `bounds` and the eye back until they fit.
+    pub fn frame(&mut self, bounds: &Bounds) {
+        self.target = bounds.center();
+        self.distance = bounds.radius() / (FOV_Y * 0.5).tan() * 1.15;
+    }
+
+    /// Direction from the target to the eye, and up.
+    fn eye_direction(&self) -> (DVec3, DVec3) {
+        self.view.fixed_direction().unwrap_or_else(|| {
+            let (sy, cy) = self.yaw.sin_cos();
+            let (sp, cp) = self.pitch.sin_cos();
+            (DVec3::new(cp * sy, sp, cp * cy), DVec3::Y)
+        })
+    }
+
+    pub fn eye(&self) -> DVec3 {
+        self.target + self.eye_direction().0 * self.distance
+    }
+
+    /// Model space → clip space for a viewport of the given aspect ratio (width / height).
+    pub fn view_projection(&self, aspect: f64) -> DMat4 {
+        let (direction, up) = self.eye_direction();
+        let view = look_at_mat4(self.target + direction * self.distance, self.target, up);
+        let far = self.distance * 20.0 + 100.0;
+        let projection = match self.view {
+            ViewKind::Persp => opengl::perspective(FOV_Y, aspect.max(1e-3), (self.distance * 0.01).max(1e-4), far),
+            _ => {
+                // The same extent as the perspective view has at the target, so switching views keeps the scale.
+                let half_height = self.distance * (FOV_Y * 0.5).tan();
+                let half_width = half_height * aspect;
+                opengl::orthographic(-half_width, half_width, -half_height, half_height, -far, far)
+            }
+        };
+        projection * view
+    }
+
+    /// Turns the 3D camera by a drag of `delta` radians (x: yaw, y: pitch); switches a 2D view to 3D.
+    pub fn orbit(&mut self, delta: DVec2) {
+        self.view = ViewKind::Persp;
+        self.yaw -= delta.x;
+        self.pitch = (self.pitch + delta.y).clamp(-1.55, 1.55);
+    }
+
+    /// Moves the target in the view plane by a fraction of the visible height.
+    pub fn pan(&mut self, delta: DVec2) {
+        let (direction, up) = self.eye_direction();
+        let right = up.cross(direction).normalize();
+        let screen_up = direction.cross(right);
+        let extent = self.distance * (FOV_Y * 0.5).tan() * 2.0;
+        self.target += (-right * delta.x + screen_up * delta.y) * extent;
+    }
+
+    /// Zooms by a factor (> 1 moves closer).
+    pub fn zoom(&mut self, factor: f64) {
+        if factor.is_finite() && factor > 0.0 {
+            self.distance = (self.distance / factor).clamp(1e-3, 1e6);
+        }
+    }
+}
+
+/// Projects model-space points into a screen rectangle.
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
+    view_projection: DMat4,
+    origin: DVec2,
+    size: DVec2,
+}
+
+impl Projection {
+    /// `origin` is the rectangle's top-left corner, `size` its width and height, in points.
+    pub fn new(camera: &Camera, origin: DVec2, size: DVec2) -> Self {
+        let aspect = if size.y > 0.0 { size.x / size.y } else { 1.0 };
+        Projection { view_projection: camera.view_projection(aspect), origin, size }
+    }
+
+    /// The screen position and depth (larger is farther) of `p`; `None` behind the eye.
+    pub fn project(&self, p: DVec3) -> Option<(DVec2, f64)> {
+        let clip: DVec4 = self.view_projection * p.extend(1.0);
+        if clip.w <= 1e-9 {
+            return None;
+        }
+        let ndc = clip.truncate() / clip.w;
+        let screen = self.origin + DVec2::new((ndc.x + 1.0) * 0.5 * self.size.x, (1.0 - ndc.y) * 0.5 * self.size.y);
+        Some((screen, ndc.z))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn projection(camera: &Camera) -> Projection {
+        Projection::new(camera, DVec2::ZERO, DVec2::new(200.0, 100.0))
+    }
+
+    #[test]
+    fn the_target_projects_to_the_centre_in_every_view() {
+        for view in ViewKind::ALL {
+            let camera = Camera { view, ..Camera::default() };
+            let (p, _) = projection(&camera).project(camera.target).unwrap();
+            assert!(p.abs_diff_eq(DVec2::new(100.0, 50.0), 1e-9), "{view:?}: {p}");
+        }
+    }
+
+    #[test]
+    fn front_view_maps_x_right_and_y_up() {
+        let camera = Camera { view: ViewKind::Front, target: DVec3::ZERO, ..Camera::default() };
+        let p = projection(&camera);
+        let (right, _) = p.project(DVec3::X).unwrap();
+        let (up, _) = p.project(DVec3::Y).unwrap();
+        assert!(right.x > 100.0 && (right.y - 50.0).abs() < 1e-9);
+        assert!(up.y < 50.0 && (up.x - 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn framing_puts_the_bounds_in_view() {
+        let bounds = Bounds { min: DVec3::new(-3.0, 0.0, -1.0), max: DVec3::new(5.0, 2.0, 1.0) };
+        let camera = Camera::framing(ViewKind::Persp, 0.6, 0.35, &bounds);
+        let p = projection(&camera);
+        for corner in 0..8 {
+            let pick = |bit: usize, lo: f64, hi: f64| if corner & bit == 0 { lo } else { hi };
+            let c = DVec3::new(
+                pick(1, bounds.min.x, bounds.max.x),
+                pick(2, bounds.min.y, bounds.max.y),
+                pick(4, bounds.min.z, bounds.max.z),
+            );
+            let (s, _) = p.project(c).unwrap();
+            assert!((-1.0..=201.0).contains(&s.x) && (-1.0..=101.0).contains(&s.y), "{c} → {s}");
+        }
+        assert!(Bounds::of([DVec3::NAN]).is_none());
+    }
+}

@@ -1,0 +1,324 @@
+//! Painting a [`Scene`] with egui's painter: the one drawing path of the app's viewport and of headless renders.
+//!
+//! Solid geometry (the translucent skinned mesh, then bones as octahedra over it) is flat-shaded and drawn back to
+//! front (painter's algorithm); lines and markers (grid, axis triads, boxes, joints, names) go on top so they are
+//! never hidden.
+
+use egui::epaint::Mesh as EguiMesh;
+use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke};
+use glam::{DMat4, DVec2, DVec3};
+
+use super::camera::{Camera, Projection};
+use super::scene::{Layer, Scene};
+use super::style::{Badge, Palette};
+
+/// Paints `scene` into `rect` as seen by `camera`.
+pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, palette: &Palette) {
+    let projection = projection(camera, rect);
+    painter.rect_filled(rect, 0.0, palette.background);
+    let painter = painter.with_clip_rect(rect);
+    let options = &scene.options;
+    if options.grid {
+        paint_grid(&painter, &projection, scene, palette);
+    }
+    if options.bind_pose
+        && let Some(bind) = &scene.bind_pose
+    {
+        paint_skeleton_lines(&painter, &projection, scene, bind, Stroke::new(1.5, palette.bind_pose));
+    }
+    // The mesh is translucent and the bones are drawn over it (x-ray), so the skeleton is never hidden.
+    if options.mesh {
+        let mut triangles = Vec::new();
+        mesh_triangles(&mut triangles, &projection, scene, &scene.primary, palette.mesh, camera);
+        paint_sorted(&painter, triangles);
+    }
+    if options.bones {
+        let mut triangles = Vec::new();
+        bone_triangles(&mut triangles, &projection, scene, &scene.primary, palette, camera, None);
+        paint_sorted(&painter, triangles);
+    }
+    if let Some(ghost) = &scene.ghost {
+        let mut ghost_triangles = Vec::new();
+        if options.bones {
+            bone_triangles(&mut ghost_triangles, &projection, scene, ghost, palette, camera, Some(palette.ghost));
+        }
+        paint_sorted(&painter, ghost_triangles);
+        if options.axes {
+            paint_axes(&painter, &projection, ghost, scene.gizmo_size, |c| c.gamma_multiply(0.45));
+        }
+    }
+    if options.wireframe {
+        paint_wireframe(&painter, &projection, scene, palette);
+    }
+    if options.boxes {
+        paint_boxes(&painter, &projection, scene, palette);
+    }
+    if options.axes {
+        paint_axes(&painter, &projection, &scene.primary, scene.gizmo_size, |c| c);
+    }
+    paint_joints(&painter, &projection, scene, palette);
+    if options.legend {
+        paint_legend(&painter, rect, palette);
+    }
+}
+
+/// The projection for a camera and a screen rectangle.
+pub fn projection(camera: &Camera, rect: Rect) -> Projection {
+    Projection::new(
+        camera,
+        DVec2::new(rect.min.x.into(), rect.min.y.into()),
+        DVec2::new(rect.width().into(), rect.height().into()),
+    )
+}
+
+fn pos(p: DVec2) -> Pos2 {
+    Pos2::new(p.x as f32, p.y as f32)
+}
+
+fn screen(projection: &Projection, p: DVec3) -> Option<Pos2> {
+    projection.project(p).map(|(s, _)| pos(s))
+}
+
+fn line(painter: &Painter, projection: &Projection, a: DVec3, b: DVec3, stroke: Stroke) {
+    if let (Some(a), Some(b)) = (screen(projection, a), screen(projection, b)) {
+        painter.line_segment([a, b], stroke);
+    }
+}
+
+/// The bone a click at `at` hits: the nearest bone segment (or joint) within 10 points.
+pub fn pick(scene: &Scene, camera: &Camera, rect: Rect, at: Pos2) -> Option<usize> {
+    let projection = projection(camera, rect);
+    let at = glam::Vec2::new(at.x, at.y);
+    let mut best: Option<(f32, usize)> = None;
+    for bone in 0..scene.primary.model.len() {
+        let Some(head) = screen(&projection, scene.primary.head(bone)) else { continue };
+        let head = glam::Vec2::new(head.x, head.y);
+        let tail =
+            scene.tail(&scene.primary, bone).and_then(|t| screen(&projection, t)).map(|t| glam::Vec2::new(t.x, t.y));
+        let distance = match tail {
+            Some(tail) => {
+                let d = tail - head;
+                let t = if d.length_squared() > 0.0 {
+                    ((at - head).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (head + d * t).distance(at)
+            }
+            None => head.distance(at),
+        };
+        if distance <= 10.0 && best.is_none_or(|(d, _)| distance < d) {
+            best = Some((distance, bone));
+        }
+    }
+    best.map(|(_, bone)| bone)
+}
+
+fn paint_grid(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
+    let radius = scene.bounds().map_or(2.0, |b| b.radius().max(b.center().length()));
+    let step = nice_step(radius / 5.0);
+    let lines = (radius * 1.5 / step).ceil() as i32;
+    let extent = f64::from(lines) * step;
+    for i in -lines..=lines {
+        let c = f64::from(i) * step;
+        let color = if i == 0 { palette.grid_axis } else { palette.grid };
+        line(painter, projection, DVec3::new(c, 0.0, -extent), DVec3::new(c, 0.0, extent), Stroke::new(1.0, color));
+        line(painter, projection, DVec3::new(-extent, 0.0, c), DVec3::new(extent, 0.0, c), Stroke::new(1.0, color));
+    }
+}
+
+/// 1, 2 or 5 times a power of ten, at least `x`.
+fn nice_step(x: f64) -> f64 {
+    let power = 10f64.powf(x.max(1e-6).log10().floor());
+    [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= x).unwrap_or(10.0 * power)
+}
+
+fn paint_skeleton_lines(painter: &Painter, projection: &Projection, scene: &Scene, model: &[DMat4], stroke: Stroke) {
+    for (bone, b) in scene.rig.skeleton.bones().iter().enumerate() {
+        if let Some(parent) = b.parent {
+            line(painter, projection, model[parent].w_axis.truncate(), model[bone].w_axis.truncate(), stroke);
+        }
+    }
+}
+
+/// A screen-space triangle with its depth and colour.
+struct Triangle {
+    points: [Pos2; 3],
+    depth: f64,
+    color: Color32,
+}
+
+/// Flat shading: brighter where the face looks at the eye.
+fn shade(color: Color32, normal: DVec3, toward_eye: DVec3) -> Color32 {
+    let light = 0.45 + 0.55 * normal.dot(toward_eye).abs();
+    let [r, g, b, a] = color.to_srgba_unmultiplied();
+    let f = |c: u8| (f64::from(c) * light).round().clamp(0.0, 255.0) as u8;
+    Color32::from_rgba_unmultiplied(f(r), f(g), f(b), a)
+}
+
+fn push_triangle(out: &mut Vec<Triangle>, projection: &Projection, corners: [DVec3; 3], color: Color32, eye: DVec3) {
+    let projected = corners.map(|c| projection.project(c));
+    let [Some(a), Some(b), Some(c)] = projected else { return };
+    let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
+    let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+    let toward_eye = (eye - centre).normalize_or_zero();
+    out.push(Triangle {
+        points: [pos(a.0), pos(b.0), pos(c.0)],
+        depth: (a.1 + b.1 + c.1) / 3.0,
+        color: shade(color, normal, toward_eye),
+    });
+}
+
+fn paint_sorted(painter: &Painter, mut triangles: Vec<Triangle>) {
+    triangles.sort_by(|a, b| b.depth.total_cmp(&a.depth));
+    let mut mesh = EguiMesh::default();
+    for t in triangles {
+        let base = mesh.vertices.len() as u32;
+        for p in t.points {
+            mesh.colored_vertex(p, t.color);
+        }
+        mesh.add_triangle(base, base + 1, base + 2);
+    }
+    painter.add(Shape::mesh(mesh));
+}
+
+fn mesh_triangles(
+    out: &mut Vec<Triangle>,
+    projection: &Projection,
+    scene: &Scene,
+    layer: &Layer,
+    color: Color32,
+    camera: &Camera,
+) {
+    let eye = camera.eye();
+    for (mesh, positions) in scene.rig.meshes.iter().zip(&layer.meshes) {
+        for tri in mesh.indices.chunks_exact(3) {
+            let corner = |i: u32| positions.get(i as usize).copied();
+            if let (Some(a), Some(b), Some(c)) = (corner(tri[0]), corner(tri[1]), corner(tri[2])) {
+                push_triangle(out, projection, [a, b, c], color, eye);
+            }
+        }
+    }
+}
+
+/// The colour of a bone: selection first, then its most serious finding.
+fn bone_color(scene: &Scene, layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
+    if scene.selected.contains(&bone) {
+        palette.selected
+    } else {
+        Badge::primary(&layer.findings[bone]).map_or(palette.bone, Badge::color)
+    }
+}
+
+/// Octahedral bones from head to tail: a waist at a fifth of the length, a tenth as wide as long, oriented by the
+/// bone's own X axis so twists show.
+fn bone_triangles(
+    out: &mut Vec<Triangle>,
+    projection: &Projection,
+    scene: &Scene,
+    layer: &Layer,
+    palette: &Palette,
+    camera: &Camera,
+    tint: Option<Color32>,
+) {
+    let eye = camera.eye();
+    for bone in 0..layer.model.len() {
+        let head = layer.head(bone);
+        let Some(tail) = scene.tail(layer, bone) else { continue };
+        let along = tail - head;
+        let length = along.length();
+        if length < 1e-9 {
+            continue;
+        }
+        let axis = along / length;
+        let reference = layer.model[bone].x_axis.truncate();
+        let reference = if reference.cross(axis).length() > 1e-6 { reference } else { axis.any_orthonormal_vector() };
+        let u = (reference - axis * reference.dot(axis)).normalize() * length * 0.1;
+        let v = axis.cross(u.normalize()) * length * 0.1;
+        let waist = head + along * 0.2;
+        let ring = [waist + u, waist + v, waist - u, waist - v];
+        let color = tint.unwrap_or_else(|| bone_color(scene, layer, bone, palette));
+        for i in 0..4 {
+            let (a, b) = (ring[i], ring[(i + 1) % 4]);
+            push_triangle(out, projection, [head, b, a], color, eye);
+            push_triangle(out, projection, [a, b, tail], color, eye);
+        }
+    }
+}
+
+fn paint_wireframe(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
+    let stroke = Stroke::new(0.6, palette.text.gamma_multiply(0.35));
+    for (mesh, positions) in scene.rig.meshes.iter().zip(&scene.primary.meshes) {
+        let screen_positions: Vec<Option<Pos2>> = positions.iter().map(|p| screen(projection, *p)).collect();
+        for tri in mesh.indices.chunks_exact(3) {
+            for (a, b) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
+                if let (Some(Some(a)), Some(Some(b))) =
+                    (screen_positions.get(a as usize), screen_positions.get(b as usize))
+                {
+                    painter.line_segment([*a, *b], stroke);
+                }
+            }
+        }
+    }
+}
+
+/// Each bone's matrix applied to a cube of side `gizmo_size` centred on the joint: shear slants it.
+fn paint_boxes(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
+    let h = scene.gizmo_size * 0.5;
+    let layer = &scene.primary;
+    for (bone, model) in layer.model.iter().enumerate() {
+        let corner = |i: usize| {
+            let pick = |bit: usize| if i & bit == 0 { -h } else { h };
+            model.transform_point3(DVec3::new(pick(1), pick(2), pick(4)))
+        };
+        let color = Badge::primary(&layer.findings[bone]).map_or(palette.bone.gamma_multiply(0.6), Badge::color);
+        for (a, b) in [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)] {
+            line(painter, projection, corner(a), corner(b), Stroke::new(1.2, color));
+        }
+    }
+}
+
+/// Axis triads from the model matrix columns, scaled by the gizmo size: their lengths show scale, their angles
+/// show shear.
+fn paint_axes(painter: &Painter, projection: &Projection, layer: &Layer, size: f64, tint: impl Fn(Color32) -> Color32) {
+    let palette_axes = Palette::new(true).axes;
+    for model in &layer.model {
+        let origin = model.w_axis.truncate();
+        for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
+            line(painter, projection, origin, origin + axis.truncate() * size, Stroke::new(2.0, tint(color)));
+        }
+    }
+}
+
+fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
+    let layer = &scene.primary;
+    for bone in 0..layer.model.len() {
+        let Some(p) = screen(projection, layer.head(bone)) else { continue };
+        let selected = scene.selected.contains(&bone);
+        let color = bone_color(scene, layer, bone, palette);
+        painter.circle_filled(p, if selected { 5.0 } else { 3.5 }, color);
+        if let Some(badge) = Badge::primary(&layer.findings[bone]) {
+            badge.paint_icon(painter, p + egui::vec2(9.0, -9.0), 4.5);
+        }
+        if scene.options.names || selected {
+            let name = &scene.rig.skeleton.bone(bone).name;
+            painter.text(p + egui::vec2(8.0, 4.0), Align2::LEFT_TOP, name, FontId::proportional(12.0), palette.text);
+        }
+    }
+}
+
+/// The meaning of the colours and icons, in the top-left corner.
+fn paint_legend(painter: &Painter, rect: Rect, palette: &Palette) {
+    let mut at = rect.min + egui::vec2(14.0, 14.0);
+    for badge in Badge::ALL {
+        badge.paint_icon(painter, at, 5.0);
+        painter.text(
+            at + egui::vec2(10.0, 0.0),
+            Align2::LEFT_CENTER,
+            badge.label(),
+            FontId::proportional(12.0),
+            palette.text,
+        );
+        at.y += 17.0;
+    }
+}

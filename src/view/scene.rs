@@ -1,0 +1,168 @@
+//! What the viewport draws, in model space: one or two evaluated poses (the current mode and a ghost mode), the
+//! skinned meshes, the bind pose. Built from the library alone, painted by [`super::paint`].
+
+use glam::{DMat4, DVec3};
+
+use super::camera::Bounds;
+use crate::analysis::{Assessment, Findings, Tolerances};
+use crate::eval::{Hierarchy, Pose, skin_meshes};
+use crate::model::{Clip, InheritMode, Rig};
+
+/// What to show, as toggled in the viewport's toolbar (persisted with the settings).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct SceneOptions {
+    pub grid: bool,
+    pub bones: bool,
+    pub mesh: bool,
+    pub wireframe: bool,
+    /// Each bone's axis triad from its model matrix columns (a sheared frame loses its right angles).
+    pub axes: bool,
+    /// A unit box per bone transformed by its model matrix (shear shows as a slanted parallelepiped).
+    pub boxes: bool,
+    pub names: bool,
+    pub bind_pose: bool,
+    pub legend: bool,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        SceneOptions {
+            grid: true,
+            bones: true,
+            mesh: true,
+            wireframe: false,
+            axes: true,
+            boxes: false,
+            names: false,
+            bind_pose: false,
+            legend: true,
+        }
+    }
+}
+
+/// One evaluated pose: model matrices, findings and skinned meshes.
+#[derive(Clone, Debug, Default)]
+pub struct Layer {
+    pub model: Vec<DMat4>,
+    pub findings: Vec<Findings>,
+    /// Per mesh of the rig, vertex positions in model space.
+    pub meshes: Vec<Vec<DVec3>>,
+}
+
+impl Layer {
+    /// Evaluates `clip` (or the rest pose) at `time` with one mode per bone.
+    pub fn evaluate(
+        rig: &Rig,
+        clip: Option<&Clip>,
+        modes: &[InheritMode],
+        time: f64,
+        tolerances: &Tolerances,
+    ) -> Layer {
+        let mut pose = Pose::default();
+        pose.evaluate(&rig.skeleton, clip, &Hierarchy::new(&rig.skeleton, modes), time);
+        Layer::from_model(rig, pose.model.model, tolerances)
+    }
+
+    pub fn from_model(rig: &Rig, model: Vec<DMat4>, tolerances: &Tolerances) -> Layer {
+        let findings = model.iter().map(|m| Assessment::of(m, tolerances).findings).collect();
+        let meshes = skin_meshes(rig, &model);
+        Layer { model, findings, meshes }
+    }
+
+    pub fn head(&self, bone: usize) -> DVec3 {
+        self.model[bone].w_axis.truncate()
+    }
+}
+
+/// Everything the viewport draws for one frame.
+#[derive(Clone, Debug)]
+pub struct Scene<'a> {
+    pub rig: &'a Rig,
+    pub primary: Layer,
+    /// The same pose under a second inheritance mode, drawn translucent over the first.
+    pub ghost: Option<Layer>,
+    /// Model matrices of the bind pose (from the skins' inverse bind matrices, the rest pose elsewhere).
+    pub bind_pose: Option<Vec<DMat4>>,
+    pub selected: Vec<usize>,
+    pub options: SceneOptions,
+    /// How long axis triads and boxes are drawn, in model units.
+    pub gizmo_size: f64,
+}
+
+impl<'a> Scene<'a> {
+    pub fn new(rig: &'a Rig, primary: Layer, options: SceneOptions) -> Self {
+        let gizmo_size = gizmo_size(rig);
+        Scene { rig, primary, ghost: None, bind_pose: None, selected: Vec::new(), options, gizmo_size }
+    }
+
+    /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on.
+    pub fn tail(&self, layer: &Layer, bone: usize) -> Option<DVec3> {
+        let skeleton = &self.rig.skeleton;
+        if let Some(child) = (bone + 1..skeleton.len()).find(|&c| skeleton.parent(c) == Some(bone)) {
+            return Some(layer.head(child));
+        }
+        let parent = skeleton.parent(bone)?;
+        let along = layer.head(bone) - layer.head(parent);
+        (along.length() > 1e-9).then(|| layer.head(bone) + along * 0.35)
+    }
+
+    /// Everything the scene may draw, for framing the camera.
+    pub fn bounds(&self) -> Option<Bounds> {
+        let heads = (0..self.primary.model.len()).map(|b| self.primary.head(b));
+        let vertices = self.primary.meshes.iter().flatten().copied();
+        Bounds::of(heads.chain(vertices))
+    }
+}
+
+/// Axis triads and boxes are drawn at 40 % of the median bone length of the rest pose, so they read at the scale
+/// of the rig whatever its units.
+fn gizmo_size(rig: &Rig) -> f64 {
+    let model = rig.skeleton.rest_model_matrices();
+    let mut lengths: Vec<f64> = rig
+        .skeleton
+        .bones()
+        .iter()
+        .enumerate()
+        .filter_map(|(b, bone)| bone.parent.map(|p| (model[b].w_axis - model[p].w_axis).truncate().length()))
+        .filter(|l| *l > 1e-9)
+        .collect();
+    lengths.sort_by(f64::total_cmp);
+    lengths.get(lengths.len() / 2).map_or_else(|| rest_bounds(rig).map_or(0.1, |b| b.radius() * 0.1), |l| l * 0.4)
+}
+
+/// The bounds of the whole motion: the clip sampled at `samples` evenly spaced times (the rest pose without a
+/// clip), so a camera framed on it does not need to move while the clip plays.
+pub fn motion_bounds(rig: &Rig, clip: Option<&Clip>, modes: &[InheritMode], samples: usize) -> Option<Bounds> {
+    let duration = clip.map_or(0.0, Clip::duration);
+    let hierarchy = Hierarchy::new(&rig.skeleton, modes);
+    let mut pose = Pose::default();
+    (0..samples.max(1))
+        .filter_map(|i| {
+            let time = duration * i as f64 / (samples.max(2) - 1) as f64;
+            pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
+            let meshes = skin_meshes(rig, &pose.model.model);
+            Bounds::of(pose.model.model.iter().map(|m| m.w_axis.truncate()).chain(meshes.into_iter().flatten()))
+        })
+        .reduce(Bounds::union)
+}
+
+/// Model matrices of the bind pose: `inverse(IBM)` for skin joints, the rest pose for other bones.
+pub fn bind_pose(rig: &Rig) -> Vec<DMat4> {
+    let mut model = rig.skeleton.rest_model_matrices();
+    for skin in &rig.skins {
+        for (&joint, ibm) in skin.joints.iter().zip(&skin.inverse_bind) {
+            if ibm.determinant().abs() > 1e-12 {
+                model[joint] = ibm.inverse();
+            }
+        }
+    }
+    model
+}
+
+/// The bounds of the rest pose's joints and meshes.
+pub fn rest_bounds(rig: &Rig) -> Option<Bounds> {
+    let model = rig.skeleton.rest_model_matrices();
+    let meshes = skin_meshes(rig, &model);
+    Bounds::of(model.iter().map(|m| m.w_axis.truncate()).chain(meshes.into_iter().flatten()))
+}

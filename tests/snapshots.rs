@@ -1,0 +1,45 @@
+//! Pictures of the main views with the demo rig, compared with the committed ones in `tests/snapshots/`
+//! (`UPDATE_SNAPSHOTS=1 cargo test --test snapshots` rewrites them; look at them before committing).
+
+use bonescope::app::{BonescopeApp, Document, Settings};
+use bonescope::view::ViewKind;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+/// The demo at 0.5 s (upper arm stretched, forearm bent) with the forearm selected.
+fn app(configure: impl FnOnce(&mut Settings)) -> Harness<'static, BonescopeApp> {
+    let mut settings = Settings::default();
+    settings.scene.boxes = true;
+    configure(&mut settings);
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_render_cursor(false)
+        .wgpu()
+        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
+    harness.state_mut().time = 0.5;
+    harness.get_by_label("forearm").click();
+    harness.run();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+    harness.run();
+    harness
+}
+
+#[test]
+fn demo_perspective_with_ghost() {
+    app(|_| {}).snapshot("demo_perspective_with_ghost");
+}
+
+#[test]
+fn demo_front_view_with_ghost() {
+    app(|s| s.camera.view = ViewKind::Front).snapshot("demo_front_view_with_ghost");
+}
+
+#[test]
+fn demo_light_theme_euler_plots() {
+    app(|s| {
+        s.dark = false;
+        s.rotation_format = bonescope::app::RotationFormat::Euler;
+    })
+    .snapshot("demo_light_theme");
+}
