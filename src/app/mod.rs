@@ -17,6 +17,7 @@ mod viewport;
 mod watch;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
 pub use document::{Document, ModeScope};
@@ -58,7 +59,7 @@ pub struct Shared<'a> {
     /// Selected bones; the last one is the inspected one.
     pub selection: &'a mut Vec<usize>,
     pub frame: &'a Frame,
-    pub analysis: Option<&'a ClipAnalysis>,
+    pub analysis: Option<&'a Arc<ClipAnalysis>>,
     /// `(done, total)` samples while the whole-clip analysis runs.
     pub progress: Option<(usize, usize)>,
     pub tolerances: &'a Tolerances,
@@ -245,7 +246,7 @@ impl BonescopeApp {
                 playing: &mut self.playing,
                 selection: &mut self.selection,
                 frame: &frame,
-                analysis: latest.as_deref(),
+                analysis: latest.as_ref(),
                 progress,
                 tolerances: &self.tolerances,
             };

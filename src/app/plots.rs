@@ -9,6 +9,8 @@ use egui_plot::{Line, Plot, PlotPoints, VLine};
 use glam::{EulerRot, Quat};
 
 use super::{RotationFormat, Shared};
+use std::sync::Arc;
+
 use crate::analysis::{ClipAnalysis, Components};
 
 /// A curve's name and how to read it from a sample.
@@ -104,6 +106,45 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
 pub struct Plots {
     pub component: Component,
     pub show_ghost: bool,
+    cache: Option<(SeriesKey, Vec<Series>)>,
+    reduced: Option<(ReducedKey, Vec<Vec<[f64; 2]>>)>,
+}
+
+/// What the curves' values depend on.
+#[derive(Clone, Debug)]
+struct SeriesKey {
+    /// Held so its address identifies the analysis for as long as the cache lives.
+    analysis: Arc<ClipAnalysis>,
+    bones: Vec<usize>,
+    component: Component,
+    format: RotationFormat,
+    model_space: bool,
+    ghost: bool,
+}
+
+impl PartialEq for SeriesKey {
+    /// The analysis by identity: comparing its contents would cost more than rebuilding the curves.
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.analysis, &other.analysis)
+            && (&self.bones, self.component, self.format, self.model_space, self.ghost)
+                == (&other.bones, other.component, other.format, other.model_space, other.ghost)
+    }
+}
+
+/// What the reduction to pixel columns depends on, besides the series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ReducedKey {
+    x_min: f64,
+    x_max: f64,
+    columns: usize,
+}
+
+/// One curve: its values at every sample time of the analysis.
+struct Series {
+    name: String,
+    color: Color32,
+    ghost: bool,
+    values: Vec<f64>,
 }
 
 impl Plots {
@@ -136,15 +177,27 @@ impl Plots {
             ui.label(RichText::new("analysing the clip…").weak());
             return;
         };
-        self.plot(ui, shared, analysis, &plotted);
+        let key = SeriesKey {
+            analysis: analysis.clone(),
+            bones: plotted,
+            component: self.component,
+            format: shared.settings.rotation_format,
+            model_space: shared.settings.plot_model_space,
+            ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
+        };
+        if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
+            let series = build_series(&key, &shared.doc.rig.skeleton);
+            self.cache = Some((key, series));
+            self.reduced = None;
+        }
+        self.plot(ui, shared);
     }
 
-    fn plot(&self, ui: &mut Ui, shared: &mut Shared, analysis: &ClipAnalysis, plotted: &[usize]) {
-        let channels = self.component.channels(shared.settings.rotation_format);
-        let model_space = shared.settings.plot_model_space;
-        let ghost = self.show_ghost && shared.doc.ghost.is_some() && model_space;
+    fn plot(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        let Some((key, series)) = &self.cache else { return };
+        let reduced_cache = &mut self.reduced;
+        let times = &key.analysis.times;
         let time = *shared.time;
-        let names: Vec<String> = plotted.iter().map(|&b| shared.doc.rig.skeleton.bone(b).name.clone()).collect();
         let response = Plot::new("components")
             .height(ui.available_height().max(120.0))
             // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
@@ -155,27 +208,23 @@ impl Plots {
             .allow_double_click_reset(true)
             .show(ui, |plot_ui| {
                 let bounds = plot_ui.plot_bounds();
-                let x_range = bounds.min()[0]..=bounds.max()[0];
-                let columns = plot_ui.response().rect.width().max(1.0) as usize;
-                for (i, (&bone, name)) in plotted.iter().zip(&names).enumerate() {
-                    let Some(curves) = analysis.curves_of(bone) else { continue };
-                    let series = continuous(if model_space { &curves.model } else { &curves.local });
-                    let ghost_series = if ghost { continuous(&curves.ghost_model) } else { Vec::new() };
-                    for (c, (channel, read)) in channels.iter().enumerate() {
-                        let color = channel_color(i * channels.len() + c);
-                        let points = aggregate(&analysis.times, |s| read(&series[s]), x_range.clone(), columns);
-                        plot_ui.line(Line::new(format!("{name} {channel}"), PlotPoints::from(points)).color(color));
-                        if ghost {
-                            let points =
-                                aggregate(&analysis.times, |s| read(&ghost_series[s]), x_range.clone(), columns);
-                            let label = format!("{name} {channel} (ghost)");
-                            plot_ui.line(
-                                Line::new(label, PlotPoints::from(points))
-                                    .color(color.gamma_multiply(0.45))
-                                    .style(egui_plot::LineStyle::dashed_loose()),
-                            );
-                        }
-                    }
+                let reduced_key = ReducedKey {
+                    x_min: bounds.min()[0],
+                    x_max: bounds.max()[0],
+                    columns: plot_ui.response().rect.width().max(1.0) as usize,
+                };
+                if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
+                    let range = reduced_key.x_min..=reduced_key.x_max;
+                    let points = series
+                        .iter()
+                        .map(|s| aggregate(times, |i| s.values[i], range.clone(), reduced_key.columns))
+                        .collect();
+                    *reduced_cache = Some((reduced_key, points));
+                }
+                let points = reduced_cache.as_ref().map(|(_, p)| p.as_slice()).unwrap_or_default();
+                for (s, points) in series.iter().zip(points) {
+                    let line = Line::new(s.name.clone(), PlotPoints::from(points.clone())).color(s.color);
+                    plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
                 }
                 plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
                 plot_ui.pointer_coordinate()
@@ -187,6 +236,27 @@ impl Plots {
             *shared.time = at.x.clamp(0.0, shared.doc.duration());
         }
     }
+}
+
+/// Every curve's values at every sample, computed once per analysis and choice of component.
+fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Series> {
+    let channels = key.component.channels(key.format);
+    let mut out = Vec::new();
+    for (slot, &bone) in key.bones.iter().enumerate() {
+        let Some(curves) = key.analysis.curves_of(bone) else { continue };
+        let name = &skeleton.bone(bone).name;
+        let primary = continuous(if key.model_space { &curves.model } else { &curves.local });
+        let ghost = if key.ghost { continuous(&curves.ghost_model) } else { Vec::new() };
+        for (c, (channel, read)) in channels.iter().enumerate() {
+            let color = channel_color(slot * channels.len() + c);
+            out.push(Series { name: format!("{name} {channel}"), color, ghost: false, values: primary.iter().map(read).collect() });
+            if key.ghost {
+                let values = ghost.iter().map(read).collect();
+                out.push(Series { name: format!("{name} {channel} (ghost)"), color: color.gamma_multiply(0.5), ghost: true, values });
+            }
+        }
+    }
+    out
 }
 
 fn ui_cursor_color() -> Color32 {
