@@ -32,7 +32,8 @@ impl Document {
         Ok(Document::new(Some(path.to_owned()), import::load(path)?))
     }
 
-    fn new(path: Option<PathBuf>, rig: Rig) -> Self {
+    /// A document on a rig that is already loaded (or generated).
+    pub fn new(path: Option<PathBuf>, rig: Rig) -> Self {
         let modes = rig.skeleton.declared_modes();
         let clip = (!rig.clips.is_empty()).then_some(0);
         Document { path, rig: Arc::new(rig), modes, ghost: None, clip }

@@ -155,6 +155,56 @@ fn ring_weights(x: f64, blend: f64) -> ([u16; 4], [f32; 4]) {
     }
 }
 
+/// A big generated rig for benchmarks: `bones` bones in chains of ten hanging off a spine, a clip of `frames`
+/// frames at 30 fps with a rotation key every `key_step` frames on every bone, and a scale key on every tenth bone
+/// (so their descendants shear under full inheritance).
+pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
+    let step = key_step.max(1);
+    let key_count = frames / step + 1;
+    let times: Arc<[f64]> = (0..key_count).map(|k| (k * step) as f64 / FPS).collect();
+    let mut skeleton_bones = Vec::with_capacity(bones);
+    let mut tracks = Vec::with_capacity(bones);
+    for b in 0..bones {
+        // Chains of ten: the first bone of each chain hangs off the root.
+        let parent = (b > 0).then(|| if b % 10 == 1 { 0 } else { b - 1 });
+        let offset = if b == 0 { DVec3::ZERO } else { DVec3::new(0.0, 0.1, 0.02 * (b % 7) as f64) };
+        skeleton_bones.push(Bone {
+            name: format!("bone{b}"),
+            node: b,
+            parent,
+            rest: Transform::from_trs(offset, DQuat::IDENTITY, DVec3::ONE),
+            inherit: InheritMode::Full,
+        });
+        let phase = b as f64 * 0.37;
+        let mut t = BoneTracks::new(b);
+        let rotation = |k: usize| {
+            let angle = 0.6 * ((k * step) as f64 * 0.05 + phase).sin();
+            Quat::from_rotation_z(angle as f32) * Quat::from_rotation_x((0.5 * angle) as f32)
+        };
+        t.rotation = Some(
+            Track::new(times.clone(), (0..key_count).map(rotation).collect(), Interpolation::Linear)
+                .expect("generated keys are valid"),
+        );
+        if b % 10 == 5 {
+            let scale = |k: usize| {
+                let s = 1.0 + 0.4 * ((k * step) as f64 * 0.03 + phase).sin();
+                Vec3::new(s as f32, (1.0 / s) as f32, 1.0)
+            };
+            t.scale = Some(
+                Track::new(times.clone(), (0..key_count).map(scale).collect(), Interpolation::Linear)
+                    .expect("generated keys are valid"),
+            );
+        }
+        tracks.push(t);
+    }
+    Rig {
+        skeleton: Skeleton::new(skeleton_bones).expect("parents come first"),
+        clips: vec![Clip::new(0, Some("generated".into()), tracks, vec![])],
+        notes: vec![format!("generated: {bones} bones, {frames} frames, a key every {step} frames")],
+        ..Rig::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::DMat4;
@@ -175,6 +225,16 @@ mod tests {
         assert_eq!(stretched_bones(0, InheritMode::Full), ["forearm", "hand"]);
         assert!(stretched_bones(0, InheritMode::SegmentCompensate).is_empty());
         assert!(stretched_bones(1, InheritMode::Full).is_empty());
+    }
+
+    #[test]
+    fn the_stress_rig_has_the_asked_size() {
+        let rig = stress_rig(50, 300, 5);
+        assert_eq!(rig.skeleton.len(), 50);
+        assert!((rig.clips[0].duration() - 10.0).abs() < 1e-12);
+        assert_eq!(rig.clips[0].tracks()[0].rotation.as_ref().unwrap().times().len(), 61);
+        assert_eq!(rig.skeleton.parent(11), Some(0));
+        assert_eq!(rig.skeleton.parent(12), Some(11));
     }
 
     #[test]

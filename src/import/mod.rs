@@ -3,7 +3,7 @@
 mod demo;
 mod gltf;
 
-pub use demo::demo_rig;
+pub use demo::{demo_rig, stress_rig};
 
 use std::fmt;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,68 @@
+//! The app's frame on a big rig: 500 bones, a 100,000-frame clip, 8 plotted bones. Measures the CPU time of one
+//! frame (layout, painting, plot reduction, tessellation) and the whole-clip analysis behind the plots.
+//! Targets (issue "The desktop app"): a frame under 8 ms, the analysis under 2 s on 2 cores, memory under 1 GiB.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use bonescope::analysis::{CurveRequest, ScanOptions, analyze};
+use bonescope::app::{BonescopeApp, Document, Settings};
+use bonescope::eval::Hierarchy;
+use bonescope::import::stress_rig;
+use criterion::{Criterion, criterion_group, criterion_main};
+
+const BONES: usize = 500;
+const FRAMES: usize = 100_000;
+/// A rotation key every 5 frames on every bone: 20,001 keys per track.
+const KEY_STEP: usize = 5;
+const PLOTTED: usize = 8;
+
+fn input() -> egui::RawInput {
+    egui::RawInput {
+        screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1600.0, 1000.0))),
+        ..Default::default()
+    }
+}
+
+fn app_frame(c: &mut Criterion) {
+    let rig = stress_rig(BONES, FRAMES, KEY_STEP);
+    let mut app = BonescopeApp::new(Settings::default(), Document::new(None, rig));
+    // The eight plotted bones sit below scaled bones, so they shear.
+    app.selection = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
+    app.time = 1234.5;
+    let ctx = egui::Context::default();
+    let started = Instant::now();
+    app.settle(&ctx);
+    eprintln!("whole-clip analysis in the app (settle): {:.2} s", started.elapsed().as_secs_f64());
+    // Two warm-up frames: fonts, layout caches, the plot's first reduction.
+    for _ in 0..2 {
+        let _ = ctx.run_ui(input(), |ui| app.ui(ui));
+    }
+    c.bench_function("app frame, 500 bones, 100k frames, 8 curves", |b| {
+        b.iter(|| {
+            let output = ctx.run_ui(input(), |ui| app.ui(ui));
+            black_box(ctx.tessellate(output.shapes, output.pixels_per_point))
+        })
+    });
+}
+
+fn clip_analysis(c: &mut Criterion) {
+    let rig = stress_rig(BONES, FRAMES, KEY_STEP);
+    let modes = rig.skeleton.declared_modes();
+    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
+    let plotted: Vec<usize> = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
+    let options = ScanOptions { rate: Settings::default().frame_rate, ..ScanOptions::default() };
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let mut group = c.benchmark_group("whole-clip analysis");
+    group.sample_size(10);
+    group.bench_function("500 bones, 100k frames, 8 curves (rayon, all cores)", |b| {
+        b.iter(|| {
+            let request = CurveRequest { bones: &plotted, ghost: None };
+            black_box(analyze(&rig.skeleton, rig.clips.first(), &hierarchy, request, &options, &|_, _| {}, &never))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, app_frame, clip_analysis);
+criterion_main!(benches);
