@@ -64,3 +64,19 @@ fn segment_compensation_removes_the_stretch() {
     let result = scan(&skeleton, Some(&clip), &hierarchy, &ScanOptions::default(), &|_, _| {});
     assert!(result.bones.iter().all(|b| !b.stretched()));
 }
+
+#[test]
+fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
+    let (skeleton, clip) = growing_parent();
+    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
+    let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let request = bonescope::analysis::CurveRequest { bones: &[1], ghost: None };
+    let analysis =
+        bonescope::analysis::analyze(&skeleton, Some(&clip), &hierarchy, request, &options, &|_, _| {}, &never)
+            .unwrap();
+    assert_eq!(analysis.stretched_spans(Some(1)), vec![(0.1, 1.0)]);
+    assert_eq!(analysis.stretched_spans(None), vec![(0.1, 1.0)]);
+    assert!(analysis.stretched_spans(Some(0)).is_empty());
+    assert_eq!(analysis.curves_of(1).unwrap().model.len(), 11);
+}

@@ -165,6 +165,28 @@ impl ClipAnalysis {
         self.any_stretched_bits.get(sample / 64).is_some_and(|word| word >> (sample % 64) & 1 == 1)
     }
 
+    /// The time spans in which `bone` (or, for `None`, any bone) is stretched: from the first flagged sample to
+    /// the first sample after it that is not (or the last sample).
+    pub fn stretched_spans(&self, bone: Option<usize>) -> Vec<(f64, f64)> {
+        let flagged = |s: usize| bone.map_or_else(|| self.any_stretched_at(s), |b| self.stretched_at(b, s));
+        let mut spans = Vec::new();
+        let mut start = None;
+        for (sample, &time) in self.times.iter().enumerate() {
+            match (start, flagged(sample)) {
+                (None, true) => start = Some(time),
+                (Some(from), false) => {
+                    spans.push((from, time));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+        if let (Some(from), Some(&last)) = (start, self.times.last()) {
+            spans.push((from, last));
+        }
+        spans
+    }
+
     pub fn curves_of(&self, bone: usize) -> Option<&Curves> {
         self.curves.iter().find(|(b, _)| *b == bone).map(|(_, c)| c)
     }

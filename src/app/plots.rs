@@ -12,6 +12,7 @@ use super::{RotationFormat, Shared};
 use std::sync::Arc;
 
 use crate::analysis::{ClipAnalysis, Components};
+use crate::view::Badge;
 
 /// A curve's name and how to read it from a sample.
 type Channel = (&'static str, fn(&Components) -> f64);
@@ -198,6 +199,7 @@ impl Plots {
         let reduced_cache = &mut self.reduced;
         let times = &key.analysis.times;
         let time = *shared.time;
+        let stretched = key.analysis.stretched_spans(shared.inspected());
         let response = Plot::new("components")
             .height(ui.available_height().max(120.0))
             // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
@@ -226,6 +228,17 @@ impl Plots {
                     let line = Line::new(s.name.clone(), PlotPoints::from(points.clone())).color(s.color);
                     plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
                 }
+                // When the inspected bone is stretched, in the colour the viewport and outliner use for it.
+                let (y_min, y_max) = (bounds.min()[1], bounds.max()[1]);
+                for (i, &(from, to)) in stretched.iter().enumerate() {
+                    let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
+                    let name = if i == 0 { "stretched" } else { "" };
+                    plot_ui.polygon(
+                        egui_plot::Polygon::new(name, PlotPoints::from(corners))
+                            .fill_color(Badge::Stretched.color().gamma_multiply(0.12))
+                            .stroke(egui::Stroke::NONE),
+                    );
+                }
                 plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
                 plot_ui.pointer_coordinate()
             });
@@ -249,10 +262,20 @@ fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Serie
         let ghost = if key.ghost { continuous(&curves.ghost_model) } else { Vec::new() };
         for (c, (channel, read)) in channels.iter().enumerate() {
             let color = channel_color(slot * channels.len() + c);
-            out.push(Series { name: format!("{name} {channel}"), color, ghost: false, values: primary.iter().map(read).collect() });
+            out.push(Series {
+                name: format!("{name} {channel}"),
+                color,
+                ghost: false,
+                values: primary.iter().map(read).collect(),
+            });
             if key.ghost {
                 let values = ghost.iter().map(read).collect();
-                out.push(Series { name: format!("{name} {channel} (ghost)"), color: color.gamma_multiply(0.5), ghost: true, values });
+                out.push(Series {
+                    name: format!("{name} {channel} (ghost)"),
+                    color: color.gamma_multiply(0.5),
+                    ghost: true,
+                    values,
+                });
             }
         }
     }

@@ -130,35 +130,17 @@ fn key_ticks(
     }
 }
 
-/// Stretched spans of the inspected bone (or of any bone) as a coloured strip, one test per pixel column.
+/// Stretched spans of the inspected bone (or of any bone) as a coloured strip.
 fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: impl Fn(f64) -> f32) {
     let Some(analysis) = shared.analysis else { return };
-    let bone = shared.inspected();
     let strip =
         Rect::from_min_size(pos2(rect.left(), rect.center().y - STRIP_HEIGHT / 2.0), vec2(rect.width(), STRIP_HEIGHT));
-    let flagged = |sample: usize| match bone {
-        Some(b) => analysis.stretched_at(b, sample),
-        None => analysis.any_stretched_at(sample),
-    };
-    let color = Badge::Stretched.color();
-    let mut span_start: Option<f64> = None;
-    for (sample, &time) in analysis.times.iter().enumerate() {
-        let on = flagged(sample);
-        let last = sample + 1 == analysis.times.len();
-        match (span_start, on) {
-            (None, true) => span_start = Some(time),
-            (Some(start), false) => {
-                paint_span(painter, strip, x_of(start), x_of(time), color);
-                span_start = None;
-            }
-            _ => {}
-        }
-        if last && let Some(start) = span_start {
-            paint_span(painter, strip, x_of(start), x_of(time), color);
-        }
+    for (from, to) in analysis.stretched_spans(shared.inspected()) {
+        let (x0, x1) = (x_of(from), x_of(to));
+        painter.rect_filled(
+            Rect::from_x_y_ranges(x0..=x1.max(x0 + 1.0), strip.y_range()),
+            0.0,
+            Badge::Stretched.color(),
+        );
     }
-}
-
-fn paint_span(painter: &egui::Painter, strip: Rect, x0: f32, x1: f32, color: Color32) {
-    painter.rect_filled(Rect::from_x_y_ranges(x0..=x1.max(x0 + 1.0), strip.y_range()), 0.0, color);
 }
