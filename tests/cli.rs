@@ -37,7 +37,7 @@ fn matrix(v: &Value) -> DMat4 {
 #[test]
 fn inspect_json_has_exactly_the_documented_shape() {
     let out = json(&bonescope(&["inspect", &stretchy(), "--time", "0.5", "--time", "1", "--format", "json"]));
-    assert_eq!(keys(&out), ["animation", "file", "inherit", "samples"]);
+    assert_eq!(keys(&out), ["animation", "file", "inherit", "notes", "samples"]);
     assert_eq!(keys(&out["animation"]), ["duration", "index", "name"]);
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");

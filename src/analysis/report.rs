@@ -118,6 +118,8 @@ pub struct SampleReport {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InspectReport {
     pub file: String,
+    /// What the importer says about the file: units and axes, how animation was read, what was skipped.
+    pub notes: Vec<String>,
     pub animation: Option<AnimationInfo>,
     /// The mode given for every bone, or `declared` when each bone keeps the file's.
     pub inherit: String,

@@ -1,8 +1,10 @@
-//! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips.
+//! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
+//! inheritance modes), `export` writes the evaluated meshes of one time.
 //!
 //! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone; 2 bad usage or a file that cannot be
 //! loaded (after reporting every file that could).
 
+mod export;
 mod inspect;
 mod options;
 mod scan;
@@ -29,6 +31,8 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Scan whole clips of one or more files and report the stretched bones.
     Scan(scan::ScanArgs),
+    /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
+    Export(export::ExportArgs),
 }
 
 /// Parses the process arguments and runs the command.
@@ -37,6 +41,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Inspect(args) => inspect::run(&args),
         Command::Scan(args) => scan::run(&args),
+        Command::Export(args) => export::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -14,7 +14,7 @@ use crate::import;
 
 #[derive(Debug, Args)]
 pub struct ScanArgs {
-    /// The animation files (glTF .gltf/.glb).
+    /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     #[command(flatten)]
