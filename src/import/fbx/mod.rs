@@ -15,9 +15,11 @@
 //! the file's own axes and units.
 //!
 //! Hostile files: ufbx is fuzzed upstream and never trusts a count; on top of that its allocators get a memory limit
-//! proportional to the file's size ([`memory_limit`]), so a header claiming 2³² nodes fails instead of allocating.
+//! proportional to the file's size ([`memory_limit`]), so an array claiming 2³² values fails instead of allocating.
+//! ufbx says what is wrong but not where, so a failed file is walked by [`locate`] to name the place.
 
 mod anim;
+mod locate;
 mod mesh;
 mod scene;
 
@@ -104,7 +106,8 @@ pub fn ufbx_load_opts(options: &Options, file_size: usize) -> ufbx::LoadOpts<'st
 }
 
 fn read(bytes: &[u8], options: &Options) -> Result<Rig> {
-    let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len())).map_err(|e| Failure::ufbx(&e, None))?;
+    let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len()))
+        .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)))?;
     let mut notes = vec![space_note(&scene, options.space)];
     let bones = scene::read(&scene, &mut notes)?;
     let (skins, meshes) = mesh::read(&scene, &bones, &mut notes)?;
