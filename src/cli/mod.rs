@@ -14,7 +14,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub use options::{EvalArgs, Format, ToleranceArgs};
+pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
 /// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.
