@@ -15,9 +15,11 @@ fn asset(path: &str) -> PathBuf {
 // ---------------------------------------------------------------------------------------------------------------
 // The shared files
 
-/// `bvh/MANIFEST.md` and `blender/README.md`: joints (ROOT + JOINT), end sites, frames, frame time as written,
-/// rotation orders seen.
-const MANIFEST: &[(&str, usize, usize, usize, f64, &[&str])] = &[
+/// One row of a manifest: file, joints (ROOT + JOINT), end sites, frames, frame time as written, rotation orders.
+type Row = (&'static str, usize, usize, usize, f64, &'static [&'static str]);
+
+/// `bvh/MANIFEST.md` and `blender/README.md`.
+const MANIFEST: &[Row] = &[
     ("bvh/cmu_12_01_walk.bvh", 31, 7, 524, 0.0083333, &["ZYX"]),
     ("bvh/bvh_test2.bvh", 23, 5, 61, 0.008333, &["YXZ"]),
     ("bvh/bvh_test3.bvh", 60, 13, 100, 0.008333, &["XYZ", "YXZ"]),

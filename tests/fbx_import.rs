@@ -59,8 +59,11 @@ fn frames(duration: f64, fps: f64) -> usize {
 // ---------------------------------------------------------------------------------------------------------------
 // What the READMEs and MANIFESTs state
 
-/// `fbx-proanimationbank/MANIFEST.md`: clips (name, frames at 30 fps, the manifest's rounded duration).
-const PROANIMATIONBANK: &[(&str, &[(&str, usize, f64)])] = &[
+/// A take as the manifest states it: name, frames at 30 fps, the manifest's rounded duration.
+type Take = (&'static str, usize, f64);
+
+/// `fbx-proanimationbank/MANIFEST.md`: each file's takes.
+const PROANIMATIONBANK: &[(&str, &[Take])] = &[
     ("skeleton.fbx", &[("Take 001", 151, 5.0)]),
     ("walk.fbx", &[("walk", 41, 1.33)]),
     ("jog.fbx", &[("jog", 25, 0.80)]),
