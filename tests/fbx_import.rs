@@ -467,6 +467,27 @@ fn ascii_counts_are_not_trusted() {
     }
 }
 
+#[test]
+fn a_take_claiming_ten_thousand_years_fails_before_sampling() {
+    // The stack's stop time in FBX ticks (46186158000 per second): 3·10¹¹ s would be 10¹³ frames to sample.
+    let path = PathBuf::from("long.fbx");
+    let text = std::fs::read_to_string(asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx")).unwrap();
+    let long = text.replacen(
+        "\"LocalStop\", \"KTime\", \"Time\", \"\",38488465000",
+        "\"LocalStop\", \"KTime\", \"Time\", \"\",9223372036854775807",
+        1,
+    );
+    assert_ne!(long, text);
+    let started = std::time::Instant::now();
+    assert_fails(
+        import::load_bytes(&path, long.as_bytes()),
+        &path,
+        "animation stack 0 `Take 001`",
+        "more than the file's size can justify",
+    );
+    assert!(started.elapsed().as_secs() < 5);
+}
+
 /// xorshift64*: deterministic noise for mutations.
 struct Noise(u64);
 

@@ -36,11 +36,14 @@ pub(super) fn read_clips(
 ) -> Result<Vec<Clip>> {
     let stated = scene.settings.frames_per_second;
     let fps = if stated.is_finite() && stated > 0.0 { stated } else { DEFAULT_FPS };
-    let budget = memory_limit(file_size) / SAMPLE_BYTES;
+    // One budget for all stacks: a file could hold many.
+    let mut budget = memory_limit(file_size) / SAMPLE_BYTES;
     let mut clips = Vec::with_capacity(scene.anim_stacks.len());
     for (index, stack) in scene.anim_stacks.iter().enumerate() {
         let reader = StackReader { scene, index, stack, fps, budget };
-        clips.push(reader.clip(bone_of_node, file_size, notes)?);
+        let (clip, samples) = reader.clip(bone_of_node, file_size, notes)?;
+        budget = budget.saturating_sub(samples);
+        clips.push(clip);
     }
     if !clips.is_empty() {
         let rate = if fps == stated { format!("{fps} fps") } else { format!("{fps} fps (the file states {stated})") };
@@ -58,7 +61,7 @@ struct StackReader<'a> {
     index: usize,
     stack: &'a ufbx::AnimStack,
     fps: f64,
-    /// The most node samples the file's size allows.
+    /// The most node samples the file's size still allows.
     budget: usize,
 }
 
@@ -67,7 +70,8 @@ impl StackReader<'_> {
         format!("animation stack {} `{}`", self.index, &*self.stack.element.name)
     }
 
-    fn clip(&self, bone_of_node: &[Option<usize>], file_size: usize, notes: &mut Vec<String>) -> Result<Clip> {
+    /// The clip, and how many node samples it holds.
+    fn clip(&self, bone_of_node: &[Option<usize>], file_size: usize, notes: &mut Vec<String>) -> Result<(Clip, usize)> {
         let limit = memory_limit(file_size);
         let mut opts = ufbx::BakeOpts { resample_rate: self.fps, ..Default::default() };
         opts.temp_allocator.memory_limit = limit;
@@ -101,8 +105,9 @@ impl StackReader<'_> {
         for (bone, node) in animated {
             tracks.push(self.sample(bone, node, &grid, &times)?);
         }
+        let samples = grid.len() * tracks.len();
         let name: &str = &self.stack.element.name;
-        Ok(Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, Vec::new()))
+        Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, Vec::new()), samples))
     }
 
     /// The stack's time span, or that of its keys when the stack states none (or a reversed one).

@@ -12,17 +12,33 @@
 use glam::Vec3;
 
 use super::scene::SceneBones;
-use super::{Failure, Result, matrix, node_name};
+use super::{Failure, Result, matrix, memory_limit, node_name};
 use crate::model::{Mesh, Skin};
 
-pub(super) fn read(scene: &ufbx::Scene, bones: &SceneBones, notes: &mut Vec<String>) -> Result<(Vec<Skin>, Vec<Mesh>)> {
+pub(super) fn read(
+    scene: &ufbx::Scene,
+    bones: &SceneBones,
+    file_size: usize,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Skin>, Vec<Mesh>)> {
     let mut skins = Vec::new();
     let mut meshes = Vec::new();
     let mut tally = Tally::default();
+    // An instanced mesh is copied per node: a small file could otherwise ask for any amount of memory.
+    let mut budget = memory_limit(file_size);
     for (bone, bone_data) in bones.skeleton.bones().iter().enumerate() {
         let Some(node) = scene.nodes.get(bone_data.node) else { continue };
         let Some(mesh) = node.mesh.as_ref() else { continue };
         let place = format!("mesh `{}` on node `{}`", mesh.element.name, node_name(node));
+        // Positions, joints and weights per vertex; three indices per triangle.
+        let bytes =
+            mesh.vertices.len().saturating_mul(12 + 8 + 16).saturating_add(mesh.num_triangles.saturating_mul(12));
+        budget = budget.checked_sub(bytes).ok_or_else(|| {
+            Failure::at(
+                &place,
+                "the meshes, copied for every node that shows them, need more memory than the file's size can justify",
+            )
+        })?;
         let mut read = Mesh { name: mesh_name(mesh, node), bone, ..Mesh::default() };
         read.indices = triangles(mesh, &place, &mut tally)?;
         match mesh.skin_deformers.first() {

@@ -110,7 +110,7 @@ fn read(bytes: &[u8], options: &Options) -> Result<Rig> {
         .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)))?;
     let mut notes = vec![space_note(&scene, options.space)];
     let bones = scene::read(&scene, &mut notes)?;
-    let (skins, meshes) = mesh::read(&scene, &bones, &mut notes)?;
+    let (skins, meshes) = mesh::read(&scene, &bones, bytes.len(), &mut notes)?;
     let clips = anim::read_clips(&scene, &bones.bone_of_node, bytes.len(), &mut notes)?;
     Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, notes })
 }
