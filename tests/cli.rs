@@ -214,7 +214,7 @@ fn export_writes_the_evaluated_mesh_in_the_files_own_units() {
     assert!(String::from_utf8_lossy(&run.stdout).contains("wrote 1 meshes (90 vertices)"));
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.starts_with("# bonescope export of "), "{text}");
-    assert!(text.contains("# units and axes: the file's own, Z-up in centimetres"), "{text}");
+    assert!(text.contains("# units and axes: the file's own (Z-up, centimetres)"), "{text}");
     let vertices: Vec<[f64; 3]> = text
         .lines()
         .filter_map(|l| l.strip_prefix("v "))

@@ -115,37 +115,46 @@ fn read(bytes: &[u8], options: &Options) -> Result<Rig> {
     Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, notes })
 }
 
-/// What the file's units and axes are, and what became of them.
+/// What the file's units and axes are, and what became of them. (ufbx keeps the file's own settings in
+/// `scene.settings` even when it converts.)
 fn space_note(scene: &ufbx::Scene, space: Space) -> String {
     let settings = &scene.settings;
-    let up = axis_name(settings.original_axis_up);
-    let unit = settings.original_unit_meters;
+    let up = match settings.axes.up {
+        ufbx::CoordinateAxis::Unknown => "no up axis stated".to_owned(),
+        axis => format!("{}-up", axis_name(axis)),
+    };
+    let unit = settings.unit_meters;
     let unit = if (unit - 0.01).abs() < 1e-12 {
         "centimetres".to_owned()
     } else if (unit - 1.0).abs() < 1e-12 {
         "metres".to_owned()
-    } else {
+    } else if unit > 0.0 && unit.is_finite() {
         format!("units of {unit} m")
+    } else {
+        "no unit stated".to_owned()
     };
+    let stated = settings.axes.up != ufbx::CoordinateAxis::Unknown;
     match space {
-        Space::YUpMetres => {
-            format!(
-                "units and axes: the file is {up}-up in {unit}; converted to Y-up metres by ufbx (top-level nodes adjusted)"
-            )
-        }
-        Space::File => format!("units and axes: the file's own, {up}-up in {unit} (not converted)"),
+        Space::YUpMetres if stated => format!(
+            "units and axes: in the file {up}, {unit}; converted to Y-up metres by ufbx (top-level nodes adjusted)"
+        ),
+        Space::YUpMetres => format!(
+            "units and axes: in the file {up}, {unit}; converted to metres by ufbx (top-level nodes adjusted), axes \
+             left as they are"
+        ),
+        Space::File => format!("units and axes: the file's own ({up}, {unit}), not converted"),
     }
 }
 
 fn axis_name(axis: ufbx::CoordinateAxis) -> &'static str {
     match axis {
-        ufbx::CoordinateAxis::PositiveX => "+X",
+        ufbx::CoordinateAxis::PositiveX => "X",
         ufbx::CoordinateAxis::NegativeX => "-X",
         ufbx::CoordinateAxis::PositiveY => "Y",
         ufbx::CoordinateAxis::NegativeY => "-Y",
         ufbx::CoordinateAxis::PositiveZ => "Z",
         ufbx::CoordinateAxis::NegativeZ => "-Z",
-        ufbx::CoordinateAxis::Unknown => "unknown",
+        ufbx::CoordinateAxis::Unknown => "?",
     }
 }
 
