@@ -584,3 +584,17 @@ fn every_inherit_type_under_every_other_matches_ufbx() {
     println!("81 chains: max relative error {worst:.2e}");
     assert!(worst < 1e-12, "{worst:e}");
 }
+
+#[test]
+fn the_synthetic_chain_is_read_as_written() {
+    let text = chain_fbx(&[1, 2, 0, 1]);
+    let rig =
+        import::load_bytes_with(Path::new("chain.fbx"), text.as_bytes(), &Options { space: Space::File }).unwrap();
+    let n1 = &rig.skeleton.bone(1).rest;
+    assert!(n1.translation.abs_diff_eq(DVec3::new(2.0, 0.5, -0.25), 1e-12));
+    assert!(n1.scale.abs_diff_eq(DVec3::new(1.5, 0.8, 1.3), 1e-12));
+    let (x, y, z) = (17f64.to_radians(), (-9f64).to_radians(), 25f64.to_radians());
+    // FBX's default rotation order XYZ means R = Rz·Ry·Rx.
+    let expected = glam::DQuat::from_rotation_z(z) * glam::DQuat::from_rotation_y(y) * glam::DQuat::from_rotation_x(x);
+    assert!(n1.rotation.abs_diff_eq(expected, 1e-12) || n1.rotation.abs_diff_eq(-expected, 1e-12));
+}
