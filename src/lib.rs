@@ -2,7 +2,8 @@
 //!
 //! Data flows one way: `import` turns a file into a [`model::Rig`]; `eval` samples a clip into local transforms and
 //! combines them into model matrices with each bone's scale-inheritance mode; `analysis` runs Shoemake's polar
-//! decomposition on every matrix and flags stretched, mirrored and degenerate bones; `cli` prints the result.
+//! decomposition on every matrix and flags stretched, mirrored and degenerate bones; `cli` prints the result;
+//! `export` writes skinned meshes at a pose (OBJ).
 //!
 //! Conventions, kept everywhere: column vectors (`W_child = W_parent · L_child`), quaternions `[x, y, z, w]`,
 //! seconds inside the library, right-handed Y-up.
@@ -11,6 +12,7 @@ pub mod analysis;
 pub mod app;
 pub mod cli;
 pub mod eval;
+pub mod export;
 pub mod import;
 pub mod math;
 pub mod model;

@@ -37,7 +37,7 @@ fn matrix(v: &Value) -> DMat4 {
 #[test]
 fn inspect_json_has_exactly_the_documented_shape() {
     let out = json(&bonescope(&["inspect", &stretchy(), "--time", "0.5", "--time", "1", "--format", "json"]));
-    assert_eq!(keys(&out), ["animation", "file", "inherit", "samples"]);
+    assert_eq!(keys(&out), ["animation", "file", "inherit", "notes", "samples"]);
     assert_eq!(keys(&out["animation"]), ["duration", "index", "name"]);
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");
@@ -197,4 +197,122 @@ fn scan_json_reports_the_stretched_bones_with_when_and_how_much() {
     }
     // The chest squashes along its own axes: non-uniform but not stretched.
     assert!(scan["non_uniform"].as_array().unwrap().iter().any(|n| n == "chest"));
+}
+
+fn fbx(name: &str) -> String {
+    asset(&format!("fbx-ufbx-data/{name}")).display().to_string()
+}
+
+#[test]
+fn export_writes_the_evaluated_mesh_in_the_files_own_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("frame5.obj");
+    let file = fbx("max_transformed_skin_7500_binary.fbx");
+    let time = (5.0f64 / 30.0).to_string();
+    let run = bonescope(&["export", &file, "--time", &time, "--format", "obj", "--out", out.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(String::from_utf8_lossy(&run.stdout).contains("wrote 1 meshes (90 vertices)"));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("# bonescope export of "), "{text}");
+    assert!(text.contains("# units and axes: the file's own (Z-up, centimetres)"), "{text}");
+    let vertices: Vec<[f64; 3]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert_eq!(vertices.len(), 90);
+    // 3ds Max's own OBJ of frame 5 starts with `v  -22.5210 -13.3501 7.6475` (centimetres, Z up).
+    let first = vertices[0];
+    assert!((first[0] + 22.5210).abs() < 0.01 && (first[1] + 13.3501).abs() < 0.01 && (first[2] - 7.6475).abs() < 0.01);
+    let faces = text.lines().filter(|l| l.starts_with("f ")).count();
+    assert!(faces >= 88, "the 88 quads and triangles as triangles: {faces}");
+}
+
+#[test]
+fn export_without_meshes_or_time_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("none.obj");
+    let bvh = asset("bvh/rotation_first_root.bvh").display().to_string();
+    let run = bonescope(&["export", &bvh, "--time", "0", "--out", out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("no meshes to export"));
+    assert!(!out.exists());
+    let no_time = bonescope(&["export", &bvh, "--out", out.to_str().unwrap()]);
+    assert_eq!(no_time.status.code(), Some(2), "--time is required");
+}
+
+#[test]
+fn compare_inherit_reports_every_bone_and_when() {
+    let file = fbx("maya_mixed_inherit_mode_7700_ascii.fbx");
+    let out = json(&bonescope(&["scan", &file, "--compare-inherit", "declared,full", "--format", "json"]));
+    assert_eq!(keys(&out[0]), ["animations", "error", "file"]);
+    let comparison = &out[0]["animations"][0];
+    assert_eq!(keys(comparison), ["a", "animation", "b", "bones", "rate", "samples"]);
+    assert_eq!((comparison["a"].as_str(), comparison["b"].as_str()), (Some("declared"), Some("full")));
+    let bones = comparison["bones"].as_array().unwrap();
+    assert_eq!(bones.len(), 7);
+    assert_eq!(
+        keys(&bones[0]),
+        [
+            "index",
+            "max_orientation_difference_deg",
+            "max_position_difference",
+            "mode_a",
+            "mode_b",
+            "name",
+            "orientation_time",
+            "position_time"
+        ]
+    );
+    for bone in bones {
+        let same_mode = bone["mode_a"] == bone["mode_b"];
+        let moved = bone["max_position_difference"].as_f64().unwrap() > 0.0
+            || bone["max_orientation_difference_deg"].as_f64().unwrap() > 0.0;
+        // A bone declared `full` above every compensating bone evaluates the same both ways.
+        if same_mode && ["Root", "Mid", "Left"].contains(&bone["name"].as_str().unwrap()) {
+            assert!(!moved, "{bone}");
+        }
+    }
+    // The compensating tips do differ, and the table says so too.
+    let right_tip = bones.iter().find(|b| b["name"] == "Right_Tip").unwrap();
+    assert_eq!(right_tip["mode_a"], "segment-compensate");
+    assert!(right_tip["max_orientation_difference_deg"].as_f64().unwrap() > 1.0, "{right_tip}");
+    // The reported maximum is what the two evaluations give at the reported time.
+    let rig = bonescope::import::load(std::path::Path::new(&file)).unwrap();
+    let bone = right_tip["index"].as_u64().unwrap() as usize;
+    let time = right_tip["position_time"].as_f64().unwrap();
+    let position = |modes: Vec<bonescope::model::InheritMode>| {
+        let hierarchy = bonescope::eval::Hierarchy::new(&rig.skeleton, &modes);
+        let mut pose = bonescope::eval::Pose::default();
+        pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, time);
+        pose.model.model[bone].w_axis.truncate()
+    };
+    let full = vec![bonescope::model::InheritMode::Full; rig.skeleton.len()];
+    let difference = position(rig.skeleton.declared_modes()).distance(position(full));
+    let reported = right_tip["max_position_difference"].as_f64().unwrap();
+    assert!(reported > 0.01 && (difference - reported).abs() < 1e-12, "{difference} vs {reported}");
+    let table = bonescope(&["scan", &file, "--compare-inherit", "declared,full"]);
+    let text = String::from_utf8(table.stdout).unwrap();
+    assert!(text.contains("declared against full") && text.contains("max Δposition"), "{text}");
+    // Identical sides differ nowhere.
+    let same = json(&bonescope(&["scan", &file, "--compare-inherit", "full,full", "--format", "json"]));
+    for bone in same[0]["animations"][0]["bones"].as_array().unwrap() {
+        assert_eq!(bone["max_position_difference"], 0.0);
+        assert_eq!(bone["max_orientation_difference_deg"], 0.0);
+    }
+}
+
+#[test]
+fn compare_inherit_usage_errors() {
+    let file = fbx("maya_mixed_inherit_mode_7700_ascii.fbx");
+    for args in [
+        vec!["scan", &file, "--compare-inherit", "declared"],
+        vec!["scan", &file, "--compare-inherit", "declared,sheared"],
+        vec!["scan", &file, "--compare-inherit", "declared,full", "--inherit", "full"],
+    ] {
+        assert_eq!(bonescope(&args).status.code(), Some(2), "{args:?}");
+    }
 }

@@ -13,7 +13,7 @@ use crate::import;
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// The animation file (glTF .gltf/.glb).
+    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,
@@ -46,6 +46,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         .collect();
     let report = InspectReport {
         file: args.file.display().to_string(),
+        notes: rig.notes.clone(),
         animation: clip.map(AnimationInfo::of),
         inherit: args.eval.inherit_label(),
         samples,
@@ -60,6 +61,9 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
 fn render_table(report: &InspectReport) -> String {
     let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {}  inherit: {}\n", report.file, animation, report.inherit);
+    for note in &report.notes {
+        out.push_str(&format!("  note: {note}\n"));
+    }
     for sample in &report.samples {
         out.push_str(&format!(
             "\nt = {:.4} s   (model space; * = stretched: scale along axes that shear)\n",

@@ -1,8 +1,10 @@
-//! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips.
+//! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
+//! inheritance modes), `export` writes the evaluated meshes of one time.
 //!
 //! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone; 2 bad usage or a file that cannot be
 //! loaded (after reporting every file that could).
 
+mod export;
 mod inspect;
 mod options;
 mod scan;
@@ -12,7 +14,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub use options::{EvalArgs, Format, ToleranceArgs};
+pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
 /// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.
@@ -33,6 +35,8 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Scan whole clips of one or more files and report the stretched bones.
     Scan(scan::ScanArgs),
+    /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
+    Export(export::ExportArgs),
 }
 
 /// Parses the process arguments and runs the command.
@@ -41,6 +45,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Inspect(args)) => inspect::run(&args),
         Some(Command::Scan(args)) => scan::run(&args),
+        Some(Command::Export(args)) => export::run(&args),
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
     };
     match result {

@@ -69,6 +69,47 @@ impl EvalArgs {
     }
 }
 
+/// One side of `--compare-inherit`: the file's own modes, or one mode for every bone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeSet {
+    Declared,
+    All(InheritMode),
+}
+
+impl ModeSet {
+    /// One mode per bone.
+    pub fn modes(self, rig: &Rig) -> Vec<InheritMode> {
+        match self {
+            ModeSet::Declared => rig.skeleton.declared_modes(),
+            ModeSet::All(mode) => vec![mode; rig.skeleton.len()],
+        }
+    }
+
+    pub fn label(self) -> String {
+        match self {
+            ModeSet::Declared => "declared".to_owned(),
+            ModeSet::All(mode) => mode.id().to_owned(),
+        }
+    }
+}
+
+impl std::str::FromStr for ModeSet {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "declared" => Ok(ModeSet::Declared),
+            mode => mode.parse().map(ModeSet::All).map_err(|e| format!("{e}, or `declared`")),
+        }
+    }
+}
+
+/// `A,B`: two mode sets to compare.
+pub fn parse_comparison(s: &str) -> Result<[ModeSet; 2], String> {
+    let (a, b) = s.split_once(',').ok_or_else(|| format!("expected two modes separated by a comma, got `{s}`"))?;
+    Ok([a.trim().parse()?, b.trim().parse()?])
+}
+
 /// The thresholds of the verdicts.
 #[derive(Clone, Debug, Args)]
 pub struct ToleranceArgs {

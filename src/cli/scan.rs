@@ -1,20 +1,22 @@
-//! `bonescope scan`: whole clips of several files, the stretched bones of each.
+//! `bonescope scan`: whole clips of several files, the stretched bones of each; or, with `--compare-inherit`, how
+//! far every bone moves between two sets of inheritance modes.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
 
+use super::options::parse_comparison;
 use super::table::Table;
-use super::{EvalArgs, Format, ToleranceArgs};
-use crate::analysis::report::{AnimationInfo, AnimationScan, FileScan};
-use crate::analysis::{ScanOptions, scan};
+use super::{EvalArgs, Format, ModeSet, ToleranceArgs};
+use crate::analysis::report::{AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileScan};
+use crate::analysis::{ScanOptions, compare, scan};
 use crate::eval::Hierarchy;
 use crate::import;
 
 #[derive(Debug, Args)]
 pub struct ScanArgs {
-    /// The animation files (glTF .gltf/.glb).
+    /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     #[command(flatten)]
@@ -27,6 +29,16 @@ pub struct ScanArgs {
     /// Exit with status 1 when any bone is stretched.
     #[arg(long)]
     pub fail_on_stretch: bool,
+    /// Instead of the stretched bones, compare two evaluations of every bone: the largest difference in position
+    /// (model units) and orientation (degrees) and when each happens. Each side is `declared` (the file's modes)
+    /// or a mode id, e.g. `declared,full` (the file as its DCC meant it, against a glTF/TRS engine).
+    #[arg(
+        long,
+        value_name = "A,B",
+        value_parser = parse_comparison,
+        conflicts_with_all = ["inherit", "inherit_bone", "fail_on_stretch"]
+    )]
+    pub compare_inherit: Option<[ModeSet; 2]>,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
 }
@@ -36,6 +48,9 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--rate must be a finite number ≥ 0, got {}", args.rate);
     }
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
+    if let Some(sides) = args.compare_inherit {
+        return run_comparison(args, sides);
+    }
     let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, &args.eval, &options)).collect();
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
@@ -83,6 +98,94 @@ fn scan_animations(
             AnimationScan::new(&rig.skeleton, clip, eval.inherit_label(), options.rate, result)
         })
         .collect())
+}
+
+fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {
+    let files: Vec<FileComparison> = args
+        .files
+        .iter()
+        .map(|path| {
+            let file = path.display().to_string();
+            match compare_animations(path, &args.eval, sides, args.rate) {
+                Ok(animations) => FileComparison { file, error: None, animations },
+                Err(error) => FileComparison { file, error: Some(format!("{error:#}")), animations: Vec::new() },
+            }
+        })
+        .collect();
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
+        Format::Table => print!("{}", render_comparisons(&files)),
+    }
+    let failed: Vec<&str> = files.iter().filter_map(|f| f.error.as_deref()).collect();
+    for error in &failed {
+        eprintln!("error: {error}");
+    }
+    Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+fn compare_animations(
+    path: &std::path::Path,
+    eval: &EvalArgs,
+    sides: [ModeSet; 2],
+    rate: f64,
+) -> anyhow::Result<Vec<AnimationComparison>> {
+    let rig = import::load(path)?;
+    let modes = sides.map(|side| side.modes(&rig));
+    let hierarchies = [Hierarchy::new(&rig.skeleton, &modes[0]), Hierarchy::new(&rig.skeleton, &modes[1])];
+    let clips = match eval.anim {
+        Some(_) => vec![eval.clip(&rig)?],
+        None if rig.clips.is_empty() => vec![None],
+        None => rig.clips.iter().map(Some).collect(),
+    };
+    Ok(clips
+        .into_iter()
+        .map(|clip| {
+            let result = compare(&rig.skeleton, clip, &hierarchies[0], &hierarchies[1], rate);
+            let labelled = [(sides[0].label(), modes[0].as_slice()), (sides[1].label(), modes[1].as_slice())];
+            AnimationComparison::new(&rig.skeleton, clip, labelled, rate, result)
+        })
+        .collect())
+}
+
+fn render_comparisons(files: &[FileComparison]) -> String {
+    let mut out = String::new();
+    for file in files {
+        if let Some(error) = &file.error {
+            out.push_str(&format!("{}\n  cannot load: {error}\n\n", file.file));
+            continue;
+        }
+        for comparison in &file.animations {
+            let what = AnimationInfo::describe(comparison.animation.as_ref());
+            out.push_str(&format!(
+                "{}  {what}  {} samples, {} against {}\n",
+                file.file, comparison.samples, comparison.a, comparison.b
+            ));
+            let mut table = Table::new(&[
+                ("bone", false),
+                ("A", false),
+                ("B", false),
+                ("max Δposition", true),
+                ("at s", true),
+                ("max Δorientation°", true),
+                ("at s", true),
+            ]);
+            for bone in &comparison.bones {
+                let d = &bone.difference;
+                table.row(vec![
+                    bone.name.clone(),
+                    bone.mode_a.id().to_owned(),
+                    bone.mode_b.id().to_owned(),
+                    format!("{:.6}", d.max_position_difference),
+                    format!("{:.4}", d.position_time),
+                    format!("{:.4}", d.max_orientation_difference_deg),
+                    format!("{:.4}", d.orientation_time),
+                ]);
+            }
+            out.push_str(&table.to_string());
+            out.push('\n');
+        }
+    }
+    out
 }
 
 fn render(files: &[FileScan]) -> String {

@@ -1,6 +1,12 @@
 //! Turning files into a [`Rig`]: one module per format and one [`load`] entry that picks the format by content.
+//!
+//! Formats: glTF 2.0 (`gltf`), FBX binary and ASCII through ufbx (`fbx`), BVH (`bvh`). Every reader turns any
+//! problem into an [`ImportError`] naming the file and the place in it; none may panic or allocate much more than
+//! the file's size suggests, whatever the bytes (the fuzz targets in `fuzz/` and `examples/fuzz_import.rs` check).
 
+mod bvh;
 mod demo;
+mod fbx;
 mod gltf;
 
 pub use demo::{demo_rig, stress_rig};
@@ -9,6 +15,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use crate::model::Rig;
+
+pub use fbx::{memory_limit as fbx_memory_limit, ufbx_load_opts as fbx_load_opts};
 
 /// A file that could not be loaded: which file, where in it, and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -40,20 +48,113 @@ impl ImportError {
 pub enum Format {
     /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
     Gltf,
+    /// FBX, binary or ASCII, any version ufbx reads (5.x to 7.x).
+    Fbx,
+    /// Biovision Hierarchy motion capture.
+    Bvh,
 }
 
-/// Recognises a format from the first bytes of a file.
+/// The space the model matrices of a loaded rig live in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Space {
+    /// bonescope's own: right-handed, Y up, metres. FBX files are converted (and say so in the notes); glTF already
+    /// is; BVH states no units or axes and is taken as written.
+    #[default]
+    YUpMetres,
+    /// The file's own axes and units, as the authoring tool wrote them (what `export` writes, so its output can be
+    /// compared with the tool's own export).
+    File,
+}
+
+/// How to load a file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    pub space: Space,
+}
+
+/// How far into a file the ASCII FBX marker is looked for.
+const FBX_ASCII_LOOKAHEAD: usize = 64 * 1024;
+
+/// Recognises a format from the content of a file (never from its name).
+///
+/// - glTF: binary `glTF` magic, or JSON (the first non-blank byte is `{`);
+/// - FBX: the binary magic `Kaydara FBX Binary  \0`, or text that starts with `; FBX` or holds `FBXHeaderExtension`
+///   in its first 64 KiB;
+/// - BVH: text whose first word is `HIERARCHY`.
 pub fn detect(bytes: &[u8]) -> Option<Format> {
-    let text_start = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let first = text_start.iter().find(|b| !b.is_ascii_whitespace());
-    if bytes.starts_with(b"glTF") || first == Some(&b'{') { Some(Format::Gltf) } else { None }
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let start = text.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(text.len());
+    let text = &text[start..];
+    if bytes.starts_with(b"glTF") || text.first() == Some(&b'{') {
+        return Some(Format::Gltf);
+    }
+    if bytes.starts_with(b"Kaydara FBX Binary  \0") || text.starts_with(b"; FBX") {
+        return Some(Format::Fbx);
+    }
+    let head = &text[..text.len().min(FBX_ASCII_LOOKAHEAD)];
+    if head.windows(b"FBXHeaderExtension".len()).any(|w| w == b"FBXHeaderExtension") {
+        return Some(Format::Fbx);
+    }
+    let word_end = text.iter().position(|b| b.is_ascii_whitespace()).unwrap_or(text.len());
+    if text[..word_end].eq_ignore_ascii_case(b"HIERARCHY") {
+        return Some(Format::Bvh);
+    }
+    None
 }
 
-/// Reads and parses the file at `path`, whatever its format.
+/// Reads and parses the file at `path`, whatever its format, into bonescope's space (Y-up metres).
 pub fn load(path: &Path) -> Result<Rig, ImportError> {
+    load_with(path, &Options::default())
+}
+
+/// Reads and parses the file at `path` with `options`.
+pub fn load_with(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     let bytes = std::fs::read(path).map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?;
-    match detect(&bytes) {
-        Some(Format::Gltf) => gltf::load(path, &bytes),
-        None => Err(ImportError::new(path, None, "not a recognised animation file (expected glTF 2.0: .gltf or .glb)")),
+    load_bytes_with(path, &bytes, options)
+}
+
+/// Parses a file already in memory; `path` names it in errors (and locates a glTF's external buffers).
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Rig, ImportError> {
+    load_bytes_with(path, bytes, &Options::default())
+}
+
+/// [`load_bytes`] with `options`.
+pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &Options) -> Result<Rig, ImportError> {
+    match detect(bytes) {
+        Some(format) => load_bytes_as(format, path, bytes, options),
+        None => Err(ImportError::new(
+            path,
+            None,
+            "not a recognised animation file (expected glTF 2.0 .gltf/.glb, FBX binary or ASCII, or BVH)",
+        )),
+    }
+}
+
+/// Parses `bytes` as `format`, whatever they look like (the fuzz targets use it to reach each parser directly).
+pub fn load_bytes_as(format: Format, path: &Path, bytes: &[u8], options: &Options) -> Result<Rig, ImportError> {
+    match format {
+        Format::Gltf => gltf::load(path, bytes),
+        Format::Fbx => fbx::load(path, bytes, options),
+        Format::Bvh => bvh::load(path, bytes),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_are_detected_by_content() {
+        assert_eq!(detect(b"glTF\x02\0\0\0"), Some(Format::Gltf));
+        assert_eq!(detect(b"\xEF\xBB\xBF  {\"asset\":{}}"), Some(Format::Gltf));
+        assert_eq!(detect(b"Kaydara FBX Binary  \0\x1a\0"), Some(Format::Fbx));
+        assert_eq!(detect(b"; FBX 7.7.0 project file\n"), Some(Format::Fbx));
+        assert_eq!(detect(b"; exported\nFBXHeaderExtension:  {\n"), Some(Format::Fbx));
+        assert_eq!(detect(b"\r\n\tHIERARCHY\r\nROOT Hips"), Some(Format::Bvh));
+        assert_eq!(detect(b"hierarchy\n"), Some(Format::Bvh));
+        assert_eq!(detect(b"HIERARCHYX\n"), None);
+        assert_eq!(detect(b"Kaydara FBX Binary"), None, "a truncated magic is not FBX");
+        assert_eq!(detect(b""), None);
+        assert_eq!(detect(b"   "), None);
     }
 }

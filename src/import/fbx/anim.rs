@@ -1,0 +1,178 @@
+//! Animation stacks as clips, sampled by ufbx at every frame and every key.
+//!
+//! FBX animates Euler angles (in the node's rotation order, between pre- and post-rotations and pivots) with
+//! per-component weighted Bézier curves, in layers; a T·R·S keyframe track interpolated linearly cannot represent
+//! that exactly. So each stack is baked onto one grid of times: every frame of the file's frame rate plus every
+//! time at which some curve has a key (and the two sides of every step), as `ufbx_bake_anim` lists them. At each
+//! grid time every animated node gets ufbx's own evaluation of its local transform (`ufbx_evaluate_transform`), so
+//! bonescope's model matrices equal ufbx's at every grid time; between grid times they are interpolated linearly
+//! (slerp for rotations), which is what a game runtime given the same keys would do.
+//!
+//! A clip covers its stack's time span (the take's start and stop, which is what DCCs play); keys outside it are
+//! not sampled. Times are the file's, in seconds; a stack that starts before t = 0 is shifted to start at 0 (and
+//! says so). The grid's size is checked against the file's size before anything is evaluated.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+
+use super::{Failure, Result, memory_limit, node_name};
+use crate::model::{BoneTracks, Clip, Interpolation, Track};
+
+/// Frames per second assumed when the file states none that makes sense.
+const DEFAULT_FPS: f64 = 30.0;
+
+/// Two times closer than this are the same time (ufbx computes both from the same integer ticks).
+const SAME_TIME: f64 = 1e-9;
+
+/// Bytes one sample of one node costs (a time, a translation, a rotation and a scale in `f32`), for the budget.
+const SAMPLE_BYTES: usize = 8 + 12 + 16 + 12;
+
+pub(super) fn read_clips(
+    scene: &ufbx::Scene,
+    bone_of_node: &[Option<usize>],
+    file_size: usize,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Clip>> {
+    let stated = scene.settings.frames_per_second;
+    let fps = if stated.is_finite() && stated > 0.0 { stated } else { DEFAULT_FPS };
+    // One budget for all stacks: a file could hold many.
+    let mut budget = memory_limit(file_size) / SAMPLE_BYTES;
+    let mut clips = Vec::with_capacity(scene.anim_stacks.len());
+    for (index, stack) in scene.anim_stacks.iter().enumerate() {
+        let reader = StackReader { scene, index, stack, fps, budget };
+        let (clip, samples) = reader.clip(bone_of_node, file_size, notes)?;
+        budget = budget.saturating_sub(samples);
+        clips.push(clip);
+    }
+    if !clips.is_empty() {
+        let rate = if fps == stated { format!("{fps} fps") } else { format!("{fps} fps (the file states {stated})") };
+        notes.push(format!(
+            "animation: {} stacks sampled by ufbx at every frame ({rate}) and every key time: exact there, linear \
+             (slerp for rotations) in between",
+            clips.len()
+        ));
+    }
+    Ok(clips)
+}
+
+struct StackReader<'a> {
+    scene: &'a ufbx::Scene,
+    index: usize,
+    stack: &'a ufbx::AnimStack,
+    fps: f64,
+    /// The most node samples the file's size still allows.
+    budget: usize,
+}
+
+impl StackReader<'_> {
+    fn place(&self) -> String {
+        format!("animation stack {} `{}`", self.index, &*self.stack.element.name)
+    }
+
+    /// The clip, and how many node samples it holds.
+    fn clip(&self, bone_of_node: &[Option<usize>], file_size: usize, notes: &mut Vec<String>) -> Result<(Clip, usize)> {
+        let limit = memory_limit(file_size);
+        let mut opts = ufbx::BakeOpts { resample_rate: self.fps, ..Default::default() };
+        opts.temp_allocator.memory_limit = limit;
+        opts.result_allocator.memory_limit = limit;
+        let baked =
+            ufbx::bake_anim(self.scene, &self.stack.anim, opts).map_err(|e| Failure::ufbx(&e, Some(self.place())))?;
+        let animated: Vec<(usize, &ufbx::Node)> = baked
+            .nodes
+            .iter()
+            .filter_map(|b| {
+                let id = b.typed_id as usize;
+                Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref()))
+            })
+            .collect();
+        let key_times = || {
+            baked.nodes.iter().flat_map(|n| {
+                let t = n.translation_keys.iter().map(|k| k.time);
+                let r = n.rotation_keys.iter().map(|k| k.time);
+                let s = n.scale_keys.iter().map(|k| k.time);
+                t.chain(r).chain(s)
+            })
+        };
+        let (begin, end) = self.span(key_times());
+        let grid = self.grid(begin, end, key_times(), animated.len())?;
+        let shift = if begin < 0.0 { -begin } else { 0.0 };
+        if shift > 0.0 {
+            notes.push(format!("{} starts at t = {begin} s; its clip is shifted to start at 0", self.place()));
+        }
+        let times: Arc<[f64]> = grid.iter().map(|t| t + shift).collect();
+        let mut tracks = Vec::with_capacity(animated.len());
+        for (bone, node) in animated {
+            tracks.push(self.sample(bone, node, &grid, &times)?);
+        }
+        let samples = grid.len() * tracks.len();
+        let name: &str = &self.stack.element.name;
+        Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, Vec::new()), samples))
+    }
+
+    /// The stack's time span, or that of its keys when the stack states none (or a reversed one).
+    fn span(&self, keys: impl Iterator<Item = f64>) -> (f64, f64) {
+        let (begin, end) = (self.stack.time_begin, self.stack.time_end);
+        if begin.is_finite() && end.is_finite() && begin < end {
+            return (begin, end);
+        }
+        let (min, max) = keys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)));
+        if min.is_finite() && max.is_finite() { (min, max) } else { (0.0, 0.0) }
+    }
+
+    /// Every frame in `[begin, end]`, the ends, and every key time in between; sorted, without near-duplicates.
+    fn grid(&self, begin: f64, end: f64, keys: impl Iterator<Item = f64>, nodes: usize) -> Result<Vec<f64>> {
+        let first = (begin * self.fps - SAME_TIME).ceil();
+        let last = (end * self.fps + SAME_TIME).floor();
+        let frames = if last >= first { last - first + 1.0 } else { 0.0 };
+        if frames * nodes.max(1) as f64 > self.budget as f64 {
+            let message = format!(
+                "spans {} s ({frames} frames at {} fps) for {nodes} animated nodes: more than the file's size can \
+                 justify",
+                end - begin,
+                self.fps
+            );
+            return Err(Failure::at(self.place(), message));
+        }
+        let mut grid: Vec<f64> = Vec::with_capacity(frames as usize + 2);
+        grid.push(begin);
+        grid.extend((0..frames as u64).map(|k| (first + k as f64) / self.fps));
+        grid.push(end);
+        for time in keys.filter(|t| (begin..=end).contains(t)) {
+            grid.push(time);
+            if grid.len().saturating_mul(nodes) > self.budget {
+                return Err(Failure::at(self.place(), "more keys than the file's size can justify"));
+            }
+        }
+        grid.sort_by(f64::total_cmp);
+        grid.dedup_by(|later, earlier| *later - *earlier < SAME_TIME);
+        Ok(grid)
+    }
+
+    /// One animated node at every grid time (`times`: the grid as the clip's times).
+    fn sample(&self, bone: usize, node: &ufbx::Node, grid: &[f64], times: &Arc<[f64]>) -> Result<BoneTracks> {
+        let (mut translations, mut rotations, mut scales) =
+            (Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()));
+        for &time in grid {
+            let t = ufbx::evaluate_transform(&self.stack.anim, node, time);
+            translations.push(Vec3::new(t.translation.x as f32, t.translation.y as f32, t.translation.z as f32));
+            rotations.push(Quat::from_xyzw(
+                t.rotation.x as f32,
+                t.rotation.y as f32,
+                t.rotation.z as f32,
+                t.rotation.w as f32,
+            ));
+            scales.push(Vec3::new(t.scale.x as f32, t.scale.y as f32, t.scale.z as f32));
+        }
+        let fail = |what: &str, e| {
+            Failure::at(format!("{}, node `{}`", self.place(), node_name(node)), format!("{what}: {e}"))
+        };
+        let mut tracks = BoneTracks::new(bone);
+        tracks.translation =
+            Some(Track::new(times.clone(), translations, Interpolation::Linear).map_err(|e| fail("translation", e))?);
+        tracks.rotation =
+            Some(Track::new(times.clone(), rotations, Interpolation::Linear).map_err(|e| fail("rotation", e))?);
+        tracks.scale = Some(Track::new(times.clone(), scales, Interpolation::Linear).map_err(|e| fail("scale", e))?);
+        Ok(tracks)
+    }
+}

@@ -1,0 +1,206 @@
+//! Meshes and their skins.
+//!
+//! Every node with a mesh gives one [`Mesh`] (an instanced mesh gives one per node), triangulated by ufbx.
+//! - Unskinned: positions are in the node's space (the node's geometric transform, which FBX does not inherit,
+//!   applied), so the node's model matrix places them.
+//! - Skinned (the first skin deformer; FBX allows several, rarely used): positions stay in geometry space and each
+//!   cluster becomes a joint with inverse bind matrix `geometry_to_bone`, so `Σ w·W_bone·geometry_to_bone·v` is
+//!   ufbx's (and the FBX SDK's) linear blend skinning. Each vertex keeps its four strongest weights, renormalised;
+//!   a vertex without weights follows the mesh's own node, as in ufbx, Maya and Blender, through one extra joint
+//!   (the mesh node, with the geometric transform as its inverse bind matrix).
+
+use glam::Vec3;
+
+use super::scene::SceneBones;
+use super::{Failure, Result, matrix, memory_limit, node_name};
+use crate::model::{Mesh, Skin};
+
+pub(super) fn read(
+    scene: &ufbx::Scene,
+    bones: &SceneBones,
+    file_size: usize,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Skin>, Vec<Mesh>)> {
+    let mut skins = Vec::new();
+    let mut meshes = Vec::new();
+    let mut tally = Tally::default();
+    // An instanced mesh is copied per node: a small file could otherwise ask for any amount of memory.
+    let mut budget = memory_limit(file_size);
+    for (bone, bone_data) in bones.skeleton.bones().iter().enumerate() {
+        let Some(node) = scene.nodes.get(bone_data.node) else { continue };
+        let Some(mesh) = node.mesh.as_ref() else { continue };
+        let place = format!("mesh `{}` on node `{}`", mesh.element.name, node_name(node));
+        // Positions, joints and weights per vertex; three indices per triangle.
+        let bytes =
+            mesh.vertices.len().saturating_mul(12 + 8 + 16).saturating_add(mesh.num_triangles.saturating_mul(12));
+        budget = budget.checked_sub(bytes).ok_or_else(|| {
+            Failure::at(
+                &place,
+                "the meshes, copied for every node that shows them, need more memory than the file's size can justify",
+            )
+        })?;
+        let mut read = Mesh { name: mesh_name(mesh, node), bone, ..Mesh::default() };
+        read.indices = triangles(mesh, &place, &mut tally)?;
+        match mesh.skin_deformers.first() {
+            Some(skin) => {
+                if mesh.skin_deformers.len() > 1 {
+                    tally.extra_skins += 1;
+                }
+                // ufbx sets a per-vertex blend towards dual-quaternion skinning for DQ and blended skins.
+                if skin.vertices.iter().any(|v| v.dq_weight > 0.0) {
+                    tally.not_linear += 1;
+                }
+                read.positions = mesh.vertices.iter().map(|v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)).collect();
+                let skin = read_skin(skin, node, bones, &mut read, &place, &mut tally)?;
+                read.skin = Some(skins.len());
+                skins.push(skin);
+            }
+            None => {
+                let to_node = matrix(&node.geometry_to_node);
+                read.positions = mesh
+                    .vertices
+                    .iter()
+                    .map(|v| to_node.transform_point3(glam::DVec3::new(v.x, v.y, v.z)).as_vec3())
+                    .collect();
+            }
+        }
+        if let Some(v) = read.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Failure::at(place, format!("vertex {v} is not finite")));
+        }
+        if !mesh.blend_deformers.is_empty() {
+            tally.blend_shapes += 1;
+        }
+        meshes.push(read);
+    }
+    tally.notes(notes);
+    Ok((skins, meshes))
+}
+
+/// What the notes say about all meshes together.
+#[derive(Default)]
+struct Tally {
+    extra_skins: usize,
+    not_linear: usize,
+    blend_shapes: usize,
+    skipped_faces: usize,
+    trimmed_weights: usize,
+    unweighted: usize,
+}
+
+impl Tally {
+    fn notes(&self, notes: &mut Vec<String>) {
+        let lines = [
+            (self.extra_skins, "meshes have more than one skin deformer; only the first is used"),
+            (self.not_linear, "skins ask for (partly) dual-quaternion skinning; bonescope skins linearly"),
+            (self.blend_shapes, "meshes have blend shapes, not evaluated"),
+            (self.skipped_faces, "faces with fewer than 3 corners (points, lines) were skipped"),
+            (self.trimmed_weights, "vertices have more than 4 weights; the 4 strongest are kept, renormalised"),
+            (self.unweighted, "skinned vertices have no weights and follow their mesh's node"),
+        ];
+        notes.extend(lines.iter().filter(|(n, _)| *n > 0).map(|(n, what)| format!("{n} {what}")));
+    }
+}
+
+fn mesh_name(mesh: &ufbx::Mesh, node: &ufbx::Node) -> String {
+    let name: &str = &mesh.element.name;
+    if name.is_empty() { node_name(node) } else { name.to_owned() }
+}
+
+/// Every polygon as triangles (ufbx's triangulation), as indices into `mesh.vertices`.
+fn triangles(mesh: &ufbx::Mesh, place: &str, tally: &mut Tally) -> Result<Vec<u32>> {
+    let vertex_count = mesh.vertices.len();
+    let mut indices = Vec::with_capacity(mesh.num_triangles.min(mesh.vertex_indices.len()).saturating_mul(3));
+    let mut corners = Vec::new();
+    for face in mesh.faces.iter() {
+        if face.num_indices < 3 {
+            tally.skipped_faces += 1;
+            continue;
+        }
+        corners.resize((face.num_indices as usize - 2) * 3, 0);
+        let count = ufbx::triangulate_face(&mut corners, mesh, *face) as usize;
+        for &corner in &corners[..(count * 3).min(corners.len())] {
+            let vertex = mesh.vertex_indices.get(corner as usize).copied().filter(|&v| (v as usize) < vertex_count);
+            let Some(vertex) = vertex else {
+                return Err(Failure::at(place, format!("face corner {corner} has no vertex")));
+            };
+            indices.push(vertex);
+        }
+    }
+    Ok(indices)
+}
+
+/// The skin of one mesh instance, filling the mesh's joints and weights.
+fn read_skin(
+    skin: &ufbx::SkinDeformer,
+    mesh_node: &ufbx::Node,
+    bones: &SceneBones,
+    mesh: &mut Mesh,
+    place: &str,
+    tally: &mut Tally,
+) -> Result<Skin> {
+    let bone_of = |node: &ufbx::Node| bones.bone_of_node.get(node.element.typed_id as usize).copied().flatten();
+    let mut joints = Vec::with_capacity(skin.clusters.len() + 1);
+    let mut inverse_bind = Vec::with_capacity(skin.clusters.len() + 1);
+    // Per cluster, its joint index (clusters without a bone get none and their weights are dropped).
+    let mut joint_of_cluster = Vec::with_capacity(skin.clusters.len());
+    for cluster in skin.clusters.iter() {
+        let bone = cluster.bone_node.as_ref().and_then(|n| bone_of(n));
+        joint_of_cluster.push(bone.map(|b| {
+            joints.push(b);
+            inverse_bind.push(matrix(&cluster.geometry_to_bone));
+            joints.len() - 1
+        }));
+    }
+    let own = joints.len();
+    let mesh_bone = bone_of(mesh_node).ok_or_else(|| Failure::at(place, "the mesh's node is not a bone"))?;
+    joints.push(mesh_bone);
+    inverse_bind.push(matrix(&mesh_node.geometry_to_node));
+    if joints.len() > usize::from(u16::MAX) + 1 {
+        return Err(Failure::at(place, format!("{} joints; at most 65536 are supported", joints.len())));
+    }
+    if let Some(k) = inverse_bind.iter().position(|m| !m.is_finite()) {
+        return Err(Failure::at(place, format!("bind matrix of joint {k} is not finite")));
+    }
+    let vertex_count = mesh.positions.len();
+    if skin.vertices.len() < vertex_count {
+        let message = format!("the skin has weights for {} vertices, the mesh has {vertex_count}", skin.vertices.len());
+        return Err(Failure::at(place, message));
+    }
+    mesh.joints.reserve_exact(vertex_count);
+    mesh.weights.reserve_exact(vertex_count);
+    let mut strongest: Vec<(f64, usize)> = Vec::new();
+    for (v, vertex) in skin.vertices.iter().take(vertex_count).enumerate() {
+        let begin = vertex.weight_begin as usize;
+        let Some(weights) = skin.weights.get(begin..begin.saturating_add(vertex.num_weights as usize)) else {
+            return Err(Failure::at(place, format!("vertex {v}: weights out of range")));
+        };
+        strongest.clear();
+        for w in weights {
+            let joint = joint_of_cluster.get(w.cluster_index as usize).copied().flatten();
+            if let Some(joint) = joint.filter(|_| w.weight > 0.0 && w.weight.is_finite()) {
+                strongest.push((w.weight, joint));
+            }
+        }
+        strongest.sort_by(|a, b| b.0.total_cmp(&a.0));
+        if strongest.len() > 4 {
+            tally.trimmed_weights += 1;
+            strongest.truncate(4);
+        }
+        let total: f64 = strongest.iter().map(|w| w.0).sum();
+        let (mut j, mut w) = ([0u16; 4], [0f32; 4]);
+        if total > 0.0 {
+            for (k, &(weight, joint)) in strongest.iter().enumerate() {
+                j[k] = joint as u16;
+                w[k] = (weight / total) as f32;
+            }
+        } else {
+            tally.unweighted += 1;
+            j[0] = own as u16;
+            w[0] = 1.0;
+        }
+        mesh.joints.push(j);
+        mesh.weights.push(w);
+    }
+    let name: &str = &skin.element.name;
+    Ok(Skin { name: (!name.is_empty()).then(|| name.to_owned()), joints, inverse_bind })
+}

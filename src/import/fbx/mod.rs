@@ -1,0 +1,172 @@
+//! FBX import (binary and ASCII, FBX 5 to 7.7) through ufbx, the best-maintained FBX reader.
+//!
+//! ufbx does the parsing and the FBX semantics; this module maps its scene onto a [`Rig`]:
+//! - every node below ufbx's root becomes a bone whose rest transform is ufbx's evaluated `local_transform`
+//!   (translation, pivots, offsets, pre/post rotation and rotation order folded into one T·R·S, exactly as ufbx
+//!   evaluates them) and whose mode is ufbx's `inherit_mode` (NORMAL → `full`, IGNORE_PARENT_SCALE →
+//!   `segment-compensate`, COMPONENTWISE_SCALE → `componentwise`), kept as the file declares it
+//!   (`inherit_mode_handling = PRESERVE`);
+//! - every animation stack becomes a clip, baked by ufbx at the file's frame rate ([`anim`]);
+//! - meshes with their skins ([`mesh`]).
+//!
+//! Units and axes: [`Space::YUpMetres`] asks ufbx to convert to right-handed Y-up metres by adjusting the
+//! transforms of the top-level nodes (`UFBX_SPACE_CONVERSION_ADJUST_TRANSFORMS`, which keeps every node's inherit
+//! mode; converting at the root would turn top-level compensating nodes into normal ones). [`Space::File`] leaves
+//! the file's own axes and units.
+//!
+//! Hostile files: ufbx is fuzzed upstream and never trusts a count; on top of that its allocators get a memory limit
+//! proportional to the file's size ([`memory_limit`]), so an array claiming 2³² values fails instead of allocating.
+//! ufbx says what is wrong but not where, so a failed file is walked by [`locate`] to name the place.
+
+mod anim;
+mod locate;
+mod mesh;
+mod scene;
+
+use std::path::Path;
+
+use super::{ImportError, Options, Space};
+use crate::model::Rig;
+
+/// Reads an FBX file whose bytes are in memory.
+pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
+    read(bytes, options).map_err(|f| ImportError::new(path, f.place, f.message))
+}
+
+/// What went wrong, and where (an element of the scene, or ufbx's own account of where parsing stopped).
+#[derive(Debug)]
+struct Failure {
+    place: Option<String>,
+    message: String,
+}
+
+impl Failure {
+    fn at(place: impl Into<String>, message: impl Into<String>) -> Self {
+        Failure { place: Some(place.into()), message: message.into() }
+    }
+
+    /// A ufbx error: its description as the message, its innermost frames as the place.
+    fn ufbx(error: &ufbx::Error, place: Option<String>) -> Self {
+        let mut message = error.description.to_string();
+        let info = error.info();
+        if !info.is_empty() {
+            message = format!("{message} ({info})");
+        }
+        if matches!(error.type_, ufbx::ErrorType::MemoryLimit | ufbx::ErrorType::AllocationLimit) {
+            message = format!("{message}: the file asks for far more memory than its size can justify");
+        }
+        // ufbx's error stack says what it was reading, innermost first: "Truncated file" while parsing a node.
+        let frames: Vec<String> = error
+            .stack
+            .iter()
+            .take(error.stack_size as usize)
+            .map(|f| f.description.to_string())
+            .filter(|d| !d.is_empty())
+            .collect();
+        let reading = (!frames.is_empty()).then(|| frames.join(" < "));
+        let place = match (place, reading) {
+            (Some(p), Some(r)) => Some(format!("{p}: {r}")),
+            (p, r) => p.or(r),
+        };
+        Failure { place, message }
+    }
+}
+
+type Result<T> = std::result::Result<T, Failure>;
+
+/// The memory ufbx may use for one file of `file_size` bytes: generous for real files (a compressed binary FBX
+/// expands several times, and ufbx keeps both the parse tree and the scene), bounded for hostile ones.
+pub fn memory_limit(file_size: usize) -> usize {
+    (256usize << 20).saturating_add(file_size.saturating_mul(64))
+}
+
+/// The ufbx load options bonescope uses, so that tests can load a file exactly the way the importer does.
+pub fn ufbx_load_opts(options: &Options, file_size: usize) -> ufbx::LoadOpts<'static> {
+    let limit = memory_limit(file_size);
+    let mut opts = ufbx::LoadOpts {
+        // Keep the file's inherit types (also the default) and its geometric transforms.
+        inherit_mode_handling: ufbx::InheritModeHandling::Preserve,
+        geometry_transform_handling: ufbx::GeometryTransformHandling::Preserve,
+        space_conversion: ufbx::SpaceConversion::AdjustTransforms,
+        ignore_embedded: true,
+        clean_skin_weights: true,
+        ..Default::default()
+    };
+    opts.temp_allocator.memory_limit = limit;
+    opts.result_allocator.memory_limit = limit;
+    if options.space == Space::YUpMetres {
+        opts.target_axes = ufbx::CoordinateAxes {
+            right: ufbx::CoordinateAxis::PositiveX,
+            up: ufbx::CoordinateAxis::PositiveY,
+            front: ufbx::CoordinateAxis::PositiveZ,
+        };
+        opts.target_unit_meters = 1.0;
+    }
+    opts
+}
+
+fn read(bytes: &[u8], options: &Options) -> Result<Rig> {
+    let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len()))
+        .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)))?;
+    let mut notes = vec![space_note(&scene, options.space)];
+    let bones = scene::read(&scene, &mut notes)?;
+    let (skins, meshes) = mesh::read(&scene, &bones, bytes.len(), &mut notes)?;
+    let clips = anim::read_clips(&scene, &bones.bone_of_node, bytes.len(), &mut notes)?;
+    Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, notes })
+}
+
+/// What the file's units and axes are, and what became of them. (ufbx keeps the file's own settings in
+/// `scene.settings` even when it converts.)
+fn space_note(scene: &ufbx::Scene, space: Space) -> String {
+    let settings = &scene.settings;
+    let up = match settings.axes.up {
+        ufbx::CoordinateAxis::Unknown => "no up axis stated".to_owned(),
+        axis => format!("{}-up", axis_name(axis)),
+    };
+    let unit = settings.unit_meters;
+    let unit = if (unit - 0.01).abs() < 1e-12 {
+        "centimetres".to_owned()
+    } else if (unit - 1.0).abs() < 1e-12 {
+        "metres".to_owned()
+    } else if unit > 0.0 && unit.is_finite() {
+        format!("units of {unit} m")
+    } else {
+        "no unit stated".to_owned()
+    };
+    let stated = settings.axes.up != ufbx::CoordinateAxis::Unknown;
+    match space {
+        Space::YUpMetres if stated => format!(
+            "units and axes: in the file {up}, {unit}; converted to Y-up metres by ufbx (top-level nodes adjusted)"
+        ),
+        Space::YUpMetres => format!(
+            "units and axes: in the file {up}, {unit}; converted to metres by ufbx (top-level nodes adjusted), axes \
+             left as they are"
+        ),
+        Space::File => format!("units and axes: the file's own ({up}, {unit}), not converted"),
+    }
+}
+
+fn axis_name(axis: ufbx::CoordinateAxis) -> &'static str {
+    match axis {
+        ufbx::CoordinateAxis::PositiveX => "X",
+        ufbx::CoordinateAxis::NegativeX => "-X",
+        ufbx::CoordinateAxis::PositiveY => "Y",
+        ufbx::CoordinateAxis::NegativeY => "-Y",
+        ufbx::CoordinateAxis::PositiveZ => "Z",
+        ufbx::CoordinateAxis::NegativeZ => "-Z",
+        ufbx::CoordinateAxis::Unknown => "?",
+    }
+}
+
+/// A ufbx matrix (columns of a 3×4 affine) as a glam matrix.
+fn matrix(m: &ufbx::Matrix) -> glam::DMat4 {
+    glam::DMat4::from_cols_array(&[
+        m.m00, m.m10, m.m20, 0.0, m.m01, m.m11, m.m21, 0.0, m.m02, m.m12, m.m22, 0.0, m.m03, m.m13, m.m23, 1.0,
+    ])
+}
+
+/// A node's name for people: its name, or `node<id>` when it has none.
+fn node_name(node: &ufbx::Node) -> String {
+    let name: &str = &node.element.name;
+    if name.is_empty() { format!("node{}", node.element.typed_id) } else { name.to_owned() }
+}

@@ -1,0 +1,87 @@
+//! ufbx's nodes as a parents-first [`Skeleton`].
+//!
+//! Every node below ufbx's synthetic root becomes a bone, depth first, children in file order. The root itself
+//! becomes a bone only when it carries a transform (it does not with the options bonescope loads with, but a bone
+//! list must not silently drop one). The walk uses an explicit stack.
+
+use glam::{DQuat, DVec3};
+
+use super::{Failure, Result, node_name};
+use crate::model::{Bone, InheritMode, Skeleton, Transform};
+
+/// The skeleton and the node ↔ bone mapping.
+pub(super) struct SceneBones {
+    pub skeleton: Skeleton,
+    /// The bone of each ufbx node (indexed by `typed_id`), `None` for the root when it is not a bone.
+    pub bone_of_node: Vec<Option<usize>>,
+}
+
+pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<SceneBones> {
+    let root = &scene.root_node;
+    let node_count = scene.nodes.len();
+    let mut bone_of_node = vec![None; node_count];
+    let mut bones: Vec<Bone> = Vec::new();
+    let mut stack: Vec<(&ufbx::Node, Option<usize>)> = Vec::new();
+    if is_identity(&root.local_transform) {
+        stack.extend(root.children.iter().rev().map(|c| (c.as_ref(), None)));
+    } else {
+        stack.push((root, None));
+    }
+    let mut counts = [0usize; 3];
+    while let Some((node, parent)) = stack.pop() {
+        let id = node.element.typed_id as usize;
+        let Some(slot) = bone_of_node.get_mut(id) else {
+            return Err(Failure::at(node_name(node), format!("node id {id} out of range ({node_count} nodes)")));
+        };
+        if slot.is_some() {
+            return Err(Failure::at(node_name(node), "reached twice in the node hierarchy"));
+        }
+        let bone = bones.len();
+        *slot = Some(bone);
+        let inherit = inherit_mode(node.inherit_mode);
+        counts[match inherit {
+            InheritMode::SegmentCompensate => 1,
+            InheritMode::Componentwise => 2,
+            _ => 0,
+        }] += 1;
+        bones.push(Bone { name: node_name(node), node: id, parent, rest: transform(node)?, inherit });
+        stack.extend(node.children.iter().rev().map(|c| (c.as_ref(), Some(bone))));
+    }
+    notes.push(format!(
+        "inherit types as declared: {} full (RSrs), {} segment-compensate (Rrs), {} componentwise (RrSs)",
+        counts[0], counts[1], counts[2]
+    ));
+    let root_id = root.element.typed_id as usize;
+    let unreached = bone_of_node.iter().enumerate().filter(|&(id, b)| b.is_none() && id != root_id).count();
+    if unreached > 0 {
+        notes.push(format!("{unreached} nodes outside the root's hierarchy are not bones"));
+    }
+    let skeleton = Skeleton::new(bones).map_err(|e| Failure { place: None, message: e.to_string() })?;
+    Ok(SceneBones { skeleton, bone_of_node })
+}
+
+/// ufbx's reading of the file's InheritType, as a bonescope mode.
+pub(super) fn inherit_mode(mode: ufbx::InheritMode) -> InheritMode {
+    match mode {
+        ufbx::InheritMode::Normal => InheritMode::Full,
+        ufbx::InheritMode::IgnoreParentScale => InheritMode::SegmentCompensate,
+        ufbx::InheritMode::ComponentwiseScale => InheritMode::Componentwise,
+    }
+}
+
+/// A ufbx transform as a bonescope one, checked finite.
+pub(super) fn from_ufbx(t: &ufbx::Transform) -> Option<Transform> {
+    let translation = DVec3::new(t.translation.x, t.translation.y, t.translation.z);
+    let rotation = DQuat::from_xyzw(t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w);
+    let scale = DVec3::new(t.scale.x, t.scale.y, t.scale.z);
+    let finite = translation.is_finite() && rotation.is_finite() && scale.is_finite();
+    finite.then(|| Transform::from_trs(translation, rotation, scale))
+}
+
+fn transform(node: &ufbx::Node) -> Result<Transform> {
+    from_ufbx(&node.local_transform).ok_or_else(|| Failure::at(node_name(node), "transform is not finite"))
+}
+
+fn is_identity(t: &ufbx::Transform) -> bool {
+    from_ufbx(t).is_some_and(|t| t == Transform::IDENTITY)
+}
