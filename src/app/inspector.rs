@@ -35,6 +35,7 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
             file: shared.doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string()),
             animation: shared.doc.clip().map(AnimationInfo::of),
             inherit: shared.doc.common_mode().map_or_else(|| "declared".to_owned(), |m| m.id().to_owned()),
+            notes: shared.doc.rig.notes.clone(),
             samples: vec![SampleReport { time: *shared.time, bones: vec![report.clone()] }],
         };
         if let Ok(json) = serde_json::to_string_pretty(&inspect) {
