@@ -102,15 +102,13 @@ pub fn decompose(m: &DMat4) -> AffineParts {
     let svd = svd(&a.to_cols_array_2d(), shortcut);
     let w = DMat3::from_cols_array_2d(&svd.u);
     let sign = if w.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let frame = quat_from_rotation(&(w * sign));
     let scale = DVec3::from_array(svd.sigma);
     if svd.v == DQuat::IDENTITY {
         // The columns were orthogonal: M = T·F·R·K with U = I.
-        let rotation = unit_with_positive_w(frame);
+        let rotation = quat_from_rotation(&(w * sign));
         return AffineParts { translation, rotation, stretch: DQuat::IDENTITY, scale, sign };
     }
-    // R = F·W·Vᵀ.
-    let rotation = unit_with_positive_w(frame * svd.v.conjugate());
+    let rotation = quat_from_rotation(&(w * DMat3::from_quat(svd.v).transpose() * sign));
     let (stretch, scale) = canonical_stretch(svd.v, scale, EQUAL_SCALE_TOLERANCE);
     AffineParts { translation, rotation, stretch, scale, sign }
 }
@@ -158,7 +156,7 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
     // w(u·p) = ⟨u, p̄⟩ with p̄ = conj(p). Over the 24 cube rotations the best |w| is one of: the largest |component|
     // of u, the two largest added and divided by √2, or all four added and halved (signs matched to u's).
     let comps = [u.x, u.y, u.z, u.w];
-    let abs = comps.map(f64::abs);
+    let abs: [f64; 4] = std::array::from_fn(|i| comps[i].abs());
     let by_size = two_largest(abs);
     let one = abs[by_size[0]];
     let two = (abs[by_size[0]] + abs[by_size[1]]) * std::f64::consts::FRAC_1_SQRT_2;
@@ -166,7 +164,7 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
     let signed = |i: usize, magnitude: f64| magnitude.copysign(comps[i]);
     let mut bar = [0.0; 4];
     if all > two && all > one {
-        bar = [0, 1, 2, 3].map(|i| signed(i, 0.5));
+        bar = std::array::from_fn(|i| signed(i, 0.5));
     } else if two > one {
         for &i in &by_size[..2] {
             bar[i] = signed(i, std::f64::consts::FRAC_1_SQRT_2);
@@ -175,14 +173,13 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
         bar[by_size[0]] = signed(by_size[0], 1.0);
     }
     let p = DQuat::from_xyzw(-bar[0], -bar[1], -bar[2], bar[3]);
-    let mut stretch = (u * p).normalize();
-    if stretch.w < 0.0 {
-        stretch = -stretch;
-    }
-    // Column i of p is ±e_j: the new axis i carries the old factor j.
-    let pm = DMat3::from_quat(p);
-    let scale = DVec3::from_array([0, 1, 2].map(|i| k[pm.col(i).abs().max_position()]));
-    (stretch, scale)
+    // Both factors are unit quaternions, so the product is one up to rounding.
+    let stretch = u * p;
+    let stretch = if stretch.w < 0.0 { -stretch } else { stretch };
+    // Column i of p is ±e_j: the new axis i carries the old factor j. Its entries are 0 or ±1 up to rounding.
+    let pm = DMat3::from_quat(p).to_cols_array_2d();
+    let scale: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| if pm[i][j].abs() > 0.5 { k[j] } else { 0.0 }).sum());
+    (stretch, DVec3::from_array(scale))
 }
 
 /// The indices of the largest and the second largest element (the earlier one first among equals).
@@ -198,15 +195,31 @@ fn two_largest(a: [f64; 4]) -> [usize; 2] {
     top
 }
 
-/// The quaternion of a proper rotation matrix (unit up to the matrix's own rounding).
+/// The unit quaternion, with `w ≥ 0`, of a rotation matrix (orthonormal up to rounding).
+///
+/// The textbook method (`DQuat::from_mat3`) picks, by a tree of branches, the largest of the four `4q²` values
+/// on the diagonal combinations and divides the other products by it; for arbitrary rotations those branches
+/// mispredict about half the time. Here all four candidates are formed, the largest is picked by selects, and the
+/// result is brought to unit length by one Newton step (the matrix is orthonormal to rounding, so the length is 1
+/// up to about 1e-15 before it and to rounding after it).
 fn quat_from_rotation(m: &DMat3) -> DQuat {
-    DQuat::from_mat3(m)
-}
-
-/// `q` normalised, with non-negative `w`.
-fn unit_with_positive_w(q: DQuat) -> DQuat {
-    let q = q.normalize();
-    if q.w < 0.0 { -q } else { q }
+    let [[m00, m01, m02], [m10, m11, m12], [m20, m21, m22]] = m.to_cols_array_2d();
+    // Row k holds 4·q_k·(x, y, z, w); its diagonal entry is 4·q_k².
+    let rows = [
+        [1.0 + m00 - m11 - m22, m01 + m10, m02 + m20, m12 - m21],
+        [m01 + m10, 1.0 - m00 + m11 - m22, m12 + m21, m20 - m02],
+        [m02 + m20, m12 + m21, 1.0 - m00 - m11 + m22, m01 - m10],
+        [m12 - m21, m20 - m02, m01 - m10, 1.0 + m00 + m11 + m22],
+    ];
+    // The row with the largest diagonal entry, by selects rather than an index (which would go through memory).
+    let pick = |a: [f64; 4], b: [f64; 4], b_wins: bool| if b_wins { b } else { a };
+    let [r0, r1, r2, r3] = rows;
+    let (r01, d01) = (pick(r0, r1, r1[1] > r0[0]), r0[0].max(r1[1]));
+    let (r23, d23) = (pick(r2, r3, r3[3] > r2[2]), r2[2].max(r3[3]));
+    let row = pick(r01, r23, d23 > d01);
+    // q = row / (4·q_k) with q_k = √(4q_k²)/2, and the sign that makes w ≥ 0.
+    let q = DQuat::from_array(row) * (0.5 / d01.max(d23).sqrt()).copysign(row[3]);
+    q * (1.5 - 0.5 * q.length_squared())
 }
 
 /// The largest deviation from 90°, in degrees, between any two columns of the 3×3 part: 0 for any rotation·scale
