@@ -69,9 +69,19 @@ impl AffineParts {
     /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees.
     ///
     /// Between nearly equal factors `U` may turn freely without changing the matrix by more than their difference,
-    /// so this is the angle that matters when asking whether a bone is stretched.
+    /// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
+    /// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
+    /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
+    /// between its axis and the nearest local axis, and 0 when all count as equal.
     pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
-        quat_angle(canonical_stretch(self.stretch, self.scale, relative_tolerance).0).to_degrees()
+        let angle = match equal_factors(self.scale, relative_tolerance) {
+            [false, false, false] => 2.0 * closest_axis_permutation_w(self.stretch).min(1.0).acos(),
+            [true, false, false] => angle_to_nearest_axis(self.stretch * DVec3::Z),
+            [false, true, false] => angle_to_nearest_axis(self.stretch * DVec3::Y),
+            [false, false, true] => angle_to_nearest_axis(self.stretch * DVec3::X),
+            _ => 0.0,
+        };
+        angle.to_degrees()
     }
 
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
@@ -130,13 +140,11 @@ fn shortcut(gram: &Gram) -> bool {
 /// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match; factors
 /// within `relative_tolerance` of the largest count as equal.
 fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVec3) {
-    let tolerance = relative_tolerance * k.max_element();
-    let equal = |i: usize, j: usize| (k[i] - k[j]).abs() <= tolerance;
-    let distinct = match (equal(0, 1), equal(0, 2), equal(1, 2)) {
-        (false, false, false) => return closest_axis_permutation(u, k),
-        (true, false, false) => 2,
-        (false, true, false) => 1,
-        (false, false, true) => 0,
+    let distinct = match equal_factors(k, relative_tolerance) {
+        [false, false, false] => return closest_axis_permutation(u, k),
+        [true, false, false] => 2,
+        [false, true, false] => 1,
+        [false, false, true] => 0,
         _ => return (DQuat::IDENTITY, k),
     };
     // Two equal factors: only the direction of the distinct one matters. Put it on the local axis nearest to it by
@@ -148,6 +156,26 @@ fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVe
     let mut scale = k.to_array();
     scale.swap(axis, distinct);
     (stretch, DVec3::from_array(scale))
+}
+
+/// `|w|` of `u·p` for the axis permutation `p` that makes it largest (see [`closest_axis_permutation`]).
+fn closest_axis_permutation_w(u: DQuat) -> f64 {
+    let [x, y, z, w] = [u.x.abs(), u.y.abs(), u.z.abs(), u.w.abs()];
+    let (high_xy, low_xy, high_zw, low_zw) = (x.max(y), x.min(y), z.max(w), z.min(w));
+    let largest = high_xy.max(high_zw);
+    let second = high_xy.min(high_zw).max(low_xy.max(low_zw));
+    largest.max((largest + second) * std::f64::consts::FRAC_1_SQRT_2).max((x + y + z + w) * 0.5)
+}
+
+/// The angle, in radians, between a unit vector and the nearest of the local axes (either direction).
+fn angle_to_nearest_axis(direction: DVec3) -> f64 {
+    direction.abs().max_element().min(1.0).acos()
+}
+
+/// Which pairs of factors, (0, 1), (0, 2) and (1, 2), are within `relative_tolerance` of the largest of each other.
+fn equal_factors(k: DVec3, relative_tolerance: f64) -> [bool; 3] {
+    let tolerance = relative_tolerance * k.max_element();
+    [(k.x - k.y).abs() <= tolerance, (k.x - k.z).abs() <= tolerance, (k.y - k.z).abs() <= tolerance]
 }
 
 /// Among the 24 rotations that permute the axes, the `p` for which `u·p` is nearest the identity (largest `|w|`);
@@ -226,14 +254,96 @@ fn quat_from_rotation(m: &DMat3) -> DQuat {
 /// matrix, whatever its frame. Pairs with a zero column do not count.
 pub fn shear_deg(m: &DMat3) -> f64 {
     let cols = [m.x_axis, m.y_axis, m.z_axis];
+    let lengths = [cols[0].length(), cols[1].length(), cols[2].length()];
     let mut worst: f64 = 0.0;
     for (i, j) in [(0, 1), (0, 2), (1, 2)] {
-        let (a, b) = (cols[i], cols[j]);
-        let lengths = a.length() * b.length();
-        if lengths > 0.0 && lengths.is_finite() {
-            let cos = (a.dot(b) / lengths).clamp(-1.0, 1.0);
-            worst = worst.max((cos.acos().to_degrees() - 90.0).abs());
+        let product = lengths[i] * lengths[j];
+        if product > 0.0 && product.is_finite() {
+            worst = worst.max((cols[i].dot(cols[j]) / product).abs());
         }
     }
-    worst
+    // |acos(c) − 90°| = asin(|c|): one inverse sine for the largest |cosine| instead of one arc cosine per pair.
+    worst.min(1.0).asin().to_degrees()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// xorshift64*: deterministic inputs without a dependency.
+    struct Rng(u64);
+
+    impl Rng {
+        fn unit(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn quat(&mut self) -> DQuat {
+            DQuat::from_xyzw(self.unit() - 0.5, self.unit() - 0.5, self.unit() - 0.5, self.unit() - 0.5).normalize()
+        }
+    }
+
+    #[test]
+    fn quat_from_rotation_matches_glam() {
+        let mut rng = Rng(7);
+        for _ in 0..1000 {
+            let q = rng.quat();
+            let ours = quat_from_rotation(&DMat3::from_quat(q));
+            let theirs = DQuat::from_mat3(&DMat3::from_quat(q));
+            assert!(ours.w >= 0.0);
+            assert!(ours.abs_diff_eq(theirs, 1e-15) || ours.abs_diff_eq(-theirs, 1e-15), "{ours} vs {theirs}");
+        }
+        // Half turns have w = 0: the other components decide.
+        let half_turn = quat_from_rotation(&DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0)));
+        assert!(half_turn.abs_diff_eq(DQuat::from_xyzw(1.0, 0.0, 0.0, 0.0), 1e-15));
+    }
+
+    /// `stretch_angle_deg_within` gives the angle of the frame `canonical_stretch` would choose.
+    #[test]
+    fn stretch_angle_within_matches_the_canonical_frame() {
+        let mut rng = Rng(11);
+        let factor_sets = [
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(2.0, 1.0, 1.0 + 1e-6),
+            DVec3::new(1.0 + 1e-6, 3.0, 1.0),
+            DVec3::new(0.5, 0.5 + 1e-7, 0.5),
+            DVec3::new(1.0, 1.0, 1.0 + 1e-5),
+        ];
+        for _ in 0..200 {
+            for scale in factor_sets {
+                let parts = AffineParts {
+                    translation: DVec3::ZERO,
+                    rotation: rng.quat(),
+                    stretch: rng.quat(),
+                    scale,
+                    sign: 1.0,
+                };
+                let canonical = canonical_stretch(parts.stretch, scale, 1e-4).0;
+                let expected = quat_angle(canonical).to_degrees();
+                let got = parts.stretch_angle_deg_within(1e-4);
+                assert!((got - expected).abs() < 1e-6, "{scale}: {got} vs {expected}");
+            }
+        }
+    }
+
+    #[test]
+    fn shear_is_the_largest_deviation_of_any_column_pair() {
+        let mut rng = Rng(3);
+        for _ in 0..200 {
+            let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.unit() * 2.0 - 1.0));
+            let cols = [m.x_axis, m.y_axis, m.z_axis];
+            let expected = [(0, 1), (0, 2), (1, 2)]
+                .map(|(i, j)| {
+                    let cos = cols[i].dot(cols[j]) / (cols[i].length() * cols[j].length());
+                    (cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs()
+                })
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!((shear_deg(&m) - expected).abs() < 1e-9, "{m}");
+        }
+        assert_eq!(shear_deg(&DMat3::from_cols(DVec3::X, DVec3::ZERO, DVec3::Y)), 0.0);
+    }
 }
