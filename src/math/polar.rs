@@ -6,8 +6,9 @@
 //! decomposition `A = W·Σ·Vᵀ` (`svd.rs`, one-sided Jacobi), since `Q = W·Vᵀ` and `S = V·Σ·Vᵀ`. That is one
 //! iteration instead of two, and more accurate: the SVD never inverts `A` the way Newton does, so the parts stay
 //! exact to rounding at scale ratios of 1e6. Steps:
-//! 1. `A = W·Σ·Vᵀ` with `V` a rotation;
-//! 2. `F = −I` when `det W < 0` (that is, `det A < 0`), so `R = F·W·Vᵀ` is a proper rotation;
+//! 1. `A = F·W·Σ·Vᵀ` with `W` and `V` rotations and `F = −I` when `det A < 0` (the SVD with the sign of the
+//!    determinant taken out of `W`);
+//! 2. `R = W·Vᵀ`, a proper rotation;
 //! 3. `U = V`, `K = Σ`;
 //! 4. the canonical `U`: among the frames that give the same `S` (axis permutations, and free turns in the plane
 //!    of equal scale factors) the one closest to the identity. Scale factors within [`EQUAL_SCALE_TOLERANCE`] of each
@@ -74,6 +75,9 @@ impl AffineParts {
     /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
     /// between its axis and the nearest local axis, and 0 when all count as equal.
     pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
+        if self.stretch == DQuat::IDENTITY {
+            return 0.0;
+        }
         let angle = match equal_factors(self.scale, relative_tolerance) {
             [false, false, false] => 2.0 * closest_axis_permutation_w(self.stretch).min(1.0).acos(),
             [true, false, false] => angle_to_nearest_axis(self.stretch * DVec3::Z),
@@ -110,15 +114,15 @@ pub fn decompose(m: &DMat4) -> AffineParts {
         };
     }
     let svd = svd(&a.to_cols_array_2d(), shortcut);
-    let w = DMat3::from_cols_array_2d(&svd.u);
-    let sign = if w.determinant() < 0.0 { -1.0 } else { 1.0 };
+    let (w, sign) = (DMat3::from_cols_array_2d(&svd.u), svd.sign);
     let scale = DVec3::from_array(svd.sigma);
     if svd.v == DQuat::IDENTITY {
         // The columns were orthogonal: M = T·F·R·K with U = I.
-        let rotation = quat_from_rotation(&(w * sign));
+        let rotation = quat_from_rotation(&w);
         return AffineParts { translation, rotation, stretch: DQuat::IDENTITY, scale, sign };
     }
-    let rotation = quat_from_rotation(&(w * DMat3::from_quat(svd.v).transpose() * sign));
+    // R = W·Vᵀ.
+    let rotation = quat_from_rotation(&(w * DMat3::from_quat(svd.v).transpose()));
     let (stretch, scale) = canonical_stretch(svd.v, scale, EQUAL_SCALE_TOLERANCE);
     AffineParts { translation, rotation, stretch, scale, sign }
 }
@@ -205,9 +209,12 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
     let stretch = u * p;
     let stretch = if stretch.w < 0.0 { -stretch } else { stretch };
     // Column i of p is ±e_j: the new axis i carries the old factor j. Its entries are 0 or ±1 up to rounding.
-    let pm = DMat3::from_quat(p).to_cols_array_2d();
-    let scale: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| if pm[i][j].abs() > 0.5 { k[j] } else { 0.0 }).sum());
-    (stretch, DVec3::from_array(scale))
+    let pm = DMat3::from_quat(p);
+    let carried = |column: DVec3| {
+        let pick = |entry: f64, factor: f64| if entry.abs() > 0.5 { factor } else { 0.0 };
+        pick(column.x, k.x) + pick(column.y, k.y) + pick(column.z, k.z)
+    };
+    (stretch, DVec3::new(carried(pm.x_axis), carried(pm.y_axis), carried(pm.z_axis)))
 }
 
 /// The indices of the largest and the second largest element (the earlier one first among equals).
