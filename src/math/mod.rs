@@ -2,6 +2,7 @@
 
 mod polar;
 mod quat;
+mod svd;
 
 pub use polar::{AffineParts, EQUAL_SCALE_TOLERANCE, decompose, quat_angle, shear_deg};
 pub use quat::{nlerp, slerp};

@@ -1,22 +1,27 @@
 //! Shoemake's polar decomposition of an affine matrix, `M = T·F·R·U·K·Uᵀ` ("Polar Matrix Decomposition",
 //! Graphics Gems IV, 1994), in `f64`, made robust where the original is not.
 //!
-//! Steps, each a function below:
-//! 1. the polar factor `Q` of the 3×3 part by Higham's scaled Newton iteration (quadratically convergent, with an
-//!    iteration cap); rank-deficient or non-converging matrices fall back to an eigen-decomposition of `MᵀM`;
-//! 2. `F = −I` when `det M < 0`, so `R = F·Q` is a proper rotation and `S = Qᵀ·M` is symmetric positive semi-definite;
-//! 3. `S = U·K·Uᵀ` by cyclic Jacobi;
+//! Shoemake reaches the parts through two iterations in a row: Newton's for the polar factor `Q` of the 3×3 part
+//! `A = Q·S`, then Jacobi's for the spectral decomposition of the stretch `S`. Both fall out of one singular value
+//! decomposition `A = W·Σ·Vᵀ` (`svd.rs`, one-sided Jacobi), since `Q = W·Vᵀ` and `S = V·Σ·Vᵀ`. That is one
+//! iteration instead of two, and more accurate: the SVD never inverts `A` the way Newton does, so the parts stay
+//! exact to rounding at scale ratios of 1e6. Steps:
+//! 1. `A = F·W·Σ·Vᵀ` with `W` and `V` rotations and `F = −I` when `det A < 0` (the SVD with the sign of the
+//!    determinant taken out of `W`);
+//! 2. `R = W·Vᵀ`, a proper rotation;
+//! 3. `U = V`, `K = Σ`;
 //! 4. the canonical `U`: among the frames that give the same `S` (axis permutations, and free turns in the plane
 //!    of equal scale factors) the one closest to the identity. Scale factors within [`EQUAL_SCALE_TOLERANCE`] of each
 //!    other count as equal, so uniformly scaled bones report `U = I` instead of a frame picked by rounding noise.
 //!
-//! Most matrices in an animation are plain rotation·scale with orthogonal columns; they take a shortcut that skips
-//! all of the above and gives the same parts.
+//! Most matrices in an animation are plain rotation·scale with orthogonal columns; they take a shortcut: the SVD
+//! does no rotation (`V = I`), and step 4 is skipped.
 //!
 //! Non-finite input gives the identity rotation and zero scale (never NaN, never a hang).
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
+use super::svd::{Gram, svd};
 use crate::model::affine;
 
 /// Scale factors whose difference is at most this fraction of the largest one are treated as equal when `U` is
@@ -26,11 +31,9 @@ pub const EQUAL_SCALE_TOLERANCE: f64 = 1e-10;
 /// Columns whose cosine is at most this are orthogonal for the shortcut (about 1e-11 degrees from 90°).
 const ORTHOGONAL_COSINE: f64 = 2e-13;
 
-/// Newton stops once an update changes the iterate by less than this fraction (the next one is then exact to
-/// rounding, since convergence is quadratic).
-const NEWTON_TOLERANCE: f64 = 1e-9;
-const NEWTON_MAX_ITERATIONS: usize = 64;
-const JACOBI_MAX_SWEEPS: usize = 32;
+/// The shortcut also wants the shortest column at least this fraction of the longest: below it, a cosine of
+/// 2e-13 would no longer bound the error relative to the short column.
+const SHORTCUT_LENGTH_RATIO: f64 = 1e-6;
 
 /// The parts of `M = T(translation)·(sign·I)·R(rotation)·U·diag(scale)·Uᵀ` with `U = R(stretch)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,9 +70,22 @@ impl AffineParts {
     /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees.
     ///
     /// Between nearly equal factors `U` may turn freely without changing the matrix by more than their difference,
-    /// so this is the angle that matters when asking whether a bone is stretched.
+    /// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
+    /// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
+    /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
+    /// between its axis and the nearest local axis, and 0 when all count as equal.
     pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
-        quat_angle(canonical_stretch(self.stretch, self.scale, relative_tolerance).0).to_degrees()
+        if self.stretch == DQuat::IDENTITY {
+            return 0.0;
+        }
+        let angle = match equal_factors(self.scale, relative_tolerance) {
+            [false, false, false] => 2.0 * closest_axis_permutation_w(self.stretch).min(1.0).acos(),
+            [true, false, false] => angle_to_nearest_axis(self.stretch * DVec3::Z),
+            [false, true, false] => angle_to_nearest_axis(self.stretch * DVec3::Y),
+            [false, false, true] => angle_to_nearest_axis(self.stretch * DVec3::X),
+            _ => 0.0,
+        };
+        angle.to_degrees()
     }
 
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
@@ -97,165 +113,42 @@ pub fn decompose(m: &DMat4) -> AffineParts {
             sign: 1.0,
         };
     }
-    let (rotation, stretch, scale, sign) = orthogonal_shortcut(&a).unwrap_or_else(|| general(&a));
+    let svd = svd(&a.to_cols_array_2d(), shortcut);
+    let (w, sign) = (DMat3::from_cols_array_2d(&svd.u), svd.sign);
+    let scale = DVec3::from_array(svd.sigma);
+    if svd.v == DQuat::IDENTITY {
+        // The columns were orthogonal: M = T·F·R·K with U = I.
+        let rotation = quat_from_rotation(&w);
+        return AffineParts { translation, rotation, stretch: DQuat::IDENTITY, scale, sign };
+    }
+    // R = W·Vᵀ.
+    let rotation = quat_from_rotation(&(w * DMat3::from_quat(svd.v).transpose()));
+    let (stretch, scale) = canonical_stretch(svd.v, scale, EQUAL_SCALE_TOLERANCE);
     AffineParts { translation, rotation, stretch, scale, sign }
 }
 
-type Parts3 = (DQuat, DQuat, DVec3, f64);
-
-/// The parts of a matrix whose columns are non-zero and mutually orthogonal: `U = I`, `K` = column lengths.
-fn orthogonal_shortcut(a: &DMat3) -> Option<Parts3> {
-    let (x, y, z) = (a.x_axis, a.y_axis, a.z_axis);
-    let lengths = DVec3::new(x.length(), y.length(), z.length());
-    let min_length = lengths.min_element();
-    if min_length <= 0.0 || min_length < lengths.max_element() * 1e-6 {
-        return None;
-    }
-    let orthogonal = |a: DVec3, b: DVec3, la: f64, lb: f64| a.dot(b).abs() <= ORTHOGONAL_COSINE * la * lb;
-    if !(orthogonal(x, y, lengths.x, lengths.y)
-        && orthogonal(y, z, lengths.y, lengths.z)
-        && orthogonal(x, z, lengths.x, lengths.z))
-    {
-        return None;
-    }
-    let sign = if a.determinant() < 0.0 { -1.0 } else { 1.0 };
-    let q = DMat3::from_cols(x / lengths.x, y / lengths.y, z / lengths.z) * sign;
-    Some((rotation_from_orthonormal(&q), DQuat::IDENTITY, lengths, sign))
-}
-
-/// The full decomposition: polar factor, sign, spectral decomposition, canonical stretch frame.
-fn general(a: &DMat3) -> Parts3 {
-    let (mut q, s) = polar_newton(a).unwrap_or_else(|| polar_degenerate(a));
-    let sign = if q.determinant() < 0.0 { -1.0 } else { 1.0 };
-    q *= sign;
-    let (u, k) = symmetric_eigen(&s);
-    let (stretch, scale) = canonical_stretch(rotation_from_orthonormal(&u), k.max(DVec3::ZERO), EQUAL_SCALE_TOLERANCE);
-    (rotation_from_orthonormal(&q), stretch, scale, sign)
-}
-
-/// `M = Q·S` by Higham's scaled Newton iteration `X ← ½(γX + γ⁻¹X⁻ᵀ)` with the (1,∞)-norm scaling.
-/// `None` when the matrix is (numerically) singular or the iteration does not settle.
-fn polar_newton(a: &DMat3) -> Option<(DMat3, DMat3)> {
-    let mut x = *a;
-    for _ in 0..NEWTON_MAX_ITERATIONS {
-        let cof = cofactor(&x);
-        let det = x.x_axis.dot(cof.x_axis);
-        if !det.is_finite() || det.abs() <= f64::MIN_POSITIVE * norm_frobenius(&x).powi(3).max(1.0) {
-            return None;
-        }
-        let ratio = (norm_one(&cof) * norm_inf(&cof)) / (norm_one(&x) * norm_inf(&x));
-        let gamma = (ratio.sqrt() / det.abs()).sqrt();
-        let next = x * (0.5 * gamma) + cof * (0.5 / (gamma * det));
-        let change = norm_one(&(next - x));
-        x = next;
-        if !x.is_finite() {
-            return None;
-        }
-        if change <= NEWTON_TOLERANCE * norm_one(&x) {
-            // One more step: the error is now about the square of `change`, i.e. at rounding level.
-            let cof = cofactor(&x);
-            let det = x.x_axis.dot(cof.x_axis);
-            x = (x + cof * (1.0 / det)) * 0.5;
-            return Some((x, symmetric_part(&(x.transpose() * *a))));
-        }
-    }
-    None
-}
-
-/// The polar decomposition of a rank-deficient matrix through the eigen-decomposition `MᵀM = V·Λ·Vᵀ`:
-/// `Q = W·Vᵀ` with `W`'s columns `M·vᵢ/σᵢ` where `σᵢ > 0`, completed to a proper rotation.
-fn polar_degenerate(a: &DMat3) -> (DMat3, DMat3) {
-    let (v, lambda) = symmetric_eigen(&(a.transpose() * *a));
-    let sigma = lambda.max(DVec3::ZERO).to_array().map(f64::sqrt);
-    let mut order = [0, 1, 2];
-    order.sort_by(|&i, &j| sigma[j].total_cmp(&sigma[i]));
-    let significant = sigma[order[0]] * 1e-12;
-    let mut w = [DVec3::ZERO; 3];
-    for (rank, &i) in order.iter().enumerate() {
-        let image = if sigma[i] > significant { *a * v.col(i) } else { DVec3::ZERO };
-        w[i] = orthonormal_completion(image, &order[..rank].iter().map(|&j| w[j]).collect::<Vec<_>>());
-    }
-    let mut w = DMat3::from_cols(w[0], w[1], w[2]);
-    if w.determinant() < 0.0 {
-        // The weakest direction is free (its σ is zero unless the matrix has full rank); flip it.
-        let weakest = order[2];
-        *w.col_mut(weakest) = -w.col(weakest);
-    }
-    let q = w * v.transpose();
-    (q, symmetric_part(&(q.transpose() * *a)))
-}
-
-/// `candidate` made orthogonal to the orthonormal `basis` and normalised; any unit vector orthogonal to it when
-/// nothing of `candidate` is left.
-fn orthonormal_completion(candidate: DVec3, basis: &[DVec3]) -> DVec3 {
-    let rest = basis.iter().fold(candidate, |c, b| c - *b * b.dot(c));
-    if rest.length() > 1e-9 * candidate.length().max(f64::MIN_POSITIVE) && rest.length() > 0.0 {
-        return rest.normalize();
-    }
-    match basis {
-        [] => DVec3::X,
-        [b] => b.any_orthonormal_vector(),
-        [b, c, ..] => b.cross(*c).normalize(),
-    }
-}
-
-/// `S = U·diag(k)·Uᵀ` for symmetric `S` by cyclic Jacobi rotations; `U` is a proper rotation.
-fn symmetric_eigen(s: &DMat3) -> (DMat3, DVec3) {
-    let mut m = s.to_cols_array_2d();
-    let mut u = DMat3::IDENTITY.to_cols_array_2d();
-    let scale = m.iter().flatten().map(|x| x.abs()).fold(0.0, f64::max);
-    for _ in 0..JACOBI_MAX_SWEEPS {
-        let off = m[0][1].abs() + m[0][2].abs() + m[1][2].abs();
-        if off <= scale * 1e-17 || off == 0.0 {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            jacobi_rotate(&mut m, &mut u, p, q);
-        }
-    }
-    (DMat3::from_cols_array_2d(&u), DVec3::new(m[0][0], m[1][1], m[2][2]))
-}
-
-/// One Jacobi rotation in the (p, q) plane zeroing `m[p][q]` (Golub & Van Loan, symmetric Schur).
-fn jacobi_rotate(m: &mut [[f64; 3]; 3], u: &mut [[f64; 3]; 3], p: usize, q: usize) {
-    let apq = m[p][q];
-    if apq == 0.0 {
-        return;
-    }
-    let theta = (m[q][q] - m[p][p]) / (2.0 * apq);
-    // Infinite θ (a negligible m[p][q]) gives t = 0: no rotation.
-    let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-    let c = 1.0 / (t * t + 1.0).sqrt();
-    let s = t * c;
-    // m ← Jᵀ·m·J with J the rotation by (c, s) in the (p, q) plane; u ← u·J. Arrays are [column][row].
-    for column in m.iter_mut() {
-        let (row_p, row_q) = (column[p], column[q]);
-        column[p] = c * row_p - s * row_q;
-        column[q] = s * row_p + c * row_q;
-    }
-    turn_columns(m, p, q, c, s);
-    m[p][q] = 0.0;
-    m[q][p] = 0.0;
-    turn_columns(u, p, q, c, s);
-}
-
-/// Columns p and q of `m` (stored [column][row]) turned by the plane rotation (c, s): `m ← m·J`.
-fn turn_columns(m: &mut [[f64; 3]; 3], p: usize, q: usize, c: f64, s: f64) {
-    let (column_p, column_q) = (m[p], m[q]);
-    m[p] = std::array::from_fn(|k| c * column_p[k] - s * column_q[k]);
-    m[q] = std::array::from_fn(|k| s * column_p[k] + c * column_q[k]);
+/// Whether the columns are non-zero, of comparable lengths, and orthogonal to within [`ORTHOGONAL_COSINE`]: then
+/// `U = I` and `K` is the column lengths, with no rotation to search for.
+fn shortcut(gram: &Gram) -> bool {
+    let [x, y, z] = gram.lengths_squared;
+    let (shortest, longest) = (x.min(y).min(z), x.max(y).max(z));
+    let orthogonal = |dot: f64, a: f64, b: f64| dot * dot <= ORTHOGONAL_COSINE * ORTHOGONAL_COSINE * a * b;
+    let [xy, xz, yz] = gram.dots;
+    shortest > 0.0
+        && shortest >= longest * (SHORTCUT_LENGTH_RATIO * SHORTCUT_LENGTH_RATIO)
+        && orthogonal(xy, x, y)
+        && orthogonal(xz, x, z)
+        && orthogonal(yz, y, z)
 }
 
 /// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match; factors
 /// within `relative_tolerance` of the largest count as equal.
 fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVec3) {
-    let tolerance = relative_tolerance * k.max_element();
-    let equal = |i: usize, j: usize| (k[i] - k[j]).abs() <= tolerance;
-    let distinct = match (equal(0, 1), equal(0, 2), equal(1, 2)) {
-        (false, false, false) => return closest_axis_permutation(u, k),
-        (true, false, false) => 2,
-        (false, true, false) => 1,
-        (false, false, true) => 0,
+    let distinct = match equal_factors(k, relative_tolerance) {
+        [false, false, false] => return closest_axis_permutation(u, k),
+        [true, false, false] => 2,
+        [false, true, false] => 1,
+        [false, false, true] => 0,
         _ => return (DQuat::IDENTITY, k),
     };
     // Two equal factors: only the direction of the distinct one matters. Put it on the local axis nearest to it by
@@ -269,22 +162,41 @@ fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVe
     (stretch, DVec3::from_array(scale))
 }
 
+/// `|w|` of `u·p` for the axis permutation `p` that makes it largest (see [`closest_axis_permutation`]).
+fn closest_axis_permutation_w(u: DQuat) -> f64 {
+    let [x, y, z, w] = [u.x.abs(), u.y.abs(), u.z.abs(), u.w.abs()];
+    let (high_xy, low_xy, high_zw, low_zw) = (x.max(y), x.min(y), z.max(w), z.min(w));
+    let largest = high_xy.max(high_zw);
+    let second = high_xy.min(high_zw).max(low_xy.max(low_zw));
+    largest.max((largest + second) * std::f64::consts::FRAC_1_SQRT_2).max((x + y + z + w) * 0.5)
+}
+
+/// The angle, in radians, between a unit vector and the nearest of the local axes (either direction).
+fn angle_to_nearest_axis(direction: DVec3) -> f64 {
+    direction.abs().max_element().min(1.0).acos()
+}
+
+/// Which pairs of factors, (0, 1), (0, 2) and (1, 2), are within `relative_tolerance` of the largest of each other.
+fn equal_factors(k: DVec3, relative_tolerance: f64) -> [bool; 3] {
+    let tolerance = relative_tolerance * k.max_element();
+    [(k.x - k.y).abs() <= tolerance, (k.x - k.z).abs() <= tolerance, (k.y - k.z).abs() <= tolerance]
+}
+
 /// Among the 24 rotations that permute the axes, the `p` for which `u·p` is nearest the identity (largest `|w|`);
 /// returns `u·p` and `k` permuted so that `(u·p)·K'·(u·p)ᵀ = u·K·uᵀ`.
 fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
     // w(u·p) = ⟨u, p̄⟩ with p̄ = conj(p). Over the 24 cube rotations the best |w| is one of: the largest |component|
     // of u, the two largest added and divided by √2, or all four added and halved (signs matched to u's).
     let comps = [u.x, u.y, u.z, u.w];
-    let abs = comps.map(f64::abs);
-    let mut by_size = [0, 1, 2, 3];
-    by_size.sort_by(|&i, &j| abs[j].total_cmp(&abs[i]));
+    let abs: [f64; 4] = std::array::from_fn(|i| comps[i].abs());
+    let by_size = two_largest(abs);
     let one = abs[by_size[0]];
     let two = (abs[by_size[0]] + abs[by_size[1]]) * std::f64::consts::FRAC_1_SQRT_2;
     let all = abs.iter().sum::<f64>() * 0.5;
     let signed = |i: usize, magnitude: f64| magnitude.copysign(comps[i]);
     let mut bar = [0.0; 4];
     if all > two && all > one {
-        bar = [0, 1, 2, 3].map(|i| signed(i, 0.5));
+        bar = std::array::from_fn(|i| signed(i, 0.5));
     } else if two > one {
         for &i in &by_size[..2] {
             bar[i] = signed(i, std::f64::consts::FRAC_1_SQRT_2);
@@ -293,57 +205,152 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
         bar[by_size[0]] = signed(by_size[0], 1.0);
     }
     let p = DQuat::from_xyzw(-bar[0], -bar[1], -bar[2], bar[3]);
-    let mut stretch = (u * p).normalize();
-    if stretch.w < 0.0 {
-        stretch = -stretch;
-    }
-    // Column i of p is ±e_j: the new axis i carries the old factor j.
+    // Both factors are unit quaternions, so the product is one up to rounding.
+    let stretch = u * p;
+    let stretch = if stretch.w < 0.0 { -stretch } else { stretch };
+    // Column i of p is ±e_j: the new axis i carries the old factor j. Its entries are 0 or ±1 up to rounding.
     let pm = DMat3::from_quat(p);
-    let scale = DVec3::from_array([0, 1, 2].map(|i| k[pm.col(i).abs().max_position()]));
-    (stretch, scale)
+    let carried = |column: DVec3| {
+        let pick = |entry: f64, factor: f64| if entry.abs() > 0.5 { factor } else { 0.0 };
+        pick(column.x, k.x) + pick(column.y, k.y) + pick(column.z, k.z)
+    };
+    (stretch, DVec3::new(carried(pm.x_axis), carried(pm.y_axis), carried(pm.z_axis)))
 }
 
-/// A unit quaternion with non-negative `w` from a proper rotation matrix.
-fn rotation_from_orthonormal(m: &DMat3) -> DQuat {
-    let q = DQuat::from_mat3(m).normalize();
-    if q.w < 0.0 { -q } else { q }
+/// The indices of the largest and the second largest element (the earlier one first among equals).
+fn two_largest(a: [f64; 4]) -> [usize; 2] {
+    let mut top = if a[1] > a[0] { [1, 0] } else { [0, 1] };
+    for i in 2..4 {
+        if a[i] > a[top[0]] {
+            top = [i, top[0]];
+        } else if a[i] > a[top[1]] {
+            top[1] = i;
+        }
+    }
+    top
 }
 
-/// Columns `x1×x2, x2×x0, x0×x1`: `det(X)·X⁻ᵀ`.
-fn cofactor(x: &DMat3) -> DMat3 {
-    DMat3::from_cols(x.y_axis.cross(x.z_axis), x.z_axis.cross(x.x_axis), x.x_axis.cross(x.y_axis))
-}
-
-fn symmetric_part(m: &DMat3) -> DMat3 {
-    (*m + m.transpose()) * 0.5
-}
-
-/// Largest column sum of absolute values.
-fn norm_one(m: &DMat3) -> f64 {
-    [m.x_axis, m.y_axis, m.z_axis].iter().map(|c| c.abs().element_sum()).fold(0.0, f64::max)
-}
-
-/// Largest row sum of absolute values.
-fn norm_inf(m: &DMat3) -> f64 {
-    norm_one(&m.transpose())
-}
-
-fn norm_frobenius(m: &DMat3) -> f64 {
-    (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()).sqrt()
+/// The unit quaternion, with `w ≥ 0`, of a rotation matrix (orthonormal up to rounding).
+///
+/// The textbook method (`DQuat::from_mat3`) picks, by a tree of branches, the largest of the four `4q²` values
+/// on the diagonal combinations and divides the other products by it; for arbitrary rotations those branches
+/// mispredict about half the time. Here all four candidates are formed, the largest is picked by selects, and the
+/// result is brought to unit length by one Newton step (the matrix is orthonormal to rounding, so the length is 1
+/// up to about 1e-15 before it and to rounding after it).
+fn quat_from_rotation(m: &DMat3) -> DQuat {
+    let [[m00, m01, m02], [m10, m11, m12], [m20, m21, m22]] = m.to_cols_array_2d();
+    // Row k holds 4·q_k·(x, y, z, w); its diagonal entry is 4·q_k².
+    let rows = [
+        [1.0 + m00 - m11 - m22, m01 + m10, m02 + m20, m12 - m21],
+        [m01 + m10, 1.0 - m00 + m11 - m22, m12 + m21, m20 - m02],
+        [m02 + m20, m12 + m21, 1.0 - m00 - m11 + m22, m01 - m10],
+        [m12 - m21, m20 - m02, m01 - m10, 1.0 + m00 + m11 + m22],
+    ];
+    // The row with the largest diagonal entry, by selects rather than an index (which would go through memory).
+    let pick = |a: [f64; 4], b: [f64; 4], b_wins: bool| if b_wins { b } else { a };
+    let [r0, r1, r2, r3] = rows;
+    let (r01, d01) = (pick(r0, r1, r1[1] > r0[0]), r0[0].max(r1[1]));
+    let (r23, d23) = (pick(r2, r3, r3[3] > r2[2]), r2[2].max(r3[3]));
+    let row = pick(r01, r23, d23 > d01);
+    // q = row / (4·q_k) with q_k = √(4q_k²)/2, and the sign that makes w ≥ 0.
+    let q = DQuat::from_array(row) * (0.5 / d01.max(d23).sqrt()).copysign(row[3]);
+    q * (1.5 - 0.5 * q.length_squared())
 }
 
 /// The largest deviation from 90°, in degrees, between any two columns of the 3×3 part: 0 for any rotation·scale
 /// matrix, whatever its frame. Pairs with a zero column do not count.
 pub fn shear_deg(m: &DMat3) -> f64 {
     let cols = [m.x_axis, m.y_axis, m.z_axis];
+    let lengths = [cols[0].length(), cols[1].length(), cols[2].length()];
     let mut worst: f64 = 0.0;
     for (i, j) in [(0, 1), (0, 2), (1, 2)] {
-        let (a, b) = (cols[i], cols[j]);
-        let lengths = a.length() * b.length();
-        if lengths > 0.0 && lengths.is_finite() {
-            let cos = (a.dot(b) / lengths).clamp(-1.0, 1.0);
-            worst = worst.max((cos.acos().to_degrees() - 90.0).abs());
+        let product = lengths[i] * lengths[j];
+        if product > 0.0 && product.is_finite() {
+            worst = worst.max((cols[i].dot(cols[j]) / product).abs());
         }
     }
-    worst
+    // |acos(c) − 90°| = asin(|c|): one inverse sine for the largest |cosine| instead of one arc cosine per pair.
+    worst.min(1.0).asin().to_degrees()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// xorshift64*: deterministic inputs without a dependency.
+    struct Rng(u64);
+
+    impl Rng {
+        fn unit(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn quat(&mut self) -> DQuat {
+            DQuat::from_xyzw(self.unit() - 0.5, self.unit() - 0.5, self.unit() - 0.5, self.unit() - 0.5).normalize()
+        }
+    }
+
+    #[test]
+    fn quat_from_rotation_matches_glam() {
+        let mut rng = Rng(7);
+        for _ in 0..1000 {
+            let q = rng.quat();
+            let ours = quat_from_rotation(&DMat3::from_quat(q));
+            let theirs = DQuat::from_mat3(&DMat3::from_quat(q));
+            assert!(ours.w >= 0.0);
+            assert!(ours.abs_diff_eq(theirs, 1e-15) || ours.abs_diff_eq(-theirs, 1e-15), "{ours} vs {theirs}");
+        }
+        // Half turns have w = 0: the other components decide.
+        let half_turn = quat_from_rotation(&DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0)));
+        assert!(half_turn.abs_diff_eq(DQuat::from_xyzw(1.0, 0.0, 0.0, 0.0), 1e-15));
+    }
+
+    /// `stretch_angle_deg_within` gives the angle of the frame `canonical_stretch` would choose.
+    #[test]
+    fn stretch_angle_within_matches_the_canonical_frame() {
+        let mut rng = Rng(11);
+        let factor_sets = [
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(2.0, 1.0, 1.0 + 1e-6),
+            DVec3::new(1.0 + 1e-6, 3.0, 1.0),
+            DVec3::new(0.5, 0.5 + 1e-7, 0.5),
+            DVec3::new(1.0, 1.0, 1.0 + 1e-5),
+        ];
+        for _ in 0..200 {
+            for scale in factor_sets {
+                let parts = AffineParts {
+                    translation: DVec3::ZERO,
+                    rotation: rng.quat(),
+                    stretch: rng.quat(),
+                    scale,
+                    sign: 1.0,
+                };
+                let canonical = canonical_stretch(parts.stretch, scale, 1e-4).0;
+                let expected = quat_angle(canonical).to_degrees();
+                let got = parts.stretch_angle_deg_within(1e-4);
+                assert!((got - expected).abs() < 1e-6, "{scale}: {got} vs {expected}");
+            }
+        }
+    }
+
+    #[test]
+    fn shear_is_the_largest_deviation_of_any_column_pair() {
+        let mut rng = Rng(3);
+        for _ in 0..200 {
+            let m = DMat3::from_cols_array(&std::array::from_fn(|_| rng.unit() * 2.0 - 1.0));
+            let cols = [m.x_axis, m.y_axis, m.z_axis];
+            let expected = [(0, 1), (0, 2), (1, 2)]
+                .map(|(i, j)| {
+                    let cos = cols[i].dot(cols[j]) / (cols[i].length() * cols[j].length());
+                    (cos.clamp(-1.0, 1.0).acos().to_degrees() - 90.0).abs()
+                })
+                .into_iter()
+                .fold(0.0, f64::max);
+            assert!((shear_deg(&m) - expected).abs() < 1e-9, "{m}");
+        }
+        assert_eq!(shear_deg(&DMat3::from_cols(DVec3::X, DVec3::ZERO, DVec3::Y)), 0.0);
+    }
 }

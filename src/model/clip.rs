@@ -129,12 +129,12 @@ impl BoneTracks {
         BoneTracks { bone, translation: None, rotation: None, scale: None }
     }
 
-    /// Key times of all three properties (unsorted, with repeats).
-    fn all_times(&self) -> impl Iterator<Item = f64> + '_ {
-        let t = self.translation.iter().flat_map(|t| t.times().iter());
-        let r = self.rotation.iter().flat_map(|t| t.times().iter());
-        let s = self.scale.iter().flat_map(|t| t.times().iter());
-        t.chain(r).chain(s).copied()
+    /// The time arrays of the animated properties (each sorted; possibly the same array more than once).
+    fn time_arrays(&self) -> impl Iterator<Item = &[f64]> {
+        let t = self.translation.iter().map(Track::times);
+        let r = self.rotation.iter().map(Track::times);
+        let s = self.scale.iter().map(Track::times);
+        t.chain(r).chain(s)
     }
 }
 
@@ -169,7 +169,7 @@ impl Clip {
         morph_channels: Vec<MorphChannel>,
     ) -> Self {
         tracks.sort_by_key(|t| t.bone);
-        let duration = tracks.iter().flat_map(BoneTracks::all_times).fold(0.0, f64::max);
+        let duration = tracks.iter().flat_map(BoneTracks::time_arrays).map(|t| t[t.len() - 1]).fold(0.0, f64::max);
         let duration = morph_channels.iter().map(|m| m.last_time).fold(duration, f64::max);
         Clip { index, name, tracks, morph_channels, duration }
     }
@@ -189,9 +189,21 @@ impl Clip {
     }
 
     /// Every key time of every track, sorted, without duplicates.
+    ///
+    /// Tracks that read the same input share one time array (a glTF sampler input, or one array for a whole clip),
+    /// and each array is sorted already: only the distinct arrays are merged, and one alone is the answer as is.
     pub fn key_times(&self) -> Vec<f64> {
-        let mut times: Vec<f64> = self.tracks.iter().flat_map(BoneTracks::all_times).collect();
-        times.sort_by(f64::total_cmp);
+        let mut arrays: Vec<&[f64]> = Vec::new();
+        for times in self.tracks.iter().flat_map(BoneTracks::time_arrays) {
+            if !arrays.iter().any(|seen| std::ptr::eq(*seen, times)) {
+                arrays.push(times);
+            }
+        }
+        if let [only] = arrays[..] {
+            return only.to_vec();
+        }
+        let mut times = arrays.concat();
+        times.sort_unstable_by(f64::total_cmp);
         times.dedup();
         times
     }
@@ -249,5 +261,24 @@ mod tests {
         assert_eq!(clip.tracks()[0].bone, 1, "tracks are sorted by bone");
         assert!(clip.tracks_of(3).is_some() && clip.tracks_of(2).is_none());
         assert_eq!(clip.label(), "animation 0");
+    }
+
+    #[test]
+    fn key_times_merge_shared_and_distinct_arrays() {
+        let shared = times(&[0.0, 1.0, 2.0]);
+        let mut tracks: Vec<BoneTracks> = (0..3)
+            .map(|bone| {
+                let mut t = BoneTracks::new(bone);
+                t.rotation = Some(Track::new(shared.clone(), vec![Quat::IDENTITY; 3], Interpolation::Linear).unwrap());
+                t.translation = Some(Track::new(shared.clone(), vec![Vec3::ZERO; 3], Interpolation::Step).unwrap());
+                t
+            })
+            .collect();
+        let one_array = Clip::new(0, None, tracks.clone(), vec![]);
+        assert_eq!(one_array.key_times(), vec![0.0, 1.0, 2.0]);
+        tracks[1].scale = Some(Track::new(times(&[0.5, 1.0, 2.5]), vec![Vec3::ONE; 3], Interpolation::Linear).unwrap());
+        let two_arrays = Clip::new(0, None, tracks, vec![]);
+        assert_eq!(two_arrays.key_times(), vec![0.0, 0.5, 1.0, 2.0, 2.5]);
+        assert_eq!(two_arrays.duration(), 2.5);
     }
 }
