@@ -15,9 +15,10 @@ fn demo_app() -> Harness<'static, BonescopeApp> {
     harness
 }
 
-/// Lets the background analysis finish and the UI catch up.
+/// Processes pending input, lets the background analysis it started finish, then lets the UI catch up. (A bare
+/// `run()` while the analysis runs would keep stepping until kittest gives up.)
 fn settle(harness: &mut Harness<'static, BonescopeApp>) {
-    harness.run();
+    harness.step();
     let ctx = harness.ctx.clone();
     harness.state_mut().settle(&ctx);
     harness.run();
@@ -47,7 +48,7 @@ fn selecting_a_bone_shows_it_in_the_inspector_with_its_findings() {
     let mut harness = demo_app();
     harness.state_mut().time = 0.5;
     harness.get_by_label("forearm").click();
-    harness.run();
+    settle(&mut harness);
     let forearm = bone(&harness, "forearm");
     assert_eq!(harness.state().selection, vec![forearm]);
     harness.get_by_label_contains("inherit full");
@@ -61,7 +62,7 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
     let mut harness = demo_app();
     harness.state_mut().time = 0.5;
     harness.get_by_label("forearm").click();
-    harness.run();
+    settle(&mut harness);
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "segment-compensate").click();

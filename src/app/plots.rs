@@ -107,7 +107,8 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
 pub struct Plots {
     pub component: Component,
     pub show_ghost: bool,
-    cache: Option<(SeriesKey, Vec<Series>)>,
+    /// The curves and their value range.
+    cache: Option<(SeriesKey, Vec<Series>, (f64, f64))>,
     reduced: Option<(ReducedKey, Vec<Vec<[f64; 2]>>)>,
 }
 
@@ -186,16 +187,18 @@ impl Plots {
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
         };
-        if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
+        if self.cache.as_ref().is_none_or(|(k, _, _)| *k != key) {
             let series = build_series(&key, &shared.doc.rig.skeleton);
-            self.cache = Some((key, series));
+            let range = value_range(&series);
+            self.cache = Some((key, series, range));
             self.reduced = None;
         }
         self.plot(ui, shared);
     }
 
     fn plot(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        let Some((key, series)) = &self.cache else { return };
+        let Some((key, series, (y_min, y_max))) = &self.cache else { return };
+        let (y_min, y_max) = (*y_min, *y_max);
         let reduced_cache = &mut self.reduced;
         let times = &key.analysis.times;
         let time = *shared.time;
@@ -228,8 +231,8 @@ impl Plots {
                     let line = Line::new(s.name.clone(), PlotPoints::from(points.clone())).color(s.color);
                     plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
                 }
-                // When the inspected bone is stretched, in the colour the viewport and outliner use for it.
-                let (y_min, y_max) = (bounds.min()[1], bounds.max()[1]);
+                // When the inspected bone is stretched, in the colour the viewport and outliner use for it. The
+                // bands span the curves' own range: spanning the plot's bounds would feed back into auto-bounds.
                 for (i, &(from, to)) in stretched.iter().enumerate() {
                     let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
                     let name = if i == 0 { "stretched" } else { "" };
@@ -249,6 +252,17 @@ impl Plots {
             *shared.time = at.x.clamp(0.0, shared.doc.duration());
         }
     }
+}
+
+/// The smallest and largest value of all curves, padded by a tenth (±1 when there are none).
+fn value_range(series: &[Series]) -> (f64, f64) {
+    let values = series.iter().flat_map(|s| s.values.iter().copied()).filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    if lo > hi {
+        return (-1.0, 1.0);
+    }
+    let pad = ((hi - lo) * 0.1).max(1e-3);
+    (lo - pad, hi + pad)
 }
 
 /// Every curve's values at every sample, computed once per analysis and choice of component.
