@@ -8,12 +8,13 @@
 //! Seeds: every file of that format under `../shared/assets`. Each input is a seed with 1–8 mutations: byte
 //! flips, inserted or deleted bytes, a 32-bit field set to an extreme value, a number in the text replaced by an
 //! absurd one, a range duplicated or spliced in from another seed, a truncation. A panic or an input slower than
-//! 5 s is written to `fuzz/artifacts/`; the run ends with executions, distinct error messages, findings and the
-//! peak resident memory.
+//! 5 s is written to `fuzz/artifacts/`, and a watchdog thread writes out an input still running after 20 s (a
+//! hang); the run ends with executions, distinct error messages, findings and the peak resident memory.
 
 use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use bonescope::import::{Format, Options, load_bytes_as};
@@ -146,6 +147,26 @@ fn main() {
     // A path that names no real folder, so a glTF's external buffers are never found on disk.
     let name = PathBuf::from(format!("/nonexistent/fuzz-input.{format}"));
     std::panic::set_hook(Box::new(|_| {}));
+
+    // The input being parsed, since when, and whether the watchdog is done with it (nothing is parsed yet).
+    let running: Arc<Mutex<(Vec<u8>, Instant, bool)>> = Arc::new(Mutex::new((Vec::new(), Instant::now(), true)));
+    {
+        let running = Arc::clone(&running);
+        let (artifacts, format) = (artifacts.clone(), format.clone());
+        std::thread::spawn(move || {
+            loop {
+                std::thread::sleep(Duration::from_secs(1));
+                let mut slot = running.lock().unwrap();
+                if !slot.2 && slot.1.elapsed() > Duration::from_secs(20) {
+                    slot.2 = true;
+                    std::fs::create_dir_all(&artifacts).unwrap();
+                    let file = artifacts.join(format!("{format}-hang-{}.bin", slot.0.len()));
+                    std::fs::write(&file, &slot.0).unwrap();
+                    println!("HANG: an input has run for 20 s (saved to {})", file.display());
+                }
+            }
+        });
+    }
 
     let deadline = Instant::now() + Duration::from_secs_f64(minutes * 60.0);
     let mut noise = Noise(seed | 1);
