@@ -2,7 +2,7 @@
 //! feeds them to that format's parser (`import::load_bytes_as`), looking for panics, hangs and runaway memory.
 //!
 //! ```sh
-//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh), minutes [, seed]
+//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh), minutes [, seed [, skip]]
 //! ```
 //!
 //! Seeds: every file of that format under `../shared/assets`. Each input is a seed with 1–8 mutations: byte
@@ -140,6 +140,7 @@ fn main() {
     let format = args.first().map_or("bvh", String::as_str).to_owned();
     let minutes: f64 = args.get(1).map_or(1.0, |m| m.parse().expect("minutes"));
     let seed: u64 = args.get(2).map_or(0x9e37_79b9_7f4a_7c15, |s| s.parse().expect("seed"));
+    let skip: u64 = args.get(3).map_or(0, |s| s.parse().expect("skip"));
     let parsed = parse_format(&format);
     let seeds = seeds(&format);
     let seed_bytes: Vec<Vec<u8>> = seeds.iter().map(|s| s.1.clone()).collect();
@@ -160,7 +161,7 @@ fn main() {
                 if !slot.2 && slot.1.elapsed() > Duration::from_secs(20) {
                     slot.2 = true;
                     std::fs::create_dir_all(&artifacts).unwrap();
-                    let file = artifacts.join(format!("{format}-hang-{}.bin", slot.0.len()));
+                    let file = artifacts.join(format!("{format}-hang-{}-bytes.bin", slot.0.len()));
                     std::fs::write(&file, &slot.0).unwrap();
                     println!("HANG: an input has run for 20 s (saved to {})", file.display());
                 }
@@ -170,14 +171,19 @@ fn main() {
 
     let deadline = Instant::now() + Duration::from_secs_f64(minutes * 60.0);
     let mut noise = Noise(seed | 1);
-    let (mut executions, mut loaded, mut panics, mut slow) = (0u64, 0u64, 0u64, 0u64);
+    for _ in 0..skip {
+        let (_, original) = &seeds[noise.below(seeds.len())];
+        mutate(&mut original.clone(), &seed_bytes, &mut noise);
+    }
+    let (mut executions, mut loaded, mut panics, mut slow) = (skip, 0u64, 0u64, 0u64);
     let mut messages: BTreeSet<String> = BTreeSet::new();
     let mut slowest = (Duration::ZERO, 0usize);
-    println!("fuzzing {format} for {minutes} min from {} seeds (seed {seed})", seeds.len());
+    println!("fuzzing {format} for {minutes} min from {} seeds (seed {seed}, skipping {skip} inputs)", seeds.len());
     while Instant::now() < deadline {
         let (_, original) = &seeds[noise.below(seeds.len())];
         let mut input = original.clone();
         mutate(&mut input, &seed_bytes, &mut noise);
+        *running.lock().unwrap() = (input.clone(), Instant::now(), false);
         let started = Instant::now();
         // Straight to the format's parser: a mutation that breaks the magic still exercises it.
         let result = catch_unwind(AssertUnwindSafe(|| load_bytes_as(parsed, &name, &input, &Options::default())));
@@ -228,6 +234,7 @@ fn main() {
             println!("  {executions} executions, {panics} panics, {} distinct errors", messages.len());
         }
     }
+    let executions = executions - skip;
     println!(
         "{format}: {executions} executions in {minutes} min ({:.0}/s), {loaded} loaded, {} distinct error messages, \
          {panics} panics, {slow} inputs over 5 s; slowest {:?} ({} bytes); peak memory {:.0} MiB",
