@@ -2,18 +2,19 @@
 //! feeds them to that format's parser (`import::load_bytes_as`), looking for panics, hangs and runaway memory.
 //!
 //! ```sh
-//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh), minutes [, seed]
+//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh), minutes [, seed [, skip]]
 //! ```
 //!
 //! Seeds: every file of that format under `../shared/assets`. Each input is a seed with 1–8 mutations: byte
 //! flips, inserted or deleted bytes, a 32-bit field set to an extreme value, a number in the text replaced by an
 //! absurd one, a range duplicated or spliced in from another seed, a truncation. A panic or an input slower than
-//! 5 s is written to `fuzz/artifacts/`; the run ends with executions, distinct error messages, findings and the
-//! peak resident memory.
+//! 5 s is written to `fuzz/artifacts/`, and a watchdog thread writes out an input still running after 20 s (a
+//! hang); the run ends with executions, distinct error messages, findings and the peak resident memory.
 
 use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use bonescope::import::{Format, Options, load_bytes_as};
@@ -139,6 +140,7 @@ fn main() {
     let format = args.first().map_or("bvh", String::as_str).to_owned();
     let minutes: f64 = args.get(1).map_or(1.0, |m| m.parse().expect("minutes"));
     let seed: u64 = args.get(2).map_or(0x9e37_79b9_7f4a_7c15, |s| s.parse().expect("seed"));
+    let skip: u64 = args.get(3).map_or(0, |s| s.parse().expect("skip"));
     let parsed = parse_format(&format);
     let seeds = seeds(&format);
     let seed_bytes: Vec<Vec<u8>> = seeds.iter().map(|s| s.1.clone()).collect();
@@ -147,16 +149,41 @@ fn main() {
     let name = PathBuf::from(format!("/nonexistent/fuzz-input.{format}"));
     std::panic::set_hook(Box::new(|_| {}));
 
+    // The input being parsed, since when, and whether the watchdog is done with it (nothing is parsed yet).
+    let running: Arc<Mutex<(Vec<u8>, Instant, bool)>> = Arc::new(Mutex::new((Vec::new(), Instant::now(), true)));
+    {
+        let running = Arc::clone(&running);
+        let (artifacts, format) = (artifacts.clone(), format.clone());
+        std::thread::spawn(move || {
+            loop {
+                std::thread::sleep(Duration::from_secs(1));
+                let mut slot = running.lock().unwrap();
+                if !slot.2 && slot.1.elapsed() > Duration::from_secs(20) {
+                    slot.2 = true;
+                    std::fs::create_dir_all(&artifacts).unwrap();
+                    let file = artifacts.join(format!("{format}-hang-{}-bytes.bin", slot.0.len()));
+                    std::fs::write(&file, &slot.0).unwrap();
+                    println!("HANG: an input has run for 20 s (saved to {})", file.display());
+                }
+            }
+        });
+    }
+
     let deadline = Instant::now() + Duration::from_secs_f64(minutes * 60.0);
     let mut noise = Noise(seed | 1);
-    let (mut executions, mut loaded, mut panics, mut slow) = (0u64, 0u64, 0u64, 0u64);
+    for _ in 0..skip {
+        let (_, original) = &seeds[noise.below(seeds.len())];
+        mutate(&mut original.clone(), &seed_bytes, &mut noise);
+    }
+    let (mut executions, mut loaded, mut panics, mut slow) = (skip, 0u64, 0u64, 0u64);
     let mut messages: BTreeSet<String> = BTreeSet::new();
     let mut slowest = (Duration::ZERO, 0usize);
-    println!("fuzzing {format} for {minutes} min from {} seeds (seed {seed})", seeds.len());
+    println!("fuzzing {format} for {minutes} min from {} seeds (seed {seed}, skipping {skip} inputs)", seeds.len());
     while Instant::now() < deadline {
         let (_, original) = &seeds[noise.below(seeds.len())];
         let mut input = original.clone();
         mutate(&mut input, &seed_bytes, &mut noise);
+        *running.lock().unwrap() = (input.clone(), Instant::now(), false);
         let started = Instant::now();
         // Straight to the format's parser: a mutation that breaks the magic still exercises it.
         let result = catch_unwind(AssertUnwindSafe(|| load_bytes_as(parsed, &name, &input, &Options::default())));
@@ -207,6 +234,7 @@ fn main() {
             println!("  {executions} executions, {panics} panics, {} distinct errors", messages.len());
         }
     }
+    let executions = executions - skip;
     println!(
         "{format}: {executions} executions in {minutes} min ({:.0}/s), {loaded} loaded, {} distinct error messages, \
          {panics} panics, {slow} inputs over 5 s; slowest {:?} ({} bytes); peak memory {:.0} MiB",

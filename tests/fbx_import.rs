@@ -488,6 +488,23 @@ fn a_take_claiming_ten_thousand_years_fails_before_sampling() {
     assert!(started.elapsed().as_secs() < 5);
 }
 
+#[test]
+fn a_key_at_an_infinite_time_does_not_hang() {
+    // Found by examples/fuzz_import.rs (seed 11400714819323198485, about 400,000 inputs in): one key time of an
+    // FBX 6.1 curve mutated to 1e308 ticks. ufbx_bake_anim, which gave the key times then, never returned; the key
+    // times are now read from the curves (non-finite ones dropped) and the load ends at once.
+    let path = PathBuf::from("infinite.fbx");
+    let text = std::fs::read_to_string(asset("fbx-ufbx-data/maya_scale_no_inherit_6100_ascii.fbx")).unwrap();
+    let mutated = text.replacen("n,46186158000,0.00600000005", "n,46181e308,0.00600000005", 1);
+    assert_ne!(mutated, text);
+    let started = std::time::Instant::now();
+    if let Err(error) = import::load_bytes(&path, mutated.as_bytes()) {
+        assert_eq!(error.path, path);
+        assert!(error.place.is_some(), "{error}");
+    }
+    assert!(started.elapsed().as_secs() < 5, "took {:?}", started.elapsed());
+}
+
 /// xorshift64*: deterministic noise for mutations.
 struct Noise(u64);
 

@@ -384,21 +384,32 @@ fn read_frames(lines: &mut Lines, joints: &[Joint], frames: u64, header_line: us
     let mut last_line = header_line;
     for (line, text) in lines.by_ref() {
         last_line = line;
-        let words = words(text);
-        if words.is_empty() {
+        // Borrowed, not copied, for text that is valid UTF-8 (the numbers of a frame always are).
+        let text = String::from_utf8_lossy(text);
+        if text.trim_ascii().is_empty() {
             continue;
         }
         read += 1;
+        let frame = read - 1;
         if read > frames {
-            let message = format!("frame {} is beyond the {frames} frames the header declares", read - 1);
+            let message = format!("frame {frame} is beyond the {frames} frames the header declares");
             return Err(Failure::line(line, message));
         }
-        if words.len() != per_frame {
-            let message = format!("frame {}: {} numbers, expected {per_frame}", read - 1, words.len());
-            return Err(Failure::line(line, message));
+        let before = values.len();
+        for word in text.split_ascii_whitespace() {
+            if values.len() - before == per_frame {
+                // Too many numbers: count them all for the message.
+                let found = text.split_ascii_whitespace().count();
+                return Err(Failure::line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
+            }
+            match word.parse::<f64>() {
+                Ok(v) if v.is_finite() => values.push(v),
+                _ => return Err(Failure::line(line, format!("frame {frame}: `{word}` is not a finite number"))),
+            }
         }
-        for word in &words {
-            values.push(number(word, line, &format!("frame {}", read - 1))?);
+        let found = values.len() - before;
+        if found != per_frame {
+            return Err(Failure::line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
         }
     }
     if read < frames {

@@ -3,14 +3,15 @@
 //! FBX animates Euler angles (in the node's rotation order, between pre- and post-rotations and pivots) with
 //! per-component weighted Bézier curves, in layers; a T·R·S keyframe track interpolated linearly cannot represent
 //! that exactly. So each stack is baked onto one grid of times: every frame of the file's frame rate plus every
-//! time at which some curve has a key (and the two sides of every step), as `ufbx_bake_anim` lists them. At each
+//! time at which some curve of the stack has a key (and, for a step, a millisecond before the value jumps). At each
 //! grid time every animated node gets ufbx's own evaluation of its local transform (`ufbx_evaluate_transform`), so
 //! bonescope's model matrices equal ufbx's at every grid time; between grid times they are interpolated linearly
 //! (slerp for rotations), which is what a game runtime given the same keys would do.
 //!
 //! A clip covers its stack's time span (the take's start and stop, which is what DCCs play); keys outside it are
 //! not sampled. Times are the file's, in seconds; a stack that starts before t = 0 is shifted to start at 0 (and
-//! says so). The grid's size is checked against the file's size before anything is evaluated.
+//! says so). The grid's size is checked against the file's size before anything is evaluated. (The key times are
+//! read from the curves here rather than from `ufbx_bake_anim`, whose run time a hostile file can make unbounded.)
 
 use std::sync::Arc;
 
@@ -24,6 +25,9 @@ const DEFAULT_FPS: f64 = 30.0;
 
 /// Two times closer than this are the same time (ufbx computes both from the same integer ticks).
 const SAME_TIME: f64 = 1e-9;
+
+/// How long before a stepped key's jump the value before it is sampled (as ufbx's baker does).
+const STEP: f64 = 1e-3;
 
 /// Bytes one sample of one node costs (a time, a translation, a rotation and a scale in `f32`), for the budget.
 const SAMPLE_BYTES: usize = 8 + 12 + 16 + 12;
@@ -41,7 +45,7 @@ pub(super) fn read_clips(
     let mut clips = Vec::with_capacity(scene.anim_stacks.len());
     for (index, stack) in scene.anim_stacks.iter().enumerate() {
         let reader = StackReader { scene, index, stack, fps, budget };
-        let (clip, samples) = reader.clip(bone_of_node, file_size, notes)?;
+        let (clip, samples) = reader.clip(bone_of_node, notes)?;
         budget = budget.saturating_sub(samples);
         clips.push(clip);
     }
@@ -71,31 +75,14 @@ impl StackReader<'_> {
     }
 
     /// The clip, and how many node samples it holds.
-    fn clip(&self, bone_of_node: &[Option<usize>], file_size: usize, notes: &mut Vec<String>) -> Result<(Clip, usize)> {
-        let limit = memory_limit(file_size);
-        let mut opts = ufbx::BakeOpts { resample_rate: self.fps, ..Default::default() };
-        opts.temp_allocator.memory_limit = limit;
-        opts.result_allocator.memory_limit = limit;
-        let baked =
-            ufbx::bake_anim(self.scene, &self.stack.anim, opts).map_err(|e| Failure::ufbx(&e, Some(self.place())))?;
-        let animated: Vec<(usize, &ufbx::Node)> = baked
-            .nodes
-            .iter()
-            .filter_map(|b| {
-                let id = b.typed_id as usize;
-                Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref()))
-            })
+    fn clip(&self, bone_of_node: &[Option<usize>], notes: &mut Vec<String>) -> Result<(Clip, usize)> {
+        let (nodes, keys) = self.keys()?;
+        let animated: Vec<(usize, &ufbx::Node)> = nodes
+            .into_iter()
+            .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref())))
             .collect();
-        let key_times = || {
-            baked.nodes.iter().flat_map(|n| {
-                let t = n.translation_keys.iter().map(|k| k.time);
-                let r = n.rotation_keys.iter().map(|k| k.time);
-                let s = n.scale_keys.iter().map(|k| k.time);
-                t.chain(r).chain(s)
-            })
-        };
-        let (begin, end) = self.span(key_times());
-        let grid = self.grid(begin, end, key_times(), animated.len())?;
+        let (begin, end) = self.span(keys.iter().copied());
+        let grid = self.grid(begin, end, keys.into_iter(), animated.len())?;
         let shift = if begin < 0.0 { -begin } else { 0.0 };
         if shift > 0.0 {
             notes.push(format!("{} starts at t = {begin} s; its clip is shifted to start at 0", self.place()));
@@ -108,6 +95,49 @@ impl StackReader<'_> {
         let samples = grid.len() * tracks.len();
         let name: &str = &self.stack.element.name;
         Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, Vec::new()), samples))
+    }
+
+    /// The nodes (typed ids) whose properties the stack animates, in order of appearance, and every key time of
+    /// their curves, with a time just before each step.
+    fn keys(&self) -> Result<(Vec<usize>, Vec<f64>)> {
+        let mut seen = vec![false; self.scene.nodes.len()];
+        let (mut nodes, mut times) = (Vec::new(), Vec::new());
+        for layer in self.stack.layers.iter() {
+            for prop in layer.anim_props.iter() {
+                let element = &prop.element;
+                if element.type_ != ufbx::ElementType::Node {
+                    continue;
+                }
+                let id = element.typed_id as usize;
+                if let Some(flag) = seen.get_mut(id)
+                    && !*flag
+                {
+                    *flag = true;
+                    nodes.push(id);
+                }
+                for curve in prop.anim_value.curves.iter().flatten() {
+                    let keys = &curve.keyframes;
+                    for (k, key) in keys.iter().enumerate() {
+                        times.push(key.time);
+                        let next = keys.get(k + 1).map(|n| n.time);
+                        match (key.interpolation, next) {
+                            (ufbx::Interpolation::ConstantPrev, Some(next)) => {
+                                times.push(next - STEP.min(0.5 * (next - key.time)));
+                            }
+                            (ufbx::Interpolation::ConstantNext, Some(next)) => {
+                                times.push(key.time + STEP.min(0.5 * (next - key.time)));
+                            }
+                            _ => {}
+                        }
+                    }
+                    if times.len() > self.budget {
+                        return Err(Failure::at(self.place(), "more keys than the file's size can justify"));
+                    }
+                }
+            }
+        }
+        times.retain(|t| t.is_finite());
+        Ok((nodes, times))
     }
 
     /// The stack's time span, or that of its keys when the stack states none (or a reversed one).

@@ -6,7 +6,7 @@
 //!   evaluates them) and whose mode is ufbx's `inherit_mode` (NORMAL → `full`, IGNORE_PARENT_SCALE →
 //!   `segment-compensate`, COMPONENTWISE_SCALE → `componentwise`), kept as the file declares it
 //!   (`inherit_mode_handling = PRESERVE`);
-//! - every animation stack becomes a clip, baked by ufbx at the file's frame rate ([`anim`]);
+//! - every animation stack becomes a clip sampled by ufbx at every frame and key time ([`anim`]);
 //! - meshes with their skins ([`mesh`]).
 //!
 //! Units and axes: [`Space::YUpMetres`] asks ufbx to convert to right-handed Y-up metres by adjusting the
