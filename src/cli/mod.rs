@@ -25,7 +25,7 @@ pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// The animation file to open in the app (glTF .gltf/.glb).
+    /// The animation file to open in the app (glTF .gltf/.glb, FBX, BVH).
     pub file: Option<std::path::PathBuf>,
 }
 
