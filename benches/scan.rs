@@ -2,8 +2,8 @@
 //!
 //! Both visit the same sample times (`sample_times(Some(&clip), 60.0)`, what `scan` uses by default). The bare pass
 //! is `Pose::evaluate` in a loop, single-threaded; `scan` runs once inside a 1-thread rayon pool (the like-for-like
-//! comparison) and once on the default pool. Sub-benchmarks split the cost into sampling, hierarchy, and the
-//! per-matrix assessment (decomposition plus verdicts).
+//! comparison) and once on the default pool. Sub-benchmarks split the cost into the pool hand-over, sampling,
+//! hierarchy, and the per-matrix assessment (decomposition plus verdicts).
 //!
 //! Rigs: a generated 100-bone rig (chains with branching, every bone animated, every tenth bone with a non-uniform
 //! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
@@ -279,6 +279,8 @@ fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
         return group.finish();
     }
     // Where the time goes.
+    // What `scan_1_thread` pays per call before any work: handing a closure to the 1-thread pool and back.
+    group.bench_function("part_pool_install", |b| b.iter(|| one_thread.install(|| black_box(0))));
     group.bench_function("part_sample_times", |b| b.iter(|| black_box(sample_times(black_box(clip), RATE))));
     group.bench_function("part_sample_clip", |b| {
         let mut local = Vec::new();
