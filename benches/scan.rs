@@ -2,8 +2,8 @@
 //!
 //! Both visit the same sample times (`sample_times(Some(&clip), 60.0)`, what `scan` uses by default). The bare pass
 //! is `Pose::evaluate` in a loop, single-threaded; `scan` runs once inside a 1-thread rayon pool (the like-for-like
-//! comparison) and once on the default pool. Sub-benchmarks split the cost into sampling, hierarchy, and the
-//! per-matrix assessment (decomposition plus verdicts).
+//! comparison) and once on the default pool. Sub-benchmarks split the cost into the pool hand-over, sampling,
+//! hierarchy, and the per-matrix assessment (decomposition plus verdicts).
 //!
 //! Rigs: a generated 100-bone rig (chains with branching, every bone animated, every tenth bone with a non-uniform
 //! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
@@ -194,23 +194,19 @@ fn blender_case() -> Option<Case> {
     Some(Case { name: "stretchy_full".into(), skeleton: rig.skeleton, clip, hierarchy })
 }
 
-/// Model matrices of every bone at every time, concatenated. With `unit_quaternions`, each sampled rotation is
-/// normalised in `f64` first (a what-if: the library does not do that; see `describe`).
-fn all_model_matrices(case: &Case, times: &[f64], unit_quaternions: bool) -> Vec<DMat4> {
+/// Model matrices of every bone at every time, concatenated.
+fn all_model_matrices(case: &Case, times: &[f64]) -> Vec<DMat4> {
     let mut pose = Pose::default();
     let mut out = Vec::with_capacity(times.len() * case.skeleton.len());
     for &t in times {
         sample_clip(&case.skeleton, &case.clip, t, &mut pose.local);
-        if unit_quaternions {
-            pose.local.iter_mut().for_each(|l| l.rotation = l.rotation.normalize());
-        }
         case.hierarchy.evaluate(&pose.local, &mut pose.model);
         out.extend_from_slice(&pose.model.model);
     }
     out
 }
 
-/// Whether `decompose` can take its shear-free shortcut: a copy of the test in `math::polar::orthogonal_shortcut`
+/// Whether `decompose` can take its shear-free shortcut: a copy of the test in `math::polar::shortcut`
 /// (columns non-zero, within a ratio of 1e6, pairwise cosines at most 2e-13).
 fn shortcut_eligible(m: &DMat4) -> bool {
     let cols = [m.x_axis.truncate(), m.y_axis.truncate(), m.z_axis.truncate()];
@@ -227,31 +223,28 @@ fn percent(part: usize, whole: usize) -> f64 {
 }
 
 /// One line on the workload: how many bone-samples are sheared for real and how many can take the shortcut.
-fn describe(case: &Case, times: &[f64], models: &[DMat4], unit_models: &[DMat4]) {
+fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
     let summary = scan(&case.skeleton, Some(&case.clip), &case.hierarchy, &ScanOptions::default(), &|_, _| {});
     let stretched_bones = summary.bones.iter().filter(|b| b.stretched()).count();
     let stretched_samples: usize = summary.bones.iter().map(|b| b.flagged_samples).sum();
     let n = models.len();
     eprintln!(
         "{}: {} bones, clip {:.3} s, {} sample times, {n} bone-samples; {stretched_bones} bones / {:.1}% of bone-samples \
-         flagged stretched; {:.1}% of bone-samples take the decompose shortcut ({:.1}% if sampled rotations were \
-         normalised in f64)",
+         flagged stretched; {:.1}% of bone-samples take the decompose shortcut",
         case.name,
         case.skeleton.len(),
         case.clip.duration(),
         times.len(),
         percent(stretched_samples, n),
         percent(models.iter().filter(|m| shortcut_eligible(m)).count(), n),
-        percent(unit_models.iter().filter(|m| shortcut_eligible(m)).count(), n),
     );
 }
 
 /// `parts`: also the sub-benchmarks that split the cost.
 fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
     let times = sample_times(Some(&case.clip), RATE);
-    let models = all_model_matrices(case, &times, false);
-    let unit_models = all_model_matrices(case, &times, true);
-    describe(case, &times, &models, &unit_models);
+    let models = all_model_matrices(case, &times);
+    describe(case, &times, &models);
     let locals: Vec<Vec<Transform>> = times
         .iter()
         .map(|&t| {
@@ -286,6 +279,8 @@ fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
         return group.finish();
     }
     // Where the time goes.
+    // What `scan_1_thread` pays per call before any work: handing a closure to the 1-thread pool and back.
+    group.bench_function("part_pool_install", |b| b.iter(|| one_thread.install(|| black_box(0))));
     group.bench_function("part_sample_times", |b| b.iter(|| black_box(sample_times(black_box(clip), RATE))));
     group.bench_function("part_sample_clip", |b| {
         let mut local = Vec::new();
@@ -308,13 +303,6 @@ fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
     group.bench_function("part_decompose", |b| {
         b.iter(|| {
             for m in &models {
-                black_box(decompose(black_box(m)));
-            }
-        })
-    });
-    group.bench_function("whatif_decompose_unit_quaternions", |b| {
-        b.iter(|| {
-            for m in &unit_models {
                 black_box(decompose(black_box(m)));
             }
         })

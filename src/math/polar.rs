@@ -193,17 +193,20 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
     let one = abs[by_size[0]];
     let two = (abs[by_size[0]] + abs[by_size[1]]) * std::f64::consts::FRAC_1_SQRT_2;
     let all = abs.iter().sum::<f64>() * 0.5;
-    let signed = |i: usize, magnitude: f64| magnitude.copysign(comps[i]);
-    let mut bar = [0.0; 4];
-    if all > two && all > one {
-        bar = std::array::from_fn(|i| signed(i, 0.5));
-    } else if two > one {
-        for &i in &by_size[..2] {
-            bar[i] = signed(i, std::f64::consts::FRAC_1_SQRT_2);
-        }
-    } else {
-        bar[by_size[0]] = signed(by_size[0], 1.0);
-    }
+    let [first, second] = by_size;
+    let (use_all, use_two) = (all > two && all > one, two > one);
+    let bar: [f64; 4] = std::array::from_fn(|i| {
+        let magnitude = if use_all {
+            0.5
+        } else if use_two {
+            if i == first || i == second { std::f64::consts::FRAC_1_SQRT_2 } else { 0.0 }
+        } else if i == first {
+            1.0
+        } else {
+            0.0
+        };
+        magnitude.copysign(comps[i])
+    });
     let p = DQuat::from_xyzw(-bar[0], -bar[1], -bar[2], bar[3]);
     // Both factors are unit quaternions, so the product is one up to rounding.
     let stretch = u * p;
@@ -219,15 +222,14 @@ fn closest_axis_permutation(u: DQuat, k: DVec3) -> (DQuat, DVec3) {
 
 /// The indices of the largest and the second largest element (the earlier one first among equals).
 fn two_largest(a: [f64; 4]) -> [usize; 2] {
-    let mut top = if a[1] > a[0] { [1, 0] } else { [0, 1] };
-    for i in 2..4 {
-        if a[i] > a[top[0]] {
-            top = [i, top[0]];
-        } else if a[i] > a[top[1]] {
-            top[1] = i;
-        }
+    // (larger, smaller) of a pair, the earlier index winning ties; then the winners against each other.
+    let pair = |i: usize, j: usize| if a[j] > a[i] { (j, i) } else { (i, j) };
+    let ((high01, low01), (high23, low23)) = (pair(0, 1), pair(2, 3));
+    if a[high23] > a[high01] {
+        [high23, if a[low23] > a[high01] { low23 } else { high01 }]
+    } else {
+        [high01, if a[high23] > a[low01] { high23 } else { low01 }]
     }
-    top
 }
 
 /// The unit quaternion, with `w ≥ 0`, of a rotation matrix (orthonormal up to rounding).
