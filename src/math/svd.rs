@@ -31,7 +31,7 @@ pub(super) type Col = [f64; 3];
 /// leave their cosine in the polar factor (measured: 4e-15 makes the worst recomposition error 3× larger).
 const ORTHOGONAL_COSINE: f64 = 1e-15;
 
-/// Iteration cap (sweeps and simultaneous steps). Random matrices need 3 to 6, rank-deficient ones up to 9;
+/// Iteration cap (sweeps and simultaneous steps). Random matrices need 3 to 6, rank-deficient ones up to 10;
 /// rounding can keep a cosine from settling below [`ORTHOGONAL_COSINE`] only in contrived cases, where the cap ends
 /// the loop.
 const MAX_STEPS: usize = 16;
