@@ -88,21 +88,28 @@ pub struct Scene<'a> {
     pub options: SceneOptions,
     /// How long axis triads and boxes are drawn, in model units.
     pub gizmo_size: f64,
+    /// Each bone's first child, found once (the tail of every bone is asked for each frame).
+    first_child: Vec<Option<usize>>,
 }
 
 impl<'a> Scene<'a> {
     pub fn new(rig: &'a Rig, primary: Layer, options: SceneOptions) -> Self {
         let gizmo_size = gizmo_size(rig);
-        Scene { rig, primary, ghost: None, bind_pose: None, selected: Vec::new(), options, gizmo_size }
+        let mut first_child = vec![None; rig.skeleton.len()];
+        for (bone, b) in rig.skeleton.bones().iter().enumerate().rev() {
+            if let Some(parent) = b.parent {
+                first_child[parent] = Some(bone);
+            }
+        }
+        Scene { rig, primary, ghost: None, bind_pose: None, selected: Vec::new(), options, gizmo_size, first_child }
     }
 
     /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on.
     pub fn tail(&self, layer: &Layer, bone: usize) -> Option<DVec3> {
-        let skeleton = &self.rig.skeleton;
-        if let Some(child) = (bone + 1..skeleton.len()).find(|&c| skeleton.parent(c) == Some(bone)) {
+        if let Some(child) = self.first_child[bone] {
             return Some(layer.head(child));
         }
-        let parent = skeleton.parent(bone)?;
+        let parent = self.rig.skeleton.parent(bone)?;
         let along = layer.head(bone) - layer.head(parent);
         (along.length() > 1e-9).then(|| layer.head(bone) + along * 0.35)
     }
