@@ -16,4 +16,5 @@ pub mod export;
 pub mod import;
 pub mod math;
 pub mod model;
+pub mod render;
 pub mod view;

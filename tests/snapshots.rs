@@ -45,3 +45,19 @@ fn demo_light_theme_euler_plots() {
     })
     .snapshot("demo_light_theme");
 }
+
+#[test]
+fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
+    let mut harness = app(|_| {});
+    // One click a frame: egui takes one press and release per pointer per frame.
+    harness.get_by_role_and_label(egui::accesskit::Role::Button, "stretch U").click();
+    harness.step();
+    harness.get_by_label("ghost").click();
+    harness.step();
+    harness.get_by_label("Only flagged").click();
+    harness.step();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+    harness.run_steps(8);
+    harness.snapshot("demo_stretch_plots_with_ghost");
+}

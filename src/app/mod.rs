@@ -85,9 +85,20 @@ impl Shared<'_> {
     }
 }
 
+/// What the window shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Chrome {
+    /// Menus, panels, plots, timeline and the viewport.
+    #[default]
+    Window,
+    /// The viewport's picture alone, edge to edge (headless renders of the viewport).
+    ViewportOnly,
+}
+
 /// The bonescope app.
 pub struct BonescopeApp {
     pub settings: Settings,
+    pub chrome: Chrome,
     pub doc: Document,
     pub time: f64,
     pub playing: bool,
@@ -110,6 +121,7 @@ impl BonescopeApp {
     pub fn new(settings: Settings, doc: Document) -> Self {
         let mut app = BonescopeApp {
             settings,
+            chrome: Chrome::Window,
             doc,
             time: 0.0,
             playing: false,
@@ -250,24 +262,30 @@ impl BonescopeApp {
                 progress,
                 tolerances: &self.tolerances,
             };
-            egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
-            egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));
-            if shared.settings.show_plots {
-                egui::Panel::bottom("plots")
-                    .resizable(true)
-                    .default_size(230.0)
-                    .min_size(160.0)
-                    .show(ui, |ui| self.plots.ui(ui, &mut shared));
-            }
-            egui::Panel::left("outliner").resizable(true).default_size(250.0).show(ui, |ui| {
-                self.outliner.ui(ui, &mut shared);
-            });
-            if shared.settings.show_inspector {
-                egui::Panel::right("inspector").resizable(true).default_size(300.0).show(ui, |ui| {
-                    inspector::ui(ui, &mut shared);
+            if self.chrome == Chrome::ViewportOnly {
+                egui::CentralPanel::default()
+                    .frame(egui::Frame::NONE)
+                    .show(ui, |ui| self.viewport.canvas(ui, &mut shared));
+            } else {
+                egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
+                egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));
+                if shared.settings.show_plots {
+                    egui::Panel::bottom("plots")
+                        .resizable(true)
+                        .default_size(230.0)
+                        .min_size(160.0)
+                        .show(ui, |ui| self.plots.ui(ui, &mut shared));
+                }
+                egui::Panel::left("outliner").resizable(true).default_size(250.0).show(ui, |ui| {
+                    self.outliner.ui(ui, &mut shared);
                 });
+                if shared.settings.show_inspector {
+                    egui::Panel::right("inspector").resizable(true).default_size(300.0).show(ui, |ui| {
+                        inspector::ui(ui, &mut shared);
+                    });
+                }
+                egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));
             }
-            egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));
         }
         self.notifications.ui(&ctx);
         self.apply(actions, &ctx);
@@ -302,6 +320,10 @@ impl BonescopeApp {
         }
         if self.watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
             self.reload();
+        }
+        // The viewport alone shows nothing of the whole-clip analysis.
+        if self.chrome == Chrome::ViewportOnly {
+            return;
         }
         let waker = ctx.clone();
         self.job.update(self.job_key(), &self.doc.rig, move || waker.request_repaint());

@@ -23,13 +23,21 @@ impl Viewport {
         }
     }
 
+    /// The view toggles above the canvas.
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         toolbar(ui, shared);
+        self.canvas(ui, shared);
+    }
+
+    /// The picture alone, filling the space left: what headless renders of the viewport show.
+    pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
         scene.ghost = shared.frame.ghost.clone();
+        scene.ghost_label = shared.doc.ghost.map_or_else(String::new, |m| format!("ghost: {}", m.id()));
+        scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {
             scene.bind_pose = Some(bind_pose(&rig));
@@ -52,6 +60,15 @@ impl Viewport {
         let palette = Palette::new(ui.visuals().dark_mode);
         paint::paint(ui.painter(), rect, camera, &scene, &palette);
     }
+}
+
+/// File and clip, time, and the modes the pose is evaluated with.
+fn caption(shared: &Shared) -> Vec<String> {
+    let doc = &*shared.doc;
+    let clip = doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
+    let settings = &*shared.settings;
+    let modes = doc.common_mode().map_or_else(|| "mixed modes".to_owned(), |m| format!("mode: {}", m.id()));
+    vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, settings.frame_rate), modes]
 }
 
 /// Orbit, pan and zoom from the pointer.

@@ -1,12 +1,13 @@
 //! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
-//! inheritance modes), `export` writes the evaluated meshes of one time.
+//! inheritance modes), `export` writes the evaluated meshes of one time, `render` draws the viewport to PNG.
 //!
-//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone; 2 bad usage or a file that cannot be
-//! loaded (after reporting every file that could).
+//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone, or `render --reference` found a
+//! picture over its threshold; 2 bad usage or a file that cannot be loaded (after reporting every file that could).
 
 mod export;
 mod inspect;
 mod options;
+mod render;
 mod scan;
 mod table;
 
@@ -37,6 +38,8 @@ pub enum Command {
     Scan(scan::ScanArgs),
     /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
     Export(export::ExportArgs),
+    /// Render the viewport (or the whole window) to PNG without a display, optionally checked against a reference.
+    Render(render::RenderArgs),
 }
 
 /// Parses the process arguments and runs the command.
@@ -46,6 +49,7 @@ pub fn main() -> ExitCode {
         Some(Command::Inspect(args)) => inspect::run(&args),
         Some(Command::Scan(args)) => scan::run(&args),
         Some(Command::Export(args)) => export::run(&args),
+        Some(Command::Render(args)) => render::run(&args),
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
     };
     match result {

@@ -41,6 +41,17 @@ impl ViewKind {
     }
 }
 
+impl std::str::FromStr for ViewKind {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        ViewKind::ALL
+            .into_iter()
+            .find(|v| v.label().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown view `{s}` (known: persp, front, side, top)"))
+    }
+}
+
 /// Axis-aligned bounds of what should be in view.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {

@@ -58,7 +58,8 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
     }
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
-        paint_legend(&painter, rect, palette);
+        paint_legend(&painter, rect, scene, palette);
+        paint_caption(&painter, rect, &scene.caption, palette);
     }
 }
 
@@ -308,17 +309,27 @@ fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palet
 }
 
 /// The meaning of the colours and icons, in the top-left corner.
-fn paint_legend(painter: &Painter, rect: Rect, palette: &Palette) {
+fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette) {
     let mut at = rect.min + egui::vec2(14.0, 14.0);
+    let line = |at: Pos2, text: &str| {
+        painter.text(at + egui::vec2(10.0, 0.0), Align2::LEFT_CENTER, text, FontId::proportional(12.0), palette.text)
+    };
     for badge in Badge::ALL {
         badge.paint_icon(painter, at, 5.0);
-        painter.text(
-            at + egui::vec2(10.0, 0.0),
-            Align2::LEFT_CENTER,
-            badge.label(),
-            FontId::proportional(12.0),
-            palette.text,
-        );
+        line(at, badge.label());
+        at.y += 17.0;
+    }
+    if scene.ghost.is_some() {
+        painter.rect_filled(Rect::from_center_size(at, egui::vec2(9.0, 9.0)), 1.0, palette.ghost.to_opaque());
+        line(at, &scene.ghost_label);
+    }
+}
+
+/// Right-aligned lines in the top right corner.
+fn paint_caption(painter: &Painter, rect: Rect, caption: &[String], palette: &Palette) {
+    let mut at = Pos2::new(rect.max.x - 14.0, rect.min.y + 14.0);
+    for text in caption {
+        painter.text(at, Align2::RIGHT_CENTER, text, FontId::proportional(12.0), palette.text);
         at.y += 17.0;
     }
 }

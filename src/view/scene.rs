@@ -41,6 +41,59 @@ impl Default for SceneOptions {
     }
 }
 
+impl SceneOptions {
+    /// The names `--show` takes, in toolbar order.
+    pub const NAMES: [&'static str; 9] =
+        ["bones", "axes", "boxes", "mesh", "wireframe", "bind-pose", "names", "grid", "legend"];
+
+    /// The switch called `name`.
+    fn switch(&mut self, name: &str) -> Option<&mut bool> {
+        Some(match name {
+            "bones" => &mut self.bones,
+            "axes" => &mut self.axes,
+            "boxes" => &mut self.boxes,
+            "mesh" => &mut self.mesh,
+            "wireframe" => &mut self.wireframe,
+            "bind-pose" => &mut self.bind_pose,
+            "names" => &mut self.names,
+            "grid" => &mut self.grid,
+            "legend" => &mut self.legend,
+            _ => return None,
+        })
+    }
+
+    /// Applies a comma-separated list: `bones,axes` shows exactly those; `+boxes,-grid` changes these defaults.
+    pub fn parse_list(list: &str) -> Result<Self, String> {
+        let items: Vec<&str> = list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
+        let relative = items.iter().all(|s| s.starts_with(['+', '-']));
+        let mut options = if relative { SceneOptions::default() } else { SceneOptions::none() };
+        for item in items {
+            let (on, name) = match item.split_at_checked(1) {
+                Some(("-", name)) => (false, name),
+                Some(("+", name)) => (true, name),
+                _ => (true, item),
+            };
+            let known = Self::NAMES.join(", ");
+            *options.switch(name).ok_or_else(|| format!("unknown item `{name}` (known: {known})"))? = on;
+        }
+        Ok(options)
+    }
+
+    fn none() -> Self {
+        SceneOptions {
+            grid: false,
+            bones: false,
+            mesh: false,
+            wireframe: false,
+            axes: false,
+            boxes: false,
+            names: false,
+            bind_pose: false,
+            legend: false,
+        }
+    }
+}
+
 /// One evaluated pose: model matrices, findings and skinned meshes.
 #[derive(Clone, Debug, Default)]
 pub struct Layer {
@@ -82,6 +135,10 @@ pub struct Scene<'a> {
     pub primary: Layer,
     /// The same pose under a second inheritance mode, drawn translucent over the first.
     pub ghost: Option<Layer>,
+    /// What the ghost is, for the legend.
+    pub ghost_label: String,
+    /// Lines naming what is shown (file, clip, time, modes), drawn in a corner with the legend.
+    pub caption: Vec<String>,
     /// Model matrices of the bind pose (from the skins' inverse bind matrices, the rest pose elsewhere).
     pub bind_pose: Option<Vec<DMat4>>,
     pub selected: Vec<usize>,
@@ -101,7 +158,18 @@ impl<'a> Scene<'a> {
                 first_child[parent] = Some(bone);
             }
         }
-        Scene { rig, primary, ghost: None, bind_pose: None, selected: Vec::new(), options, gizmo_size, first_child }
+        Scene {
+            rig,
+            primary,
+            ghost: None,
+            ghost_label: String::new(),
+            caption: Vec::new(),
+            bind_pose: None,
+            selected: Vec::new(),
+            options,
+            gizmo_size,
+            first_child,
+        }
     }
 
     /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on.
@@ -172,4 +240,20 @@ pub fn rest_bounds(rig: &Rig) -> Option<Bounds> {
     let model = rig.skeleton.rest_model_matrices();
     let meshes = skin_meshes(rig, &model);
     Bounds::of(model.iter().map(|m| m.w_axis.truncate()).chain(meshes.into_iter().flatten()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_show_list_names_exactly_what_is_shown_or_changes_the_defaults() {
+        let only = SceneOptions::parse_list("bones, boxes").unwrap();
+        assert_eq!(only, SceneOptions { bones: true, boxes: true, ..SceneOptions::none() });
+        let changed = SceneOptions::parse_list("+boxes,-grid").unwrap();
+        assert_eq!(changed, SceneOptions { boxes: true, grid: false, ..SceneOptions::default() });
+        assert_eq!(SceneOptions::parse_list("").unwrap(), SceneOptions::default());
+        let error = SceneOptions::parse_list("bones,shear").unwrap_err();
+        assert!(error.contains("`shear`") && error.contains("bind-pose"), "{error}");
+    }
 }
