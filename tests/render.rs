@@ -127,6 +127,22 @@ fn a_sequence_template_writes_one_file_per_frame_matching_single_renders() {
 }
 
 #[test]
+fn the_background_is_the_viewports_or_transparent_on_request() {
+    let dir = TempDir::new().unwrap();
+    let (opaque, transparent) = (path(&dir, "opaque.png"), path(&dir, "transparent.png"));
+    succeeds(&render_demo(&opaque, &[]));
+    succeeds(&render_demo(&transparent, &["--transparent"]));
+    let opaque = image::open(opaque).unwrap().to_rgba8();
+    let transparent = image::open(transparent).unwrap().to_rgba8();
+    // The bottom-left corner is empty (no grid line, no legend): the dark palette's background, or nothing.
+    let corner = (2, 267);
+    assert_eq!(opaque.get_pixel(corner.0, corner.1).0, [30, 32, 36, 255]);
+    assert_eq!(transparent.get_pixel(corner.0, corner.1).0[3], 0);
+    assert!(opaque.pixels().all(|p| p.0[3] == 255));
+    assert!(transparent.pixels().any(|p| p.0[3] == 255), "the bones are opaque");
+}
+
+#[test]
 fn the_whole_window_shows_the_panels_and_differs_from_the_viewport() {
     let dir = TempDir::new().unwrap();
     let (window, viewport) = (path(&dir, "window.png"), path(&dir, "viewport.png"));
@@ -141,7 +157,8 @@ fn the_whole_window_shows_the_panels_and_differs_from_the_viewport() {
 fn bad_requests_fail_with_a_message_that_names_the_problem() {
     let dir = TempDir::new().unwrap();
     let out = path(&dir, "x.png");
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
+        (&["render", "--out", "/no/such/dir/x.png"], "cannot write /no/such/dir/x.png"),
         (&["render", "/no/such/file.glb", "--out", arg(&out)], "/no/such/file.glb"),
         (&["render", "--frames", "0:10:5", "--out", arg(&out)], "put {frame} or {time} in it"),
         (&["render", "--select", "elbow", "--out", arg(&out)], "no bone named `elbow`"),
@@ -156,4 +173,34 @@ fn bad_requests_fail_with_a_message_that_names_the_problem() {
         assert!(stderr.contains(expected), "{args:?}: `{expected}` not in {stderr}");
     }
     assert!(!out.exists());
+}
+
+/// The README's pictures are made by the `bonescope render … --out assets/readme/…` commands it shows: each is run
+/// again against the committed picture, so neither the pictures nor the commands go stale.
+#[test]
+fn the_readme_pictures_are_what_their_commands_render() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let commands: Vec<&str> = readme
+        .lines()
+        .filter(|line| line.starts_with("bonescope render ") && line.contains("--out assets/readme/"))
+        .collect();
+    assert_eq!(commands.len(), 3, "the README shows three pictures' commands");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    for command in commands {
+        let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_owned).collect();
+        let at = args.iter().position(|a| a == "--out").unwrap();
+        let picture = args[at + 1].clone();
+        let name = Path::new(&picture).file_name().unwrap();
+        args[at] = "--reference".to_owned();
+        args.extend(["--out".to_owned(), out.join(name).display().to_string()]);
+        let output = Command::new(env!("CARGO_BIN_EXE_bonescope")).current_dir(root).args(&args).output().unwrap();
+        assert!(
+            output.status.success(),
+            "`{command}` no longer renders {picture} (new picture and diff in {}):\n{}{}",
+            out.display(),
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
 }

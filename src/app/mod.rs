@@ -91,7 +91,7 @@ pub enum Chrome {
     /// Menus, panels, plots, timeline and the viewport.
     #[default]
     Window,
-    /// The viewport's picture alone, edge to edge (headless renders of the viewport).
+    /// The viewport's picture alone, edge to edge, on a transparent background (headless renders of the viewport).
     ViewportOnly,
 }
 
@@ -135,7 +135,7 @@ impl BonescopeApp {
             repaint: None,
             outliner: outliner::Outliner::default(),
             plots: plots::Plots::default(),
-            viewport: viewport::Viewport,
+            viewport: viewport::Viewport::default(),
         };
         app.document_replaced(true);
         app
@@ -262,6 +262,7 @@ impl BonescopeApp {
                 progress,
                 tolerances: &self.tolerances,
             };
+            self.viewport.transparent = self.chrome == Chrome::ViewportOnly;
             if self.chrome == Chrome::ViewportOnly {
                 egui::CentralPanel::default()
                     .frame(egui::Frame::NONE)

@@ -13,7 +13,11 @@ use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, bind_pose, motion_bo
 const MOTION_SAMPLES: usize = 24;
 
 #[derive(Default)]
-pub struct Viewport;
+pub struct Viewport {
+    /// Paint no background: headless renders put it behind the picture after reading it back, because a
+    /// window-sized fill costs the software rasteriser as much as everything else it draws together.
+    pub transparent: bool,
+}
 
 impl Viewport {
     /// Frames the whole motion of the current clip.
@@ -57,7 +61,10 @@ impl Viewport {
             frame_selection(&scene, shared.selection, &mut shared.settings.camera);
         }
         let camera = &shared.settings.camera;
-        let palette = Palette::new(ui.visuals().dark_mode);
+        let mut palette = Palette::new(ui.visuals().dark_mode);
+        if self.transparent {
+            palette.background = egui::Color32::TRANSPARENT;
+        }
         paint::paint(ui.painter(), rect, camera, &scene, &palette);
     }
 }

@@ -11,7 +11,7 @@ use super::EvalArgs;
 use crate::app::{BonescopeApp, Chrome, Document, Settings};
 use crate::import;
 use crate::model::InheritMode;
-use crate::render::{Difference, Renderer, compare};
+use crate::render::{Background, Difference, Renderer, compare};
 use crate::view::{SceneOptions, ViewKind};
 
 #[derive(Debug, Args)]
@@ -53,6 +53,9 @@ pub struct RenderArgs {
     pub ui: bool,
     #[arg(long, value_enum, default_value_t)]
     pub theme: Theme,
+    /// Leave the viewport's background transparent (a PNG with alpha, for compositing; not with --ui).
+    #[arg(long, conflicts_with = "ui")]
+    pub transparent: bool,
     /// Where to write the PNG. `{frame}` becomes the frame number (four digits), `{time}` the time in seconds.
     #[arg(long, value_name = "PATH", required_unless_present = "reference")]
     pub out: Option<PathBuf>,
@@ -161,20 +164,39 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
             bail!("{} frames would all go to {}: put {{frame}} or {{time}} in it", shots.len(), template.display());
         }
     }
-    let mut renderer = Renderer::new(app(args)?, args.size.0, args.size.1)?;
-    let mut within = true;
-    for shot in &shots {
-        let image = renderer.render(shot.time)?;
-        if let Some(out) = &args.out {
-            let path = shot.path(out);
-            image.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
-            println!("wrote {}", path.display());
+    let background = if args.transparent { Background::Transparent } else { Background::Viewport };
+    let mut renderer = Renderer::new(app(args)?, args.size.0, args.size.1, background)?;
+    // Pictures are written and compared on a second thread while the next one renders.
+    std::thread::scope(|scope| {
+        let (pictures, received) = std::sync::mpsc::sync_channel::<(&Shot, image::RgbaImage)>(2);
+        let finisher = scope.spawn(move || {
+            received
+                .into_iter()
+                .try_fold(true, |within, (shot, image)| finish(args, shot, &image).map(|ok| ok && within))
+        });
+        for shot in &shots {
+            // A closed channel means the finisher stopped on an error, which its result carries.
+            if pictures.send((shot, renderer.render(shot.time)?)).is_err() {
+                break;
+            }
         }
-        if let Some(reference) = &args.reference {
-            within &= check(args, shot, &image, &shot.path(reference))?;
-        }
+        drop(pictures);
+        let within = finisher.join().map_err(|_| anyhow::anyhow!("the PNG writer stopped unexpectedly"))??;
+        Ok(if within { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    })
+}
+
+/// Writes one picture and compares it with its reference; whether it is within the threshold.
+fn finish(args: &RenderArgs, shot: &Shot, image: &image::RgbaImage) -> anyhow::Result<bool> {
+    if let Some(out) = &args.out {
+        let path = shot.path(out);
+        image.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
+        println!("wrote {}", path.display());
     }
-    Ok(if within { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    match &args.reference {
+        Some(reference) => check(args, shot, image, &shot.path(reference)),
+        None => Ok(true),
+    }
 }
 
 fn is_template(path: &Path) -> bool {
