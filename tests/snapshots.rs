@@ -61,3 +61,21 @@ fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
     harness.run_steps(8);
     harness.snapshot("demo_stretch_plots_with_ghost");
 }
+
+/// A clip far longer than the plot is wide: curves drawn as min/max envelopes, stretched bands merged per pixel.
+#[test]
+fn long_clip_envelopes() {
+    let rig = bonescope::import::stress_rig(20, 20_000, 5);
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_render_cursor(false)
+        .wgpu()
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    harness.state_mut().selection = vec![6, 16];
+    harness.state_mut().time = 300.0;
+    harness.step();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+    harness.run_steps(8);
+    harness.snapshot("long_clip_envelopes");
+}

@@ -10,6 +10,7 @@ mod job;
 mod notifications;
 mod outliner;
 mod plots;
+mod reduce;
 mod settings;
 mod timeline;
 mod toolbar;
@@ -60,6 +61,8 @@ pub struct Shared<'a> {
     pub selection: &'a mut Vec<usize>,
     pub frame: &'a Frame,
     pub analysis: Option<&'a Arc<ClipAnalysis>>,
+    /// When the inspected bone (or, with none, any bone) is stretched, per the analysis.
+    pub stretched: &'a [(f64, f64)],
     /// `(done, total)` samples while the whole-clip analysis runs.
     pub progress: Option<(usize, usize)>,
     pub tolerances: &'a Tolerances,
@@ -95,6 +98,25 @@ pub enum Chrome {
     ViewportOnly,
 }
 
+/// The stretched spans of the inspected bone (or of any bone), kept until the analysis or the bone changes: walking
+/// a long clip's flags every frame would cost more than drawing them.
+#[derive(Default)]
+struct SpanCache {
+    key: Option<(Arc<ClipAnalysis>, Option<usize>)>,
+    spans: Vec<(f64, f64)>,
+}
+
+impl SpanCache {
+    fn get(&mut self, analysis: Option<&Arc<ClipAnalysis>>, bone: Option<usize>) -> &[(f64, f64)] {
+        let Some(analysis) = analysis else { return &[] };
+        if self.key.as_ref().is_none_or(|(a, b)| !Arc::ptr_eq(a, analysis) || *b != bone) {
+            self.spans = analysis.stretched_spans(bone);
+            self.key = Some((analysis.clone(), bone));
+        }
+        &self.spans
+    }
+}
+
 /// The bonescope app.
 pub struct BonescopeApp {
     pub settings: Settings,
@@ -114,6 +136,7 @@ pub struct BonescopeApp {
     outliner: outliner::Outliner,
     plots: plots::Plots,
     viewport: viewport::Viewport,
+    spans: SpanCache,
 }
 
 impl BonescopeApp {
@@ -136,6 +159,7 @@ impl BonescopeApp {
             outliner: outliner::Outliner::default(),
             plots: plots::Plots::default(),
             viewport: viewport::Viewport::default(),
+            spans: SpanCache::default(),
         };
         app.document_replaced(true);
         app
@@ -249,6 +273,7 @@ impl BonescopeApp {
         let frame = Frame::evaluate(&self.doc, self.time, &self.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
         let progress = self.job.progress();
+        let stretched = self.spans.get(latest.as_ref(), self.selection.last().copied());
         let mut actions = toolbar::Actions::default();
         {
             let mut shared = Shared {
@@ -259,6 +284,7 @@ impl BonescopeApp {
                 selection: &mut self.selection,
                 frame: &frame,
                 analysis: latest.as_ref(),
+                stretched,
                 progress,
                 tolerances: &self.tolerances,
             };

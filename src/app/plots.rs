@@ -2,15 +2,17 @@
 //! current modes and optionally the ghost mode. A cursor marks the current time; a click seeks.
 //!
 //! Long clips stay smooth: curves are reduced to the minimum and maximum of each pixel column of the visible
-//! range before drawing (as Rerun's time-series view does).
+//! range (see `reduce`) and drawn as a filled envelope at least a pixel thick; zoomed in far enough that every
+//! sample has its own pixels, they are drawn as lines through the samples.
 
 use egui::{Color32, RichText, Ui};
-use egui_plot::{Line, Plot, PlotPoints, VLine};
+use egui_plot::{FilledArea, Line, Plot, PlotPoint, PlotPoints, VLine};
 use glam::{EulerRot, Quat};
 
 use super::{RotationFormat, Shared};
 use std::sync::Arc;
 
+use super::reduce::{Reduced, merge_spans, reduce};
 use crate::analysis::{ClipAnalysis, Components};
 use crate::view::Badge;
 
@@ -109,7 +111,22 @@ pub struct Plots {
     pub show_ghost: bool,
     /// The curves and their value range.
     cache: Option<(SeriesKey, Vec<Series>, (f64, f64))>,
-    reduced: Option<(ReducedKey, Vec<Vec<[f64; 2]>>)>,
+    reduced: Option<(ReducedKey, Vec<Drawn>)>,
+}
+
+/// A reduced curve in the plot's own types, kept across frames.
+enum Drawn {
+    Line(Vec<PlotPoint>),
+    Envelope { xs: Vec<f64>, lows: Vec<f64>, highs: Vec<f64> },
+}
+
+impl From<Reduced> for Drawn {
+    fn from(reduced: Reduced) -> Self {
+        match reduced {
+            Reduced::Points(points) => Drawn::Line(points.into_iter().map(|[x, y]| PlotPoint::new(x, y)).collect()),
+            Reduced::Envelope { xs, lows, highs } => Drawn::Envelope { xs, lows, highs },
+        }
+    }
 }
 
 /// What the curves' values depend on.
@@ -202,7 +219,7 @@ impl Plots {
         let reduced_cache = &mut self.reduced;
         let times = &key.analysis.times;
         let time = *shared.time;
-        let stretched = key.analysis.stretched_spans(shared.inspected());
+        let stretched = shared.stretched;
         let response = Plot::new("components")
             .height(ui.available_height().max(120.0))
             // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
@@ -213,27 +230,40 @@ impl Plots {
             .allow_double_click_reset(true)
             .show(ui, |plot_ui| {
                 let bounds = plot_ui.plot_bounds();
+                let rect = plot_ui.response().rect;
                 let reduced_key = ReducedKey {
                     x_min: bounds.min()[0],
                     x_max: bounds.max()[0],
-                    columns: plot_ui.response().rect.width().max(1.0) as usize,
+                    columns: rect.width().max(1.0) as usize,
                 };
                 if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
                     let range = reduced_key.x_min..=reduced_key.x_max;
-                    let points = series
+                    let drawn = series
                         .iter()
-                        .map(|s| aggregate(times, |i| s.values[i], range.clone(), reduced_key.columns))
+                        .map(|s| reduce(times, |i| s.values[i], range.clone(), reduced_key.columns).into())
                         .collect();
-                    *reduced_cache = Some((reduced_key, points));
+                    *reduced_cache = Some((reduced_key, drawn));
                 }
-                let points = reduced_cache.as_ref().map(|(_, p)| p.as_slice()).unwrap_or_default();
-                for (s, points) in series.iter().zip(points) {
-                    let line = Line::new(s.name.clone(), PlotPoints::from(points.clone())).color(s.color);
-                    plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
+                let drawn = reduced_cache.as_ref().map(|(_, d)| d.as_slice()).unwrap_or_default();
+                // Half a pixel in plot units either side of an envelope keeps flat stretches visible.
+                let half_pixel = 0.5 * (bounds.max()[1] - bounds.min()[1]) / f64::from(rect.height().max(1.0));
+                for (s, drawn) in series.iter().zip(drawn) {
+                    match drawn {
+                        Drawn::Line(points) => {
+                            let line = Line::new(s.name.clone(), PlotPoints::Borrowed(points)).color(s.color);
+                            plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
+                        }
+                        Drawn::Envelope { xs, lows, highs } => {
+                            let lows: Vec<f64> = lows.iter().map(|v| v - half_pixel).collect();
+                            let highs: Vec<f64> = highs.iter().map(|v| v + half_pixel).collect();
+                            plot_ui.add(FilledArea::new(s.name.clone(), xs, &lows, &highs).fill_color(s.color));
+                        }
+                    }
                 }
                 // When the inspected bone is stretched, in the colour the viewport and outliner use for it. The
                 // bands span the curves' own range: spanning the plot's bounds would feed back into auto-bounds.
-                for (i, &(from, to)) in stretched.iter().enumerate() {
+                let pixel = (bounds.max()[0] - bounds.min()[0]) / f64::from(rect.width().max(1.0));
+                for (i, (from, to)) in merge_spans(stretched, pixel).into_iter().enumerate() {
                     let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
                     let name = if i == 0 { "stretched" } else { "" };
                     plot_ui.polygon(
@@ -335,67 +365,4 @@ fn channel_color(index: usize) -> Color32 {
         Color32::from_rgb(160, 160, 160),
     ];
     COLORS[index % COLORS.len()]
-}
-
-/// The samples inside `x_range` reduced to at most two points (minimum and maximum, in time order) per pixel
-/// column, plus one sample either side so lines reach the edges. Short series pass through unchanged.
-pub fn aggregate(
-    times: &[f64],
-    value: impl Fn(usize) -> f64,
-    x_range: std::ops::RangeInclusive<f64>,
-    columns: usize,
-) -> Vec<[f64; 2]> {
-    let start = times.partition_point(|&t| t < *x_range.start()).saturating_sub(1);
-    let end = (times.partition_point(|&t| t <= *x_range.end()) + 1).min(times.len());
-    if start >= end {
-        return Vec::new();
-    }
-    if end - start <= 2 * columns.max(1) {
-        return (start..end).map(|s| [times[s], value(s)]).collect();
-    }
-    let (t0, t1) = (times[start], times[end - 1]);
-    let width = (t1 - t0).max(f64::MIN_POSITIVE) / columns as f64;
-    let mut points = Vec::with_capacity(2 * columns + 2);
-    let mut s = start;
-    while s < end {
-        let column = ((times[s] - t0) / width).floor();
-        let (mut lo, mut hi) = (s, s);
-        let mut next = s + 1;
-        while next < end && ((times[next] - t0) / width).floor() == column {
-            if value(next) < value(lo) {
-                lo = next;
-            }
-            if value(next) > value(hi) {
-                hi = next;
-            }
-            next += 1;
-        }
-        let (first, second) = if lo <= hi { (lo, hi) } else { (hi, lo) };
-        points.push([times[first], value(first)]);
-        if second != first {
-            points.push([times[second], value(second)]);
-        }
-        s = next;
-    }
-    points
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn aggregation_keeps_extremes_and_bounds_the_point_count() {
-        let times: Vec<f64> = (0..100_000).map(|i| i as f64 * 0.001).collect();
-        // A spike at one sample must survive the reduction.
-        let value = |s: usize| if s == 54_321 { 10.0 } else { (s as f64 * 0.01).sin() };
-        let points = aggregate(&times, value, 0.0..=100.0, 500);
-        assert!(points.len() <= 2 * 500 + 2, "{}", points.len());
-        assert!(points.iter().any(|p| p[1] == 10.0));
-        assert!(points.windows(2).all(|w| w[0][0] <= w[1][0]), "in time order");
-        // A visible range with few samples passes through, with a neighbour either side.
-        let few = aggregate(&times, value, 1.0..=1.0045, 500);
-        assert_eq!(few.len(), 7, "samples 1.000 to 1.004 and one either side");
-        assert!(aggregate(&[], value, 0.0..=1.0, 10).is_empty());
-    }
 }

@@ -3,6 +3,7 @@
 
 use egui::{Color32, Rect, Sense, Stroke, pos2, vec2};
 
+use super::reduce::merge_spans;
 use super::{Shared, TimeUnit};
 use crate::model::Clip;
 use crate::view::Badge;
@@ -102,7 +103,8 @@ fn seconds_grid(painter: &egui::Painter, rect: Rect, duration: f64, color: Color
     }
 }
 
-/// Key times of the selected bones' tracks as short ticks at the top.
+/// Key times of the selected bones' tracks as short ticks at the top: one per pixel column that has a key, runs of
+/// such columns as one bar (a key every frame of a long clip is a solid bar, drawn as one rectangle).
 fn key_ticks(
     painter: &egui::Painter,
     rect: Rect,
@@ -111,31 +113,42 @@ fn key_ticks(
     color: Color32,
     x_of: impl Fn(f64) -> f32,
 ) {
-    let mut last_x = f32::NEG_INFINITY;
-    for &bone in selection {
-        let Some(tracks) = clip.tracks_of(bone) else { continue };
+    let columns = rect.width().max(1.0) as usize;
+    let mut keyed = vec![false; columns + 1];
+    for tracks in selection.iter().filter_map(|&bone| clip.tracks_of(bone)) {
         let times = [
             tracks.translation.as_ref().map(|t| t.times()),
             tracks.rotation.as_ref().map(|t| t.times()),
             tracks.scale.as_ref().map(|t| t.times()),
         ];
         for &t in times.into_iter().flatten().flatten() {
-            let x = x_of(t);
-            // Thousands of keys collapse to one tick per pixel.
-            if (x - last_x).abs() >= 1.0 {
-                painter.line_segment([pos2(x, rect.top() + 2.0), pos2(x, rect.top() + 9.0)], Stroke::new(1.0, color));
-                last_x = x;
-            }
+            let column = (x_of(t) - rect.left()).round().clamp(0.0, columns as f32) as usize;
+            keyed[column] = true;
         }
+    }
+    let mut column = 0;
+    while column <= columns {
+        if !keyed[column] {
+            column += 1;
+            continue;
+        }
+        let run = keyed[column..].iter().take_while(|&&k| k).count();
+        let x0 = rect.left() + column as f32 - 0.5;
+        painter.rect_filled(
+            Rect::from_x_y_ranges(x0..=x0 + run as f32, rect.top() + 2.0..=rect.top() + 9.0),
+            0.0,
+            color,
+        );
+        column += run;
     }
 }
 
-/// Stretched spans of the inspected bone (or of any bone) as a coloured strip.
+/// Stretched spans of the inspected bone (or of any bone) as a coloured strip, merged to what the pixels show.
 fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: impl Fn(f64) -> f32) {
-    let Some(analysis) = shared.analysis else { return };
     let strip =
         Rect::from_min_size(pos2(rect.left(), rect.center().y - STRIP_HEIGHT / 2.0), vec2(rect.width(), STRIP_HEIGHT));
-    for (from, to) in analysis.stretched_spans(shared.inspected()) {
+    let pixel = shared.doc.duration() / f64::from(rect.width().max(1.0));
+    for (from, to) in merge_spans(shared.stretched, pixel) {
         let (x0, x1) = (x_of(from), x_of(to));
         painter.rect_filled(
             Rect::from_x_y_ranges(x0..=x1.max(x0 + 1.0), strip.y_range()),
