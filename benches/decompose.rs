@@ -13,7 +13,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use bonescope::math::{AffineParts, decompose};
+use bonescope::math::{AffineParts, decompose, decompose_near};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use nalgebra::Matrix3;
@@ -223,6 +223,42 @@ fn bench_set(c: &mut Criterion, name: &str, set: &[DMat4]) {
     group.finish();
 }
 
+/// One sheared bone over consecutive frames: a rotation and a parent's squash-and-stretch that change a little each
+/// frame, as a whole-clip scan meets them.
+fn animated_set() -> Vec<DMat4> {
+    (0..1000)
+        .map(|frame| {
+            let t = f64::from(frame) / 30.0;
+            let squash = 1.0 + 0.4 * (t * 2.0).sin();
+            let parent = DMat4::from_quat(DQuat::from_rotation_z(0.3 * t.sin()))
+                * DMat4::from_scale(DVec3::new(squash, 1.0 / squash, 1.0));
+            parent * DMat4::from_quat(DQuat::from_euler(glam::EulerRot::XYZ, 0.3 * t.cos(), 0.5, 0.2 + 0.1 * t))
+        })
+        .collect()
+}
+
+/// The same sequence decomposed cold, and warm: each search starting from the previous frame's stretch frame.
+fn bench_sequence(c: &mut Criterion, set: &[DMat4]) {
+    let mut group = c.benchmark_group("decompose/sheared_sequence");
+    group.throughput(Throughput::Elements(set.len() as u64));
+    group.bench_function("cold", |b| {
+        b.iter(|| {
+            for m in set {
+                black_box(decompose(black_box(m)));
+            }
+        })
+    });
+    group.bench_function("warm (previous frame's stretch)", |b| {
+        b.iter(|| {
+            let mut previous = DQuat::IDENTITY;
+            for m in set {
+                previous = black_box(decompose_near(black_box(m), previous)).stretch;
+            }
+        })
+    });
+    group.finish();
+}
+
 fn benches(c: &mut Criterion) {
     print_accuracy();
     let mut rng = Rng(SEED);
@@ -235,6 +271,7 @@ fn benches(c: &mut Criterion) {
     bench_set(c, "decompose/shear_free", &shear_free);
     bench_set(c, "decompose/sheared", &sheared);
     bench_set(c, "decompose/sheared_extreme", &extreme);
+    bench_sequence(c, &animated_set());
 }
 
 criterion_group! {

@@ -1,7 +1,7 @@
 //! The polar decomposition against independent oracles: closed forms derived by hand, recomposition of random
 //! parts, and nalgebra's SVD-based polar factor.
 
-use bonescope::math::{AffineParts, decompose, quat_angle, shear_deg};
+use bonescope::math::{AffineParts, decompose, decompose_near, quat_angle, shear_deg};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use proptest::prelude::*;
 
@@ -212,5 +212,26 @@ proptest! {
         // The orthogonal polar factor is unique for non-singular matrices. nalgebra's 3×3 SVD goes through the
         // eigenvectors of MᵀM, so its error grows with cond(M)²·ε: the factors here stay within 0.1..10.
         prop_assert!(ours.abs_diff_eq(theirs, 1e-9), "ours {ours} theirs {theirs}");
+    }
+
+    /// A warm start only shortens the search: from any start, near the answer or far from it, the parts are those
+    /// of the cold decomposition (rotation and stretch compared as rotations, to rounding).
+    #[test]
+    fn the_result_does_not_depend_on_where_the_search_starts(
+        parts in random_parts(),
+        start in unit_quat(),
+        nudge in unit_quat(),
+        far in any::<bool>(),
+    ) {
+        let m = parts.matrix();
+        let cold = decompose(&m);
+        // Near: the cold stretch turned by a tenth of a random rotation; far: any rotation.
+        let start = if far { start } else { cold.stretch * DQuat::IDENTITY.slerp(nudge, 0.1) };
+        let warm = decompose_near(&m, start);
+        prop_assert!(relative_error(&warm.matrix(), &m) <= 1e-9);
+        prop_assert!(warm.scale.abs_diff_eq(cold.scale, 1e-9 * cold.scale.max_element().max(1.0)), "{warm:?} {cold:?}");
+        prop_assert!(quat_angle(warm.rotation * cold.rotation.inverse()) < 1e-7, "{warm:?} {cold:?}");
+        prop_assert!((warm.stretch_angle_deg() - cold.stretch_angle_deg()).abs() < 1e-6, "{warm:?} {cold:?}");
+        prop_assert_eq!(warm.sign, cold.sign);
     }
 }

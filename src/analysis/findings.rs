@@ -2,7 +2,7 @@
 
 use glam::{DMat3, DMat4, DQuat};
 
-use crate::math::{AffineParts, decompose, shear_deg};
+use crate::math::{AffineParts, decompose_near, shear_deg};
 
 /// The tolerances behind the verdicts.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -54,7 +54,13 @@ pub struct Assessment {
 
 impl Assessment {
     pub fn of(m: &DMat4, tolerances: &Tolerances) -> Self {
-        let parts = decompose(m);
+        Self::near(m, tolerances, DQuat::IDENTITY)
+    }
+
+    /// [`Assessment::of`], the decomposition searching from `start` (see [`decompose_near`]): the same bone's
+    /// stretch frame at the previous sample makes a whole-clip scan faster.
+    pub fn near(m: &DMat4, tolerances: &Tolerances, start: DQuat) -> Self {
+        let parts = decompose_near(m, start);
         // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
         let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
         let anisotropic = parts.anisotropy() > tolerances.min_anisotropy;

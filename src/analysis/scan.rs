@@ -3,7 +3,7 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use glam::{DVec3, Quat, Vec3};
+use glam::{DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::{Assessment, Tolerances};
@@ -277,10 +277,13 @@ fn analyze_chunk(
         bits: vec![0; skeleton.len()],
         curves: vec![Curves::default(); request.bones.len()],
     };
+    // Each bone's stretch frame at the previous sample, where the next decomposition starts its search.
+    let mut previous = vec![DQuat::IDENTITY; skeleton.len()];
     for (sample, &time) in chunk.iter().enumerate() {
         pose.evaluate(skeleton, clip, hierarchy, time);
         for (bone, model) in pose.model.model.iter().enumerate() {
-            let assessment = Assessment::of(model, &options.tolerances);
+            let assessment = Assessment::near(model, &options.tolerances, previous[bone]);
+            previous[bone] = assessment.parts.stretch;
             result.summaries[bone].add(time, &assessment);
             result.bits[bone] |= u64::from(assessment.findings.stretched) << sample;
             if let Some(slot) = request.bones.iter().position(|&b| b == bone) {

@@ -102,6 +102,13 @@ pub fn quat_angle(q: DQuat) -> f64 {
 
 /// Decomposes an affine matrix (the bottom row is ignored).
 pub fn decompose(m: &DMat4) -> AffineParts {
+    decompose_near(m, DQuat::IDENTITY)
+}
+
+/// [`decompose`], searching for the stretch frame from `start`: for a sequence of similar matrices (a bone over
+/// consecutive frames) the previous one's `stretch` makes the search short. The result does not depend on `start`
+/// beyond rounding.
+pub fn decompose_near(m: &DMat4, start: DQuat) -> AffineParts {
     let translation = m.w_axis.truncate();
     let a = DMat3::from_mat4(*m);
     if !a.is_finite() {
@@ -113,7 +120,7 @@ pub fn decompose(m: &DMat4) -> AffineParts {
             sign: 1.0,
         };
     }
-    let svd = svd(&a.to_cols_array_2d(), shortcut);
+    let svd = svd(&a.to_cols_array_2d(), start, shortcut);
     let (w, sign) = (DMat3::from_cols_array_2d(&svd.u), svd.sign);
     let scale = DVec3::from_array(svd.sigma);
     if svd.v == DQuat::IDENTITY {
