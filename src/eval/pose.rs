@@ -1,7 +1,7 @@
 //! One evaluation step from a clip and a time to local and model matrices, with reusable buffers.
 
-use super::{Hierarchy, ModelPose, sample_clip};
-use crate::model::{Clip, Skeleton, Transform};
+use super::{Hierarchy, LayerStack, ModelPose, sample_clip};
+use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// The local transforms and model matrices of every bone at one time. Reuse it across times to avoid allocating.
 #[derive(Clone, Debug, Default)]
@@ -20,6 +20,19 @@ impl Pose {
                 self.local.extend(skeleton.bones().iter().map(|b| b.rest));
             }
         }
+        hierarchy.evaluate(&self.local, &mut self.model);
+    }
+
+    /// Like [`Pose::evaluate`], through `layers` (built for `rig`).
+    pub fn evaluate_layered(
+        &mut self,
+        rig: &Rig,
+        clip: Option<&Clip>,
+        hierarchy: &Hierarchy,
+        layers: &mut LayerStack,
+        time: f64,
+    ) {
+        layers.evaluate(rig, clip, time, &mut self.local);
         hierarchy.evaluate(&self.local, &mut self.model);
     }
 }
