@@ -198,7 +198,8 @@ pub fn describe(layers: &Layers, rig: &Rig, clip: Option<&Clip>) -> String {
     }
     if let Some(b) = &layers.blend {
         let sync = if b.sync {
-            let cycle = SyncedCycle::new(clip.map_or(0.0, Clip::duration), rig.clips[b.clip].duration(), b.weight);
+            let other = rig.clips.get(b.clip).map_or(0.0, Clip::duration);
+            let cycle = SyncedCycle::new(clip.map_or(0.0, Clip::duration), other, b.weight);
             format!(", synced: cycle {:.4} s, rates {:.4} and {:.4}", cycle.length, cycle.rates[0], cycle.rates[1])
         } else {
             String::new()

@@ -1,5 +1,6 @@
 //! One evaluation step from a clip and a time to local and model matrices, with reusable buffers.
 
+use super::sample::rest_pose_into;
 use super::{Hierarchy, LayerStack, ModelPose, sample_clip};
 use crate::model::{Clip, Rig, Skeleton, Transform};
 
@@ -15,10 +16,7 @@ impl Pose {
     pub fn evaluate(&mut self, skeleton: &Skeleton, clip: Option<&Clip>, hierarchy: &Hierarchy, time: f64) {
         match clip {
             Some(clip) => sample_clip(skeleton, clip, time, &mut self.local),
-            None => {
-                self.local.clear();
-                self.local.extend(skeleton.bones().iter().map(|b| b.rest));
-            }
+            None => rest_pose_into(skeleton, &mut self.local),
         }
         hierarchy.evaluate(&self.local, &mut self.model);
     }

@@ -127,6 +127,12 @@ pub(crate) fn hermite_basis(t: f64) -> [f64; 4] {
     [2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + t, -2.0 * t3 + 3.0 * t2, t3 - t2]
 }
 
+/// Writes the rest pose of every bone into `pose`.
+pub(crate) fn rest_pose_into(skeleton: &Skeleton, pose: &mut Vec<Transform>) {
+    pose.clear();
+    pose.extend(skeleton.bones().iter().map(|b| b.rest));
+}
+
 /// How each kind of track is read at a time: as authored ([`sample_track`]), or resampled by a layer.
 pub(crate) trait TrackSampler {
     fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3;
@@ -159,8 +165,7 @@ pub(crate) fn sample_clip_with(
     sampler: &impl TrackSampler,
     pose: &mut Vec<Transform>,
 ) {
-    pose.clear();
-    pose.extend(skeleton.bones().iter().map(|b| b.rest));
+    rest_pose_into(skeleton, pose);
     for tracks in clip.tracks() {
         let Some(local) = pose.get_mut(tracks.bone) else {
             continue;

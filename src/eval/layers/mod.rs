@@ -33,7 +33,7 @@ pub use time::{SyncedCycle, TICKS_PER_SECOND, TimeUnit};
 use glam::DQuat;
 
 use super::bind_pose;
-use super::sample::sample_clip_with;
+use super::sample::{rest_pose_into, sample_clip_with};
 use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// A second clip blended with the main one.
@@ -90,6 +90,11 @@ impl Layers {
     /// Whether these layers leave the clip exactly as sampled.
     pub fn is_empty(&self) -> bool {
         *self == Layers::default()
+    }
+
+    /// The same layers with every clip read as authored: the ghost to show beside an interpolation override.
+    pub fn authored(&self) -> Layers {
+        Layers { interpolation: Resampling::default(), ..self.clone() }
     }
 }
 
@@ -229,9 +234,6 @@ fn sample(skeleton: &Skeleton, clip: Option<&Clip>, time: f64, resampling: &Resa
     match clip {
         Some(clip) if resampling.is_authored() => super::sample_clip(skeleton, clip, time, out),
         Some(clip) => sample_clip_with(skeleton, clip, time, resampling, out),
-        None => {
-            out.clear();
-            out.extend(skeleton.bones().iter().map(|b| b.rest));
-        }
+        None => rest_pose_into(skeleton, out),
     }
 }
