@@ -225,10 +225,10 @@ impl<'a> Runtime<'a> {
         let bones = self.rig.skeleton.len();
         self.seed.resize(bones, DMat4::IDENTITY);
         self.trs.resize(bones, DMat4::IDENTITY);
-        for bone in 0..bones {
+        for (bone, &marked) in marks.iter().enumerate().take(bones) {
             let stored = rounded(&self.stored(bone).0);
             let trs_local = Transform { stretch: DQuat::IDENTITY, ..stored }.matrix();
-            let seed_local = if marks[bone] { stored.matrix() } else { trs_local };
+            let seed_local = if marked { stored.matrix() } else { trs_local };
             let parent = self.rig.skeleton.parent(bone);
             self.seed[bone] = parent.map_or(seed_local, |p| self.seed[p] * seed_local);
             self.trs[bone] = parent.map_or(trs_local, |p| self.trs[p] * trs_local);

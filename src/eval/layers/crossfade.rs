@@ -37,13 +37,11 @@ impl Crossfade {
     /// The incoming clip's weight at `time`: 0 before `at`, rising along the curve, 1 from `at + duration` on (a
     /// cut at `at` when the duration is not positive).
     pub fn weight(&self, time: f64) -> f64 {
-        if !(time >= self.at) {
-            return 0.0;
+        match (time.partial_cmp(&self.at), self.duration > 0.0) {
+            (None | Some(std::cmp::Ordering::Less), _) => 0.0,
+            (_, false) => 1.0,
+            (_, true) => self.curve.weight((time - self.at) / self.duration),
         }
-        if !(self.duration > 0.0) {
-            return 1.0;
-        }
-        self.curve.weight((time - self.at) / self.duration)
     }
 
     /// The incoming clip's own time at `time`: it starts from its beginning at `at`.

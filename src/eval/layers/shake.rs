@@ -105,7 +105,7 @@ pub fn shake_pose(pose: &mut [Transform], modifiers: &[f64], params: &ShakeParam
             let f = factor * modifier;
             let turn = params.rotation * f;
             local.translation += params.translation * f;
-            local.rotation = local.rotation * DQuat::from_euler(EulerRot::XYZ, turn.x, turn.y, turn.z);
+            local.rotation *= DQuat::from_euler(EulerRot::XYZ, turn.x, turn.y, turn.z);
         }
     }
 }
