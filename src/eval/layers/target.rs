@@ -31,7 +31,11 @@ pub fn pin_pose(skeleton: &Skeleton, pose: &mut [Transform], targets: &[Target],
         let parent = bone.parent.map_or(DQuat::IDENTITY, |p| chain[p]);
         while let Some(target) = pending.next_if(|t| t.bone == index) {
             let pinned = parent.inverse() * unit(target.rotation);
-            local.rotation = slerp(local.rotation, pinned, super::unit_weight(target.weight));
+            local.rotation = match super::unit_weight(target.weight) {
+                0.0 => local.rotation,
+                1.0 => pinned,
+                w => slerp(local.rotation, pinned, w),
+            };
         }
         chain.push(parent * local.rotation);
     }
