@@ -37,7 +37,9 @@ fn matrix(v: &Value) -> DMat4 {
 #[test]
 fn inspect_json_has_exactly_the_documented_shape() {
     let out = json(&bonescope(&["inspect", &stretchy(), "--time", "0.5", "--time", "1", "--format", "json"]));
-    assert_eq!(keys(&out), ["animation", "file", "inherit", "notes", "samples"]);
+    assert_eq!(keys(&out), ["animation", "bind_mismatches", "file", "inherit", "layers", "notes", "samples"]);
+    assert_eq!(out["layers"]["bind_weight"], 1.0, "no layers: {}", out["layers"]);
+    assert_eq!(out["layers"]["blend"], Value::Null);
     assert_eq!(keys(&out["animation"]), ["duration", "index", "name"]);
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");
@@ -315,4 +317,162 @@ fn compare_inherit_usage_errors() {
     ] {
         assert_eq!(bonescope(&args).status.code(), Some(2), "{args:?}");
     }
+}
+
+fn locomotions() -> String {
+    asset("fbx-proanimationbank/locomotions.fbx").display().to_string()
+}
+
+fn stderr_of(args: &[&str]) -> String {
+    let out = bonescope(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?} should be a usage error");
+    String::from_utf8(out.stderr).unwrap()
+}
+
+#[test]
+fn inspect_echoes_the_layers_it_evaluated_through() {
+    let out = json(&bonescope(&[
+        "inspect",
+        &locomotions(),
+        "--anim",
+        "walk",
+        "--blend",
+        "run",
+        "--weight",
+        "0.25",
+        "--sync",
+        "--additive",
+        "jog",
+        "--additive-ref",
+        "rest",
+        "--additive-order",
+        "global",
+        "--additive-weight",
+        "0.5",
+        "--crossfade",
+        "0",
+        "--crossfade-at",
+        "0.5",
+        "--crossfade-duration",
+        "0.25",
+        "--shake",
+        "LeftArm",
+        "--shake-param",
+        "speed=20",
+        "--target",
+        "Head=0,0,0,1@0.5",
+        "--interp",
+        "cubic",
+        "--rot-interp",
+        "nlerp",
+        "--bind-weight",
+        "0.75",
+        "--time",
+        "0.3",
+        "--format",
+        "json",
+    ]));
+    let layers = &out["layers"];
+    assert_eq!(keys(layers), ["additive", "bind_weight", "blend", "crossfade", "interpolation", "shake", "targets"]);
+    assert_eq!(layers["bind_weight"], 0.75);
+    assert_eq!(layers["interpolation"]["keys"], "cubic");
+    assert_eq!(layers["interpolation"]["rotation"], "nlerp");
+    assert_eq!(layers["blend"]["clip"], 1, "run is the file's animation 1");
+    assert_eq!((layers["blend"]["weight"].as_f64(), layers["blend"]["sync"].as_bool()), (Some(0.25), Some(true)));
+    assert_eq!(layers["additive"]["reference"], "rest");
+    assert_eq!(layers["additive"]["order"], "global");
+    assert_eq!(layers["crossfade"]["duration"], 0.25);
+    assert_eq!(layers["shake"]["params"]["speed"], 20.0);
+    assert_eq!(layers["shake"]["params"]["amplitude"], 0.3, "the seed's default");
+    assert_eq!(layers["targets"][0]["rotation"], serde_json::json!([0.0, 0.0, 0.0, 1.0]));
+    assert_eq!(layers["targets"][0]["weight"], 0.5);
+}
+
+#[test]
+fn a_synced_blend_wraps_time_at_the_blended_cycle() {
+    // walk 4/3 s, run 2/3 s, a = 0.5: the cycle lasts 1 s, so t = 0.25 and t = 1.25 are the same pose.
+    let at = |t: &str| {
+        let args = ["inspect", &locomotions(), "--anim", "walk", "--blend", "run", "--weight", "0.5", "--sync"];
+        let out = json(&bonescope(&[&args[..], &["--time", t, "--format", "json"]].concat()));
+        out["samples"][0]["bones"].as_array().unwrap().iter().map(|b| matrix(&b["model"]["matrix"])).collect::<Vec<_>>()
+    };
+    let (first, second) = (at("0.25"), at("1.25"));
+    assert!(first.iter().zip(&second).all(|(a, b)| a.abs_diff_eq(*b, 1e-9)));
+    let table = String::from_utf8(
+        bonescope(&["inspect", &locomotions(), "--anim", "walk", "--blend", "run", "--weight", "0.5", "--sync"]).stdout,
+    )
+    .unwrap();
+    assert!(table.contains("synced: cycle 1.0000 s, rates 1.3333 and 0.6667"), "{table}");
+}
+
+#[test]
+fn layer_options_name_what_is_wrong() {
+    let file = locomotions();
+    let err = stderr_of(&["inspect", &file, "--blend", "sprint", "--weight", "0.5"]);
+    assert!(err.contains("--blend: no animation `sprint` (available: 0 (jog), 1 (run), 2 (walk))"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--blend", "run", "--weight", "1.5"]);
+    assert!(err.contains("--weight must be between 0 and 1, got 1.5"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--blend", "run"]);
+    assert!(err.contains("--weight"), "--blend requires --weight: {err}");
+    let err = stderr_of(&["inspect", &file, "--shake", "Tail"]);
+    assert!(err.contains("--shake: no bone named `Tail`"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--shake", "Head", "--shake-param", "wobble=1"]);
+    assert!(err.contains("no shake parameter `wobble`") && err.contains("attenuation"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--target", "Head=0,0,0"]);
+    assert!(err.contains("four quaternion components"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--target", "Head=0,0,0,0"]);
+    assert!(err.contains("non-zero quaternion"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--bind-weight", "NaN"]);
+    assert!(err.contains("--bind-weight must be between 0 and 1"), "{err}");
+    let err = stderr_of(&["inspect", &file, "--crossfade", "run", "--crossfade-at", "1"]);
+    assert!(err.contains("--crossfade-duration"), "{err}");
+}
+
+#[test]
+fn scan_evaluates_through_the_layers() {
+    // Full bind weight 0 on stretchy: every sample is the bind pose, which shears nothing.
+    let plain = json(&bonescope(&["scan", &stretchy(), "--anim", "0", "--format", "json"]));
+    assert!(!plain[0]["animations"][0]["stretched"].as_array().unwrap().is_empty());
+    let bound = json(&bonescope(&["scan", &stretchy(), "--anim", "0", "--bind-weight", "0", "--format", "json"]));
+    assert!(bound[0]["animations"][0]["stretched"].as_array().unwrap().is_empty(), "{}", bound[0]["animations"][0]);
+    let err = stderr_of(&["scan", &stretchy(), "--compare-inherit", "declared,full", "--bind-weight", "0.5"]);
+    assert!(err.contains("no layer options"), "{err}");
+}
+
+#[test]
+fn scan_storage_reports_marked_bones_bytes_and_errors() {
+    let args = ["scan", &stretchy(), "--anim", "squash_stretch", "--storage", "--inherit", "segment-compensate"];
+    let out = json(&bonescope(&[&args[..], &["--format", "json"]].concat()));
+    let report = &out[0]["animations"][0];
+    assert_eq!(
+        keys(report),
+        [
+            "animation",
+            "bones",
+            "bytes_trs",
+            "bytes_with_stretch",
+            "frames",
+            "inherit",
+            "marked",
+            "probe_distance",
+            "rate",
+            "reconstruction",
+            "trs_only"
+        ]
+    );
+    let marked: Vec<&str> = report["marked"].as_array().unwrap().iter().map(|m| m["name"].as_str().unwrap()).collect();
+    assert_eq!(marked, ["forearm", "neck"]);
+    let (frames, bones) = (report["frames"].as_u64().unwrap(), report["bones"].as_u64().unwrap());
+    assert_eq!(report["bytes_trs"].as_u64().unwrap(), frames * bones * 40);
+    assert_eq!(report["bytes_with_stretch"].as_u64().unwrap(), frames * bones * 40 + frames * 2 * 16);
+    let max = |runtime: &str, at: &str| report[runtime][at]["max"].as_f64().unwrap();
+    assert!(max("reconstruction", "bone_axes") < 1e-5 && max("reconstruction", "vertices") < 1e-5);
+    assert!(max("trs_only", "bone_axes") > 1e-2 && max("trs_only", "vertices") > 1e-2);
+    let table = String::from_utf8(bonescope(&args).stdout).unwrap();
+    assert!(
+        table.contains("marked (stretch channel): forearm (") && table.contains("TRS only (stretch dropped)"),
+        "{table}"
+    );
+    let err = stderr_of(&["scan", &stretchy(), "--storage", "--probe-distance", "0"]);
+    assert!(err.contains("--probe-distance"), "{err}");
 }

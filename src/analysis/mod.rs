@@ -1,13 +1,17 @@
 //! Decomposition of every bone, findings (stretched, non-uniform, mirrored, degenerate), whole-clip analysis and
 //! the reports built from them.
 
+mod bind;
 mod compare;
 mod findings;
 pub mod report;
 mod scan;
+pub mod storage;
 
+pub use bind::{BindMismatch, BindTolerance, bind_mismatches};
 pub use compare::{BoneDifference, ClipComparison, compare};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use scan::{
-    BoneSummary, ClipAnalysis, ClipScan, Components, CurveRequest, Curves, ScanOptions, analyze, sample_times, scan,
+    BoneSummary, ClipAnalysis, ClipScan, Components, CurveRequest, Curves, Layered, ScanOptions, analyze,
+    analyze_layered, layered_sample_times, sample_times, scan, scan_layered,
 };

@@ -242,3 +242,13 @@ pub struct FileComparison {
     pub error: Option<String>,
     pub animations: Vec<AnimationComparison>,
 }
+
+/// `bonescope inspect --format json`: the report, the layers every sample was evaluated through (the default: none)
+/// and the skin joints whose bind matrix is not their rest model matrix.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LayeredInspectReport {
+    #[serde(flatten)]
+    pub report: InspectReport,
+    pub layers: crate::eval::Layers,
+    pub bind_mismatches: Vec<super::BindMismatch>,
+}

@@ -7,8 +7,8 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::{Assessment, Tolerances};
-use crate::eval::{Hierarchy, Pose};
-use crate::model::{Clip, Skeleton};
+use crate::eval::{Hierarchy, LayerStack, Pose};
+use crate::model::{Clip, Rig, Skeleton};
 
 /// How a clip is scanned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -196,9 +196,27 @@ impl ClipAnalysis {
 /// sorted, without duplicates. Just `[0]` without a clip.
 pub fn sample_times(clip: Option<&Clip>, rate: f64) -> Vec<f64> {
     let Some(clip) = clip else { return vec![0.0] };
-    let duration = clip.duration();
     let mut times = clip.key_times();
-    if rate > 0.0 && rate.is_finite() {
+    add_grid(&mut times, clip.duration(), rate);
+    times
+}
+
+/// The times a layered scan visits: [`sample_times`] of the main clip, unless the layers change the timeline (a
+/// synced blend plays a cycle of another length, a crossfade runs on into the incoming clip): then the grid
+/// `0, 1/rate, …` over the layered duration, plus its end.
+pub fn layered_sample_times(rig: &Rig, clip: Option<&Clip>, layers: &LayerStack, rate: f64) -> Vec<f64> {
+    let duration = layers.duration(rig, clip);
+    if layers.synced_cycle(rig, clip).is_none() && duration == clip.map_or(0.0, Clip::duration) {
+        return sample_times(clip, rate);
+    }
+    let mut times = Vec::new();
+    add_grid(&mut times, duration, rate);
+    times
+}
+
+/// Adds `0, 1/rate, …` up to `duration`, `0` and `duration` to `times`, then sorts them and drops duplicates.
+fn add_grid(times: &mut Vec<f64>, duration: f64, rate: f64) {
+    if rate > 0.0 && rate.is_finite() && duration.is_finite() {
         let steps = (duration * rate).floor() as usize;
         times.extend((0..=steps).map(|i| i as f64 / rate));
     }
@@ -206,7 +224,43 @@ pub fn sample_times(clip: Option<&Clip>, rate: f64) -> Vec<f64> {
     times.push(duration);
     times.sort_by(f64::total_cmp);
     times.dedup();
-    times
+}
+
+/// A rig evaluated through layers: what [`scan_layered`] and [`analyze_layered`] sample.
+#[derive(Clone, Copy, Debug)]
+pub struct Layered<'a> {
+    pub rig: &'a Rig,
+    /// Built for `rig`; each worker thread evaluates its own copy.
+    pub layers: &'a LayerStack,
+}
+
+/// What one analysis evaluates at each sample time.
+#[derive(Clone, Copy)]
+struct Subject<'a> {
+    skeleton: &'a Skeleton,
+    clip: Option<&'a Clip>,
+    layered: Option<Layered<'a>>,
+}
+
+impl Subject<'_> {
+    /// A worker's own copy of the layers (`None` without layers).
+    fn worker_layers(&self) -> Option<LayerStack> {
+        self.layered.map(|l| l.layers.clone())
+    }
+
+    fn evaluate(&self, pose: &mut Pose, hierarchy: &Hierarchy, layers: &mut Option<LayerStack>, time: f64) {
+        match (self.layered, layers) {
+            (Some(layered), Some(stack)) => pose.evaluate_layered(layered.rig, self.clip, hierarchy, stack, time),
+            _ => pose.evaluate(self.skeleton, self.clip, hierarchy, time),
+        }
+    }
+
+    fn times(&self, rate: f64) -> Vec<f64> {
+        match self.layered {
+            Some(l) => layered_sample_times(l.rig, self.clip, l.layers, rate),
+            None => sample_times(self.clip, rate),
+        }
+    }
 }
 
 /// Samples per parallel work item: one 64-bit word of flags per bone, big enough to amortise the buffers.
@@ -235,6 +289,20 @@ pub fn scan(
         .scan
 }
 
+/// [`scan`] through layers: `clip` is the main clip of `layered.layers`.
+pub fn scan_layered(
+    layered: Layered,
+    clip: Option<&Clip>,
+    hierarchy: &Hierarchy,
+    options: &ScanOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> ClipScan {
+    let never = AtomicBool::new(false);
+    analyze_layered(layered, clip, hierarchy, CurveRequest::default(), options, progress, &never)
+        .expect("an analysis that is never cancelled completes")
+        .scan
+}
+
 /// The whole-clip analysis behind [`scan`] and the app's plots. Returns `None` when `cancel` was set.
 pub fn analyze(
     skeleton: &Skeleton,
@@ -245,7 +313,34 @@ pub fn analyze(
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &AtomicBool,
 ) -> Option<ClipAnalysis> {
-    let times = sample_times(clip, options.rate);
+    let subject = Subject { skeleton, clip, layered: None };
+    analyze_subject(subject, hierarchy, request, options, progress, cancel)
+}
+
+/// [`analyze`] through layers: `clip` is the main clip of `layered.layers`.
+pub fn analyze_layered(
+    layered: Layered,
+    clip: Option<&Clip>,
+    hierarchy: &Hierarchy,
+    request: CurveRequest,
+    options: &ScanOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Option<ClipAnalysis> {
+    let subject = Subject { skeleton: &layered.rig.skeleton, clip, layered: Some(layered) };
+    analyze_subject(subject, hierarchy, request, options, progress, cancel)
+}
+
+fn analyze_subject(
+    subject: Subject,
+    hierarchy: &Hierarchy,
+    request: CurveRequest,
+    options: &ScanOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Option<ClipAnalysis> {
+    let skeleton = subject.skeleton;
+    let times = subject.times(options.rate);
     let done = AtomicUsize::new(0);
     let chunks: Vec<Option<ChunkResult>> = times
         .par_chunks(CHUNK)
@@ -253,7 +348,7 @@ pub fn analyze(
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let result = analyze_chunk(skeleton, clip, hierarchy, request, options, chunk);
+            let result = analyze_chunk(subject, hierarchy, request, options, chunk);
             progress(done.fetch_add(chunk.len(), Ordering::Relaxed) + chunk.len(), times.len());
             Some(result)
         })
@@ -263,13 +358,14 @@ pub fn analyze(
 }
 
 fn analyze_chunk(
-    skeleton: &Skeleton,
-    clip: Option<&Clip>,
+    subject: Subject,
     hierarchy: &Hierarchy,
     request: CurveRequest,
     options: &ScanOptions,
     chunk: &[f64],
 ) -> ChunkResult {
+    let skeleton = subject.skeleton;
+    let mut layers = subject.worker_layers();
     let mut pose = Pose::default();
     let mut ghost_pose = Pose::default();
     let mut result = ChunkResult {
@@ -280,7 +376,7 @@ fn analyze_chunk(
     // Each bone's stretch frame at the previous sample, where the next decomposition starts its search.
     let mut previous = vec![DQuat::IDENTITY; skeleton.len()];
     for (sample, &time) in chunk.iter().enumerate() {
-        pose.evaluate(skeleton, clip, hierarchy, time);
+        subject.evaluate(&mut pose, hierarchy, &mut layers, time);
         for (bone, model) in pose.model.model.iter().enumerate() {
             let assessment = Assessment::near(model, &options.tolerances, previous[bone]);
             previous[bone] = assessment.parts.stretch;
@@ -293,7 +389,7 @@ fn analyze_chunk(
             }
         }
         if let Some(ghost) = request.ghost {
-            ghost_pose.evaluate(skeleton, clip, ghost, time);
+            subject.evaluate(&mut ghost_pose, ghost, &mut layers, time);
             for (slot, &bone) in request.bones.iter().enumerate() {
                 let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
                 result.curves[slot].ghost_model.push(Components::of(&assessment));

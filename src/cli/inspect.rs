@@ -5,10 +5,12 @@ use std::process::ExitCode;
 
 use clap::Args;
 
+use super::layers::{LayerArgs, describe};
 use super::table::{Table, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
-use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, SampleReport};
-use crate::eval::{Hierarchy, Pose};
+use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, LayeredInspectReport, SampleReport};
+use crate::analysis::{BindTolerance, bind_mismatches};
+use crate::eval::{Hierarchy, LayerStack, Pose};
 use crate::import;
 
 #[derive(Debug, Args)]
@@ -24,6 +26,8 @@ pub struct InspectArgs {
     pub format: Format,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
+    #[command(flatten)]
+    pub layers: LayerArgs,
 }
 
 pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
@@ -35,12 +39,14 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--time must be a finite number of seconds, got {bad}");
     }
     let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
+    let layers = args.layers.layers(&rig)?;
+    let mut stack = LayerStack::new(&rig, &layers)?;
     let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
     let mut pose = Pose::default();
     let samples = times
         .iter()
         .map(|&time| {
-            pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
+            pose.evaluate_layered(&rig, clip, &hierarchy, &mut stack, time);
             SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, &pose, &tolerances) }
         })
         .collect();
@@ -51,18 +57,37 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         inherit: args.eval.inherit_label(),
         samples,
     };
+    let summary = describe(&layers, &rig, clip);
+    let report = LayeredInspectReport {
+        report,
+        layers,
+        bind_mismatches: bind_mismatches(&rig, &hierarchy, &BindTolerance::default()),
+    };
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        Format::Table => print!("{}", render_table(&report)),
+        Format::Table => print!("{}", render_table(&report, &summary)),
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn render_table(report: &InspectReport) -> String {
+fn render_table(layered: &LayeredInspectReport, layers_summary: &str) -> String {
+    let report = &layered.report;
     let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {}  inherit: {}\n", report.file, animation, report.inherit);
     for note in &report.notes {
         out.push_str(&format!("  note: {note}\n"));
+    }
+    if !layers_summary.is_empty() {
+        out.push_str(&format!("  layers: {layers_summary}\n"));
+    }
+    for m in &layered.bind_mismatches {
+        out.push_str(&format!(
+            "  warning: `{}` is bound {:.6} units and {:.4}° away from its rest pose (scale {:+.4} %)\n",
+            m.name,
+            m.distance,
+            m.angle_deg,
+            100.0 * m.scale_change
+        ));
     }
     for sample in &report.samples {
         out.push_str(&format!(

@@ -6,6 +6,7 @@
 
 mod export;
 mod inspect;
+mod layers;
 mod options;
 mod render;
 mod scan;
@@ -15,6 +16,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub use layers::{LayerArgs, TargetArg, describe as describe_layers};
 pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's

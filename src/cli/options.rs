@@ -31,6 +31,15 @@ pub struct EvalArgs {
     pub inherit_bone: Vec<(String, InheritMode)>,
 }
 
+/// The clip named `name`, or with index `name`; the error lists the available ones.
+pub fn find_clip<'a>(rig: &'a Rig, name: &str) -> anyhow::Result<&'a Clip> {
+    rig.find_clip(name).ok_or_else(|| {
+        let available: Vec<String> = rig.clips.iter().map(|c| format!("{} ({})", c.index, c.label())).collect();
+        let available = if available.is_empty() { "none".to_owned() } else { available.join(", ") };
+        anyhow!("no animation `{name}` (available: {available})")
+    })
+}
+
 fn parse_bone_mode(s: &str) -> Result<(String, InheritMode), String> {
     let (name, mode) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=MODE, got `{s}`"))?;
     Ok((name.to_owned(), mode.parse().map_err(|e| format!("{e}"))?))
@@ -41,11 +50,7 @@ impl EvalArgs {
     pub fn clip<'a>(&self, rig: &'a Rig) -> anyhow::Result<Option<&'a Clip>> {
         match &self.anim {
             None => Ok(rig.clips.first()),
-            Some(name) => rig.find_clip(name).map(Some).ok_or_else(|| {
-                let available: Vec<String> = rig.clips.iter().map(|c| format!("{} ({})", c.index, c.label())).collect();
-                let available = if available.is_empty() { "none".to_owned() } else { available.join(", ") };
-                anyhow!("no animation `{name}` (available: {available})")
-            }),
+            Some(name) => find_clip(rig, name).map(Some),
         }
     }
 

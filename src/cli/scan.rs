@@ -6,13 +6,16 @@ use std::process::ExitCode;
 
 use clap::Args;
 
+use super::layers::LayerArgs;
 use super::options::parse_comparison;
 use super::table::Table;
 use super::{EvalArgs, Format, ModeSet, ToleranceArgs};
 use crate::analysis::report::{AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileScan};
-use crate::analysis::{ScanOptions, compare, scan};
-use crate::eval::Hierarchy;
+use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
+use crate::analysis::{Layered, ScanOptions, compare, scan_layered};
+use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
+use crate::model::{Clip, Rig};
 
 #[derive(Debug, Args)]
 pub struct ScanArgs {
@@ -39,8 +42,37 @@ pub struct ScanArgs {
         conflicts_with_all = ["inherit", "inherit_bone", "fail_on_stretch"]
     )]
     pub compare_inherit: Option<[ModeSet; 2]>,
+    /// Instead of the stretched bones, report the seed's stretch-quaternion storage of each clip: the bones that
+    /// need a stretch channel, bytes as plain TRS and with it, and the error of rebuilding the matrices with and
+    /// without it (at points along each bone's axes and at skinned vertices).
+    #[arg(long, conflicts_with_all = ["compare_inherit", "fail_on_stretch"])]
+    pub storage: bool,
+    /// With --storage: how far along each bone's axes the error is measured, in the bone's local units.
+    #[arg(long, value_name = "DISTANCE", default_value_t = StorageOptions::default().probe_distance, requires = "storage")]
+    pub probe_distance: f64,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
+    #[command(flatten)]
+    pub layers: LayerArgs,
+}
+
+/// One clip of one file, as `scan --storage` reports it.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AnimationStorage {
+    /// `null` for a file without animations, whose rest pose is measured instead.
+    pub animation: Option<AnimationInfo>,
+    pub inherit: String,
+    pub rate: f64,
+    #[serde(flatten)]
+    pub report: StorageReport,
+}
+
+/// One file of `scan --storage`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FileStorage {
+    pub file: String,
+    pub error: Option<String>,
+    pub animations: Vec<AnimationStorage>,
 }
 
 pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
@@ -49,9 +81,15 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     }
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
     if let Some(sides) = args.compare_inherit {
+        if args.layers != LayerArgs::default() {
+            anyhow::bail!("--compare-inherit compares the clips as authored: it takes no layer options");
+        }
         return run_comparison(args, sides);
     }
-    let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, &args.eval, &options)).collect();
+    if args.storage {
+        return run_storage(args, &options);
+    }
+    let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, args, &options)).collect();
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
         Format::Table => print!("{}", render(&files)),
@@ -70,34 +108,131 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn scan_file(path: &std::path::Path, eval: &EvalArgs, options: &ScanOptions) -> FileScan {
+fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = path.display().to_string();
-    match scan_animations(path, eval, options) {
+    let scanned = load_layered(path, args).map(|loaded| {
+        loaded.each_clip(|layered, clip, hierarchy| {
+            let result = scan_layered(layered, clip, hierarchy, options, &|_, _| {});
+            AnimationScan::new(&layered.rig.skeleton, clip, args.eval.inherit_label(), options.rate, result)
+        })
+    });
+    match scanned {
         Ok(animations) => FileScan { file, error: None, animations },
         Err(error) => FileScan { file, error: Some(format!("{error:#}")), animations: Vec::new() },
     }
 }
 
-fn scan_animations(
-    path: &std::path::Path,
-    eval: &EvalArgs,
-    options: &ScanOptions,
-) -> anyhow::Result<Vec<AnimationScan>> {
+/// A file loaded with its modes and layers resolved, and the clips `--anim` picks.
+struct Loaded {
+    rig: Rig,
+    hierarchy: Hierarchy,
+    layers: LayerStack,
+    /// Positions in `rig.clips`; `None` for the rest pose of a file without animations.
+    clips: Vec<Option<usize>>,
+}
+
+fn load_layered(path: &std::path::Path, args: &ScanArgs) -> anyhow::Result<Loaded> {
     let rig = import::load(path)?;
-    let modes = eval.modes(&rig)?;
-    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
-    let clips = match eval.anim {
-        Some(_) => vec![eval.clip(&rig)?],
+    let hierarchy = Hierarchy::new(&rig.skeleton, &args.eval.modes(&rig)?);
+    let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
+    let clips = match &args.eval.anim {
+        Some(_) => {
+            let clip = args.eval.clip(&rig)?;
+            vec![clip.and_then(|c| rig.clips.iter().position(|other| std::ptr::eq(other, c)))]
+        }
         None if rig.clips.is_empty() => vec![None],
-        None => rig.clips.iter().map(Some).collect(),
+        None => (0..rig.clips.len()).map(Some).collect(),
     };
-    Ok(clips
-        .into_iter()
-        .map(|clip| {
-            let result = scan(&rig.skeleton, clip, &hierarchy, options, &|_, _| {});
-            AnimationScan::new(&rig.skeleton, clip, eval.inherit_label(), options.rate, result)
+    Ok(Loaded { rig, hierarchy, layers, clips })
+}
+
+impl Loaded {
+    fn each_clip<T>(&self, mut f: impl FnMut(Layered, Option<&Clip>, &Hierarchy) -> T) -> Vec<T> {
+        let layered = Layered { rig: &self.rig, layers: &self.layers };
+        self.clips.iter().map(|c| f(layered, c.map(|i| &self.rig.clips[i]), &self.hierarchy)).collect()
+    }
+}
+
+fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCode> {
+    if !(args.probe_distance > 0.0 && args.probe_distance.is_finite()) {
+        anyhow::bail!("--probe-distance must be a positive number, got {}", args.probe_distance);
+    }
+    let storage =
+        StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
+    let files: Vec<FileStorage> = args
+        .files
+        .iter()
+        .map(|path| {
+            let file = path.display().to_string();
+            let measured = load_layered(path, args).map(|loaded| {
+                loaded.each_clip(|layered, clip, hierarchy| AnimationStorage {
+                    animation: clip.map(AnimationInfo::of),
+                    inherit: args.eval.inherit_label(),
+                    rate: storage.rate,
+                    report: storage_report(layered, clip, hierarchy, &storage),
+                })
+            });
+            match measured {
+                Ok(animations) => FileStorage { file, error: None, animations },
+                Err(error) => FileStorage { file, error: Some(format!("{error:#}")), animations: Vec::new() },
+            }
         })
-        .collect())
+        .collect();
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
+        Format::Table => print!("{}", render_storage(&files)),
+    }
+    let failed: Vec<&str> = files.iter().filter_map(|f| f.error.as_deref()).collect();
+    for error in &failed {
+        eprintln!("error: {error}");
+    }
+    Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+}
+
+fn render_storage(files: &[FileStorage]) -> String {
+    let mut out = String::new();
+    for file in files {
+        if let Some(error) = &file.error {
+            out.push_str(&format!("{}\n  cannot load: {error}\n\n", file.file));
+            continue;
+        }
+        for a in &file.animations {
+            let r = &a.report;
+            let what = AnimationInfo::describe(a.animation.as_ref());
+            out.push_str(&format!(
+                "{}  {what}  {} frames × {} bones, inherit: {}\n",
+                file.file, r.frames, r.bones, a.inherit
+            ));
+            let marked: Vec<String> =
+                r.marked.iter().map(|m| format!("{} ({}/{} frames)", m.name, m.stretched_frames, r.frames)).collect();
+            let marked = if marked.is_empty() { "none".to_owned() } else { marked.join(", ") };
+            out.push_str(&format!("  marked (stretch channel): {marked}\n"));
+            let extra = r.bytes_with_stretch - r.bytes_trs;
+            let percent = if r.bytes_trs > 0 { 100.0 * extra as f64 / r.bytes_trs as f64 } else { 0.0 };
+            out.push_str(&format!(
+                "  bytes: plain TRS {}, with stretch channel {} (+{extra}, +{percent:.2} %)\n",
+                r.bytes_trs, r.bytes_with_stretch
+            ));
+            let mut table = Table::new(&[("error, model units", false), ("max", true), ("mean", true)]);
+            for (label, runtime) in
+                [("seed recomposition", &r.reconstruction), ("TRS only (stretch dropped)", &r.trs_only)]
+            {
+                error_rows(&mut table, label, runtime, r.probe_distance);
+            }
+            out.push_str(&table.to_string());
+            out.push('\n');
+        }
+    }
+    out
+}
+
+fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_distance: f64) {
+    let row = |what: String, max: f64, mean: f64| vec![what, format!("{max:.3e}"), format!("{mean:.3e}")];
+    let axes = runtime.bone_axes;
+    table.row(row(format!("{label}, bone axes at {probe_distance}"), axes.max, axes.mean));
+    if let Some(vertices) = runtime.vertices {
+        table.row(row(format!("{label}, skinned vertices"), vertices.max, vertices.mean));
+    }
 }
 
 fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {

@@ -1,13 +1,18 @@
-//! Pure evaluation: sample a clip at a time into local transforms, then combine them into model matrices with
-//! each bone's scale-inheritance mode; skin meshes at the resulting pose.
+//! Pure evaluation: sample a clip at a time into local transforms, layer runtime techniques on it (blends,
+//! additive clips, crossfades, procedural shake, targets), then combine them into model matrices with each bone's
+//! scale-inheritance mode; skin meshes at the resulting pose.
 
+mod bind;
 pub mod blender;
 mod hierarchy;
+pub mod layers;
 mod pose;
 mod sample;
 pub mod skinning;
 
+pub use bind::{bind_model_matrices, bind_pose};
 pub use hierarchy::{Hierarchy, ModelPose};
+pub use layers::{LayerStack, Layers};
 pub use pose::Pose;
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use skinning::skin_meshes;

@@ -1,7 +1,8 @@
 //! One evaluation step from a clip and a time to local and model matrices, with reusable buffers.
 
-use super::{Hierarchy, ModelPose, sample_clip};
-use crate::model::{Clip, Skeleton, Transform};
+use super::sample::rest_pose_into;
+use super::{Hierarchy, LayerStack, ModelPose, sample_clip};
+use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// The local transforms and model matrices of every bone at one time. Reuse it across times to avoid allocating.
 #[derive(Clone, Debug, Default)]
@@ -15,11 +16,21 @@ impl Pose {
     pub fn evaluate(&mut self, skeleton: &Skeleton, clip: Option<&Clip>, hierarchy: &Hierarchy, time: f64) {
         match clip {
             Some(clip) => sample_clip(skeleton, clip, time, &mut self.local),
-            None => {
-                self.local.clear();
-                self.local.extend(skeleton.bones().iter().map(|b| b.rest));
-            }
+            None => rest_pose_into(skeleton, &mut self.local),
         }
+        hierarchy.evaluate(&self.local, &mut self.model);
+    }
+
+    /// Like [`Pose::evaluate`], through `layers` (built for `rig`).
+    pub fn evaluate_layered(
+        &mut self,
+        rig: &Rig,
+        clip: Option<&Clip>,
+        hierarchy: &Hierarchy,
+        layers: &mut LayerStack,
+        time: f64,
+    ) {
+        layers.evaluate(rig, clip, time, &mut self.local);
         hierarchy.evaluate(&self.local, &mut self.model);
     }
 }

@@ -66,55 +66,118 @@ impl Interpolate for Quat {
     }
 }
 
+/// Where a time falls among a track's keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Span {
+    /// At key `k`, or clamped to it (before the first key, after the last, or NaN).
+    Key(usize),
+    /// `times[k] < time < times[k + 1]`, at fraction `t` of the way.
+    Between { k: usize, t: f64 },
+}
+
+impl Span {
+    /// `times` is non-empty and strictly increasing (as [`Track`] guarantees).
+    pub(crate) fn locate(times: &[f64], time: f64) -> Span {
+        let last = times.len() - 1;
+        if time.is_nan() || time <= times[0] {
+            return Span::Key(0);
+        }
+        if time >= times[last] {
+            return Span::Key(last);
+        }
+        // times[k] ≤ time < times[k + 1]
+        let k = times.partition_point(|&t| t <= time) - 1;
+        if times[k] == time {
+            return Span::Key(k);
+        }
+        Span::Between { k, t: (time - times[k]) / (times[k + 1] - times[k]) }
+    }
+}
+
+/// The value of key `k` (for cubic splines, key `k` stores `[a_k, v_k, b_k]`).
+pub(crate) fn key_value<T: Interpolate>(track: &Track<T>, k: usize) -> T::Wide {
+    let per_key = track.interpolation().values_per_key();
+    track.values()[k * per_key + per_key / 2].value()
+}
+
 /// The track's value at `time` (seconds).
 pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
+    let value = |k: usize| key_value(track, k);
+    let (k, t) = match Span::locate(track.times(), time) {
+        Span::Key(k) => return value(k),
+        Span::Between { k, t } => (k, t),
+    };
     let times = track.times();
-    let per_key = track.interpolation().values_per_key();
-    // For cubic splines, key k stores [a_k, v_k, b_k].
-    let value = |k: usize| track.values()[k * per_key + per_key / 2].value();
-    let last = times.len() - 1;
-    if time.is_nan() || time <= times[0] {
-        return value(0);
-    }
-    if time >= times[last] {
-        return value(last);
-    }
-    // times[k] ≤ time < times[k + 1]
-    let k = times.partition_point(|&t| t <= time) - 1;
-    if times[k] == time {
-        return value(k);
-    }
     let span = times[k + 1] - times[k];
-    let t = (time - times[k]) / span;
     match track.interpolation() {
         Interpolation::Step => value(k),
         Interpolation::Linear => T::linear(value(k), value(k + 1), t),
         Interpolation::CubicSpline => {
             let out_tangent = track.values()[3 * k + 2].widen();
             let in_tangent = track.values()[3 * (k + 1)].widen();
-            let (t2, t3) = (t * t, t * t * t);
-            let h = [2.0 * t3 - 3.0 * t2 + 1.0, span * (t3 - 2.0 * t2 + t), -2.0 * t3 + 3.0 * t2, span * (t3 - t2)];
-            T::hermite(value(k), out_tangent, value(k + 1), in_tangent, h)
+            let [h00, h10, h01, h11] = hermite_basis(t);
+            T::hermite(value(k), out_tangent, value(k + 1), in_tangent, [h00, span * h10, h01, span * h11])
         }
+    }
+}
+
+/// The cubic Hermite basis `(h00, h10, h01, h11)` at `t` in `[0, 1]`, tangents not yet scaled by the key interval.
+pub(crate) fn hermite_basis(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + t, -2.0 * t3 + 3.0 * t2, t3 - t2]
+}
+
+/// Writes the rest pose of every bone into `pose`.
+pub(crate) fn rest_pose_into(skeleton: &Skeleton, pose: &mut Vec<Transform>) {
+    pose.clear();
+    pose.extend(skeleton.bones().iter().map(|b| b.rest));
+}
+
+/// How each kind of track is read at a time: as authored ([`sample_track`]), or resampled by a layer.
+pub(crate) trait TrackSampler {
+    fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3;
+    fn rotation(&self, track: &Track<Quat>, time: f64) -> DQuat;
+}
+
+/// Every track as its file says.
+struct Authored;
+
+impl TrackSampler for Authored {
+    fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3 {
+        sample_track(track, time)
+    }
+
+    fn rotation(&self, track: &Track<Quat>, time: f64) -> DQuat {
+        sample_track(track, time)
     }
 }
 
 /// Writes the local pose of every bone at `time` into `pose` (resized to the skeleton).
 pub fn sample_clip(skeleton: &Skeleton, clip: &Clip, time: f64, pose: &mut Vec<Transform>) {
-    pose.clear();
-    pose.extend(skeleton.bones().iter().map(|b| b.rest));
+    sample_clip_with(skeleton, clip, time, &Authored, pose);
+}
+
+/// [`sample_clip`] with each track read by `sampler`.
+pub(crate) fn sample_clip_with(
+    skeleton: &Skeleton,
+    clip: &Clip,
+    time: f64,
+    sampler: &impl TrackSampler,
+    pose: &mut Vec<Transform>,
+) {
+    rest_pose_into(skeleton, pose);
     for tracks in clip.tracks() {
         let Some(local) = pose.get_mut(tracks.bone) else {
             continue;
         };
         if let Some(track) = &tracks.translation {
-            local.translation = sample_track(track, time);
+            local.translation = sampler.vector(track, time);
         }
         if let Some(track) = &tracks.rotation {
-            local.rotation = sample_track(track, time);
+            local.rotation = sampler.rotation(track, time);
         }
         if let Some(track) = &tracks.scale {
-            local.scale = sample_track(track, time);
+            local.scale = sampler.vector(track, time);
         }
     }
 }

@@ -22,7 +22,7 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::svd::{Gram, svd};
-use crate::model::affine;
+use crate::model::{Transform, affine};
 
 /// Scale factors whose difference is at most this fraction of the largest one are treated as equal when `U` is
 /// chosen. Recomposition is exact up to that difference.
@@ -60,6 +60,17 @@ impl AffineParts {
         let u = DMat3::from_quat(self.stretch);
         let s = u * DMat3::from_diagonal(self.scale) * u.transpose();
         DMat3::from_quat(self.rotation) * s * self.sign
+    }
+
+    /// The parts as a local transform, the mirror carried in the scale's sign (`−I` commutes, so
+    /// `F·R·U·K·Uᵀ = R·U·(−K)·Uᵀ`).
+    pub fn transform(&self) -> Transform {
+        Transform {
+            translation: self.translation,
+            rotation: self.rotation,
+            scale: self.sign * self.scale,
+            stretch: self.stretch,
+        }
     }
 
     /// The angle of the stretch rotation `U`, in degrees (0 for a shear-free matrix).

@@ -7,8 +7,10 @@ use glam::DQuat;
 pub fn slerp(a: DQuat, b: DQuat, t: f64) -> DQuat {
     let dot = a.dot(b);
     let sign = if dot < 0.0 { -1.0 } else { 1.0 };
-    let angle = dot.abs().min(1.0).acos();
-    let sin = angle.sin();
+    let cos = dot.abs().min(1.0);
+    let angle = cos.acos();
+    // sin(acos(c)) without a third sine.
+    let sin = (1.0 - cos * cos).sqrt();
     if sin < 1e-9 {
         return (a * (1.0 - t) + b * (sign * t)).normalize();
     }

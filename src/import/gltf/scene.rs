@@ -145,11 +145,9 @@ fn rest_transform(node: &gltf::Node) -> Result<Transform> {
     if finite { Ok(rest) } else { Err(Failure::at(place(), "transform is not finite")) }
 }
 
-/// A node `matrix` as a transform, keeping any shear in the stretch rotation and a mirror in the scale's sign
-/// (`−I` commutes, so `F·R·U·K·Uᵀ = R·U·(−K)·Uᵀ`).
+/// A node `matrix` as a transform, keeping any shear in the stretch rotation and a mirror in the scale's sign.
 fn matrix_to_transform(m: &DMat4) -> Transform {
-    let p = crate::math::decompose(m);
-    Transform { translation: p.translation, rotation: p.rotation, scale: p.sign * p.scale, stretch: p.stretch }
+    crate::math::decompose(m).transform()
 }
 
 #[cfg(test)]

@@ -1,0 +1,98 @@
+//! Does a skin's bind pose agree with the skeleton's rest pose? Keys are stored relative to one of them (seed 001);
+//! when the two disagree, engines that start from the rest pose and engines that start from the bind pose show
+//! different things. The check names the joints and says by how much.
+
+use glam::DMat4;
+use serde::Serialize;
+
+use crate::eval::{Hierarchy, ModelPose, bind_model_matrices};
+use crate::math::decompose;
+use crate::model::Rig;
+
+/// How far a bind matrix may be from the rest matrix before it is reported.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BindTolerance {
+    /// Model units (default 1e-4).
+    pub distance: f64,
+    /// Degrees (default 0.01).
+    pub angle_deg: f64,
+    /// Relative change of any scale factor (default 1e-4).
+    pub scale: f64,
+}
+
+impl Default for BindTolerance {
+    fn default() -> Self {
+        BindTolerance { distance: 1e-4, angle_deg: 0.01, scale: 1e-4 }
+    }
+}
+
+/// One joint whose bind matrix `IBM⁻¹` is not its rest model matrix.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BindMismatch {
+    pub bone: usize,
+    pub name: String,
+    /// Between the two origins, in model units.
+    pub distance: f64,
+    /// Between the two rotations (polar decomposition), in degrees.
+    pub angle_deg: f64,
+    /// The largest relative change of a scale factor.
+    pub scale_change: f64,
+}
+
+/// Every skin joint whose bind matrix differs from its rest model matrix (evaluated by `hierarchy`) by more than
+/// `tolerance`, in bone order.
+pub fn bind_mismatches(rig: &Rig, hierarchy: &Hierarchy, tolerance: &BindTolerance) -> Vec<BindMismatch> {
+    let mut rest = ModelPose::default();
+    hierarchy.evaluate(&rig.skeleton.rest_pose(), &mut rest);
+    let bind = bind_model_matrices(rig);
+    let mut joints: Vec<usize> = rig.skins.iter().flat_map(|s| s.joints.iter().copied()).collect();
+    joints.sort_unstable();
+    joints.dedup();
+    joints
+        .into_iter()
+        .filter_map(|bone| {
+            let mismatch = compare(bone, rig.skeleton.bones().get(bone)?.name.clone(), &bind[bone], &rest.model[bone]);
+            let off = mismatch.distance > tolerance.distance
+                || mismatch.angle_deg > tolerance.angle_deg
+                || mismatch.scale_change > tolerance.scale;
+            off.then_some(mismatch)
+        })
+        .collect()
+}
+
+fn compare(bone: usize, name: String, bind: &DMat4, rest: &DMat4) -> BindMismatch {
+    let (b, r) = (decompose(bind), decompose(rest));
+    let ratio = b.scale / r.scale;
+    BindMismatch {
+        bone,
+        name,
+        distance: b.translation.distance(r.translation),
+        angle_deg: b.rotation.angle_between(r.rotation).to_degrees(),
+        scale_change: (ratio - 1.0).abs().max_element(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+    use crate::import::demo_rig;
+
+    #[test]
+    fn names_the_joints_bound_elsewhere_and_says_by_how_much() {
+        let mut rig = demo_rig();
+        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+        assert!(bind_mismatches(&rig, &hierarchy, &BindTolerance::default()).is_empty(), "bound at rest");
+        // The forearm (joint 1, bone 2) rests at (1, 1.5, 0); bind it 3 cm higher, turned 10° about Z.
+        let bound =
+            DMat4::from_rotation_translation(DQuat::from_rotation_z(10f64.to_radians()), DVec3::new(1.0, 1.53, 0.0));
+        rig.skins[0].inverse_bind[1] = bound.inverse();
+        let found = bind_mismatches(&rig, &hierarchy, &BindTolerance::default());
+        assert_eq!(found.len(), 1);
+        assert_eq!((found[0].bone, found[0].name.as_str()), (2, "forearm"));
+        assert!((found[0].distance - 0.03).abs() < 1e-12);
+        assert!((found[0].angle_deg - 10.0).abs() < 1e-9);
+        assert!(found[0].scale_change < 1e-12);
+    }
+}

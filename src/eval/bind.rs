@@ -1,0 +1,96 @@
+//! The bind pose (seed 001): where each joint was when the mesh was bound to the skeleton, read back from the
+//! skin's inverse bind matrices.
+
+use glam::DMat4;
+
+use crate::math::decompose;
+use crate::model::{Rig, Transform};
+
+/// Model matrices of the bind pose: `IBM⁻¹` for every joint (of the first skin that lists it); any other bone sits
+/// at its rest transform below its parent's bind matrix. An inverse bind matrix that cannot be inverted counts as
+/// missing.
+pub fn bind_model_matrices(rig: &Rig) -> Vec<DMat4> {
+    let bones = rig.skeleton.bones();
+    let mut bound: Vec<Option<DMat4>> = vec![None; bones.len()];
+    for skin in &rig.skins {
+        for (&joint, ibm) in skin.joints.iter().zip(&skin.inverse_bind) {
+            if let Some(slot @ None) = bound.get_mut(joint) {
+                *slot = invert(ibm);
+            }
+        }
+    }
+    let mut model: Vec<DMat4> = Vec::with_capacity(bones.len());
+    for (bone, bound) in bones.iter().zip(bound) {
+        let below_parent = || bone.parent.map_or(DMat4::IDENTITY, |p| model[p]) * bone.rest.matrix();
+        model.push(bound.unwrap_or_else(below_parent));
+    }
+    model
+}
+
+/// The bind pose as local transforms, `B_parent⁻¹ · B` decomposed (exact under full inheritance; a shear is kept
+/// in the stretch rotation, a mirror in the scale's sign). The rest pose for a rig without skins.
+pub fn bind_pose(rig: &Rig) -> Vec<Transform> {
+    let model = bind_model_matrices(rig);
+    rig.skeleton
+        .bones()
+        .iter()
+        .zip(&model)
+        .map(|(bone, m)| match bone.parent {
+            None => decompose(m).transform(),
+            Some(p) => match invert(&model[p]) {
+                Some(parent_inverse) => decompose(&(parent_inverse * *m)).transform(),
+                None => bone.rest,
+            },
+        })
+        .collect()
+}
+
+/// The inverse of an affine matrix, if it has a finite one.
+fn invert(m: &DMat4) -> Option<DMat4> {
+    let determinant = m.determinant();
+    let inverse = m.inverse();
+    (determinant != 0.0 && determinant.is_finite() && inverse.is_finite()).then_some(inverse)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::model::Skin;
+
+    #[test]
+    fn a_rig_bound_at_rest_has_its_rest_pose_as_bind_pose() {
+        let rig = demo_rig();
+        for (bind, rest) in bind_pose(&rig).iter().zip(rig.skeleton.rest_pose()) {
+            assert!(bind.matrix().abs_diff_eq(rest.matrix(), 1e-12));
+        }
+    }
+
+    #[test]
+    fn inverse_bind_matrices_define_the_bind_pose() {
+        let mut rig = demo_rig();
+        // Bind the forearm (joint 1 of the skin, bone 2) turned 90° about Z at the elbow, (1, 1.5, 0) in model space.
+        let elbow = DMat4::from_rotation_translation(DQuat::from_rotation_z(1.0), DVec3::new(1.0, 1.5, 0.0));
+        rig.skins[0].inverse_bind[1] = elbow.inverse();
+        let model = bind_model_matrices(&rig);
+        assert!(model[2].abs_diff_eq(elbow, 1e-12));
+        let pose = bind_pose(&rig);
+        // Its parent (the upper arm) is bound at rest, at (0, 1.5, 0): the local bind is 1 along X, turned 1 rad.
+        assert!(pose[2].translation.abs_diff_eq(DVec3::X, 1e-12));
+        assert!(pose[2].rotation.abs_diff_eq(DQuat::from_rotation_z(1.0), 1e-12));
+        // The hand (bone 3) is bound at rest relative to the model, so its local bind undoes the forearm's turn.
+        assert!((model[2] * pose[3].matrix()).abs_diff_eq(model[3], 1e-12));
+    }
+
+    #[test]
+    fn singular_inverse_bind_matrices_fall_back_to_the_rest_pose() {
+        let mut rig = demo_rig();
+        rig.skins.push(Skin { name: None, joints: vec![0, 77], inverse_bind: vec![DMat4::ZERO, DMat4::IDENTITY] });
+        rig.skins.swap(0, 1);
+        let pose = bind_pose(&rig);
+        assert!(pose.iter().all(|t| t.translation.is_finite() && t.rotation.is_finite()));
+        assert_eq!(pose[0], rig.skeleton.bone(0).rest);
+    }
+}

@@ -1,0 +1,239 @@
+//! Runtime techniques layered on a sampled clip, each as a game runtime does it (the seeds in `shared/seeds`):
+//!
+//! ```text
+//! clip ──sample (interpolation override)──▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ targets ─▶ pose
+//!          every clip a layer reads is          (mix with   (second   (difference  (into a third  (cosine   (model-space
+//!          sampled the same way                  bind pose)  clip,     from a ref,  clip, weight   wobble)   rotations)
+//!                                                            synced)   local/global) over time)
+//! ```
+//!
+//! [`Layers`] says what to do (serialisable; the default does nothing), [`LayerStack`] holds what it needs prepared
+//! once (bind pose, additive reference, shake modifiers) and the buffers for evaluating any number of times without
+//! allocating. Every step is also a pure function in its own module, tested against the seed's formulas.
+//!
+//! Weights are clamped to `[0, 1]`, NaN counting as 0; clip and bone indices are checked when the stack is built;
+//! a non-finite time counts as 0. Nothing here panics on bad input.
+
+mod additive;
+mod crossfade;
+mod interpolate;
+mod mix;
+mod shake;
+mod target;
+mod time;
+
+pub use additive::{AdditiveOrder, AdditiveReference, add, add_poses, difference};
+pub use crossfade::{Crossfade, FadeCurve};
+pub use interpolate::{Channel, KeyInterpolation, Resampling, RotationInterpolation};
+pub use mix::{RotationBlend, mix, mix_poses, unit_weight};
+pub use shake::{Shake, ShakeParams, UnknownShakeParam, bone_modifiers, shake_pose};
+pub use target::{Target, pin_pose};
+pub use time::{SyncedCycle, TICKS_PER_SECOND, TimeUnit};
+
+use glam::DQuat;
+
+use super::bind_pose;
+use super::sample::{rest_pose_into, sample_clip_with};
+use crate::model::{Clip, Rig, Skeleton, Transform};
+
+/// A second clip blended with the main one.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Blend {
+    /// Index of the clip in the rig.
+    pub clip: usize,
+    /// The seed's `a`: 0 is the main clip, 1 this one.
+    pub weight: f64,
+    /// Play both at one normalised time over the blended cycle ([`SyncedCycle`]); else each at its own speed.
+    pub sync: bool,
+    pub rotation: RotationBlend,
+}
+
+/// An additive clip on top.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Additive {
+    pub clip: usize,
+    pub reference: AdditiveReference,
+    pub order: AdditiveOrder,
+    pub weight: f64,
+}
+
+/// Which techniques to layer on a clip, applied in the order of the fields. The default is no layers at all.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct Layers {
+    /// 1: the clip as sampled; 0: the bind pose (seed 001); between: mixed bone by bone.
+    pub bind_weight: f64,
+    /// How every clip a layer reads is sampled.
+    pub interpolation: Resampling,
+    pub blend: Option<Blend>,
+    pub additive: Option<Additive>,
+    pub crossfade: Option<Crossfade>,
+    pub shake: Option<Shake>,
+    pub targets: Vec<Target>,
+}
+
+impl Default for Layers {
+    fn default() -> Self {
+        Layers {
+            bind_weight: 1.0,
+            interpolation: Resampling::default(),
+            blend: None,
+            additive: None,
+            crossfade: None,
+            shake: None,
+            targets: Vec::new(),
+        }
+    }
+}
+
+impl Layers {
+    /// Whether these layers leave the clip exactly as sampled.
+    pub fn is_empty(&self) -> bool {
+        *self == Layers::default()
+    }
+
+    /// The same layers with every clip read as authored: the ghost to show beside an interpolation override.
+    pub fn authored(&self) -> Layers {
+        Layers { interpolation: Resampling::default(), ..self.clone() }
+    }
+}
+
+/// Layers that name a clip or bone the rig does not have.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LayerError {
+    #[error("{layer}: no animation {index} (the file has {count})")]
+    NoClip { layer: &'static str, index: usize, count: usize },
+    #[error("{layer}: no bone {index} (the skeleton has {count})")]
+    NoBone { layer: &'static str, index: usize, count: usize },
+}
+
+/// [`Layers`] prepared for one rig, with the buffers to evaluate them.
+#[derive(Clone, Debug, Default)]
+pub struct LayerStack {
+    layers: Layers,
+    /// The bind pose, when the bind weight is below 1.
+    bind: Vec<Transform>,
+    /// The additive clip's reference pose.
+    reference: Vec<Transform>,
+    /// The shake's per-bone modifiers.
+    modifiers: Vec<f64>,
+    scratch: Vec<Transform>,
+    chain: Vec<DQuat>,
+}
+
+impl LayerStack {
+    /// Checks every index against `rig` and prepares what does not change with time.
+    pub fn new(rig: &Rig, layers: &Layers) -> Result<Self, LayerError> {
+        let clips = rig.clips.len();
+        let bones = rig.skeleton.len();
+        let clip_of =
+            |layer, index: usize| rig.clips.get(index).ok_or(LayerError::NoClip { layer, index, count: clips });
+        let check_bone = |layer, index: usize| {
+            if index < bones { Ok(()) } else { Err(LayerError::NoBone { layer, index, count: bones }) }
+        };
+        if let Some(blend) = &layers.blend {
+            clip_of("blend", blend.clip)?;
+        }
+        if let Some(crossfade) = &layers.crossfade {
+            clip_of("crossfade", crossfade.clip)?;
+        }
+        for target in &layers.targets {
+            check_bone("target", target.bone)?;
+        }
+        let reference = match &layers.additive {
+            None => Vec::new(),
+            Some(additive) => {
+                let clip = clip_of("additive", additive.clip)?;
+                let mut reference = Vec::new();
+                match additive.reference {
+                    AdditiveReference::First => {
+                        sample(&rig.skeleton, Some(clip), 0.0, &layers.interpolation, &mut reference)
+                    }
+                    AdditiveReference::Rest => reference = rig.skeleton.rest_pose(),
+                }
+                reference
+            }
+        };
+        let modifiers = match &layers.shake {
+            None => Vec::new(),
+            Some(shake) => {
+                check_bone("shake", shake.bone)?;
+                bone_modifiers(&rig.skeleton, shake.bone, shake.params.attenuation)
+            }
+        };
+        let mut layers = layers.clone();
+        layers.targets.sort_by_key(|t| t.bone);
+        let bind = if unit_weight(layers.bind_weight) < 1.0 { bind_pose(rig) } else { Vec::new() };
+        Ok(LayerStack { layers, bind, reference, modifiers, scratch: Vec::new(), chain: Vec::new() })
+    }
+
+    pub fn layers(&self) -> &Layers {
+        &self.layers
+    }
+
+    /// The blended cycle, when a synced blend is on: the timeline then runs over `cycle.length` and repeats.
+    pub fn synced_cycle(&self, rig: &Rig, clip: Option<&Clip>) -> Option<SyncedCycle> {
+        let blend = self.layers.blend.filter(|b| b.sync)?;
+        let other = rig.clips.get(blend.clip)?;
+        Some(SyncedCycle::new(clip.map_or(0.0, Clip::duration), other.duration(), blend.weight))
+    }
+
+    /// How long the layered timeline runs: the synced cycle, or the main clip until the crossfade has brought the
+    /// incoming clip to its end (the main clip's duration without either).
+    pub fn duration(&self, rig: &Rig, clip: Option<&Clip>) -> f64 {
+        if let Some(cycle) = self.synced_cycle(rig, clip) {
+            return cycle.length;
+        }
+        let main = clip.map_or(0.0, Clip::duration);
+        let incoming = self.layers.crossfade.and_then(|c| Some(c.at.max(0.0) + rig.clips.get(c.clip)?.duration()));
+        incoming.filter(|end| end.is_finite()).map_or(main, |end| end.max(main))
+    }
+
+    /// The local pose of every bone of `rig` at `time` with the layers applied, written into `local`. `clip` is
+    /// the main clip (`None`: the rest pose); `rig` must be the one the stack was built for.
+    pub fn evaluate(&mut self, rig: &Rig, clip: Option<&Clip>, time: f64, local: &mut Vec<Transform>) {
+        let skeleton = &rig.skeleton;
+        let time = if time.is_finite() { time } else { 0.0 };
+        let layers = &self.layers;
+        let resampling = &layers.interpolation;
+        let [main_time, blend_time] = self.synced_cycle(rig, clip).map_or([time, time], |c| c.clip_times(time));
+        sample(skeleton, clip, main_time, resampling, local);
+        if !self.bind.is_empty() {
+            mix_poses(local, &self.bind, 1.0 - unit_weight(layers.bind_weight), RotationBlend::Slerp);
+        }
+        if let Some(blend) = &layers.blend
+            && let Some(other) = rig.clips.get(blend.clip)
+        {
+            sample(skeleton, Some(other), blend_time, resampling, &mut self.scratch);
+            mix_poses(local, &self.scratch, blend.weight, blend.rotation);
+        }
+        if let Some(additive) = &layers.additive
+            && let Some(other) = rig.clips.get(additive.clip)
+        {
+            sample(skeleton, Some(other), time, resampling, &mut self.scratch);
+            add_poses(local, &self.scratch, &self.reference, additive.weight, additive.order);
+        }
+        if let Some(crossfade) = &layers.crossfade
+            && let Some(incoming) = rig.clips.get(crossfade.clip)
+        {
+            let weight = crossfade.weight(time);
+            if weight > 0.0 {
+                sample(skeleton, Some(incoming), crossfade.incoming_time(time), resampling, &mut self.scratch);
+                mix_poses(local, &self.scratch, weight, RotationBlend::Slerp);
+            }
+        }
+        if let Some(shake) = &layers.shake {
+            shake_pose(local, &self.modifiers, &shake.params, time);
+        }
+        pin_pose(skeleton, local, &layers.targets, &mut self.chain);
+    }
+}
+
+/// `clip` sampled at `time` (the rest pose for `None`).
+fn sample(skeleton: &Skeleton, clip: Option<&Clip>, time: f64, resampling: &Resampling, out: &mut Vec<Transform>) {
+    match clip {
+        Some(clip) if resampling.is_authored() => super::sample_clip(skeleton, clip, time, out),
+        Some(clip) => sample_clip_with(skeleton, clip, time, resampling, out),
+        None => rest_pose_into(skeleton, out),
+    }
+}
