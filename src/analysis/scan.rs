@@ -135,8 +135,16 @@ pub struct Curves {
 pub struct CurveRequest<'a> {
     /// Bones whose full curves are kept.
     pub bones: &'a [usize],
-    /// A second hierarchy (other modes) evaluated for those bones.
-    pub ghost: Option<&'a Hierarchy>,
+    /// A second evaluation of those bones, kept as their ghost curves.
+    pub ghost: Option<GhostRequest<'a>>,
+}
+
+/// How the ghost curves are evaluated: under other modes, and with or without the analysis's layers.
+#[derive(Clone, Copy, Debug)]
+pub struct GhostRequest<'a> {
+    pub hierarchy: &'a Hierarchy,
+    /// The clip as authored, without the layers (for comparing a layer's result with its input).
+    pub unlayered: bool,
 }
 
 /// A whole clip analysed: per-bone summaries, per-bone per-sample stretched flags, and curves of chosen bones.
@@ -389,7 +397,10 @@ fn analyze_chunk(
             }
         }
         if let Some(ghost) = request.ghost {
-            subject.evaluate(&mut ghost_pose, ghost, &mut layers, time);
+            match ghost.unlayered {
+                true => ghost_pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
+                false => subject.evaluate(&mut ghost_pose, ghost.hierarchy, &mut layers, time),
+            }
             for (slot, &bone) in request.bones.iter().enumerate() {
                 let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
                 result.curves[slot].ghost_model.push(Components::of(&assessment));

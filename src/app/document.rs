@@ -1,10 +1,31 @@
-//! The open document: the loaded rig, where it came from, and the user's choices about it (clip, modes, ghost).
+//! The open document: the loaded rig, where it came from, and the user's choices about it (clip, modes, ghost,
+//! layers).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::eval::layers::LayerError;
+use crate::eval::{Hierarchy, LayerStack, Layers, Pose};
 use crate::import::{self, ImportError};
 use crate::model::{Clip, InheritMode, Rig};
+
+/// A second pose drawn translucent over the first and plotted dashed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ghost {
+    /// Every bone under this mode (with the same layers).
+    Mode(InheritMode),
+    /// The clip as authored: the document's modes without the layers.
+    Unlayered,
+}
+
+impl Ghost {
+    pub fn label(self) -> &'static str {
+        match self {
+            Ghost::Mode(mode) => mode.id(),
+            Ghost::Unlayered => "without layers",
+        }
+    }
+}
 
 /// A loaded rig and the choices that change how it evaluates.
 #[derive(Clone, Debug)]
@@ -14,17 +35,18 @@ pub struct Document {
     pub rig: Arc<Rig>,
     /// One mode per bone, starting from what the file declares.
     pub modes: Vec<InheritMode>,
-    /// A second mode for every bone, drawn and plotted as a translucent ghost.
-    pub ghost: Option<InheritMode>,
+    pub ghost: Option<Ghost>,
     /// Index into `rig.clips`.
     pub clip: Option<usize>,
+    /// The runtime techniques layered on the clip, prepared for the rig.
+    layers: LayerStack,
 }
 
 impl Document {
     pub fn demo() -> Self {
         let mut doc = Document::new(None, import::demo_rig());
         // The demo exists to show shear: put the ghost where the shear disappears.
-        doc.ghost = Some(InheritMode::SegmentCompensate);
+        doc.ghost = Some(Ghost::Mode(InheritMode::SegmentCompensate));
         doc
     }
 
@@ -36,7 +58,7 @@ impl Document {
     pub fn new(path: Option<PathBuf>, rig: Rig) -> Self {
         let modes = rig.skeleton.declared_modes();
         let clip = (!rig.clips.is_empty()).then_some(0);
-        Document { path, rig: Arc::new(rig), modes, ghost: None, clip }
+        Document { path, rig: Arc::new(rig), modes, ghost: None, clip, layers: LayerStack::default() }
     }
 
     /// The same file re-read (after it changed on disk), keeping clip, modes and ghost where they still fit.
@@ -47,7 +69,24 @@ impl Document {
         }
         doc.ghost = self.ghost;
         doc.clip = self.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.clip);
+        // Layers naming clips or bones the new file lacks are dropped rather than kept half-valid.
+        let _ = doc.set_layers(self.layers());
         doc
+    }
+
+    pub fn layers(&self) -> &Layers {
+        self.layers.layers()
+    }
+
+    /// The layers prepared for evaluating (a copy per evaluating thread: it holds scratch buffers).
+    pub fn layer_stack(&self) -> &LayerStack {
+        &self.layers
+    }
+
+    /// Replaces the layers; on an index the rig does not have, keeps the old ones.
+    pub fn set_layers(&mut self, layers: &Layers) -> Result<(), LayerError> {
+        self.layers = LayerStack::new(&self.rig, layers)?;
+        Ok(())
     }
 
     pub fn title(&self) -> String {
@@ -61,13 +100,30 @@ impl Document {
         self.clip.and_then(|c| self.rig.clips.get(c))
     }
 
+    /// How long the timeline runs: the clip's duration, or what the layers make of it (a synced blend's cycle, a
+    /// crossfade into a longer clip).
     pub fn duration(&self) -> f64 {
-        self.clip().map_or(0.0, Clip::duration)
+        self.layers.duration(&self.rig, self.clip())
     }
 
-    /// The modes of the ghost pose, when a ghost is shown.
-    pub fn ghost_modes(&self) -> Option<Vec<InheritMode>> {
-        self.ghost.map(|mode| vec![mode; self.modes.len()])
+    /// How the ghost pose is evaluated, when a ghost is shown: its modes, and whether through the layers.
+    pub fn ghost_evaluation(&self) -> Option<(Vec<InheritMode>, bool)> {
+        self.ghost.map(|ghost| match ghost {
+            Ghost::Mode(mode) => (vec![mode; self.modes.len()], true),
+            Ghost::Unlayered => (self.modes.clone(), false),
+        })
+    }
+
+    /// The pose at `time` under `modes`, through the layers when `layered`.
+    pub fn evaluate(&self, modes: &[InheritMode], time: f64, layered: bool) -> Pose {
+        let hierarchy = Hierarchy::new(&self.rig.skeleton, modes);
+        let mut pose = Pose::default();
+        if layered && !self.layers().is_empty() {
+            pose.evaluate_layered(&self.rig, self.clip(), &hierarchy, &mut self.layers.clone(), time);
+        } else {
+            pose.evaluate(&self.rig.skeleton, self.clip(), &hierarchy, time);
+        }
+        pose
     }
 
     /// Sets the mode of one bone, of its subtree, or of all bones.

@@ -5,8 +5,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
-use crate::analysis::{ClipAnalysis, CurveRequest, ScanOptions, analyze};
-use crate::eval::Hierarchy;
+use super::Ghost;
+use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, analyze, analyze_layered};
+use crate::eval::{Hierarchy, LayerStack, Layers};
 use crate::model::{InheritMode, Rig};
 
 /// Everything the result depends on.
@@ -16,7 +17,8 @@ pub struct JobKey {
     pub generation: u64,
     pub clip: Option<usize>,
     pub modes: Vec<InheritMode>,
-    pub ghost: Option<InheritMode>,
+    pub ghost: Option<Ghost>,
+    pub layers: Layers,
     pub plotted: Vec<usize>,
     pub rate: f64,
 }
@@ -91,15 +93,30 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
     let (job_key, job_done, job_total, job_cancel) = (key.clone(), done.clone(), total.clone(), cancel.clone());
     std::thread::spawn(move || {
         let hierarchy = Hierarchy::new(&rig.skeleton, &job_key.modes);
-        let ghost = job_key.ghost.map(|mode| Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]));
+        let ghost_modes = job_key.ghost.map(|ghost| match ghost {
+            Ghost::Mode(mode) => (vec![mode; rig.skeleton.len()], false),
+            Ghost::Unlayered => (job_key.modes.clone(), true),
+        });
+        let ghost_hierarchy = ghost_modes.as_ref().map(|(modes, _)| Hierarchy::new(&rig.skeleton, modes));
+        let ghost = ghost_hierarchy.as_ref().zip(ghost_modes.as_ref()).map(|(hierarchy, (_, unlayered))| {
+            GhostRequest { hierarchy, unlayered: *unlayered }
+        });
         let clip = job_key.clip.and_then(|c| rig.clips.get(c));
         let options = ScanOptions { rate: job_key.rate, ..ScanOptions::default() };
-        let request = CurveRequest { bones: &job_key.plotted, ghost: ghost.as_ref() };
+        let request = CurveRequest { bones: &job_key.plotted, ghost };
         let progress = |d: usize, t: usize| {
             job_done.store(d, Ordering::Relaxed);
             job_total.store(t, Ordering::Relaxed);
         };
-        let analysis = analyze(&rig.skeleton, clip, &hierarchy, request, &options, &progress, &job_cancel);
+        // The document checked the layers against this rig; without layers the plain analysis is the same.
+        let stack = LayerStack::new(&rig, &job_key.layers).ok().filter(|_| !job_key.layers.is_empty());
+        let analysis = match &stack {
+            Some(layers) => {
+                let layered = Layered { rig: &rig, layers };
+                analyze_layered(layered, clip, &hierarchy, request, &options, &progress, &job_cancel)
+            }
+            None => analyze(&rig.skeleton, clip, &hierarchy, request, &options, &progress, &job_cancel),
+        };
         // The receiver may be gone (a newer job replaced this one): nothing to do then.
         let _ = sender.send(analysis);
         on_done();

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
-pub use document::{Document, ModeScope};
+pub use document::{Document, Ghost, ModeScope};
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Tolerances};
@@ -33,7 +33,7 @@ use notifications::Notifications;
 /// At most this many bones are plotted at once (the most recently selected).
 pub const MAX_PLOTTED: usize = 8;
 
-/// The pose at the current time under the document's modes, and under the ghost mode.
+/// The pose at the current time under the document's modes and layers, and the ghost pose.
 pub struct Frame {
     pub pose: Pose,
     pub primary: Layer,
@@ -43,10 +43,11 @@ pub struct Frame {
 impl Frame {
     fn evaluate(doc: &Document, time: f64, tolerances: &Tolerances) -> Frame {
         let rig = &doc.rig;
-        let mut pose = Pose::default();
-        pose.evaluate(&rig.skeleton, doc.clip(), &crate::eval::Hierarchy::new(&rig.skeleton, &doc.modes), time);
+        let pose = doc.evaluate(&doc.modes, time, true);
         let primary = Layer::from_model(rig, pose.model.model.clone(), tolerances);
-        let ghost = doc.ghost_modes().map(|modes| Layer::evaluate(rig, doc.clip(), &modes, time, tolerances));
+        let ghost = doc.ghost_evaluation().map(|(modes, layered)| {
+            Layer::from_model(rig, doc.evaluate(&modes, time, layered).model.model, tolerances)
+        });
         Frame { pose, primary, ghost }
     }
 }
@@ -236,6 +237,7 @@ impl BonescopeApp {
             clip: self.doc.clip,
             modes: self.doc.modes.clone(),
             ghost: self.doc.ghost,
+            layers: self.doc.layers().clone(),
             plotted: self.plotted(),
             rate: self.settings.frame_rate,
         }

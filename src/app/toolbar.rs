@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use egui::RichText;
 
-use super::{ModeScope, Shared};
+use super::{Ghost, ModeScope, Shared};
 use crate::model::InheritMode;
 
 /// What the toolbar asks the app to do after the frame (things that replace the document).
@@ -118,14 +118,17 @@ fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
 
 fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Ghost");
-    let text = shared.doc.ghost.map_or("off", InheritMode::id);
+    let text = shared.doc.ghost.map_or("off", Ghost::label);
     egui::ComboBox::from_id_salt("ghost")
         .selected_text(text)
         .width(170.0)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
+            ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
+                .on_hover_text("the clip as authored, without the layers");
             for mode in InheritMode::ALL {
-                ui.selectable_value(&mut shared.doc.ghost, Some(mode), mode.id()).on_hover_text(mode.description());
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Mode(mode)), mode.id())
+                    .on_hover_text(mode.description());
             }
         })
         .response

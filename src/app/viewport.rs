@@ -40,7 +40,7 @@ impl Viewport {
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
         scene.ghost = shared.frame.ghost.clone();
-        scene.ghost_label = shared.doc.ghost.map_or_else(String::new, |m| format!("ghost: {}", m.id()));
+        scene.ghost_label = shared.doc.ghost.map_or_else(String::new, |g| format!("ghost: {}", g.label()));
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {

@@ -8,9 +8,9 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use crate::app::{BonescopeApp, Chrome, Document, Settings};
+use super::layers::LayerArgs;
+use crate::app::{BonescopeApp, Chrome, Document, Ghost, Settings};
 use crate::import;
-use crate::model::InheritMode;
 use crate::render::{Background, Difference, Renderer, compare};
 use crate::view::{SceneOptions, ViewKind};
 
@@ -20,6 +20,8 @@ pub struct RenderArgs {
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
+    #[command(flatten)]
+    pub layers: LayerArgs,
     /// The time to render, in seconds (default 0).
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, conflicts_with = "frames")]
     pub time: Option<f64>,
@@ -35,9 +37,10 @@ pub struct RenderArgs {
     /// Picture size in pixels.
     #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Draw the pose under this mode translucent over the first (`none`: no ghost; the demo rig has one).
-    #[arg(long, value_name = "MODE|none", value_parser = parse_ghost)]
-    pub ghost: Option<Ghost>,
+    /// Draw a second pose translucent over the first: under this mode, or `unlayered` (the clip without the
+    /// layers); `none`: no ghost (the demo rig has one).
+    #[arg(long, value_name = "MODE|unlayered|none", value_parser = parse_ghost)]
+    pub ghost: Option<GhostArg>,
     /// Select a bone by name (repeatable): highlighted in the viewport, plotted and inspected with --ui.
     #[arg(long, value_name = "NAME")]
     pub select: Vec<String>,
@@ -75,11 +78,9 @@ pub enum Theme {
     Light,
 }
 
+/// `--ghost`: off, or which ghost.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Ghost {
-    None,
-    Mode(InheritMode),
-}
+pub struct GhostArg(Option<Ghost>);
 
 /// `--frames START:END:STEP`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,10 +119,11 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
-fn parse_ghost(s: &str) -> Result<Ghost, String> {
+fn parse_ghost(s: &str) -> Result<GhostArg, String> {
     match s {
-        "none" => Ok(Ghost::None),
-        mode => mode.parse().map(Ghost::Mode).map_err(|e| format!("{e}, or `none`")),
+        "none" => Ok(GhostArg(None)),
+        "unlayered" => Ok(GhostArg(Some(Ghost::Unlayered))),
+        mode => mode.parse().map(|m| GhostArg(Some(Ghost::Mode(m)))).map_err(|e| format!("{e}, `unlayered` or `none`")),
     }
 }
 
@@ -225,10 +227,9 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
     let rig = doc.rig.clone();
     doc.clip = args.eval.clip(&rig)?.map(|c| c.index);
     doc.modes = args.eval.modes(&rig)?;
-    match args.ghost {
-        Some(Ghost::None) => doc.ghost = None,
-        Some(Ghost::Mode(mode)) => doc.ghost = Some(mode),
-        None => {}
+    doc.set_layers(&args.layers.layers(&rig)?)?;
+    if let Some(GhostArg(ghost)) = args.ghost {
+        doc.ghost = ghost;
     }
     let selection = args
         .select
@@ -289,6 +290,7 @@ fn diff_path(path: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::InheritMode;
 
     #[test]
     fn frame_ranges_parse_and_reject_nonsense() {
@@ -306,8 +308,9 @@ mod tests {
         assert!(parse_size("1280").is_err());
         assert_eq!(parse_camera("30,-10,4.5"), Ok([30.0, -10.0, 4.5]));
         assert!(parse_camera("30,10,0").is_err());
-        assert_eq!(parse_ghost("none"), Ok(Ghost::None));
-        assert_eq!(parse_ghost("segment-compensate"), Ok(Ghost::Mode(InheritMode::SegmentCompensate)));
+        assert_eq!(parse_ghost("none"), Ok(GhostArg(None)));
+        assert_eq!(parse_ghost("unlayered"), Ok(GhostArg(Some(Ghost::Unlayered))));
+        assert_eq!(parse_ghost("segment-compensate"), Ok(GhostArg(Some(Ghost::Mode(InheritMode::SegmentCompensate)))));
         assert!(parse_ghost("sideways").is_err());
     }
 

@@ -104,19 +104,6 @@ pub struct Layer {
 }
 
 impl Layer {
-    /// Evaluates `clip` (or the rest pose) at `time` with one mode per bone.
-    pub fn evaluate(
-        rig: &Rig,
-        clip: Option<&Clip>,
-        modes: &[InheritMode],
-        time: f64,
-        tolerances: &Tolerances,
-    ) -> Layer {
-        let mut pose = Pose::default();
-        pose.evaluate(&rig.skeleton, clip, &Hierarchy::new(&rig.skeleton, modes), time);
-        Layer::from_model(rig, pose.model.model, tolerances)
-    }
-
     pub fn from_model(rig: &Rig, model: Vec<DMat4>, tolerances: &Tolerances) -> Layer {
         let findings = model.iter().map(|m| Assessment::of(m, tolerances).findings).collect();
         let meshes = skin_meshes(rig, &model);
@@ -207,19 +194,40 @@ fn gizmo_size(rig: &Rig) -> f64 {
 }
 
 /// The bounds of the whole motion: the clip sampled at `samples` evenly spaced times (the rest pose without a
-/// clip), so a camera framed on it does not need to move while the clip plays.
+/// clip), so a camera framed on it does not need to move while the clip plays. Only the bones that matter count
+/// (see [`framed_bones`]), and the skinned meshes.
 pub fn motion_bounds(rig: &Rig, clip: Option<&Clip>, modes: &[InheritMode], samples: usize) -> Option<Bounds> {
     let duration = clip.map_or(0.0, Clip::duration);
     let hierarchy = Hierarchy::new(&rig.skeleton, modes);
+    let framed = framed_bones(rig, clip);
     let mut pose = Pose::default();
     (0..samples.max(1))
         .filter_map(|i| {
             let time = duration * i as f64 / (samples.max(2) - 1) as f64;
             pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
             let meshes = skin_meshes(rig, &pose.model.model);
-            Bounds::of(pose.model.model.iter().map(|m| m.w_axis.truncate()).chain(meshes.into_iter().flatten()))
+            let heads = pose.model.model.iter().zip(&framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
+            Bounds::of(heads.chain(meshes.into_iter().flatten()))
         })
         .reduce(Bounds::union)
+}
+
+/// The bones a camera frames: those the clip animates and the skins' joints, so that a file's cameras, lights and
+/// helpers far from the character (FBX exports often carry six "Producer" cameras 150 m out) stay out of the
+/// picture; every bone when that leaves none.
+fn framed_bones(rig: &Rig, clip: Option<&Clip>) -> Vec<bool> {
+    let mut framed = vec![false; rig.skeleton.len()];
+    let animated = clip.into_iter().flat_map(|c| c.tracks().iter().map(|t| t.bone));
+    let joints = rig.skins.iter().flat_map(|s| s.joints.iter().copied());
+    for bone in animated.chain(joints) {
+        if let Some(f) = framed.get_mut(bone) {
+            *f = true;
+        }
+    }
+    if !framed.contains(&true) {
+        framed.fill(true);
+    }
+    framed
 }
 
 /// Model matrices of the bind pose: `inverse(IBM)` for skin joints, the rest pose for other bones.
