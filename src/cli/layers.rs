@@ -67,7 +67,13 @@ pub struct LayerArgs {
     pub shake: Option<String>,
     /// Set a shake parameter (repeatable): speed (40), amplitude (0.3), attenuation (0.3), transx, transy (1),
     /// transz, rotx, roty (0.1), rotz, fade (0).
-    #[arg(long, value_name = "NAME=VALUE", value_parser = parse_shake_param, requires = "shake", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NAME=VALUE",
+        value_parser = parse_shake_param,
+        requires = "shake",
+        allow_negative_numbers = true
+    )]
     pub shake_param: Vec<(String, f64)>,
     /// Pin a bone to a model-space rotation (quaternion x,y,z,w), with an optional weight (repeatable).
     #[arg(long, value_name = "BONE=x,y,z,w[@WEIGHT]", value_parser = parse_target, allow_negative_numbers = true)]
