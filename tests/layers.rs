@@ -292,17 +292,18 @@ fn vector_track() -> impl Strategy<Value = Track<Vec3>> {
 proptest! {
     #[test]
     fn every_interpolation_passes_through_the_keys_and_stays_finite(track in vector_track(), at in -1.0..9.0f64) {
-        use bonescope::eval::layers::KeyInterpolation;
-        for keys in [KeyInterpolation::Authored, KeyInterpolation::Nearest, KeyInterpolation::Linear, KeyInterpolation::Cubic] {
+        use bonescope::eval::layers::KeyInterpolation::{Authored, Cubic, Linear, Nearest};
+        for keys in [Authored, Nearest, Linear, Cubic] {
             let resampling = Resampling { keys, ..Resampling::default() };
             prop_assert!(resampling.sample(&track, at).is_finite());
             for (time, value) in track.times().iter().zip(track.values()) {
                 prop_assert_eq!(resampling.sample(&track, *time), value.as_dvec3());
             }
             // Nearest and linear never leave the range of the keys (cubic may overshoot).
-            if keys != KeyInterpolation::Cubic {
+            if keys != Cubic {
                 let x = resampling.sample(&track, at).x;
-                let (lo, hi) = track.values().iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v.x.into()), h.max(v.x.into())));
+                let xs = track.values().iter().map(|v| f64::from(v.x));
+                let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
                 prop_assert!(lo - 1e-9 <= x && x <= hi + 1e-9);
             }
         }
