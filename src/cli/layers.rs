@@ -213,16 +213,12 @@ pub fn describe(layers: &Layers, rig: &Rig, clip: Option<&Clip>) -> String {
         parts.push(format!("blend `{}` a = {}{sync}", name(b.clip), b.weight));
     }
     if let Some(a) = &layers.additive {
-        parts.push(format!(
-            "additive `{}` ({:?} reference, {:?} order, weight {})",
-            name(a.clip),
-            a.reference,
-            a.order,
-            a.weight
-        ));
+        let how = format!("{:?} reference, {:?} order", a.reference, a.order).to_lowercase();
+        parts.push(format!("additive `{}` ({how}, weight {})", name(a.clip), a.weight));
     }
     if let Some(c) = &layers.crossfade {
-        parts.push(format!("crossfade into `{}` at {} s over {} s ({:?})", name(c.clip), c.at, c.duration, c.curve));
+        let curve = format!("{:?}", c.curve).to_lowercase();
+        parts.push(format!("crossfade into `{}` at {} s over {} s ({curve})", name(c.clip), c.at, c.duration));
     }
     if let Some(s) = &layers.shake {
         parts.push(format!("shake `{}`", bone(s.bone)));
