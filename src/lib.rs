@@ -1,7 +1,8 @@
 //! bonescope: see what a skeletal animation really does to every bone.
 //!
-//! Data flows one way: `import` turns a file into a [`model::Rig`]; `eval` samples a clip into local transforms and
-//! combines them into model matrices with each bone's scale-inheritance mode; `analysis` runs Shoemake's polar
+//! Data flows one way: `import` turns a file into a [`model::Rig`]; `eval` samples a clip into local transforms,
+//! layers a game runtime's techniques on them (`eval::layers`: blends, additive clips, crossfades, shake, targets)
+//! and combines them into model matrices with each bone's scale-inheritance mode; `analysis` runs Shoemake's polar
 //! decomposition on every matrix and flags stretched, mirrored and degenerate bones; `cli` prints the result;
 //! `export` writes skinned meshes at a pose (OBJ).
 //!

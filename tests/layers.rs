@@ -271,9 +271,41 @@ proptest! {
             let m = bonescope::eval::layers::mix(&a, &b, w, rotation);
             prop_assert!((m.rotation.length() - 1.0).abs() < 1e-12);
             // The mixed rotation lies on the arc: its angles to the ends add up to the angle between them.
-            let (to_a, to_b, ab) = (m.rotation.angle_between(a.rotation), m.rotation.angle_between(b.rotation), a.rotation.angle_between(b.rotation));
+            let to_a = m.rotation.angle_between(a.rotation);
+            let to_b = m.rotation.angle_between(b.rotation);
+            let ab = a.rotation.angle_between(b.rotation);
             prop_assert!((to_a + to_b - ab).abs() < 1e-6, "{to_a} + {to_b} vs {ab}");
             prop_assert!(m.translation.distance(a.translation) <= a.translation.distance(b.translation) + 1e-9);
+        }
+    }
+}
+
+/// A linear track of 1–8 keys at increasing times with values in ±100.
+fn vector_track() -> impl Strategy<Value = Track<Vec3>> {
+    prop::collection::vec((0.01..1.0f64, -100.0..100.0f32), 1..8).prop_map(|keys| {
+        let times: Vec<f64> = keys.iter().scan(0.0, |t, (step, _)| Some(std::mem::replace(t, *t + step))).collect();
+        let values = keys.iter().map(|&(_, x)| Vec3::new(x, -x, 0.5 * x)).collect();
+        Track::new(Arc::from(times), values, Interpolation::Linear).unwrap()
+    })
+}
+
+proptest! {
+    #[test]
+    fn every_interpolation_passes_through_the_keys_and_stays_finite(track in vector_track(), at in -1.0..9.0f64) {
+        use bonescope::eval::layers::KeyInterpolation::{Authored, Cubic, Linear, Nearest};
+        for keys in [Authored, Nearest, Linear, Cubic] {
+            let resampling = Resampling { keys, ..Resampling::default() };
+            prop_assert!(resampling.sample(&track, at).is_finite());
+            for (time, value) in track.times().iter().zip(track.values()) {
+                prop_assert_eq!(resampling.sample(&track, *time), value.as_dvec3());
+            }
+            // Nearest and linear never leave the range of the keys (cubic may overshoot).
+            if keys != Cubic {
+                let x = resampling.sample(&track, at).x;
+                let xs = track.values().iter().map(|v| f64::from(v.x));
+                let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
+                prop_assert!(lo - 1e-9 <= x && x <= hi + 1e-9);
+            }
         }
     }
 }

@@ -67,7 +67,13 @@ pub struct LayerArgs {
     pub shake: Option<String>,
     /// Set a shake parameter (repeatable): speed (40), amplitude (0.3), attenuation (0.3), transx, transy (1),
     /// transz, rotx, roty (0.1), rotz, fade (0).
-    #[arg(long, value_name = "NAME=VALUE", value_parser = parse_shake_param, requires = "shake", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "NAME=VALUE",
+        value_parser = parse_shake_param,
+        requires = "shake",
+        allow_negative_numbers = true
+    )]
     pub shake_param: Vec<(String, f64)>,
     /// Pin a bone to a model-space rotation (quaternion x,y,z,w), with an optional weight (repeatable).
     #[arg(long, value_name = "BONE=x,y,z,w[@WEIGHT]", value_parser = parse_target, allow_negative_numbers = true)]
@@ -207,16 +213,12 @@ pub fn describe(layers: &Layers, rig: &Rig, clip: Option<&Clip>) -> String {
         parts.push(format!("blend `{}` a = {}{sync}", name(b.clip), b.weight));
     }
     if let Some(a) = &layers.additive {
-        parts.push(format!(
-            "additive `{}` ({:?} reference, {:?} order, weight {})",
-            name(a.clip),
-            a.reference,
-            a.order,
-            a.weight
-        ));
+        let how = format!("{:?} reference, {:?} order", a.reference, a.order).to_lowercase();
+        parts.push(format!("additive `{}` ({how}, weight {})", name(a.clip), a.weight));
     }
     if let Some(c) = &layers.crossfade {
-        parts.push(format!("crossfade into `{}` at {} s over {} s ({:?})", name(c.clip), c.at, c.duration, c.curve));
+        let curve = format!("{:?}", c.curve).to_lowercase();
+        parts.push(format!("crossfade into `{}` at {} s over {} s ({curve})", name(c.clip), c.at, c.duration));
     }
     if let Some(s) = &layers.shake {
         parts.push(format!("shake `{}`", bone(s.bone)));

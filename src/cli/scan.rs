@@ -48,7 +48,12 @@ pub struct ScanArgs {
     #[arg(long, conflicts_with_all = ["compare_inherit", "fail_on_stretch"])]
     pub storage: bool,
     /// With --storage: how far along each bone's axes the error is measured, in the bone's local units.
-    #[arg(long, value_name = "DISTANCE", default_value_t = StorageOptions::default().probe_distance, requires = "storage")]
+    #[arg(
+        long,
+        value_name = "DISTANCE",
+        default_value_t = StorageOptions::default().probe_distance,
+        requires = "storage"
+    )]
     pub probe_distance: f64,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,

@@ -77,7 +77,8 @@ mod tests {
             assert_eq!(m.scale, DVec3::splat(1.5));
             assert_eq!(m.stretch, DQuat::IDENTITY);
         }
-        // Slerp turns a quarter of the angle; nlerp of a 1 rad turn at t = 0.25: atan2(0.25·sin 0.5, 0.75 + 0.25·cos 0.5).
+        // Slerp turns a quarter of the angle. Nlerp of a 1 rad turn at t = 0.25 turns by twice
+        // atan2(0.25·sin 0.5, 0.75 + 0.25·cos 0.5).
         assert!(mix(&a, &b, 0.25, RotationBlend::Slerp).rotation.abs_diff_eq(DQuat::from_rotation_y(0.25), 1e-15));
         let half = (0.25 * 0.5f64.sin()).atan2(0.75 + 0.25 * 0.5f64.cos());
         let nlerped = mix(&a, &b, 0.25, RotationBlend::Nlerp).rotation;

@@ -1,10 +1,11 @@
 //! Runtime techniques layered on a sampled clip, each as a game runtime does it (the seeds in `shared/seeds`):
 //!
 //! ```text
-//! clip ──sample (interpolation override)──▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ targets ─▶ pose
-//!          every clip a layer reads is          (mix with   (second   (difference  (into a third  (cosine   (model-space
-//!          sampled the same way                  bind pose)  clip,     from a ref,  clip, weight   wobble)   rotations)
-//!                                                            synced)   local/global) over time)
+//! clip ─sample─▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ targets ─▶ pose
+//!   (interpolation       (mix with     (second   (difference  (into a third  (cosine   (model-space
+//!    override, for        bind pose)    clip,     from a ref,  clip, weight   wobble)   rotations)
+//!    every clip read)                   synced)   local or     over time)
+//!                                                 global)
 //! ```
 //!
 //! [`Layers`] says what to do (serialisable; the default does nothing), [`LayerStack`] holds what it needs prepared
