@@ -98,9 +98,10 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
             Ghost::Unlayered => (job_key.modes.clone(), true),
         });
         let ghost_hierarchy = ghost_modes.as_ref().map(|(modes, _)| Hierarchy::new(&rig.skeleton, modes));
-        let ghost = ghost_hierarchy.as_ref().zip(ghost_modes.as_ref()).map(|(hierarchy, (_, unlayered))| {
-            GhostRequest { hierarchy, unlayered: *unlayered }
-        });
+        let ghost = ghost_hierarchy
+            .as_ref()
+            .zip(ghost_modes.as_ref())
+            .map(|(hierarchy, (_, unlayered))| GhostRequest { hierarchy, unlayered: *unlayered });
         let clip = job_key.clip.and_then(|c| rig.clips.get(c));
         let options = ScanOptions { rate: job_key.rate, ..ScanOptions::default() };
         let request = CurveRequest { bones: &job_key.plotted, ghost };

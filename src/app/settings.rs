@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::eval::layers::TICKS_PER_SECOND;
 use crate::view::{Camera, SceneOptions};
 
 /// How times are shown. The library always works in seconds.
@@ -17,7 +18,6 @@ pub enum TimeUnit {
 
 impl TimeUnit {
     pub const ALL: [TimeUnit; 3] = [TimeUnit::Seconds, TimeUnit::Frames, TimeUnit::Ticks];
-    pub const TICKS_PER_SECOND: f64 = 4800.0;
 
     pub fn label(self) -> &'static str {
         match self {
@@ -32,7 +32,7 @@ impl TimeUnit {
         match self {
             TimeUnit::Seconds => format!("{seconds:.3} s"),
             TimeUnit::Frames => format!("frame {:.1}", seconds * frame_rate),
-            TimeUnit::Ticks => format!("{:.0} ticks", seconds * Self::TICKS_PER_SECOND),
+            TimeUnit::Ticks => format!("{:.0} ticks", seconds * TICKS_PER_SECOND),
         }
     }
 }

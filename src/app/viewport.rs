@@ -7,7 +7,8 @@ use egui::{Sense, Ui};
 use glam::DVec2;
 
 use super::{Document, Shared};
-use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, bind_pose, motion_bounds, paint};
+use crate::eval::bind_model_matrices;
+use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
@@ -44,7 +45,7 @@ impl Viewport {
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {
-            scene.bind_pose = Some(bind_pose(&rig));
+            scene.bind_pose = Some(bind_model_matrices(&rig));
         }
         navigate(ui, &response, rect, &mut shared.settings.camera);
         if response.clicked()
@@ -69,13 +70,17 @@ impl Viewport {
     }
 }
 
-/// File and clip, time, and the modes the pose is evaluated with.
+/// File and clip, time, the modes the pose is evaluated with, and its layers.
 fn caption(shared: &Shared) -> Vec<String> {
     let doc = &*shared.doc;
     let clip = doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
     let settings = &*shared.settings;
     let modes = doc.common_mode().map_or_else(|| "mixed modes".to_owned(), |m| format!("mode: {}", m.id()));
-    vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, settings.frame_rate), modes]
+    let mut lines =
+        vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, settings.frame_rate), modes];
+    let layers = doc.layers().summary(&doc.rig, doc.clip());
+    lines.extend((!layers.is_empty()).then_some(layers));
+    lines
 }
 
 /// Orbit, pan and zoom from the pointer.

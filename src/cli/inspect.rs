@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use super::layers::{LayerArgs, describe};
+use super::layers::LayerArgs;
 use super::table::{Table, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, LayeredInspectReport, SampleReport};
@@ -57,7 +57,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         inherit: args.eval.inherit_label(),
         samples,
     };
-    let summary = describe(&layers, &rig, clip);
+    let summary = layers.summary(&rig, clip);
     let report = LayeredInspectReport {
         report,
         layers,

@@ -8,9 +8,9 @@ use glam::DQuat;
 use super::options::find_clip;
 use crate::eval::layers::{
     Additive, AdditiveOrder, AdditiveReference, Blend, Crossfade, FadeCurve, KeyInterpolation, Layers, Resampling,
-    RotationBlend, RotationInterpolation, Shake, ShakeParams, SyncedCycle, Target,
+    RotationBlend, RotationInterpolation, Shake, ShakeParams, Target,
 };
-use crate::model::{Clip, Rig};
+use crate::model::Rig;
 
 /// Runtime techniques layered on the animation, applied in this order: bind weight, interpolation, blend,
 /// additive, crossfade, shake, targets.
@@ -187,44 +187,4 @@ fn weight(option: &str, value: f64) -> anyhow::Result<f64> {
 
 fn seconds(option: &str, value: f64) -> anyhow::Result<f64> {
     if value.is_finite() { Ok(value) } else { bail!("{option} must be a finite number of seconds, got {value}") }
-}
-
-/// One line for people: what the layers do, by name.
-pub fn describe(layers: &Layers, rig: &Rig, clip: Option<&Clip>) -> String {
-    let name = |index: usize| rig.clips.get(index).map_or_else(|| format!("animation {index}"), Clip::label);
-    let bone =
-        |index: usize| rig.skeleton.bones().get(index).map_or_else(|| format!("bone {index}"), |b| b.name.clone());
-    let mut parts = Vec::new();
-    if layers.bind_weight < 1.0 {
-        parts.push(format!("bind weight {}", layers.bind_weight));
-    }
-    if !layers.interpolation.is_authored() {
-        let r = layers.interpolation;
-        parts.push(format!("interpolation {:?}/{:?}", r.keys, r.rotation).to_lowercase());
-    }
-    if let Some(b) = &layers.blend {
-        let sync = if b.sync {
-            let other = rig.clips.get(b.clip).map_or(0.0, Clip::duration);
-            let cycle = SyncedCycle::new(clip.map_or(0.0, Clip::duration), other, b.weight);
-            format!(", synced: cycle {:.4} s, rates {:.4} and {:.4}", cycle.length, cycle.rates[0], cycle.rates[1])
-        } else {
-            String::new()
-        };
-        parts.push(format!("blend `{}` a = {}{sync}", name(b.clip), b.weight));
-    }
-    if let Some(a) = &layers.additive {
-        let how = format!("{:?} reference, {:?} order", a.reference, a.order).to_lowercase();
-        parts.push(format!("additive `{}` ({how}, weight {})", name(a.clip), a.weight));
-    }
-    if let Some(c) = &layers.crossfade {
-        let curve = format!("{:?}", c.curve).to_lowercase();
-        parts.push(format!("crossfade into `{}` at {} s over {} s ({curve})", name(c.clip), c.at, c.duration));
-    }
-    if let Some(s) = &layers.shake {
-        parts.push(format!("shake `{}`", bone(s.bone)));
-    }
-    for t in &layers.targets {
-        parts.push(format!("target `{}` weight {}", bone(t.bone), t.weight));
-    }
-    parts.join("; ")
 }

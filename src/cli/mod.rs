@@ -16,7 +16,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub use layers::{LayerArgs, TargetArg, describe as describe_layers};
+pub use layers::{LayerArgs, TargetArg};
 pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's

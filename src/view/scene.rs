@@ -230,19 +230,6 @@ fn framed_bones(rig: &Rig, clip: Option<&Clip>) -> Vec<bool> {
     framed
 }
 
-/// Model matrices of the bind pose: `inverse(IBM)` for skin joints, the rest pose for other bones.
-pub fn bind_pose(rig: &Rig) -> Vec<DMat4> {
-    let mut model = rig.skeleton.rest_model_matrices();
-    for skin in &rig.skins {
-        for (&joint, ibm) in skin.joints.iter().zip(&skin.inverse_bind) {
-            if ibm.determinant().abs() > 1e-12 {
-                model[joint] = ibm.inverse();
-            }
-        }
-    }
-    model
-}
-
 /// The bounds of the rest pose's joints and meshes.
 pub fn rest_bounds(rig: &Rig) -> Option<Bounds> {
     let model = rig.skeleton.rest_model_matrices();

@@ -29,7 +29,7 @@ pub use interpolate::{Channel, KeyInterpolation, Resampling, RotationInterpolati
 pub use mix::{RotationBlend, mix, mix_poses, unit_weight};
 pub use shake::{Shake, ShakeParams, UnknownShakeParam, bone_modifiers, shake_pose};
 pub use target::{Target, pin_pose};
-pub use time::{SyncedCycle, TICKS_PER_SECOND, TimeUnit};
+pub use time::{SyncedCycle, TICKS_PER_SECOND};
 
 use glam::DQuat;
 
@@ -88,6 +88,47 @@ impl Default for Layers {
 }
 
 impl Layers {
+    /// One line for people: what the layers do, by name (empty without layers).
+    pub fn summary(&self, rig: &Rig, clip: Option<&Clip>) -> String {
+        let layers = self;
+        let name = |index: usize| rig.clips.get(index).map_or_else(|| format!("animation {index}"), Clip::label);
+        let bone =
+            |index: usize| rig.skeleton.bones().get(index).map_or_else(|| format!("bone {index}"), |b| b.name.clone());
+        let mut parts = Vec::new();
+        if layers.bind_weight < 1.0 {
+            parts.push(format!("bind weight {}", layers.bind_weight));
+        }
+        if !layers.interpolation.is_authored() {
+            let r = layers.interpolation;
+            parts.push(format!("interpolation {:?}/{:?}", r.keys, r.rotation).to_lowercase());
+        }
+        if let Some(b) = &layers.blend {
+            let sync = if b.sync {
+                let other = rig.clips.get(b.clip).map_or(0.0, Clip::duration);
+                let cycle = SyncedCycle::new(clip.map_or(0.0, Clip::duration), other, b.weight);
+                format!(", synced: cycle {:.4} s, rates {:.4} and {:.4}", cycle.length, cycle.rates[0], cycle.rates[1])
+            } else {
+                String::new()
+            };
+            parts.push(format!("blend `{}` a = {}{sync}", name(b.clip), b.weight));
+        }
+        if let Some(a) = &layers.additive {
+            let how = format!("{:?} reference, {:?} order", a.reference, a.order).to_lowercase();
+            parts.push(format!("additive `{}` ({how}, weight {})", name(a.clip), a.weight));
+        }
+        if let Some(c) = &layers.crossfade {
+            let curve = format!("{:?}", c.curve).to_lowercase();
+            parts.push(format!("crossfade into `{}` at {} s over {} s ({curve})", name(c.clip), c.at, c.duration));
+        }
+        if let Some(s) = &layers.shake {
+            parts.push(format!("shake `{}`", bone(s.bone)));
+        }
+        for t in &layers.targets {
+            parts.push(format!("target `{}` weight {}", bone(t.bone), t.weight));
+        }
+        parts.join("; ")
+    }
+
     /// Whether these layers leave the clip exactly as sampled.
     pub fn is_empty(&self) -> bool {
         *self == Layers::default()

@@ -1,40 +1,7 @@
-//! Time: the units people count in, and the seed's sync of two cycles of different lengths (seed 001).
+//! Time: 3ds Max's ticks, and the seed's sync of two cycles of different lengths (seed 001).
 
 /// 3ds Max's time unit: 1/4800 s, a multiple of the frame periods at 24, 25, 30, 50 and 60 fps (seed 004).
 pub const TICKS_PER_SECOND: f64 = 4800.0;
-
-/// A unit to show or type times in; the library itself counts in seconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case", tag = "unit")]
-pub enum TimeUnit {
-    #[default]
-    Seconds,
-    /// Frames at `rate` per second.
-    Frames { rate: f64 },
-    /// 3ds Max ticks, [`TICKS_PER_SECOND`].
-    Ticks,
-}
-
-impl TimeUnit {
-    /// How many of this unit make a second.
-    pub fn per_second(self) -> f64 {
-        match self {
-            TimeUnit::Seconds => 1.0,
-            TimeUnit::Frames { rate } => rate,
-            TimeUnit::Ticks => TICKS_PER_SECOND,
-        }
-    }
-
-    pub fn from_seconds(self, seconds: f64) -> f64 {
-        seconds * self.per_second()
-    }
-
-    /// Seconds of `value` in this unit; 0 for a frame rate that is not a positive number.
-    pub fn to_seconds(self, value: f64) -> f64 {
-        let per_second = self.per_second();
-        if per_second > 0.0 && per_second.is_finite() { value / per_second } else { 0.0 }
-    }
-}
 
 /// Two cycles played at one normalised time, the seed's walk–run blend: with clip lengths `T1`, `T2` and blend
 /// factor `a`, the blended cycle lasts `(T2 − T1)·a + T1` and the clips play at rates `T1/len` and `T2/len`.
@@ -75,16 +42,6 @@ impl SyncedCycle {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn units_convert_as_the_seed_counts() {
-        // Seed 004: frame = time · 4800 / 30 ticks per frame at 30 fps. 1.5 s = 7200 ticks = 45 frames.
-        assert_eq!(TimeUnit::Ticks.from_seconds(1.5), 7200.0);
-        assert_eq!(TimeUnit::Frames { rate: 30.0 }.from_seconds(1.5), 45.0);
-        assert_eq!(TimeUnit::Ticks.to_seconds(7200.0) * 30.0, 45.0);
-        assert_eq!(TimeUnit::Seconds.to_seconds(2.5), 2.5);
-        assert_eq!(TimeUnit::Frames { rate: 0.0 }.to_seconds(10.0), 0.0);
-    }
 
     #[test]
     fn the_seeds_walk_run_numbers() {
