@@ -120,3 +120,62 @@ fn the_timeline_strip_and_plots_follow_the_analysis() {
     assert!(!analysis.stretched_at(forearm, 0));
     assert!((0..analysis.times.len()).any(|s| analysis.stretched_at(forearm, s)));
 }
+
+#[test]
+fn the_layers_panel_turns_on_a_synced_blend_and_the_timeline_follows_its_cycle() {
+    let mut harness = demo_app();
+    harness.get_by_role_and_label(Role::Button, "Layers").click();
+    settle(&mut harness);
+    harness.get_by_label("Blend").click();
+    settle(&mut harness);
+    harness.get_by_label("blend a second clip").click();
+    settle(&mut harness);
+    let doc = &harness.state().doc;
+    let blend = doc.layers().blend.expect("the checkbox turned the blend on");
+    // The demo's second clip ("bend"), half way, synced: the cycle is (T2 − T1)·a + T1.
+    assert_eq!((blend.clip, blend.weight, blend.sync), (1, 0.5, true));
+    let (t1, t2) = (doc.rig.clips[0].duration(), doc.rig.clips[1].duration());
+    let cycle = (t2 - t1) * 0.5 + t1;
+    assert!((doc.duration() - cycle).abs() < 1e-12, "timeline {} s, cycle {cycle} s", doc.duration());
+    harness.get_by_label(&format!("cycle (T2 − T1)·a + T1 = {cycle:.4} s"));
+    // Turning it off again restores the clip's own length.
+    harness.get_by_label("blend a second clip").click();
+    settle(&mut harness);
+    assert!(harness.state().doc.layers().is_empty());
+    assert_eq!(harness.state().doc.duration(), t1);
+}
+
+#[test]
+fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
+    let mut harness = demo_app();
+    harness.state_mut().settings.show_layers = true;
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    let forearm = bone(&harness, "forearm");
+    // The target's model rotation: the chain of local rotations from the root (seed 003's joints).
+    let rotation_at = |harness: &Harness<'static, BonescopeApp>, time: f64| {
+        let doc = &harness.state().doc;
+        let local = doc.evaluate(&doc.modes, time, true).local;
+        let skeleton = &doc.rig.skeleton;
+        let mut rotation = local[forearm].rotation;
+        let mut at = skeleton.parent(forearm);
+        while let Some(parent) = at {
+            rotation = local[parent].rotation * rotation;
+            at = skeleton.parent(parent);
+        }
+        rotation
+    };
+    let unpinned = [0.25, 0.5, 1.0].map(|t| rotation_at(&harness, t));
+    harness.get_by_label("World-space targets").click();
+    settle(&mut harness);
+    harness.get_by_label("Pin forearm where it is now").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.layers().targets.len(), 1);
+    let pinned = rotation_at(&harness, 0.0);
+    for (time, free) in [0.25, 0.5, 1.0].into_iter().zip(unpinned) {
+        // Without the pin the forearm turns with the bending arm; pinned, it keeps the rotation it had at 0 s.
+        assert!(free.angle_between(pinned) > 0.05, "the clip moves the forearm at {time} s");
+        let held = rotation_at(&harness, time);
+        assert!(held.angle_between(pinned) < 1e-9, "at {time} s: {held:?} vs {pinned:?}");
+    }
+}

@@ -185,7 +185,7 @@ fn the_readme_pictures_are_what_their_commands_render() {
         .lines()
         .filter(|line| line.starts_with("bonescope render ") && line.contains("--out assets/readme/"))
         .collect();
-    assert_eq!(commands.len(), 3, "the README shows three pictures' commands");
+    assert_eq!(commands.len(), 4, "the README shows four pictures' commands");
     let out = Path::new(env!("CARGO_TARGET_TMPDIR"));
     for command in commands {
         let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_owned).collect();

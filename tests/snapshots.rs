@@ -79,3 +79,36 @@ fn long_clip_envelopes() {
     harness.run_steps(8);
     harness.snapshot("long_clip_envelopes");
 }
+
+/// The Layers panel with a synced blend into the demo's bend, an additive bend and a shake on the forearm, and the
+/// viewport showing their sum over the unlayered clip (the ghost).
+#[test]
+fn demo_layers_blend_additive_shake() {
+    use bonescope::app::Ghost;
+    use bonescope::eval::Layers;
+    use bonescope::eval::layers::{Additive, Blend, Shake, ShakeParams};
+    let mut doc = Document::demo();
+    let forearm = doc.rig.skeleton.find("forearm").unwrap();
+    let layers = Layers {
+        blend: Some(Blend { clip: 1, weight: 0.5, sync: true, rotation: Default::default() }),
+        additive: Some(Additive { clip: 1, reference: Default::default(), order: Default::default(), weight: 0.5 }),
+        shake: Some(Shake { bone: forearm, params: ShakeParams::default() }),
+        ..Layers::default()
+    };
+    doc.set_layers(&layers).unwrap();
+    doc.ghost = Some(Ghost::Unlayered);
+    let mut settings = Settings { show_layers: true, show_inspector: false, ..Settings::default() };
+    settings.scene.boxes = true;
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_render_cursor(false)
+        .wgpu()
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    harness.state_mut().time = 0.4;
+    harness.get_by_label("forearm").click();
+    harness.step();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+    harness.run_steps(8);
+    harness.snapshot("demo_layers_blend_additive_shake");
+}

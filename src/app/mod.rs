@@ -7,6 +7,7 @@
 mod document;
 mod inspector;
 mod job;
+mod layers;
 mod notifications;
 mod outliner;
 mod plots;
@@ -137,6 +138,7 @@ pub struct BonescopeApp {
     outliner: outliner::Outliner,
     plots: plots::Plots,
     viewport: viewport::Viewport,
+    layers: layers::LayersPanel,
     spans: SpanCache,
 }
 
@@ -160,6 +162,7 @@ impl BonescopeApp {
             outliner: outliner::Outliner::default(),
             plots: plots::Plots::default(),
             viewport: viewport::Viewport::default(),
+            layers: layers::LayersPanel::default(),
             spans: SpanCache::default(),
         };
         app.document_replaced(true);
@@ -311,6 +314,11 @@ impl BonescopeApp {
                 if shared.settings.show_inspector {
                     egui::Panel::right("inspector").resizable(true).default_size(300.0).show(ui, |ui| {
                         inspector::ui(ui, &mut shared);
+                    });
+                }
+                if shared.settings.show_layers {
+                    egui::Panel::right("layers").resizable(true).default_size(290.0).show(ui, |ui| {
+                        self.layers.ui(ui, &mut shared);
                     });
                 }
                 egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));

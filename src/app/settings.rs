@@ -65,6 +65,8 @@ pub struct Settings {
     pub plot_model_space: bool,
     pub show_plots: bool,
     pub show_inspector: bool,
+    /// The Layers panel (runtime techniques on the clip).
+    pub show_layers: bool,
 }
 
 impl Default for Settings {
@@ -82,6 +84,7 @@ impl Default for Settings {
             plot_model_space: true,
             show_plots: true,
             show_inspector: true,
+            show_layers: false,
         }
     }
 }

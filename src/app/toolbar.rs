@@ -30,6 +30,9 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         mode_picker(ui, shared);
         ui.separator();
         ghost_picker(ui, shared);
+        ui.separator();
+        ui.toggle_value(&mut shared.settings.show_layers, "Layers")
+            .on_hover_text("blend, additive, crossfade, shake, targets, interpolation, bind pose, storage");
     });
 }
 
@@ -60,6 +63,7 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     ui.checkbox(&mut shared.settings.dark, "Dark theme");
     ui.checkbox(&mut shared.settings.show_plots, "Plots");
     ui.checkbox(&mut shared.settings.show_inspector, "Inspector");
+    ui.checkbox(&mut shared.settings.show_layers, "Layers");
     if ui.button("Frame all").clicked() {
         actions.frame_all = true;
     }

@@ -79,7 +79,7 @@ fn caption(shared: &Shared) -> Vec<String> {
     let mut lines =
         vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, settings.frame_rate), modes];
     let layers = doc.layers().summary(&doc.rig, doc.clip());
-    lines.extend((!layers.is_empty()).then_some(layers));
+    lines.extend(layers.split("; ").filter(|l| !l.is_empty()).map(str::to_owned));
     lines
 }
 
