@@ -204,3 +204,22 @@ fn the_readme_pictures_are_what_their_commands_render() {
         );
     }
 }
+
+/// ozz's blend sample on ProAnimationBank's mocap: walk and run synced at `a` = 0.5 play one cycle of
+/// (0.667 − 1.333)·0.5 + 1.333 = 1 s, so a sequence over two seconds repeats itself after one.
+#[test]
+fn a_synced_blend_sequence_repeats_with_the_blended_cycle() {
+    let dir = TempDir::new().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
+    let template = path(&dir, "blend_{frame}.png");
+    // No legend: its caption states the time, which does differ.
+    let args = ["--anim", "walk", "--blend", "run", "--weight", "0.5", "--sync", "--view", "side", "--show", "-legend"];
+    let out = succeeds(&bonescope(
+        &[&["render", arg(&file)], &args[..], &["--frames", "0:45:15", "--size", "320x180", "--out", arg(&template)]]
+            .concat(),
+    ));
+    let frame = |n: &str| std::fs::read(path(&dir, &format!("blend_{n}.png"))).unwrap();
+    assert!(frame("0000") == frame("0030"), "one cycle later the blend is where it started:\n{out}");
+    assert!(frame("0015") == frame("0045"));
+    assert!(frame("0000") != frame("0015"), "half a cycle later it is not");
+}
