@@ -5,7 +5,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use bonescope::analysis::{CurveRequest, ScanOptions, analyze};
+use bonescope::analysis::{CurveRequest, ScanOptions, Subject, analyze};
 use bonescope::app::{BonescopeApp, Document, Settings};
 use bonescope::eval::Hierarchy;
 use bonescope::import::stress_rig;
@@ -58,7 +58,14 @@ fn clip_analysis(c: &mut Criterion) {
     group.bench_function("500 bones, 100k frames, 8 curves (rayon, all cores)", |b| {
         b.iter(|| {
             let request = CurveRequest { bones: &plotted, ghost: None };
-            black_box(analyze(&rig.skeleton, rig.clips.first(), &hierarchy, request, &options, &|_, _| {}, &never))
+            black_box(analyze(
+                Subject::clip(&rig.skeleton, rig.clips.first()),
+                &hierarchy,
+                request,
+                &options,
+                &|_, _| {},
+                &never,
+            ))
         })
     });
     group.finish();

@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
-use bonescope::analysis::{Assessment, ScanOptions, Tolerances, sample_times, scan};
+use bonescope::analysis::{Assessment, ScanOptions, Subject, Tolerances, sample_times, scan};
 use bonescope::eval::{Hierarchy, Pose, sample_clip};
 use bonescope::math::decompose;
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
@@ -224,7 +224,8 @@ fn percent(part: usize, whole: usize) -> f64 {
 
 /// One line on the workload: how many bone-samples are sheared for real and how many can take the shortcut.
 fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
-    let summary = scan(&case.skeleton, Some(&case.clip), &case.hierarchy, &ScanOptions::default(), &|_, _| {});
+    let summary =
+        scan(Subject::clip(&case.skeleton, Some(&case.clip)), &case.hierarchy, &ScanOptions::default(), &|_, _| {});
     let stretched_bones = summary.bones.iter().filter(|b| b.stretched()).count();
     let stretched_samples: usize = summary.bones.iter().map(|b| b.flagged_samples).sum();
     let n = models.len();
@@ -270,10 +271,12 @@ fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
         })
     });
     group.bench_function("scan_1_thread", |b| {
-        b.iter(|| one_thread.install(|| black_box(scan(skeleton, clip, hierarchy, &options, &|_, _| {}))))
+        b.iter(|| {
+            one_thread.install(|| black_box(scan(Subject::clip(skeleton, clip), hierarchy, &options, &|_, _| {})))
+        })
     });
     group.bench_function("scan_parallel", |b| {
-        b.iter(|| black_box(scan(skeleton, clip, hierarchy, &options, &|_, _| {})))
+        b.iter(|| black_box(scan(Subject::clip(skeleton, clip), hierarchy, &options, &|_, _| {})))
     });
     if !parts {
         return group.finish();

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use bonescope::analysis::{ScanOptions, sample_times, scan};
+use bonescope::analysis::{ScanOptions, Subject, sample_times, scan};
 use bonescope::eval::Hierarchy;
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
 use glam::{DQuat, DVec3, Vec3};
@@ -41,7 +41,7 @@ fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end(
         last.fetch_max(done, Ordering::Relaxed);
     };
     let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
-    let result = scan(&skeleton, Some(&clip), &hierarchy, &options, &progress);
+    let result = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &options, &progress);
     assert_eq!(result.samples, 11);
     assert!(calls.load(Ordering::Relaxed) >= 1);
     assert_eq!(last.load(Ordering::Relaxed), 11, "progress reaches the total");
@@ -61,7 +61,7 @@ fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end(
 fn segment_compensation_removes_the_stretch() {
     let (skeleton, clip) = growing_parent();
     let hierarchy = Hierarchy::new(&skeleton, &[InheritMode::Full, InheritMode::SegmentCompensate]);
-    let result = scan(&skeleton, Some(&clip), &hierarchy, &ScanOptions::default(), &|_, _| {});
+    let result = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &ScanOptions::default(), &|_, _| {});
     assert!(result.bones.iter().all(|b| !b.stretched()));
 }
 
@@ -72,9 +72,15 @@ fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
     let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
     let never = std::sync::atomic::AtomicBool::new(false);
     let request = bonescope::analysis::CurveRequest { bones: &[1], ghost: None };
-    let analysis =
-        bonescope::analysis::analyze(&skeleton, Some(&clip), &hierarchy, request, &options, &|_, _| {}, &never)
-            .unwrap();
+    let analysis = bonescope::analysis::analyze(
+        Subject::clip(&skeleton, Some(&clip)),
+        &hierarchy,
+        request,
+        &options,
+        &|_, _| {},
+        &never,
+    )
+    .unwrap();
     assert_eq!(analysis.stretched_spans(Some(1)), vec![(0.1, 1.0)]);
     assert_eq!(analysis.stretched_spans(None), vec![(0.1, 1.0)]);
     assert!(analysis.stretched_spans(Some(0)).is_empty());

@@ -242,12 +242,25 @@ pub struct Layered<'a> {
     pub layers: &'a LayerStack,
 }
 
-/// What one analysis evaluates at each sample time.
-#[derive(Clone, Copy)]
-struct Subject<'a> {
-    skeleton: &'a Skeleton,
-    clip: Option<&'a Clip>,
-    layered: Option<Layered<'a>>,
+/// What an analysis evaluates at each sample time: a skeleton's clip (the rest pose for `None`), directly or through
+/// layers.
+#[derive(Clone, Copy, Debug)]
+pub struct Subject<'a> {
+    pub skeleton: &'a Skeleton,
+    pub clip: Option<&'a Clip>,
+    pub layered: Option<Layered<'a>>,
+}
+
+impl<'a> Subject<'a> {
+    /// The clip as sampled.
+    pub fn clip(skeleton: &'a Skeleton, clip: Option<&'a Clip>) -> Self {
+        Subject { skeleton, clip, layered: None }
+    }
+
+    /// The clip through layers (`clip` is their main clip).
+    pub fn layered(layered: Layered<'a>, clip: Option<&'a Clip>) -> Self {
+        Subject { skeleton: &layered.rig.skeleton, clip, layered: Some(layered) }
+    }
 }
 
 impl Subject<'_> {
@@ -282,64 +295,22 @@ struct ChunkResult {
     curves: Vec<Curves>,
 }
 
-/// Scans `clip` (or the rest pose) under `hierarchy`'s modes. `progress(done, total)` is called from worker
-/// threads as samples complete.
+/// Scans `subject` under `hierarchy`'s modes. `progress(done, total)` is called from worker threads as samples
+/// complete.
 pub fn scan(
-    skeleton: &Skeleton,
-    clip: Option<&Clip>,
+    subject: Subject,
     hierarchy: &Hierarchy,
     options: &ScanOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> ClipScan {
     let never = AtomicBool::new(false);
-    analyze(skeleton, clip, hierarchy, CurveRequest::default(), options, progress, &never)
-        .expect("an analysis that is never cancelled completes")
-        .scan
-}
-
-/// [`scan`] through layers: `clip` is the main clip of `layered.layers`.
-pub fn scan_layered(
-    layered: Layered,
-    clip: Option<&Clip>,
-    hierarchy: &Hierarchy,
-    options: &ScanOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> ClipScan {
-    let never = AtomicBool::new(false);
-    analyze_layered(layered, clip, hierarchy, CurveRequest::default(), options, progress, &never)
+    analyze(subject, hierarchy, CurveRequest::default(), options, progress, &never)
         .expect("an analysis that is never cancelled completes")
         .scan
 }
 
 /// The whole-clip analysis behind [`scan`] and the app's plots. Returns `None` when `cancel` was set.
 pub fn analyze(
-    skeleton: &Skeleton,
-    clip: Option<&Clip>,
-    hierarchy: &Hierarchy,
-    request: CurveRequest,
-    options: &ScanOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-    cancel: &AtomicBool,
-) -> Option<ClipAnalysis> {
-    let subject = Subject { skeleton, clip, layered: None };
-    analyze_subject(subject, hierarchy, request, options, progress, cancel)
-}
-
-/// [`analyze`] through layers: `clip` is the main clip of `layered.layers`.
-pub fn analyze_layered(
-    layered: Layered,
-    clip: Option<&Clip>,
-    hierarchy: &Hierarchy,
-    request: CurveRequest,
-    options: &ScanOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-    cancel: &AtomicBool,
-) -> Option<ClipAnalysis> {
-    let subject = Subject { skeleton: &layered.rig.skeleton, clip, layered: Some(layered) };
-    analyze_subject(subject, hierarchy, request, options, progress, cancel)
-}
-
-fn analyze_subject(
     subject: Subject,
     hierarchy: &Hierarchy,
     request: CurveRequest,

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
 use super::Ghost;
-use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, analyze, analyze_layered};
+use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, Subject, analyze};
 use crate::eval::{Hierarchy, LayerStack, Layers};
 use crate::model::{InheritMode, Rig};
 
@@ -111,13 +111,11 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
         };
         // The document checked the layers against this rig; without layers the plain analysis is the same.
         let stack = LayerStack::new(&rig, &job_key.layers).ok().filter(|_| !job_key.layers.is_empty());
-        let analysis = match &stack {
-            Some(layers) => {
-                let layered = Layered { rig: &rig, layers };
-                analyze_layered(layered, clip, &hierarchy, request, &options, &progress, &job_cancel)
-            }
-            None => analyze(&rig.skeleton, clip, &hierarchy, request, &options, &progress, &job_cancel),
+        let subject = match &stack {
+            Some(layers) => Subject::layered(Layered { rig: &rig, layers }, clip),
+            None => Subject::clip(&rig.skeleton, clip),
         };
+        let analysis = analyze(subject, &hierarchy, request, &options, &progress, &job_cancel);
         // The receiver may be gone (a newer job replaced this one): nothing to do then.
         let _ = sender.send(analysis);
         on_done();

@@ -12,7 +12,7 @@ use super::table::Table;
 use super::{EvalArgs, Format, ModeSet, ToleranceArgs};
 use crate::analysis::report::{AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
-use crate::analysis::{Layered, ScanOptions, compare, scan_layered};
+use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
 use crate::model::{Clip, Rig};
@@ -117,7 +117,7 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
     let file = path.display().to_string();
     let scanned = load_layered(path, args).map(|loaded| {
         loaded.each_clip(|layered, clip, hierarchy| {
-            let result = scan_layered(layered, clip, hierarchy, options, &|_, _| {});
+            let result = scan(Subject::layered(layered, clip), hierarchy, options, &|_, _| {});
             AnimationScan::new(&layered.rig.skeleton, clip, args.eval.inherit_label(), options.rate, result)
         })
     });

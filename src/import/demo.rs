@@ -210,13 +210,14 @@ mod tests {
     use glam::DMat4;
 
     use super::*;
-    use crate::analysis::{ScanOptions, scan};
+    use crate::analysis::{ScanOptions, Subject, scan};
     use crate::eval::Hierarchy;
 
     fn stretched_bones(clip: usize, mode: InheritMode) -> Vec<String> {
         let rig = demo_rig();
         let hierarchy = Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]);
-        let result = scan(&rig.skeleton, Some(&rig.clips[clip]), &hierarchy, &ScanOptions::default(), &|_, _| {});
+        let result =
+            scan(Subject::clip(&rig.skeleton, Some(&rig.clips[clip])), &hierarchy, &ScanOptions::default(), &|_, _| {});
         result.bones.iter().filter(|b| b.stretched()).map(|b| rig.skeleton.bone(b.index).name.clone()).collect()
     }
 
