@@ -179,13 +179,27 @@ impl AnimationScan {
     }
 }
 
-/// One file of `bonescope scan`: its clips, or why it could not be loaded.
+/// One file of `bonescope scan` (plain, `--compare-inherit` or `--storage`): a report per clip, or why the file
+/// could not be loaded.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FileScan {
+pub struct FileReport<T> {
     pub file: String,
     pub error: Option<String>,
-    pub animations: Vec<AnimationScan>,
+    pub animations: Vec<T>,
 }
+
+impl<T> FileReport<T> {
+    /// The reports of `file`'s clips, or the error that stopped them (in its alternate form, which for an
+    /// `anyhow::Error` lists the causes).
+    pub fn new(file: String, animations: Result<Vec<T>, impl std::fmt::Display>) -> Self {
+        match animations {
+            Ok(animations) => FileReport { file, error: None, animations },
+            Err(error) => FileReport { file, error: Some(format!("{error:#}")), animations: Vec::new() },
+        }
+    }
+}
+
+pub type FileScan = FileReport<AnimationScan>;
 
 /// One bone of `scan --compare-inherit`: its mode on each side and how far apart the two evaluations get.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -235,13 +249,7 @@ impl AnimationComparison {
     }
 }
 
-/// One file of `bonescope scan --compare-inherit`: its clips, or why it could not be loaded.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FileComparison {
-    pub file: String,
-    pub error: Option<String>,
-    pub animations: Vec<AnimationComparison>,
-}
+pub type FileComparison = FileReport<AnimationComparison>;
 
 /// `bonescope inspect --format json`: the report, the layers every sample was evaluated through (the default: none)
 /// and the skin joints whose bind matrix is not their rest model matrix.

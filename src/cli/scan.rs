@@ -10,7 +10,9 @@ use super::layers::LayerArgs;
 use super::options::parse_comparison;
 use super::table::Table;
 use super::{EvalArgs, Format, ModeSet, ToleranceArgs};
-use crate::analysis::report::{AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileScan};
+use crate::analysis::report::{
+    AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileReport, FileScan,
+};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
@@ -72,13 +74,7 @@ pub struct AnimationStorage {
     pub report: StorageReport,
 }
 
-/// One file of `scan --storage`.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct FileStorage {
-    pub file: String,
-    pub error: Option<String>,
-    pub animations: Vec<AnimationStorage>,
-}
+pub type FileStorage = FileReport<AnimationStorage>;
 
 pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     if !(args.rate >= 0.0 && args.rate.is_finite()) {
@@ -95,22 +91,36 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         return run_storage(args, &options);
     }
     let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, args, &options)).collect();
-    match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
-        Format::Table => print!("{}", render(&files)),
-    }
-    let failed = files.iter().any(|f| f.error.is_some());
+    let loaded = print_files(&files, args.format, render)?;
     let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
-    for file in files.iter().filter(|f| f.error.is_some()) {
-        eprintln!("error: {}", file.error.as_deref().unwrap_or_default());
-    }
-    Ok(if failed {
+    Ok(if !loaded {
         ExitCode::from(2)
     } else if stretched && args.fail_on_stretch {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// Prints the reports (JSON or the table) and, on standard error, every file's error; whether all loaded.
+fn print_files<T: serde::Serialize>(
+    files: &[FileReport<T>],
+    format: Format,
+    table: fn(&[FileReport<T>]) -> String,
+) -> anyhow::Result<bool> {
+    match format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(files)?),
+        Format::Table => print!("{}", table(files)),
+    }
+    for error in files.iter().filter_map(|f| f.error.as_deref()) {
+        eprintln!("error: {error}");
+    }
+    Ok(files.iter().all(|f| f.error.is_none()))
+}
+
+/// 0 when every file loaded, 2 when one did not.
+fn loaded_code(all_loaded: bool) -> ExitCode {
+    if all_loaded { ExitCode::SUCCESS } else { ExitCode::from(2) }
 }
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
@@ -121,10 +131,7 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
             AnimationScan::new(&layered.rig.skeleton, clip, args.eval.inherit_label(), options.rate, result)
         })
     });
-    match scanned {
-        Ok(animations) => FileScan { file, error: None, animations },
-        Err(error) => FileScan { file, error: Some(format!("{error:#}")), animations: Vec::new() },
-    }
+    FileReport::new(file, scanned)
 }
 
 /// A file loaded with its modes and layers resolved, and the clips `--anim` picks.
@@ -177,21 +184,10 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
                     report: storage_report(layered, clip, hierarchy, &storage),
                 })
             });
-            match measured {
-                Ok(animations) => FileStorage { file, error: None, animations },
-                Err(error) => FileStorage { file, error: Some(format!("{error:#}")), animations: Vec::new() },
-            }
+            FileReport::new(file, measured)
         })
         .collect();
-    match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
-        Format::Table => print!("{}", render_storage(&files)),
-    }
-    let failed: Vec<&str> = files.iter().filter_map(|f| f.error.as_deref()).collect();
-    for error in &failed {
-        eprintln!("error: {error}");
-    }
-    Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+    Ok(loaded_code(print_files(&files, args.format, render_storage)?))
 }
 
 fn render_storage(files: &[FileStorage]) -> String {
@@ -246,21 +242,10 @@ fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCo
         .iter()
         .map(|path| {
             let file = path.display().to_string();
-            match compare_animations(path, &args.eval, sides, args.rate) {
-                Ok(animations) => FileComparison { file, error: None, animations },
-                Err(error) => FileComparison { file, error: Some(format!("{error:#}")), animations: Vec::new() },
-            }
+            FileReport::new(file, compare_animations(path, &args.eval, sides, args.rate))
         })
         .collect();
-    match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&files)?),
-        Format::Table => print!("{}", render_comparisons(&files)),
-    }
-    let failed: Vec<&str> = files.iter().filter_map(|f| f.error.as_deref()).collect();
-    for error in &failed {
-        eprintln!("error: {error}");
-    }
-    Ok(if failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(2) })
+    Ok(loaded_code(print_files(&files, args.format, render_comparisons)?))
 }
 
 fn compare_animations(
