@@ -91,7 +91,7 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         return run_storage(args, &options);
     }
     let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, args, &options)).collect();
-    let loaded = print_files(&files, args.format, render)?;
+    let loaded = print_files(&files, args.format, render_animation)?;
     let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
     Ok(if !loaded {
         ExitCode::from(2)
@@ -102,15 +102,16 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-/// Prints the reports (JSON or the table) and, on standard error, every file's error; whether all loaded.
+/// Prints the reports (JSON, or per file its clips as `animation` renders them) and, on standard error, every
+/// file's error; whether all loaded.
 fn print_files<T: serde::Serialize>(
     files: &[FileReport<T>],
     format: Format,
-    table: fn(&[FileReport<T>]) -> String,
+    animation: fn(&str, &T) -> String,
 ) -> anyhow::Result<bool> {
     match format {
         Format::Json => println!("{}", serde_json::to_string_pretty(files)?),
-        Format::Table => print!("{}", table(files)),
+        Format::Table => print!("{}", render_files(files, animation)),
     }
     for error in files.iter().filter_map(|f| f.error.as_deref()) {
         eprintln!("error: {error}");
@@ -190,40 +191,26 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     Ok(loaded_code(print_files(&files, args.format, render_storage)?))
 }
 
-fn render_storage(files: &[FileStorage]) -> String {
-    let mut out = String::new();
-    for file in files {
-        if let Some(error) = &file.error {
-            out.push_str(&format!("{}\n  cannot load: {error}\n\n", file.file));
-            continue;
-        }
-        for a in &file.animations {
-            let r = &a.report;
-            let what = AnimationInfo::describe(a.animation.as_ref());
-            out.push_str(&format!(
-                "{}  {what}  {} frames × {} bones, inherit: {}\n",
-                file.file, r.frames, r.bones, a.inherit
-            ));
-            let marked: Vec<String> =
-                r.marked.iter().map(|m| format!("{} ({}/{} frames)", m.name, m.stretched_frames, r.frames)).collect();
-            let marked = if marked.is_empty() { "none".to_owned() } else { marked.join(", ") };
-            out.push_str(&format!("  marked (stretch channel): {marked}\n"));
-            let extra = r.bytes_with_stretch - r.bytes_trs;
-            let percent = if r.bytes_trs > 0 { 100.0 * extra as f64 / r.bytes_trs as f64 } else { 0.0 };
-            out.push_str(&format!(
-                "  bytes: plain TRS {}, with stretch channel {} (+{extra}, +{percent:.2} %)\n",
-                r.bytes_trs, r.bytes_with_stretch
-            ));
-            let mut table = Table::new(&[("error, model units", false), ("max", true), ("mean", true)]);
-            for (label, runtime) in
-                [("seed recomposition", &r.reconstruction), ("TRS only (stretch dropped)", &r.trs_only)]
-            {
-                error_rows(&mut table, label, runtime, r.probe_distance);
-            }
-            out.push_str(&table.to_string());
-            out.push('\n');
-        }
+fn render_storage(file: &str, a: &AnimationStorage) -> String {
+    let r = &a.report;
+    let what = AnimationInfo::describe(a.animation.as_ref());
+    let mut out = format!("{file}  {what}  {} frames × {} bones, inherit: {}\n", r.frames, r.bones, a.inherit);
+    let marked: Vec<String> =
+        r.marked.iter().map(|m| format!("{} ({}/{} frames)", m.name, m.stretched_frames, r.frames)).collect();
+    let marked = if marked.is_empty() { "none".to_owned() } else { marked.join(", ") };
+    out.push_str(&format!("  marked (stretch channel): {marked}\n"));
+    let extra = r.bytes_with_stretch - r.bytes_trs;
+    let percent = if r.bytes_trs > 0 { 100.0 * extra as f64 / r.bytes_trs as f64 } else { 0.0 };
+    out.push_str(&format!(
+        "  bytes: plain TRS {}, with stretch channel {} (+{extra}, +{percent:.2} %)\n",
+        r.bytes_trs, r.bytes_with_stretch
+    ));
+    let mut table = Table::new(&[("error, model units", false), ("max", true), ("mean", true)]);
+    for (label, runtime) in [("seed recomposition", &r.reconstruction), ("TRS only (stretch dropped)", &r.trs_only)] {
+        error_rows(&mut table, label, runtime, r.probe_distance);
     }
+    out.push_str(&table.to_string());
+    out.push('\n');
     out
 }
 
@@ -245,7 +232,7 @@ fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCo
             FileReport::new(file, compare_animations(path, &args.eval, sides, args.rate))
         })
         .collect();
-    Ok(loaded_code(print_files(&files, args.format, render_comparisons)?))
+    Ok(loaded_code(print_files(&files, args.format, render_comparison)?))
 }
 
 fn compare_animations(
@@ -272,56 +259,46 @@ fn compare_animations(
         .collect())
 }
 
-fn render_comparisons(files: &[FileComparison]) -> String {
-    let mut out = String::new();
-    for file in files {
-        if let Some(error) = &file.error {
-            out.push_str(&format!("{}\n  cannot load: {error}\n\n", file.file));
-            continue;
-        }
-        for comparison in &file.animations {
-            let what = AnimationInfo::describe(comparison.animation.as_ref());
-            out.push_str(&format!(
-                "{}  {what}  {} samples, {} against {}\n",
-                file.file, comparison.samples, comparison.a, comparison.b
-            ));
-            let mut table = Table::new(&[
-                ("bone", false),
-                ("A", false),
-                ("B", false),
-                ("max Δposition", true),
-                ("at s", true),
-                ("max Δorientation°", true),
-                ("at s", true),
-            ]);
-            for bone in &comparison.bones {
-                let d = &bone.difference;
-                table.row(vec![
-                    bone.name.clone(),
-                    bone.mode_a.id().to_owned(),
-                    bone.mode_b.id().to_owned(),
-                    format!("{:.6}", d.max_position_difference),
-                    format!("{:.4}", d.position_time),
-                    format!("{:.4}", d.max_orientation_difference_deg),
-                    format!("{:.4}", d.orientation_time),
-                ]);
-            }
-            out.push_str(&table.to_string());
-            out.push('\n');
-        }
+fn render_comparison(file: &str, comparison: &AnimationComparison) -> String {
+    let what = AnimationInfo::describe(comparison.animation.as_ref());
+    let mut out =
+        format!("{file}  {what}  {} samples, {} against {}\n", comparison.samples, comparison.a, comparison.b);
+    let mut table = Table::new(&[
+        ("bone", false),
+        ("A", false),
+        ("B", false),
+        ("max Δposition", true),
+        ("at s", true),
+        ("max Δorientation°", true),
+        ("at s", true),
+    ]);
+    for bone in &comparison.bones {
+        let d = &bone.difference;
+        table.row(vec![
+            bone.name.clone(),
+            bone.mode_a.id().to_owned(),
+            bone.mode_b.id().to_owned(),
+            format!("{:.6}", d.max_position_difference),
+            format!("{:.4}", d.position_time),
+            format!("{:.4}", d.max_orientation_difference_deg),
+            format!("{:.4}", d.orientation_time),
+        ]);
     }
+    out.push_str(&table.to_string());
+    out.push('\n');
     out
 }
 
-fn render(files: &[FileScan]) -> String {
+/// The table form: per file its clips, or why it could not be loaded.
+fn render_files<T>(files: &[FileReport<T>], animation: fn(&str, &T) -> String) -> String {
     let mut out = String::new();
     for file in files {
         if let Some(error) = &file.error {
             out.push_str(&format!("{}\n  cannot load: {error}\n\n", file.file));
             continue;
         }
-        for scan in &file.animations {
-            out.push_str(&render_animation(&file.file, scan));
+        for a in &file.animations {
+            out.push_str(&animation(&file.file, a));
         }
     }
     out
