@@ -236,7 +236,9 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
         .iter()
         .map(|name| rig.skeleton.find(name).with_context(|| format!("--select: no bone named `{name}`")))
         .collect::<anyhow::Result<Vec<usize>>>()?;
-    let mut settings = Settings { dark: args.theme == Theme::Dark, ..Settings::default() };
+    // With layers, the whole window shows the panel that describes them.
+    let show_layers = !doc.layers().is_empty();
+    let mut settings = Settings { dark: args.theme == Theme::Dark, show_layers, ..Settings::default() };
     settings.scene = args.show.unwrap_or_default();
     settings.camera.view = args.view;
     if let Some([yaw, pitch, _]) = args.camera {

@@ -325,11 +325,11 @@ fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette)
     }
 }
 
-/// Right-aligned lines in the top right corner.
+/// Right-aligned lines in the bottom right corner, clear of the legend at the top left however long they are.
 fn paint_caption(painter: &Painter, rect: Rect, caption: &[String], palette: &Palette) {
-    let mut at = Pos2::new(rect.max.x - 14.0, rect.min.y + 14.0);
-    for text in caption {
+    let mut at = Pos2::new(rect.max.x - 14.0, rect.max.y - 14.0);
+    for text in caption.iter().rev() {
         painter.text(at, Align2::RIGHT_CENTER, text, FontId::proportional(12.0), palette.text);
-        at.y += 17.0;
+        at.y -= 17.0;
     }
 }

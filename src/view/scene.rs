@@ -124,7 +124,7 @@ pub struct Scene<'a> {
     pub ghost: Option<Layer>,
     /// What the ghost is, for the legend.
     pub ghost_label: String,
-    /// Lines naming what is shown (file, clip, time, modes), drawn in a corner with the legend.
+    /// Lines naming what is shown (file, clip, time, modes, layers), drawn in the corner opposite the legend.
     pub caption: Vec<String>,
     /// Model matrices of the bind pose (from the skins' inverse bind matrices, the rest pose elsewhere).
     pub bind_pose: Option<Vec<DMat4>>,
