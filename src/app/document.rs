@@ -183,7 +183,26 @@ mod tests {
         let mut doc = Document::demo();
         doc.clip = Some(1);
         doc.set_mode(2, ModeScope::Bone, InheritMode::BlenderAligned);
+        let blend = crate::eval::layers::Blend { clip: 0, weight: 0.3, sync: true, rotation: Default::default() };
+        doc.set_layers(&Layers { blend: Some(blend), ..Layers::default() }).unwrap();
         let again = doc.reloaded(import::demo_rig());
         assert_eq!((again.clip, again.modes.clone(), again.ghost), (doc.clip, doc.modes.clone(), doc.ghost));
+        assert_eq!(again.layers(), doc.layers());
+        // A file that lost the blended clip keeps the document but drops the layers that no longer fit.
+        let mut one_clip = import::demo_rig();
+        one_clip.clips.truncate(1);
+        doc.set_layers(&Layers { blend: Some(crate::eval::layers::Blend { clip: 1, ..blend }), ..Layers::default() })
+            .unwrap();
+        assert!(doc.reloaded(one_clip).layers().is_empty());
+    }
+
+    #[test]
+    fn layers_naming_a_missing_clip_are_refused_and_the_old_ones_kept() {
+        let mut doc = Document::demo();
+        let before = doc.layers().clone();
+        let blend = crate::eval::layers::Blend { clip: 7, weight: 0.5, sync: false, rotation: Default::default() };
+        let error = doc.set_layers(&Layers { blend: Some(blend), ..Layers::default() }).unwrap_err();
+        assert!(error.to_string().contains("no animation 7"), "{error}");
+        assert_eq!(doc.layers(), &before);
     }
 }
