@@ -76,8 +76,11 @@ pub(crate) enum Span {
 }
 
 impl Span {
-    /// `times` is non-empty and strictly increasing (as [`Track`] guarantees).
-    pub(crate) fn locate(times: &[f64], time: f64) -> Span {
+    /// Where `time` falls in `times` (non-empty and strictly increasing, as [`Track`] guarantees), looking first at
+    /// segment `*hint` and the one after it (where a slightly earlier time fell), then searching; `*hint` becomes
+    /// the segment found. Increasing times, as a whole-clip scan visits them, then cost a comparison or two instead
+    /// of a binary search; any hint gives the same answer.
+    pub(crate) fn locate_near(times: &[f64], time: f64, hint: &mut usize) -> Span {
         let last = times.len() - 1;
         if time.is_nan() || time <= times[0] {
             return Span::Key(0);
@@ -86,7 +89,10 @@ impl Span {
             return Span::Key(last);
         }
         // times[k] ≤ time < times[k + 1]
-        let k = times.partition_point(|&t| t <= time) - 1;
+        let within = |k: usize| k < last && times[k] <= time && time < times[k + 1];
+        let k = [*hint, *hint + 1].into_iter().find(|&k| within(k));
+        let k = k.unwrap_or_else(|| times.partition_point(|&t| t <= time) - 1);
+        *hint = k;
         if times[k] == time {
             return Span::Key(k);
         }
@@ -102,8 +108,13 @@ pub(crate) fn key_value<T: Interpolate>(track: &Track<T>, k: usize) -> T::Wide {
 
 /// The track's value at `time` (seconds).
 pub fn sample_track<T: Interpolate>(track: &Track<T>, time: f64) -> T::Wide {
+    sample_track_near(track, time, &mut 0)
+}
+
+/// [`sample_track`], the key search starting at `*hint` (see [`Span::locate_near`]).
+pub(crate) fn sample_track_near<T: Interpolate>(track: &Track<T>, time: f64, hint: &mut usize) -> T::Wide {
     let value = |k: usize| key_value(track, k);
-    let (k, t) = match Span::locate(track.times(), time) {
+    let (k, t) = match Span::locate_near(track.times(), time, hint) {
         Span::Key(k) => return value(k),
         Span::Between { k, t } => (k, t),
     };
@@ -133,51 +144,70 @@ pub(crate) fn rest_pose_into(skeleton: &Skeleton, pose: &mut Vec<Transform>) {
     pose.extend(skeleton.bones().iter().map(|b| b.rest));
 }
 
-/// How each kind of track is read at a time: as authored ([`sample_track`]), or resampled by a layer.
+/// How each kind of track is read at a time: as authored ([`sample_track`]), or resampled by a layer. `hint` is
+/// where the track's key search starts (see [`Span::locate_near`]).
 pub(crate) trait TrackSampler {
-    fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3;
-    fn rotation(&self, track: &Track<Quat>, time: f64) -> DQuat;
+    fn vector(&self, track: &Track<Vec3>, time: f64, hint: &mut usize) -> DVec3;
+    fn rotation(&self, track: &Track<Quat>, time: f64, hint: &mut usize) -> DQuat;
 }
 
 /// Every track as its file says.
 struct Authored;
 
 impl TrackSampler for Authored {
-    fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3 {
-        sample_track(track, time)
+    fn vector(&self, track: &Track<Vec3>, time: f64, hint: &mut usize) -> DVec3 {
+        sample_track_near(track, time, hint)
     }
 
-    fn rotation(&self, track: &Track<Quat>, time: f64) -> DQuat {
-        sample_track(track, time)
+    fn rotation(&self, track: &Track<Quat>, time: f64, hint: &mut usize) -> DQuat {
+        sample_track_near(track, time, hint)
     }
 }
 
 /// Writes the local pose of every bone at `time` into `pose` (resized to the skeleton).
 pub fn sample_clip(skeleton: &Skeleton, clip: &Clip, time: f64, pose: &mut Vec<Transform>) {
-    sample_clip_with(skeleton, clip, time, &Authored, pose);
+    sample_clip_with(skeleton, clip, time, &Authored, pose, None);
 }
 
-/// [`sample_clip`] with each track read by `sampler`.
+/// [`sample_clip`] keeping in `hints` (when given) where each track's keys were found, so that sampling the same
+/// clip at a slightly later time next skips the key searches (a whole-clip scan walks its times in order).
+pub(crate) fn sample_clip_near(
+    skeleton: &Skeleton,
+    clip: &Clip,
+    time: f64,
+    pose: &mut Vec<Transform>,
+    hints: Option<&mut Vec<usize>>,
+) {
+    sample_clip_with(skeleton, clip, time, &Authored, pose, hints);
+}
+
+/// [`sample_clip`] with each track read by `sampler`, and with key hints (three per bone's tracks) when given.
 pub(crate) fn sample_clip_with(
     skeleton: &Skeleton,
     clip: &Clip,
     time: f64,
     sampler: &impl TrackSampler,
     pose: &mut Vec<Transform>,
+    mut hints: Option<&mut Vec<usize>>,
 ) {
     rest_pose_into(skeleton, pose);
-    for tracks in clip.tracks() {
+    if let Some(hints) = &mut hints {
+        hints.resize(3 * clip.tracks().len(), 0);
+    }
+    for (i, tracks) in clip.tracks().iter().enumerate() {
         let Some(local) = pose.get_mut(tracks.bone) else {
             continue;
         };
+        let mut fresh = [0; 3];
+        let hint = hints.as_deref_mut().map_or(&mut fresh[..], |h| &mut h[3 * i..3 * i + 3]);
         if let Some(track) = &tracks.translation {
-            local.translation = sampler.vector(track, time);
+            local.translation = sampler.vector(track, time, &mut hint[0]);
         }
         if let Some(track) = &tracks.rotation {
-            local.rotation = sampler.rotation(track, time);
+            local.rotation = sampler.rotation(track, time, &mut hint[1]);
         }
         if let Some(track) = &tracks.scale {
-            local.scale = sampler.vector(track, time);
+            local.scale = sampler.vector(track, time, &mut hint[2]);
         }
     }
 }
@@ -190,6 +220,26 @@ mod tests {
 
     fn vec_track(times: &[f64], values: &[[f32; 3]], interpolation: Interpolation) -> Track<Vec3> {
         Track::new(Arc::from(times), values.iter().map(|&v| Vec3::from(v)).collect(), interpolation).unwrap()
+    }
+
+    #[test]
+    fn a_key_hint_never_changes_the_value() {
+        let times: Vec<f64> = (0..50).map(|k| f64::from(k) * 0.1 + 0.03 * f64::from(k % 3)).collect();
+        let values: Vec<[f32; 3]> = (0..50).map(|k| [k as f32, (k * k) as f32, -(k as f32)]).collect();
+        for interpolation in [Interpolation::Step, Interpolation::Linear] {
+            let track = vec_track(&times, &values, interpolation);
+            // Forward in small steps (the scan's order), then jumps back and past the ends: every hint must end
+            // where a fresh search ends.
+            let mut queries: Vec<f64> = (0..700).map(|i| f64::from(i) * 0.01 - 0.5).collect();
+            queries.extend([3.3, 0.2, 6.0, -1.0, f64::NAN, 2.45, 2.45, times[17]]);
+            let mut hint = 0;
+            for &time in &queries {
+                let fresh = sample_track(&track, time);
+                let near = sample_track_near(&track, time, &mut hint);
+                assert!(fresh == near || (fresh.is_nan() && near.is_nan()), "{interpolation:?} at {time}");
+                assert!(hint < times.len(), "hint {hint} out of range");
+            }
+        }
     }
 
     #[test]

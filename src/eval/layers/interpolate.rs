@@ -15,7 +15,7 @@ use std::f64::consts::TAU;
 
 use glam::{DQuat, DVec3, EulerRot, Quat, Vec3};
 
-use super::super::sample::{Interpolate, Span, TrackSampler, hermite_basis, key_value, sample_track};
+use super::super::sample::{Interpolate, Span, TrackSampler, hermite_basis, key_value, sample_track_near};
 use crate::math::{nlerp, slerp};
 use crate::model::{Interpolation, Track};
 
@@ -60,11 +60,16 @@ impl Resampling {
 
     /// One track's value at `time`.
     pub fn sample<T: Channel>(&self, track: &Track<T>, time: f64) -> T::Wide {
+        self.sample_near(track, time, &mut 0)
+    }
+
+    /// [`Resampling::sample`], the key search starting at `*hint` (see `Span::locate_near`).
+    fn sample_near<T: Channel>(&self, track: &Track<T>, time: f64, hint: &mut usize) -> T::Wide {
         let segment = Segment::of(self.keys, track.interpolation());
         if segment == Segment::Hermite {
-            return sample_track(track, time);
+            return sample_track_near(track, time, hint);
         }
-        let (k, t) = match Span::locate(track.times(), time) {
+        let (k, t) = match Span::locate_near(track.times(), time, hint) {
             Span::Key(k) => return key_value(track, k),
             Span::Between { k, t } => (k, t),
         };
@@ -81,12 +86,12 @@ impl Resampling {
 }
 
 impl TrackSampler for Resampling {
-    fn vector(&self, track: &Track<Vec3>, time: f64) -> DVec3 {
-        self.sample(track, time)
+    fn vector(&self, track: &Track<Vec3>, time: f64, hint: &mut usize) -> DVec3 {
+        self.sample_near(track, time, hint)
     }
 
-    fn rotation(&self, track: &Track<Quat>, time: f64) -> DQuat {
-        self.sample(track, time)
+    fn rotation(&self, track: &Track<Quat>, time: f64, hint: &mut usize) -> DQuat {
+        self.sample_near(track, time, hint)
     }
 }
 
@@ -195,6 +200,7 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
+    use crate::eval::sample_track;
 
     fn x_track(times: &[f64], xs: &[f32], interpolation: Interpolation) -> Track<Vec3> {
         Track::new(Arc::from(times), xs.iter().map(|&x| Vec3::new(x, 0.0, 0.0)).collect(), interpolation).unwrap()

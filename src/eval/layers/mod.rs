@@ -34,7 +34,7 @@ pub use time::{SyncedCycle, TICKS_PER_SECOND};
 use glam::DQuat;
 
 use super::bind_pose;
-use super::sample::{rest_pose_into, sample_clip_with};
+use super::sample::{rest_pose_into, sample_clip_near, sample_clip_with};
 use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// A second clip blended with the main one.
@@ -161,6 +161,8 @@ pub struct LayerStack {
     modifiers: Vec<f64>,
     scratch: Vec<Transform>,
     chain: Vec<DQuat>,
+    /// Key-search hints of the main, blended, additive and incoming clips (see `sample_clip_near`).
+    hints: [Vec<usize>; 4],
 }
 
 impl LayerStack {
@@ -189,7 +191,7 @@ impl LayerStack {
                 let mut reference = Vec::new();
                 match additive.reference {
                     AdditiveReference::First => {
-                        sample(&rig.skeleton, Some(clip), 0.0, &layers.interpolation, &mut reference)
+                        sample(&rig.skeleton, Some(clip), 0.0, &layers.interpolation, &mut reference, None)
                     }
                     AdditiveReference::Rest => reference = rig.skeleton.rest_pose(),
                 }
@@ -206,7 +208,15 @@ impl LayerStack {
         let mut layers = layers.clone();
         layers.targets.sort_by_key(|t| t.bone);
         let bind = if unit_weight(layers.bind_weight) < 1.0 { bind_pose(rig) } else { Vec::new() };
-        Ok(LayerStack { layers, bind, reference, modifiers, scratch: Vec::new(), chain: Vec::new() })
+        Ok(LayerStack {
+            layers,
+            bind,
+            reference,
+            modifiers,
+            scratch: Vec::new(),
+            chain: Vec::new(),
+            hints: Default::default(),
+        })
     }
 
     pub fn layers(&self) -> &Layers {
@@ -239,20 +249,21 @@ impl LayerStack {
         let layers = &self.layers;
         let resampling = &layers.interpolation;
         let [main_time, blend_time] = self.synced_cycle(rig, clip).map_or([time, time], |c| c.clip_times(time));
-        sample(skeleton, clip, main_time, resampling, local);
+        let [main_hints, blend_hints, additive_hints, incoming_hints] = &mut self.hints;
+        sample(skeleton, clip, main_time, resampling, local, Some(main_hints));
         if !self.bind.is_empty() {
             mix_poses(local, &self.bind, 1.0 - unit_weight(layers.bind_weight), RotationBlend::Slerp);
         }
         if let Some(blend) = &layers.blend
             && let Some(other) = rig.clips.get(blend.clip)
         {
-            sample(skeleton, Some(other), blend_time, resampling, &mut self.scratch);
+            sample(skeleton, Some(other), blend_time, resampling, &mut self.scratch, Some(blend_hints));
             mix_poses(local, &self.scratch, blend.weight, blend.rotation);
         }
         if let Some(additive) = &layers.additive
             && let Some(other) = rig.clips.get(additive.clip)
         {
-            sample(skeleton, Some(other), time, resampling, &mut self.scratch);
+            sample(skeleton, Some(other), time, resampling, &mut self.scratch, Some(additive_hints));
             add_poses(local, &self.scratch, &self.reference, additive.weight, additive.order);
         }
         if let Some(crossfade) = &layers.crossfade
@@ -260,7 +271,8 @@ impl LayerStack {
         {
             let weight = crossfade.weight(time);
             if weight > 0.0 {
-                sample(skeleton, Some(incoming), crossfade.incoming_time(time), resampling, &mut self.scratch);
+                let at = crossfade.incoming_time(time);
+                sample(skeleton, Some(incoming), at, resampling, &mut self.scratch, Some(incoming_hints));
                 mix_poses(local, &self.scratch, weight, RotationBlend::Slerp);
             }
         }
@@ -271,11 +283,18 @@ impl LayerStack {
     }
 }
 
-/// `clip` sampled at `time` (the rest pose for `None`).
-fn sample(skeleton: &Skeleton, clip: Option<&Clip>, time: f64, resampling: &Resampling, out: &mut Vec<Transform>) {
+/// `clip` sampled at `time` (the rest pose for `None`), the key searches starting from `hints` when given.
+fn sample(
+    skeleton: &Skeleton,
+    clip: Option<&Clip>,
+    time: f64,
+    resampling: &Resampling,
+    out: &mut Vec<Transform>,
+    hints: Option<&mut Vec<usize>>,
+) {
     match clip {
-        Some(clip) if resampling.is_authored() => super::sample_clip(skeleton, clip, time, out),
-        Some(clip) => sample_clip_with(skeleton, clip, time, resampling, out),
+        Some(clip) if resampling.is_authored() => sample_clip_near(skeleton, clip, time, out, hints),
+        Some(clip) => sample_clip_with(skeleton, clip, time, resampling, out, hints),
         None => rest_pose_into(skeleton, out),
     }
 }
