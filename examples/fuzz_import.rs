@@ -18,73 +18,60 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use bonescope::import::{Format, Options, load_bytes_as};
-
-/// xorshift64*.
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 { 0 } else { (self.next() % n as u64) as usize }
-    }
-}
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 
 const ABSURD: &[&str] =
     &["4294967296", "4294967295", "-1", "0", "1e308", "-1e308", "nan", "inf", "99999999999999999999", "65536"];
 
-fn mutate(input: &mut Vec<u8>, seeds: &[Vec<u8>], noise: &mut Noise) {
-    for _ in 0..1 + noise.below(8) {
+fn mutate(input: &mut Vec<u8>, seeds: &[Vec<u8>], noise: &mut XorShiftRng) {
+    for _ in 0..1 + noise.random_range(0..8) {
         let len = input.len();
-        match noise.below(9) {
+        match noise.random_range(0..9) {
             0 | 1 if len > 0 => {
-                let at = noise.below(len);
-                input[at] ^= 1 << noise.below(8);
+                let at = noise.random_range(0..len);
+                input[at] ^= 1 << noise.random_range(0..8);
             }
             2 if len > 0 => {
-                let at = noise.below(len);
-                input[at] = noise.next() as u8;
+                let at = noise.random_range(0..len);
+                input[at] = noise.random::<u8>();
             }
             3 => {
-                let at = noise.below(len + 1);
-                input.insert(at, noise.next() as u8);
+                let at = noise.random_range(0..len + 1);
+                input.insert(at, noise.random::<u8>());
             }
             4 if len > 0 => {
-                let at = noise.below(len);
-                let end = (at + 1 + noise.below(64)).min(len);
+                let at = noise.random_range(0..len);
+                let end = (at + 1 + noise.random_range(0..64)).min(len);
                 input.drain(at..end);
             }
             5 if len >= 4 => {
                 // A 32-bit little-endian field (a count, an offset, a length) set to an extreme.
-                let at = noise.below(len - 3);
-                let value: u32 = [u32::MAX, 0x8000_0000, 0, 0xFFFF, noise.next() as u32][noise.below(5)];
+                let at = noise.random_range(0..len - 3);
+                let value: u32 = [u32::MAX, 0x8000_0000, 0, 0xFFFF, noise.random::<u32>()][noise.random_range(0..5)];
                 input[at..at + 4].copy_from_slice(&value.to_le_bytes());
             }
             6 if len > 0 => {
                 // A number in text replaced by an absurd one.
-                let at = noise.below(len);
+                let at = noise.random_range(0..len);
                 if let Some(start) = (at..len).find(|&i| input[i].is_ascii_digit()) {
                     let end = (start..len).find(|&i| !input[i].is_ascii_digit() && input[i] != b'.').unwrap_or(len);
-                    let absurd = ABSURD[noise.below(ABSURD.len())].as_bytes();
+                    let absurd = ABSURD[noise.random_range(0..ABSURD.len())].as_bytes();
                     input.splice(start..end, absurd.iter().copied());
                 }
             }
             7 if len > 0 => {
                 // A range duplicated, or spliced in from another seed.
-                let source = &seeds[noise.below(seeds.len())];
-                let from = if noise.below(2) == 0 || source.is_empty() { input.clone() } else { source.clone() };
-                let start = noise.below(from.len());
-                let end = (start + noise.below(256)).min(from.len());
-                let at = noise.below(len + 1);
+                let source = &seeds[noise.random_range(0..seeds.len())];
+                let from =
+                    if noise.random_range(0..2) == 0 || source.is_empty() { input.clone() } else { source.clone() };
+                let start = noise.random_range(0..from.len());
+                let end = (start + noise.random_range(0..256)).min(from.len());
+                let at = noise.random_range(0..len + 1);
                 input.splice(at..at, from[start..end].iter().copied());
             }
             _ => {
-                let keep = noise.below(len + 1);
+                let keep = noise.random_range(0..len + 1);
                 input.truncate(keep);
             }
         }
@@ -170,9 +157,9 @@ fn main() {
     }
 
     let deadline = Instant::now() + Duration::from_secs_f64(minutes * 60.0);
-    let mut noise = Noise(seed | 1);
+    let mut noise = XorShiftRng::seed_from_u64(seed);
     for _ in 0..skip {
-        let (_, original) = &seeds[noise.below(seeds.len())];
+        let (_, original) = &seeds[noise.random_range(0..seeds.len())];
         mutate(&mut original.clone(), &seed_bytes, &mut noise);
     }
     let (mut executions, mut loaded, mut panics, mut slow) = (skip, 0u64, 0u64, 0u64);
@@ -180,7 +167,7 @@ fn main() {
     let mut slowest = (Duration::ZERO, 0usize);
     println!("fuzzing {format} for {minutes} min from {} seeds (seed {seed}, skipping {skip} inputs)", seeds.len());
     while Instant::now() < deadline {
-        let (_, original) = &seeds[noise.below(seeds.len())];
+        let (_, original) = &seeds[noise.random_range(0..seeds.len())];
         let mut input = original.clone();
         mutate(&mut input, &seed_bytes, &mut noise);
         *running.lock().unwrap() = (input.clone(), Instant::now(), false);

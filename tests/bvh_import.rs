@@ -7,6 +7,8 @@ use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
 use bonescope::model::Rig;
 use glam::{DMat3, DMat4, DVec3};
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 
 fn asset(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path)
@@ -219,22 +221,6 @@ fn zero_frames_is_a_skeleton_without_animation() {
     assert_eq!(rig.skeleton.len(), 3);
 }
 
-/// xorshift64*: deterministic noise for mutations.
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
-
 #[test]
 fn every_prefix_and_random_mutations_fail_cleanly() {
     let bytes = std::fs::read(asset("bvh/rotation_first_root.bvh")).unwrap();
@@ -245,16 +231,16 @@ fn every_prefix_and_random_mutations_fail_cleanly() {
             assert_eq!(e.path, path);
         }
     }
-    let mut noise = Noise(0x2545_f491_4f6c_dd1d);
+    let mut noise = XorShiftRng::seed_from_u64(0x2545_f491_4f6c_dd1d);
     let alphabet = b" \t\r\n{}0123456789.-+eE:ROOTJOINTEndSiteOFFSETCHANNELSXYZrotationposition";
     for _ in 0..2000 {
         let mut mutated = bytes.clone();
-        for _ in 0..1 + noise.below(4) {
-            let at = noise.below(mutated.len());
-            match noise.below(3) {
-                0 => mutated[at] = alphabet[noise.below(alphabet.len())],
+        for _ in 0..1 + noise.random_range(0..4) {
+            let at = noise.random_range(0..mutated.len());
+            match noise.random_range(0..3) {
+                0 => mutated[at] = alphabet[noise.random_range(0..alphabet.len())],
                 1 => drop(mutated.remove(at)),
-                _ => mutated.insert(at, alphabet[noise.below(alphabet.len())]),
+                _ => mutated.insert(at, alphabet[noise.random_range(0..alphabet.len())]),
             }
         }
         let _ = import::load_bytes(path, &mutated);

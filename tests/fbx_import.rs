@@ -9,6 +9,8 @@ use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError, Options, Space};
 use bonescope::model::{InheritMode, Rig};
 use glam::{DMat4, DVec3};
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 
 fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
@@ -505,26 +507,10 @@ fn a_key_at_an_infinite_time_does_not_hang() {
     assert!(started.elapsed().as_secs() < 5, "took {:?}", started.elapsed());
 }
 
-/// xorshift64*: deterministic noise for mutations.
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
-
 #[test]
 fn random_byte_flips_never_panic() {
     let path = PathBuf::from("mutated.fbx");
-    let mut noise = Noise(0x9e37_79b9_7f4a_7c15);
+    let mut noise = XorShiftRng::seed_from_u64(0x9e37_79b9_7f4a_7c15);
     for file in [
         "fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx",
         "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
@@ -532,9 +518,9 @@ fn random_byte_flips_never_panic() {
         let original = std::fs::read(asset(file)).unwrap();
         for _ in 0..150 {
             let mut bytes = original.clone();
-            for _ in 0..1 + noise.below(8) {
-                let at = noise.below(bytes.len());
-                bytes[at] = noise.next() as u8;
+            for _ in 0..1 + noise.random_range(0..8) {
+                let at = noise.random_range(0..bytes.len());
+                bytes[at] = noise.random::<u8>();
             }
             if let Err(error) = import::load_bytes(&path, &bytes) {
                 assert_eq!(error.path, path);

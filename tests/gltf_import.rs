@@ -8,6 +8,8 @@ use base64::Engine as _;
 use bonescope::import::{self, ImportError};
 use bonescope::model::{Interpolation, Rig};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 use serde_json::{Value, json};
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -682,22 +684,6 @@ fn non_data_uri_schemes_are_refused() {
 // ---------------------------------------------------------------------------------------------------------------
 // Mutated files: any error is fine, a panic is not.
 
-/// A small deterministic generator (xorshift64*), enough to pick bytes and positions.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
-
 #[test]
 fn prefixes_of_a_glb_never_panic() {
     let dir = tempfile::tempdir().unwrap();
@@ -720,13 +706,13 @@ fn prefixes_of_a_glb_never_panic() {
 #[test]
 fn random_byte_flips_never_panic() {
     let dir = tempfile::tempdir().unwrap();
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut rng = XorShiftRng::seed_from_u64(0x9E37_79B9_7F4A_7C15);
     for (name, original) in [("f.glb", sample().glb()), ("f.gltf", sample().gltf())] {
         for _ in 0..1500 {
             let mut bytes = original.clone();
-            for _ in 0..1 + rng.below(4) {
-                let at = rng.below(bytes.len());
-                bytes[at] ^= 1 << rng.below(8);
+            for _ in 0..1 + rng.random_range(0..4) {
+                let at = rng.random_range(0..bytes.len());
+                bytes[at] ^= 1 << rng.random_range(0..8);
             }
             // Any outcome but a panic is fine: a flip inside key data may well still load.
             let _ = load_file(dir.path(), name, &bytes);
@@ -740,14 +726,14 @@ fn random_json_numbers_never_panic() {
     const INTERESTING: [f64; 14] =
         [0.0, 1.0, 2.0, 3.0, 4.0, 7.0, 64.0, 255.0, 4095.0, -1.0, 0.5, 2147483648.0, 4294967297.0, 1e19];
     let dir = tempfile::tempdir().unwrap();
-    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
+    let mut rng = XorShiftRng::seed_from_u64(0xD1B5_4A32_D192_ED03);
     let original = sample();
     let slots = count_numbers(&original.json);
     for i in 0..1500 {
         let mut sample = self::sample();
-        for _ in 0..1 + rng.below(3) {
-            let value = INTERESTING[rng.below(INTERESTING.len())];
-            set_number(&mut sample.json, &mut rng.below(slots), value);
+        for _ in 0..1 + rng.random_range(0..3) {
+            let value = INTERESTING[rng.random_range(0..INTERESTING.len())];
+            set_number(&mut sample.json, &mut rng.random_range(0..slots), value);
         }
         let bytes = if i % 2 == 0 { sample.glb() } else { sample.gltf() };
         let _ = load_file(dir.path(), if i % 2 == 0 { "n.glb" } else { "n.gltf" }, &bytes);
