@@ -22,27 +22,18 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3, Quat, Vec3};
 
 use super::ImportError;
+use super::failure::{Failure, Result};
 use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
 
 /// Reads a BVH file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8]) -> std::result::Result<Rig, ImportError> {
-    read(bytes).map_err(|f| ImportError::new(path, f.place, f.message))
+    read(bytes).map_err(|f| f.with_path(path))
 }
 
-/// What went wrong, and on which line.
-#[derive(Debug)]
-struct Failure {
-    place: Option<String>,
-    message: String,
+/// A problem on one line.
+fn on_line(line: usize, message: impl Into<String>) -> Failure {
+    Failure::at(format!("line {line}"), message)
 }
-
-impl Failure {
-    fn line(line: usize, message: impl Into<String>) -> Self {
-        Failure { place: Some(format!("line {line}")), message: message.into() }
-    }
-}
-
-type Result<T> = std::result::Result<T, Failure>;
 
 /// One degree of freedom a joint reads from each frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -157,7 +148,7 @@ fn words(line: &[u8]) -> Vec<String> {
 fn number(word: &str, line: usize, what: &str) -> Result<f64> {
     match word.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(Failure::line(line, format!("{what}: `{word}` is not a finite number"))),
+        _ => Err(on_line(line, format!("{what}: `{word}` is not a finite number"))),
     }
 }
 
@@ -203,7 +194,7 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
         let keyword = keyword.to_ascii_uppercase();
         if !seen_hierarchy {
             if keyword != "HIERARCHY" || words.len() > 1 {
-                return Err(Failure::line(line, "expected `HIERARCHY`"));
+                return Err(on_line(line, "expected `HIERARCHY`"));
             }
             seen_hierarchy = true;
             continue;
@@ -211,7 +202,7 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
         if let Some(joint) = pending
             && keyword != "{"
         {
-            return Err(Failure::line(line, format!("expected `{{` after `{}`", joints[joint].name)));
+            return Err(on_line(line, format!("expected `{{` after `{}`", joints[joint].name)));
         }
         match keyword.as_str() {
             "ROOT" | "JOINT" | "END" => {
@@ -220,7 +211,7 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
                 if let Some(p) = parent
                     && joints[p].end_site
                 {
-                    return Err(Failure::line(line, "an End Site cannot have children"));
+                    return Err(on_line(line, "an End Site cannot have children"));
                 }
                 let name = if end_site {
                     format!("{}_end", parent.map_or("", |p| joints[p].name.as_str()))
@@ -238,31 +229,31 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
             }
             "{" => {
                 let Some(joint) = pending.take() else {
-                    return Err(Failure::line(line, "`{` without a ROOT, JOINT or End Site before it"));
+                    return Err(on_line(line, "`{` without a ROOT, JOINT or End Site before it"));
                 };
                 if words.len() > 1 {
-                    return Err(Failure::line(line, format!("unexpected `{}` after `{{`", words[1])));
+                    return Err(on_line(line, format!("unexpected `{}` after `{{`", words[1])));
                 }
                 open.push(joint);
             }
             "}" => {
                 let Some(joint) = open.pop() else {
-                    return Err(Failure::line(line, "`}` without a matching `{`"));
+                    return Err(on_line(line, "`}` without a matching `{`"));
                 };
                 if joints[joint].offset.is_none() {
-                    return Err(Failure::line(line, format!("`{}` has no OFFSET", joints[joint].name)));
+                    return Err(on_line(line, format!("`{}` has no OFFSET", joints[joint].name)));
                 }
                 if words.len() > 1 {
-                    return Err(Failure::line(line, format!("unexpected `{}` after `}}`", words[1])));
+                    return Err(on_line(line, format!("unexpected `{}` after `}}`", words[1])));
                 }
             }
             "OFFSET" => {
                 let joint = current(&open, line, "OFFSET")?;
                 if joints[joint].offset.is_some() {
-                    return Err(Failure::line(line, format!("a second OFFSET for `{}`", joints[joint].name)));
+                    return Err(on_line(line, format!("a second OFFSET for `{}`", joints[joint].name)));
                 }
                 if words.len() != 4 {
-                    return Err(Failure::line(line, format!("OFFSET needs 3 numbers, found {}", words.len() - 1)));
+                    return Err(on_line(line, format!("OFFSET needs 3 numbers, found {}", words.len() - 1)));
                 }
                 let mut offset = DVec3::ZERO;
                 for axis in 0..3 {
@@ -273,42 +264,42 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
             "CHANNELS" => {
                 let joint = current(&open, line, "CHANNELS")?;
                 if joints[joint].end_site {
-                    return Err(Failure::line(line, "an End Site has no CHANNELS"));
+                    return Err(on_line(line, "an End Site has no CHANNELS"));
                 }
                 if !joints[joint].channels.is_empty() {
-                    return Err(Failure::line(line, format!("a second CHANNELS for `{}`", joints[joint].name)));
+                    return Err(on_line(line, format!("a second CHANNELS for `{}`", joints[joint].name)));
                 }
                 joints[joint].channels = channels(&words, line)?;
             }
             "MOTION" => {
                 if let Some(&joint) = open.last() {
-                    return Err(Failure::line(line, format!("MOTION before the `}}` of `{}`", joints[joint].name)));
+                    return Err(on_line(line, format!("MOTION before the `}}` of `{}`", joints[joint].name)));
                 }
                 if joints.is_empty() {
-                    return Err(Failure::line(line, "MOTION before any ROOT"));
+                    return Err(on_line(line, "MOTION before any ROOT"));
                 }
                 return Ok(joints);
             }
-            _ => return Err(Failure::line(line, format!("unexpected `{}` in the hierarchy", words[0]))),
+            _ => return Err(on_line(line, format!("unexpected `{}` in the hierarchy", words[0]))),
         }
     }
-    let place = Failure::line(lines.number, "the file ends before MOTION");
-    Err(if seen_hierarchy { place } else { Failure::line(lines.number, "empty file: expected `HIERARCHY`") })
+    let place = on_line(lines.number, "the file ends before MOTION");
+    Err(if seen_hierarchy { place } else { on_line(lines.number, "empty file: expected `HIERARCHY`") })
 }
 
 /// Checks a `ROOT name`, `JOINT name` or `End Site` line: whether it is an end site, and whether it ends in `{`.
 fn declaration(keyword: &str, words: &[String], at_top: bool, line: usize) -> Result<(bool, bool)> {
     let opens = words.len() > 1 && words[words.len() - 1] == "{";
     match keyword {
-        "ROOT" if !at_top => Err(Failure::line(line, "ROOT inside another joint")),
-        "JOINT" if at_top => Err(Failure::line(line, "JOINT outside any ROOT")),
+        "ROOT" if !at_top => Err(on_line(line, "ROOT inside another joint")),
+        "JOINT" if at_top => Err(on_line(line, "JOINT outside any ROOT")),
         "END" => {
             let site = words.get(1).is_some_and(|w| w.eq_ignore_ascii_case("site"));
             if !site || words.len() > 2 + usize::from(opens) {
-                return Err(Failure::line(line, "expected `End Site`"));
+                return Err(on_line(line, "expected `End Site`"));
             }
             if at_top {
-                return Err(Failure::line(line, "End Site outside any joint"));
+                return Err(on_line(line, "End Site outside any joint"));
             }
             Ok((true, opens))
         }
@@ -318,7 +309,7 @@ fn declaration(keyword: &str, words: &[String], at_top: bool, line: usize) -> Re
 
 /// The innermost open joint, which an `OFFSET` or `CHANNELS` line describes.
 fn current(open: &[usize], line: usize, what: &str) -> Result<usize> {
-    open.last().copied().ok_or_else(|| Failure::line(line, format!("{what} outside any joint")))
+    open.last().copied().ok_or_else(|| on_line(line, format!("{what} outside any joint")))
 }
 
 /// `CHANNELS n name…`: n names, at most six, none twice.
@@ -326,17 +317,17 @@ fn channels(words: &[String], line: usize) -> Result<Vec<Channel>> {
     let count = words.get(1).and_then(|w| w.parse::<usize>().ok());
     let Some(count) = count.filter(|&n| n <= 6) else {
         let found = words.get(1).map_or("nothing", String::as_str);
-        return Err(Failure::line(line, format!("CHANNELS needs a count from 0 to 6, found `{found}`")));
+        return Err(on_line(line, format!("CHANNELS needs a count from 0 to 6, found `{found}`")));
     };
     let names = &words[2..];
     if names.len() != count {
-        return Err(Failure::line(line, format!("CHANNELS {count} names {} channels", names.len())));
+        return Err(on_line(line, format!("CHANNELS {count} names {} channels", names.len())));
     }
     let mut channels = Vec::with_capacity(count);
     for name in names {
-        let channel = Channel::parse(name).ok_or_else(|| Failure::line(line, format!("unknown channel `{name}`")))?;
+        let channel = Channel::parse(name).ok_or_else(|| on_line(line, format!("unknown channel `{name}`")))?;
         if channels.contains(&channel) {
-            return Err(Failure::line(line, format!("channel {} listed twice", channel.name())));
+            return Err(on_line(line, format!("channel {} listed twice", channel.name())));
         }
         channels.push(channel);
     }
@@ -355,20 +346,19 @@ fn read_motion_header(lines: &mut Lines) -> Result<(u64, f64, usize)> {
             let (key, value) = text.split_once(':').unwrap_or((text, ""));
             let key: Vec<&str> = key.split_ascii_whitespace().collect();
             if !key.join(" ").eq_ignore_ascii_case(name) {
-                return Err(Failure::line(line, format!("expected `{name}:`")));
+                return Err(on_line(line, format!("expected `{name}:`")));
             }
             return Ok((value.trim().to_owned(), line));
         }
-        Err(Failure::line(lines.number, format!("the file ends before `{name}:`")))
+        Err(on_line(lines.number, format!("the file ends before `{name}:`")))
     };
     let (frames, line) = next_field("Frames")?;
-    let frames = frames
-        .parse::<u64>()
-        .map_err(|_| Failure::line(line, format!("Frames: `{frames}` is not a whole number ≥ 0")))?;
+    let frames =
+        frames.parse::<u64>().map_err(|_| on_line(line, format!("Frames: `{frames}` is not a whole number ≥ 0")))?;
     let (frame_time, line) = next_field("Frame Time")?;
     let frame_time = number(&frame_time, line, "Frame Time")?;
     if frame_time <= 0.0 {
-        return Err(Failure::line(line, format!("Frame Time must be above 0, found {frame_time}")));
+        return Err(on_line(line, format!("Frame Time must be above 0, found {frame_time}")));
     }
     Ok((frames, frame_time, line))
 }
@@ -393,28 +383,28 @@ fn read_frames(lines: &mut Lines, joints: &[Joint], frames: u64, header_line: us
         let frame = read - 1;
         if read > frames {
             let message = format!("frame {frame} is beyond the {frames} frames the header declares");
-            return Err(Failure::line(line, message));
+            return Err(on_line(line, message));
         }
         let before = values.len();
         for word in text.split_ascii_whitespace() {
             if values.len() - before == per_frame {
                 // Too many numbers: count them all for the message.
                 let found = text.split_ascii_whitespace().count();
-                return Err(Failure::line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
+                return Err(on_line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
             }
             match word.parse::<f64>() {
                 Ok(v) if v.is_finite() => values.push(v),
-                _ => return Err(Failure::line(line, format!("frame {frame}: `{word}` is not a finite number"))),
+                _ => return Err(on_line(line, format!("frame {frame}: `{word}` is not a finite number"))),
             }
         }
         let found = values.len() - before;
         if found != per_frame {
-            return Err(Failure::line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
+            return Err(on_line(line, format!("frame {frame}: {found} numbers, expected {per_frame}")));
         }
     }
     if read < frames {
         let message = format!("the file ends after {read} frames, but the header declares {frames}");
-        return Err(Failure::line(last_line, message));
+        return Err(on_line(last_line, message));
     }
     Ok((frames > 0).then_some(values))
 }
@@ -451,7 +441,7 @@ fn skeleton(joints: &[Joint]) -> Result<Skeleton> {
         })
         .collect();
     // Cannot fail: a joint is declared after its parent.
-    Skeleton::new(bones).map_err(|e| Failure { place: None, message: e.to_string() })
+    Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))
 }
 
 /// One clip: a LINEAR translation and/or rotation track per joint with channels, one key per frame.
@@ -478,7 +468,7 @@ fn clip(joints: &[Joint], values: &[f64], frames: usize, frame_time: f64) -> Res
             }
         }
         first += count;
-        let track_error = |e| Failure::line(joint.line, format!("`{}`: {e}", joint.name));
+        let track_error = |e| on_line(joint.line, format!("`{}`: {e}", joint.name));
         let mut bone = BoneTracks::new(index);
         if joint.has_position() {
             bone.translation =

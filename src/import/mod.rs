@@ -6,6 +6,7 @@
 
 mod bvh;
 mod demo;
+mod failure;
 mod fbx;
 mod gltf;
 

@@ -25,26 +25,16 @@ mod scene;
 
 use std::path::Path;
 
+use super::failure::{Failure, Result};
 use super::{ImportError, Options, Space};
 use crate::model::Rig;
 
 /// Reads an FBX file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
-    read(bytes, options).map_err(|f| ImportError::new(path, f.place, f.message))
-}
-
-/// What went wrong, and where (an element of the scene, or ufbx's own account of where parsing stopped).
-#[derive(Debug)]
-struct Failure {
-    place: Option<String>,
-    message: String,
+    read(bytes, options).map_err(|f| f.with_path(path))
 }
 
 impl Failure {
-    fn at(place: impl Into<String>, message: impl Into<String>) -> Self {
-        Failure { place: Some(place.into()), message: message.into() }
-    }
-
     /// A ufbx error: its description as the message, its innermost frames as the place.
     fn ufbx(error: &ufbx::Error, place: Option<String>) -> Self {
         let mut message = error.description.to_string();
@@ -71,8 +61,6 @@ impl Failure {
         Failure { place, message }
     }
 }
-
-type Result<T> = std::result::Result<T, Failure>;
 
 /// The memory ufbx may use for one file of `file_size` bytes: generous for real files (a compressed binary FBX
 /// expands several times, and ufbx keeps both the parse tree and the scene), bounded for hostile ones.

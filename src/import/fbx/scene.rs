@@ -56,7 +56,7 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
     if unreached > 0 {
         notes.push(format!("{unreached} nodes outside the root's hierarchy are not bones"));
     }
-    let skeleton = Skeleton::new(bones).map_err(|e| Failure { place: None, message: e.to_string() })?;
+    let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
     Ok(SceneBones { skeleton, bone_of_node })
 }
 

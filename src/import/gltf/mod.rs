@@ -17,30 +17,11 @@ use std::path::Path;
 use super::ImportError;
 use crate::model::Rig;
 
-/// What went wrong, and where in the document; [`load`] adds the file's path.
-#[derive(Debug)]
-struct Failure {
-    place: Option<String>,
-    message: String,
-}
-
-impl Failure {
-    /// A problem with a named part of the document.
-    fn at(place: impl Into<String>, message: impl Into<String>) -> Self {
-        Failure { place: Some(place.into()), message: message.into() }
-    }
-
-    /// A problem with the file as a whole.
-    fn whole(message: impl Into<String>) -> Self {
-        Failure { place: None, message: message.into() }
-    }
-}
-
-type Result<T> = std::result::Result<T, Failure>;
+use super::failure::{Failure, Result};
 
 /// Reads a glTF 2.0 file (its bytes already in memory; external buffers are read from beside `path`).
 pub fn load(path: &Path, bytes: &[u8]) -> std::result::Result<Rig, ImportError> {
-    read(path, bytes).map_err(|f| ImportError::new(path, f.place, f.message))
+    read(path, bytes).map_err(|f| f.with_path(path))
 }
 
 fn read(path: &Path, bytes: &[u8]) -> Result<Rig> {
