@@ -1,25 +1,54 @@
 //! The Layers panel: the runtime techniques layered on the clip (bind weight, interpolation, blend, additive,
 //! crossfade, shake, targets), the bind pose check and the stretch-quaternion storage report.
 //!
-//! A technique's section starts open when its layer is on. Edits go to a copy of the document's layers; the document takes the copy at the end of the frame (it checks every
-//! clip and bone index, so a bad combination is reported, not applied).
+//! A technique's section starts open when its layer is on. Edits go to a copy of the document's layers; the
+//! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
+//! reported, not applied).
+
+use std::sync::mpsc::Receiver;
 
 use clap::ValueEnum;
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
-use super::{Ghost, Shared};
+use super::{Document, Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{BindMismatch, BindTolerance, Layered, bind_mismatches};
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
 use crate::eval::{Hierarchy, Layers};
-use crate::model::{Rig, Skeleton, Transform};
+use crate::model::{InheritMode, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
 /// The panel's own state: results computed on request, kept while they still describe the document.
 #[derive(Default)]
 pub struct LayersPanel {
-    storage: Option<(Layers, Option<usize>, StorageReport)>,
+    storage: Option<Measurement>,
+}
+
+/// A storage report of one document state: measured off the UI thread (it walks the whole clip), then kept.
+struct Measurement {
+    of: (Layers, Option<usize>, Vec<InheritMode>),
+    result: Receiver<StorageReport>,
+    report: Option<StorageReport>,
+}
+
+impl Measurement {
+    fn start(doc: &Document, ctx: egui::Context) -> Self {
+        let (rig, layers, clip, modes) = (doc.rig.clone(), doc.layer_stack().clone(), doc.clip, doc.modes.clone());
+        let (sender, result) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
+            let layered = Layered { rig: &rig, layers: &layers };
+            let clip = clip.and_then(|c| rig.clips.get(c));
+            let _ = sender.send(storage_report(layered, clip, &hierarchy, &StorageOptions::default()));
+            ctx.request_repaint();
+        });
+        Measurement { of: Self::key(doc), result, report: None }
+    }
+
+    fn key(doc: &Document) -> (Layers, Option<usize>, Vec<InheritMode>) {
+        (doc.layers().clone(), doc.clip, doc.modes.clone())
+    }
 }
 
 impl LayersPanel {
@@ -43,21 +72,29 @@ impl LayersPanel {
         }
     }
 
-    /// The seed's runtime format for the current clip, computed when asked (it walks the whole clip).
+    /// The seed's runtime format for the current clip, measured when asked, off the UI thread.
     fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
         CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
             let doc = &*shared.doc;
-            let current = |(layers, clip, _): &(Layers, Option<usize>, StorageReport)| {
-                layers == doc.layers() && *clip == doc.clip
-            };
             if ui.button("Measure the clip").clicked() {
-                let hierarchy = Hierarchy::new(&doc.rig.skeleton, &doc.modes);
-                let layered = Layered { rig: &doc.rig, layers: doc.layer_stack() };
-                let report = storage_report(layered, doc.clip(), &hierarchy, &StorageOptions::default());
-                self.storage = Some((doc.layers().clone(), doc.clip, report));
+                self.storage = Some(Measurement::start(doc, ui.ctx().clone()));
             }
-            match self.storage.as_ref().filter(|s| current(s)) {
-                Some((_, _, report)) => storage_table(ui, report),
+            let current = self.storage.as_mut().filter(|m| m.of == Measurement::key(doc));
+            match current {
+                Some(m) => {
+                    if let Ok(report) = m.result.try_recv() {
+                        m.report = Some(report);
+                    }
+                    match &m.report {
+                        Some(report) => storage_table(ui, report),
+                        None => {
+                            ui.horizontal(|ui| {
+                                ui.spinner();
+                                ui.label("measuring the clip…");
+                            });
+                        }
+                    }
+                }
                 None => {
                     ui.label(RichText::new("Marks the bones stretched in any frame and prices their channel.").weak());
                 }
