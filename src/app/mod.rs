@@ -228,7 +228,7 @@ impl BonescopeApp {
             })
         });
         if frame_camera {
-            self.viewport.frame_all(&self.doc, &mut self.settings.camera);
+            self.viewport.frame_all(&self.doc);
         }
         self.time = self.time.clamp(0.0, self.doc.duration());
     }
@@ -252,6 +252,12 @@ impl BonescopeApp {
         let mut bones: Vec<usize> = self.selection[skip..].to_vec();
         bones.sort_unstable();
         bones
+    }
+
+    /// Frames the document now, for a viewport of this aspect ratio, instead of at the next frame (headless
+    /// renders that then set the camera's distance themselves).
+    pub fn frame_now(&mut self, aspect: f64) {
+        self.viewport.frame_now(&mut self.settings.camera, aspect);
     }
 
     /// Waits for the background analysis to finish (for tests and headless renders).
@@ -339,7 +345,7 @@ impl BonescopeApp {
             self.open_demo();
         }
         if actions.frame_all {
-            self.viewport.frame_all(&self.doc, &mut self.settings.camera);
+            self.viewport.frame_all(&self.doc);
         }
         if actions.clip_changed {
             self.time = 0.0;

@@ -18,13 +18,21 @@ pub struct Viewport {
     /// Paint no background: headless renders put it behind the picture after reading it back, because a
     /// window-sized fill costs the software rasteriser as much as everything else it draws together.
     pub transparent: bool,
+    /// Bounds to frame once the canvas knows its shape (framing fits them to the aspect ratio).
+    framing: Option<Bounds>,
 }
 
 impl Viewport {
-    /// Frames the whole motion of the current clip.
-    pub fn frame_all(&self, doc: &Document, camera: &mut Camera) {
-        if let Some(bounds) = motion_bounds(&doc.rig, doc.clip(), &doc.modes, MOTION_SAMPLES) {
-            camera.frame(&bounds);
+    /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
+    pub fn frame_all(&mut self, doc: &Document) {
+        let pose_at = |time| doc.evaluate(&doc.modes, time, true).model.model;
+        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.duration(), MOTION_SAMPLES, pose_at);
+    }
+
+    /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
+    pub fn frame_now(&mut self, camera: &mut Camera, aspect: f64) {
+        if let Some(bounds) = self.framing.take() {
+            camera.frame(&bounds, aspect);
         }
     }
 
@@ -47,6 +55,7 @@ impl Viewport {
         if shared.settings.scene.bind_pose {
             scene.bind_pose = Some(bind_model_matrices(&rig));
         }
+        self.frame_now(&mut shared.settings.camera, aspect(rect));
         navigate(ui, &response, rect, &mut shared.settings.camera);
         if response.clicked()
             && let Some(at) = response.interact_pointer_pos()
@@ -59,7 +68,7 @@ impl Viewport {
             }
         }
         if response.hovered() && ui.input(|i| i.key_pressed(egui::Key::F)) {
-            frame_selection(&scene, shared.selection, &mut shared.settings.camera);
+            frame_selection(&scene, shared.selection, &mut shared.settings.camera, aspect(rect));
         }
         let camera = &shared.settings.camera;
         let mut palette = Palette::new(ui.visuals().dark_mode);
@@ -101,11 +110,15 @@ fn navigate(ui: &Ui, response: &egui::Response, rect: egui::Rect, camera: &mut C
     }
 }
 
-fn frame_selection(scene: &Scene, selection: &[usize], camera: &mut Camera) {
+fn frame_selection(scene: &Scene, selection: &[usize], camera: &mut Camera, aspect: f64) {
     let selected = Bounds::of(selection.iter().map(|&b| scene.primary.head(b)));
     if let Some(bounds) = selected.filter(|_| !selection.is_empty()).or_else(|| scene.bounds()) {
-        camera.frame(&bounds);
+        camera.frame(&bounds, aspect);
     }
+}
+
+fn aspect(rect: egui::Rect) -> f64 {
+    f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0))
 }
 
 fn toolbar(ui: &mut Ui, shared: &mut Shared) {

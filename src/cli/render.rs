@@ -246,6 +246,8 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
     }
     let mut app = BonescopeApp::new(settings, doc);
     if let Some([_, _, distance]) = args.camera {
+        // Frame first (for the target), then take the asked distance.
+        app.frame_now(f64::from(args.size.0) / f64::from(args.size.1.max(1)));
         app.settings.camera.distance = distance;
     }
     app.selection = selection;

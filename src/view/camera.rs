@@ -79,6 +79,18 @@ impl Bounds {
     pub fn radius(&self) -> f64 {
         ((self.max - self.min).length() * 0.5).max(0.01)
     }
+
+    /// The eight corners.
+    pub fn corners(&self) -> [DVec3; 8] {
+        let (min, max) = (self.min, self.max);
+        std::array::from_fn(|i| {
+            DVec3::new(
+                if i & 1 == 0 { min.x } else { max.x },
+                if i & 2 == 0 { min.y } else { max.y },
+                if i & 4 == 0 { min.z } else { max.z },
+            )
+        })
+    }
 }
 
 /// Where the camera looks from. Angles in radians; `distance` in model units.
@@ -103,17 +115,29 @@ impl Default for Camera {
 const FOV_Y: f64 = 0.8;
 
 impl Camera {
-    /// A camera with this view and angles that frames `bounds`.
-    pub fn framing(view: ViewKind, yaw: f64, pitch: f64, bounds: &Bounds) -> Self {
-        let mut camera = Camera { view, yaw, pitch, ..Camera::default() };
-        camera.frame(bounds);
-        camera
-    }
-
-    /// Moves the target to the centre of `bounds` and the eye back until they fit.
-    pub fn frame(&mut self, bounds: &Bounds) {
+    /// Moves the target to the centre of `bounds` and the eye back (or, in a 2D view, the zoom out) until every
+    /// corner of them is inside a viewport of this aspect ratio (width / height), with a margin: the whole box
+    /// fills the picture along its tighter side, whatever the view direction.
+    pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
+        const MARGIN: f64 = 1.15;
         self.target = bounds.center();
-        self.distance = bounds.radius() / (FOV_Y * 0.5).tan() * 1.15;
+        let (back, up) = self.eye_direction();
+        let right = up.cross(back).normalize();
+        let up = back.cross(right);
+        let tan_y = (FOV_Y * 0.5).tan();
+        let tan_x = tan_y * aspect.max(1e-3);
+        let needed = bounds.corners().into_iter().map(|corner| {
+            let d = corner - self.target;
+            let (x, y) = (d.dot(right).abs() * MARGIN / tan_x, d.dot(up).abs() * MARGIN / tan_y);
+            match self.view {
+                // The corner's depth in front of the eye, `distance − z`, must see it within the field of view.
+                ViewKind::Persp => d.dot(back) + x.max(y),
+                // 2D views show `distance·tan(fov/2)` either side of the target.
+                _ => x.max(y),
+            }
+        });
+        // At least a centimetre in view, so a single point still frames.
+        self.distance = needed.fold(0.01 * MARGIN / tan_y, f64::max);
     }
 
     /// Direction from the target to the eye, and up.
@@ -227,17 +251,23 @@ mod tests {
     #[test]
     fn framing_puts_the_bounds_in_view() {
         let bounds = Bounds { min: DVec3::new(-3.0, 0.0, -1.0), max: DVec3::new(5.0, 2.0, 1.0) };
-        let camera = Camera::framing(ViewKind::Persp, 0.6, 0.35, &bounds);
-        let p = projection(&camera);
-        for corner in 0..8 {
-            let pick = |bit: usize, lo: f64, hi: f64| if corner & bit == 0 { lo } else { hi };
-            let c = DVec3::new(
-                pick(1, bounds.min.x, bounds.max.x),
-                pick(2, bounds.min.y, bounds.max.y),
-                pick(4, bounds.min.z, bounds.max.z),
-            );
-            let (s, _) = p.project(c).unwrap();
-            assert!((-1.0..=201.0).contains(&s.x) && (-1.0..=101.0).contains(&s.y), "{c} → {s}");
+        for view in ViewKind::ALL {
+            let mut camera = Camera { view, yaw: 0.6, pitch: 0.35, ..Camera::default() };
+            camera.frame(&bounds, 2.0);
+            let p = projection(&camera);
+            let screen: Vec<DVec2> = bounds.corners().into_iter().map(|c| p.project(c).unwrap().0).collect();
+            for s in &screen {
+                assert!((0.0..=200.0).contains(&s.x) && (0.0..=100.0).contains(&s.y), "{view:?}: {s}");
+            }
+            // Tight: along one side of the picture the box spans most of it (the margin is 15 %; in perspective the
+            // near corners reach the edge while the far ones, smaller, stop short of the other).
+            let span = |f: fn(&DVec2) -> f64| {
+                let values: Vec<f64> = screen.iter().map(f).collect();
+                values.iter().copied().fold(f64::MIN, f64::max) - values.iter().copied().fold(f64::MAX, f64::min)
+            };
+            let filled = (span(|s| s.x) / 200.0).max(span(|s| s.y) / 100.0);
+            let tight = if view == ViewKind::Persp { 0.6 } else { 0.85 };
+            assert!(filled > tight, "{view:?}: the box fills only {filled} of the picture");
         }
         assert!(Bounds::of([DVec3::NAN]).is_none());
     }

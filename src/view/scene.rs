@@ -5,8 +5,8 @@ use glam::{DMat4, DVec3};
 
 use super::camera::Bounds;
 use crate::analysis::{Assessment, Findings, Tolerances};
-use crate::eval::{Hierarchy, Pose, skin_meshes};
-use crate::model::{Clip, InheritMode, Rig};
+use crate::eval::skin_meshes;
+use crate::model::{Clip, Rig};
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -193,23 +193,28 @@ fn gizmo_size(rig: &Rig) -> f64 {
     lengths.get(lengths.len() / 2).map_or_else(|| rest_bounds(rig).map_or(0.1, |b| b.radius() * 0.1), |l| l * 0.4)
 }
 
-/// The bounds of the whole motion: the clip sampled at `samples` evenly spaced times (the rest pose without a
-/// clip), so a camera framed on it does not need to move while the clip plays. Only the bones that matter count
-/// (see [`framed_bones`]), and the skinned meshes.
-pub fn motion_bounds(rig: &Rig, clip: Option<&Clip>, modes: &[InheritMode], samples: usize) -> Option<Bounds> {
-    let duration = clip.map_or(0.0, Clip::duration);
-    let hierarchy = Hierarchy::new(&rig.skeleton, modes);
+/// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `duration` by `pose_at`
+/// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
+/// matter count (see [`framed_bones`]), and the skinned meshes; the bounds grow by the size of the axis triads and
+/// boxes drawn around the joints.
+pub fn motion_bounds(
+    rig: &Rig,
+    clip: Option<&Clip>,
+    duration: f64,
+    samples: usize,
+    mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
+) -> Option<Bounds> {
     let framed = framed_bones(rig, clip);
-    let mut pose = Pose::default();
-    (0..samples.max(1))
+    let bounds = (0..samples.max(1))
         .filter_map(|i| {
-            let time = duration * i as f64 / (samples.max(2) - 1) as f64;
-            pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
-            let meshes = skin_meshes(rig, &pose.model.model);
-            let heads = pose.model.model.iter().zip(&framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
+            let model = pose_at(duration * i as f64 / (samples.max(2) - 1) as f64);
+            let meshes = skin_meshes(rig, &model);
+            let heads = model.iter().zip(&framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
             Bounds::of(heads.chain(meshes.into_iter().flatten()))
         })
-        .reduce(Bounds::union)
+        .reduce(Bounds::union)?;
+    let gizmo = DVec3::splat(gizmo_size(rig));
+    Some(Bounds { min: bounds.min - gizmo, max: bounds.max + gizmo })
 }
 
 /// The bones a camera frames: those the clip animates and the skins' joints, so that a file's cameras, lights and
