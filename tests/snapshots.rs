@@ -6,25 +6,36 @@ use bonescope::view::ViewKind;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
-/// The demo at 0.5 s (upper arm stretched, forearm bent) with the forearm selected.
-fn app(configure: impl FnOnce(&mut Settings)) -> Harness<'static, BonescopeApp> {
-    let mut settings = Settings::default();
-    settings.scene.boxes = true;
-    configure(&mut settings);
+/// The app on `doc` at `time` in a 1400×900 window, with `bone` selected (when given) and the analysis settled.
+fn window(settings: Settings, doc: Document, time: f64, bone: Option<&str>) -> Harness<'static, BonescopeApp> {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
         .with_render_cursor(false)
         .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
-    harness.state_mut().time = 0.5;
-    harness.get_by_label("forearm").click();
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    harness.state_mut().time = time;
+    if let Some(bone) = bone {
+        harness.get_by_label(bone).click();
+    }
+    settle(&mut harness);
+    harness
+}
+
+/// Lets the background analysis finish, then runs a fixed number of frames, not `run()`: the analysis thread's
+/// wake-up may land in any step, and the plot needs a few frames to fit its bounds to the curves.
+fn settle(harness: &mut Harness<'static, BonescopeApp>) {
     harness.step();
     let ctx = harness.ctx.clone();
     harness.state_mut().settle(&ctx);
-    // A fixed number of frames, not `run()`: the analysis thread's wake-up may land in any step, and the plot
-    // needs a few frames to fit its bounds to the curves.
     harness.run_steps(8);
-    harness
+}
+
+/// The demo at 0.5 s (upper arm stretched, forearm bent) with boxes on and the forearm selected.
+fn app(configure: impl FnOnce(&mut Settings)) -> Harness<'static, BonescopeApp> {
+    let mut settings = Settings::default();
+    settings.scene.boxes = true;
+    configure(&mut settings);
+    window(settings, Document::demo(), 0.5, Some("forearm"))
 }
 
 #[test]
@@ -55,10 +66,7 @@ fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
     harness.get_by_label("ghost").click();
     harness.step();
     harness.get_by_label("Only flagged").click();
-    harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
-    harness.run_steps(8);
+    settle(&mut harness);
     harness.snapshot("demo_stretch_plots_with_ghost");
 }
 
@@ -66,17 +74,9 @@ fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
 #[test]
 fn long_clip_envelopes() {
     let rig = bonescope::import::stress_rig(20, 20_000, 5);
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_render_cursor(false)
-        .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    let mut harness = window(Settings::default(), Document::new(None, rig), 300.0, None);
     harness.state_mut().selection = vec![6, 16];
-    harness.state_mut().time = 300.0;
-    harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
-    harness.run_steps(8);
+    settle(&mut harness);
     harness.snapshot("long_clip_envelopes");
 }
 
@@ -99,16 +99,5 @@ fn demo_layers_blend_additive_shake() {
     doc.ghost = Some(Ghost::Unlayered);
     let mut settings = Settings { show_layers: true, show_inspector: false, ..Settings::default() };
     settings.scene.boxes = true;
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_render_cursor(false)
-        .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
-    harness.state_mut().time = 0.4;
-    harness.get_by_label("forearm").click();
-    harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
-    harness.run_steps(8);
-    harness.snapshot("demo_layers_blend_additive_shake");
+    window(settings, doc, 0.4, Some("forearm")).snapshot("demo_layers_blend_additive_shake");
 }
