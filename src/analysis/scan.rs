@@ -354,6 +354,13 @@ fn analyze_chunk(
     };
     // Each bone's stretch frame at the previous sample, where the next decomposition starts its search.
     let mut previous = vec![DQuat::IDENTITY; skeleton.len()];
+    // Each bone's place among the requested curves, found once rather than per bone per sample.
+    let mut slot_of = vec![None; skeleton.len()];
+    for (slot, &bone) in request.bones.iter().enumerate() {
+        if let Some(s) = slot_of.get_mut(bone) {
+            *s = Some(slot);
+        }
+    }
     for (sample, &time) in chunk.iter().enumerate() {
         subject.evaluate(&mut pose, hierarchy, &mut layers, time);
         for (bone, model) in pose.model.model.iter().enumerate() {
@@ -361,7 +368,7 @@ fn analyze_chunk(
             previous[bone] = assessment.parts.stretch;
             result.summaries[bone].add(time, &assessment);
             result.bits[bone] |= u64::from(assessment.findings.stretched) << sample;
-            if let Some(slot) = request.bones.iter().position(|&b| b == bone) {
+            if let Some(slot) = slot_of[bone] {
                 let curves = &mut result.curves[slot];
                 curves.model.push(Components::of(&assessment));
                 curves.local.push(Components::of(&Assessment::of(&pose.local[bone].matrix(), &options.tolerances)));

@@ -299,11 +299,10 @@ impl BonescopeApp {
                 progress,
                 tolerances: &self.tolerances,
             };
-            self.viewport.transparent = self.chrome == Chrome::ViewportOnly;
             if self.chrome == Chrome::ViewportOnly {
                 egui::CentralPanel::default()
                     .frame(egui::Frame::NONE)
-                    .show(ui, |ui| self.viewport.canvas(ui, &mut shared));
+                    .show(ui, |ui| self.viewport.canvas(ui, &mut shared, viewport::Background::Left));
             } else {
                 egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
                 egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));

@@ -13,11 +13,17 @@ use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, motion_bounds, paint
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
 
+/// Whether the canvas paints its background.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Background {
+    Painted,
+    /// Left out: headless renders put it behind the picture after reading it back, because a window-sized fill
+    /// costs the software rasteriser as much as everything else it draws together.
+    Left,
+}
+
 #[derive(Default)]
 pub struct Viewport {
-    /// Paint no background: headless renders put it behind the picture after reading it back, because a
-    /// window-sized fill costs the software rasteriser as much as everything else it draws together.
-    pub transparent: bool,
     /// Bounds to frame once the canvas knows its shape (framing fits them to the aspect ratio).
     framing: Option<Bounds>,
 }
@@ -39,11 +45,11 @@ impl Viewport {
     /// The view toggles above the canvas.
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         toolbar(ui, shared);
-        self.canvas(ui, shared);
+        self.canvas(ui, shared, Background::Painted);
     }
 
     /// The picture alone, filling the space left: what headless renders of the viewport show.
-    pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared) {
+    pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared, background: Background) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
         let rig = shared.doc.rig.clone();
@@ -72,7 +78,7 @@ impl Viewport {
         }
         let camera = &shared.settings.camera;
         let mut palette = Palette::new(ui.visuals().dark_mode);
-        if self.transparent {
+        if background == Background::Left {
             palette.background = egui::Color32::TRANSPARENT;
         }
         paint::paint(ui.painter(), rect, camera, &scene, &palette);
