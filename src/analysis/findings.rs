@@ -1,8 +1,8 @@
 //! What is wrong with one matrix: stretched (sheared), non-uniformly scaled, mirrored, degenerate.
 
-use glam::{DMat3, DMat4, DQuat};
+use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use crate::math::{AffineParts, decompose_near, shear_deg};
+use crate::math::{AffineParts, anisotropy, decompose_near, shear_deg, stretch_angle_deg_within};
 
 /// The tolerances behind the verdicts.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -63,18 +63,37 @@ impl Assessment {
         let parts = decompose_near(m, start);
         // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
         let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
-        let anisotropic = parts.anisotropy() > tolerances.min_anisotropy;
-        let stretch_deg = if anisotropic { parts.stretch_angle_deg_within(tolerances.min_anisotropy) } else { 0.0 };
-        let stretched = stretch_deg > tolerances.min_stretch_deg;
-        let (min, max) = (parts.scale.min_element(), parts.scale.max_element());
-        let findings = Findings {
-            stretched,
-            non_uniform: anisotropic && !stretched,
-            mirrored: parts.sign < 0.0,
-            degenerate: min <= tolerances.degenerate_ratio * max,
-        };
+        let (stretch_deg, findings) = judge(parts.stretch, parts.scale, parts.sign, tolerances);
         Assessment { parts, shear_deg, stretch_deg, findings }
     }
+}
+
+/// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`) and whose
+/// determinant has the sign `sign`: all they depend on. Also returns the stretch angle
+/// ([`stretch_angle_deg_within`] at the anisotropy tolerance; 0 when the factors count as equal).
+pub(crate) fn judge(stretch: DQuat, scale: DVec3, sign: f64, tolerances: &Tolerances) -> (f64, Findings) {
+    let anisotropic = anisotropy(scale) > tolerances.min_anisotropy;
+    let stretch_deg =
+        if anisotropic { stretch_angle_deg_within(stretch, scale, tolerances.min_anisotropy) } else { 0.0 };
+    let stretched = stretch_deg > tolerances.min_stretch_deg;
+    let (min, max) = (scale.min_element(), scale.max_element());
+    let findings = Findings {
+        stretched,
+        non_uniform: anisotropic && !stretched,
+        mirrored: sign < 0.0,
+        degenerate: min <= tolerances.degenerate_ratio * max,
+    };
+    (stretch_deg, findings)
+}
+
+/// One sample's verdicts and the measures behind them, as a whole-clip summary accumulates them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Verdict {
+    pub findings: Findings,
+    /// See [`Assessment::stretch_deg`].
+    pub stretch_deg: f64,
+    /// The shear as [`crate::math::largest_column_cosine`]: its inverse sine is taken only for a new worst.
+    pub shear_cosine: f64,
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ mod findings;
 pub mod report;
 mod scan;
 pub mod storage;
+mod stretch;
 
 pub use bind::{BindMismatch, BindTolerance, bind_mismatches};
 pub use compare::{BoneDifference, ClipComparison, compare};

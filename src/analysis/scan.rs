@@ -3,12 +3,15 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
+use super::findings::Verdict;
+use super::stretch::Stretch;
 use super::{Assessment, Tolerances};
-use crate::eval::{Hierarchy, LayerStack, Pose};
-use crate::model::{Clip, Rig, Skeleton};
+use crate::eval::{ClipCursor, Hierarchy, LayerStack, Pose};
+use crate::math::shear_deg_of_cosine;
+use crate::model::{Clip, InheritMode, Rig, Skeleton};
 
 /// How a clip is scanned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,6 +43,9 @@ pub struct BoneSummary {
     pub non_uniform_samples: usize,
     pub mirrored_samples: usize,
     pub degenerate_samples: usize,
+    /// The worst shear as a cosine (see [`Verdict::shear_cosine`]), so that only a new worst costs an inverse sine.
+    #[serde(skip)]
+    worst_shear_cosine: f64,
 }
 
 impl BoneSummary {
@@ -47,14 +53,15 @@ impl BoneSummary {
         BoneSummary { index, ..BoneSummary::default() }
     }
 
-    fn add(&mut self, time: f64, a: &Assessment) {
-        if a.shear_deg > self.worst_shear_deg {
-            self.worst_shear_deg = a.shear_deg;
+    fn add(&mut self, time: f64, verdict: &Verdict) {
+        if verdict.shear_cosine > self.worst_shear_cosine {
+            self.worst_shear_cosine = verdict.shear_cosine;
+            self.worst_shear_deg = shear_deg_of_cosine(verdict.shear_cosine);
             self.worst_shear_time = time;
         }
-        let f = a.findings;
+        let f = verdict.findings;
         if f.stretched {
-            self.worst_stretch_deg = self.worst_stretch_deg.max(a.stretch_deg);
+            self.worst_stretch_deg = self.worst_stretch_deg.max(verdict.stretch_deg);
             self.flagged_samples += 1;
             self.first_flagged_time.get_or_insert(time);
         }
@@ -65,7 +72,8 @@ impl BoneSummary {
 
     /// Combines the summary of an earlier stretch of time with that of a later one.
     fn merge(&mut self, later: &BoneSummary) {
-        if later.worst_shear_deg > self.worst_shear_deg {
+        if later.worst_shear_cosine > self.worst_shear_cosine {
+            self.worst_shear_cosine = later.worst_shear_cosine;
             self.worst_shear_deg = later.worst_shear_deg;
             self.worst_shear_time = later.worst_shear_time;
         }
@@ -343,41 +351,38 @@ fn analyze_chunk(
     options: &ScanOptions,
     chunk: &[f64],
 ) -> ChunkResult {
-    let skeleton = subject.skeleton;
-    let mut layers = subject.worker_layers();
-    let mut pose = Pose::default();
-    let mut ghost_pose = Pose::default();
+    let bones = subject.skeleton.len();
     let mut result = ChunkResult {
-        summaries: (0..skeleton.len()).map(BoneSummary::new).collect(),
-        bits: vec![0; skeleton.len()],
+        summaries: (0..bones).map(BoneSummary::new).collect(),
+        bits: vec![0; bones],
         curves: vec![Curves::default(); request.bones.len()],
     };
-    // Each bone's stretch frame at the previous sample, where the next decomposition starts its search.
-    let mut previous = vec![DQuat::IDENTITY; skeleton.len()];
+    let mut evaluation = Evaluation::new(subject, hierarchy, request.bones);
     // Each bone's place among the requested curves, found once rather than per bone per sample.
-    let mut slot_of = vec![None; skeleton.len()];
+    let mut slot_of = vec![None; bones];
     for (slot, &bone) in request.bones.iter().enumerate() {
         if let Some(s) = slot_of.get_mut(bone) {
             *s = Some(slot);
         }
     }
+    let mut ghost_pose = Pose::default();
     for (sample, &time) in chunk.iter().enumerate() {
-        subject.evaluate(&mut pose, hierarchy, &mut layers, time);
-        for (bone, model) in pose.model.model.iter().enumerate() {
-            let assessment = Assessment::near(model, &options.tolerances, previous[bone]);
-            previous[bone] = assessment.parts.stretch;
-            result.summaries[bone].add(time, &assessment);
-            result.bits[bone] |= u64::from(assessment.findings.stretched) << sample;
-            if let Some(slot) = slot_of[bone] {
+        evaluation.seek(time);
+        for (bone, slot) in slot_of.iter().enumerate() {
+            let verdict = evaluation.stretch(bone).verdict(&options.tolerances);
+            result.summaries[bone].add(time, &verdict);
+            result.bits[bone] |= u64::from(verdict.findings.stretched) << sample;
+            if let Some(slot) = *slot {
+                let (local, model) = evaluation.matrices(bone);
                 let curves = &mut result.curves[slot];
-                curves.model.push(Components::of(&assessment));
-                curves.local.push(Components::of(&Assessment::of(&pose.local[bone].matrix(), &options.tolerances)));
+                curves.model.push(Components::of(&Assessment::of(&model, &options.tolerances)));
+                curves.local.push(Components::of(&Assessment::of(&local, &options.tolerances)));
             }
         }
         if let Some(ghost) = request.ghost {
             match ghost.unlayered {
-                true => ghost_pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
-                false => subject.evaluate(&mut ghost_pose, ghost.hierarchy, &mut layers, time),
+                true => ghost_pose.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time),
+                false => subject.evaluate(&mut ghost_pose, ghost.hierarchy, &mut evaluation.layers, time),
             }
             for (slot, &bone) in request.bones.iter().enumerate() {
                 let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
@@ -386,6 +391,108 @@ fn analyze_chunk(
         }
     }
     result
+}
+
+/// One worker's evaluation of the subject, one sample time after another: every bone's [`Stretch`] for the
+/// verdicts, and the local and model matrices of the bones whose curves are kept.
+///
+/// A clip without layers on a fully inheriting rig is read channel by channel: only the channels the stretches
+/// need (scales everywhere, rotations below non-uniform scale), and all of them only for the plotted bones and their
+/// ancestors. Layers, or any other inheritance mode, evaluate the whole pose.
+struct Evaluation<'a> {
+    subject: Subject<'a>,
+    hierarchy: &'a Hierarchy,
+    /// This worker's copy of the layers.
+    layers: Option<LayerStack>,
+    source: Source<'a>,
+    stretches: Vec<Stretch>,
+    /// Each bone's stretch frame at the previous sample, where a decomposition starts its search.
+    previous: Vec<DQuat>,
+}
+
+enum Source<'a> {
+    /// Every bone evaluated.
+    Pose(Pose),
+    /// Channels read on demand; full local and model matrices for `modelled` (parents first).
+    Channels { cursor: ClipCursor<'a>, modelled: Vec<usize>, local: Vec<DMat4>, model: Vec<DMat4> },
+}
+
+impl<'a> Evaluation<'a> {
+    fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
+        let bones = subject.skeleton.len();
+        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
+        let source = match subject.clip {
+            Some(clip) if subject.layered.is_none() && all_full => Source::Channels {
+                cursor: ClipCursor::new(subject.skeleton, clip),
+                modelled: with_ancestors(subject.skeleton, plotted),
+                local: vec![DMat4::IDENTITY; bones],
+                model: vec![DMat4::IDENTITY; bones],
+            },
+            _ => Source::Pose(Pose::default()),
+        };
+        Evaluation {
+            subject,
+            hierarchy,
+            layers: subject.worker_layers(),
+            source,
+            stretches: vec![Stretch::NONE; bones],
+            previous: vec![DQuat::IDENTITY; bones],
+        }
+    }
+
+    /// Evaluates the sample at `time`; then [`Evaluation::stretch`] each bone in order.
+    fn seek(&mut self, time: f64) {
+        match &mut self.source {
+            Source::Pose(pose) => self.subject.evaluate(pose, self.hierarchy, &mut self.layers, time),
+            Source::Channels { cursor, modelled, local, model } => {
+                cursor.seek(time);
+                for &bone in modelled.iter() {
+                    local[bone] = cursor.local(bone).matrix();
+                    model[bone] = match self.subject.skeleton.parent(bone) {
+                        Some(parent) => model[parent] * local[bone],
+                        None => local[bone],
+                    };
+                }
+            }
+        }
+    }
+
+    /// The stretch of `bone`'s model matrix at this sample; its parent's must have been asked for first.
+    fn stretch(&mut self, bone: usize) -> Stretch {
+        let parent = self.subject.skeleton.parent(bone);
+        let start = self.previous[bone];
+        let inherits = parent.is_none() || self.hierarchy.modes()[bone] == InheritMode::Full;
+        let above = parent.map_or(Stretch::NONE, |p| self.stretches[p]);
+        let stretch = match &mut self.source {
+            Source::Pose(pose) if inherits => above.child(bone, &mut pose.local.as_slice(), start),
+            Source::Pose(pose) => Stretch::of_matrix(&pose.model.model[bone], start),
+            Source::Channels { cursor, .. } => above.child(bone, cursor, start),
+        };
+        self.stretches[bone] = stretch;
+        self.previous[bone] = stretch.frame;
+        stretch
+    }
+
+    /// The local and model matrices of a plotted bone at this sample.
+    fn matrices(&self, bone: usize) -> (DMat4, DMat4) {
+        match &self.source {
+            Source::Pose(pose) => (pose.local[bone].matrix(), pose.model.model[bone]),
+            Source::Channels { local, model, .. } => (local[bone], model[bone]),
+        }
+    }
+}
+
+/// `bones` and all their ancestors, sorted (so parents come first).
+fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
+    let mut wanted = vec![false; skeleton.len()];
+    for &bone in bones.iter().filter(|&&b| b < skeleton.len()) {
+        let mut next = Some(bone);
+        while let Some(b) = next.filter(|&b| !wanted[b]) {
+            wanted[b] = true;
+            next = skeleton.parent(b);
+        }
+    }
+    (0..skeleton.len()).filter(|&b| wanted[b]).collect()
 }
 
 fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<ChunkResult>) -> ClipAnalysis {

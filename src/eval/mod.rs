@@ -4,6 +4,7 @@
 
 mod bind;
 pub mod blender;
+mod cursor;
 mod hierarchy;
 pub mod layers;
 mod pose;
@@ -11,6 +12,7 @@ mod sample;
 pub mod skinning;
 
 pub use bind::{bind_model_matrices, bind_pose};
+pub use cursor::ClipCursor;
 pub use hierarchy::{Hierarchy, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use pose::Pose;

@@ -4,5 +4,8 @@ mod polar;
 mod quat;
 mod svd;
 
-pub use polar::{AffineParts, EQUAL_SCALE_TOLERANCE, decompose, decompose_near, quat_angle, shear_deg};
+pub use polar::{
+    AffineParts, EQUAL_SCALE_TOLERANCE, anisotropy, decompose, decompose_near, largest_column_cosine, quat_angle,
+    shear_deg, shear_deg_of_cosine, stretch_angle_deg_within,
+};
 pub use quat::{nlerp, slerp};

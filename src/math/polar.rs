@@ -78,32 +78,44 @@ impl AffineParts {
         quat_angle(self.stretch).to_degrees()
     }
 
-    /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees.
-    ///
-    /// Between nearly equal factors `U` may turn freely without changing the matrix by more than their difference,
-    /// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
-    /// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
-    /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
-    /// between its axis and the nearest local axis, and 0 when all count as equal.
+    /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees
+    /// (see [`stretch_angle_deg_within`]).
     pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
-        if self.stretch == DQuat::IDENTITY {
-            return 0.0;
-        }
-        let angle = match equal_factors(self.scale, relative_tolerance) {
-            [false, false, false] => 2.0 * closest_axis_permutation_w(self.stretch).min(1.0).acos(),
-            [true, false, false] => angle_to_nearest_axis(self.stretch * DVec3::Z),
-            [false, true, false] => angle_to_nearest_axis(self.stretch * DVec3::Y),
-            [false, false, true] => angle_to_nearest_axis(self.stretch * DVec3::X),
-            _ => 0.0,
-        };
-        angle.to_degrees()
+        stretch_angle_deg_within(self.stretch, self.scale, relative_tolerance)
     }
 
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
     pub fn anisotropy(&self) -> f64 {
-        let (min, max) = (self.scale.min_element(), self.scale.max_element());
-        if max == 0.0 { 0.0 } else { max / min - 1.0 }
+        anisotropy(self.scale)
     }
+}
+
+/// The angle of the stretch frame `stretch` with factors `scale` once factors within `relative_tolerance` of each
+/// other count as equal, in degrees.
+///
+/// Between nearly equal factors `U` may turn freely without changing `U·K·Uᵀ` by more than their difference,
+/// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
+/// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
+/// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
+/// between its axis and the nearest local axis, and 0 when all count as equal.
+pub fn stretch_angle_deg_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
+    if stretch == DQuat::IDENTITY {
+        return 0.0;
+    }
+    let angle = match equal_factors(scale, relative_tolerance) {
+        [false, false, false] => 2.0 * closest_axis_permutation_w(stretch).min(1.0).acos(),
+        [true, false, false] => angle_to_nearest_axis(stretch * DVec3::Z),
+        [false, true, false] => angle_to_nearest_axis(stretch * DVec3::Y),
+        [false, false, true] => angle_to_nearest_axis(stretch * DVec3::X),
+        _ => 0.0,
+    };
+    angle.to_degrees()
+}
+
+/// How unequal stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
+pub fn anisotropy(scale: DVec3) -> f64 {
+    let (min, max) = (scale.min_element(), scale.max_element());
+    if max == 0.0 { 0.0 } else { max / min - 1.0 }
 }
 
 /// The angle of a unit quaternion's rotation, in radians, in `[0, π]`.
@@ -280,6 +292,12 @@ fn quat_from_rotation(m: &DMat3) -> DQuat {
 /// The largest deviation from 90°, in degrees, between any two columns of the 3×3 part: 0 for any rotation·scale
 /// matrix, whatever its frame. Pairs with a zero column do not count.
 pub fn shear_deg(m: &DMat3) -> f64 {
+    shear_deg_of_cosine(largest_column_cosine(m))
+}
+
+/// The largest `|cos|` of the angle between two columns (pairs with a zero column do not count): the shear
+/// without its inverse sine, which orders matrices the same way.
+pub fn largest_column_cosine(m: &DMat3) -> f64 {
     let cols = [m.x_axis, m.y_axis, m.z_axis];
     let lengths = [cols[0].length(), cols[1].length(), cols[2].length()];
     let mut worst: f64 = 0.0;
@@ -289,8 +307,12 @@ pub fn shear_deg(m: &DMat3) -> f64 {
             worst = worst.max((cols[i].dot(cols[j]) / product).abs());
         }
     }
-    // |acos(c) − 90°| = asin(|c|): one inverse sine for the largest |cosine| instead of one arc cosine per pair.
-    worst.min(1.0).asin().to_degrees()
+    worst.min(1.0)
+}
+
+/// The shear in degrees from [`largest_column_cosine`]: `|acos(c) − 90°| = asin(|c|)`.
+pub fn shear_deg_of_cosine(cosine: f64) -> f64 {
+    cosine.asin().to_degrees()
 }
 
 #[cfg(test)]

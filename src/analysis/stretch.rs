@@ -1,0 +1,210 @@
+//! Every bone's stretch without its model matrix, for whole-clip verdicts.
+//!
+//! The verdicts on a model matrix `M = F·W·K·Vᵀ` (stretched, non-uniform, mirrored, degenerate, and the shear)
+//! depend only on `MᵀM = V·K²·Vᵀ` and the sign `F`, never on the rotation `W`. A fully inheriting child has
+//! `M_c = M_p·L`, so `M_cᵀM_c = Lᵀ·(M_pᵀM_p)·L`: the parent's rotation and every translation drop out, and the
+//! stretch passes down a chain from local channels alone. The two common cases need no decomposition:
+//! - the parent stretches equally in every direction (`K_p = k·I`: only uniform scale above): the child's stretch
+//!   is its own local one, times `k`; its rotation is not even read;
+//! - the child's own scale is uniform (`c·I`, no local stretch): `V_c = R_cᵀ·V_p`, `K_c = c·K_p`.
+//!
+//! Only a non-uniformly scaled bone below another one is decomposed (`K_p·V_pᵀ·L`, by SVD). Bones that do not
+//! inherit fully are judged from their model matrix.
+
+use glam::{DMat3, DMat4, DQuat, DVec3};
+
+use super::Tolerances;
+use super::findings::{Verdict, judge};
+use crate::eval::ClipCursor;
+use crate::math::{decompose_near, largest_column_cosine};
+use crate::model::{Transform, affine};
+
+/// A bone's local channels at one time, read on demand.
+pub(crate) trait LocalChannels {
+    fn rotation(&mut self, bone: usize) -> DQuat;
+    fn scale(&mut self, bone: usize) -> DVec3;
+    /// The local stretch rotation (the `U` of `T·R·U·S·Uᵀ`).
+    fn stretch(&mut self, bone: usize) -> DQuat;
+}
+
+impl LocalChannels for ClipCursor<'_> {
+    fn rotation(&mut self, bone: usize) -> DQuat {
+        ClipCursor::rotation(self, bone)
+    }
+
+    fn scale(&mut self, bone: usize) -> DVec3 {
+        ClipCursor::scale(self, bone)
+    }
+
+    fn stretch(&mut self, bone: usize) -> DQuat {
+        ClipCursor::stretch(self, bone)
+    }
+}
+
+/// A local pose evaluated in full.
+impl LocalChannels for &[Transform] {
+    fn rotation(&mut self, bone: usize) -> DQuat {
+        self[bone].rotation
+    }
+
+    fn scale(&mut self, bone: usize) -> DVec3 {
+        self[bone].scale
+    }
+
+    fn stretch(&mut self, bone: usize) -> DQuat {
+        self[bone].stretch
+    }
+}
+
+/// The stretch `V·K·Vᵀ` and sign `F` of a model matrix `M = F·W·K·Vᵀ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Stretch {
+    /// `V`. The identity when `M` has orthogonal columns (it need not be canonical otherwise).
+    pub frame: DQuat,
+    /// `K`, all ≥ 0.
+    pub scale: DVec3,
+    pub sign: f64,
+}
+
+impl Stretch {
+    /// The stretch of the identity: what a root bone inherits.
+    pub const NONE: Stretch = Stretch { frame: DQuat::IDENTITY, scale: DVec3::ONE, sign: 1.0 };
+
+    /// The stretch of a model matrix, decomposed with the search starting from `start`.
+    pub fn of_matrix(m: &DMat4, start: DQuat) -> Self {
+        let parts = decompose_near(m, start);
+        Stretch { frame: parts.stretch, scale: parts.scale, sign: parts.sign }
+    }
+
+    /// The stretch of `M·L`, `self` being `M`'s and `L` the local transform of `bone`: a fully inheriting child
+    /// (or a root, under [`Stretch::NONE`]). `start` is where a decomposition, when one is needed, starts its search.
+    pub fn child(&self, bone: usize, local: &mut impl LocalChannels, start: DQuat) -> Self {
+        let (scale, own) = (local.scale(bone), local.stretch(bone));
+        if let Some(k) = uniform(self.scale) {
+            // M·L = F·k·(W·Vᵀ)·L with W·Vᵀ a rotation: L's own stretch, times k. Negative factors mirror; the
+            // stretch keeps their magnitudes (`U·S·Uᵀ = U·|S|·Uᵀ·D` with `D` diagonal ±1 commuting with `|S|`).
+            let sign = if scale.x * scale.y * scale.z < 0.0 { -self.sign } else { self.sign };
+            return Stretch { frame: own, scale: scale.abs() * k, sign };
+        }
+        let rotation = local.rotation(bone);
+        if own == DQuat::IDENTITY
+            && let Some(c) = uniform(scale)
+            && c > 0.0
+        {
+            // K·Vᵀ·R·c = (c·K)·(Rᵀ·V)ᵀ.
+            return Stretch { frame: rotation.conjugate() * self.frame, scale: self.scale * c, sign: self.sign };
+        }
+        let linear = Transform { translation: DVec3::ZERO, rotation, scale, stretch: own }.matrix();
+        let parent = DMat3::from_diagonal(self.scale) * DMat3::from_quat(self.frame).transpose();
+        let parts = decompose_near(&(affine(parent, DVec3::ZERO) * linear), start);
+        Stretch { frame: parts.stretch, scale: parts.scale, sign: self.sign * parts.sign }
+    }
+
+    pub fn verdict(&self, tolerances: &Tolerances) -> Verdict {
+        let (stretch_deg, findings) = judge(self.frame, self.scale, self.sign, tolerances);
+        Verdict { findings, stretch_deg, shear_cosine: self.shear_cosine() }
+    }
+
+    /// `MᵀM = V·K²·Vᵀ` is also the Gram matrix of the columns of `K·Vᵀ`: their angles are `M`'s.
+    fn shear_cosine(&self) -> f64 {
+        if self.frame == DQuat::IDENTITY || uniform(self.scale).is_some() {
+            return 0.0;
+        }
+        largest_column_cosine(&(DMat3::from_diagonal(self.scale) * DMat3::from_quat(self.frame).transpose()))
+    }
+}
+
+/// The common factor of a vector whose components are exactly equal.
+fn uniform(v: DVec3) -> Option<f64> {
+    (v.x == v.y && v.y == v.z).then_some(v.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::analysis::Assessment;
+
+    fn quat() -> impl Strategy<Value = DQuat> {
+        prop::array::uniform4(-1.0..1.0f64)
+            .prop_filter("not near zero", |q| q.iter().map(|c| c * c).sum::<f64>() > 1e-3)
+            .prop_map(|q| DQuat::from_array(q).normalize())
+    }
+
+    /// A local scale: uniform, non-uniform, with a negative factor, or the identity (each case has its path).
+    fn scale() -> impl Strategy<Value = DVec3> {
+        prop_oneof![
+            Just(DVec3::ONE),
+            (0.2..3.0f64).prop_map(DVec3::splat),
+            prop::array::uniform3(0.2..3.0f64).prop_map(DVec3::from_array),
+            prop::array::uniform3(0.2..3.0f64).prop_map(|s| DVec3::new(-s[0], s[1], s[2])),
+        ]
+    }
+
+    fn transform() -> impl Strategy<Value = Transform> {
+        let stretch = prop_oneof![3 => Just(DQuat::IDENTITY), 1 => quat()];
+        (prop::array::uniform3(-2.0..2.0f64), quat(), scale(), stretch).prop_map(|(t, rotation, scale, stretch)| {
+            Transform { translation: DVec3::from_array(t), rotation, scale, stretch }
+        })
+    }
+
+    proptest! {
+        /// Down a chain of fully inheriting bones, the propagated stretch gives the verdicts, the stretch angle
+        /// and the shear of the decomposed model matrix (to 1e-9 degrees; exactly for the verdicts, whose inputs
+        /// here stay away from the tolerances).
+        #[test]
+        fn the_propagated_stretch_judges_as_the_model_matrix(chain in prop::collection::vec(transform(), 1..7)) {
+            let tolerances = Tolerances::default();
+            let (mut model, mut stretch) = (DMat4::IDENTITY, Stretch::NONE);
+            let mut locals: &[Transform] = &chain;
+            for (bone, local) in chain.iter().enumerate() {
+                model *= local.matrix();
+                stretch = stretch.child(bone, &mut locals, DQuat::IDENTITY);
+                let expected = Assessment::of(&model, &tolerances);
+                let verdict = stretch.verdict(&tolerances);
+                prop_assert_eq!(verdict.findings, expected.findings, "bone {}", bone);
+                prop_assert!((verdict.stretch_deg - expected.stretch_deg).abs() < 1e-9, "bone {}", bone);
+                let shear = crate::math::shear_deg_of_cosine(verdict.shear_cosine);
+                prop_assert!((shear - expected.shear_deg).abs() < 1e-9, "bone {}: {} vs {}", bone, shear, expected.shear_deg);
+                let scale = expected.parts.scale;
+                prop_assert!((stretch.scale.max_element() - scale.max_element()).abs() < 1e-12 * scale.max_element());
+                prop_assert!((stretch.scale.min_element() - scale.min_element()).abs() < 1e-12 * scale.max_element());
+            }
+        }
+    }
+
+    #[test]
+    fn a_root_under_none_and_a_uniform_chain_read_no_rotation() {
+        struct Counting<'a>(&'a [Transform], usize);
+        impl LocalChannels for Counting<'_> {
+            fn rotation(&mut self, bone: usize) -> DQuat {
+                self.1 += 1;
+                self.0[bone].rotation
+            }
+            fn scale(&mut self, bone: usize) -> DVec3 {
+                self.0[bone].scale
+            }
+            fn stretch(&mut self, bone: usize) -> DQuat {
+                self.0[bone].stretch
+            }
+        }
+        let r = DQuat::from_rotation_z(0.7);
+        let chain = [
+            Transform::from_trs(DVec3::X, r, DVec3::splat(2.0)),
+            Transform::from_trs(DVec3::Y, r, DVec3::new(1.0, 3.0, 1.0)),
+            Transform::from_trs(DVec3::Y, r, DVec3::ONE),
+        ];
+        let mut channels = Counting(&chain, 0);
+        let root = Stretch::NONE.child(0, &mut channels, DQuat::IDENTITY);
+        let aligned = root.child(1, &mut channels, DQuat::IDENTITY);
+        assert_eq!(channels.1, 0, "uniform scale above: no rotation needed");
+        assert_eq!(aligned, Stretch { frame: DQuat::IDENTITY, scale: DVec3::new(2.0, 6.0, 2.0), sign: 1.0 });
+        assert!(aligned.verdict(&Tolerances::default()).findings.non_uniform);
+        // Below the non-uniform bone the child's rotation turns the stretch frame: V = Rᵀ, sheared by 0.7 rad.
+        let sheared = aligned.child(2, &mut channels, DQuat::IDENTITY);
+        assert_eq!(channels.1, 1);
+        assert!(sheared.frame.abs_diff_eq(r.conjugate(), 1e-15));
+        assert!(sheared.verdict(&Tolerances::default()).findings.stretched);
+    }
+}
