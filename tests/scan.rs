@@ -1,9 +1,9 @@
 //! Whole-clip scans on a clip whose answer is known by hand.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use bonescope::analysis::{Assessment, ScanOptions, Subject, sample_times, scan};
+use bonescope::analysis::{Assessment, CurveRequest, ScanOptions, Subject, analyze, sample_times, scan};
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
@@ -98,6 +98,7 @@ fn brute_force(skeleton: &Skeleton, clip: &Clip, hierarchy: &Hierarchy, options:
         for (summary, model) in summaries.iter_mut().zip(&pose.model.model) {
             let a = Assessment::of(model, &options.tolerances);
             summary.shear_at.push((time, a.shear_deg));
+            summary.stretched_at.push(a.findings.stretched);
             summary.worst_shear_deg = summary.worst_shear_deg.max(a.shear_deg);
             if a.findings.stretched {
                 summary.worst_stretch_deg = summary.worst_stretch_deg.max(a.stretch_deg);
@@ -122,17 +123,20 @@ struct BruteSummary {
     mirrored: usize,
     degenerate: usize,
     shear_at: Vec<(f64, f64)>,
+    stretched_at: Vec<bool>,
 }
 
 /// The scan judges bones from stretches passed down the hierarchy (model matrices only where a bone does not
 /// inherit fully); it must agree with decomposing every model matrix: counts and first times exactly, angles to
-/// 1e-9 degrees, and the reported worst-shear time must be one where the shear is that worst.
+/// 1e-9 degrees, the reported worst-shear time one where the shear is that worst, and every sample's flag.
 fn assert_scan_matches_brute_force(label: &str, skeleton: &Skeleton, clip: &Clip, modes: &[InheritMode]) {
     let hierarchy = Hierarchy::new(skeleton, modes);
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
-    let scanned = scan(Subject::clip(skeleton, Some(clip)), &hierarchy, &options, &|_, _| {});
+    let never = AtomicBool::new(false);
+    let subject = Subject::clip(skeleton, Some(clip));
+    let analysis = analyze(subject, &hierarchy, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
     let expected = brute_force(skeleton, clip, &hierarchy, &options);
-    for (got, want) in scanned.bones.iter().zip(&expected) {
+    for (got, want) in analysis.scan.bones.iter().zip(&expected) {
         let bone = format!("{label}: bone {} ({})", got.index, skeleton.bone(got.index).name);
         let shear = (got.worst_shear_deg, want.worst_shear_deg);
         assert!((shear.0 - shear.1).abs() < 1e-9, "{bone}: worst shear {shear:?}");
@@ -146,14 +150,22 @@ fn assert_scan_matches_brute_force(label: &str, skeleton: &Skeleton, clip: &Clip
             "{bone}"
         );
         assert_eq!((got.mirrored_samples, got.degenerate_samples), (want.mirrored, want.degenerate), "{bone}");
+        let flags: Vec<bool> = (0..analysis.times.len()).map(|s| analysis.stretched_at(got.index, s)).collect();
+        assert!(flags == want.stretched_at, "{bone}: stretched flags per sample");
     }
 }
 
 #[test]
 fn the_scan_agrees_with_decomposing_every_model_matrix() {
-    let stress = stress_rig(40, 240, 4);
+    // The long clip spreads over several chunks of several words of flags each.
+    let (stress, long) = (stress_rig(40, 240, 4), stress_rig(12, 2400, 4));
     let demo = demo_rig();
-    let mut subjects = vec![("stress rig", &stress, 0), ("demo stretch", &demo, 0), ("demo plain", &demo, 1)];
+    let mut subjects = vec![
+        ("stress rig", &stress, 0),
+        ("long stress rig", &long, 0),
+        ("demo stretch", &demo, 0),
+        ("demo plain", &demo, 1),
+    ];
     let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
     let stretchy = bonescope::import::load(&shared);
     match &stretchy {

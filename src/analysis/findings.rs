@@ -2,7 +2,10 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use crate::math::{AffineParts, anisotropy, decompose_near, shear_deg, stretch_angle_deg_within};
+use crate::math::{
+    AffineParts, angle_of_half_cosine, anisotropy, decompose_near, largest_column_cosine, shear_deg_of_cosine,
+    stretch_half_cosine_within,
+};
 
 /// The tolerances behind the verdicts.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -62,38 +65,67 @@ impl Assessment {
     pub fn near(m: &DMat4, tolerances: &Tolerances, start: DQuat) -> Self {
         let parts = decompose_near(m, start);
         // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
-        let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
-        let (stretch_deg, findings) = judge(parts.stretch, parts.scale, parts.sign, tolerances);
-        Assessment { parts, shear_deg, stretch_deg, findings }
+        let shear_cosine =
+            if parts.stretch == DQuat::IDENTITY { 0.0 } else { largest_column_cosine(&DMat3::from_mat4(*m)) };
+        let verdict = Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, shear_cosine);
+        Assessment {
+            parts,
+            shear_deg: shear_deg_of_cosine(shear_cosine),
+            stretch_deg: verdict.stretch_deg(),
+            findings: verdict.findings,
+        }
     }
 }
 
-/// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`) and whose
-/// determinant has the sign `sign`: all they depend on. Also returns the stretch angle
-/// ([`stretch_angle_deg_within`] at the anisotropy tolerance; 0 when the factors count as equal).
-pub(crate) fn judge(stretch: DQuat, scale: DVec3, sign: f64, tolerances: &Tolerances) -> (f64, Findings) {
-    let anisotropic = anisotropy(scale) > tolerances.min_anisotropy;
-    let stretch_deg =
-        if anisotropic { stretch_angle_deg_within(stretch, scale, tolerances.min_anisotropy) } else { 0.0 };
-    let stretched = stretch_deg > tolerances.min_stretch_deg;
-    let (min, max) = (scale.min_element(), scale.max_element());
-    let findings = Findings {
-        stretched,
-        non_uniform: anisotropic && !stretched,
-        mirrored: sign < 0.0,
-        degenerate: min <= tolerances.degenerate_ratio * max,
-    };
-    (stretch_deg, findings)
+/// The tolerances prepared for judging many matrices.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Judge {
+    tolerances: Tolerances,
+    /// `cos(θ/2)` at `θ = min_stretch_deg`: stretch frames turned further have a smaller half-angle cosine.
+    stretch_half_cosine: f64,
 }
 
-/// One sample's verdicts and the measures behind them, as a whole-clip summary accumulates them.
+impl Judge {
+    pub fn new(tolerances: &Tolerances) -> Self {
+        let stretch_half_cosine = (tolerances.min_stretch_deg.to_radians() * 0.5).cos();
+        Judge { tolerances: *tolerances, stretch_half_cosine }
+    }
+
+    /// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`), whose
+    /// determinant has the sign `sign` (all they depend on) and whose [`largest_column_cosine`] is `shear_cosine`.
+    pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine: f64) -> Verdict {
+        let tolerances = &self.tolerances;
+        let anisotropic = anisotropy(scale) > tolerances.min_anisotropy;
+        let stretch_half_cosine =
+            if anisotropic { stretch_half_cosine_within(stretch, scale, tolerances.min_anisotropy) } else { 1.0 };
+        let stretched = stretch_half_cosine < self.stretch_half_cosine;
+        let (min, max) = (scale.min_element(), scale.max_element());
+        let findings = Findings {
+            stretched,
+            non_uniform: anisotropic && !stretched,
+            mirrored: sign < 0.0,
+            degenerate: min <= tolerances.degenerate_ratio * max,
+        };
+        Verdict { findings, stretch_half_cosine, shear_cosine }
+    }
+}
+
+/// One matrix's verdicts and the measures behind them, in the form a whole-clip summary compares them: cosines,
+/// whose inverse is taken only for a new worst.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Verdict {
     pub findings: Findings,
-    /// See [`Assessment::stretch_deg`].
-    pub stretch_deg: f64,
-    /// The shear as [`crate::math::largest_column_cosine`]: its inverse sine is taken only for a new worst.
+    /// `cos(θ/2)` of the stretch angle `θ` ([`Assessment::stretch_deg`]).
+    pub stretch_half_cosine: f64,
+    /// The shear as [`largest_column_cosine`].
     pub shear_cosine: f64,
+}
+
+impl Verdict {
+    /// See [`Assessment::stretch_deg`].
+    pub fn stretch_deg(&self) -> f64 {
+        angle_of_half_cosine(self.stretch_half_cosine)
+    }
 }
 
 #[cfg(test)]

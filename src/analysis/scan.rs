@@ -6,11 +6,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
-use super::findings::Verdict;
+use super::findings::{Judge, Verdict};
 use super::stretch::Stretch;
 use super::{Assessment, Tolerances};
 use crate::eval::{ClipCursor, Hierarchy, LayerStack, Pose};
-use crate::math::shear_deg_of_cosine;
+use crate::math::{angle_of_half_cosine, shear_deg_of_cosine};
 use crate::model::{Clip, InheritMode, Rig, Skeleton};
 
 /// How a clip is scanned.
@@ -28,7 +28,7 @@ impl Default for ScanOptions {
 }
 
 /// One bone over a whole clip. Times are in seconds.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct BoneSummary {
     pub index: usize,
     pub worst_shear_deg: f64,
@@ -43,25 +43,39 @@ pub struct BoneSummary {
     pub non_uniform_samples: usize,
     pub mirrored_samples: usize,
     pub degenerate_samples: usize,
-    /// The worst shear as a cosine (see [`Verdict::shear_cosine`]), so that only a new worst costs an inverse sine.
+    /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end.
     #[serde(skip)]
     worst_shear_cosine: f64,
+    #[serde(skip)]
+    worst_stretch_half_cosine: f64,
 }
 
 impl BoneSummary {
     fn new(index: usize) -> Self {
-        BoneSummary { index, ..BoneSummary::default() }
+        BoneSummary {
+            index,
+            worst_shear_deg: 0.0,
+            worst_shear_time: 0.0,
+            worst_stretch_deg: 0.0,
+            flagged_samples: 0,
+            first_flagged_time: None,
+            non_uniform_samples: 0,
+            mirrored_samples: 0,
+            degenerate_samples: 0,
+            worst_shear_cosine: 0.0,
+            worst_stretch_half_cosine: 1.0,
+        }
     }
 
+    /// Adds one sample. The worst angles are kept as cosines until [`BoneSummary::finish`].
     fn add(&mut self, time: f64, verdict: &Verdict) {
         if verdict.shear_cosine > self.worst_shear_cosine {
             self.worst_shear_cosine = verdict.shear_cosine;
-            self.worst_shear_deg = shear_deg_of_cosine(verdict.shear_cosine);
             self.worst_shear_time = time;
         }
         let f = verdict.findings;
         if f.stretched {
-            self.worst_stretch_deg = self.worst_stretch_deg.max(verdict.stretch_deg);
+            self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(verdict.stretch_half_cosine);
             self.flagged_samples += 1;
             self.first_flagged_time.get_or_insert(time);
         }
@@ -74,15 +88,20 @@ impl BoneSummary {
     fn merge(&mut self, later: &BoneSummary) {
         if later.worst_shear_cosine > self.worst_shear_cosine {
             self.worst_shear_cosine = later.worst_shear_cosine;
-            self.worst_shear_deg = later.worst_shear_deg;
             self.worst_shear_time = later.worst_shear_time;
         }
-        self.worst_stretch_deg = self.worst_stretch_deg.max(later.worst_stretch_deg);
+        self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(later.worst_stretch_half_cosine);
         self.flagged_samples += later.flagged_samples;
         self.first_flagged_time = self.first_flagged_time.or(later.first_flagged_time);
         self.non_uniform_samples += later.non_uniform_samples;
         self.mirrored_samples += later.mirrored_samples;
         self.degenerate_samples += later.degenerate_samples;
+    }
+
+    /// Turns the worst cosines into angles.
+    fn finish(&mut self) {
+        self.worst_shear_deg = shear_deg_of_cosine(self.worst_shear_cosine);
+        self.worst_stretch_deg = angle_of_half_cosine(self.worst_stretch_half_cosine);
     }
 
     pub fn stretched(&self) -> bool {
@@ -292,14 +311,16 @@ impl Subject<'_> {
     }
 }
 
-/// Samples per parallel work item: one 64-bit word of flags per bone, big enough to amortise the buffers.
-const CHUNK: usize = 64;
+/// Words of 64 sample flags per parallel work item, at most: long enough to amortise a worker's buffers, and
+/// short enough for every thread to get several.
+const MAX_CHUNK_WORDS: usize = 16;
 
 /// What one chunk of samples produced.
 struct ChunkResult {
     summaries: Vec<BoneSummary>,
-    /// One word per bone.
+    /// `words` words of flags per bone.
     bits: Vec<u64>,
+    words: usize,
     curves: Vec<Curves>,
 }
 
@@ -329,8 +350,10 @@ pub fn analyze(
     let skeleton = subject.skeleton;
     let times = subject.times(options.rate);
     let done = AtomicUsize::new(0);
+    let words = times.len().div_ceil(64);
+    let chunk_words = (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
     let chunks: Vec<Option<ChunkResult>> = times
-        .par_chunks(CHUNK)
+        .par_chunks(64 * chunk_words)
         .map(|chunk| {
             if cancel.load(Ordering::Relaxed) {
                 return None;
@@ -352,12 +375,15 @@ fn analyze_chunk(
     chunk: &[f64],
 ) -> ChunkResult {
     let bones = subject.skeleton.len();
+    let words = chunk.len().div_ceil(64);
     let mut result = ChunkResult {
         summaries: (0..bones).map(BoneSummary::new).collect(),
-        bits: vec![0; bones],
+        bits: vec![0; bones * words],
+        words,
         curves: vec![Curves::default(); request.bones.len()],
     };
     let mut evaluation = Evaluation::new(subject, hierarchy, request.bones);
+    let judge = Judge::new(&options.tolerances);
     // Each bone's place among the requested curves, found once rather than per bone per sample.
     let mut slot_of = vec![None; bones];
     for (slot, &bone) in request.bones.iter().enumerate() {
@@ -369,9 +395,9 @@ fn analyze_chunk(
     for (sample, &time) in chunk.iter().enumerate() {
         evaluation.seek(time);
         for (bone, slot) in slot_of.iter().enumerate() {
-            let verdict = evaluation.stretch(bone).verdict(&options.tolerances);
+            let verdict = evaluation.stretch(bone).verdict(&judge);
             result.summaries[bone].add(time, &verdict);
-            result.bits[bone] |= u64::from(verdict.findings.stretched) << sample;
+            result.bits[bone * words + sample / 64] |= u64::from(verdict.findings.stretched) << (sample % 64);
             if let Some(slot) = *slot {
                 let (local, model) = evaluation.matrices(bone);
                 let curves = &mut result.curves[slot];
@@ -496,23 +522,29 @@ fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
 }
 
 fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<ChunkResult>) -> ClipAnalysis {
-    let words_per_bone = chunks.len();
+    let words_per_bone = times.len().div_ceil(64);
     let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();
     let mut stretched_bits = vec![0u64; bones * words_per_bone];
     let mut any_stretched_bits = vec![0u64; words_per_bone];
     let mut curves: Vec<(usize, Curves)> = request.bones.iter().map(|&b| (b, Curves::default())).collect();
-    for (word, chunk) in chunks.into_iter().enumerate() {
-        for (bone, (summary, bits)) in chunk.summaries.iter().zip(&chunk.bits).enumerate() {
+    let mut first_word = 0;
+    for chunk in chunks {
+        let words = first_word..first_word + chunk.words;
+        for (bone, (summary, bits)) in chunk.summaries.iter().zip(chunk.bits.chunks(chunk.words)).enumerate() {
             summaries[bone].merge(summary);
-            stretched_bits[bone * words_per_bone + word] = *bits;
-            any_stretched_bits[word] |= *bits;
+            stretched_bits[bone * words_per_bone..][words.clone()].copy_from_slice(bits);
+            for (any, word) in any_stretched_bits[words.clone()].iter_mut().zip(bits) {
+                *any |= word;
+            }
         }
         for ((_, all), part) in curves.iter_mut().zip(chunk.curves) {
             all.local.extend(part.local);
             all.model.extend(part.model);
             all.ghost_model.extend(part.ghost_model);
         }
+        first_word = words.end;
     }
+    summaries.iter_mut().for_each(BoneSummary::finish);
     ClipAnalysis {
         scan: ClipScan { samples: times.len(), bones: summaries },
         times,

@@ -13,8 +13,7 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use super::Tolerances;
-use super::findings::{Verdict, judge};
+use super::findings::{Judge, Verdict};
 use crate::eval::ClipCursor;
 use crate::math::{decompose_near, largest_column_cosine};
 use crate::model::{Transform, affine};
@@ -100,9 +99,8 @@ impl Stretch {
         Stretch { frame: parts.stretch, scale: parts.scale, sign: self.sign * parts.sign }
     }
 
-    pub fn verdict(&self, tolerances: &Tolerances) -> Verdict {
-        let (stretch_deg, findings) = judge(self.frame, self.scale, self.sign, tolerances);
-        Verdict { findings, stretch_deg, shear_cosine: self.shear_cosine() }
+    pub fn verdict(&self, judge: &Judge) -> Verdict {
+        judge.verdict(self.frame, self.scale, self.sign, self.shear_cosine())
     }
 
     /// `MᵀM = V·K²·Vᵀ` is also the Gram matrix of the columns of `K·Vᵀ`: their angles are `M`'s.
@@ -124,7 +122,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::analysis::Assessment;
+    use crate::analysis::{Assessment, Tolerances};
 
     fn quat() -> impl Strategy<Value = DQuat> {
         prop::array::uniform4(-1.0..1.0f64)
@@ -156,15 +154,16 @@ mod tests {
         #[test]
         fn the_propagated_stretch_judges_as_the_model_matrix(chain in prop::collection::vec(transform(), 1..7)) {
             let tolerances = Tolerances::default();
+            let judge = Judge::new(&tolerances);
             let (mut model, mut stretch) = (DMat4::IDENTITY, Stretch::NONE);
             let mut locals: &[Transform] = &chain;
             for (bone, local) in chain.iter().enumerate() {
                 model *= local.matrix();
                 stretch = stretch.child(bone, &mut locals, DQuat::IDENTITY);
                 let expected = Assessment::of(&model, &tolerances);
-                let verdict = stretch.verdict(&tolerances);
+                let verdict = stretch.verdict(&judge);
                 prop_assert_eq!(verdict.findings, expected.findings, "bone {}", bone);
-                prop_assert!((verdict.stretch_deg - expected.stretch_deg).abs() < 1e-9, "bone {}", bone);
+                prop_assert!((verdict.stretch_deg() - expected.stretch_deg).abs() < 1e-9, "bone {}", bone);
                 let shear = crate::math::shear_deg_of_cosine(verdict.shear_cosine);
                 prop_assert!((shear - expected.shear_deg).abs() < 1e-9, "bone {}: {} vs {}", bone, shear, expected.shear_deg);
                 let scale = expected.parts.scale;
@@ -200,11 +199,12 @@ mod tests {
         let aligned = root.child(1, &mut channels, DQuat::IDENTITY);
         assert_eq!(channels.1, 0, "uniform scale above: no rotation needed");
         assert_eq!(aligned, Stretch { frame: DQuat::IDENTITY, scale: DVec3::new(2.0, 6.0, 2.0), sign: 1.0 });
-        assert!(aligned.verdict(&Tolerances::default()).findings.non_uniform);
+        let judge = Judge::new(&Tolerances::default());
+        assert!(aligned.verdict(&judge).findings.non_uniform);
         // Below the non-uniform bone the child's rotation turns the stretch frame: V = Rᵀ, sheared by 0.7 rad.
         let sheared = aligned.child(2, &mut channels, DQuat::IDENTITY);
         assert_eq!(channels.1, 1);
         assert!(sheared.frame.abs_diff_eq(r.conjugate(), 1e-15));
-        assert!(sheared.verdict(&Tolerances::default()).findings.stretched);
+        assert!(sheared.verdict(&judge).findings.stretched);
     }
 }

@@ -2,10 +2,11 @@
 //! reads a bone's rotation only where its parent stretches unevenly, and never its translation unless it plots the
 //! bone.
 
-use glam::{DQuat, DVec3};
+use glam::{DQuat, DVec3, Quat};
 
-use super::sample::sample_track_near;
-use crate::model::{BoneTracks, Clip, Skeleton, Transform};
+use super::sample::{Span, key_value, sample_track_near};
+use crate::math::Slerp;
+use crate::model::{BoneTracks, Clip, Interpolation, Skeleton, Track, Transform};
 
 const TRANSLATION: u8 = 1;
 const ROTATION: u8 = 2;
@@ -25,6 +26,8 @@ pub struct ClipCursor<'a> {
     /// The channels sampled at `time` so far (bits `TRANSLATION | ROTATION | SCALE`), and their values.
     sampled: Vec<u8>,
     values: Vec<Transform>,
+    /// Each bone's last rotation key interval and its slerp.
+    slerps: Vec<(usize, Slerp)>,
 }
 
 impl<'a> ClipCursor<'a> {
@@ -40,6 +43,7 @@ impl<'a> ClipCursor<'a> {
             hints: vec![[0; 3]; tracks.len()],
             sampled: vec![0; tracks.len()],
             values: skeleton.bones().iter().map(|b| b.rest).collect(),
+            slerps: vec![(usize::MAX, Slerp::new(DQuat::IDENTITY, DQuat::IDENTITY)); tracks.len()],
             tracks,
             time: 0.0,
         }
@@ -66,6 +70,7 @@ impl<'a> ClipCursor<'a> {
         if self.fresh(bone, ROTATION) {
             let track = self.tracks[bone].and_then(|t| t.rotation.as_ref());
             self.values[bone].rotation = match track {
+                Some(track) if track.interpolation() == Interpolation::Linear => self.slerp(bone, track),
                 Some(track) => sample_track_near(track, self.time, &mut self.hints[bone][1]),
                 None => self.skeleton.bone(bone).rest.rotation,
             };
@@ -96,6 +101,21 @@ impl<'a> ClipCursor<'a> {
             rotation: self.rotation(bone),
             scale: self.scale(bone),
             stretch: self.stretch(bone),
+        }
+    }
+
+    /// A linear rotation track at this time, as [`sample_track_near`] samples it, keeping the key interval's
+    /// [`Slerp`] for the next times that fall in it.
+    fn slerp(&mut self, bone: usize, track: &Track<Quat>) -> DQuat {
+        match Span::locate_near(track.times(), self.time, &mut self.hints[bone][1]) {
+            Span::Key(k) => key_value(track, k),
+            Span::Between { k, t } => {
+                let (interval, slerp) = &mut self.slerps[bone];
+                if *interval != k {
+                    (*interval, *slerp) = (k, Slerp::new(key_value(track, k), key_value(track, k + 1)));
+                }
+                slerp.at(t)
+            }
         }
     }
 

@@ -99,17 +99,30 @@ impl AffineParts {
 /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
 /// between its axis and the nearest local axis, and 0 when all count as equal.
 pub fn stretch_angle_deg_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
+    angle_of_half_cosine(stretch_half_cosine_within(stretch, scale, relative_tolerance))
+}
+
+/// `cos(θ/2)` of the angle `θ` of [`stretch_angle_deg_within`]: 1 for no turn, smaller for larger turns, and
+/// without an inverse cosine (a whole-clip scan compares these and converts only the worst).
+pub fn stretch_half_cosine_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
     if stretch == DQuat::IDENTITY {
-        return 0.0;
+        return 1.0;
     }
-    let angle = match equal_factors(scale, relative_tolerance) {
-        [false, false, false] => 2.0 * closest_axis_permutation_w(stretch).min(1.0).acos(),
-        [true, false, false] => angle_to_nearest_axis(stretch * DVec3::Z),
-        [false, true, false] => angle_to_nearest_axis(stretch * DVec3::Y),
-        [false, false, true] => angle_to_nearest_axis(stretch * DVec3::X),
-        _ => 0.0,
-    };
-    angle.to_degrees()
+    // With one distinct factor the angle θ is between its axis and the nearest local one: cos θ = c, and
+    // cos(θ/2) = √((1 + c)/2).
+    let to_nearest_axis = |direction: DVec3| ((1.0 + direction.abs().max_element().min(1.0)) * 0.5).sqrt();
+    match equal_factors(scale, relative_tolerance) {
+        [false, false, false] => closest_axis_permutation_w(stretch).min(1.0),
+        [true, false, false] => to_nearest_axis(stretch * DVec3::Z),
+        [false, true, false] => to_nearest_axis(stretch * DVec3::Y),
+        [false, false, true] => to_nearest_axis(stretch * DVec3::X),
+        _ => 1.0,
+    }
+}
+
+/// The angle `θ` in degrees whose `cos(θ/2)` is `half_cosine`.
+pub fn angle_of_half_cosine(half_cosine: f64) -> f64 {
+    (2.0 * half_cosine.min(1.0).acos()).to_degrees()
 }
 
 /// How unequal stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
@@ -199,11 +212,6 @@ fn closest_axis_permutation_w(u: DQuat) -> f64 {
     let largest = high_xy.max(high_zw);
     let second = high_xy.min(high_zw).max(low_xy.max(low_zw));
     largest.max((largest + second) * std::f64::consts::FRAC_1_SQRT_2).max((x + y + z + w) * 0.5)
-}
-
-/// The angle, in radians, between a unit vector and the nearest of the local axes (either direction).
-fn angle_to_nearest_axis(direction: DVec3) -> f64 {
-    direction.abs().max_element().min(1.0).acos()
 }
 
 /// Which pairs of factors, (0, 1), (0, 2) and (1, 2), are within `relative_tolerance` of the largest of each other.

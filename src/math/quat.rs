@@ -5,19 +5,47 @@ use glam::DQuat;
 /// Spherical linear interpolation along the shortest path; falls back to linear interpolation (then normalised)
 /// when the two rotations are too close for `sin(a)` to be divided by.
 pub fn slerp(a: DQuat, b: DQuat, t: f64) -> DQuat {
-    let dot = a.dot(b);
-    let sign = if dot < 0.0 { -1.0 } else { 1.0 };
-    let cos = dot.abs().min(1.0);
-    // sin(acos(c)) without a sine.
-    let sin = (1.0 - cos * cos).sqrt();
-    if sin < 1e-9 {
-        return (a * (1.0 - t) + b * (sign * t)).normalize();
-    }
-    // sin((1 − t)·θ) = sin θ·cos tθ − cos θ·sin tθ: one sine-cosine pair instead of two sines.
-    let (sin_t, cos_t) = (cos.acos() * t).sin_cos();
-    let inverse = 1.0 / sin;
-    a * ((sin * cos_t - cos * sin_t) * inverse) + b * (sign * sin_t * inverse)
+    Slerp::new(a, b).at(t)
 }
+
+/// Slerp between two rotations prepared for many fractions: the angle between them is found once (sampling a key
+/// interval at several times costs one sine–cosine pair per time, no inverse cosine).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slerp {
+    a: DQuat,
+    /// `b`, or `−b` when that is nearer `a` (the shortest path).
+    b: DQuat,
+    /// `cos θ`, `sin θ` and `θ` of the angle between `a` and `b` as 4-vectors.
+    cos: f64,
+    sin: f64,
+    angle: f64,
+}
+
+impl Slerp {
+    pub fn new(a: DQuat, b: DQuat) -> Self {
+        let dot = a.dot(b);
+        let b = if dot < 0.0 { -b } else { b };
+        let cos = dot.abs().min(1.0);
+        // sin(acos(c)) without a sine.
+        let sin = (1.0 - cos * cos).sqrt();
+        Slerp { a, b, cos, sin, angle: if sin < NEARLY_EQUAL { 0.0 } else { cos.acos() } }
+    }
+
+    /// The rotation a fraction `t` of the way.
+    pub fn at(&self, t: f64) -> DQuat {
+        let Slerp { a, b, cos, sin, angle } = *self;
+        if sin < NEARLY_EQUAL {
+            return (a * (1.0 - t) + b * t).normalize();
+        }
+        // sin((1 − t)·θ) = sin θ·cos tθ − cos θ·sin tθ: one sine-cosine pair instead of two sines.
+        let (sin_t, cos_t) = (angle * t).sin_cos();
+        let inverse = 1.0 / sin;
+        a * ((sin * cos_t - cos * sin_t) * inverse) + b * (sin_t * inverse)
+    }
+}
+
+/// Below this `sin θ` the rotations are the same to rounding, and slerp falls back to normalised lerp.
+const NEARLY_EQUAL: f64 = 1e-9;
 
 /// Normalised linear interpolation along the shortest path.
 pub fn nlerp(a: DQuat, b: DQuat, t: f64) -> DQuat {
