@@ -7,7 +7,7 @@ use bonescope::analysis::{Assessment, CurveRequest, ScanOptions, Subject, analyz
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
-use glam::{DQuat, DVec3, Vec3};
+use glam::{DQuat, DVec3, Quat, Vec3};
 
 /// A parent whose X scale grows linearly from 1 at t = 0 to 2 at t = 1, and a child turned 45° about Z.
 fn growing_parent() -> (Skeleton, Clip) {
@@ -155,8 +155,41 @@ fn assert_scan_matches_brute_force(label: &str, skeleton: &Skeleton, clip: &Clip
     }
 }
 
+/// Bones whose stretch never changes (judged once per chunk) beside ones that do: a constantly sheared bone under a
+/// rest scale of (1, 2, 1), a turning bone below it, and a bone with a constant non-uniform scale track.
+fn fixed_and_moving() -> (Skeleton, Clip) {
+    let bone = |name: &str, parent: Option<usize>, rest: Transform| Bone {
+        name: name.into(),
+        node: 0,
+        parent,
+        rest,
+        inherit: InheritMode::Full,
+    };
+    let turned = DQuat::from_rotation_z(0.5);
+    let bones = vec![
+        bone("root", None, Transform::IDENTITY),
+        bone("squashed", Some(0), Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::new(1.0, 2.0, 1.0))),
+        bone("sheared", Some(1), Transform::from_trs(DVec3::Y, turned, DVec3::ONE)),
+        bone("turning", Some(2), Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE)),
+        bone("held", Some(0), Transform::IDENTITY),
+    ];
+    let times: Arc<[f64]> = (0..=100).map(f64::from).collect();
+    let turning = |speed: f32| (0..=100).map(|k| Quat::from_rotation_x(speed * k as f32)).collect::<Vec<_>>();
+    let linear = Interpolation::Linear;
+    let mut root = BoneTracks::new(0);
+    root.rotation = Some(Track::new(times.clone(), turning(0.3), linear).unwrap());
+    let mut turns = BoneTracks::new(3);
+    turns.rotation = Some(Track::new(times.clone(), turning(0.2), linear).unwrap());
+    let mut held = BoneTracks::new(4);
+    held.scale = Some(Track::new(times.clone(), vec![Vec3::new(1.0, 3.0, 1.0); 101], linear).unwrap());
+    held.rotation = Some(Track::new(times, turning(0.1), linear).unwrap());
+    (Skeleton::new(bones).unwrap(), Clip::new(0, None, vec![root, turns, held], vec![]))
+}
+
 #[test]
 fn the_scan_agrees_with_decomposing_every_model_matrix() {
+    let (skeleton, clip) = fixed_and_moving();
+    assert_scan_matches_brute_force("fixed and moving", &skeleton, &clip, &vec![InheritMode::Full; 5]);
     // The long clip spreads over several chunks of several words of flags each.
     let (stress, long) = (stress_rig(40, 240, 4), stress_rig(12, 2400, 4));
     let demo = demo_rig();

@@ -3,7 +3,7 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use crate::math::{
-    AffineParts, angle_of_half_cosine, anisotropy, decompose_near, largest_column_cosine, shear_deg_of_cosine,
+    AffineParts, angle_of_half_cosine, decompose_near, largest_column_cosine, shear_deg_of_cosine,
     stretch_half_cosine_within,
 };
 
@@ -95,11 +95,12 @@ impl Judge {
     /// determinant has the sign `sign` (all they depend on) and whose [`largest_column_cosine`] is `shear_cosine`.
     pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine: f64) -> Verdict {
         let tolerances = &self.tolerances;
-        let anisotropic = anisotropy(scale) > tolerances.min_anisotropy;
+        let (min, max) = (scale.min_element(), scale.max_element());
+        // `anisotropy(scale) > min_anisotropy`, without the division.
+        let anisotropic = max > min * (1.0 + tolerances.min_anisotropy);
         let stretch_half_cosine =
             if anisotropic { stretch_half_cosine_within(stretch, scale, tolerances.min_anisotropy) } else { 1.0 };
         let stretched = stretch_half_cosine < self.stretch_half_cosine;
-        let (min, max) = (scale.min_element(), scale.max_element());
         let findings = Findings {
             stretched,
             non_uniform: anisotropic && !stretched,

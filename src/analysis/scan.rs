@@ -11,7 +11,7 @@ use super::stretch::Stretch;
 use super::{Assessment, Tolerances};
 use crate::eval::{ClipCursor, Hierarchy, LayerStack, Pose};
 use crate::math::{angle_of_half_cosine, shear_deg_of_cosine};
-use crate::model::{Clip, InheritMode, Rig, Skeleton};
+use crate::model::{BoneTracks, Clip, InheritMode, Rig, Skeleton};
 
 /// How a clip is scanned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,6 +96,15 @@ impl BoneSummary {
         self.non_uniform_samples += later.non_uniform_samples;
         self.mirrored_samples += later.mirrored_samples;
         self.degenerate_samples += later.degenerate_samples;
+    }
+
+    /// Adds `count` more samples with the same verdict as the last one added (at later times).
+    fn repeat(&mut self, count: usize, verdict: &Verdict) {
+        let f = verdict.findings;
+        self.flagged_samples += count * usize::from(f.stretched);
+        self.non_uniform_samples += count * usize::from(f.non_uniform);
+        self.mirrored_samples += count * usize::from(f.mirrored);
+        self.degenerate_samples += count * usize::from(f.degenerate);
     }
 
     /// Turns the worst cosines into angles.
@@ -349,6 +358,7 @@ pub fn analyze(
 ) -> Option<ClipAnalysis> {
     let skeleton = subject.skeleton;
     let times = subject.times(options.rate);
+    let plan = Plan::new(subject, hierarchy, request.bones);
     let done = AtomicUsize::new(0);
     let words = times.len().div_ceil(64);
     let chunk_words = (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
@@ -358,7 +368,7 @@ pub fn analyze(
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let result = analyze_chunk(subject, hierarchy, request, options, chunk);
+            let result = analyze_chunk(subject, &plan, request, options, chunk);
             progress(done.fetch_add(chunk.len(), Ordering::Relaxed) + chunk.len(), times.len());
             Some(result)
         })
@@ -367,13 +377,7 @@ pub fn analyze(
     Some(assemble(skeleton.len(), times, request, chunks))
 }
 
-fn analyze_chunk(
-    subject: Subject,
-    hierarchy: &Hierarchy,
-    request: CurveRequest,
-    options: &ScanOptions,
-    chunk: &[f64],
-) -> ChunkResult {
+fn analyze_chunk(subject: Subject, plan: &Plan, request: CurveRequest, options: &ScanOptions, chunk: &[f64]) -> ChunkResult {
     let bones = subject.skeleton.len();
     let words = chunk.len().div_ceil(64);
     let mut result = ChunkResult {
@@ -382,41 +386,94 @@ fn analyze_chunk(
         words,
         curves: vec![Curves::default(); request.bones.len()],
     };
-    let mut evaluation = Evaluation::new(subject, hierarchy, request.bones);
+    let mut evaluation = Evaluation::new(subject, plan);
     let judge = Judge::new(&options.tolerances);
-    // Each bone's place among the requested curves, found once rather than per bone per sample.
-    let mut slot_of = vec![None; bones];
-    for (slot, &bone) in request.bones.iter().enumerate() {
-        if let Some(s) = slot_of.get_mut(bone) {
-            *s = Some(slot);
-        }
-    }
     let mut ghost_pose = Pose::default();
+    // Every bone at the first sample; then only those whose stretch can change.
+    let mut judged: Vec<usize> = (0..bones).collect();
+    let (mut first, mut fixed) = (vec![None; bones], vec![false; bones]);
+    // Where each plotted bone's decomposition starts: its stretch frame at the previous sample.
+    let mut curve_starts = vec![DQuat::IDENTITY; request.bones.len()];
     for (sample, &time) in chunk.iter().enumerate() {
         evaluation.seek(time);
-        for (bone, slot) in slot_of.iter().enumerate() {
+        for &bone in &judged {
             let verdict = evaluation.stretch(bone).verdict(&judge);
             result.summaries[bone].add(time, &verdict);
             result.bits[bone * words + sample / 64] |= u64::from(verdict.findings.stretched) << (sample % 64);
-            if let Some(slot) = *slot {
-                let (local, model) = evaluation.matrices(bone);
-                let curves = &mut result.curves[slot];
-                curves.model.push(Components::of(&Assessment::of(&model, &options.tolerances)));
-                curves.local.push(Components::of(&Assessment::of(&local, &options.tolerances)));
+            if sample == 0 {
+                first[bone] = Some(verdict);
             }
+        }
+        if sample == 0 {
+            fixed = evaluation.fixed_bones();
+            judged.retain(|&bone| !fixed[bone]);
+        }
+        for ((curves, &bone), start) in result.curves.iter_mut().zip(request.bones).zip(&mut curve_starts) {
+            let (local, model) = evaluation.matrices(bone);
+            let assessment = Assessment::near(&model, &options.tolerances, *start);
+            *start = assessment.parts.stretch;
+            curves.model.push(Components::of(&assessment));
+            curves.local.push(Components::of(&Assessment::of(&local, &options.tolerances)));
         }
         if let Some(ghost) = request.ghost {
             match ghost.unlayered {
                 true => ghost_pose.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time),
                 false => subject.evaluate(&mut ghost_pose, ghost.hierarchy, &mut evaluation.layers, time),
             }
-            for (slot, &bone) in request.bones.iter().enumerate() {
+            for (curves, &bone) in result.curves.iter_mut().zip(request.bones) {
                 let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
-                result.curves[slot].ghost_model.push(Components::of(&assessment));
+                curves.ghost_model.push(Components::of(&assessment));
             }
         }
     }
+    // Fixed bones were judged once: the rest of the chunk repeats that verdict.
+    let repeats = chunk.len() - 1;
+    for bone in (0..bones).filter(|&b| fixed[b]) {
+        let verdict = first[bone].expect("every bone is judged at the first sample");
+        result.summaries[bone].repeat(repeats, &verdict);
+        if verdict.findings.stretched {
+            set_bits(&mut result.bits[bone * words..][..words], chunk.len());
+        }
+    }
     result
+}
+
+/// Sets the first `count` bits of `words`.
+fn set_bits(words: &mut [u64], count: usize) {
+    for (w, word) in words.iter_mut().enumerate() {
+        let bits = count.saturating_sub(64 * w).min(64);
+        *word |= if bits == 64 { u64::MAX } else { (1 << bits) - 1 };
+    }
+}
+
+/// What the workers need to know about the subject, found once per analysis.
+struct Plan<'a> {
+    hierarchy: &'a Hierarchy,
+    /// Read the clip channel by channel (a clip without layers on a fully inheriting rig), not pose by pose.
+    by_channel: bool,
+    /// The plotted bones and their ancestors, parents first: their local and model matrices are evaluated.
+    modelled: Vec<usize>,
+    /// Whether the clip changes each bone's scale, and its rotation, over time (constant tracks do not).
+    varying_scale: Vec<bool>,
+    varying_rotation: Vec<bool>,
+}
+
+impl<'a> Plan<'a> {
+    fn new(subject: Subject, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
+        let skeleton = subject.skeleton;
+        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
+        let clip = subject.clip.filter(|_| subject.layered.is_none() && all_full);
+        let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
+            (0..skeleton.len()).map(|b| clip.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
+        };
+        Plan {
+            hierarchy,
+            by_channel: clip.is_some(),
+            modelled: with_ancestors(skeleton, plotted),
+            varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
+            varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
+        }
+    }
 }
 
 /// One worker's evaluation of the subject, one sample time after another: every bone's [`Stretch`] for the
@@ -427,7 +484,7 @@ fn analyze_chunk(
 /// ancestors. Layers, or any other inheritance mode, evaluate the whole pose.
 struct Evaluation<'a> {
     subject: Subject<'a>,
-    hierarchy: &'a Hierarchy,
+    plan: &'a Plan<'a>,
     /// This worker's copy of the layers.
     layers: Option<LayerStack>,
     source: Source<'a>,
@@ -439,18 +496,16 @@ struct Evaluation<'a> {
 enum Source<'a> {
     /// Every bone evaluated.
     Pose(Pose),
-    /// Channels read on demand; full local and model matrices for `modelled` (parents first).
-    Channels { cursor: ClipCursor<'a>, modelled: Vec<usize>, local: Vec<DMat4>, model: Vec<DMat4> },
+    /// Channels read on demand; full local and model matrices for the plan's `modelled` bones.
+    Channels { cursor: ClipCursor<'a>, local: Vec<DMat4>, model: Vec<DMat4> },
 }
 
 impl<'a> Evaluation<'a> {
-    fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
+    fn new(subject: Subject<'a>, plan: &'a Plan<'a>) -> Self {
         let bones = subject.skeleton.len();
-        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
         let source = match subject.clip {
-            Some(clip) if subject.layered.is_none() && all_full => Source::Channels {
+            Some(clip) if plan.by_channel => Source::Channels {
                 cursor: ClipCursor::new(subject.skeleton, clip),
-                modelled: with_ancestors(subject.skeleton, plotted),
                 local: vec![DMat4::IDENTITY; bones],
                 model: vec![DMat4::IDENTITY; bones],
             },
@@ -458,7 +513,7 @@ impl<'a> Evaluation<'a> {
         };
         Evaluation {
             subject,
-            hierarchy,
+            plan,
             layers: subject.worker_layers(),
             source,
             stretches: vec![Stretch::NONE; bones],
@@ -469,10 +524,10 @@ impl<'a> Evaluation<'a> {
     /// Evaluates the sample at `time`; then [`Evaluation::stretch`] each bone in order.
     fn seek(&mut self, time: f64) {
         match &mut self.source {
-            Source::Pose(pose) => self.subject.evaluate(pose, self.hierarchy, &mut self.layers, time),
-            Source::Channels { cursor, modelled, local, model } => {
+            Source::Pose(pose) => self.subject.evaluate(pose, self.plan.hierarchy, &mut self.layers, time),
+            Source::Channels { cursor, local, model } => {
                 cursor.seek(time);
-                for &bone in modelled.iter() {
+                for &bone in &self.plan.modelled {
                     local[bone] = cursor.local(bone).matrix();
                     model[bone] = match self.subject.skeleton.parent(bone) {
                         Some(parent) => model[parent] * local[bone],
@@ -487,7 +542,7 @@ impl<'a> Evaluation<'a> {
     fn stretch(&mut self, bone: usize) -> Stretch {
         let parent = self.subject.skeleton.parent(bone);
         let start = self.previous[bone];
-        let inherits = parent.is_none() || self.hierarchy.modes()[bone] == InheritMode::Full;
+        let inherits = parent.is_none() || self.plan.hierarchy.modes()[bone] == InheritMode::Full;
         let above = parent.map_or(Stretch::NONE, |p| self.stretches[p]);
         let stretch = match &mut self.source {
             Source::Pose(pose) if inherits => above.child(bone, &mut pose.local.as_slice(), start),
@@ -497,6 +552,23 @@ impl<'a> Evaluation<'a> {
         self.stretches[bone] = stretch;
         self.previous[bone] = stretch.frame;
         stretch
+    }
+
+    /// The bones whose stretch is the same at every sample, once every bone's stretch has been asked for: read
+    /// channel by channel, a bone the clip neither scales nor, below non-uniform scale, turns, under such bones.
+    fn fixed_bones(&self) -> Vec<bool> {
+        let (skeleton, plan) = (self.subject.skeleton, self.plan);
+        let mut fixed = vec![false; skeleton.len()];
+        if !plan.by_channel {
+            return fixed;
+        }
+        for bone in 0..skeleton.len() {
+            let above = skeleton.parent(bone).map_or(Some(Stretch::NONE), |p| fixed[p].then(|| self.stretches[p]));
+            fixed[bone] = above.is_some_and(|above| {
+                !plan.varying_scale[bone] && (!plan.varying_rotation[bone] || above.is_uniform())
+            });
+        }
+        fixed
     }
 
     /// The local and model matrices of a plotted bone at this sample.

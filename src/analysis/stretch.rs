@@ -15,7 +15,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::findings::{Judge, Verdict};
 use crate::eval::ClipCursor;
-use crate::math::{decompose_near, largest_column_cosine};
+use crate::math::decompose_near;
 use crate::model::{Transform, affine};
 
 /// A bone's local channels at one time, read on demand.
@@ -99,16 +99,36 @@ impl Stretch {
         Stretch { frame: parts.stretch, scale: parts.scale, sign: self.sign * parts.sign }
     }
 
+    /// Whether it stretches equally in every direction (exactly: the parent of [`Stretch::child`]'s shortcut).
+    pub fn is_uniform(&self) -> bool {
+        uniform(self.scale).is_some()
+    }
+
     pub fn verdict(&self, judge: &Judge) -> Verdict {
         judge.verdict(self.frame, self.scale, self.sign, self.shear_cosine())
     }
 
-    /// `MᵀM = V·K²·Vᵀ` is also the Gram matrix of the columns of `K·Vᵀ`: their angles are `M`'s.
+    /// [`crate::math::largest_column_cosine`] of `M`, from `MᵀM = V·K²·Vᵀ`: `cos²` of columns `i, j` is
+    /// `G_ij²/(G_ii·G_jj)`, so the largest needs one square root (and no column lengths).
     fn shear_cosine(&self) -> f64 {
-        if self.frame == DQuat::IDENTITY || uniform(self.scale).is_some() {
+        if self.frame == DQuat::IDENTITY || self.is_uniform() {
             return 0.0;
         }
-        largest_column_cosine(&(DMat3::from_diagonal(self.scale) * DMat3::from_quat(self.frame).transpose()))
+        let v = DMat3::from_quat(self.frame);
+        let k2 = self.scale * self.scale;
+        // Row i of V, weighted by K², dotted with row j: (V·K²·Vᵀ)_ij.
+        let rows = [v.row(0), v.row(1), v.row(2)];
+        let gram = |i: usize, j: usize| (rows[i] * k2).dot(rows[j]);
+        let diagonal = [gram(0, 0), gram(1, 1), gram(2, 2)];
+        let mut worst: f64 = 0.0;
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            let lengths = diagonal[i] * diagonal[j];
+            if lengths > 0.0 && lengths.is_finite() {
+                let dot = gram(i, j);
+                worst = worst.max(dot * dot / lengths);
+            }
+        }
+        worst.sqrt().min(1.0)
     }
 }
 

@@ -15,9 +15,10 @@ pub struct Slerp {
     a: DQuat,
     /// `b`, or `−b` when that is nearer `a` (the shortest path).
     b: DQuat,
-    /// `cos θ`, `sin θ` and `θ` of the angle between `a` and `b` as 4-vectors.
+    /// `cos θ`, `sin θ`, `1/sin θ` and `θ` of the angle between `a` and `b` as 4-vectors.
     cos: f64,
     sin: f64,
+    inverse_sin: f64,
     angle: f64,
 }
 
@@ -28,19 +29,19 @@ impl Slerp {
         let cos = dot.abs().min(1.0);
         // sin(acos(c)) without a sine.
         let sin = (1.0 - cos * cos).sqrt();
-        Slerp { a, b, cos, sin, angle: if sin < NEARLY_EQUAL { 0.0 } else { cos.acos() } }
+        let (inverse_sin, angle) = if sin < NEARLY_EQUAL { (0.0, 0.0) } else { (1.0 / sin, cos.acos()) };
+        Slerp { a, b, cos, sin, inverse_sin, angle }
     }
 
     /// The rotation a fraction `t` of the way.
     pub fn at(&self, t: f64) -> DQuat {
-        let Slerp { a, b, cos, sin, angle } = *self;
+        let Slerp { a, b, cos, sin, inverse_sin, angle } = *self;
         if sin < NEARLY_EQUAL {
             return (a * (1.0 - t) + b * t).normalize();
         }
         // sin((1 − t)·θ) = sin θ·cos tθ − cos θ·sin tθ: one sine-cosine pair instead of two sines.
         let (sin_t, cos_t) = (angle * t).sin_cos();
-        let inverse = 1.0 / sin;
-        a * ((sin * cos_t - cos * sin_t) * inverse) + b * (sin_t * inverse)
+        a * ((sin * cos_t - cos * sin_t) * inverse_sin) + b * (sin_t * inverse_sin)
     }
 }
 

@@ -52,19 +52,29 @@ pub enum TrackError {
 }
 
 /// A key value in single precision whose components can be checked for finiteness.
-pub trait KeyValue: Copy {
+pub trait KeyValue: Copy + PartialEq {
     fn is_finite(&self) -> bool;
+    /// Whether every component is zero (a flat tangent).
+    fn is_zero(&self) -> bool;
 }
 
 impl KeyValue for Vec3 {
     fn is_finite(&self) -> bool {
         Vec3::is_finite(*self)
     }
+
+    fn is_zero(&self) -> bool {
+        *self == Vec3::ZERO
+    }
 }
 
 impl KeyValue for Quat {
     fn is_finite(&self) -> bool {
         Quat::is_finite(*self)
+    }
+
+    fn is_zero(&self) -> bool {
+        *self == Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)
     }
 }
 
@@ -93,6 +103,16 @@ impl<T: KeyValue> Track<T> {
             return Err(TrackError::NonFinite { index });
         }
         Ok(Track { times, values, interpolation })
+    }
+
+    /// Whether the track holds one value throughout: all keys equal and, for cubic splines, all tangents flat.
+    /// (Sampled between keys such a track may still differ from its key by rounding.)
+    pub fn is_constant(&self) -> bool {
+        let per_key = self.interpolation.values_per_key();
+        let first = self.values[per_key / 2];
+        self.values.chunks(per_key).all(|key| {
+            key.iter().enumerate().all(|(i, v)| if i == per_key / 2 { *v == first } else { v.is_zero() })
+        })
     }
 }
 
@@ -220,6 +240,19 @@ mod tests {
 
     fn times(t: &[f64]) -> Arc<[f64]> {
         t.into()
+    }
+
+    #[test]
+    fn constant_tracks() {
+        let (one, two) = (Vec3::ONE, Vec3::new(1.0, 2.0, 1.0));
+        let track = |values: Vec<Vec3>, interpolation| Track::new(times(&[0.0, 1.0]), values, interpolation).unwrap();
+        assert!(track(vec![one, one], Interpolation::Linear).is_constant());
+        assert!(!track(vec![one, two], Interpolation::Step).is_constant());
+        assert!(Track::new(times(&[0.5]), vec![two], Interpolation::Linear).unwrap().is_constant());
+        // Cubic splines: equal values are not enough, the tangents must be flat too.
+        let z = Vec3::ZERO;
+        assert!(track(vec![z, one, z, z, one, z], Interpolation::CubicSpline).is_constant());
+        assert!(!track(vec![z, one, two, z, one, z], Interpolation::CubicSpline).is_constant());
     }
 
     #[test]
