@@ -67,7 +67,8 @@ impl Assessment {
         // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
         let shear_cosine =
             if parts.stretch == DQuat::IDENTITY { 0.0 } else { largest_column_cosine(&DMat3::from_mat4(*m)) };
-        let verdict = Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, shear_cosine);
+        let verdict =
+            Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, shear_cosine * shear_cosine);
         Assessment {
             parts,
             shear_deg: shear_deg_of_cosine(shear_cosine),
@@ -92,8 +93,9 @@ impl Judge {
     }
 
     /// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`), whose
-    /// determinant has the sign `sign` (all they depend on) and whose [`largest_column_cosine`] is `shear_cosine`.
-    pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine: f64) -> Verdict {
+    /// determinant has the sign `sign` (all they depend on) and whose [`largest_column_cosine`] is the square root
+    /// of `shear_cosine_squared`.
+    pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine_squared: f64) -> Verdict {
         let tolerances = &self.tolerances;
         let (min, max) = (scale.min_element(), scale.max_element());
         // `anisotropy(scale) > min_anisotropy`, without the division.
@@ -107,7 +109,7 @@ impl Judge {
             mirrored: sign < 0.0,
             degenerate: min <= tolerances.degenerate_ratio * max,
         };
-        Verdict { findings, stretch_half_cosine, shear_cosine }
+        Verdict { findings, stretch_half_cosine, shear_cosine_squared }
     }
 }
 
@@ -118,8 +120,8 @@ pub(crate) struct Verdict {
     pub findings: Findings,
     /// `cos(θ/2)` of the stretch angle `θ` ([`Assessment::stretch_deg`]).
     pub stretch_half_cosine: f64,
-    /// The shear as [`largest_column_cosine`].
-    pub shear_cosine: f64,
+    /// The shear as the square of [`largest_column_cosine`].
+    pub shear_cosine_squared: f64,
 }
 
 impl Verdict {

@@ -2,6 +2,7 @@
 //! the reports built from them.
 
 mod bind;
+mod chunk;
 mod compare;
 mod findings;
 pub mod report;

@@ -3,15 +3,15 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
+use glam::{DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
-use super::findings::{Judge, Verdict};
-use super::stretch::Stretch;
+use super::chunk::{ChunkResult, Plan, analyze_chunk};
+use super::findings::Verdict;
 use super::{Assessment, Tolerances};
-use crate::eval::{ClipCursor, Hierarchy, LayerStack, Pose};
+use crate::eval::{Hierarchy, LayerStack, Pose};
 use crate::math::{angle_of_half_cosine, shear_deg_of_cosine};
-use crate::model::{BoneTracks, Clip, InheritMode, Rig, Skeleton};
+use crate::model::{Clip, Rig, Skeleton};
 
 /// How a clip is scanned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,13 +45,13 @@ pub struct BoneSummary {
     pub degenerate_samples: usize,
     /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end.
     #[serde(skip)]
-    worst_shear_cosine: f64,
+    worst_shear_cosine_squared: f64,
     #[serde(skip)]
     worst_stretch_half_cosine: f64,
 }
 
 impl BoneSummary {
-    fn new(index: usize) -> Self {
+    pub(super) fn new(index: usize) -> Self {
         BoneSummary {
             index,
             worst_shear_deg: 0.0,
@@ -62,15 +62,15 @@ impl BoneSummary {
             non_uniform_samples: 0,
             mirrored_samples: 0,
             degenerate_samples: 0,
-            worst_shear_cosine: 0.0,
+            worst_shear_cosine_squared: 0.0,
             worst_stretch_half_cosine: 1.0,
         }
     }
 
     /// Adds one sample. The worst angles are kept as cosines until [`BoneSummary::finish`].
-    fn add(&mut self, time: f64, verdict: &Verdict) {
-        if verdict.shear_cosine > self.worst_shear_cosine {
-            self.worst_shear_cosine = verdict.shear_cosine;
+    pub(super) fn add(&mut self, time: f64, verdict: &Verdict) {
+        if verdict.shear_cosine_squared > self.worst_shear_cosine_squared {
+            self.worst_shear_cosine_squared = verdict.shear_cosine_squared;
             self.worst_shear_time = time;
         }
         let f = verdict.findings;
@@ -86,8 +86,8 @@ impl BoneSummary {
 
     /// Combines the summary of an earlier stretch of time with that of a later one.
     fn merge(&mut self, later: &BoneSummary) {
-        if later.worst_shear_cosine > self.worst_shear_cosine {
-            self.worst_shear_cosine = later.worst_shear_cosine;
+        if later.worst_shear_cosine_squared > self.worst_shear_cosine_squared {
+            self.worst_shear_cosine_squared = later.worst_shear_cosine_squared;
             self.worst_shear_time = later.worst_shear_time;
         }
         self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(later.worst_stretch_half_cosine);
@@ -99,7 +99,7 @@ impl BoneSummary {
     }
 
     /// Adds `count` more samples with the same verdict as the last one added (at later times).
-    fn repeat(&mut self, count: usize, verdict: &Verdict) {
+    pub(super) fn repeat(&mut self, count: usize, verdict: &Verdict) {
         let f = verdict.findings;
         self.flagged_samples += count * usize::from(f.stretched);
         self.non_uniform_samples += count * usize::from(f.non_uniform);
@@ -109,7 +109,7 @@ impl BoneSummary {
 
     /// Turns the worst cosines into angles.
     fn finish(&mut self) {
-        self.worst_shear_deg = shear_deg_of_cosine(self.worst_shear_cosine);
+        self.worst_shear_deg = shear_deg_of_cosine(self.worst_shear_cosine_squared.sqrt());
         self.worst_stretch_deg = angle_of_half_cosine(self.worst_stretch_half_cosine);
     }
 
@@ -139,7 +139,7 @@ pub struct Components {
 }
 
 impl Components {
-    fn of(assessment: &Assessment) -> Self {
+    pub(super) fn of(assessment: &Assessment) -> Self {
         let p = &assessment.parts;
         Components {
             translation: p.translation.as_vec3(),
@@ -270,7 +270,7 @@ fn add_grid(times: &mut Vec<f64>, duration: f64, rate: f64) {
     times.dedup();
 }
 
-/// A rig evaluated through layers: what [`scan_layered`] and [`analyze_layered`] sample.
+/// A rig evaluated through layers.
 #[derive(Clone, Copy, Debug)]
 pub struct Layered<'a> {
     pub rig: &'a Rig,
@@ -301,11 +301,11 @@ impl<'a> Subject<'a> {
 
 impl Subject<'_> {
     /// A worker's own copy of the layers (`None` without layers).
-    fn worker_layers(&self) -> Option<LayerStack> {
+    pub(super) fn worker_layers(&self) -> Option<LayerStack> {
         self.layered.map(|l| l.layers.clone())
     }
 
-    fn evaluate(&self, pose: &mut Pose, hierarchy: &Hierarchy, layers: &mut Option<LayerStack>, time: f64) {
+    pub(super) fn evaluate(&self, pose: &mut Pose, hierarchy: &Hierarchy, layers: &mut Option<LayerStack>, time: f64) {
         match (self.layered, layers) {
             (Some(layered), Some(stack)) => pose.evaluate_layered(layered.rig, self.clip, hierarchy, stack, time),
             _ => pose.evaluate(self.skeleton, self.clip, hierarchy, time),
@@ -323,15 +323,6 @@ impl Subject<'_> {
 /// Words of 64 sample flags per parallel work item, at most: long enough to amortise a worker's buffers, and
 /// short enough for every thread to get several.
 const MAX_CHUNK_WORDS: usize = 16;
-
-/// What one chunk of samples produced.
-struct ChunkResult {
-    summaries: Vec<BoneSummary>,
-    /// `words` words of flags per bone.
-    bits: Vec<u64>,
-    words: usize,
-    curves: Vec<Curves>,
-}
 
 /// Scans `subject` under `hierarchy`'s modes. `progress(done, total)` is called from worker threads as samples
 /// complete.
@@ -375,222 +366,6 @@ pub fn analyze(
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
     Some(assemble(skeleton.len(), times, request, chunks))
-}
-
-fn analyze_chunk(subject: Subject, plan: &Plan, request: CurveRequest, options: &ScanOptions, chunk: &[f64]) -> ChunkResult {
-    let bones = subject.skeleton.len();
-    let words = chunk.len().div_ceil(64);
-    let mut result = ChunkResult {
-        summaries: (0..bones).map(BoneSummary::new).collect(),
-        bits: vec![0; bones * words],
-        words,
-        curves: vec![Curves::default(); request.bones.len()],
-    };
-    let mut evaluation = Evaluation::new(subject, plan);
-    let judge = Judge::new(&options.tolerances);
-    let mut ghost_pose = Pose::default();
-    // Every bone at the first sample; then only those whose stretch can change.
-    let mut judged: Vec<usize> = (0..bones).collect();
-    let (mut first, mut fixed) = (vec![None; bones], vec![false; bones]);
-    // Where each plotted bone's decomposition starts: its stretch frame at the previous sample.
-    let mut curve_starts = vec![DQuat::IDENTITY; request.bones.len()];
-    for (sample, &time) in chunk.iter().enumerate() {
-        evaluation.seek(time);
-        for &bone in &judged {
-            let verdict = evaluation.stretch(bone).verdict(&judge);
-            result.summaries[bone].add(time, &verdict);
-            result.bits[bone * words + sample / 64] |= u64::from(verdict.findings.stretched) << (sample % 64);
-            if sample == 0 {
-                first[bone] = Some(verdict);
-            }
-        }
-        if sample == 0 {
-            fixed = evaluation.fixed_bones();
-            judged.retain(|&bone| !fixed[bone]);
-        }
-        for ((curves, &bone), start) in result.curves.iter_mut().zip(request.bones).zip(&mut curve_starts) {
-            let (local, model) = evaluation.matrices(bone);
-            let assessment = Assessment::near(&model, &options.tolerances, *start);
-            *start = assessment.parts.stretch;
-            curves.model.push(Components::of(&assessment));
-            curves.local.push(Components::of(&Assessment::of(&local, &options.tolerances)));
-        }
-        if let Some(ghost) = request.ghost {
-            match ghost.unlayered {
-                true => ghost_pose.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time),
-                false => subject.evaluate(&mut ghost_pose, ghost.hierarchy, &mut evaluation.layers, time),
-            }
-            for (curves, &bone) in result.curves.iter_mut().zip(request.bones) {
-                let assessment = Assessment::of(&ghost_pose.model.model[bone], &options.tolerances);
-                curves.ghost_model.push(Components::of(&assessment));
-            }
-        }
-    }
-    // Fixed bones were judged once: the rest of the chunk repeats that verdict.
-    let repeats = chunk.len() - 1;
-    for bone in (0..bones).filter(|&b| fixed[b]) {
-        let verdict = first[bone].expect("every bone is judged at the first sample");
-        result.summaries[bone].repeat(repeats, &verdict);
-        if verdict.findings.stretched {
-            set_bits(&mut result.bits[bone * words..][..words], chunk.len());
-        }
-    }
-    result
-}
-
-/// Sets the first `count` bits of `words`.
-fn set_bits(words: &mut [u64], count: usize) {
-    for (w, word) in words.iter_mut().enumerate() {
-        let bits = count.saturating_sub(64 * w).min(64);
-        *word |= if bits == 64 { u64::MAX } else { (1 << bits) - 1 };
-    }
-}
-
-/// What the workers need to know about the subject, found once per analysis.
-struct Plan<'a> {
-    hierarchy: &'a Hierarchy,
-    /// Read the clip channel by channel (a clip without layers on a fully inheriting rig), not pose by pose.
-    by_channel: bool,
-    /// The plotted bones and their ancestors, parents first: their local and model matrices are evaluated.
-    modelled: Vec<usize>,
-    /// Whether the clip changes each bone's scale, and its rotation, over time (constant tracks do not).
-    varying_scale: Vec<bool>,
-    varying_rotation: Vec<bool>,
-}
-
-impl<'a> Plan<'a> {
-    fn new(subject: Subject, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
-        let skeleton = subject.skeleton;
-        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
-        let clip = subject.clip.filter(|_| subject.layered.is_none() && all_full);
-        let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
-            (0..skeleton.len()).map(|b| clip.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
-        };
-        Plan {
-            hierarchy,
-            by_channel: clip.is_some(),
-            modelled: with_ancestors(skeleton, plotted),
-            varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
-            varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
-        }
-    }
-}
-
-/// One worker's evaluation of the subject, one sample time after another: every bone's [`Stretch`] for the
-/// verdicts, and the local and model matrices of the bones whose curves are kept.
-///
-/// A clip without layers on a fully inheriting rig is read channel by channel: only the channels the stretches
-/// need (scales everywhere, rotations below non-uniform scale), and all of them only for the plotted bones and their
-/// ancestors. Layers, or any other inheritance mode, evaluate the whole pose.
-struct Evaluation<'a> {
-    subject: Subject<'a>,
-    plan: &'a Plan<'a>,
-    /// This worker's copy of the layers.
-    layers: Option<LayerStack>,
-    source: Source<'a>,
-    stretches: Vec<Stretch>,
-    /// Each bone's stretch frame at the previous sample, where a decomposition starts its search.
-    previous: Vec<DQuat>,
-}
-
-enum Source<'a> {
-    /// Every bone evaluated.
-    Pose(Pose),
-    /// Channels read on demand; full local and model matrices for the plan's `modelled` bones.
-    Channels { cursor: ClipCursor<'a>, local: Vec<DMat4>, model: Vec<DMat4> },
-}
-
-impl<'a> Evaluation<'a> {
-    fn new(subject: Subject<'a>, plan: &'a Plan<'a>) -> Self {
-        let bones = subject.skeleton.len();
-        let source = match subject.clip {
-            Some(clip) if plan.by_channel => Source::Channels {
-                cursor: ClipCursor::new(subject.skeleton, clip),
-                local: vec![DMat4::IDENTITY; bones],
-                model: vec![DMat4::IDENTITY; bones],
-            },
-            _ => Source::Pose(Pose::default()),
-        };
-        Evaluation {
-            subject,
-            plan,
-            layers: subject.worker_layers(),
-            source,
-            stretches: vec![Stretch::NONE; bones],
-            previous: vec![DQuat::IDENTITY; bones],
-        }
-    }
-
-    /// Evaluates the sample at `time`; then [`Evaluation::stretch`] each bone in order.
-    fn seek(&mut self, time: f64) {
-        match &mut self.source {
-            Source::Pose(pose) => self.subject.evaluate(pose, self.plan.hierarchy, &mut self.layers, time),
-            Source::Channels { cursor, local, model } => {
-                cursor.seek(time);
-                for &bone in &self.plan.modelled {
-                    local[bone] = cursor.local(bone).matrix();
-                    model[bone] = match self.subject.skeleton.parent(bone) {
-                        Some(parent) => model[parent] * local[bone],
-                        None => local[bone],
-                    };
-                }
-            }
-        }
-    }
-
-    /// The stretch of `bone`'s model matrix at this sample; its parent's must have been asked for first.
-    fn stretch(&mut self, bone: usize) -> Stretch {
-        let parent = self.subject.skeleton.parent(bone);
-        let start = self.previous[bone];
-        let inherits = parent.is_none() || self.plan.hierarchy.modes()[bone] == InheritMode::Full;
-        let above = parent.map_or(Stretch::NONE, |p| self.stretches[p]);
-        let stretch = match &mut self.source {
-            Source::Pose(pose) if inherits => above.child(bone, &mut pose.local.as_slice(), start),
-            Source::Pose(pose) => Stretch::of_matrix(&pose.model.model[bone], start),
-            Source::Channels { cursor, .. } => above.child(bone, cursor, start),
-        };
-        self.stretches[bone] = stretch;
-        self.previous[bone] = stretch.frame;
-        stretch
-    }
-
-    /// The bones whose stretch is the same at every sample, once every bone's stretch has been asked for: read
-    /// channel by channel, a bone the clip neither scales nor, below non-uniform scale, turns, under such bones.
-    fn fixed_bones(&self) -> Vec<bool> {
-        let (skeleton, plan) = (self.subject.skeleton, self.plan);
-        let mut fixed = vec![false; skeleton.len()];
-        if !plan.by_channel {
-            return fixed;
-        }
-        for bone in 0..skeleton.len() {
-            let above = skeleton.parent(bone).map_or(Some(Stretch::NONE), |p| fixed[p].then(|| self.stretches[p]));
-            fixed[bone] = above.is_some_and(|above| {
-                !plan.varying_scale[bone] && (!plan.varying_rotation[bone] || above.is_uniform())
-            });
-        }
-        fixed
-    }
-
-    /// The local and model matrices of a plotted bone at this sample.
-    fn matrices(&self, bone: usize) -> (DMat4, DMat4) {
-        match &self.source {
-            Source::Pose(pose) => (pose.local[bone].matrix(), pose.model.model[bone]),
-            Source::Channels { local, model, .. } => (local[bone], model[bone]),
-        }
-    }
-}
-
-/// `bones` and all their ancestors, sorted (so parents come first).
-fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
-    let mut wanted = vec![false; skeleton.len()];
-    for &bone in bones.iter().filter(|&&b| b < skeleton.len()) {
-        let mut next = Some(bone);
-        while let Some(b) = next.filter(|&b| !wanted[b]) {
-            wanted[b] = true;
-            next = skeleton.parent(b);
-        }
-    }
-    (0..skeleton.len()).filter(|&b| wanted[b]).collect()
 }
 
 fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<ChunkResult>) -> ClipAnalysis {

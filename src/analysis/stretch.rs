@@ -14,44 +14,47 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::findings::{Judge, Verdict};
-use crate::eval::ClipCursor;
+use crate::eval::BoneCursor;
 use crate::math::decompose_near;
 use crate::model::{Transform, affine};
 
 /// A bone's local channels at one time, read on demand.
 pub(crate) trait LocalChannels {
-    fn rotation(&mut self, bone: usize) -> DQuat;
-    fn scale(&mut self, bone: usize) -> DVec3;
+    fn rotation(&mut self) -> DQuat;
+    fn scale(&mut self) -> DVec3;
     /// The local stretch rotation (the `U` of `T·R·U·S·Uᵀ`).
-    fn stretch(&mut self, bone: usize) -> DQuat;
+    fn stretch(&mut self) -> DQuat;
 }
 
-impl LocalChannels for ClipCursor<'_> {
-    fn rotation(&mut self, bone: usize) -> DQuat {
-        ClipCursor::rotation(self, bone)
+/// A bone's channels read from a clip at one time.
+pub(crate) struct CursorAt<'c, 'a>(pub &'c mut BoneCursor<'a>, pub f64);
+
+impl LocalChannels for CursorAt<'_, '_> {
+    fn rotation(&mut self) -> DQuat {
+        self.0.rotation(self.1)
     }
 
-    fn scale(&mut self, bone: usize) -> DVec3 {
-        ClipCursor::scale(self, bone)
+    fn scale(&mut self) -> DVec3 {
+        self.0.scale(self.1)
     }
 
-    fn stretch(&mut self, bone: usize) -> DQuat {
-        ClipCursor::stretch(self, bone)
+    fn stretch(&mut self) -> DQuat {
+        self.0.stretch()
     }
 }
 
-/// A local pose evaluated in full.
-impl LocalChannels for &[Transform] {
-    fn rotation(&mut self, bone: usize) -> DQuat {
-        self[bone].rotation
+/// A local transform evaluated in full.
+impl LocalChannels for &Transform {
+    fn rotation(&mut self) -> DQuat {
+        self.rotation
     }
 
-    fn scale(&mut self, bone: usize) -> DVec3 {
-        self[bone].scale
+    fn scale(&mut self) -> DVec3 {
+        self.scale
     }
 
-    fn stretch(&mut self, bone: usize) -> DQuat {
-        self[bone].stretch
+    fn stretch(&mut self) -> DQuat {
+        self.stretch
     }
 }
 
@@ -75,17 +78,18 @@ impl Stretch {
         Stretch { frame: parts.stretch, scale: parts.scale, sign: parts.sign }
     }
 
-    /// The stretch of `M·L`, `self` being `M`'s and `L` the local transform of `bone`: a fully inheriting child
-    /// (or a root, under [`Stretch::NONE`]). `start` is where a decomposition, when one is needed, starts its search.
-    pub fn child(&self, bone: usize, local: &mut impl LocalChannels, start: DQuat) -> Self {
-        let (scale, own) = (local.scale(bone), local.stretch(bone));
+    /// The stretch of `M·L`, `self` being `M`'s and `L` the local transform read from `local`: a fully inheriting
+    /// child (or a root, under [`Stretch::NONE`]). `start` is where a decomposition, when one is needed, starts its
+    /// search.
+    pub fn child(&self, local: &mut impl LocalChannels, start: DQuat) -> Self {
+        let (scale, own) = (local.scale(), local.stretch());
         if let Some(k) = uniform(self.scale) {
             // M·L = F·k·(W·Vᵀ)·L with W·Vᵀ a rotation: L's own stretch, times k. Negative factors mirror; the
             // stretch keeps their magnitudes (`U·S·Uᵀ = U·|S|·Uᵀ·D` with `D` diagonal ±1 commuting with `|S|`).
             let sign = if scale.x * scale.y * scale.z < 0.0 { -self.sign } else { self.sign };
             return Stretch { frame: own, scale: scale.abs() * k, sign };
         }
-        let rotation = local.rotation(bone);
+        let rotation = local.rotation();
         if own == DQuat::IDENTITY
             && let Some(c) = uniform(scale)
             && c > 0.0
@@ -105,12 +109,13 @@ impl Stretch {
     }
 
     pub fn verdict(&self, judge: &Judge) -> Verdict {
-        judge.verdict(self.frame, self.scale, self.sign, self.shear_cosine())
+        judge.verdict(self.frame, self.scale, self.sign, self.shear_cosine_squared())
     }
 
-    /// [`crate::math::largest_column_cosine`] of `M`, from `MᵀM = V·K²·Vᵀ`: `cos²` of columns `i, j` is
-    /// `G_ij²/(G_ii·G_jj)`, so the largest needs one square root (and no column lengths).
-    fn shear_cosine(&self) -> f64 {
+    /// The square of [`crate::math::largest_column_cosine`] of `M`, from `MᵀM = V·K²·Vᵀ`: `cos²` of columns
+    /// `i, j` is `G_ij²/(G_ii·G_jj)`; the largest is found by cross-multiplying, so it takes one division (and no
+    /// square root, no column lengths).
+    fn shear_cosine_squared(&self) -> f64 {
         if self.frame == DQuat::IDENTITY || self.is_uniform() {
             return 0.0;
         }
@@ -120,15 +125,15 @@ impl Stretch {
         let rows = [v.row(0), v.row(1), v.row(2)];
         let gram = |i: usize, j: usize| (rows[i] * k2).dot(rows[j]);
         let diagonal = [gram(0, 0), gram(1, 1), gram(2, 2)];
-        let mut worst: f64 = 0.0;
+        let (mut numerator, mut denominator) = (0.0, 1.0);
         for (i, j) in [(0, 1), (0, 2), (1, 2)] {
             let lengths = diagonal[i] * diagonal[j];
-            if lengths > 0.0 && lengths.is_finite() {
-                let dot = gram(i, j);
-                worst = worst.max(dot * dot / lengths);
+            let dot = gram(i, j);
+            if lengths > 0.0 && lengths.is_finite() && dot * dot * denominator > numerator * lengths {
+                (numerator, denominator) = (dot * dot, lengths);
             }
         }
-        worst.sqrt().min(1.0)
+        (numerator / denominator).min(1.0)
     }
 }
 
@@ -176,15 +181,14 @@ mod tests {
             let tolerances = Tolerances::default();
             let judge = Judge::new(&tolerances);
             let (mut model, mut stretch) = (DMat4::IDENTITY, Stretch::NONE);
-            let mut locals: &[Transform] = &chain;
             for (bone, local) in chain.iter().enumerate() {
                 model *= local.matrix();
-                stretch = stretch.child(bone, &mut locals, DQuat::IDENTITY);
+                stretch = stretch.child(&mut &*local, DQuat::IDENTITY);
                 let expected = Assessment::of(&model, &tolerances);
                 let verdict = stretch.verdict(&judge);
                 prop_assert_eq!(verdict.findings, expected.findings, "bone {}", bone);
                 prop_assert!((verdict.stretch_deg() - expected.stretch_deg).abs() < 1e-9, "bone {}", bone);
-                let shear = crate::math::shear_deg_of_cosine(verdict.shear_cosine);
+                let shear = crate::math::shear_deg_of_cosine(verdict.shear_cosine_squared.sqrt());
                 prop_assert!((shear - expected.shear_deg).abs() < 1e-9, "bone {}: {} vs {}", bone, shear, expected.shear_deg);
                 let scale = expected.parts.scale;
                 prop_assert!((stretch.scale.max_element() - scale.max_element()).abs() < 1e-12 * scale.max_element());
@@ -195,17 +199,17 @@ mod tests {
 
     #[test]
     fn a_root_under_none_and_a_uniform_chain_read_no_rotation() {
-        struct Counting<'a>(&'a [Transform], usize);
+        struct Counting<'a>(&'a Transform, &'a mut usize);
         impl LocalChannels for Counting<'_> {
-            fn rotation(&mut self, bone: usize) -> DQuat {
-                self.1 += 1;
-                self.0[bone].rotation
+            fn rotation(&mut self) -> DQuat {
+                *self.1 += 1;
+                self.0.rotation
             }
-            fn scale(&mut self, bone: usize) -> DVec3 {
-                self.0[bone].scale
+            fn scale(&mut self) -> DVec3 {
+                self.0.scale
             }
-            fn stretch(&mut self, bone: usize) -> DQuat {
-                self.0[bone].stretch
+            fn stretch(&mut self) -> DQuat {
+                self.0.stretch
             }
         }
         let r = DQuat::from_rotation_z(0.7);
@@ -214,16 +218,16 @@ mod tests {
             Transform::from_trs(DVec3::Y, r, DVec3::new(1.0, 3.0, 1.0)),
             Transform::from_trs(DVec3::Y, r, DVec3::ONE),
         ];
-        let mut channels = Counting(&chain, 0);
-        let root = Stretch::NONE.child(0, &mut channels, DQuat::IDENTITY);
-        let aligned = root.child(1, &mut channels, DQuat::IDENTITY);
-        assert_eq!(channels.1, 0, "uniform scale above: no rotation needed");
+        let mut reads = 0;
+        let root = Stretch::NONE.child(&mut Counting(&chain[0], &mut reads), DQuat::IDENTITY);
+        let aligned = root.child(&mut Counting(&chain[1], &mut reads), DQuat::IDENTITY);
+        assert_eq!(reads, 0, "uniform scale above: no rotation needed");
         assert_eq!(aligned, Stretch { frame: DQuat::IDENTITY, scale: DVec3::new(2.0, 6.0, 2.0), sign: 1.0 });
         let judge = Judge::new(&Tolerances::default());
         assert!(aligned.verdict(&judge).findings.non_uniform);
         // Below the non-uniform bone the child's rotation turns the stretch frame: V = Rᵀ, sheared by 0.7 rad.
-        let sheared = aligned.child(2, &mut channels, DQuat::IDENTITY);
-        assert_eq!(channels.1, 1);
+        let sheared = aligned.child(&mut Counting(&chain[2], &mut reads), DQuat::IDENTITY);
+        assert_eq!(reads, 1);
         assert!(sheared.frame.abs_diff_eq(r.conjugate(), 1e-15));
         assert!(sheared.verdict(&judge).findings.stretched);
     }

@@ -12,7 +12,7 @@ mod sample;
 pub mod skinning;
 
 pub use bind::{bind_model_matrices, bind_pose};
-pub use cursor::ClipCursor;
+pub use cursor::BoneCursor;
 pub use hierarchy::{Hierarchy, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use pose::Pose;

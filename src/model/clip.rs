@@ -110,9 +110,9 @@ impl<T: KeyValue> Track<T> {
     pub fn is_constant(&self) -> bool {
         let per_key = self.interpolation.values_per_key();
         let first = self.values[per_key / 2];
-        self.values.chunks(per_key).all(|key| {
-            key.iter().enumerate().all(|(i, v)| if i == per_key / 2 { *v == first } else { v.is_zero() })
-        })
+        self.values
+            .chunks(per_key)
+            .all(|key| key.iter().enumerate().all(|(i, v)| if i == per_key / 2 { *v == first } else { v.is_zero() }))
     }
 }
 

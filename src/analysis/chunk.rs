@@ -1,0 +1,294 @@
+//! One parallel work item of a whole-clip analysis: a run of consecutive sample times, every bone judged at each,
+//! curves of the plotted bones.
+//!
+//! Verdicts come from each bone's [`Stretch`] passed down the hierarchy (see `stretch.rs`). A clip without layers
+//! on a fully inheriting rig is judged bone by bone, each bone over the whole run before the next: only the
+//! channels a stretch needs are read (scales everywhere, rotations below non-uniform scale), one track at a time,
+//! and a bone whose stretch cannot change in the run is judged once. Layers, or bones that inherit otherwise, need
+//! whole poses: those runs are judged sample by sample.
+
+use glam::{DMat4, DQuat};
+
+use super::Assessment;
+use super::findings::{Judge, Verdict};
+use super::scan::{BoneSummary, Components, CurveRequest, Curves, ScanOptions, Subject};
+use super::stretch::{CursorAt, Stretch};
+use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
+use crate::model::{BoneTracks, Clip, InheritMode, Skeleton};
+
+/// What the workers need to know about the subject, found once per analysis.
+pub(super) struct Plan<'a> {
+    hierarchy: &'a Hierarchy,
+    /// The clip, when it is judged bone by bone: no layers, every bone inheriting fully.
+    by_bone: Option<&'a Clip>,
+    /// Each bone's parent, and whether its stretch passes down from it ([`Stretch::child`]: full inheritance, or a
+    /// root) rather than coming from its model matrix.
+    parents: Vec<Option<usize>>,
+    inherits: Vec<bool>,
+    /// How many children each bone has: a bone's stretches are dropped once they are all judged.
+    children: Vec<usize>,
+    /// Whether the clip changes each bone's scale, and its rotation, over time (constant tracks do not).
+    varying_scale: Vec<bool>,
+    varying_rotation: Vec<bool>,
+    /// The plotted bones and their ancestors, parents first: their local and model matrices are evaluated.
+    modelled: Vec<usize>,
+}
+
+impl<'a> Plan<'a> {
+    pub fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
+        let skeleton = subject.skeleton;
+        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
+        let by_bone = subject.clip.filter(|_| subject.layered.is_none() && all_full);
+        let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
+            (0..skeleton.len()).map(|b| by_bone.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
+        };
+        let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
+        let mut children = vec![0; parents.len()];
+        parents.iter().flatten().for_each(|&p| children[p] += 1);
+        Plan {
+            hierarchy,
+            by_bone,
+            inherits: parents
+                .iter()
+                .zip(hierarchy.modes())
+                .map(|(p, &m)| p.is_none() || m == InheritMode::Full)
+                .collect(),
+            parents,
+            children,
+            varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
+            varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
+            modelled: with_ancestors(skeleton, plotted),
+        }
+    }
+}
+
+/// What one chunk of samples produced.
+pub(super) struct ChunkResult {
+    pub summaries: Vec<BoneSummary>,
+    /// `words` words of flags per bone.
+    pub bits: Vec<u64>,
+    pub words: usize,
+    pub curves: Vec<Curves>,
+}
+
+impl ChunkResult {
+    fn new(bones: usize, samples: usize, curves: usize) -> Self {
+        let words = samples.div_ceil(64);
+        ChunkResult {
+            summaries: (0..bones).map(BoneSummary::new).collect(),
+            bits: vec![0; bones * words],
+            words,
+            curves: vec![Curves::default(); curves],
+        }
+    }
+
+    fn add(&mut self, bone: usize, sample: usize, time: f64, verdict: &Verdict) {
+        self.summaries[bone].add(time, verdict);
+        self.bits[bone * self.words + sample / 64] |= u64::from(verdict.findings.stretched) << (sample % 64);
+    }
+
+    /// `verdict` for `bone` at every one of `times`.
+    fn add_throughout(&mut self, bone: usize, times: &[f64], verdict: &Verdict) {
+        self.add(bone, 0, times[0], verdict);
+        self.summaries[bone].repeat(times.len() - 1, verdict);
+        if verdict.findings.stretched {
+            let words = &mut self.bits[bone * self.words..][..self.words];
+            for (w, word) in words.iter_mut().enumerate() {
+                let bits = times.len().saturating_sub(64 * w).min(64);
+                *word = if bits == 64 { u64::MAX } else { (1 << bits) - 1 };
+            }
+        }
+    }
+}
+
+/// Analyses the samples at `times`.
+pub(super) fn analyze_chunk(
+    subject: Subject,
+    plan: &Plan,
+    request: CurveRequest,
+    options: &ScanOptions,
+    times: &[f64],
+) -> ChunkResult {
+    let chunk = Chunk { subject, plan, request, options, judge: Judge::new(&options.tolerances), times };
+    let mut result = ChunkResult::new(subject.skeleton.len(), times.len(), request.bones.len());
+    let mut layers = subject.worker_layers();
+    match plan.by_bone {
+        Some(clip) => {
+            chunk.judge_by_bone(clip, &mut result);
+            chunk.plot_by_bone(clip, &mut result);
+        }
+        None => chunk.judge_by_pose(&mut layers, &mut result),
+    }
+    if let Some(ghost) = request.ghost {
+        let mut pose = Pose::default();
+        for &time in times {
+            match ghost.unlayered {
+                true => pose.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time),
+                false => subject.evaluate(&mut pose, ghost.hierarchy, &mut layers, time),
+            }
+            for (curves, &bone) in result.curves.iter_mut().zip(request.bones) {
+                let assessment = Assessment::of(&pose.model.model[bone], &options.tolerances);
+                curves.ghost_model.push(Components::of(&assessment));
+            }
+        }
+    }
+    result
+}
+
+/// One bone's stretches over the run.
+enum Run {
+    /// The same at every sample.
+    Fixed(Stretch),
+    /// One per sample.
+    Varying(Vec<Stretch>),
+    /// Dropped once every child was judged.
+    Done,
+}
+
+const ROOT: Run = Run::Fixed(Stretch::NONE);
+
+/// One chunk's work: the subject and what to compute at `times`.
+struct Chunk<'a> {
+    subject: Subject<'a>,
+    plan: &'a Plan<'a>,
+    request: CurveRequest<'a>,
+    options: &'a ScanOptions,
+    judge: Judge,
+    times: &'a [f64],
+}
+
+impl Chunk<'_> {
+    /// Judges every bone of a fully inheriting rig, one bone over all the times before the next.
+    fn judge_by_bone(&self, clip: &Clip, result: &mut ChunkResult) {
+        let (skeleton, plan, times) = (self.subject.skeleton, self.plan, self.times);
+        let mut runs: Vec<Run> = (0..skeleton.len()).map(|_| Run::Done).collect();
+        let mut pending_children = plan.children.clone();
+        let mut spare: Vec<Vec<Stretch>> = Vec::new();
+        for bone in 0..skeleton.len() {
+            let mut cursor = BoneCursor::new(skeleton, clip, bone);
+            let above = plan.parents[bone].map_or(&ROOT, |p| &runs[p]);
+            // A bone the clip does not scale, under a fixed stretch that is uniform or with a rotation that does
+            // not change, keeps one stretch throughout.
+            let fixed = match above {
+                Run::Fixed(above) if !plan.varying_scale[bone] => {
+                    (above.is_uniform() || !plan.varying_rotation[bone]).then_some(*above)
+                }
+                _ => None,
+            };
+            let run = match fixed {
+                Some(above) => {
+                    let stretch = above.child(&mut CursorAt(&mut cursor, times[0]), DQuat::IDENTITY);
+                    result.add_throughout(bone, times, &stretch.verdict(&self.judge));
+                    Run::Fixed(stretch)
+                }
+                None => {
+                    let mut stretches = spare.pop().unwrap_or_default();
+                    stretches.clear();
+                    let mut start = DQuat::IDENTITY;
+                    for (sample, &time) in times.iter().enumerate() {
+                        let parent = match above {
+                            Run::Varying(stretches) => stretches[sample],
+                            Run::Fixed(stretch) => *stretch,
+                            Run::Done => unreachable!("a parent's stretches are kept until its children are judged"),
+                        };
+                        let stretch = parent.child(&mut CursorAt(&mut cursor, time), start);
+                        start = stretch.frame;
+                        result.add(bone, sample, time, &stretch.verdict(&self.judge));
+                        stretches.push(stretch);
+                    }
+                    Run::Varying(stretches)
+                }
+            };
+            runs[bone] = run;
+            if let Some(parent) = plan.parents[bone] {
+                pending_children[parent] -= 1;
+                if pending_children[parent] == 0
+                    && let Run::Varying(stretches) = std::mem::replace(&mut runs[parent], Run::Done)
+                {
+                    spare.push(stretches);
+                }
+            }
+        }
+    }
+
+    /// The curves of the plotted bones, from their local transforms and those of their ancestors.
+    fn plot_by_bone(&self, clip: &Clip, result: &mut ChunkResult) {
+        let (skeleton, plan, bones) = (self.subject.skeleton, self.plan, self.request.bones);
+        if bones.is_empty() {
+            return;
+        }
+        let mut cursors: Vec<(usize, BoneCursor)> =
+            plan.modelled.iter().map(|&b| (b, BoneCursor::new(skeleton, clip, b))).collect();
+        let (mut local, mut model) = (vec![DMat4::IDENTITY; skeleton.len()], vec![DMat4::IDENTITY; skeleton.len()]);
+        let mut plot = Plotter::new(bones.len());
+        for &time in self.times {
+            for (bone, cursor) in &mut cursors {
+                local[*bone] = cursor.local(time).matrix();
+                model[*bone] = plan.parents[*bone].map_or(local[*bone], |p| model[p] * local[*bone]);
+            }
+            plot.push(bones, &local, &model, self.options, &mut result.curves);
+        }
+    }
+
+    /// Judges every bone from whole poses, one sample after another (layers, or bones that do not inherit
+    /// fully), keeping the plotted bones' curves on the way.
+    fn judge_by_pose(&self, layers: &mut Option<LayerStack>, result: &mut ChunkResult) {
+        let (plan, plotted) = (self.plan, self.request.bones);
+        let bones = self.subject.skeleton.len();
+        let (mut pose, mut stretches) = (Pose::default(), vec![Stretch::NONE; bones]);
+        let mut plot = Plotter::new(plotted.len());
+        let mut local = vec![DMat4::IDENTITY; bones];
+        for (sample, &time) in self.times.iter().enumerate() {
+            self.subject.evaluate(&mut pose, plan.hierarchy, layers, time);
+            for bone in 0..bones {
+                let start = stretches[bone].frame;
+                let stretch = match plan.parents[bone] {
+                    _ if !plan.inherits[bone] => Stretch::of_matrix(&pose.model.model[bone], start),
+                    Some(parent) => stretches[parent].child(&mut &pose.local[bone], start),
+                    None => Stretch::NONE.child(&mut &pose.local[bone], start),
+                };
+                stretches[bone] = stretch;
+                result.add(bone, sample, time, &stretch.verdict(&self.judge));
+            }
+            for &bone in plotted {
+                local[bone] = pose.local[bone].matrix();
+            }
+            plot.push(plotted, &local, &pose.model.model, self.options, &mut result.curves);
+        }
+    }
+}
+
+/// Appends the plotted bones' components, sample by sample.
+struct Plotter {
+    /// Where each plotted bone's decomposition starts: its stretch frame at the previous sample.
+    starts: Vec<DQuat>,
+}
+
+impl Plotter {
+    fn new(bones: usize) -> Self {
+        Plotter { starts: vec![DQuat::IDENTITY; bones] }
+    }
+
+    /// One sample of `bones`, given every bone's local and model matrices (only the plotted ones are read).
+    fn push(&mut self, bones: &[usize], local: &[DMat4], model: &[DMat4], options: &ScanOptions, out: &mut [Curves]) {
+        for ((curves, &bone), start) in out.iter_mut().zip(bones).zip(&mut self.starts) {
+            let assessment = Assessment::near(&model[bone], &options.tolerances, *start);
+            *start = assessment.parts.stretch;
+            curves.model.push(Components::of(&assessment));
+            curves.local.push(Components::of(&Assessment::of(&local[bone], &options.tolerances)));
+        }
+    }
+}
+
+/// `bones` and all their ancestors, sorted (so parents come first).
+fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
+    let mut wanted = vec![false; skeleton.len()];
+    for &bone in bones.iter().filter(|&&b| b < skeleton.len()) {
+        let mut next = Some(bone);
+        while let Some(b) = next.filter(|&b| !wanted[b]) {
+            wanted[b] = true;
+            next = skeleton.parent(b);
+        }
+    }
+    (0..skeleton.len()).filter(|&b| wanted[b]).collect()
+}
