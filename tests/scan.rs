@@ -189,7 +189,7 @@ fn fixed_and_moving() -> (Skeleton, Clip) {
 #[test]
 fn the_scan_agrees_with_decomposing_every_model_matrix() {
     let (skeleton, clip) = fixed_and_moving();
-    assert_scan_matches_brute_force("fixed and moving", &skeleton, &clip, &vec![InheritMode::Full; 5]);
+    assert_scan_matches_brute_force("fixed and moving", &skeleton, &clip, &[InheritMode::Full; 5]);
     // The long clip spreads over several chunks of several words of flags each.
     let (stress, long) = (stress_rig(40, 240, 4), stress_rig(12, 2400, 4));
     let demo = demo_rig();

@@ -72,13 +72,13 @@ pub(super) struct ChunkResult {
 }
 
 impl ChunkResult {
-    fn new(bones: usize, samples: usize, curves: usize) -> Self {
+    fn new(bones: usize, samples: usize, request: CurveRequest) -> Self {
         let words = samples.div_ceil(64);
         ChunkResult {
             summaries: (0..bones).map(BoneSummary::new).collect(),
             bits: vec![0; bones * words],
             words,
-            curves: vec![Curves::default(); curves],
+            curves: vec![Curves::with_capacity(samples, request.ghost.is_some()); request.bones.len()],
         }
     }
 
@@ -110,7 +110,7 @@ pub(super) fn analyze_chunk(
     times: &[f64],
 ) -> ChunkResult {
     let chunk = Chunk { subject, plan, request, options, judge: Judge::new(&options.tolerances), times };
-    let mut result = ChunkResult::new(subject.skeleton.len(), times.len(), request.bones.len());
+    let mut result = ChunkResult::new(subject.skeleton.len(), times.len(), request);
     let mut layers = subject.worker_layers();
     match plan.by_bone {
         Some(clip) => {

@@ -166,6 +166,18 @@ pub struct Curves {
     pub ghost_model: Vec<Components>,
 }
 
+impl Curves {
+    /// Room for `samples` samples, with or without ghost curves (long clips fill hundreds of megabytes: no
+    /// copies while they grow).
+    pub(super) fn with_capacity(samples: usize, ghost: bool) -> Self {
+        Curves {
+            local: Vec::with_capacity(samples),
+            model: Vec::with_capacity(samples),
+            ghost_model: Vec::with_capacity(if ghost { samples } else { 0 }),
+        }
+    }
+}
+
 /// What a whole-clip analysis computes besides the per-bone summaries.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CurveRequest<'a> {
@@ -373,7 +385,8 @@ fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<Ch
     let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();
     let mut stretched_bits = vec![0u64; bones * words_per_bone];
     let mut any_stretched_bits = vec![0u64; words_per_bone];
-    let mut curves: Vec<(usize, Curves)> = request.bones.iter().map(|&b| (b, Curves::default())).collect();
+    let mut curves: Vec<(usize, Curves)> =
+        request.bones.iter().map(|&b| (b, Curves::with_capacity(times.len(), request.ghost.is_some()))).collect();
     let mut first_word = 0;
     for chunk in chunks {
         let words = first_word..first_word + chunk.words;
