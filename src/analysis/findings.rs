@@ -95,6 +95,7 @@ impl Judge {
     /// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`), whose
     /// determinant has the sign `sign` (all they depend on) and whose [`largest_column_cosine`] is the square root
     /// of `shear_cosine_squared`.
+    #[inline]
     pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine_squared: f64) -> Verdict {
         let tolerances = &self.tolerances;
         let (min, max) = (scale.min_element(), scale.max_element());

@@ -81,6 +81,7 @@ impl Stretch {
     /// The stretch of `M·L`, `self` being `M`'s and `L` the local transform read from `local`: a fully inheriting
     /// child (or a root, under [`Stretch::NONE`]). `start` is where a decomposition, when one is needed, starts its
     /// search.
+    #[inline]
     pub fn child(&self, local: &mut impl LocalChannels, start: DQuat) -> Self {
         let (scale, own) = (local.scale(), local.stretch());
         if let Some(k) = uniform(self.scale) {
@@ -108,6 +109,7 @@ impl Stretch {
         uniform(self.scale).is_some()
     }
 
+    #[inline]
     pub fn verdict(&self, judge: &Judge) -> Verdict {
         judge.verdict(self.frame, self.scale, self.sign, self.shear_cosine_squared())
     }
@@ -115,6 +117,7 @@ impl Stretch {
     /// The square of [`crate::math::largest_column_cosine`] of `M`, from `MᵀM = V·K²·Vᵀ`: `cos²` of columns
     /// `i, j` is `G_ij²/(G_ii·G_jj)`; the largest is found by cross-multiplying, so it takes one division (and no
     /// square root, no column lengths).
+    #[inline]
     fn shear_cosine_squared(&self) -> f64 {
         if self.frame == DQuat::IDENTITY || self.is_uniform() {
             return 0.0;

@@ -37,6 +37,7 @@ impl<'a> BoneCursor<'a> {
         }
     }
 
+    #[inline]
     pub fn rotation(&mut self, time: f64) -> DQuat {
         match self.tracks.and_then(|t| t.rotation.as_ref()) {
             Some(track) if track.interpolation() == Interpolation::Linear => self.slerp(track, time),
@@ -69,6 +70,7 @@ impl<'a> BoneCursor<'a> {
 
     /// A linear rotation track at `time` as [`sample_track_near`] samples it, the key interval's [`Slerp`] kept
     /// for the next times that fall in it.
+    #[inline]
     fn slerp(&mut self, track: &Track<Quat>, time: f64) -> DQuat {
         match Span::locate_near(track.times(), time, &mut self.hints[1]) {
             Span::Key(k) => key_value(track, k),

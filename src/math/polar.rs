@@ -104,6 +104,7 @@ pub fn stretch_angle_deg_within(stretch: DQuat, scale: DVec3, relative_tolerance
 
 /// `cos(θ/2)` of the angle `θ` of [`stretch_angle_deg_within`]: 1 for no turn, smaller for larger turns, and
 /// without an inverse cosine (a whole-clip scan compares these and converts only the worst).
+#[inline]
 pub fn stretch_half_cosine_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
     if stretch == DQuat::IDENTITY {
         return 1.0;
