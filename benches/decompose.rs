@@ -7,13 +7,21 @@
 //! - `sheared_extreme`: as `sheared`, the largest/smallest factor ratio 10^e with e uniform in [0, 6] and an overall
 //!   magnitude in [1e-2, 1e2].
 //!
+//! And the matrices an animation really gives: every model matrix of a clip at every 30 Hz sample time, for the
+//! generated `stress_rig` (a non-uniformly scaled bone in each chain of ten, the bones below it sheared) and for
+//! Blender's `stretchy_full.glb` from `../shared/assets` (skipped when missing).
+//!
 //! nalgebra gets the same matrices, already converted to `Matrix3<f64>` outside the timed loop. Accuracy is measured
 //! once in the setup and printed to stderr (see `BENCHMARKS.md`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
+use bonescope::analysis::sample_times;
+use bonescope::eval::{Hierarchy, Pose};
+use bonescope::import::stress_rig;
 use bonescope::math::{AffineParts, decompose, decompose_near};
+use bonescope::model::Rig;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use nalgebra::Matrix3;
@@ -223,6 +231,19 @@ fn bench_set(c: &mut Criterion, name: &str, set: &[DMat4]) {
     group.finish();
 }
 
+/// Every model matrix of the rig's first clip at every 30 Hz sample time (with the key times).
+fn clip_set(rig: &Rig) -> Vec<DMat4> {
+    let (skeleton, clip) = (&rig.skeleton, rig.clips.first());
+    let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes());
+    let mut pose = Pose::default();
+    let mut set = Vec::new();
+    for time in sample_times(clip, 30.0) {
+        pose.evaluate(skeleton, clip, &hierarchy, time);
+        set.extend_from_slice(&pose.model.model);
+    }
+    set
+}
+
 /// One sheared bone over consecutive frames: a rotation and a parent's squash-and-stretch that change a little each
 /// frame, as a whole-clip scan meets them.
 fn animated_set() -> Vec<DMat4> {
@@ -272,6 +293,12 @@ fn benches(c: &mut Criterion) {
     bench_set(c, "decompose/sheared", &sheared);
     bench_set(c, "decompose/sheared_extreme", &extreme);
     bench_sequence(c, &animated_set());
+    bench_set(c, "decompose/clip_stress_rig", &clip_set(&stress_rig(50, 200, 5)));
+    let stretchy = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    match bonescope::import::load(&stretchy) {
+        Ok(rig) => bench_set(c, "decompose/clip_stretchy_full", &clip_set(&rig)),
+        Err(e) => eprintln!("skipping decompose/clip_stretchy_full: {e}"),
+    }
 }
 
 criterion_group! {

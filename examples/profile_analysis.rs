@@ -1,0 +1,42 @@
+//! The whole-clip analysis of the app benchmark's rig, timed, for profilers (`perf record`): 500 bones in chains of
+//! ten, a key every 5 frames, 8 plotted bones below scaled bones (see `benches/app_frame.rs`).
+//!
+//! `cargo build --profile bench --example profile_analysis`, then
+//! `PLOT=8 THREADS=1 target/release/examples/profile_analysis 10000` (frames; `PLOT` plotted bones, `THREADS`
+//! worker threads). Prints the time of three runs and the cost per bone-sample.
+
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use bonescope::analysis::{CurveRequest, ScanOptions, Subject, analyze};
+use bonescope::eval::Hierarchy;
+use bonescope::import::stress_rig;
+
+fn setting(name: &str, default: usize) -> usize {
+    std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+fn main() {
+    let frames = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(10_000);
+    let rig = stress_rig(500, frames, 5);
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let plotted: Vec<usize> = (0..setting("PLOT", 8)).map(|i| 6 + 10 * i).collect();
+    let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
+    let never = AtomicBool::new(false);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(setting("THREADS", 1)).build().expect("a thread pool");
+    for _ in 0..3 {
+        let started = Instant::now();
+        let analysis = pool.install(|| {
+            let subject = Subject::clip(&rig.skeleton, rig.clips.first());
+            let request = CurveRequest { bones: &plotted, ghost: None };
+            analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).expect("never cancelled")
+        });
+        let seconds = started.elapsed().as_secs_f64();
+        let bone_samples = analysis.times.len() * rig.skeleton.len();
+        let stretched = analysis.scan.bones.iter().filter(|b| b.stretched()).count();
+        println!(
+            "{seconds:.3} s, {:.1} ns/bone-sample, {stretched} bones stretched",
+            seconds * 1e9 / bone_samples as f64
+        );
+    }
+}
