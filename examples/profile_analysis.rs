@@ -3,14 +3,16 @@
 //!
 //! `cargo build --profile bench --example profile_analysis`, then
 //! `PLOT=8 THREADS=1 target/release/examples/profile_analysis 10000` (frames; `PLOT` plotted bones, `THREADS`
-//! worker threads). Prints the time of three runs and the cost per bone-sample.
+//! worker threads; `GHOST=segment-compensate` adds ghost curves under that mode). Prints the time of three runs and
+//! the cost per bone-sample.
 
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use bonescope::analysis::{CurveRequest, ScanOptions, Subject, analyze};
+use bonescope::analysis::{CurveRequest, GhostRequest, ScanOptions, Subject, analyze};
 use bonescope::eval::Hierarchy;
 use bonescope::import::stress_rig;
+use bonescope::model::InheritMode;
 
 fn setting(name: &str, default: usize) -> usize {
     std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
@@ -21,6 +23,9 @@ fn main() {
     let rig = stress_rig(500, frames, 5);
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
     let plotted: Vec<usize> = (0..setting("PLOT", 8)).map(|i| 6 + 10 * i).collect();
+    let ghost_mode = std::env::var("GHOST").ok().map(|id| id.parse::<InheritMode>().expect("a mode id"));
+    let ghost_hierarchy = ghost_mode.map(|mode| Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]));
+    let ghost = ghost_hierarchy.as_ref().map(|hierarchy| GhostRequest { hierarchy, unlayered: false });
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let never = AtomicBool::new(false);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(setting("THREADS", 1)).build().expect("a thread pool");
@@ -28,7 +33,7 @@ fn main() {
         let started = Instant::now();
         let analysis = pool.install(|| {
             let subject = Subject::clip(&rig.skeleton, rig.clips.first());
-            let request = CurveRequest { bones: &plotted, ghost: None };
+            let request = CurveRequest { bones: &plotted, ghost };
             analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).expect("never cancelled")
         });
         let seconds = started.elapsed().as_secs_f64();

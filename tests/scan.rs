@@ -3,7 +3,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use bonescope::analysis::{Assessment, CurveRequest, ScanOptions, Subject, analyze, sample_times, scan};
+use bonescope::analysis::{Assessment, CurveRequest, GhostRequest, ScanOptions, Subject, analyze, sample_times, scan};
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
@@ -214,5 +214,36 @@ fn the_scan_agrees_with_decomposing_every_model_matrix() {
         // Mixed: fully inheriting bones below bones judged from their model matrices.
         let mixed: Vec<InheritMode> = (0..skeleton.len()).map(|b| InheritMode::ALL[b % 3]).collect();
         assert_scan_matches_brute_force(&format!("{label}, mixed"), skeleton, &rig.clips[clip], &mixed);
+    }
+}
+
+/// Ghost curves are the plotted bones under the ghost's modes, evaluated only down their chains: they must be the
+/// components of the whole pose evaluated under those modes.
+#[test]
+fn ghost_curves_match_the_whole_pose_under_the_ghost_modes() {
+    let rig = stress_rig(30, 150, 5);
+    let (skeleton, clip) = (&rig.skeleton, &rig.clips[0]);
+    let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes());
+    let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
+    let plotted = [7, 16, 25];
+    let never = AtomicBool::new(false);
+    for mode in InheritMode::ALL {
+        let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]);
+        let ghost = GhostRequest { hierarchy: &ghost_hierarchy, unlayered: false };
+        let request = CurveRequest { bones: &plotted, ghost: Some(ghost) };
+        let subject = Subject::clip(skeleton, Some(clip));
+        let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
+        let mut pose = Pose::default();
+        for (sample, &time) in analysis.times.iter().enumerate() {
+            pose.evaluate(skeleton, Some(clip), &ghost_hierarchy, time);
+            for &bone in &plotted {
+                let expected = Assessment::of(&pose.model.model[bone], &options.tolerances);
+                let got = analysis.curves_of(bone).unwrap().ghost_model[sample];
+                let label = format!("{}: bone {bone} at {time}", mode.id());
+                assert!(got.position().abs_diff_eq(expected.parts.translation, 1e-6), "{label}");
+                assert!(got.rotation.abs_diff_eq(expected.parts.rotation.as_quat(), 1e-6), "{label}");
+                assert!(got.scale.abs_diff_eq(expected.parts.scale.as_vec3(), 1e-6), "{label}");
+            }
+        }
     }
 }

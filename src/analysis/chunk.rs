@@ -11,10 +11,10 @@ use glam::{DMat4, DQuat};
 
 use super::Assessment;
 use super::findings::{Judge, Verdict};
-use super::scan::{BoneSummary, Components, CurveRequest, Curves, ScanOptions, Subject};
+use super::scan::{BoneSummary, Components, CurveRequest, Curves, GhostRequest, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
-use crate::model::{BoneTracks, Clip, InheritMode, Skeleton};
+use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 
 /// What the workers need to know about the subject, found once per analysis.
 pub(super) struct Plan<'a> {
@@ -120,17 +120,7 @@ pub(super) fn analyze_chunk(
         None => chunk.judge_by_pose(&mut layers, &mut result),
     }
     if let Some(ghost) = request.ghost {
-        let mut pose = Pose::default();
-        for &time in times {
-            match ghost.unlayered {
-                true => pose.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time),
-                false => subject.evaluate(&mut pose, ghost.hierarchy, &mut layers, time),
-            }
-            for (curves, &bone) in result.curves.iter_mut().zip(request.bones) {
-                let assessment = Assessment::of(&pose.model.model[bone], &options.tolerances);
-                curves.ghost_model.push(Components::of(&assessment));
-            }
-        }
+        chunk.plot_ghost(ghost, &mut layers, &mut result);
     }
     result
 }
@@ -227,6 +217,36 @@ impl Chunk<'_> {
                 model[*bone] = plan.parents[*bone].map_or(local[*bone], |p| model[p] * local[*bone]);
             }
             plot.push(bones, &local, &model, self.options, &mut result.curves);
+        }
+    }
+
+    /// The ghost curves: the plotted bones under the ghost's modes. Without layers only the plotted bones and their
+    /// ancestors are sampled and evaluated; through layers, whole poses.
+    fn plot_ghost(&self, ghost: GhostRequest, layers: &mut Option<LayerStack>, result: &mut ChunkResult) {
+        let (subject, bones) = (self.subject, self.request.bones);
+        let skeleton = subject.skeleton;
+        let by_bone = subject.clip.filter(|_| ghost.unlayered || subject.layered.is_none());
+        let mut cursors: Vec<(usize, BoneCursor)> = match by_bone {
+            Some(clip) => self.plan.modelled.iter().map(|&b| (b, BoneCursor::new(skeleton, clip, b))).collect(),
+            None => Vec::new(),
+        };
+        let mut pose = Pose::default();
+        for &time in self.times {
+            match by_bone {
+                Some(_) => {
+                    pose.local.resize(skeleton.len(), Transform::IDENTITY);
+                    for (bone, cursor) in &mut cursors {
+                        pose.local[*bone] = cursor.local(time);
+                    }
+                    ghost.hierarchy.evaluate_bones(&pose.local, &self.plan.modelled, &mut pose.model);
+                }
+                None if ghost.unlayered => pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
+                None => subject.evaluate(&mut pose, ghost.hierarchy, layers, time),
+            }
+            for (curves, &bone) in result.curves.iter_mut().zip(bones) {
+                let assessment = Assessment::of(&pose.model.model[bone], &self.options.tolerances);
+                curves.ghost_model.push(Components::of(&assessment));
+            }
         }
     }
 

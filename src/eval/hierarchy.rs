@@ -68,6 +68,22 @@ impl Hierarchy {
 
     /// Model matrices of the local pose `local` (one transform per bone, parents first).
     pub fn evaluate(&self, local: &[Transform], out: &mut ModelPose) {
+        self.size(local, out);
+        for (i, bone_local) in local.iter().enumerate() {
+            self.evaluate_bone(i, bone_local, out);
+        }
+    }
+
+    /// Model matrices of `bones` only (in increasing order, with every ancestor of each), for a few bones of a big
+    /// rig; only their entries of `local` are read, and the other bones' entries of `out` are not written.
+    pub fn evaluate_bones(&self, local: &[Transform], bones: &[usize], out: &mut ModelPose) {
+        self.size(local, out);
+        for &i in bones {
+            self.evaluate_bone(i, &local[i], out);
+        }
+    }
+
+    fn size(&self, local: &[Transform], out: &mut ModelPose) {
         let n = self.parents.len();
         assert_eq!(local.len(), n, "one local transform per bone");
         for v in [&mut out.model, &mut out.unscaled, &mut out.rigid] {
@@ -75,9 +91,6 @@ impl Hierarchy {
         }
         out.inherit_scale.resize(n, DVec3::ONE);
         out.carried_scale.resize(n, DVec3::ONE);
-        for (i, bone_local) in local.iter().enumerate() {
-            self.evaluate_bone(i, bone_local, out);
-        }
     }
 
     fn evaluate_bone(&self, i: usize, local: &Transform, out: &mut ModelPose) {
