@@ -9,7 +9,6 @@
 
 use glam::{DMat4, DQuat};
 
-use super::Assessment;
 use super::findings::{Judge, Verdict};
 use super::scan::{BoneSummary, Components, CurveRequest, Curves, GhostRequest, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
@@ -109,7 +108,7 @@ pub(super) fn analyze_chunk(
     options: &ScanOptions,
     times: &[f64],
 ) -> ChunkResult {
-    let chunk = Chunk { subject, plan, request, options, judge: Judge::new(&options.tolerances), times };
+    let chunk = Chunk { subject, plan, request, judge: Judge::new(&options.tolerances), times };
     let mut result = ChunkResult::new(subject.skeleton.len(), times.len(), request);
     let mut layers = subject.worker_layers();
     match plan.by_bone {
@@ -142,7 +141,6 @@ struct Chunk<'a> {
     subject: Subject<'a>,
     plan: &'a Plan<'a>,
     request: CurveRequest<'a>,
-    options: &'a ScanOptions,
     judge: Judge,
     times: &'a [f64],
 }
@@ -209,14 +207,16 @@ impl Chunk<'_> {
         }
         let mut cursors: Vec<(usize, BoneCursor)> =
             plan.modelled.iter().map(|&b| (b, BoneCursor::new(skeleton, clip, b))).collect();
-        let (mut local, mut model) = (vec![DMat4::IDENTITY; skeleton.len()], vec![DMat4::IDENTITY; skeleton.len()]);
+        let mut local = vec![Transform::IDENTITY; skeleton.len()];
+        let mut model = vec![DMat4::IDENTITY; skeleton.len()];
         let mut plot = Plotter::new(bones.len());
         for &time in self.times {
             for (bone, cursor) in &mut cursors {
-                local[*bone] = cursor.local(time).matrix();
-                model[*bone] = plan.parents[*bone].map_or(local[*bone], |p| model[p] * local[*bone]);
+                local[*bone] = cursor.local(time);
+                let matrix = local[*bone].matrix();
+                model[*bone] = plan.parents[*bone].map_or(matrix, |p| model[p] * matrix);
             }
-            plot.push(bones, &local, &model, self.options, &mut result.curves);
+            plot.push(bones, &local, &model, &mut result.curves);
         }
     }
 
@@ -231,6 +231,8 @@ impl Chunk<'_> {
             None => Vec::new(),
         };
         let mut pose = Pose::default();
+        // Where each ghost curve's decomposition starts: its stretch frame at the previous sample.
+        let mut starts = vec![DQuat::IDENTITY; bones.len()];
         for &time in self.times {
             match by_bone {
                 Some(_) => {
@@ -243,9 +245,10 @@ impl Chunk<'_> {
                 None if ghost.unlayered => pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
                 None => subject.evaluate(&mut pose, ghost.hierarchy, layers, time),
             }
-            for (curves, &bone) in result.curves.iter_mut().zip(bones) {
-                let assessment = Assessment::of(&pose.model.model[bone], &self.options.tolerances);
-                curves.ghost_model.push(Components::of(&assessment));
+            for ((curves, &bone), start) in result.curves.iter_mut().zip(bones).zip(&mut starts) {
+                let components = Components::of_matrix(&pose.model.model[bone], *start);
+                *start = components.stretch.as_dquat();
+                curves.ghost_model.push(components);
             }
         }
     }
@@ -257,7 +260,6 @@ impl Chunk<'_> {
         let bones = self.subject.skeleton.len();
         let (mut pose, mut stretches) = (Pose::default(), vec![Stretch::NONE; bones]);
         let mut plot = Plotter::new(plotted.len());
-        let mut local = vec![DMat4::IDENTITY; bones];
         for (sample, &time) in self.times.iter().enumerate() {
             self.subject.evaluate(&mut pose, plan.hierarchy, layers, time);
             for bone in 0..bones {
@@ -270,10 +272,7 @@ impl Chunk<'_> {
                 stretches[bone] = stretch;
                 result.add(bone, sample, time, &stretch.verdict(&self.judge));
             }
-            for &bone in plotted {
-                local[bone] = pose.local[bone].matrix();
-            }
-            plot.push(plotted, &local, &pose.model.model, self.options, &mut result.curves);
+            plot.push(plotted, &pose.local, &pose.model.model, &mut result.curves);
         }
     }
 }
@@ -289,13 +288,13 @@ impl Plotter {
         Plotter { starts: vec![DQuat::IDENTITY; bones] }
     }
 
-    /// One sample of `bones`, given every bone's local and model matrices (only the plotted ones are read).
-    fn push(&mut self, bones: &[usize], local: &[DMat4], model: &[DMat4], options: &ScanOptions, out: &mut [Curves]) {
+    /// One sample of `bones`, given every bone's local transform and model matrix (only the plotted ones are read).
+    fn push(&mut self, bones: &[usize], local: &[Transform], model: &[DMat4], out: &mut [Curves]) {
         for ((curves, &bone), start) in out.iter_mut().zip(bones).zip(&mut self.starts) {
-            let assessment = Assessment::near(&model[bone], &options.tolerances, *start);
-            *start = assessment.parts.stretch;
-            curves.model.push(Components::of(&assessment));
-            curves.local.push(Components::of(&Assessment::of(&local[bone], &options.tolerances)));
+            let components = Components::of_matrix(&model[bone], *start);
+            *start = components.stretch.as_dquat();
+            curves.model.push(components);
+            curves.local.push(Components::of_local(&local[bone]));
         }
     }
 }
