@@ -99,7 +99,7 @@ impl Judge {
     pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine_squared: f64) -> Verdict {
         let tolerances = &self.tolerances;
         let (min, max) = (scale.min_element(), scale.max_element());
-        // `anisotropy(scale) > min_anisotropy`, without the division.
+        // `max/min − 1 > min_anisotropy` (`AffineParts::anisotropy`), without the division.
         let anisotropic = max > min * (1.0 + tolerances.min_anisotropy);
         let stretch_half_cosine =
             if anisotropic { stretch_half_cosine_within(stretch, scale, tolerances.min_anisotropy) } else { 1.0 };

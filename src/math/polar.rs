@@ -78,32 +78,27 @@ impl AffineParts {
         quat_angle(self.stretch).to_degrees()
     }
 
-    /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees
-    /// (see [`stretch_angle_deg_within`]).
+    /// The angle of `U` once scale factors within `relative_tolerance` of each other count as equal, in degrees.
+    ///
+    /// Between nearly equal factors `U` may turn freely without changing the matrix by more than their difference,
+    /// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
+    /// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
+    /// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
+    /// between its axis and the nearest local axis, and 0 when all count as equal.
     pub fn stretch_angle_deg_within(&self, relative_tolerance: f64) -> f64 {
-        stretch_angle_deg_within(self.stretch, self.scale, relative_tolerance)
+        angle_of_half_cosine(stretch_half_cosine_within(self.stretch, self.scale, relative_tolerance))
     }
 
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
     pub fn anisotropy(&self) -> f64 {
-        anisotropy(self.scale)
+        let (min, max) = (self.scale.min_element(), self.scale.max_element());
+        if max == 0.0 { 0.0 } else { max / min - 1.0 }
     }
 }
 
-/// The angle of the stretch frame `stretch` with factors `scale` once factors within `relative_tolerance` of each
-/// other count as equal, in degrees.
-///
-/// Between nearly equal factors `U` may turn freely without changing `U·K·Uᵀ` by more than their difference,
-/// so this is the angle that matters when asking whether a bone is stretched. It is the angle of the frame
-/// [`decompose`] would choose with that tolerance, found without building the frame: with distinct factors the
-/// smallest angle over the 24 frames that differ by an axis permutation, with one distinct factor the angle
-/// between its axis and the nearest local axis, and 0 when all count as equal.
-pub fn stretch_angle_deg_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
-    angle_of_half_cosine(stretch_half_cosine_within(stretch, scale, relative_tolerance))
-}
-
-/// `cos(θ/2)` of the angle `θ` of [`stretch_angle_deg_within`]: 1 for no turn, smaller for larger turns, and
-/// without an inverse cosine (a whole-clip scan compares these and converts only the worst).
+/// `cos(θ/2)` of the angle `θ` of [`AffineParts::stretch_angle_deg_within`] for the frame `stretch` with factors
+/// `scale`: 1 for no turn, smaller for larger turns, and without an inverse cosine (a whole-clip scan compares these
+/// and converts only the worst).
 #[inline]
 pub fn stretch_half_cosine_within(stretch: DQuat, scale: DVec3, relative_tolerance: f64) -> f64 {
     if stretch == DQuat::IDENTITY {
@@ -124,12 +119,6 @@ pub fn stretch_half_cosine_within(stretch: DQuat, scale: DVec3, relative_toleran
 /// The angle `θ` in degrees whose `cos(θ/2)` is `half_cosine`.
 pub fn angle_of_half_cosine(half_cosine: f64) -> f64 {
     (2.0 * half_cosine.min(1.0).acos()).to_degrees()
-}
-
-/// How unequal stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
-pub fn anisotropy(scale: DVec3) -> f64 {
-    let (min, max) = (scale.min_element(), scale.max_element());
-    if max == 0.0 { 0.0 } else { max / min - 1.0 }
 }
 
 /// The angle of a unit quaternion's rotation, in radians, in `[0, π]`.
