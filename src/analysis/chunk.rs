@@ -10,7 +10,7 @@
 use glam::{DMat4, DQuat};
 
 use super::findings::{Judge, Verdict};
-use super::scan::{BoneSummary, Components, CurveRequest, Curves, GhostRequest, ScanOptions, Subject};
+use super::scan::{BoneSummary, Components, CurveRequest, GhostRequest, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
@@ -67,18 +67,12 @@ pub(super) struct ChunkResult {
     /// `words` words of flags per bone.
     pub bits: Vec<u64>,
     pub words: usize,
-    pub curves: Vec<Curves>,
 }
 
 impl ChunkResult {
-    fn new(bones: usize, samples: usize, request: CurveRequest) -> Self {
+    fn new(bones: usize, samples: usize) -> Self {
         let words = samples.div_ceil(64);
-        ChunkResult {
-            summaries: (0..bones).map(BoneSummary::new).collect(),
-            bits: vec![0; bones * words],
-            words,
-            curves: vec![Curves::with_capacity(samples, request.ghost.is_some()); request.bones.len()],
-        }
+        ChunkResult { summaries: (0..bones).map(BoneSummary::new).collect(), bits: vec![0; bones * words], words }
     }
 
     fn add(&mut self, bone: usize, sample: usize, time: f64, verdict: &Verdict) {
@@ -100,26 +94,36 @@ impl ChunkResult {
     }
 }
 
-/// Analyses the samples at `times`.
+/// The stretch of every requested curve that one chunk fills, one slice per plotted bone (none for the ghost
+/// without one).
+#[derive(Default)]
+pub(super) struct CurveSlices<'a> {
+    pub local: Vec<&'a mut [Components]>,
+    pub model: Vec<&'a mut [Components]>,
+    pub ghost_model: Vec<&'a mut [Components]>,
+}
+
+/// Analyses the samples at `times`, writing the plotted bones' components into `curves`.
 pub(super) fn analyze_chunk(
     subject: Subject,
     plan: &Plan,
     request: CurveRequest,
     options: &ScanOptions,
     times: &[f64],
+    mut curves: CurveSlices,
 ) -> ChunkResult {
     let chunk = Chunk { subject, plan, request, judge: Judge::new(&options.tolerances), times };
-    let mut result = ChunkResult::new(subject.skeleton.len(), times.len(), request);
+    let mut result = ChunkResult::new(subject.skeleton.len(), times.len());
     let mut layers = subject.worker_layers();
     match plan.by_bone {
         Some(clip) => {
             chunk.judge_by_bone(clip, &mut result);
-            chunk.plot_by_bone(clip, &mut result);
+            chunk.plot_by_bone(clip, &mut curves);
         }
-        None => chunk.judge_by_pose(&mut layers, &mut result),
+        None => chunk.judge_by_pose(&mut layers, &mut result, &mut curves),
     }
     if let Some(ghost) = request.ghost {
-        chunk.plot_ghost(ghost, &mut layers, &mut result);
+        chunk.plot_ghost(ghost, &mut layers, &mut curves.ghost_model);
     }
     result
 }
@@ -200,7 +204,7 @@ impl Chunk<'_> {
     }
 
     /// The curves of the plotted bones, from their local transforms and those of their ancestors.
-    fn plot_by_bone(&self, clip: &Clip, result: &mut ChunkResult) {
+    fn plot_by_bone(&self, clip: &Clip, curves: &mut CurveSlices) {
         let (skeleton, plan, bones) = (self.subject.skeleton, self.plan, self.request.bones);
         if bones.is_empty() {
             return;
@@ -210,19 +214,19 @@ impl Chunk<'_> {
         let mut local = vec![Transform::IDENTITY; skeleton.len()];
         let mut model = vec![DMat4::IDENTITY; skeleton.len()];
         let mut plot = Plotter::new(bones.len());
-        for &time in self.times {
+        for (sample, &time) in self.times.iter().enumerate() {
             for (bone, cursor) in &mut cursors {
                 local[*bone] = cursor.local(time);
                 let matrix = local[*bone].matrix();
                 model[*bone] = plan.parents[*bone].map_or(matrix, |p| model[p] * matrix);
             }
-            plot.push(bones, &local, &model, &mut result.curves);
+            plot.put(sample, bones, &local, &model, curves);
         }
     }
 
     /// The ghost curves: the plotted bones under the ghost's modes. Without layers only the plotted bones and their
     /// ancestors are sampled and evaluated; through layers, whole poses.
-    fn plot_ghost(&self, ghost: GhostRequest, layers: &mut Option<LayerStack>, result: &mut ChunkResult) {
+    fn plot_ghost(&self, ghost: GhostRequest, layers: &mut Option<LayerStack>, curves: &mut [&mut [Components]]) {
         let (subject, bones) = (self.subject, self.request.bones);
         let skeleton = subject.skeleton;
         let by_bone = subject.clip.filter(|_| ghost.unlayered || subject.layered.is_none());
@@ -233,7 +237,7 @@ impl Chunk<'_> {
         let mut pose = Pose::default();
         // Where each ghost curve's decomposition starts: its stretch frame at the previous sample.
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
-        for &time in self.times {
+        for (sample, &time) in self.times.iter().enumerate() {
             match by_bone {
                 Some(_) => {
                     pose.local.resize(skeleton.len(), Transform::IDENTITY);
@@ -245,17 +249,17 @@ impl Chunk<'_> {
                 None if ghost.unlayered => pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
                 None => subject.evaluate(&mut pose, ghost.hierarchy, layers, time),
             }
-            for ((curves, &bone), start) in result.curves.iter_mut().zip(bones).zip(&mut starts) {
+            for ((curve, &bone), start) in curves.iter_mut().zip(bones).zip(&mut starts) {
                 let components = Components::of_matrix(&pose.model.model[bone], *start);
                 *start = components.stretch.as_dquat();
-                curves.ghost_model.push(components);
+                curve[sample] = components;
             }
         }
     }
 
     /// Judges every bone from whole poses, one sample after another (layers, or bones that do not inherit
     /// fully), keeping the plotted bones' curves on the way.
-    fn judge_by_pose(&self, layers: &mut Option<LayerStack>, result: &mut ChunkResult) {
+    fn judge_by_pose(&self, layers: &mut Option<LayerStack>, result: &mut ChunkResult, curves: &mut CurveSlices) {
         let (plan, plotted) = (self.plan, self.request.bones);
         let bones = self.subject.skeleton.len();
         let (mut pose, mut stretches) = (Pose::default(), vec![Stretch::NONE; bones]);
@@ -272,12 +276,12 @@ impl Chunk<'_> {
                 stretches[bone] = stretch;
                 result.add(bone, sample, time, &stretch.verdict(&self.judge));
             }
-            plot.push(plotted, &pose.local, &pose.model.model, &mut result.curves);
+            plot.put(sample, plotted, &pose.local, &pose.model.model, curves);
         }
     }
 }
 
-/// Appends the plotted bones' components, sample by sample.
+/// Writes the plotted bones' components, sample by sample.
 struct Plotter {
     /// Where each plotted bone's decomposition starts: its stretch frame at the previous sample.
     starts: Vec<DQuat>,
@@ -288,13 +292,15 @@ impl Plotter {
         Plotter { starts: vec![DQuat::IDENTITY; bones] }
     }
 
-    /// One sample of `bones`, given every bone's local transform and model matrix (only the plotted ones are read).
-    fn push(&mut self, bones: &[usize], local: &[Transform], model: &[DMat4], out: &mut [Curves]) {
-        for ((curves, &bone), start) in out.iter_mut().zip(bones).zip(&mut self.starts) {
+    /// Sample `sample` of `bones`, given every bone's local transform and model matrix (only the plotted ones are
+    /// read).
+    fn put(&mut self, sample: usize, bones: &[usize], local: &[Transform], model: &[DMat4], out: &mut CurveSlices) {
+        let curves = out.local.iter_mut().zip(&mut out.model);
+        for (((local_curve, model_curve), &bone), start) in curves.zip(bones).zip(&mut self.starts) {
             let components = Components::of_matrix(&model[bone], *start);
             *start = components.stretch.as_dquat();
-            curves.model.push(components);
-            curves.local.push(Components::of_local(&local[bone]));
+            model_curve[sample] = components;
+            local_curve[sample] = Components::of_local(&local[bone]);
         }
     }
 }

@@ -7,7 +7,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::Tolerances;
-use super::chunk::{ChunkResult, Plan, analyze_chunk};
+use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::findings::Verdict;
 use crate::eval::{Hierarchy, LayerStack, Pose};
 use crate::math::{angle_of_half_cosine, decompose_near, shear_deg, shear_deg_of_cosine};
@@ -139,6 +139,16 @@ pub struct Components {
 }
 
 impl Components {
+    /// A placeholder for a sample not computed yet.
+    const UNSET: Components = Components {
+        translation: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+        scale: Vec3::ZERO,
+        stretch: Quat::IDENTITY,
+        sign: 1.0,
+        shear_deg: 0.0,
+    };
+
     /// The components of `m`, its decomposition searching from `start` (see [`decompose_near`]; the previous
     /// sample's stretch makes a curve faster).
     pub(super) fn of_matrix(m: &DMat4, start: DQuat) -> Self {
@@ -192,14 +202,16 @@ pub struct Curves {
 }
 
 impl Curves {
-    /// Room for `samples` samples, with or without ghost curves (long clips fill hundreds of megabytes: no
-    /// copies while they grow).
-    pub(super) fn with_capacity(samples: usize, ghost: bool) -> Self {
-        Curves {
-            local: Vec::with_capacity(samples),
-            model: Vec::with_capacity(samples),
-            ghost_model: Vec::with_capacity(if ghost { samples } else { 0 }),
-        }
+    /// Curves of `samples` samples (and ghost curves, or none), to be overwritten: the chunks of an analysis write
+    /// their parts in place. Filled in parallel, so that long clips' hundreds of megabytes are not first touched
+    /// on one thread.
+    fn for_samples(samples: usize, ghost: bool) -> Self {
+        let unset = || {
+            let mut curve = Vec::new();
+            rayon::iter::repeat_n(Components::UNSET, samples).collect_into_vec(&mut curve);
+            curve
+        };
+        Curves { local: unset(), model: unset(), ghost_model: if ghost { unset() } else { Vec::new() } }
     }
 }
 
@@ -389,29 +401,50 @@ pub fn analyze(
     let plan = Plan::new(subject, hierarchy, request.bones);
     let done = AtomicUsize::new(0);
     let words = times.len().div_ceil(64);
-    let chunk_words = (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
+    let chunk_len = 64 * (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
+    let mut curves: Vec<(usize, Curves)> =
+        request.bones.iter().map(|&b| (b, Curves::for_samples(times.len(), request.ghost.is_some()))).collect();
     let chunks: Vec<Option<ChunkResult>> = times
-        .par_chunks(64 * chunk_words)
-        .map(|chunk| {
+        .par_chunks(chunk_len)
+        .zip(split_curves(&mut curves, chunk_len, times.len().div_ceil(chunk_len)))
+        .map(|(chunk, slices)| {
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let result = analyze_chunk(subject, &plan, request, options, chunk);
+            let result = analyze_chunk(subject, &plan, request, options, chunk, slices);
             progress(done.fetch_add(chunk.len(), Ordering::Relaxed) + chunk.len(), times.len());
             Some(result)
         })
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
-    Some(assemble(skeleton.len(), times, request, chunks))
+    Some(assemble(skeleton.len(), times, curves, chunks))
 }
 
-fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<ChunkResult>) -> ClipAnalysis {
+/// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.
+fn split_curves(curves: &mut [(usize, Curves)], len: usize, count: usize) -> Vec<CurveSlices<'_>> {
+    let mut slices: Vec<CurveSlices> = (0..count).map(|_| CurveSlices::default()).collect();
+    for (_, curve) in curves {
+        let parts =
+            pieces(&mut curve.local, len).zip(pieces(&mut curve.model, len)).zip(pieces(&mut curve.ghost_model, len));
+        for (slice, ((local, model), ghost)) in slices.iter_mut().zip(parts) {
+            slice.local.extend(local);
+            slice.model.extend(model);
+            slice.ghost_model.extend(ghost);
+        }
+    }
+    slices
+}
+
+/// `samples` in pieces of `len`, then `None` for ever (ghost curves are empty without a ghost).
+fn pieces(samples: &mut [Components], len: usize) -> impl Iterator<Item = Option<&mut [Components]>> {
+    samples.chunks_mut(len).map(Some).chain(std::iter::repeat_with(|| None))
+}
+
+fn assemble(bones: usize, times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks: Vec<ChunkResult>) -> ClipAnalysis {
     let words_per_bone = times.len().div_ceil(64);
     let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();
     let mut stretched_bits = vec![0u64; bones * words_per_bone];
     let mut any_stretched_bits = vec![0u64; words_per_bone];
-    let mut curves: Vec<(usize, Curves)> =
-        request.bones.iter().map(|&b| (b, Curves::with_capacity(times.len(), request.ghost.is_some()))).collect();
     let mut first_word = 0;
     for chunk in chunks {
         let words = first_word..first_word + chunk.words;
@@ -421,11 +454,6 @@ fn assemble(bones: usize, times: Vec<f64>, request: CurveRequest, chunks: Vec<Ch
             for (any, word) in any_stretched_bits[words.clone()].iter_mut().zip(bits) {
                 *any |= word;
             }
-        }
-        for ((_, all), part) in curves.iter_mut().zip(chunk.curves) {
-            all.local.extend(part.local);
-            all.model.extend(part.model);
-            all.ghost_model.extend(part.ghost_model);
         }
         first_word = words.end;
     }
