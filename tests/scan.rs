@@ -1,13 +1,15 @@
-//! Whole-clip scans on a clip whose answer is known by hand.
+//! Whole-clip scans: on clips whose answer is known by hand, and against decomposing every model matrix.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use bonescope::analysis::{Assessment, CurveRequest, GhostRequest, ScanOptions, Subject, analyze, sample_times, scan};
+use bonescope::analysis::{
+    Assessment, Components, CurveRequest, GhostRequest, ScanOptions, Subject, analyze, sample_times, scan,
+};
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
-use glam::{DQuat, DVec3, Quat, Vec3};
+use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 
 /// A parent whose X scale grows linearly from 1 at t = 0 to 2 at t = 1, and a child turned 45° about Z.
 fn growing_parent() -> (Skeleton, Clip) {
@@ -217,10 +219,33 @@ fn the_scan_agrees_with_decomposing_every_model_matrix() {
     }
 }
 
-/// Ghost curves are the plotted bones under the ghost's modes, evaluated only down their chains: they must be the
-/// components of the whole pose evaluated under those modes.
+/// A curve's components are those of `matrix`'s assessment (in single precision).
+fn assert_components(got: &Components, matrix: &DMat4, label: &str) {
+    let expected = Assessment::of(matrix, &ScanOptions::default().tolerances);
+    let parts = &expected.parts;
+    assert!(got.position().abs_diff_eq(parts.translation, 1e-6), "{label}");
+    assert!(
+        got.rotation.abs_diff_eq(parts.rotation.as_quat(), 1e-6),
+        "{label}: {:?} vs {:?}",
+        got.rotation,
+        parts.rotation
+    );
+    assert!(got.scale.abs_diff_eq(parts.scale.as_vec3(), 1e-6), "{label}: {} vs {}", got.scale, parts.scale);
+    assert!(
+        got.stretch.abs_diff_eq(parts.stretch.as_quat(), 1e-5),
+        "{label}: {:?} vs {:?}",
+        got.stretch,
+        parts.stretch
+    );
+    assert!((got.shear_deg - expected.shear_deg as f32).abs() < 1e-4, "{label}");
+    assert_eq!(got.sign, parts.sign as f32, "{label}");
+}
+
+/// Curves are the plotted bones' decomposed local and model matrices (the model ones from the judged stretches),
+/// and the ghost curves the same under the ghost's modes, evaluated only down their chains: they must be the
+/// components of whole poses.
 #[test]
-fn ghost_curves_match_the_whole_pose_under_the_ghost_modes() {
+fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes() {
     let rig = stress_rig(30, 150, 5);
     let (skeleton, clip) = (&rig.skeleton, &rig.clips[0]);
     let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes());
@@ -233,16 +258,17 @@ fn ghost_curves_match_the_whole_pose_under_the_ghost_modes() {
         let request = CurveRequest { bones: &plotted, ghost: Some(ghost) };
         let subject = Subject::clip(skeleton, Some(clip));
         let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
-        let mut pose = Pose::default();
+        let (mut pose, mut ghost_pose) = (Pose::default(), Pose::default());
         for (sample, &time) in analysis.times.iter().enumerate() {
-            pose.evaluate(skeleton, Some(clip), &ghost_hierarchy, time);
+            pose.evaluate(skeleton, Some(clip), &hierarchy, time);
+            ghost_pose.evaluate(skeleton, Some(clip), &ghost_hierarchy, time);
             for &bone in &plotted {
-                let expected = Assessment::of(&pose.model.model[bone], &options.tolerances);
-                let got = analysis.curves_of(bone).unwrap().ghost_model[sample];
+                let curves = analysis.curves_of(bone).unwrap();
                 let label = format!("{}: bone {bone} at {time}", mode.id());
-                assert!(got.position().abs_diff_eq(expected.parts.translation, 1e-6), "{label}");
-                assert!(got.rotation.abs_diff_eq(expected.parts.rotation.as_quat(), 1e-6), "{label}");
-                assert!(got.scale.abs_diff_eq(expected.parts.scale.as_vec3(), 1e-6), "{label}");
+                assert_components(&curves.model[sample], &pose.model.model[bone], &format!("{label}, model"));
+                assert_components(&curves.local[sample], &pose.local[bone].matrix(), &format!("{label}, local"));
+                let ghost = &ghost_pose.model.model[bone];
+                assert_components(&curves.ghost_model[sample], ghost, &format!("{label}, ghost"));
             }
         }
     }

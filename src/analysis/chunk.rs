@@ -13,6 +13,7 @@ use super::findings::{Judge, Verdict};
 use super::scan::{BoneSummary, Components, CurveRequest, GhostRequest, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
+use crate::math::{decompose_near, decompose_with_stretch};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 
 /// What the workers need to know about the subject, found once per analysis.
@@ -117,8 +118,8 @@ pub(super) fn analyze_chunk(
     let mut layers = subject.worker_layers();
     match plan.by_bone {
         Some(clip) => {
-            chunk.judge_by_bone(clip, &mut result);
-            chunk.plot_by_bone(clip, &mut curves);
+            let plotted = chunk.judge_by_bone(clip, &mut result);
+            chunk.plot_by_bone(clip, &plotted, &mut curves);
         }
         None => chunk.judge_by_pose(&mut layers, &mut result, &mut curves),
     }
@@ -129,6 +130,7 @@ pub(super) fn analyze_chunk(
 }
 
 /// One bone's stretches over the run.
+#[derive(Clone)]
 enum Run {
     /// The same at every sample.
     Fixed(Stretch),
@@ -140,6 +142,17 @@ enum Run {
 
 const ROOT: Run = Run::Fixed(Stretch::NONE);
 
+impl Run {
+    /// The stretch at `sample`.
+    fn at(&self, sample: usize) -> Stretch {
+        match self {
+            Run::Varying(stretches) => stretches[sample],
+            Run::Fixed(stretch) => *stretch,
+            Run::Done => unreachable!("a bone's stretches are kept while they are needed"),
+        }
+    }
+}
+
 /// One chunk's work: the subject and what to compute at `times`.
 struct Chunk<'a> {
     subject: Subject<'a>,
@@ -150,8 +163,9 @@ struct Chunk<'a> {
 }
 
 impl Chunk<'_> {
-    /// Judges every bone of a fully inheriting rig, one bone over all the times before the next.
-    fn judge_by_bone(&self, clip: &Clip, result: &mut ChunkResult) {
+    /// Judges every bone of a fully inheriting rig, one bone over all the times before the next. Returns the
+    /// plotted bones' stretches.
+    fn judge_by_bone(&self, clip: &Clip, result: &mut ChunkResult) -> Vec<Run> {
         let (skeleton, plan, times) = (self.subject.skeleton, self.plan, self.times);
         let mut runs: Vec<Run> = (0..skeleton.len()).map(|_| Run::Done).collect();
         let mut pending_children = plan.children.clone();
@@ -178,12 +192,7 @@ impl Chunk<'_> {
                     stretches.clear();
                     let mut start = DQuat::IDENTITY;
                     for (sample, &time) in times.iter().enumerate() {
-                        let parent = match above {
-                            Run::Varying(stretches) => stretches[sample],
-                            Run::Fixed(stretch) => *stretch,
-                            Run::Done => unreachable!("a parent's stretches are kept until its children are judged"),
-                        };
-                        let stretch = parent.child(&mut CursorAt(&mut cursor, time), start);
+                        let stretch = above.at(sample).child(&mut CursorAt(&mut cursor, time), start);
                         start = stretch.frame;
                         result.add(bone, sample, time, &stretch.verdict(&self.judge));
                         stretches.push(stretch);
@@ -195,16 +204,19 @@ impl Chunk<'_> {
             if let Some(parent) = plan.parents[bone] {
                 pending_children[parent] -= 1;
                 if pending_children[parent] == 0
+                    && !self.request.bones.contains(&parent)
                     && let Run::Varying(stretches) = std::mem::replace(&mut runs[parent], Run::Done)
                 {
                     spare.push(stretches);
                 }
             }
         }
+        self.request.bones.iter().map(|&b| runs[b].clone()).collect()
     }
 
     /// The curves of the plotted bones, from their local transforms and those of their ancestors.
-    fn plot_by_bone(&self, clip: &Clip, curves: &mut CurveSlices) {
+    /// `stretches` are the plotted bones' (see [`Chunk::judge_by_bone`]).
+    fn plot_by_bone(&self, clip: &Clip, stretches: &[Run], curves: &mut CurveSlices) {
         let (skeleton, plan, bones) = (self.subject.skeleton, self.plan, self.request.bones);
         if bones.is_empty() {
             return;
@@ -220,7 +232,8 @@ impl Chunk<'_> {
                 let matrix = local[*bone].matrix();
                 model[*bone] = plan.parents[*bone].map_or(matrix, |p| model[p] * matrix);
             }
-            plot.put(sample, bones, &local, &model, curves);
+            let stretches = stretches.iter().map(|run| run.at(sample));
+            plot.put(sample, bones, &local, &model, stretches, curves);
         }
     }
 
@@ -276,7 +289,8 @@ impl Chunk<'_> {
                 stretches[bone] = stretch;
                 result.add(bone, sample, time, &stretch.verdict(&self.judge));
             }
-            plot.put(sample, plotted, &pose.local, &pose.model.model, curves);
+            let judged = plotted.iter().map(|&bone| stretches[bone]);
+            plot.put(sample, plotted, &pose.local, &pose.model.model, judged, curves);
         }
     }
 }
@@ -293,13 +307,26 @@ impl Plotter {
     }
 
     /// Sample `sample` of `bones`, given every bone's local transform and model matrix (only the plotted ones are
-    /// read).
-    fn put(&mut self, sample: usize, bones: &[usize], local: &[Transform], model: &[DMat4], out: &mut CurveSlices) {
+    /// read) and the plotted bones' judged stretches: dividing a stretch out of the model matrix gives its parts
+    /// without an SVD (see [`decompose_with_stretch`]).
+    fn put(
+        &mut self,
+        sample: usize,
+        bones: &[usize],
+        local: &[Transform],
+        model: &[DMat4],
+        stretches: impl Iterator<Item = Stretch>,
+        out: &mut CurveSlices,
+    ) {
         let curves = out.local.iter_mut().zip(&mut out.model);
-        for (((local_curve, model_curve), &bone), start) in curves.zip(bones).zip(&mut self.starts) {
-            let components = Components::of_matrix(&model[bone], *start);
-            *start = components.stretch.as_dquat();
-            model_curve[sample] = components;
+        for ((((local_curve, model_curve), &bone), start), stretch) in
+            curves.zip(bones).zip(&mut self.starts).zip(stretches)
+        {
+            let m = &model[bone];
+            let parts = decompose_with_stretch(m, stretch.frame, stretch.scale, stretch.sign)
+                .unwrap_or_else(|| decompose_near(m, *start));
+            *start = parts.stretch;
+            model_curve[sample] = Components::of_parts(&parts, m);
             local_curve[sample] = Components::of_local(&local[bone]);
         }
     }

@@ -10,7 +10,7 @@ use super::Tolerances;
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::findings::Verdict;
 use crate::eval::{Hierarchy, LayerStack, Pose};
-use crate::math::{angle_of_half_cosine, decompose_near, shear_deg, shear_deg_of_cosine};
+use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg, shear_deg_of_cosine};
 use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// How a clip is scanned.
@@ -152,7 +152,11 @@ impl Components {
     /// The components of `m`, its decomposition searching from `start` (see [`decompose_near`]; the previous
     /// sample's stretch makes a curve faster).
     pub(super) fn of_matrix(m: &DMat4, start: DQuat) -> Self {
-        let parts = decompose_near(m, start);
+        Components::of_parts(&decompose_near(m, start), m)
+    }
+
+    /// The components of `m` decomposed into `parts`.
+    pub(super) fn of_parts(parts: &AffineParts, m: &DMat4) -> Self {
         // An identity stretch means orthogonal columns: no shear to measure (as in `Assessment`).
         let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
         Components {

@@ -160,6 +160,30 @@ pub fn decompose_near(m: &DMat4, start: DQuat) -> AffineParts {
     AffineParts { translation, rotation, stretch, scale, sign }
 }
 
+/// The parts of `m` when its stretch is already known, `M = F·R·V·K·Vᵀ` with `V = R(stretch)` in any frame (a
+/// whole-clip analysis passes stretches down the hierarchy): `R = F·M·V·K⁻¹·Vᵀ` without an SVD, then the canonical
+/// frame as [`decompose`] chooses it. `None` when `K` is too unequal for dividing it out to keep the accuracy of
+/// [`decompose`] (a factor below 1e-3 of the largest: the rotation's error grows with the ratio's inverse, to
+/// about 1e-13 there), or not finite.
+pub fn decompose_with_stretch(m: &DMat4, stretch: DQuat, scale: DVec3, sign: f64) -> Option<AffineParts> {
+    let (min, max) = (scale.min_element(), scale.max_element());
+    if !(min >= STRETCH_RATIO * max && max.is_finite() && min > 0.0) {
+        return None;
+    }
+    let v = DMat3::from_quat(stretch);
+    let inverse_stretch = v * DMat3::from_diagonal(scale.recip()) * v.transpose();
+    let rotation = quat_from_rotation(&(DMat3::from_mat4(*m) * inverse_stretch * sign));
+    let (stretch, scale) = if stretch == DQuat::IDENTITY {
+        (stretch, scale)
+    } else {
+        canonical_stretch(stretch, scale, EQUAL_SCALE_TOLERANCE)
+    };
+    Some(AffineParts { translation: m.w_axis.truncate(), rotation, stretch, scale, sign })
+}
+
+/// The smallest ratio of stretch factors [`decompose_with_stretch`] divides out.
+const STRETCH_RATIO: f64 = 1e-3;
+
 /// Whether the columns are non-zero, of comparable lengths, and orthogonal to within [`ORTHOGONAL_COSINE`]: then
 /// `U = I` and `K` is the column lengths, with no rotation to search for.
 fn shortcut(gram: &Gram) -> bool {
@@ -323,6 +347,36 @@ mod tests {
     /// A rotation drawn from deterministic noise.
     fn random_quat(rng: &mut XorShiftRng) -> DQuat {
         DQuat::from_array(std::array::from_fn(|_| rng.random::<f64>() - 0.5)).normalize()
+    }
+
+    /// Given the stretch (in the SVD's frame or any equivalent one), the parts are [`decompose`]'s.
+    #[test]
+    fn decomposing_with_a_known_stretch_gives_the_decomposition() {
+        let mut rng = XorShiftRng::seed_from_u64(5);
+        let factor = |rng: &mut XorShiftRng| 0.2 + 3.0 * rng.random::<f64>();
+        for case in 0..2000 {
+            let (r, u) = (random_quat(&mut rng), random_quat(&mut rng));
+            let k = DVec3::new(factor(&mut rng), factor(&mut rng), if case % 4 == 0 { 1.0 } else { factor(&mut rng) });
+            let k = if case % 8 == 0 { DVec3::new(k.x, k.x, k.z) } else { k };
+            let sign = if case % 3 == 0 { -1.0 } else { 1.0 };
+            let parts = AffineParts { translation: DVec3::new(1.0, 2.0, 3.0), rotation: r, stretch: u, scale: k, sign };
+            let m = parts.matrix();
+            let expected = decompose(&m);
+            // The frame as given and turned by a quarter turn about Z with two factors swapped: the same stretch.
+            let quarter = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
+            for (frame, factors) in [(u, k), (u * quarter, DVec3::new(k.y, k.x, k.z))] {
+                let got = decompose_with_stretch(&m, frame, factors, sign).expect("well conditioned");
+                let same_rotation = got.rotation.abs_diff_eq(expected.rotation, 1e-12)
+                    || got.rotation.abs_diff_eq(-expected.rotation, 1e-12);
+                assert!(same_rotation, "{case}: {:?} vs {:?}", got.rotation, expected.rotation);
+                assert!(got.matrix().abs_diff_eq(m, 1e-12), "{case}");
+                assert!(got.scale.abs_diff_eq(expected.scale, 1e-12), "{case}: {} vs {}", got.scale, expected.scale);
+                assert!((got.stretch_angle_deg() - expected.stretch_angle_deg()).abs() < 1e-6, "{case}");
+                assert_eq!(got.sign, expected.sign);
+            }
+        }
+        let flat = DMat4::from_scale(DVec3::new(1.0, 1e-4, 1.0));
+        assert_eq!(decompose_with_stretch(&flat, DQuat::IDENTITY, DVec3::new(1.0, 1e-4, 1.0), 1.0), None);
     }
 
     #[test]
