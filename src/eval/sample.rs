@@ -80,6 +80,7 @@ impl Span {
     /// segment `*hint` and the one after it (where a slightly earlier time fell), then searching; `*hint` becomes
     /// the segment found. Increasing times, as a whole-clip scan visits them, then cost a comparison or two instead
     /// of a binary search; any hint gives the same answer.
+    #[inline]
     pub(crate) fn locate_near(times: &[f64], time: f64, hint: &mut usize) -> Span {
         let last = times.len() - 1;
         if time.is_nan() || time <= times[0] {

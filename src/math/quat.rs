@@ -34,6 +34,7 @@ impl Slerp {
     }
 
     /// The rotation a fraction `t` of the way.
+    #[inline]
     pub fn at(&self, t: f64) -> DQuat {
         let Slerp { a, b, cos, sin, inverse_sin, angle } = *self;
         if sin < NEARLY_EQUAL {
