@@ -95,7 +95,7 @@ impl ChunkResult {
     }
 }
 
-/// The stretch of every requested curve that one chunk fills, one slice per plotted bone (none for the ghost
+/// The part of every requested curve that one chunk fills, one slice per plotted bone (none for the ghost
 /// without one).
 #[derive(Default)]
 pub(super) struct CurveSlices<'a> {

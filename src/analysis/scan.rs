@@ -84,7 +84,7 @@ impl BoneSummary {
         self.degenerate_samples += usize::from(f.degenerate);
     }
 
-    /// Combines the summary of an earlier stretch of time with that of a later one.
+    /// Combines the summary of an earlier run of samples with that of a later one.
     fn merge(&mut self, later: &BoneSummary) {
         if later.worst_shear_cosine_squared > self.worst_shear_cosine_squared {
             self.worst_shear_cosine_squared = later.worst_shear_cosine_squared;
