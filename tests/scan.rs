@@ -273,3 +273,24 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
         }
     }
 }
+
+/// Degenerate subjects still give an answer: no bones, a clip of one key, no clip at all.
+#[test]
+fn empty_rigs_single_keys_and_rest_poses_scan() {
+    let options = ScanOptions::default();
+    let none = Skeleton::new(vec![]).unwrap();
+    let empty = Clip::new(0, None, vec![], vec![]);
+    let scanned = scan(Subject::clip(&none, Some(&empty)), &Hierarchy::new(&none, &[]), &options, &|_, _| {});
+    assert_eq!((scanned.samples, scanned.bones.len()), (1, 0));
+    let (skeleton, _) = growing_parent();
+    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
+    let mut one_key = BoneTracks::new(0);
+    let squashed = vec![Vec3::new(2.0, 1.0, 1.0)];
+    one_key.scale = Some(Track::new(Arc::from([0.5].as_slice()), squashed, Interpolation::Step).unwrap());
+    let clip = Clip::new(0, None, vec![one_key], vec![]);
+    let scanned = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &options, &|_, _| {});
+    // The child under a constant (2, 1, 1) scale, turned 45°: sheared at every sample, judged once.
+    assert_eq!(scanned.bones[1].flagged_samples, scanned.samples);
+    let rest = scan(Subject::clip(&skeleton, None), &hierarchy, &options, &|_, _| {});
+    assert_eq!((rest.samples, rest.bones[1].flagged_samples), (1, 0));
+}
