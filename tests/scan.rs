@@ -274,9 +274,10 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
     }
 }
 
-/// Degenerate subjects still give an answer: no bones, a clip of one key, no clip at all.
+/// Degenerate requests still give an answer: no bones, a clip of one key, no clip at all, curves of a bone that
+/// is not there.
 #[test]
-fn empty_rigs_single_keys_and_rest_poses_scan() {
+fn empty_rigs_single_keys_rest_poses_and_missing_bones_scan() {
     let options = ScanOptions::default();
     let none = Skeleton::new(vec![]).unwrap();
     let empty = Clip::new(0, None, vec![], vec![]);
@@ -293,4 +294,11 @@ fn empty_rigs_single_keys_and_rest_poses_scan() {
     assert_eq!(scanned.bones[1].flagged_samples, scanned.samples);
     let rest = scan(Subject::clip(&skeleton, None), &hierarchy, &options, &|_, _| {});
     assert_eq!((rest.samples, rest.bones[1].flagged_samples), (1, 0));
+    // Curves asked for a bone the skeleton does not have (a selection kept across a reload) are left out.
+    let request = CurveRequest { bones: &[1, 7], ghost: None };
+    let never = AtomicBool::new(false);
+    let subject = Subject::clip(&skeleton, Some(&clip));
+    let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
+    assert_eq!(analysis.curves_of(1).map(|c| c.model.len()), Some(analysis.times.len()));
+    assert!(analysis.curves_of(7).is_none());
 }

@@ -222,7 +222,7 @@ impl Curves {
 /// What a whole-clip analysis computes besides the per-bone summaries.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct CurveRequest<'a> {
-    /// Bones whose full curves are kept.
+    /// Bones whose full curves are kept (indices past the skeleton's end are left out).
     pub bones: &'a [usize],
     /// A second evaluation of those bones, kept as their ghost curves.
     pub ghost: Option<GhostRequest<'a>>,
@@ -402,6 +402,8 @@ pub fn analyze(
 ) -> Option<ClipAnalysis> {
     let skeleton = subject.skeleton;
     let times = subject.times(options.rate);
+    let in_range: Vec<usize> = request.bones.iter().copied().filter(|&b| b < skeleton.len()).collect();
+    let request = CurveRequest { bones: &in_range, ..request };
     let plan = Plan::new(subject, hierarchy, request.bones);
     let done = AtomicUsize::new(0);
     let words = times.len().div_ceil(64);
