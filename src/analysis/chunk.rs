@@ -217,23 +217,16 @@ impl Chunk<'_> {
     /// The curves of the plotted bones, from their local transforms and those of their ancestors.
     /// `stretches` are the plotted bones' (see [`Chunk::judge_by_bone`]).
     fn plot_by_bone(&self, clip: &Clip, stretches: &[Run], curves: &mut CurveSlices) {
-        let (skeleton, plan, bones) = (self.subject.skeleton, self.plan, self.request.bones);
+        let (plan, bones) = (self.plan, self.request.bones);
         if bones.is_empty() {
             return;
         }
-        let mut cursors: Vec<(usize, BoneCursor)> =
-            plan.modelled.iter().map(|&b| (b, BoneCursor::new(skeleton, clip, b))).collect();
-        let mut local = vec![Transform::IDENTITY; skeleton.len()];
-        let mut model = vec![DMat4::IDENTITY; skeleton.len()];
+        let mut chains = Chains::new(self.subject.skeleton, clip, &plan.modelled);
         let mut plot = Plotter::new(bones.len());
         for (sample, &time) in self.times.iter().enumerate() {
-            for (bone, cursor) in &mut cursors {
-                local[*bone] = cursor.local(time);
-                let matrix = local[*bone].matrix();
-                model[*bone] = plan.parents[*bone].map_or(matrix, |p| model[p] * matrix);
-            }
+            let pose = chains.evaluate(time, plan.hierarchy);
             let stretches = stretches.iter().map(|run| run.at(sample));
-            plot.put(sample, bones, &local, &model, stretches, curves);
+            plot.put(sample, bones, &pose.local, &pose.model.model, stretches, curves);
         }
     }
 
@@ -241,27 +234,23 @@ impl Chunk<'_> {
     /// ancestors are sampled and evaluated; through layers, whole poses.
     fn plot_ghost(&self, ghost: GhostRequest, layers: &mut Option<LayerStack>, curves: &mut [&mut [Components]]) {
         let (subject, bones) = (self.subject, self.request.bones);
-        let skeleton = subject.skeleton;
         let by_bone = subject.clip.filter(|_| ghost.unlayered || subject.layered.is_none());
-        let mut cursors: Vec<(usize, BoneCursor)> = match by_bone {
-            Some(clip) => self.plan.modelled.iter().map(|&b| (b, BoneCursor::new(skeleton, clip, b))).collect(),
-            None => Vec::new(),
-        };
-        let mut pose = Pose::default();
+        let mut chains = by_bone.map(|clip| Chains::new(subject.skeleton, clip, &self.plan.modelled));
+        let mut whole = Pose::default();
         // Where each ghost curve's decomposition starts: its stretch frame at the previous sample.
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
         for (sample, &time) in self.times.iter().enumerate() {
-            match by_bone {
-                Some(_) => {
-                    pose.local.resize(skeleton.len(), Transform::IDENTITY);
-                    for (bone, cursor) in &mut cursors {
-                        pose.local[*bone] = cursor.local(time);
-                    }
-                    ghost.hierarchy.evaluate_bones(&pose.local, &self.plan.modelled, &mut pose.model);
+            let pose = match &mut chains {
+                Some(chains) => chains.evaluate(time, ghost.hierarchy),
+                None if ghost.unlayered => {
+                    whole.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time);
+                    &whole
                 }
-                None if ghost.unlayered => pose.evaluate(skeleton, subject.clip, ghost.hierarchy, time),
-                None => subject.evaluate(&mut pose, ghost.hierarchy, layers, time),
-            }
+                None => {
+                    subject.evaluate(&mut whole, ghost.hierarchy, layers, time);
+                    &whole
+                }
+            };
             for ((curve, &bone), start) in curves.iter_mut().zip(bones).zip(&mut starts) {
                 let components = Components::of_matrix(&pose.model.model[bone], *start);
                 *start = components.stretch.as_dquat();
@@ -292,6 +281,33 @@ impl Chunk<'_> {
             let judged = plotted.iter().map(|&bone| stretches[bone]);
             plot.put(sample, plotted, &pose.local, &pose.model.model, judged, curves);
         }
+    }
+}
+
+/// Some bones (plotted ones and all their ancestors) read from a clip one bone at a time and evaluated under a
+/// hierarchy, sample by sample: the rest of a big rig is never sampled.
+struct Chains<'a> {
+    /// The bones, parents first.
+    bones: &'a [usize],
+    cursors: Vec<BoneCursor<'a>>,
+    /// Only the bones' entries are meaningful.
+    pose: Pose,
+}
+
+impl<'a> Chains<'a> {
+    fn new(skeleton: &Skeleton, clip: &'a Clip, bones: &'a [usize]) -> Self {
+        let cursors = bones.iter().map(|&b| BoneCursor::new(skeleton, clip, b)).collect();
+        let mut pose = Pose::default();
+        pose.local = vec![Transform::IDENTITY; skeleton.len()];
+        Chains { bones, cursors, pose }
+    }
+
+    fn evaluate(&mut self, time: f64, hierarchy: &Hierarchy) -> &Pose {
+        for (&bone, cursor) in self.bones.iter().zip(&mut self.cursors) {
+            self.pose.local[bone] = cursor.local(time);
+        }
+        hierarchy.evaluate_bones(&self.pose.local, self.bones, &mut self.pose.model);
+        &self.pose
     }
 }
 
