@@ -343,7 +343,7 @@ impl Plotter {
                 .unwrap_or_else(|| decompose_near(m, *start));
             *start = parts.stretch;
             model_curve[sample] = Components::of_parts(&parts, m);
-            local_curve[sample] = Components::of_local(&local[bone]);
+            local_curve[sample] = Components::of_matrix(&local[bone].matrix(), DQuat::IDENTITY);
         }
     }
 }

@@ -64,18 +64,21 @@ impl Assessment {
     /// stretch frame at the previous sample makes a whole-clip scan faster.
     pub fn near(m: &DMat4, tolerances: &Tolerances, start: DQuat) -> Self {
         let parts = decompose_near(m, start);
-        // An identity stretch means M = F·R·K: orthogonal columns, so the shear is zero without measuring it.
-        let shear_cosine =
-            if parts.stretch == DQuat::IDENTITY { 0.0 } else { largest_column_cosine(&DMat3::from_mat4(*m)) };
-        let verdict =
-            Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, shear_cosine * shear_cosine);
+        let cosine = shear_cosine(&parts, m);
+        let verdict = Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, cosine * cosine);
         Assessment {
             parts,
-            shear_deg: shear_deg_of_cosine(shear_cosine),
+            shear_deg: shear_deg_of_cosine(cosine),
             stretch_deg: verdict.stretch_deg(),
             findings: verdict.findings,
         }
     }
+}
+
+/// [`largest_column_cosine`] of `m` decomposed into `parts`: an identity stretch means `M = F·R·K`, orthogonal
+/// columns, so the shear is zero without measuring it.
+pub(crate) fn shear_cosine(parts: &AffineParts, m: &DMat4) -> f64 {
+    if parts.stretch == DQuat::IDENTITY { 0.0 } else { largest_column_cosine(&DMat3::from_mat4(*m)) }
 }
 
 /// The tolerances prepared for judging many matrices.

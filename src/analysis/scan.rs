@@ -3,15 +3,15 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use glam::{DMat3, DMat4, DQuat, DVec3, Quat, Vec3};
+use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::Tolerances;
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
-use super::findings::Verdict;
+use super::findings::{Verdict, shear_cosine};
 use crate::eval::{Hierarchy, LayerStack, Pose};
-use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg, shear_deg_of_cosine};
-use crate::model::{Clip, Rig, Skeleton, Transform};
+use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg_of_cosine};
+use crate::model::{Clip, Rig, Skeleton};
 
 /// How a clip is scanned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,8 +157,7 @@ impl Components {
 
     /// The components of `m` decomposed into `parts`.
     pub(super) fn of_parts(parts: &AffineParts, m: &DMat4) -> Self {
-        // An identity stretch means orthogonal columns: no shear to measure (as in `Assessment`).
-        let shear_deg = if parts.stretch == DQuat::IDENTITY { 0.0 } else { shear_deg(&DMat3::from_mat4(*m)) };
+        let shear_deg = shear_deg_of_cosine(shear_cosine(parts, m));
         Components {
             translation: parts.translation.as_vec3(),
             rotation: parts.rotation.as_quat(),
@@ -166,27 +165,6 @@ impl Components {
             stretch: parts.stretch.as_quat(),
             sign: parts.sign as f32,
             shear_deg: shear_deg as f32,
-        }
-    }
-
-    /// The components of a local transform: read off a plain `T·R·S` with positive, comparable factors and a unit
-    /// rotation (what its decomposition gives, to rounding: `R` with `w ≥ 0`, `K = S`, no stretch), decomposed
-    /// otherwise.
-    pub(super) fn of_local(local: &Transform) -> Self {
-        let (min, max) = (local.scale.min_element(), local.scale.max_element());
-        let plain =
-            local.is_trs() && min > 0.0 && min >= 1e-6 * max && (local.rotation.length_squared() - 1.0).abs() < 1e-12;
-        if !plain {
-            return Components::of_matrix(&local.matrix(), DQuat::IDENTITY);
-        }
-        let rotation = if local.rotation.w < 0.0 { -local.rotation } else { local.rotation };
-        Components {
-            translation: local.translation.as_vec3(),
-            rotation: rotation.as_quat(),
-            scale: local.scale.as_vec3(),
-            stretch: Quat::IDENTITY,
-            sign: 1.0,
-            shear_deg: 0.0,
         }
     }
 
@@ -471,37 +449,5 @@ fn assemble(bones: usize, times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks:
         words_per_bone,
         any_stretched_bits,
         curves,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use proptest::prelude::*;
-
-    use super::*;
-
-    fn close(a: &Components, b: &Components) -> bool {
-        a.translation.abs_diff_eq(b.translation, 1e-6)
-            && a.rotation.abs_diff_eq(b.rotation, 1e-6)
-            && a.scale.abs_diff_eq(b.scale, 1e-6)
-            && a.stretch.abs_diff_eq(b.stretch, 1e-6)
-            && a.sign == b.sign
-            && (a.shear_deg - b.shear_deg).abs() < 1e-4
-    }
-
-    proptest! {
-        /// A local transform's components read off its channels are its matrix's decomposed components.
-        #[test]
-        fn local_components_are_the_decomposition(
-            t in prop::array::uniform3(-3.0..3.0f64),
-            q in prop::array::uniform4(-1.0..1.0f64).prop_filter("not zero", |q| q.iter().any(|c| c.abs() > 0.1)),
-            s in prop::array::uniform3(0.05..4.0f64),
-            negative in any::<bool>(),
-        ) {
-            let scale = DVec3::from_array(s) * if negative { DVec3::new(-1.0, 1.0, 1.0) } else { DVec3::ONE };
-            let local = Transform::from_trs(DVec3::from_array(t), DQuat::from_array(q).normalize(), scale);
-            let decomposed = Components::of_matrix(&local.matrix(), DQuat::IDENTITY);
-            prop_assert!(close(&Components::of_local(&local), &decomposed), "{local:?}");
-        }
     }
 }
