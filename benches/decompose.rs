@@ -20,7 +20,7 @@ use std::time::Duration;
 use bonescope::analysis::sample_times;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::stress_rig;
-use bonescope::math::{AffineParts, decompose, decompose_near};
+use bonescope::math::{AffineParts, decompose, decompose_all, decompose_near};
 use bonescope::model::Rig;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat3, DMat4, DQuat, DVec3};
@@ -139,7 +139,11 @@ impl Errors {
 }
 
 fn ours(m: &DMat4) -> (DMat3, DMat3, f64) {
-    let parts: AffineParts = decompose(m);
+    ours_from(m, &decompose(m))
+}
+
+/// The recomposed matrix, the orthogonal factor and the smallest factor of `parts`.
+fn ours_from(m: &DMat4, parts: &AffineParts) -> (DMat3, DMat3, f64) {
     assert_eq!(parts.translation, m.w_axis.truncate());
     let q = DMat3::from_quat(parts.rotation) * parts.sign;
     (DMat3::from_mat4(parts.matrix()), q, parts.scale.min_element())
@@ -153,30 +157,35 @@ fn theirs(m: &DMat4) -> (DMat3, DMat3, f64) {
     (from_nalgebra(&(p * u)), from_nalgebra(&u), smallest)
 }
 
-/// Accuracy of both on matrices of one largest/smallest ratio, printed as one table row.
+/// Accuracy of ours (one matrix at a time and all at once) and nalgebra's on matrices of one largest/smallest
+/// ratio, printed as one table row.
 fn accuracy_row(label: &str, set: &[(DMat4, f64)]) {
-    let (mut a, mut b) = (Errors::default(), Errors::default());
-    for (m, smallest_true) in set {
+    let (mut one, mut all, mut theirs_errors) = (Errors::default(), Errors::default(), Errors::default());
+    let matrices: Vec<DMat4> = set.iter().map(|(m, _)| *m).collect();
+    for ((m, smallest_true), parts) in set.iter().zip(decompose_all(&matrices)) {
         let m3 = DMat3::from_mat4(*m);
         let (r, q, s) = ours(m);
-        a.add(&m3, &r, &q, s, *smallest_true);
+        one.add(&m3, &r, &q, s, *smallest_true);
+        let (r, q, s) = ours_from(m, &parts);
+        all.add(&m3, &r, &q, s, *smallest_true);
         let (r, q, s) = theirs(m);
-        b.add(&m3, &r, &q, s, *smallest_true);
+        theirs_errors.add(&m3, &r, &q, s, *smallest_true);
     }
-    eprintln!(
-        "{label:<22} | {:>9.2e} {:>9.2e} {:>9.2e} {:>4} | {:>9.2e} {:>9.2e} {:>9.2e} {:>4}",
-        a.recompose, a.orthogonality, a.smallest_factor, a.bad, b.recompose, b.orthogonality, b.smallest_factor, b.bad
-    );
+    let columns = |e: &Errors| {
+        format!("{:>9.2e} {:>9.2e} {:>9.2e} {:>4}", e.recompose, e.orthogonality, e.smallest_factor, e.bad)
+    };
+    eprintln!("{label:<22} | {} | {} | {}", columns(&one), columns(&all), columns(&theirs_errors));
 }
 
 fn print_accuracy() {
     let mut rng = Rng(SEED ^ 0xACC);
     eprintln!("accuracy over {BATCH} matrices per row (worst case; `bad` = recomposition error > 1e-12)");
+    let header = format!("{:>9} {:>9} {:>9} {:>4}", "recompose", "orthog", "k_min", "bad");
+    eprintln!("{:<22} | {header} | {header} | {header}", "set");
     eprintln!(
-        "{:<22} | {:>9} {:>9} {:>9} {:>4} | {:>9} {:>9} {:>9} {:>4}",
-        "set", "recompose", "orthog", "k_min", "bad", "recompose", "orthog", "k_min", "bad"
+        "{:<22} | {:<34} | {:<34} | {:<34}",
+        "", "bonescope decompose", "bonescope decompose_all", "nalgebra polar (SVD)"
     );
-    eprintln!("{:<22} | {:<34} | {:<34}", "", "bonescope decompose", "nalgebra polar (SVD)");
     let shear_free: Vec<(DMat4, f64)> = (0..BATCH)
         .map(|_| {
             let s = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
@@ -221,6 +230,7 @@ fn bench_set(c: &mut Criterion, name: &str, set: &[DMat4]) {
             }
         })
     });
+    group.bench_function("bonescope_all", |b| b.iter(|| black_box(decompose_all(black_box(set)))));
     group.bench_function("nalgebra_polar", |b| {
         b.iter(|| {
             for m in &converted {

@@ -1,7 +1,7 @@
 //! The polar decomposition against independent oracles: closed forms derived by hand, recomposition of random
 //! parts, and nalgebra's SVD-based polar factor.
 
-use bonescope::math::{AffineParts, decompose, decompose_near, quat_angle, shear_deg};
+use bonescope::math::{AffineParts, decompose, decompose_all, decompose_near, quat_angle, shear_deg};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use proptest::prelude::*;
 
@@ -227,11 +227,70 @@ proptest! {
         let cold = decompose(&m);
         // Near: the cold stretch turned by a tenth of a random rotation; far: any rotation.
         let start = if far { start } else { cold.stretch * DQuat::IDENTITY.slerp(nudge, 0.1) };
-        let warm = decompose_near(&m, start);
-        prop_assert!(relative_error(&warm.matrix(), &m) <= 1e-9);
-        prop_assert!(warm.scale.abs_diff_eq(cold.scale, 1e-9 * cold.scale.max_element().max(1.0)), "{warm:?} {cold:?}");
-        prop_assert!(quat_angle(warm.rotation * cold.rotation.inverse()) < 1e-7, "{warm:?} {cold:?}");
-        prop_assert!((warm.stretch_angle_deg() - cold.stretch_angle_deg()).abs() < 1e-6, "{warm:?} {cold:?}");
-        prop_assert_eq!(warm.sign, cold.sign);
+        assert_same_parts(&decompose_near(&m, start), &cold, &m);
     }
+
+    /// Decomposing a whole pose at once gives each matrix's own decomposition, whatever the mix (sheared pairs,
+    /// shortcuts in between, singular matrices, an odd one out at the end).
+    #[test]
+    fn decomposing_all_at_once_gives_each_decomposition(ms in prop::collection::vec(any_matrix(), 0..12)) {
+        let all = decompose_all(&ms);
+        prop_assert_eq!(all.len(), ms.len());
+        for (got, m) in all.iter().zip(&ms) {
+            assert_parts_finite(got);
+            assert_same_parts(got, &decompose(m), m);
+        }
+    }
+}
+
+/// Sheared, shear-free, and singular (a factor of zero) matrices.
+fn any_matrix() -> impl Strategy<Value = DMat4> {
+    prop_oneof![
+        random_parts().prop_map(|p| p.matrix()),
+        random_parts().prop_map(|p| AffineParts { stretch: DQuat::IDENTITY, ..p }.matrix()),
+        random_parts().prop_map(|p| AffineParts { scale: DVec3::new(p.scale.x, 0.0, p.scale.z), ..p }.matrix()),
+    ]
+}
+
+/// `got` and `expected` are parts of `m` that agree to rounding: both recompose `m` with the same factors; sign,
+/// rotation and stretch angle agree where they are unique (no zero factor).
+fn assert_same_parts(got: &AffineParts, expected: &AffineParts, m: &DMat4) {
+    assert!(relative_error(&got.matrix(), m) <= 1e-9, "{got:?} for {m}");
+    let largest = expected.scale.max_element();
+    assert!(got.scale.abs_diff_eq(expected.scale, 1e-9 * largest.max(1.0)), "{got:?} {expected:?}");
+    if expected.scale.min_element() > 1e-9 * largest {
+        assert_eq!(got.sign, expected.sign);
+        assert!(quat_angle(got.rotation * expected.rotation.inverse()) < 1e-7, "{got:?} {expected:?}");
+        assert!((got.stretch_angle_deg() - expected.stretch_angle_deg()).abs() < 1e-6, "{got:?} {expected:?}");
+    }
+}
+
+#[test]
+fn decomposing_all_keeps_the_order_and_survives_bad_matrices() {
+    let sheared = AffineParts {
+        translation: DVec3::new(1.0, 2.0, 3.0),
+        rotation: DQuat::from_rotation_y(0.7),
+        stretch: DQuat::from_rotation_z(0.4),
+        scale: DVec3::new(1.0, 2.0, 3.0),
+        sign: 1.0,
+    }
+    .matrix();
+    let nan = DMat4::from_cols_array(&[f64::NAN; 16]);
+    let ms = [
+        sheared,
+        nan,
+        DMat4::from_scale(DVec3::splat(2.0)),
+        DMat4::from_mat3(DMat3::ZERO),
+        DMat4::from_scale(DVec3::splat(1e-7)) * sheared,
+        sheared,
+    ];
+    let all = decompose_all(&ms);
+    for (i, (got, m)) in all.iter().zip(&ms).enumerate() {
+        assert!(got.rotation.is_finite() && got.scale.is_finite() && got.stretch.is_finite(), "{i}");
+        if m.is_finite() {
+            assert_same_parts(got, &decompose(m), m);
+        }
+    }
+    assert_eq!(all[1].scale, DVec3::ZERO);
+    assert!(decompose_all(&[]).is_empty());
 }

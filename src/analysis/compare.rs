@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::sample_times;
 use crate::eval::{Hierarchy, ModelPose, sample_clip};
-use crate::math::decompose;
+use crate::math::decompose_all;
 use crate::model::{Clip, Skeleton, Transform};
 
 /// Differences at most this big (model units, degrees) are floating-point rounding, not a difference.
@@ -80,9 +80,10 @@ pub fn compare(skeleton: &Skeleton, clip: Option<&Clip>, a: &Hierarchy, b: &Hier
                 }
                 a.evaluate(&local, &mut pose_a);
                 b.evaluate(&local, &mut pose_b);
-                for ((summary, ma), mb) in summaries.iter_mut().zip(&pose_a.model).zip(&pose_b.model) {
-                    let position = (ma.w_axis - mb.w_axis).truncate().length();
-                    let angle = angle_between(decompose(ma).rotation, decompose(mb).rotation).to_degrees();
+                let (parts_a, parts_b) = (decompose_all(&pose_a.model), decompose_all(&pose_b.model));
+                for ((summary, pa), pb) in summaries.iter_mut().zip(parts_a).zip(parts_b) {
+                    let position = (pa.translation - pb.translation).length();
+                    let angle = angle_between(pa.rotation, pb.rotation).to_degrees();
                     summary.add(time, position, angle);
                 }
             }

@@ -3,7 +3,7 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use crate::math::{
-    AffineParts, angle_of_half_cosine, decompose_near, largest_column_cosine, shear_deg_of_cosine,
+    AffineParts, angle_of_half_cosine, decompose_all, decompose_near, largest_column_cosine, shear_deg_of_cosine,
     stretch_half_cosine_within,
 };
 
@@ -63,9 +63,20 @@ impl Assessment {
     /// [`Assessment::of`], the decomposition searching from `start` (see [`decompose_near`]): the same bone's
     /// stretch frame at the previous sample makes a whole-clip scan faster.
     pub fn near(m: &DMat4, tolerances: &Tolerances, start: DQuat) -> Self {
-        let parts = decompose_near(m, start);
+        Self::judged(m, decompose_near(m, start), &Judge::new(tolerances))
+    }
+
+    /// [`Assessment::of`] every matrix (a whole pose), decomposed together ([`decompose_all`]: less time per
+    /// matrix).
+    pub fn all(ms: &[DMat4], tolerances: &Tolerances) -> Vec<Self> {
+        let judge = Judge::new(tolerances);
+        decompose_all(ms).into_iter().zip(ms).map(|(parts, m)| Self::judged(m, parts, &judge)).collect()
+    }
+
+    /// `m`, decomposed into `parts`, judged.
+    fn judged(m: &DMat4, parts: AffineParts, judge: &Judge) -> Self {
         let cosine = shear_cosine(&parts, m);
-        let verdict = Judge::new(tolerances).verdict(parts.stretch, parts.scale, parts.sign, cosine * cosine);
+        let verdict = judge.verdict(parts.stretch, parts.scale, parts.sign, cosine * cosine);
         Assessment {
             parts,
             shear_deg: shear_deg_of_cosine(cosine),

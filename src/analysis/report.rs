@@ -82,14 +82,15 @@ pub struct BoneReport {
 impl BoneReport {
     /// Every bone of an evaluated pose.
     pub fn all(skeleton: &Skeleton, modes: &[InheritMode], pose: &Pose, tolerances: &Tolerances) -> Vec<BoneReport> {
+        let assessments = Assessment::all(&pose.model.model, tolerances);
         skeleton
             .bones()
             .iter()
+            .zip(assessments)
             .enumerate()
-            .map(|(index, bone)| {
+            .map(|(index, (bone, assessment))| {
                 let local = pose.local[index].matrix();
                 let model = pose.model.model[index];
-                let assessment = Assessment::of(&model, tolerances);
                 BoneReport {
                     index,
                     node: bone.node,

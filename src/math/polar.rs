@@ -21,7 +21,8 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use super::svd::{Gram, svd};
+use super::rotation::quat_from_rotation;
+use super::svd::{Col, Gram, Svd, svd, svd_each};
 use crate::model::{Transform, affine};
 
 /// Scale factors whose difference is at most this fraction of the largest one are treated as equal when `U` is
@@ -50,6 +51,15 @@ pub struct AffineParts {
 }
 
 impl AffineParts {
+    /// The parts of the identity matrix.
+    pub const IDENTITY: AffineParts = AffineParts {
+        translation: DVec3::ZERO,
+        rotation: DQuat::IDENTITY,
+        stretch: DQuat::IDENTITY,
+        scale: DVec3::ONE,
+        sign: 1.0,
+    };
+
     /// The matrix these parts describe.
     pub fn matrix(&self) -> DMat4 {
         affine(self.linear(), self.translation)
@@ -135,27 +145,32 @@ pub fn decompose(m: &DMat4) -> AffineParts {
 /// consecutive frames) the previous one's `stretch` makes the search short. The result does not depend on `start`
 /// beyond rounding.
 pub fn decompose_near(m: &DMat4, start: DQuat) -> AffineParts {
-    let translation = m.w_axis.truncate();
+    parts(svd(&linear_part(m), start, shortcut), m)
+}
+
+/// [`decompose`] of every matrix, two at a time where they shear (see `lanes.rs`): the same parts up to rounding,
+/// in less time per matrix than one call each (the whole skeleton of a pose, every bone at once).
+pub fn decompose_all(ms: &[DMat4]) -> Vec<AffineParts> {
+    let mut all = vec![AffineParts::IDENTITY; ms.len()];
+    svd_each(ms.iter().map(linear_part), shortcut, |i, svd| all[i] = parts(svd, &ms[i]));
+    all
+}
+
+/// The 3×3 part of `m` as columns, or the zero matrix when it is not finite (so that non-finite input decomposes
+/// into the identity rotation and zero scale, never NaN).
+fn linear_part(m: &DMat4) -> [Col; 3] {
     let a = DMat3::from_mat4(*m);
-    if !a.is_finite() {
-        return AffineParts {
-            translation,
-            rotation: DQuat::IDENTITY,
-            stretch: DQuat::IDENTITY,
-            scale: DVec3::ZERO,
-            sign: 1.0,
-        };
-    }
-    let svd = svd(&a.to_cols_array_2d(), start, shortcut);
-    let (w, sign) = (DMat3::from_cols_array_2d(&svd.u), svd.sign);
+    if a.is_finite() { a.to_cols_array_2d() } else { [[0.0; 3]; 3] }
+}
+
+/// `m`'s parts from the SVD of its 3×3 part.
+fn parts(svd: Svd, m: &DMat4) -> AffineParts {
+    let (translation, rotation, sign) = (m.w_axis.truncate(), svd.rotation, svd.sign);
     let scale = DVec3::from_array(svd.sigma);
     if svd.v == DQuat::IDENTITY {
         // The columns were orthogonal: M = T·F·R·K with U = I.
-        let rotation = quat_from_rotation(&w);
         return AffineParts { translation, rotation, stretch: DQuat::IDENTITY, scale, sign };
     }
-    // R = W·Vᵀ.
-    let rotation = quat_from_rotation(&(w * DMat3::from_quat(svd.v).transpose()));
     let (stretch, scale) = canonical_stretch(svd.v, scale, EQUAL_SCALE_TOLERANCE);
     AffineParts { translation, rotation, stretch, scale, sign }
 }
@@ -172,7 +187,7 @@ pub fn decompose_with_stretch(m: &DMat4, stretch: DQuat, scale: DVec3, sign: f64
     }
     let v = DMat3::from_quat(stretch);
     let inverse_stretch = v * DMat3::from_diagonal(scale.recip()) * v.transpose();
-    let rotation = quat_from_rotation(&(DMat3::from_mat4(*m) * inverse_stretch * sign));
+    let rotation = quat_of(&(DMat3::from_mat4(*m) * inverse_stretch * sign));
     let (stretch, scale) = if stretch == DQuat::IDENTITY {
         (stretch, scale)
     } else {
@@ -285,30 +300,8 @@ fn two_largest(a: [f64; 4]) -> [usize; 2] {
 }
 
 /// The unit quaternion, with `w ≥ 0`, of a rotation matrix (orthonormal up to rounding).
-///
-/// The textbook method (`DQuat::from_mat3`) picks, by a tree of branches, the largest of the four `4q²` values
-/// on the diagonal combinations and divides the other products by it; for arbitrary rotations those branches
-/// mispredict about half the time. Here all four candidates are formed, the largest is picked by selects, and the
-/// result is brought to unit length by one Newton step (the matrix is orthonormal to rounding, so the length is 1
-/// up to about 1e-15 before it and to rounding after it).
-fn quat_from_rotation(m: &DMat3) -> DQuat {
-    let [[m00, m01, m02], [m10, m11, m12], [m20, m21, m22]] = m.to_cols_array_2d();
-    // Row k holds 4·q_k·(x, y, z, w); its diagonal entry is 4·q_k².
-    let rows = [
-        [1.0 + m00 - m11 - m22, m01 + m10, m02 + m20, m12 - m21],
-        [m01 + m10, 1.0 - m00 + m11 - m22, m12 + m21, m20 - m02],
-        [m02 + m20, m12 + m21, 1.0 - m00 - m11 + m22, m01 - m10],
-        [m12 - m21, m20 - m02, m01 - m10, 1.0 + m00 + m11 + m22],
-    ];
-    // The row with the largest diagonal entry, by selects rather than an index (which would go through memory).
-    let pick = |a: [f64; 4], b: [f64; 4], b_wins: bool| if b_wins { b } else { a };
-    let [r0, r1, r2, r3] = rows;
-    let (r01, d01) = (pick(r0, r1, r1[1] > r0[0]), r0[0].max(r1[1]));
-    let (r23, d23) = (pick(r2, r3, r3[3] > r2[2]), r2[2].max(r3[3]));
-    let row = pick(r01, r23, d23 > d01);
-    // q = row / (4·q_k) with q_k = √(4q_k²)/2, and the sign that makes w ≥ 0.
-    let q = DQuat::from_array(row) * (0.5 / d01.max(d23).sqrt()).copysign(row[3]);
-    q * (1.5 - 0.5 * q.length_squared())
+fn quat_of(m: &DMat3) -> DQuat {
+    DQuat::from_array(quat_from_rotation(&m.to_cols_array_2d()))
 }
 
 /// The largest deviation from 90°, in degrees, between any two columns of the 3×3 part: 0 for any rotation·scale
@@ -377,21 +370,6 @@ mod tests {
         }
         let flat = DMat4::from_scale(DVec3::new(1.0, 1e-4, 1.0));
         assert_eq!(decompose_with_stretch(&flat, DQuat::IDENTITY, DVec3::new(1.0, 1e-4, 1.0), 1.0), None);
-    }
-
-    #[test]
-    fn quat_from_rotation_matches_glam() {
-        let mut rng = XorShiftRng::seed_from_u64(7);
-        for _ in 0..1000 {
-            let q = random_quat(&mut rng);
-            let ours = quat_from_rotation(&DMat3::from_quat(q));
-            let theirs = DQuat::from_mat3(&DMat3::from_quat(q));
-            assert!(ours.w >= 0.0);
-            assert!(ours.abs_diff_eq(theirs, 1e-15) || ours.abs_diff_eq(-theirs, 1e-15), "{ours} vs {theirs}");
-        }
-        // Half turns have w = 0: the other components decide.
-        let half_turn = quat_from_rotation(&DMat3::from_diagonal(DVec3::new(1.0, -1.0, -1.0)));
-        assert!(half_turn.abs_diff_eq(DQuat::from_xyzw(1.0, 0.0, 0.0, 0.0), 1e-15));
     }
 
     /// `stretch_angle_deg_within` gives the angle of the frame `canonical_stretch` would choose.

@@ -22,6 +22,10 @@
 //!   converges quadratically too, at about half the latency of a sweep.
 
 use glam::DQuat;
+use wide::f64x2;
+
+use super::lanes::Lanes;
+use super::rotation::{Cols, Quat, matrix_of, quat_from_rotation, times_transpose};
 
 /// A column of a 3×3 matrix.
 pub(super) type Col = [f64; 3];
@@ -46,17 +50,18 @@ const SIMULTANEOUS_TURN: f64 = 0.01;
 /// `U` is completed from the others. Far below anything a cosine test on squared lengths could resolve.
 const NULL_RATIO_SQUARED: f64 = 1e-200;
 
-/// `A = sign·U·Σ·Vᵀ` with `U` and `V` rotations: the SVD with the sign of the determinant taken out of `U`.
-#[derive(Clone, Copy, Debug)]
+/// `A = sign·W·Σ·Vᵀ` with `W` and `V` rotations: the SVD with the sign of the determinant taken out of `W`, given
+/// as what the polar decomposition needs: `Σ`, `V` and the rotation `R = W·Vᵀ` of the polar factor (`W = R·V`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Svd {
-    /// `−1` when `det A < 0`, else `1` (also `1` when a singular value is zero: `U` is then completed as a rotation).
+    /// `−1` when `det A < 0`, else `1` (also `1` when a singular value is zero: `W` is then completed as a rotation).
     pub sign: f64,
-    /// The columns of `U`, orthonormal with `det U = +1`.
-    pub u: [Col; 3],
-    /// The singular values `σᵢ ≥ 0`, in the order of `U`'s and `V`'s columns (not sorted).
+    /// The singular values `σᵢ ≥ 0`, in the order of `W`'s and `V`'s columns (not sorted).
     pub sigma: [f64; 3],
     /// The rotation `V` as a unit quaternion; exactly the identity when `A`'s columns were orthogonal already.
     pub v: DQuat,
+    /// `R = W·Vᵀ` as a unit quaternion with `w ≥ 0`.
+    pub rotation: DQuat,
 }
 
 /// The SVD of `a` (columns). `a` must be finite.
@@ -64,61 +69,86 @@ pub(super) struct Svd {
 /// `start` is where the search for `V` begins: the identity, or a rotation close to the answer (the stretch frame of
 /// the same bone one frame earlier), from which the columns are nearly orthogonal and one or two simultaneous turns
 /// finish the job instead of three or four sweeps. Any start converges to the same result; a far one only costs
-/// steps.
+/// steps. When `already_orthogonal` says so of `a`'s columns, `V` is the identity without a search.
 pub(super) fn svd(a: &[Col; 3], start: DQuat, already_orthogonal: impl Fn(&Gram) -> bool) -> Svd {
     let (a, exponent) = rescaled(a);
-    let mut jacobi = Jacobi { b: a, v: DQuat::IDENTITY, growth: 1.0 };
-    let mut gram = Gram::of(&a);
-    if !already_orthogonal(&gram) {
-        if start != DQuat::IDENTITY && start.is_finite() {
-            jacobi.start_at(start.normalize());
-            gram = Gram::of(&jacobi.b);
+    if already_orthogonal(&Gram::of(&a)) {
+        return Jacobi::at_identity(a).finished(Turned::No).svd(exponent);
+    }
+    let mut jacobi = Jacobi::starting_at(a, start);
+    jacobi.iterate();
+    jacobi.finished(Turned::Yes).svd(exponent)
+}
+
+/// [`svd`] of every matrix (from the identity), each result handed to `found` with its index; those that need a
+/// search go two at a time, one in each lane of SIMD registers ([`Lanes`]), where a pair costs little more than
+/// one. The two take their sweeps and simultaneous turns together (a lane that has converged turns by exactly
+/// nothing), so a result may differ from [`svd`]'s by rounding.
+pub(super) fn svd_each(
+    matrices: impl Iterator<Item = [Col; 3]>,
+    already_orthogonal: impl Fn(&Gram) -> bool,
+    mut found: impl FnMut(usize, Svd),
+) {
+    let mut waiting: Option<(usize, Jacobi<f64>, i32)> = None;
+    for (index, a) in matrices.enumerate() {
+        let (a, exponent) = rescaled(&a);
+        let jacobi = Jacobi::at_identity(a);
+        if already_orthogonal(&Gram::of(&a)) {
+            found(index, jacobi.finished(Turned::No).svd(exponent));
+            continue;
         }
-        for _ in 0..MAX_STEPS {
-            if gram.orthogonal() {
-                break;
+        match waiting.take() {
+            None => waiting = Some((index, jacobi, exponent)),
+            Some((other_index, other, other_exponent)) => {
+                let mut pair = Jacobi::pair([other, jacobi]);
+                pair.iterate();
+                let [first, second] = pair.finished(Turned::Yes).lanes();
+                found(other_index, first.svd(other_exponent));
+                found(index, second.svd(exponent));
             }
-            if gram.small_turns() {
-                jacobi.turn_all(&gram);
-            } else {
-                jacobi.sweep();
-            }
-            gram = Gram::of(&jacobi.b);
         }
     }
-    jacobi.finish(exponent)
+    if let Some((index, mut jacobi, exponent)) = waiting {
+        jacobi.iterate();
+        found(index, jacobi.finished(Turned::Yes).svd(exponent));
+    }
 }
 
 /// Squared column lengths and pairwise dot products.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Gram {
+pub(super) struct Gram<L = f64> {
     /// `|aᵢ|²`.
-    pub lengths_squared: [f64; 3],
+    pub lengths_squared: [L; 3],
     /// `a₀·a₁, a₀·a₂, a₁·a₂`.
-    pub dots: [f64; 3],
+    pub dots: [L; 3],
 }
 
-impl Gram {
-    fn of(a: &[Col; 3]) -> Self {
+impl<L: Lanes> Gram<L> {
+    #[inline(always)]
+    fn of(a: &Cols<L>) -> Self {
         Gram { lengths_squared: a.map(|c| dot(c, c)), dots: [dot(a[0], a[1]), dot(a[0], a[2]), dot(a[1], a[2])] }
     }
 
     /// The pairs (0, 1), (0, 2), (1, 2) as `(α, β, γ)`: squared lengths and dot product.
-    fn pairs(&self) -> [(f64, f64, f64); 3] {
+    #[inline(always)]
+    fn pairs(&self) -> [(L, L, L); 3] {
         let ([a0, a1, a2], [g01, g02, g12]) = (self.lengths_squared, self.dots);
         [(a0, a1, g01), (a0, a2, g02), (a1, a2, g12)]
     }
 
     /// Whether every pair is orthogonal to within [`ORTHOGONAL_COSINE`].
-    fn orthogonal(&self) -> bool {
+    #[inline(always)]
+    fn orthogonal(&self) -> L::Mask {
         let [p, q, r] = self.pairs().map(|(alpha, beta, gamma)| cosine_negligible(alpha, beta, gamma));
         p & q & r
     }
 
     /// Whether every pair needs only a small turn (see [`SIMULTANEOUS_TURN`]).
-    fn small_turns(&self) -> bool {
-        let x2 = SIMULTANEOUS_TURN * SIMULTANEOUS_TURN;
-        let [p, q, r] = self.pairs().map(|(alpha, beta, gamma)| gamma * gamma <= x2 * (beta - alpha) * (beta - alpha));
+    #[inline(always)]
+    fn small_turns(&self) -> L::Mask {
+        let x2 = L::splat(SIMULTANEOUS_TURN * SIMULTANEOUS_TURN);
+        let [p, q, r] =
+            self.pairs().map(|(alpha, beta, gamma)| (gamma * gamma).le(x2 * (beta - alpha) * (beta - alpha)));
         p & q & r
     }
 }
@@ -141,26 +171,65 @@ fn times_power_of_two(x: f64, exponent: i32) -> f64 {
     x * 2f64.powi(half) * 2f64.powi(exponent - half)
 }
 
-/// The iteration's state: `b = growth·A·V`.
-struct Jacobi {
-    b: [Col; 3],
-    /// `V`, unnormalised (each rotation scales it by `√(1 + τ²)`).
-    v: DQuat,
+/// The iteration's state: `b = growth·A·V`, one matrix per lane.
+struct Jacobi<L> {
+    b: Cols<L>,
+    /// `V` as a quaternion `[x, y, z, w]`, unnormalised (each rotation scales it by `√(1 + τ²)`).
+    v: [L; 4],
     /// How much the unnormalised rotations have scaled `b`: the product of their `1 + τ²`.
-    growth: f64,
+    growth: L,
 }
 
-impl Jacobi {
-    /// Begins at `V = start` (a unit quaternion): `b = A·R(start)`.
-    fn start_at(&mut self, start: DQuat) {
+impl Jacobi<f64> {
+    fn at_identity(a: [Col; 3]) -> Self {
+        Jacobi { b: a, v: [0.0, 0.0, 0.0, 1.0], growth: 1.0 }
+    }
+
+    /// Begins at `V = start` when it is a usable rotation other than the identity: `b = A·R(start)`.
+    fn starting_at(a: [Col; 3], start: DQuat) -> Self {
+        if start == DQuat::IDENTITY || !start.is_finite() {
+            return Self::at_identity(a);
+        }
+        let start = start.normalize();
         let r = glam::DMat3::from_quat(start).to_cols_array_2d();
-        let a = self.b;
-        self.b =
+        let b =
             std::array::from_fn(|j| std::array::from_fn(|i| a[0][i] * r[j][0] + a[1][i] * r[j][1] + a[2][i] * r[j][2]));
-        self.v = start;
+        Jacobi { b, v: start.to_array(), growth: 1.0 }
+    }
+}
+
+impl Jacobi<f64x2> {
+    /// Two matrices' states side by side.
+    fn pair([first, second]: [Jacobi<f64>; 2]) -> Self {
+        let join = |x: f64, y: f64| f64x2::from([x, y]);
+        Jacobi {
+            b: std::array::from_fn(|j| std::array::from_fn(|i| join(first.b[j][i], second.b[j][i]))),
+            v: std::array::from_fn(|i| join(first.v[i], second.v[i])),
+            growth: join(first.growth, second.growth),
+        }
+    }
+}
+
+impl<L: Lanes> Jacobi<L> {
+    /// Cyclic sweeps until every pair needs only a small turn, then simultaneous turns, until every pair is
+    /// orthogonal (in every lane).
+    #[inline(always)]
+    fn iterate(&mut self) {
+        for _ in 0..MAX_STEPS {
+            let gram = Gram::of(&self.b);
+            if L::all(gram.orthogonal()) {
+                break;
+            }
+            if L::all(gram.small_turns()) {
+                self.turn_all(&gram);
+            } else {
+                self.sweep();
+            }
+        }
     }
 
     /// One cyclic sweep over the three pairs.
+    #[inline(always)]
     fn sweep(&mut self) {
         // A rotation in the (p, q) plane turns about the third axis k: by −φ when (p, q, k) is cyclic, else by +φ.
         self.rotate::<0, 1, 2>(-1.0);
@@ -173,66 +242,125 @@ impl Jacobi {
     fn rotate<const P: usize, const Q: usize, const K: usize>(&mut self, turn: f64) {
         let (p, q) = (self.b[P], self.b[Q]);
         let (alpha, beta, gamma) = (dot(p, p), dot(q, q), dot(p, q));
-        if cosine_negligible(alpha, beta, gamma) {
+        if L::all(cosine_negligible(alpha, beta, gamma)) {
             return;
         }
         let tau = half_angle_tangent(alpha, beta, gamma);
-        let (c, s) = (1.0 - tau * tau, 2.0 * tau);
+        let (c, s) = (L::splat(1.0) - tau * tau, L::splat(2.0) * tau);
         self.b[P] = std::array::from_fn(|i| c * p[i] - s * q[i]);
         self.b[Q] = std::array::from_fn(|i| s * p[i] + c * q[i]);
         // Columns P and Q grew by 1 + τ²; K follows so that all three keep one common scale.
-        let growth = 1.0 + tau * tau;
+        let growth = L::splat(1.0) + tau * tau;
         self.b[K] = self.b[K].map(|x| x * growth);
-        self.growth *= growth;
-        self.v = turned::<K>(self.v, turn * tau);
+        self.growth = self.growth * growth;
+        self.v = turned::<L, K>(self.v, L::splat(turn) * tau);
     }
 
     /// The turns of all three pairs at once, each computed from `gram` as if it were alone: the rotation whose
     /// quaternion is `(t, 1)` with `t` the three signed half-angle tangents (turn about k for the pair (p, q), as in
     /// [`Jacobi::sweep`]). Its matrix `|q|²·R` is `(1 − |t|²)·I + 2·t·tᵀ + 2·[t]×`, exact up to rounding.
-    fn turn_all(&mut self, gram: &Gram) {
+    #[inline(always)]
+    fn turn_all(&mut self, gram: &Gram<L>) {
         let [t01, t02, t12] = gram.pairs().map(|(alpha, beta, gamma)| half_angle_tangent(alpha, beta, gamma));
         let [x, y, z] = [-t12, t02, -t01];
         let (xx, yy, zz, xy, xz, yz) = (x * x, y * y, z * z, x * y, x * z, y * z);
         let squared = xx + yy + zz;
+        let (one, two) = (L::splat(1.0), L::splat(2.0));
         // Columns: the images of the axes.
-        let m: [Col; 3] = [
-            [1.0 - squared + 2.0 * xx, 2.0 * (xy + z), 2.0 * (xz - y)],
-            [2.0 * (xy - z), 1.0 - squared + 2.0 * yy, 2.0 * (yz + x)],
-            [2.0 * (xz + y), 2.0 * (yz - x), 1.0 - squared + 2.0 * zz],
+        let m: Cols<L> = [
+            [one - squared + two * xx, two * (xy + z), two * (xz - y)],
+            [two * (xy - z), one - squared + two * yy, two * (yz + x)],
+            [two * (xz + y), two * (yz - x), one - squared + two * zz],
         ];
         let b = self.b;
         self.b =
             std::array::from_fn(|j| std::array::from_fn(|i| b[0][i] * m[j][0] + b[1][i] * m[j][1] + b[2][i] * m[j][2]));
-        self.growth *= 1.0 + squared;
-        self.v *= DQuat::from_xyzw(x, y, z, 1.0);
+        self.growth = self.growth * (one + squared);
+        self.v = times_turn(self.v, [x, y, z]);
     }
 
-    /// `U` and `Σ` from the columns, `V` normalised; singular values scaled back by `2^exponent`.
-    fn finish(self, exponent: i32) -> Svd {
+    /// `Σ`, `V` (normalised) and `R = W·Vᵀ` from the columns, with `W` their directions; when some columns are
+    /// null, [`Finished::svd`] completes `W`. `turned` says whether `V` may differ from the identity.
+    #[inline(always)]
+    fn finished(self, turned: Turned) -> Finished<L> {
         let b = self.b;
         let lengths_squared = b.map(|c| dot(c, c));
         let largest = lengths_squared[0].max(lengths_squared[1]).max(lengths_squared[2]);
-        let null = lengths_squared.map(|l| l <= largest * NULL_RATIO_SQUARED);
-        let lengths = lengths_squared.map(f64::sqrt);
+        let null = lengths_squared.map(|l| l.le(largest * L::splat(NULL_RATIO_SQUARED)));
+        let any_null = null[0] | null[1] | null[2];
+        let lengths = lengths_squared.map(L::sqrt);
         // det B = det A·growth³ has the sign of det A, and takes less time than the lengths it runs beside. With a
-        // zero singular value the sign is free: U is completed as a rotation below.
-        let any_null = null.iter().any(|&n| n);
-        let sign = if dot(b[0], cross(b[1], b[2])) < 0.0 && !any_null { -1.0 } else { 1.0 };
-        let shrink = 1.0 / self.growth;
-        let mut sigma = lengths.map(|l| l * shrink);
+        // zero singular value the sign is free: W is completed as a rotation.
+        let (one, zero) = (L::splat(1.0), L::splat(0.0));
+        let mirrored = dot(b[0], cross(b[1], b[2])).lt(zero);
+        let sign = L::select(any_null, one, L::select(mirrored, -one, one));
+        let shrink = one / self.growth;
+        let w: Cols<L> = std::array::from_fn(|i| {
+            let inverse = L::select(null[i], zero, sign / lengths[i]);
+            b[i].map(|x| x * inverse)
+        });
+        let [x, y, z, s] = self.v;
+        let v = self.v.map(|c| c * (one / (x * x + y * y + z * z + s * s).sqrt()));
+        let rotation = match turned {
+            Turned::No => quat_from_rotation(&w),
+            Turned::Yes => quat_from_rotation(&times_transpose(&w, &matrix_of(v))),
+        };
+        Finished { sign, sigma: lengths.map(|l| l * shrink), v, rotation, w, null }
+    }
+}
+
+/// Whether the iteration turned `V` away from the identity (the shortcut's columns are taken as they are).
+#[derive(Clone, Copy)]
+enum Turned {
+    No,
+    Yes,
+}
+
+/// [`Jacobi::finished`]: the SVD's parts in lanes, before the rare completions.
+struct Finished<L: Lanes> {
+    sign: L,
+    /// Not yet scaled back by the exponent of [`rescaled`].
+    sigma: [L; 3],
+    v: Quat<L>,
+    rotation: Quat<L>,
+    /// The normalised columns, zero where `null`.
+    w: Cols<L>,
+    /// Which columns are null (their direction in `W` is free).
+    null: [L::Mask; 3],
+}
+
+impl Finished<f64> {
+    /// The [`Svd`], with singular values scaled back by `2^exponent` and, where columns were null, `W` completed
+    /// as a rotation and `R` taken from it.
+    fn svd(self, exponent: i32) -> Svd {
+        let mut sigma = self.sigma;
         if exponent != 0 {
             sigma = sigma.map(|s| times_power_of_two(s, exponent));
         }
-        let mut u: [Col; 3] = std::array::from_fn(|i| {
-            let inverse = if null[i] { 0.0 } else { sign / lengths[i] };
-            b[i].map(|x| x * inverse)
-        });
-        if any_null {
-            complete(&mut u, null);
+        let mut rotation = self.rotation;
+        if self.null.iter().any(|&n| n) {
+            let mut w = self.w;
+            complete(&mut w, self.null);
+            rotation = quat_from_rotation(&times_transpose(&w, &matrix_of(self.v)));
         }
-        let v = if self.v == DQuat::IDENTITY { self.v } else { self.v.normalize() };
-        Svd { sign, u, sigma, v }
+        Svd { sign: self.sign, sigma, v: DQuat::from_array(self.v), rotation: DQuat::from_array(rotation) }
+    }
+}
+
+impl Finished<f64x2> {
+    /// The two matrices' parts apart.
+    fn lanes(self) -> [Finished<f64>; 2] {
+        std::array::from_fn(|lane| {
+            let pick = |x: f64x2| x.to_array()[lane];
+            Finished {
+                sign: pick(self.sign),
+                sigma: self.sigma.map(pick),
+                v: self.v.map(pick),
+                rotation: self.rotation.map(pick),
+                w: self.w.map(|c| c.map(pick)),
+                null: self.null.map(|n| n.to_bitmask() >> lane & 1 == 1),
+            }
+        })
     }
 }
 
@@ -270,43 +398,57 @@ const B: f64 = E * (std::f64::consts::SQRT_2 - 1.0);
 /// written homogeneously in `e = |β − α|` and `g = |γ|` (numerator and denominator multiplied by `e²`), which takes
 /// the division by `β − α` out and leaves one division in all.
 #[inline(always)]
-fn half_angle_tangent(alpha: f64, beta: f64, gamma: f64) -> f64 {
+fn half_angle_tangent<L: Lanes>(alpha: L, beta: L, gamma: L) -> L {
     let d = beta - alpha;
     let (e, g) = (d.abs(), gamma.abs());
-    let numerator = e + B * g;
-    let denominator = 2.0 * e * numerator + E * g * g;
+    let numerator = e + L::splat(B) * g;
+    let denominator = L::splat(2.0) * e * numerator + L::splat(E) * g * g;
     // The sign of τ is that of x: of γ, flipped when β < α.
-    let tau = g.copysign(gamma * d) * numerator / denominator;
-    if cosine_negligible(alpha, beta, gamma) || denominator <= 0.0 { 0.0 } else { tau }
+    let tau = gamma.times_sign_of(d) * numerator / denominator;
+    let none = cosine_negligible(alpha, beta, gamma) | denominator.le(L::splat(0.0));
+    L::select(none, L::splat(0.0), tau)
 }
 
 /// Whether columns with squared lengths `alpha`, `beta` and dot product `gamma` are orthogonal to within
 /// [`ORTHOGONAL_COSINE`].
 #[inline(always)]
-fn cosine_negligible(alpha: f64, beta: f64, gamma: f64) -> bool {
-    gamma * gamma <= ORTHOGONAL_COSINE * ORTHOGONAL_COSINE * alpha * beta
+fn cosine_negligible<L: Lanes>(alpha: L, beta: L, gamma: L) -> L::Mask {
+    (gamma * gamma).le(L::splat(ORTHOGONAL_COSINE * ORTHOGONAL_COSINE) * alpha * beta)
 }
 
 /// `q ⊗ (t·e_K, 1)`: `q` followed by a turn about axis K whose quaternion is `(t·e_K, 1)` up to scale.
 #[inline(always)]
-fn turned<const K: usize>(q: DQuat, t: f64) -> DQuat {
+fn turned<L: Lanes, const K: usize>(q: [L; 4], t: L) -> [L; 4] {
     // With (i, j, K) cyclic: v × e_K has v_j at i and −v_i at j.
     let (i, j) = ((K + 1) % 3, (K + 2) % 3);
-    let v = [q.x, q.y, q.z];
-    let mut out = v;
-    out[i] = v[i] + t * v[j];
-    out[j] = v[j] - t * v[i];
-    out[K] = v[K] + t * q.w;
-    DQuat::from_xyzw(out[0], out[1], out[2], q.w - t * v[K])
+    let mut out = q;
+    out[i] = q[i] + t * q[j];
+    out[j] = q[j] - t * q[i];
+    out[K] = q[K] + t * q[3];
+    out[3] = q[3] - t * q[K];
+    out
+}
+
+/// `q ⊗ (t, 1)`: `(w − v·t, w·t + v + v × t)` for `q = (v, w)`.
+#[inline(always)]
+fn times_turn<L: Lanes>(q: [L; 4], t: [L; 3]) -> [L; 4] {
+    let [x, y, z, w] = q;
+    let [tx, ty, tz] = t;
+    [
+        w * tx + x + (y * tz - z * ty),
+        w * ty + y + (z * tx - x * tz),
+        w * tz + z + (x * ty - y * tx),
+        w - (x * tx + y * ty + z * tz),
+    ]
 }
 
 #[inline(always)]
-pub(super) fn dot(a: Col, b: Col) -> f64 {
+fn dot<L: Lanes>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 #[inline(always)]
-pub(super) fn cross(a: Col, b: Col) -> Col {
+fn cross<L: Lanes>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
@@ -320,9 +462,14 @@ mod tests {
         DMat3::from_cols_array_2d(cols)
     }
 
+    /// `W = R·V`.
+    fn w(s: &Svd) -> DMat3 {
+        DMat3::from_quat(s.rotation * s.v)
+    }
+
     fn recomposed(s: &Svd) -> DMat3 {
         let v = DMat3::from_quat(s.v);
-        matrix(&s.u) * DMat3::from_diagonal(DVec3::from_array(s.sigma)) * v.transpose() * s.sign
+        w(s) * DMat3::from_diagonal(DVec3::from_array(s.sigma)) * v.transpose() * s.sign
     }
 
     fn never(_: &Gram) -> bool {
@@ -345,12 +492,18 @@ mod tests {
     }
 
     #[test]
-    fn turned_matches_quaternion_product() {
+    fn turns_match_quaternion_products() {
         let q = DQuat::from_xyzw(0.1, -0.7, 0.3, 0.6);
         let t = 0.37;
-        assert!(turned::<0>(q, t).abs_diff_eq(q * DQuat::from_xyzw(t, 0.0, 0.0, 1.0), 1e-15));
-        assert!(turned::<1>(q, t).abs_diff_eq(q * DQuat::from_xyzw(0.0, t, 0.0, 1.0), 1e-15));
-        assert!(turned::<2>(q, t).abs_diff_eq(q * DQuat::from_xyzw(0.0, 0.0, t, 1.0), 1e-15));
+        let turns =
+            [turned::<f64, 0>(q.to_array(), t), turned::<f64, 1>(q.to_array(), t), turned::<f64, 2>(q.to_array(), t)];
+        for (turn, axis) in turns.into_iter().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
+            let expected = q * DQuat::from_vec4((axis * t).extend(1.0));
+            assert!(DQuat::from_array(turn).abs_diff_eq(expected, 1e-15), "{axis}");
+        }
+        let t = [0.2, -0.1, 0.05];
+        let expected = q * DQuat::from_xyzw(t[0], t[1], t[2], 1.0);
+        assert!(DQuat::from_array(times_turn(q.to_array(), t)).abs_diff_eq(expected, 1e-15));
     }
 
     #[test]
@@ -358,14 +511,32 @@ mod tests {
         let a = [[1.0, 2.0, 0.5], [-1.0, 0.5, 2.0], [0.3, 2.5, -2.5]];
         let s = svd(&a, DQuat::IDENTITY, never);
         assert!(recomposed(&s).abs_diff_eq(matrix(&a), 1e-14));
-        let u = matrix(&s.u);
+        let u = w(&s);
         assert!((u.transpose() * u).abs_diff_eq(DMat3::IDENTITY, 1e-15));
         assert!(u.determinant() > 0.0 && s.sign == matrix(&a).determinant().signum());
         let mirrored = [a[0], a[1], a[2].map(|x| -x)];
         let m = svd(&mirrored, DQuat::IDENTITY, never);
         assert!(recomposed(&m).abs_diff_eq(matrix(&mirrored), 1e-14));
-        assert!(matrix(&m.u).determinant() > 0.0 && m.sign == -s.sign);
+        assert!(w(&m).determinant() > 0.0 && m.sign == -s.sign);
         assert!(s.sigma.iter().all(|&x| x > 0.0));
+    }
+
+    /// Two lanes compute what one does: a matrix beside itself gives its own SVD bit for bit, and a matrix that
+    /// needs no turn beside one that needs many is left exactly as it was.
+    #[test]
+    fn lanes_give_the_single_results() {
+        let a = [[1.0, 2.0, 0.5], [-1.0, 0.5, 2.0], [0.3, 2.5, -2.5]];
+        let orthogonal = [[2.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 3.0, 0.0]];
+        let mut found = Vec::new();
+        svd_each([a, a, a, orthogonal].into_iter(), never, |i, s| found.push((i, s)));
+        found.sort_by_key(|&(i, _)| i);
+        let single = svd(&a, DQuat::IDENTITY, never);
+        assert_eq!(found[0].1, single);
+        assert_eq!(found[1].1, single);
+        assert_eq!(found[2].1.sigma, single.sigma);
+        assert_eq!(found[3].1, svd(&orthogonal, DQuat::IDENTITY, never));
+        assert_eq!(found[3].1.v, DQuat::IDENTITY);
+        assert!(recomposed(&found[2].1).abs_diff_eq(matrix(&a), 1e-14));
     }
 
     #[test]
@@ -381,15 +552,15 @@ mod tests {
     #[test]
     fn completes_null_columns_to_a_rotation() {
         let s = svd(&[[0.0; 3], [0.0, 2.0, 0.0], [0.0; 3]], DQuat::IDENTITY, never);
-        assert!(matrix(&s.u).determinant() > 0.999_999);
+        assert!(w(&s).determinant() > 0.999_999);
         assert_eq!(s.sigma, [0.0, 2.0, 0.0]);
         let s = svd(&[[0.0; 3]; 3], DQuat::IDENTITY, never);
-        assert_eq!(matrix(&s.u), DMat3::IDENTITY);
+        assert_eq!(w(&s), DMat3::IDENTITY);
         // A mirroring rank-2 matrix: the sign is free, U a rotation, and the recomposition exact.
         let a = [[-1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.5, 0.0, 2.0]];
         let s = svd(&a, DQuat::IDENTITY, never);
         assert_eq!(s.sign, 1.0);
-        assert!(matrix(&s.u).determinant() > 0.999_999);
+        assert!(w(&s).determinant() > 0.999_999);
         assert!(recomposed(&s).abs_diff_eq(matrix(&a), 1e-15));
     }
 }

@@ -105,7 +105,7 @@ pub struct Layer {
 
 impl Layer {
     pub fn from_model(rig: &Rig, model: Vec<DMat4>, tolerances: &Tolerances) -> Layer {
-        let findings = model.iter().map(|m| Assessment::of(m, tolerances).findings).collect();
+        let findings = Assessment::all(&model, tolerances).into_iter().map(|a| a.findings).collect();
         let meshes = skin_meshes(rig, &model);
         Layer { model, findings, meshes }
     }
