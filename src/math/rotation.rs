@@ -22,6 +22,13 @@ pub(super) fn matrix_of<L: Lanes>(q: Quat<L>) -> Cols<L> {
     ]
 }
 
+/// `a·b`.
+#[inline(always)]
+pub(super) fn times<L: Lanes>(a: &Cols<L>, b: &Cols<L>) -> Cols<L> {
+    // Column j of a·b is Σ_k a_k·b[j][k].
+    std::array::from_fn(|j| std::array::from_fn(|i| a[0][i] * b[j][0] + a[1][i] * b[j][1] + a[2][i] * b[j][2]))
+}
+
 /// `a·bᵀ`.
 #[inline(always)]
 pub(super) fn times_transpose<L: Lanes>(a: &Cols<L>, b: &Cols<L>) -> Cols<L> {
@@ -100,8 +107,9 @@ mod tests {
             let (p, q) = (random_quat(&mut rng), random_quat(&mut rng));
             let [mp, mq] = [p, q].map(|x| matrix_of(x.to_array()));
             assert!(DMat3::from_cols_array_2d(&mp).abs_diff_eq(DMat3::from_quat(p), 1e-15));
-            let product = DMat3::from_quat(p) * DMat3::from_quat(q).transpose();
-            assert!(DMat3::from_cols_array_2d(&times_transpose(&mp, &mq)).abs_diff_eq(product, 1e-15));
+            let (gp, gq) = (DMat3::from_quat(p), DMat3::from_quat(q));
+            assert!(DMat3::from_cols_array_2d(&times(&mp, &mq)).abs_diff_eq(gp * gq, 1e-15));
+            assert!(DMat3::from_cols_array_2d(&times_transpose(&mp, &mq)).abs_diff_eq(gp * gq.transpose(), 1e-15));
             // Two matrices in lanes give each one's own quaternion, bit for bit.
             let joined: Cols<f64x2> =
                 std::array::from_fn(|j| std::array::from_fn(|i| f64x2::from([mp[j][i], mq[j][i]])));

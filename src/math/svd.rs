@@ -1,7 +1,7 @@
-//! The singular value decomposition of a 3×3 matrix, `A·V = U·Σ`, by one-sided (Hestenes) Jacobi rotations.
+//! The singular value decomposition of a 3×3 matrix, `A·V = W·Σ`, by one-sided (Hestenes) Jacobi rotations.
 //!
-//! Rotating pairs of columns of `B = A·V` until every pair is orthogonal leaves `B = U·Σ`: the column lengths are
-//! the singular values, the normalised columns are `U`, and the accumulated rotations are `V`. Working on the columns
+//! Rotating pairs of columns of `B = A·V` until every pair is orthogonal leaves `B = W·Σ`: the column lengths are
+//! the singular values, the normalised columns are `W`, and the accumulated rotations are `V`. Working on the columns
 //! of `A` itself, never on `AᵀA`, keeps the small singular values accurate relative to their size (forming `AᵀA`
 //! squares the condition number), which is what recomposition at scale ratios up to 1e6 needs.
 //!
@@ -20,12 +20,15 @@
 //!   pair needs only a small turn, the three turns commute up to terms of their products' size, so they are taken
 //!   together ([`Jacobi::turn_all`]): one rotation built from three half-angle tangents computed side by side, which
 //!   converges quadratically too, at about half the latency of a sweep.
+//!
+//! Because the chain leaves most of the processor idle, [`svd_each`] runs two matrices through it at once, one in
+//! each lane of SIMD registers: the iteration is written once over [`Lanes`] (one `f64`, or two in an `f64x2`).
 
 use glam::DQuat;
 use wide::f64x2;
 
 use super::lanes::Lanes;
-use super::rotation::{Cols, Quat, matrix_of, quat_from_rotation, times_transpose};
+use super::rotation::{Cols, Quat, matrix_of, quat_from_rotation, times, times_transpose};
 
 /// A column of a 3×3 matrix.
 pub(super) type Col = [f64; 3];
@@ -47,7 +50,7 @@ const MAX_STEPS: usize = 16;
 const SIMULTANEOUS_TURN: f64 = 0.01;
 
 /// A column whose squared length is at most this fraction of the largest one is treated as zero: its direction in
-/// `U` is completed from the others. Far below anything a cosine test on squared lengths could resolve.
+/// `W` is completed from the others. Far below anything a cosine test on squared lengths could resolve.
 const NULL_RATIO_SQUARED: f64 = 1e-200;
 
 /// `A = sign·W·Σ·Vᵀ` with `W` and `V` rotations: the SVD with the sign of the determinant taken out of `W`, given
@@ -174,8 +177,8 @@ fn times_power_of_two(x: f64, exponent: i32) -> f64 {
 /// The iteration's state: `b = growth·A·V`, one matrix per lane.
 struct Jacobi<L> {
     b: Cols<L>,
-    /// `V` as a quaternion `[x, y, z, w]`, unnormalised (each rotation scales it by `√(1 + τ²)`).
-    v: [L; 4],
+    /// `V`, unnormalised (each rotation scales it by `√(1 + τ²)`).
+    v: Quat<L>,
     /// How much the unnormalised rotations have scaled `b`: the product of their `1 + τ²`.
     growth: L,
 }
@@ -190,11 +193,8 @@ impl Jacobi<f64> {
         if start == DQuat::IDENTITY || !start.is_finite() {
             return Self::at_identity(a);
         }
-        let start = start.normalize();
-        let r = glam::DMat3::from_quat(start).to_cols_array_2d();
-        let b =
-            std::array::from_fn(|j| std::array::from_fn(|i| a[0][i] * r[j][0] + a[1][i] * r[j][1] + a[2][i] * r[j][2]));
-        Jacobi { b, v: start.to_array(), growth: 1.0 }
+        let v = start.normalize().to_array();
+        Jacobi { b: times(&a, &matrix_of(v)), v, growth: 1.0 }
     }
 }
 
@@ -272,9 +272,7 @@ impl<L: Lanes> Jacobi<L> {
             [two * (xy - z), one - squared + two * yy, two * (yz + x)],
             [two * (xz + y), two * (yz - x), one - squared + two * zz],
         ];
-        let b = self.b;
-        self.b =
-            std::array::from_fn(|j| std::array::from_fn(|i| b[0][i] * m[j][0] + b[1][i] * m[j][1] + b[2][i] * m[j][2]));
+        self.b = times(&self.b, &m);
         self.growth = self.growth * (one + squared);
         self.v = times_turn(self.v, [x, y, z]);
     }
@@ -364,21 +362,21 @@ impl Finished<f64x2> {
     }
 }
 
-/// Fills the columns of `u` marked `null` so that `u` is a rotation (`det = +1`).
-fn complete(u: &mut [Col; 3], null: [bool; 3]) {
+/// Fills the columns of `w` marked `null` so that `w` is a rotation (`det = +1`).
+fn complete(w: &mut [Col; 3], null: [bool; 3]) {
     match null.iter().filter(|&&n| n).count() {
         1 => {
             let k = null.iter().position(|&n| n).unwrap_or(2);
-            u[k] = cross(u[(k + 1) % 3], u[(k + 2) % 3]);
+            w[k] = cross(w[(k + 1) % 3], w[(k + 2) % 3]);
         }
         2 => {
             let i = null.iter().position(|&n| !n).unwrap_or(0);
-            let first = glam::DVec3::from_array(u[i]);
+            let first = glam::DVec3::from_array(w[i]);
             let second = first.any_orthonormal_vector();
-            u[(i + 1) % 3] = second.to_array();
-            u[(i + 2) % 3] = first.cross(second).to_array();
+            w[(i + 1) % 3] = second.to_array();
+            w[(i + 2) % 3] = first.cross(second).to_array();
         }
-        _ => *u = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        _ => *w = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
     }
 }
 
@@ -418,7 +416,7 @@ fn cosine_negligible<L: Lanes>(alpha: L, beta: L, gamma: L) -> L::Mask {
 
 /// `q ⊗ (t·e_K, 1)`: `q` followed by a turn about axis K whose quaternion is `(t·e_K, 1)` up to scale.
 #[inline(always)]
-fn turned<L: Lanes, const K: usize>(q: [L; 4], t: L) -> [L; 4] {
+fn turned<L: Lanes, const K: usize>(q: Quat<L>, t: L) -> Quat<L> {
     // With (i, j, K) cyclic: v × e_K has v_j at i and −v_i at j.
     let (i, j) = ((K + 1) % 3, (K + 2) % 3);
     let mut out = q;
@@ -431,7 +429,7 @@ fn turned<L: Lanes, const K: usize>(q: [L; 4], t: L) -> [L; 4] {
 
 /// `q ⊗ (t, 1)`: `(w − v·t, w·t + v + v × t)` for `q = (v, w)`.
 #[inline(always)]
-fn times_turn<L: Lanes>(q: [L; 4], t: [L; 3]) -> [L; 4] {
+fn times_turn<L: Lanes>(q: Quat<L>, t: [L; 3]) -> Quat<L> {
     let [x, y, z, w] = q;
     let [tx, ty, tz] = t;
     [
@@ -556,7 +554,7 @@ mod tests {
         assert_eq!(s.sigma, [0.0, 2.0, 0.0]);
         let s = svd(&[[0.0; 3]; 3], DQuat::IDENTITY, never);
         assert_eq!(w(&s), DMat3::IDENTITY);
-        // A mirroring rank-2 matrix: the sign is free, U a rotation, and the recomposition exact.
+        // A mirroring rank-2 matrix: the sign is free, W a rotation, and the recomposition exact.
         let a = [[-1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.5, 0.0, 2.0]];
         let s = svd(&a, DQuat::IDENTITY, never);
         assert_eq!(s.sign, 1.0);
