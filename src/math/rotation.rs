@@ -8,6 +8,18 @@ pub(super) type Cols<L> = [[L; 3]; 3];
 /// A quaternion `[x, y, z, w]`, each component one value per lane.
 pub(super) type Quat<L> = [L; 4];
 
+/// The Hamilton product `a·b`: `(a_w·b_v + b_w·a_v + a_v × b_v, a_w·b_w − a_v·b_v)`.
+#[inline(always)]
+pub(super) fn product<L: Lanes>(a: Quat<L>, b: Quat<L>) -> Quat<L> {
+    let ([ax, ay, az, aw], [bx, by, bz, bw]) = (a, b);
+    [
+        aw * bx + bw * ax + (ay * bz - az * by),
+        aw * by + bw * ay + (az * bx - ax * bz),
+        aw * bz + bw * az + (ax * by - ay * bx),
+        aw * bw - (ax * bx + ay * by + az * bz),
+    ]
+}
+
 /// The rotation matrix of a unit quaternion.
 #[inline(always)]
 pub(super) fn matrix_of<L: Lanes>(q: Quat<L>) -> Cols<L> {
@@ -108,6 +120,7 @@ mod tests {
             let [mp, mq] = [p, q].map(|x| matrix_of(x.to_array()));
             assert!(DMat3::from_cols_array_2d(&mp).abs_diff_eq(DMat3::from_quat(p), 1e-15));
             let (gp, gq) = (DMat3::from_quat(p), DMat3::from_quat(q));
+            assert!(DQuat::from_array(product(p.to_array(), q.to_array())).abs_diff_eq(p * q, 1e-15));
             assert!(DMat3::from_cols_array_2d(&times(&mp, &mq)).abs_diff_eq(gp * gq, 1e-15));
             assert!(DMat3::from_cols_array_2d(&times_transpose(&mp, &mq)).abs_diff_eq(gp * gq.transpose(), 1e-15));
             // Two matrices in lanes give each one's own quaternion, bit for bit.

@@ -28,7 +28,7 @@ use glam::DQuat;
 use wide::f64x2;
 
 use super::lanes::Lanes;
-use super::rotation::{Cols, Quat, matrix_of, quat_from_rotation, times, times_transpose};
+use super::rotation::{Cols, Quat, matrix_of, product, quat_from_rotation, times, times_transpose};
 
 /// A column of a 3×3 matrix.
 pub(super) type Col = [f64; 3];
@@ -274,7 +274,7 @@ impl<L: Lanes> Jacobi<L> {
         ];
         self.b = times(&self.b, &m);
         self.growth = self.growth * (one + squared);
-        self.v = times_turn(self.v, [x, y, z]);
+        self.v = product(self.v, [x, y, z, one]);
     }
 
     /// `Σ`, `V` (normalised) and `R = W·Vᵀ` from the columns, with `W` their directions; when some columns are
@@ -427,19 +427,6 @@ fn turned<L: Lanes, const K: usize>(q: Quat<L>, t: L) -> Quat<L> {
     out
 }
 
-/// `q ⊗ (t, 1)`: `(w − v·t, w·t + v + v × t)` for `q = (v, w)`.
-#[inline(always)]
-fn times_turn<L: Lanes>(q: Quat<L>, t: [L; 3]) -> Quat<L> {
-    let [x, y, z, w] = q;
-    let [tx, ty, tz] = t;
-    [
-        w * tx + x + (y * tz - z * ty),
-        w * ty + y + (z * tx - x * tz),
-        w * tz + z + (x * ty - y * tx),
-        w - (x * tx + y * ty + z * tz),
-    ]
-}
-
 #[inline(always)]
 fn dot<L: Lanes>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -499,9 +486,6 @@ mod tests {
             let expected = q * DQuat::from_vec4((axis * t).extend(1.0));
             assert!(DQuat::from_array(turn).abs_diff_eq(expected, 1e-15), "{axis}");
         }
-        let t = [0.2, -0.1, 0.05];
-        let expected = q * DQuat::from_xyzw(t[0], t[1], t[2], 1.0);
-        assert!(DQuat::from_array(times_turn(q.to_array(), t)).abs_diff_eq(expected, 1e-15));
     }
 
     #[test]
