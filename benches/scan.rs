@@ -176,6 +176,14 @@ fn generated_case(squash: Squash) -> Case {
     Case { name, skeleton, clip, hierarchy }
 }
 
+/// `generated_100` with every bone in Maya's segment scale compensate: no stretch passes down the hierarchy, every
+/// bone is judged from its decomposed model matrix.
+fn compensating_case() -> Case {
+    let case = generated_case(Squash::Limbs);
+    let hierarchy = Hierarchy::new(&case.skeleton, &vec![InheritMode::SegmentCompensate; case.skeleton.len()]);
+    Case { name: "generated_100_compensate".into(), hierarchy, ..case }
+}
+
 fn blender_case() -> Option<Case> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
     if !path.exists() {
@@ -324,6 +332,7 @@ fn benches(c: &mut Criterion) {
     bench_case(c, &generated_case(Squash::Limbs), true);
     bench_case(c, &generated_case(Squash::Spine), false);
     bench_case(c, &generated_case(Squash::None), false);
+    bench_case(c, &compensating_case(), false);
     if let Some(case) = blender_case() {
         bench_case(c, &case, true);
     }
