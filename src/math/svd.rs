@@ -301,7 +301,7 @@ impl<L: Lanes> Jacobi<L> {
         let v = self.v.map(|c| c * (one / (x * x + y * y + z * z + s * s).sqrt()));
         let rotation = match turned {
             Turned::No => quat_from_rotation(&w),
-            Turned::Yes => quat_from_rotation(&times_transpose(&w, &matrix_of(v))),
+            Turned::Yes => polar_rotation(&w, v),
         };
         Finished { sign, sigma: lengths.map(|l| l * shrink), v, rotation, w, null }
     }
@@ -339,7 +339,7 @@ impl Finished<f64> {
         if self.null.iter().any(|&n| n) {
             let mut w = self.w;
             complete(&mut w, self.null);
-            rotation = quat_from_rotation(&times_transpose(&w, &matrix_of(self.v)));
+            rotation = polar_rotation(&w, self.v);
         }
         Svd { sign: self.sign, sigma, v: DQuat::from_array(self.v), rotation: DQuat::from_array(rotation) }
     }
@@ -360,6 +360,12 @@ impl Finished<f64x2> {
             }
         })
     }
+}
+
+/// The quaternion of `R = W·Vᵀ`, the rotation of the polar factor.
+#[inline(always)]
+fn polar_rotation<L: Lanes>(w: &Cols<L>, v: Quat<L>) -> Quat<L> {
+    quat_from_rotation(&times_transpose(w, &matrix_of(v)))
 }
 
 /// Fills the columns of `w` marked `null` so that `w` is a rotation (`det = +1`).
