@@ -43,7 +43,7 @@ pub enum TrackError {
     Empty,
     #[error("{values} output values for {keys} keys with {interpolation:?} interpolation (expected {expected})")]
     CountMismatch { keys: usize, values: usize, expected: usize, interpolation: Interpolation },
-    #[error("key time {index} ({time}) is not finite, negative, or not after the previous key")]
+    #[error("key time {index} ({time}) is not finite, negative, or before the previous key")]
     BadTime { index: usize, time: f64 },
     #[error("output value {index} is not finite")]
     NonFinite { index: usize },
@@ -79,8 +79,10 @@ impl KeyValue for Quat {
 }
 
 impl<T: KeyValue> Track<T> {
-    /// Checks the glTF rules: times finite, non-negative and strictly increasing; one value per key
-    /// (three for cubic splines, at least two keys); every value finite.
+    /// Checks the glTF rules: times finite, non-negative and increasing; one value per key (three for cubic
+    /// splines, at least two keys); every value finite. Keys closer than [`KEY_TIME_RESOLUTION`] (equal times
+    /// included, as exporters and zero-filled accessors write them) count once: the last of them holds from that
+    /// time on, as a jump does.
     pub fn new(times: Arc<[f64]>, values: Vec<T>, interpolation: Interpolation) -> Result<Self, TrackError> {
         if times.is_empty() {
             return Err(TrackError::Empty);
@@ -89,18 +91,19 @@ impl<T: KeyValue> Track<T> {
         if values.len() != expected {
             return Err(TrackError::CountMismatch { keys: times.len(), values: values.len(), expected, interpolation });
         }
-        if interpolation == Interpolation::CubicSpline && times.len() < 2 {
-            return Err(TrackError::TooFewCubicKeys);
-        }
         let mut previous = f64::NEG_INFINITY;
         for (index, &time) in times.iter().enumerate() {
-            if !time.is_finite() || time < 0.0 || time <= previous {
+            if !time.is_finite() || time < 0.0 || time < previous {
                 return Err(TrackError::BadTime { index, time });
             }
             previous = time;
         }
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             return Err(TrackError::NonFinite { index });
+        }
+        let (times, values) = merge_close_keys(times, values, interpolation.values_per_key());
+        if interpolation == Interpolation::CubicSpline && times.len() < 2 {
+            return Err(TrackError::TooFewCubicKeys);
         }
         Ok(Track { times, values, interpolation })
     }
@@ -133,6 +136,24 @@ impl<T> Track<T> {
     pub fn last_time(&self) -> f64 {
         self.times[self.times.len() - 1]
     }
+}
+
+/// Key times closer than this are one key: one FBX tick (1/46,186,158,000 s), the finest time any supported
+/// format stores.
+pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
+
+/// Sorted `times` and their keys (`per_key` values each) with each run of keys closer than
+/// [`KEY_TIME_RESOLUTION`] to the previous one reduced to its last key; the inputs themselves when there is none.
+fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Vec<T>, per_key: usize) -> (Arc<[f64]>, Vec<T>) {
+    let close = |w: &[f64]| w[1] - w[0] < KEY_TIME_RESOLUTION;
+    if !times.windows(2).any(close) {
+        return (times, values);
+    }
+    let keep = |k: usize| times.get(k + 1).is_none_or(|next| next - times[k] >= KEY_TIME_RESOLUTION);
+    let kept: Vec<usize> = (0..times.len()).filter(|&k| keep(k)).collect();
+    let merged_times = kept.iter().map(|&k| times[k]).collect();
+    let merged_values = kept.iter().flat_map(|&k| values[k * per_key..(k + 1) * per_key].iter().copied()).collect();
+    (merged_times, merged_values)
 }
 
 /// The animated properties of one bone in a clip.
@@ -265,7 +286,7 @@ mod tests {
             Err(TrackError::CountMismatch { expected: 6, .. })
         ));
         assert!(matches!(
-            Track::new(times(&[1.0, 1.0]), v.clone(), Interpolation::Linear),
+            Track::new(times(&[1.0, 0.5]), v.clone(), Interpolation::Linear),
             Err(TrackError::BadTime { index: 1, .. })
         ));
         assert!(matches!(
@@ -279,6 +300,26 @@ mod tests {
         assert_eq!(
             Track::new(times(&[0.0]), vec![Vec3::ZERO; 3], Interpolation::CubicSpline),
             Err(TrackError::TooFewCubicKeys)
+        );
+    }
+
+    #[test]
+    fn keys_closer_than_a_tick_count_once_the_last_holding() {
+        let (a, b, c) = (Vec3::X, Vec3::Y, Vec3::Z);
+        let track = Track::new(times(&[0.0, 0.0, 1.0, 1.0 + 1e-12]), vec![a, b, c, a], Interpolation::Linear).unwrap();
+        assert_eq!(track.times(), &[0.0, 1.0 + 1e-12]);
+        assert_eq!(track.values(), &[b, a]);
+        let cubic = |v: Vec3| [Vec3::ZERO, v, Vec3::ZERO];
+        let values = [cubic(a), cubic(b), cubic(c)].concat();
+        let track = Track::new(times(&[0.0, 0.5, 0.5]), values, Interpolation::CubicSpline).unwrap();
+        assert_eq!(track.values(), &[cubic(a), cubic(c)].concat());
+        let shared = times(&[0.0, 1.0]);
+        let track = Track::new(shared.clone(), vec![a, b], Interpolation::Step).unwrap();
+        assert!(Arc::ptr_eq(&track.times, &shared), "times without close keys stay shared");
+        assert_eq!(
+            Track::new(times(&[0.0, 0.0]), vec![Vec3::ZERO; 6], Interpolation::CubicSpline),
+            Err(TrackError::TooFewCubicKeys),
+            "one key left"
         );
     }
 

@@ -6,7 +6,7 @@ mod skeleton;
 mod skin;
 mod transform;
 
-pub use clip::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Track, TrackError};
+pub use clip::{BoneTracks, Clip, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphChannel, Track, TrackError};
 pub use inherit::{InheritMode, UnknownInheritMode};
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, Skin};

@@ -1,14 +1,56 @@
-//! A bounds-checked accessor reader.
+//! A bounds-checked accessor reader, with sparse accessors and accessors without a buffer view.
 //!
-//! Before a byte is read, the accessor's element type is checked against what its use allows (the spec's
-//! tables), and its whole range (`offset + stride·(count−1) + element size`) against its buffer view, and the view
-//! against its buffer. Every allocation is then one element per `count`, which the range check has tied to bytes
-//! actually present. Sparse accessors are refused: nothing bonescope reads uses them in practice.
+//! Before a byte is read, the accessor's element type is checked against what its use allows (the spec's tables,
+//! and `KHR_mesh_quantization`'s for vertex attributes), and its whole range (`offset + stride·(count−1) + element
+//! size`) against its buffer view, and the view against its buffer. An accessor without a `bufferView` is zeros;
+//! `sparse` then replaces the elements it lists (indices strictly increasing, each below `count`). Allocations are
+//! one element per `count`, which the range check ties to bytes present, except for zeros: those are capped at
+//! [`MAX_ZEROS`] bytes so a tiny hostile file cannot ask for gigabytes.
 
 use glam::{DMat4, Quat, Vec3};
-use gltf::accessor::{DataType, Dimensions};
 
+use super::buffers::Buffers;
+use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
+
+/// The most bytes of elements an accessor may hold without a buffer view behind them.
+const MAX_ZEROS: usize = 64 << 20;
+
+/// glTF's component types (`componentType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum DataType {
+    I8 = 5120,
+    U8 = 5121,
+    I16 = 5122,
+    U16 = 5123,
+    U32 = 5125,
+    F32 = 5126,
+}
+
+impl DataType {
+    fn from_code(code: Uint) -> Option<Self> {
+        [Self::I8, Self::U8, Self::I16, Self::U16, Self::U32, Self::F32].into_iter().find(|t| *t as usize == code.0)
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::U32 | Self::F32 => 4,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::I8 => "BYTE",
+            Self::U8 => "UNSIGNED_BYTE",
+            Self::I16 => "SHORT",
+            Self::U16 => "UNSIGNED_SHORT",
+            Self::U32 => "UNSIGNED_INT",
+            Self::F32 => "FLOAT",
+        }
+    }
+}
 
 /// An allowed component type and whether it must be `normalized`.
 type Component = (DataType, bool);
@@ -19,174 +61,335 @@ const FLOAT_OR_NORMALIZED: &[Component] =
     &[(DataType::F32, false), (DataType::I8, true), (DataType::U8, true), (DataType::I16, true), (DataType::U16, true)];
 /// `WEIGHTS_0`: float, or unsigned normalized bytes and shorts.
 const FLOAT_OR_UNORM: &[Component] = &[(DataType::F32, false), (DataType::U8, true), (DataType::U16, true)];
+/// `POSITION` and morph-target displacements with `KHR_mesh_quantization`: float, or bytes and shorts, signed or
+/// not, normalized or not.
+const QUANTIZED: &[Component] = &[
+    (DataType::F32, false),
+    (DataType::I8, false),
+    (DataType::I8, true),
+    (DataType::U8, false),
+    (DataType::U8, true),
+    (DataType::I16, false),
+    (DataType::I16, true),
+    (DataType::U16, false),
+    (DataType::U16, true),
+];
 const JOINT_INDEX: &[Component] = &[(DataType::U8, false), (DataType::U16, false)];
 const VERTEX_INDEX: &[Component] = &[(DataType::U8, false), (DataType::U16, false), (DataType::U32, false)];
+const SPARSE_INDEX: &[DataType] = &[DataType::U8, DataType::U16, DataType::U32];
 
-/// The checked bytes of an accessor: `count` elements, `stride` apart, the last one ending the slice.
-struct Elements<'a> {
-    bytes: &'a [u8],
-    stride: usize,
-    data_type: DataType,
-    normalized: bool,
+/// What a use of an accessor allows: its `type` (and so `N` components per element) and component types.
+struct Use {
+    what: &'static str,
+    kind: &'static str,
+    components: &'static [Component],
 }
 
-/// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
-pub(super) fn times(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<f64>> {
-    let elements = checked(accessor, buffers, Dimensions::Scalar, FLOAT, "keyframe times")?;
-    Ok(elements.floats::<1>().map(|[t]| f64::from(t)).collect())
+const TIMES: Use = Use { what: "keyframe times", kind: "SCALAR", components: FLOAT };
+const ROTATIONS: Use = Use { what: "rotation output", kind: "VEC4", components: FLOAT_OR_NORMALIZED };
+const MORPH_WEIGHTS: Use = Use { what: "morph-weight output", kind: "SCALAR", components: FLOAT_OR_NORMALIZED };
+const MATRICES: Use = Use { what: "inverse bind matrices", kind: "MAT4", components: FLOAT };
+const JOINTS: Use = Use { what: "JOINTS_0", kind: "VEC4", components: JOINT_INDEX };
+const WEIGHTS: Use = Use { what: "WEIGHTS_0", kind: "VEC4", components: FLOAT_OR_UNORM };
+const INDICES: Use = Use { what: "indices", kind: "SCALAR", components: VERTEX_INDEX };
+
+/// The accessors of a document and the buffers behind them.
+pub(super) struct Accessors<'a> {
+    root: &'a Root,
+    buffers: &'a Buffers<'a>,
 }
 
-/// `VEC3` float: translations, scales, positions.
-pub(super) fn vec3s(accessor: &gltf::Accessor, buffers: &[Vec<u8>], what: &str) -> Result<Vec<Vec3>> {
-    let elements = checked(accessor, buffers, Dimensions::Vec3, FLOAT, what)?;
-    Ok(elements.floats::<3>().map(Vec3::from_array).collect())
-}
-
-/// `VEC4` quaternions `[x, y, z, w]`, float or normalized integers (decoded, not renormalized).
-pub(super) fn rotations(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<Quat>> {
-    let elements = checked(accessor, buffers, Dimensions::Vec4, FLOAT_OR_NORMALIZED, "rotation output")?;
-    Ok(elements.floats::<4>().map(Quat::from_array).collect())
-}
-
-/// Checks a morph-weight output accessor without reading it (the weights are not evaluated).
-pub(super) fn check_morph_weights(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<()> {
-    checked(accessor, buffers, Dimensions::Scalar, FLOAT_OR_NORMALIZED, "morph-weight output").map(drop)
-}
-
-/// `MAT4` float, column-major as glTF stores it.
-pub(super) fn matrices(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<DMat4>> {
-    let elements = checked(accessor, buffers, Dimensions::Mat4, FLOAT, "inverse bind matrices")?;
-    Ok(elements.floats::<16>().map(|m| DMat4::from_cols_array(&m.map(f64::from))).collect())
-}
-
-/// `JOINTS_0`: four unsigned byte or short joint indices per vertex.
-pub(super) fn joints(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<[u16; 4]>> {
-    let elements = checked(accessor, buffers, Dimensions::Vec4, JOINT_INDEX, "JOINTS_0")?;
-    // Both allowed types fit in u16.
-    Ok(elements.uints::<4>().map(|j| j.map(|i| i as u16)).collect())
-}
-
-/// `WEIGHTS_0`: four weights per vertex, float or unsigned normalized.
-pub(super) fn weights(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<[f32; 4]>> {
-    let elements = checked(accessor, buffers, Dimensions::Vec4, FLOAT_OR_UNORM, "WEIGHTS_0")?;
-    Ok(elements.floats::<4>().collect())
-}
-
-/// Vertex indices (`SCALAR` unsigned byte, short or int).
-pub(super) fn indices(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>> {
-    let elements = checked(accessor, buffers, Dimensions::Scalar, VERTEX_INDEX, "indices")?;
-    Ok(elements.uints::<1>().map(|[i]| i).collect())
-}
-
-/// Checks type and range of `accessor` for a use that allows `dimensions` and `allowed` component types.
-fn checked<'a>(
-    accessor: &gltf::Accessor,
-    buffers: &'a [Vec<u8>],
-    dimensions: Dimensions,
-    allowed: &[Component],
-    what: &str,
-) -> Result<Elements<'a>> {
-    let place = format!("accessors[{}]", accessor.index());
-    let component = (accessor.data_type(), accessor.normalized());
-    if accessor.dimensions() != dimensions || !allowed.contains(&component) {
-        let expected = allowed.iter().map(|&c| component_name(c)).collect::<Vec<_>>().join(" or ");
-        let found = format!("{} of {}", type_name(accessor.dimensions()), component_name(component));
-        let message = format!("{what} must be {} of {expected}, found {found}", type_name(dimensions));
-        return Err(Failure::at(place, message));
-    }
-    if accessor.sparse().is_some() {
-        return Err(Failure::at(place, "sparse accessors are not supported"));
-    }
-    let Some(view) = accessor.view() else {
-        return Err(Failure::at(place, "has no bufferView"));
-    };
-    let view_bytes = view_bytes(&view, buffers)?;
-    let element_size = accessor.size();
-    let stride = view.stride().unwrap_or(element_size);
-    if stride < element_size {
-        let message =
-            format!("bufferViews[{}] has byteStride {stride}, less than the element size {element_size}", view.index());
-        return Err(Failure::at(place, message));
-    }
-    let count = accessor.count();
-    let end = count
-        .checked_sub(1)
-        .ok_or_else(|| Failure::at(&place, "count is 0"))?
-        .checked_mul(stride)
-        .and_then(|n| n.checked_add(accessor.offset()))
-        .and_then(|n| n.checked_add(element_size));
-    let Some(bytes) = end.and_then(|end| view_bytes.get(accessor.offset()..end)) else {
-        let message = format!(
-            "{count} elements of {element_size} bytes (stride {stride}) from byteOffset {} \
-             do not fit in bufferViews[{}] ({} bytes)",
-            accessor.offset(),
-            view.index(),
-            view_bytes.len()
-        );
-        return Err(Failure::at(place, message));
-    };
-    Ok(Elements { bytes, stride, data_type: component.0, normalized: component.1 })
-}
-
-/// The bytes of a buffer view, checked to lie inside its buffer.
-fn view_bytes<'a>(view: &gltf::buffer::View, buffers: &'a [Vec<u8>]) -> Result<&'a [u8]> {
-    let buffer = buffers.get(view.buffer().index()).map_or(&[][..], Vec::as_slice);
-    let end = view.offset().checked_add(view.length());
-    end.and_then(|end| buffer.get(view.offset()..end)).ok_or_else(|| {
-        let message = format!(
-            "bytes {}..{} lie outside buffers[{}] ({} bytes)",
-            view.offset(),
-            view.offset().saturating_add(view.length()),
-            view.buffer().index(),
-            buffer.len()
-        );
-        Failure::at(format!("bufferViews[{}]", view.index()), message)
-    })
-}
-
-impl Elements<'_> {
-    /// Each element's first `N` components, as the spec decodes them into floats.
-    fn floats<const N: usize>(&self) -> impl Iterator<Item = [f32; N]> + '_ {
-        self.components::<N>().map(|components| components.map(|c| decode_float(self.data_type, self.normalized, c)))
+impl<'a> Accessors<'a> {
+    pub fn new(root: &'a Root, buffers: &'a Buffers<'a>) -> Self {
+        Accessors { root, buffers }
     }
 
-    /// Each element's first `N` components as unsigned integers.
-    fn uints<const N: usize>(&self) -> impl Iterator<Item = [u32; N]> + '_ {
-        self.components::<N>().map(|components| components.map(|c| decode_uint(self.data_type, c)))
+    /// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
+    pub fn times(&self, index: Uint, user: &str) -> Result<Vec<f64>> {
+        Ok(self.read::<f32, 1>(index, user, &TIMES)?.into_iter().map(|[t]| f64::from(t)).collect())
     }
 
-    /// The bytes of each element's first `N` components.
-    fn components<const N: usize>(&self) -> impl Iterator<Item = [&[u8]; N]> + '_ {
-        let size = self.data_type.size();
-        // `bytes` holds `count` elements exactly: `chunks` yields `count` slices, each at least one element long.
-        self.bytes.chunks(self.stride).map(move |element| {
-            let mut components = element.chunks_exact(size);
-            std::array::from_fn(|_| components.next().unwrap_or_default())
+    /// `VEC3` float: translation and scale outputs.
+    pub fn vec3s(&self, index: Uint, user: &str, what: &'static str) -> Result<Vec<Vec3>> {
+        let vec3s = Use { what, kind: "VEC3", components: FLOAT };
+        Ok(self.read::<f32, 3>(index, user, &vec3s)?.into_iter().map(Vec3::from_array).collect())
+    }
+
+    /// `VEC3` positions or morph-target displacements, float or quantized.
+    pub fn positions(&self, index: Uint, user: &str, what: &'static str) -> Result<Vec<Vec3>> {
+        let positions = Use { what, kind: "VEC3", components: QUANTIZED };
+        Ok(self.read::<f32, 3>(index, user, &positions)?.into_iter().map(Vec3::from_array).collect())
+    }
+
+    /// `VEC4` quaternions `[x, y, z, w]`, float or normalized integers (decoded, not renormalized).
+    pub fn rotations(&self, index: Uint, user: &str) -> Result<Vec<Quat>> {
+        Ok(self.read::<f32, 4>(index, user, &ROTATIONS)?.into_iter().map(Quat::from_array).collect())
+    }
+
+    /// Morph-target weights (`SCALAR`, float or normalized).
+    pub fn morph_weights(&self, index: Uint, user: &str) -> Result<Vec<f32>> {
+        Ok(self.read::<f32, 1>(index, user, &MORPH_WEIGHTS)?.into_iter().map(|[w]| w).collect())
+    }
+
+    /// `MAT4` float, column-major as glTF stores it.
+    pub fn matrices(&self, index: Uint, user: &str) -> Result<Vec<DMat4>> {
+        let matrices = self.read::<f32, 16>(index, user, &MATRICES)?;
+        Ok(matrices.into_iter().map(|m| DMat4::from_cols_array(&m.map(f64::from))).collect())
+    }
+
+    /// `JOINTS_0`: four unsigned byte or short joint indices per vertex.
+    pub fn joints(&self, index: Uint, user: &str) -> Result<Vec<[u16; 4]>> {
+        // Both allowed types fit in u16.
+        Ok(self.read::<u32, 4>(index, user, &JOINTS)?.into_iter().map(|j| j.map(|i| i as u16)).collect())
+    }
+
+    /// `WEIGHTS_0`: four weights per vertex, float or unsigned normalized.
+    pub fn weights(&self, index: Uint, user: &str) -> Result<Vec<[f32; 4]>> {
+        self.read::<f32, 4>(index, user, &WEIGHTS)
+    }
+
+    /// Vertex indices (`SCALAR` unsigned byte, short or int).
+    pub fn indices(&self, index: Uint, user: &str) -> Result<Vec<u32>> {
+        Ok(self.read::<u32, 1>(index, user, &INDICES)?.into_iter().map(|[i]| i).collect())
+    }
+
+    /// The first buffer that `accessors[index]` reads and that has no source in the file (see
+    /// [`Buffers::has_source`]); `None` when every one has, or when a reference is broken (reading says so).
+    pub fn unsupplied_buffer(&self, index: Uint) -> Option<Uint> {
+        let accessor = self.root.accessors.get(index.0)?;
+        let sparse = accessor.sparse.iter().flat_map(|s| [s.indices.buffer_view, s.values.buffer_view]);
+        let views = accessor.buffer_view.into_iter().chain(sparse);
+        let buffers = views.filter_map(|v| self.root.buffer_views.get(v.0)).map(|view| view.buffer);
+        buffers.into_iter().find(|&b| !self.buffers.has_source(b))
+    }
+
+    /// Every element of `accessors[index]`, used by `user` as `usage` allows, with its sparse substitutions.
+    fn read<T: Decode, const N: usize>(&self, index: Uint, user: &str, usage: &Use) -> Result<Vec<[T; N]>> {
+        let accessor = schema::item(&self.root.accessors, index, "accessors", user)?;
+        let place = format!("accessors[{}]", index.0);
+        let data_type = check_type(accessor, usage, N, &place)?;
+        let count = accessor.count.0;
+        let mut elements = match accessor.buffer_view {
+            Some(view) => {
+                let layout = Layout { data_type, normalized: accessor.normalized, components: N };
+                self.elements(view, accessor.byte_offset.0, count, layout, true, &place)?.decode().collect()
+            }
+            None => zeros(count, size_of::<[T; N]>(), &place)?,
+        };
+        if let Some(sparse) = &accessor.sparse {
+            self.substitute(sparse, data_type, accessor.normalized, &mut elements, &format!("{place}.sparse"))?;
+        }
+        Ok(elements)
+    }
+
+    /// Replaces the elements that `sparse` lists by its values.
+    fn substitute<T: Decode, const N: usize>(
+        &self,
+        sparse: &schema::Sparse,
+        data_type: DataType,
+        normalized: bool,
+        elements: &mut [[T; N]],
+        place: &str,
+    ) -> Result<()> {
+        let count = sparse.count.0;
+        if count == 0 || count > elements.len() {
+            return Err(Failure::at(place, format!("count {count} is not in 1..={}", elements.len())));
+        }
+        let indices = &sparse.indices;
+        let index_type = DataType::from_code(indices.component_type).filter(|t| SPARSE_INDEX.contains(t));
+        let Some(index_type) = index_type else {
+            let message = format!("componentType {} is not an unsigned integer type", indices.component_type.0);
+            return Err(Failure::at(format!("{place}.indices"), message));
+        };
+        let index_layout = Layout { data_type: index_type, normalized: false, components: 1 };
+        let index_place = format!("{place}.indices");
+        let positions =
+            self.elements(indices.buffer_view, indices.byte_offset.0, count, index_layout, false, &index_place)?;
+        let value_layout = Layout { data_type, normalized, components: N };
+        let values = &sparse.values;
+        let value_place = format!("{place}.values");
+        let values =
+            self.elements(values.buffer_view, values.byte_offset.0, count, value_layout, false, &value_place)?;
+        let mut previous = None;
+        for (k, ([position], value)) in positions.decode::<u32, 1>().zip(values.decode::<T, N>()).enumerate() {
+            let position = position as usize;
+            if previous.is_some_and(|p| position <= p) || position >= elements.len() {
+                let message = format!(
+                    "index {k} is {position}: indices must increase strictly and stay below count {}",
+                    elements.len()
+                );
+                return Err(Failure::at(index_place, message));
+            }
+            elements[position] = value;
+            previous = Some(position);
+        }
+        Ok(())
+    }
+
+    /// The checked bytes of `count` elements laid out as `layout` from `offset` in `bufferViews[view]`; `strided`
+    /// honours the view's `byteStride` (sparse data is always tightly packed).
+    fn elements(
+        &self,
+        view_index: Uint,
+        offset: usize,
+        count: usize,
+        layout: Layout,
+        strided: bool,
+        place: &str,
+    ) -> Result<Elements<'a>> {
+        let view = schema::item(&self.root.buffer_views, view_index, "bufferViews", place)?;
+        let view_place = format!("bufferViews[{}]", view_index.0);
+        let view_bytes = self.view_bytes(view, &view_place, place)?;
+        let element_size = layout.element_size();
+        let stride = match view.byte_stride {
+            Some(stride) if strided => stride.0,
+            _ => element_size,
+        };
+        if stride < element_size {
+            let message = format!("{view_place} has byteStride {stride}, less than the element size {element_size}");
+            return Err(Failure::at(place, message));
+        }
+        let end = match count.checked_sub(1) {
+            None => Some(offset),
+            Some(last) => {
+                last.checked_mul(stride).and_then(|n| n.checked_add(offset)).and_then(|n| n.checked_add(element_size))
+            }
+        };
+        let Some(bytes) = end.and_then(|end| view_bytes.get(offset..end)) else {
+            let message = format!(
+                "{count} elements of {element_size} bytes (stride {stride}) from byteOffset {offset} do not fit in \
+                 {view_place} ({} bytes)",
+                view_bytes.len()
+            );
+            return Err(Failure::at(place, message));
+        };
+        Ok(Elements { bytes, stride, layout })
+    }
+
+    /// The bytes of a buffer view (at `place`), checked to lie inside its buffer, which `user` needs.
+    fn view_bytes(&self, view: &schema::BufferView, place: &str, user: &str) -> Result<&'a [u8]> {
+        let buffer = self.buffers.bytes(view.buffer, user)?;
+        let (offset, length) = (view.byte_offset.0, view.byte_length.0);
+        offset.checked_add(length).and_then(|end| buffer.get(offset..end)).ok_or_else(|| {
+            let message = format!(
+                "bytes {offset}..{} lie outside buffers[{}] ({} bytes)",
+                offset.saturating_add(length),
+                view.buffer.0,
+                buffer.len()
+            );
+            Failure::at(place, message)
         })
     }
 }
 
-/// One component as a float: floats as stored, normalized integers by the spec's rules (`max(c/127, −1)`,
-/// `c/255`, `max(c/32767, −1)`, `c/65535`), other integers by value.
-fn decode_float(data_type: DataType, normalized: bool, bytes: &[u8]) -> f32 {
-    let (value, scale) = match data_type {
-        DataType::F32 => return f32::from_le_bytes(array(bytes)),
-        DataType::I8 => (f32::from(i8::from_le_bytes(array(bytes))), 127.0),
-        DataType::U8 => (f32::from(bytes.first().copied().unwrap_or_default()), 255.0),
-        DataType::I16 => (f32::from(i16::from_le_bytes(array(bytes))), 32767.0),
-        DataType::U16 => (f32::from(u16::from_le_bytes(array(bytes))), 65535.0),
-        DataType::U32 => return decode_uint(data_type, bytes) as f32,
-    };
-    if normalized { (value / scale).max(-1.0) } else { value }
+/// Checks the accessor's `type` and component type against `usage`; `components` is what the reader decodes.
+fn check_type(accessor: &schema::Accessor, usage: &Use, components: usize, place: &str) -> Result<DataType> {
+    debug_assert_eq!(components_of(usage.kind), Some(components));
+    let data_type = DataType::from_code(accessor.component_type);
+    let allowed = data_type.is_some_and(|t| usage.components.contains(&(t, accessor.normalized)));
+    match data_type {
+        Some(data_type) if allowed && accessor.kind == usage.kind => Ok(data_type),
+        _ => {
+            let expected = usage.components.iter().map(|&c| component_name(c)).collect::<Vec<_>>().join(" or ");
+            let found_type = data_type.map_or_else(
+                || format!("componentType {}", accessor.component_type.0),
+                |t| component_name((t, accessor.normalized)),
+            );
+            let message =
+                format!("{} must be {} of {expected}, found {} of {found_type}", usage.what, usage.kind, accessor.kind);
+            Err(Failure::at(place, message))
+        }
+    }
 }
 
-fn decode_uint(data_type: DataType, bytes: &[u8]) -> u32 {
-    match data_type {
-        DataType::U8 => u32::from(u8::from_le_bytes(array(bytes))),
-        DataType::U16 => u32::from(u16::from_le_bytes(array(bytes))),
-        DataType::U32 => u32::from_le_bytes(array(bytes)),
-        // Not allowed for any integer use (see the `Component` tables).
-        DataType::I8 | DataType::I16 | DataType::F32 => 0,
+/// Components per element of an accessor `type` this reader decodes (matrices other than `MAT4` are never read).
+fn components_of(kind: &str) -> Option<usize> {
+    match kind {
+        "SCALAR" => Some(1),
+        "VEC2" => Some(2),
+        "VEC3" => Some(3),
+        "VEC4" => Some(4),
+        "MAT4" => Some(16),
+        _ => None,
+    }
+}
+
+/// `count` zero elements of `size` bytes each, within [`MAX_ZEROS`].
+fn zeros<T: Decode, const N: usize>(count: usize, size: usize, place: &str) -> Result<Vec<[T; N]>> {
+    if count.checked_mul(size).is_none_or(|bytes| bytes > MAX_ZEROS) {
+        let message = format!(
+            "{count} elements without a bufferView would take more than the {} MiB bonescope fills with zeros",
+            MAX_ZEROS >> 20
+        );
+        return Err(Failure::at(place, message));
+    }
+    Ok(vec![[T::default(); N]; count])
+}
+
+/// How one element is stored.
+#[derive(Clone, Copy)]
+struct Layout {
+    data_type: DataType,
+    normalized: bool,
+    components: usize,
+}
+
+impl Layout {
+    fn element_size(self) -> usize {
+        self.data_type.size() * self.components
+    }
+}
+
+/// The checked bytes of some elements: `stride` apart, the last one ending the slice.
+struct Elements<'a> {
+    bytes: &'a [u8],
+    stride: usize,
+    layout: Layout,
+}
+
+impl Elements<'_> {
+    /// Each element's `N` components, decoded.
+    fn decode<T: Decode, const N: usize>(&self) -> impl Iterator<Item = [T; N]> + '_ {
+        let Layout { data_type, normalized, .. } = self.layout;
+        let size = data_type.size();
+        // `bytes` ends with the last element: `chunks` yields each element, the last one possibly without padding.
+        self.bytes.chunks(self.stride).map(move |element| {
+            let mut components = element.chunks_exact(size);
+            std::array::from_fn(|_| T::decode(data_type, normalized, components.next().unwrap_or_default()))
+        })
+    }
+}
+
+/// A component as a reader wants it.
+trait Decode: Copy + Default {
+    fn decode(data_type: DataType, normalized: bool, bytes: &[u8]) -> Self;
+}
+
+impl Decode for f32 {
+    /// Floats as stored, normalized integers by the spec's rules (`max(c/127, −1)`, `c/255`, `max(c/32767, −1)`,
+    /// `c/65535`), other integers by value.
+    fn decode(data_type: DataType, normalized: bool, bytes: &[u8]) -> f32 {
+        let (value, scale) = match data_type {
+            DataType::F32 => return f32::from_le_bytes(array(bytes)),
+            DataType::I8 => (f32::from(i8::from_le_bytes(array(bytes))), 127.0),
+            DataType::U8 => (f32::from(bytes.first().copied().unwrap_or_default()), 255.0),
+            DataType::I16 => (f32::from(i16::from_le_bytes(array(bytes))), 32767.0),
+            DataType::U16 => (f32::from(u16::from_le_bytes(array(bytes))), 65535.0),
+            DataType::U32 => return u32::decode(data_type, normalized, bytes) as f32,
+        };
+        if normalized { (value / scale).max(-1.0) } else { value }
+    }
+}
+
+impl Decode for u32 {
+    fn decode(data_type: DataType, _normalized: bool, bytes: &[u8]) -> u32 {
+        match data_type {
+            DataType::U8 => u32::from(u8::from_le_bytes(array(bytes))),
+            DataType::U16 => u32::from(u16::from_le_bytes(array(bytes))),
+            DataType::U32 => u32::from_le_bytes(array(bytes)),
+            // Not allowed for any integer use (see the `Component` tables).
+            DataType::I8 | DataType::I16 | DataType::F32 => 0,
+        }
     }
 }
 
@@ -195,55 +398,48 @@ fn array<const N: usize>(bytes: &[u8]) -> [u8; N] {
     bytes.first_chunk().copied().unwrap_or([0; N])
 }
 
-fn type_name(dimensions: Dimensions) -> &'static str {
-    match dimensions {
-        Dimensions::Scalar => "SCALAR",
-        Dimensions::Vec2 => "VEC2",
-        Dimensions::Vec3 => "VEC3",
-        Dimensions::Vec4 => "VEC4",
-        Dimensions::Mat2 => "MAT2",
-        Dimensions::Mat3 => "MAT3",
-        Dimensions::Mat4 => "MAT4",
-    }
-}
-
 fn component_name((data_type, normalized): Component) -> String {
-    let name = match data_type {
-        DataType::I8 => "BYTE",
-        DataType::U8 => "UNSIGNED_BYTE",
-        DataType::I16 => "SHORT",
-        DataType::U16 => "UNSIGNED_SHORT",
-        DataType::U32 => "UNSIGNED_INT",
-        DataType::F32 => "FLOAT",
-    };
-    if normalized { format!("normalized {name}") } else { name.to_owned() }
+    if normalized { format!("normalized {}", data_type.name()) } else { data_type.name().to_owned() }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn float(data_type: DataType, normalized: bool, bytes: &[u8]) -> f32 {
+        f32::decode(data_type, normalized, bytes)
+    }
+
     #[test]
     fn normalized_integers_decode_per_spec() {
-        let i16s = |v: i16| decode_float(DataType::I16, true, &v.to_le_bytes());
+        let i16s = |v: i16| float(DataType::I16, true, &v.to_le_bytes());
         assert_eq!(i16s(32767), 1.0);
         assert_eq!(i16s(-32767), -1.0);
         assert_eq!(i16s(-32768), -1.0, "clamped to −1");
         assert_eq!(i16s(16384), 16384.0 / 32767.0);
-        let i8s = |v: i8| decode_float(DataType::I8, true, &v.to_le_bytes());
+        let i8s = |v: i8| float(DataType::I8, true, &v.to_le_bytes());
         assert_eq!((i8s(127), i8s(-128), i8s(64)), (1.0, -1.0, 64.0 / 127.0));
-        assert_eq!(decode_float(DataType::U8, true, &[255]), 1.0);
-        assert_eq!(decode_float(DataType::U8, true, &[51]), 0.2);
-        assert_eq!(decode_float(DataType::U16, true, &65535u16.to_le_bytes()), 1.0);
-        assert_eq!(decode_float(DataType::F32, false, &1.5f32.to_le_bytes()), 1.5);
-        assert_eq!(decode_float(DataType::U16, false, &300u16.to_le_bytes()), 300.0);
+        assert_eq!(float(DataType::U8, true, &[255]), 1.0);
+        assert_eq!(float(DataType::U8, true, &[51]), 0.2);
+        assert_eq!(float(DataType::U16, true, &65535u16.to_le_bytes()), 1.0);
+        assert_eq!(float(DataType::F32, false, &1.5f32.to_le_bytes()), 1.5);
+        assert_eq!(float(DataType::U16, false, &300u16.to_le_bytes()), 300.0);
+        assert_eq!(float(DataType::I8, false, &(-3i8).to_le_bytes()), -3.0, "quantized, not normalized");
     }
 
     #[test]
     fn strided_elements_read_only_their_components() {
         // Two VEC2 u16 elements with stride 6: [1, 2, pad], [3, 4].
         let bytes = [1, 0, 2, 0, 0xEE, 0xEE, 3, 0, 4, 0];
-        let elements = Elements { bytes: &bytes, stride: 6, data_type: DataType::U16, normalized: false };
-        assert_eq!(elements.uints::<2>().collect::<Vec<_>>(), vec![[1, 2], [3, 4]]);
+        let layout = Layout { data_type: DataType::U16, normalized: false, components: 2 };
+        let elements = Elements { bytes: &bytes, stride: 6, layout };
+        assert_eq!(elements.decode::<u32, 2>().collect::<Vec<_>>(), vec![[1, 2], [3, 4]]);
+    }
+
+    #[test]
+    fn zeros_are_capped() {
+        assert_eq!(zeros::<f32, 3>(2, 12, "a").unwrap(), vec![[0.0; 3]; 2]);
+        assert!(zeros::<f32, 16>(usize::MAX / 2, 64, "a").is_err());
+        assert!(zeros::<f32, 16>(2_000_000, 64, "a").is_err());
     }
 }

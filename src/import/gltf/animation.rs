@@ -1,16 +1,18 @@
 //! Animations as [`Clip`]s: translation, rotation and scale channels become tracks, morph-weight channels are
 //! listed.
 //!
-//! Key times are read once per input accessor and shared (`Arc`) by every track that uses it, as exporters
-//! commonly give all channels of a clip one time accessor.
+//! A channel names its target by `node` and `path`, or with `KHR_animation_pointer` by a JSON pointer: pointers to a
+//! node's `translation`, `rotation`, `scale` or `weights`, or a mesh's `weights`, are read like ordinary channels;
+//! others (materials, cameras, lights) are counted in the notes. Key times are read once per input accessor and
+//! shared (`Arc`) by every track that uses it, as exporters commonly give all channels of a clip one time accessor.
 
 use std::collections::hash_map::{Entry, HashMap};
 use std::collections::{BTreeMap, HashSet};
 use std::sync::Arc;
 
-use gltf::animation::{Interpolation as GltfInterpolation, Property};
-
-use super::{Failure, Result, accessor};
+use super::accessor::Accessors;
+use super::schema::{self, Root, Uint};
+use super::{Failure, Result};
 use crate::model::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Track};
 
 /// What the channels of all clips add up to, for the notes.
@@ -18,90 +20,216 @@ use crate::model::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Trac
 struct Tally {
     morph_channels: usize,
     outside_scene: usize,
+    /// `KHR_animation_pointer` targets bonescope does not evaluate, by pointer.
+    other_pointers: BTreeMap<String, usize>,
 }
 
 pub(super) fn read_clips(
-    doc: &gltf::Document,
-    buffers: &[Vec<u8>],
+    root: &Root,
+    accessors: &Accessors<'_>,
     bone_of_node: &[Option<usize>],
     notes: &mut Vec<String>,
 ) -> Result<Vec<Clip>> {
-    let mut reader = Reader { buffers, bone_of_node, times: HashMap::new(), tally: Tally::default() };
-    let clips = doc.animations().map(|a| reader.clip(&a)).collect::<Result<Vec<_>>>()?;
-    if reader.tally.morph_channels > 0 {
-        notes.push(format!("{} morph-weight channels listed, not evaluated", reader.tally.morph_channels));
+    let mut reader = Reader { root, accessors, bone_of_node, times: HashMap::new(), tally: Tally::default() };
+    let clips = root.animations.iter().enumerate().map(|(i, a)| reader.clip(i, a)).collect::<Result<Vec<_>>>()?;
+    let tally = reader.tally;
+    if tally.morph_channels > 0 {
+        notes.push(format!("{} morph-weight channels listed, not evaluated", tally.morph_channels));
     }
-    if reader.tally.outside_scene > 0 {
-        notes
-            .push(format!("{} animation channels target nodes outside the scene, ignored", reader.tally.outside_scene));
+    if tally.outside_scene > 0 {
+        notes.push(format!("{} animation channels target nodes outside the scene, ignored", tally.outside_scene));
+    }
+    if !tally.other_pointers.is_empty() {
+        let count: usize = tally.other_pointers.values().sum();
+        let pointers = tally.other_pointers.keys().map(|p| format!("`{p}`")).collect::<Vec<_>>().join(", ");
+        notes.push(format!("{count} animation channels animate properties bonescope does not evaluate: {pointers}"));
     }
     Ok(clips)
 }
 
-struct Reader<'a> {
-    buffers: &'a [Vec<u8>],
+/// What a channel animates.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum Property {
+    Translation,
+    Rotation,
+    Scale,
+    Weights,
+}
+
+impl Property {
+    fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "translation" => Some(Property::Translation),
+            "rotation" => Some(Property::Rotation),
+            "scale" => Some(Property::Scale),
+            "weights" => Some(Property::Weights),
+            _ => None,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Property::Translation => "translation",
+            Property::Rotation => "rotation",
+            Property::Scale => "scale",
+            Property::Weights => "morph weights",
+        }
+    }
+}
+
+/// A channel's target: which nodes (a mesh's weights animate every node that shows the mesh) and what of them.
+enum Target {
+    Node(usize, Property),
+    MeshWeights(usize),
+    /// A `KHR_animation_pointer` bonescope does not evaluate.
+    Other(String),
+}
+
+struct Reader<'a, 'd> {
+    root: &'a Root,
+    accessors: &'a Accessors<'d>,
     bone_of_node: &'a [Option<usize>],
     /// Key times by input accessor index.
-    times: HashMap<usize, Arc<[f64]>>,
+    times: HashMap<Uint, Arc<[f64]>>,
     tally: Tally,
 }
 
-impl Reader<'_> {
-    fn clip(&mut self, animation: &gltf::Animation) -> Result<Clip> {
+impl Reader<'_, '_> {
+    fn clip(&mut self, index: usize, animation: &schema::Animation) -> Result<Clip> {
         let mut tracks: BTreeMap<usize, BoneTracks> = BTreeMap::new();
         let mut morph_channels = Vec::new();
         let mut targets = HashSet::new();
-        for channel in animation.channels() {
-            let node = channel.target().node().index();
-            let property = channel.target().property();
-            if !targets.insert((node, property_name(property))) {
-                let place = format!("animations[{}].channels[{}]", animation.index(), channel.index());
-                let message = format!("a second channel for the {} of nodes[{node}]", property_name(property));
-                return Err(Failure::at(place, message));
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let channel_place = format!("animations[{index}].channels[{c}]");
+            let (node, property) = match self.target(&channel.target, &channel_place)? {
+                Target::Node(node, property) => (node, property),
+                Target::MeshWeights(mesh) => {
+                    let sampler = self.sampler(animation, channel.sampler, &channel_place)?;
+                    for bone in self.bones_showing(mesh) {
+                        morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?);
+                    }
+                    continue;
+                }
+                Target::Other(pointer) => {
+                    *self.tally.other_pointers.entry(pointer).or_default() += 1;
+                    continue;
+                }
+            };
+            if !targets.insert((node, property)) {
+                let message = format!("a second channel for the {} of nodes[{node}]", property.name());
+                return Err(Failure::at(channel_place, message));
             }
             let Some(bone) = self.bone_of_node[node] else {
                 self.tally.outside_scene += 1;
                 continue;
             };
-            let sampler = channel.sampler();
-            let place = format!("animations[{}].samplers[{}]", animation.index(), sampler.index());
-            let times = self.times(&sampler.input())?;
-            let interpolation = interpolation(sampler.interpolation());
-            let output = sampler.output();
+            let sampler = self.sampler(animation, channel.sampler, &channel_place)?;
+            if property == Property::Weights {
+                morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?);
+                continue;
+            }
+            let place = format!("animations[{index}].samplers[{}]", channel.sampler.0);
+            let times = self.times(sampler.input, &place)?;
+            let interpolation = interpolation(sampler, &place)?;
+            let output = sampler.output;
             let bone_tracks = tracks.entry(bone).or_insert_with(|| BoneTracks::new(bone));
             match property {
                 Property::Translation => {
-                    let values = accessor::vec3s(&output, self.buffers, "translation output")?;
+                    let values = self.accessors.vec3s(output, &place, "translation output")?;
                     bone_tracks.translation = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Scale => {
-                    let values = accessor::vec3s(&output, self.buffers, "scale output")?;
+                    let values = self.accessors.vec3s(output, &place, "scale output")?;
                     bone_tracks.scale = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Rotation => {
-                    let values = accessor::rotations(&output, self.buffers)?;
+                    let values = self.accessors.rotations(output, &place)?;
                     bone_tracks.rotation = Some(track(times, values, interpolation, &place)?);
                 }
-                Property::MorphTargetWeights => {
-                    accessor::check_morph_weights(&output, self.buffers)?;
-                    morph_channels.push(morph_channel(bone, &times, interpolation, output.count(), &place)?);
-                    self.tally.morph_channels += 1;
-                }
+                Property::Weights => unreachable!("handled above"),
             }
         }
+        self.tally.morph_channels += morph_channels.len();
         // A bone whose only channels were morph weights has an empty entry.
         let tracks = tracks
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
             .collect();
-        Ok(Clip::new(animation.index(), animation.name().map(str::to_owned), tracks, morph_channels))
+        Ok(Clip::new(index, animation.name.clone(), tracks, morph_channels))
+    }
+
+    /// What `target` animates, checked to exist.
+    fn target(&self, target: &schema::Target, place: &str) -> Result<Target> {
+        if let Some(pointer) = &target.extensions.animation_pointer
+            && target.path == "pointer"
+        {
+            return self.pointer_target(&pointer.pointer, &format!("{place}.target"));
+        }
+        let Some(node) = target.node else {
+            // Valid only with an extension bonescope does not know; nothing here to evaluate.
+            return Ok(Target::Other(format!("path `{}` without a node", target.path)));
+        };
+        schema::item(&self.root.nodes, node, "nodes", format!("{place}.target.node"))?;
+        match Property::from_name(&target.path) {
+            Some(property) => Ok(Target::Node(node.0, property)),
+            None => Err(Failure::at(format!("{place}.target.path"), format!("unknown path `{}`", target.path))),
+        }
+    }
+
+    /// A `KHR_animation_pointer` target: `/nodes/N/{translation,rotation,scale,weights}` or `/meshes/M/weights`.
+    fn pointer_target(&self, pointer: &str, place: &str) -> Result<Target> {
+        let parts: Vec<&str> = pointer.strip_prefix('/').unwrap_or_default().split('/').collect();
+        let index = |text: &str, list_len: usize, kind: &str| -> Result<usize> {
+            match text.parse::<usize>() {
+                Ok(i) if i < list_len => Ok(i),
+                _ => Err(Failure::at(place, format!("pointer `{pointer}` names no existing {kind}"))),
+            }
+        };
+        match parts[..] {
+            ["nodes", node, property] => match Property::from_name(property) {
+                Some(property) => Ok(Target::Node(index(node, self.root.nodes.len(), "node")?, property)),
+                None => Ok(Target::Other(pointer.to_owned())),
+            },
+            ["meshes", mesh, "weights"] => Ok(Target::MeshWeights(index(mesh, self.root.meshes.len(), "mesh")?)),
+            _ => Ok(Target::Other(pointer.to_owned())),
+        }
+    }
+
+    /// The bones whose node shows `meshes[mesh]`.
+    fn bones_showing(&self, mesh: usize) -> Vec<usize> {
+        let nodes = self.root.nodes.iter().enumerate().filter(|(_, n)| n.mesh.is_some_and(|m| m.0 == mesh));
+        nodes.filter_map(|(node, _)| self.bone_of_node[node]).collect()
+    }
+
+    fn sampler<'s>(
+        &self,
+        animation: &'s schema::Animation,
+        index: Uint,
+        place: &str,
+    ) -> Result<&'s schema::AnimationSampler> {
+        schema::item(&animation.samplers, index, "samplers", format!("{place}.sampler"))
+    }
+
+    /// A morph-weight channel of `bone`, with its times and outputs checked.
+    fn morph_channel(
+        &mut self,
+        bone: usize,
+        sampler: &schema::AnimationSampler,
+        sampler_index: Uint,
+        animation: usize,
+    ) -> Result<MorphChannel> {
+        let place = format!("animations[{animation}].samplers[{}]", sampler_index.0);
+        let times = self.times(sampler.input, &place)?;
+        let interpolation = interpolation(sampler, &place)?;
+        let outputs = self.accessors.morph_weights(sampler.output, &place)?.len();
+        morph_channel(bone, &times, interpolation, outputs, &place)
     }
 
     /// The key times of an input accessor, read on first use.
-    fn times(&mut self, input: &gltf::Accessor) -> Result<Arc<[f64]>> {
-        match self.times.entry(input.index()) {
+    fn times(&mut self, input: Uint, place: &str) -> Result<Arc<[f64]>> {
+        match self.times.entry(input) {
             Entry::Occupied(entry) => Ok(entry.get().clone()),
-            Entry::Vacant(entry) => Ok(entry.insert(accessor::times(input, self.buffers)?.into()).clone()),
+            Entry::Vacant(entry) => Ok(entry.insert(self.accessors.times(input, place)?.into()).clone()),
         }
     }
 }
@@ -126,7 +254,7 @@ fn morph_channel(
     place: &str,
 ) -> Result<MorphChannel> {
     let valid_times = times.first().is_some_and(|&t| t >= 0.0)
-        && times.windows(2).all(|w| w[0] < w[1])
+        && times.windows(2).all(|w| w[0] <= w[1])
         && times.iter().all(|t| t.is_finite());
     if !valid_times {
         return Err(Failure::at(place, "key times are not finite, non-negative and increasing"));
@@ -140,19 +268,12 @@ fn morph_channel(
     Ok(MorphChannel { bone, keys: times.len(), interpolation, last_time })
 }
 
-fn interpolation(interpolation: GltfInterpolation) -> Interpolation {
-    match interpolation {
-        GltfInterpolation::Step => Interpolation::Step,
-        GltfInterpolation::Linear => Interpolation::Linear,
-        GltfInterpolation::CubicSpline => Interpolation::CubicSpline,
-    }
-}
-
-fn property_name(property: Property) -> &'static str {
-    match property {
-        Property::Translation => "translation",
-        Property::Rotation => "rotation",
-        Property::Scale => "scale",
-        Property::MorphTargetWeights => "morph weights",
+/// The sampler's interpolation (`LINEAR` when absent).
+fn interpolation(sampler: &schema::AnimationSampler, place: &str) -> Result<Interpolation> {
+    match sampler.interpolation.as_deref() {
+        None | Some("LINEAR") => Ok(Interpolation::Linear),
+        Some("STEP") => Ok(Interpolation::Step),
+        Some("CUBICSPLINE") => Ok(Interpolation::CubicSpline),
+        Some(other) => Err(Failure::at(format!("{place}.interpolation"), format!("unknown interpolation `{other}`"))),
     }
 }

@@ -1,18 +1,22 @@
-//! Buffer bytes: the GLB `BIN` chunk, base64 `data:` URIs, or files beside the glTF file.
+//! Buffer bytes: the GLB `BIN` chunk, base64 `data:` URIs, or files beside the glTF file, each read on first use.
 //!
-//! A URI may name a file in the glTF file's folder or below it, percent-encoded or not; absolute paths, `..`
-//! and every scheme but `data:` are refused, so a downloaded file cannot make bonescope read elsewhere on disk or
-//! reach the network. Each buffer is cut to its declared `byteLength` (a GLB chunk may carry padding), and an
-//! external file is read no further than that, so memory stays bounded by what the files actually hold.
+//! A buffer nothing reads is never opened, so a file whose unused buffer points at a missing file or an `http:` URI
+//! still loads; a buffer that is read and cannot be had fails naming who needed it. A URI may name a file in the
+//! glTF file's folder or below it, percent-encoded or not; absolute paths, `..` and every scheme but `data:` are
+//! refused, so a downloaded file cannot make bonescope read elsewhere on disk or reach the network. Each buffer is
+//! cut to its declared `byteLength` (a GLB chunk may carry padding), and an external file is read no further than
+//! that, so memory stays bounded by what the files actually hold.
 
+use std::borrow::Cow;
+use std::cell::OnceCell;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
 use base64::engine::DecodePaddingMode;
 use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
-use gltf::buffer::Source;
 
+use super::schema::{self, Uint};
 use super::{Failure, Result};
 
 /// Base64 as glTF writers produce it; some leave out the `=` padding.
@@ -21,28 +25,54 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
     GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
 );
 
-/// One byte vector per buffer of the document, each exactly `byteLength` long.
-pub(super) fn load(doc: &gltf::Document, mut blob: Option<Vec<u8>>, folder: &Path) -> Result<Vec<Vec<u8>>> {
-    doc.buffers()
-        .map(|buffer| {
-            let place = format!("buffers[{}]", buffer.index());
-            let mut data = match buffer.source() {
-                Source::Bin if buffer.index() == 0 => {
-                    blob.take().ok_or_else(|| Failure::at(&place, "has no uri, and the file has no GLB BIN chunk"))?
-                }
-                Source::Bin => {
-                    return Err(Failure::at(&place, "has no uri (only buffers[0] can be the GLB BIN chunk)"));
-                }
-                Source::Uri(uri) => read_uri(uri, folder, buffer.length()).map_err(|m| Failure::at(&place, m))?,
-            };
-            if data.len() < buffer.length() {
-                let message = format!("byteLength is {} but the data holds {} bytes", buffer.length(), data.len());
-                return Err(Failure::at(place, message));
+/// The document's buffers, loaded when first asked for.
+pub(super) struct Buffers<'a> {
+    declared: &'a [schema::Buffer],
+    blob: Option<&'a [u8]>,
+    folder: &'a Path,
+    loaded: Vec<OnceCell<std::result::Result<Cow<'a, [u8]>, String>>>,
+}
+
+impl<'a> Buffers<'a> {
+    pub fn new(declared: &'a [schema::Buffer], blob: Option<&'a [u8]>, folder: &'a Path) -> Self {
+        Buffers { declared, blob, folder, loaded: declared.iter().map(|_| OnceCell::new()).collect() }
+    }
+
+    /// The bytes of `buffers[index]`, exactly `byteLength` of them; `user` (`bufferViews[2]`) names who needs them.
+    pub fn bytes(&self, index: Uint, user: &str) -> Result<&[u8]> {
+        let declared = schema::item(self.declared, index, "buffers", user)?;
+        let loaded = self.loaded[index.0].get_or_init(|| self.load(index.0, declared));
+        match loaded {
+            Ok(bytes) => Ok(bytes),
+            Err(why) => Err(Failure::at(user, format!("needs buffers[{}]: {why}", index.0))),
+        }
+    }
+
+    /// Whether `buffers[index]` has a source in the file: a uri, or the GLB `BIN` chunk. One without is valid glTF
+    /// ("defined by the application"), and what it holds cannot be had here.
+    pub fn has_source(&self, index: Uint) -> bool {
+        self.declared.get(index.0).is_some_and(|b| b.uri.is_some()) || (index.0 == 0 && self.blob.is_some())
+    }
+
+    fn load(&self, index: usize, declared: &schema::Buffer) -> std::result::Result<Cow<'a, [u8]>, String> {
+        let length = declared.byte_length.0;
+        let data = match (&declared.uri, self.blob) {
+            (Some(uri), _) => Cow::Owned(read_uri(uri, self.folder, length)?),
+            (None, Some(blob)) if index == 0 => Cow::Borrowed(blob),
+            (None, _) if index == 0 => return Err("it has no uri, and the file has no GLB BIN chunk".into()),
+            (None, _) => return Err("it has no uri (only buffers[0] can be the GLB BIN chunk)".into()),
+        };
+        if data.len() < length {
+            return Err(format!("its byteLength is {length} but the data holds {} bytes", data.len()));
+        }
+        Ok(match data {
+            Cow::Borrowed(bytes) => Cow::Borrowed(&bytes[..length]),
+            Cow::Owned(mut bytes) => {
+                bytes.truncate(length);
+                Cow::Owned(bytes)
             }
-            data.truncate(buffer.length());
-            Ok(data)
         })
-        .collect()
+    }
 }
 
 /// The bytes a buffer URI names (at most `length` of them for a file).

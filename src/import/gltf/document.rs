@@ -1,94 +1,136 @@
-//! Parsing the container (JSON text or GLB) with the `gltf` crate, and validating the document.
+//! The container (JSON text or GLB) and the document inside it.
 //!
-//! Two guards come first because the crate panics without them: a GLB header whose length field is below 12
-//! (it subtracts the header size unchecked), and a primitive whose `POSITION` index is out of range (its
-//! validation indexes the accessor list before checking). The crate's validation then checks every index and
-//! enum (and, added here, animation channel targets, which it skips), so the `gltf::Document` wrappers used
-//! afterwards cannot panic either.
+//! GLB framing is read here rather than by the `gltf` crate, because the crate refuses what the specification
+//! allows (chunks of unknown types, which a loader must skip) and panics on a header length below 12. The JSON is
+//! deserialized into [`schema::Root`], which declares only what bonescope reads; an error names its place as a
+//! JSON path (`accessors[3].count`). Extensions listed in `extensionsRequired` are refused unless bonescope
+//! evaluates them or they only change what bonescope neither reads nor draws (materials, textures, lights).
 
-use gltf::binary::{ChunkType, Error as GlbError};
-use gltf::json::validation::{Error as ValidationError, Validate};
-use gltf::json::{self, Path as JsonPath, Root};
-use gltf::mesh::Semantic;
-
+use super::schema::Root;
 use super::{Failure, Result};
 
+const GLB_MAGIC: &[u8] = b"glTF";
 const GLB_HEADER_LEN: usize = 12;
+const CHUNK_HEADER_LEN: usize = 8;
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+const CHUNK_BIN: u32 = 0x004E_4942;
 
-/// A validated document with the GLB `BIN` chunk, if any.
-pub(super) struct Parsed {
-    pub document: gltf::Document,
-    pub blob: Option<Vec<u8>>,
-    /// Facts worth telling the user (extensions the file requires, say).
+/// Extensions bonescope evaluates.
+const EVALUATED: &[&str] = &["KHR_mesh_quantization", "KHR_animation_pointer"];
+/// Prefixes of extensions that only touch materials, textures, images or lights, which bonescope does not draw.
+const NOT_DRAWN: &[&str] = &["KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "EXT_lights_"];
+
+/// The parsed document with the GLB `BIN` chunk, if any.
+pub(super) struct Parsed<'a> {
+    pub root: Root,
+    pub blob: Option<&'a [u8]>,
+    /// Facts worth telling the user (required extensions ignored, say).
     pub notes: Vec<String>,
 }
 
-pub(super) fn parse(bytes: &[u8]) -> Result<Parsed> {
-    let bytes = if bytes.starts_with(b"glTF") {
-        check_glb_header(bytes)?
+pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>> {
+    let (json, blob) = if bytes.starts_with(GLB_MAGIC) {
+        split_glb(bytes)?
     } else {
-        bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
+        (bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes), None)
     };
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(parse_failure)?;
-    let root = gltf.document.as_json();
-    check_version(root)?;
-    check_position_indices(root)?;
-    let notes = validate(root)?;
-    Ok(Parsed { document: gltf.document, blob: gltf.blob, notes })
+    let root = deserialize(json)?;
+    check_version(&root)?;
+    let notes = check_required_extensions(&root)?;
+    Ok(Parsed { root, blob, notes })
 }
 
-/// Checks the 12-byte GLB header and returns the bytes it declares (trailing bytes are ignored).
-fn check_glb_header(bytes: &[u8]) -> Result<&[u8]> {
-    let header = Failure::at;
-    let Some(fields) = bytes.get(4..GLB_HEADER_LEN) else {
-        return Err(header("GLB header", format!("truncated: {} of 12 bytes", bytes.len())));
+/// The JSON chunk and the first `BIN` chunk of a GLB; chunks of other types are skipped, as the spec asks.
+fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
+    let header = |message: String| Failure::at("GLB header", message);
+    let word = |bytes: &[u8], at: usize| bytes.get(at..at + 4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
+    let (Some(version), Some(length)) = (word(bytes, 4), word(bytes, 8)) else {
+        return Err(header(format!("truncated: {} of 12 bytes", bytes.len())));
     };
-    let word = |i: usize| u32::from_le_bytes([fields[i], fields[i + 1], fields[i + 2], fields[i + 3]]);
-    let (version, length) = (word(0), word(4) as usize);
     if version != 2 {
-        return Err(header("GLB header", format!("version {version}, expected 2")));
+        return Err(header(format!("version {version}, expected 2")));
     }
+    let length = length as usize;
     if length < GLB_HEADER_LEN {
-        return Err(header("GLB header", format!("declares a total length of {length} bytes")));
+        return Err(header(format!("declares a total length of {length} bytes")));
     }
-    bytes.get(..length).ok_or_else(|| {
-        header("GLB header", format!("declares {length} bytes but the file has {} (truncated?)", bytes.len()))
-    })
+    let Some(body) = bytes.get(GLB_HEADER_LEN..length) else {
+        return Err(header(format!("declares {length} bytes but the file has {} (truncated?)", bytes.len())));
+    };
+    let mut chunks = Chunks { rest: body, index: 0 };
+    let json = match chunks.next().transpose()? {
+        Some((CHUNK_JSON, json)) => json,
+        Some(_) => return Err(Failure::at("GLB chunks[0]", "is not the JSON chunk (JSON must come first)")),
+        None => return Err(Failure::at("GLB chunks", "no JSON chunk")),
+    };
+    for chunk in chunks {
+        if let (CHUNK_BIN, bin) = chunk? {
+            return Ok((json, Some(bin)));
+        }
+    }
+    Ok((json, None))
 }
 
-fn parse_failure(error: gltf::Error) -> Failure {
-    match error {
-        gltf::Error::Deserialize(e) => json_failure(&e),
-        gltf::Error::Binary(e) => glb_failure(e),
-        other => Failure::whole(other.to_string()),
+/// The chunks of a GLB body: `(type, data)`.
+struct Chunks<'a> {
+    rest: &'a [u8],
+    index: usize,
+}
+
+impl<'a> Iterator for Chunks<'a> {
+    type Item = Result<(u32, &'a [u8])>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.rest.is_empty() {
+            return None;
+        }
+        let place = format!("GLB chunks[{}]", self.index);
+        self.index += 1;
+        let Some((header, data)) = self.rest.split_first_chunk::<CHUNK_HEADER_LEN>() else {
+            self.rest = &[];
+            return Some(Err(Failure::at(place, "truncated chunk header")));
+        };
+        let length = u32::from_le_bytes([header[0], header[1], header[2], header[3]]) as usize;
+        let kind = u32::from_le_bytes([header[4], header[5], header[6], header[7]]);
+        let Some((chunk, rest)) = data.split_at_checked(length) else {
+            self.rest = &[];
+            let message = format!("declares {length} bytes but only {} remain (truncated?)", data.len());
+            return Some(Err(Failure::at(place, message)));
+        };
+        self.rest = rest;
+        Some(Ok((kind, chunk)))
     }
 }
 
-/// A JSON syntax or schema error, placed by line and column (serde_json's message without its suffix).
-fn json_failure(e: &json::Error) -> Failure {
+/// The JSON as [`Root`]; a syntax error is placed by line and column, a schema error by its JSON path.
+fn deserialize(json: &[u8]) -> Result<Root> {
+    let mut deserializer = serde_json::Deserializer::from_slice(json);
+    let root = serde_path_to_error::deserialize(&mut deserializer).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if inner.is_syntax() || inner.is_eof() || path == "." {
+            json_failure(&inner)
+        } else {
+            Failure::at(path, strip_position(&inner))
+        }
+    })?;
+    deserializer.end().map_err(|e| json_failure(&e))?;
+    Ok(root)
+}
+
+/// serde_json's message without its ` at line L column C` suffix, which the place says instead.
+fn strip_position(e: &serde_json::Error) -> String {
     let full = e.to_string();
     let suffix = format!(" at line {} column {}", e.line(), e.column());
-    let message = full.strip_suffix(&suffix).unwrap_or(&full);
-    if e.line() == 0 {
-        Failure::whole(format!("malformed JSON: {message}"))
-    } else {
-        let place = format!("JSON line {}, column {}", e.line(), e.column());
-        Failure::at(place, format!("malformed JSON: {message}"))
-    }
+    full.strip_suffix(&suffix).unwrap_or(&full).to_owned()
 }
 
-fn glb_failure(e: GlbError) -> Failure {
-    let chunk = |ty: ChunkType| match ty {
-        ChunkType::Json => "GLB JSON chunk",
-        ChunkType::Bin => "GLB BIN chunk",
-    };
-    match e {
-        GlbError::ChunkLength { ty, length, length_read } => {
-            Failure::at(chunk(ty), format!("declares {length} bytes but only {length_read} remain (truncated?)"))
-        }
-        GlbError::ChunkType(ty) => Failure::at(chunk(ty), "unexpected chunk (JSON must come first, then BIN)"),
-        GlbError::Io(e) => Failure::at("GLB chunks", format!("truncated chunk header ({e})")),
-        other => Failure::at("GLB chunks", other.to_string()),
+fn json_failure(e: &serde_json::Error) -> Failure {
+    let message = format!("malformed JSON: {}", strip_position(e));
+    if e.line() == 0 {
+        Failure::whole(message)
+    } else {
+        Failure::at(format!("JSON line {}, column {}", e.line(), e.column()), message)
     }
 }
 
@@ -101,60 +143,87 @@ fn check_version(root: &Root) -> Result<()> {
     }
 }
 
-/// The `gltf` crate's validation indexes `accessors` by the `POSITION` attribute before checking the index.
-fn check_position_indices(root: &Root) -> Result<()> {
-    for (m, mesh) in root.meshes.iter().enumerate() {
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            let position = primitive.attributes.get(&json::validation::Checked::Valid(Semantic::Positions));
-            if let Some(index) = position.filter(|i| i.value() >= root.accessors.len()) {
-                return Err(Failure::at(
-                    format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
-                    format!("accessor {} does not exist ({} accessors)", index.value(), root.accessors.len()),
-                ));
-            }
+/// Refuses the first required extension that could change what bonescope shows; notes the ones it may ignore.
+fn check_required_extensions(root: &Root) -> Result<Vec<String>> {
+    let mut ignored: Vec<&str> = Vec::new();
+    for (i, name) in root.extensions_required.iter().enumerate() {
+        if EVALUATED.contains(&name.as_str()) {
+            continue;
+        }
+        if !NOT_DRAWN.iter().any(|prefix| name.starts_with(prefix)) {
+            let message = format!("the file requires the extension `{name}`, which bonescope does not implement");
+            return Err(Failure::at(format!("extensionsRequired[{i}]"), message));
+        }
+        if !ignored.contains(&name.as_str()) {
+            ignored.push(name);
         }
     }
-    Ok(())
+    Ok(match ignored[..] {
+        [] => vec![],
+        _ => {
+            let names = ignored.iter().map(|e| format!("`{e}`")).collect::<Vec<_>>().join(", ");
+            vec![format!("required extensions that change only materials, textures or lights, not drawn: {names}")]
+        }
+    })
 }
 
-/// Runs the crate's validation; the first problem becomes the error. Required extensions bonescope does not
-/// implement become a note instead: most (materials, textures) do not touch what bonescope reads, and one that
-/// does (mesh compression, quantization) fails later with an accessor error.
-fn validate(root: &Root) -> Result<Vec<String>> {
-    let mut problems: Vec<(JsonPath, ValidationError)> = Vec::new();
-    let mut report = |path: &dyn Fn() -> JsonPath, error| problems.push((path(), error));
-    root.validate(root, JsonPath::new, &mut report);
-    // gltf-json 1.4 validates an animation's samplers but not its channels' targets.
-    for (a, animation) in root.animations.iter().enumerate() {
-        for (c, channel) in animation.channels.iter().enumerate() {
-            let path = || JsonPath::new().field("animations").index(a).field("channels").index(c).field("target");
-            channel.target.validate(root, path, &mut report);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn glb(chunks: &[(u32, &[u8])]) -> Vec<u8> {
+        let mut body = Vec::new();
+        for (kind, data) in chunks {
+            body.extend((data.len() as u32).to_le_bytes());
+            body.extend(kind.to_le_bytes());
+            body.extend(*data);
         }
+        let mut out = b"glTF".to_vec();
+        out.extend(2u32.to_le_bytes());
+        out.extend(((GLB_HEADER_LEN + body.len()) as u32).to_le_bytes());
+        out.extend(body);
+        out
     }
-    let (unsupported, problems): (Vec<_>, Vec<_>) =
-        problems.into_iter().partition(|(_, e)| *e == ValidationError::Unsupported);
-    if let Some((path, error)) = problems.first() {
-        let more = match problems.len() {
-            1 => String::new(),
-            n => format!(" (and {} more problems)", n - 1),
+
+    #[test]
+    fn glb_chunks_of_unknown_types_are_skipped() {
+        let bytes = glb(&[(CHUNK_JSON, b"{}  "), (0x1234, b"xxxx"), (CHUNK_BIN, b"\x01\x02\x03\x04")]);
+        let (json, bin) = split_glb(&bytes).unwrap();
+        assert_eq!((json, bin), (&b"{}  "[..], Some(&b"\x01\x02\x03\x04"[..])));
+        assert_eq!(split_glb(&glb(&[(CHUNK_JSON, b"{}  ")])).unwrap().1, None);
+    }
+
+    #[test]
+    fn broken_glb_framing_is_placed() {
+        let place = |bytes: &[u8]| split_glb(bytes).unwrap_err().place.unwrap();
+        assert_eq!(place(b"glTF\x02\0\0\0\x04\0\0\0"), "GLB header");
+        assert_eq!(place(&glb(&[(CHUNK_BIN, b"")])), "GLB chunks[0]");
+        let mut truncated = glb(&[(CHUNK_JSON, b"{}  "), (CHUNK_BIN, b"abcd")]);
+        let n = truncated.len();
+        truncated[n - 12] = 40; // the BIN chunk claims 40 bytes
+        assert_eq!(place(&truncated), "GLB chunks[1]");
+    }
+
+    #[test]
+    fn schema_errors_name_their_json_path() {
+        let failure = deserialize(br#"{"asset": {"version": "2.0"}, "accessors": [{"count": "many"}]}"#).unwrap_err();
+        assert_eq!(failure.place.as_deref(), Some("accessors[0].count"));
+        let failure = deserialize(b"{\"asset\": ").unwrap_err();
+        assert!(failure.message.starts_with("malformed JSON"), "{failure:?}");
+    }
+
+    #[test]
+    fn required_extensions_are_refused_unless_evaluated_or_not_drawn() {
+        let root = |required: &str| {
+            deserialize(format!(r#"{{"asset": {{"version": "2.0"}}, "extensionsRequired": {required}}}"#).as_bytes())
+                .unwrap()
         };
-        return Err(Failure::at(path.as_str(), format!("{}{more}", describe(*error))));
-    }
-    let notes = if unsupported.is_empty() {
-        vec![]
-    } else {
-        let names = root.extensions_required.iter().map(|e| format!("`{e}`")).collect::<Vec<_>>();
-        vec![format!("the file requires extensions bonescope ignores: {}", names.join(", "))]
-    };
-    Ok(notes)
-}
-
-fn describe(error: ValidationError) -> &'static str {
-    match error {
-        ValidationError::IndexOutOfBounds => "index out of range",
-        ValidationError::Invalid => "invalid value",
-        ValidationError::Missing => "missing",
-        ValidationError::Oversize => "too large for this system",
-        ValidationError::Unsupported => "unsupported extension",
+        assert!(check_required_extensions(&root(r#"["KHR_mesh_quantization"]"#)).unwrap().is_empty());
+        let notes = check_required_extensions(&root(r#"["KHR_texture_basisu", "KHR_texture_basisu"]"#)).unwrap();
+        assert_eq!(notes.len(), 1);
+        let refused = check_required_extensions(&root(r#"["KHR_texture_basisu", "KHR_draco_mesh_compression"]"#));
+        let failure = refused.unwrap_err();
+        assert_eq!(failure.place.as_deref(), Some("extensionsRequired[1]"));
+        assert!(failure.message.contains("KHR_draco_mesh_compression"));
     }
 }

@@ -1,9 +1,12 @@
 //! glTF 2.0 import (`.gltf` with external or `data:` buffers, and `.glb`).
 //!
-//! The `gltf` crate parses the container and the JSON; everything that touches binary data goes through the
-//! bounds-checked reader in [`accessor`], because the crate's own readers can panic or silently truncate on bad
-//! ranges. Every check fails with a [`Failure`] that names the place in the document (`accessors[5]`,
-//! `animations[0].samplers[2]`), which [`load`] turns into an [`ImportError`].
+//! Read as leniently as the specification allows and exactly where it matters: [`document`] frames the GLB and
+//! deserializes only the parts of the JSON bonescope uses ([`schema`]), so materials, textures and unknown
+//! extensions can never stop a file from loading; references are checked where they are followed, and buffers are
+//! read when an accessor first needs them. Everything that touches binary data goes through the bounds-checked
+//! reader in [`accessor`] (sparse accessors and accessors without a buffer view included). Every check fails with a
+//! [`Failure`] that names the place in the document (`accessors[5]`, `animations[0].samplers[2]`), which [`load`]
+//! turns into an [`ImportError`].
 
 mod accessor;
 mod animation;
@@ -11,6 +14,7 @@ mod buffers;
 mod document;
 mod mesh;
 mod scene;
+mod schema;
 
 use std::path::Path;
 
@@ -28,12 +32,13 @@ fn read(path: &Path, bytes: &[u8]) -> Result<Rig> {
     let parsed = document::parse(bytes)?;
     let mut notes = vec!["units: metres, Y-up (glTF)".to_owned()];
     notes.extend(parsed.notes);
-    let doc = &parsed.document;
+    let root = &parsed.root;
     let folder = path.parent().unwrap_or(Path::new(""));
-    let buffers = buffers::load(doc, parsed.blob, folder)?;
-    let scene = scene::read(doc, &mut notes)?;
-    let skins = mesh::read_skins(doc, &buffers, &scene.bone_of_node)?;
-    let meshes = mesh::read_meshes(doc, &buffers, &scene, &skins, &mut notes)?;
-    let clips = animation::read_clips(doc, &buffers, &scene.bone_of_node, &mut notes)?;
+    let buffers = buffers::Buffers::new(&root.buffers, parsed.blob, folder);
+    let accessors = accessor::Accessors::new(root, &buffers);
+    let scene = scene::read(root, &mut notes)?;
+    let skins = mesh::read_skins(root, &accessors, &scene.bone_of_node, &mut notes)?;
+    let meshes = mesh::read_meshes(root, &accessors, &scene, &skins, &mut notes)?;
+    let clips = animation::read_clips(root, &accessors, &scene.bone_of_node, &mut notes)?;
     Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, notes })
 }

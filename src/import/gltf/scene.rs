@@ -5,8 +5,8 @@
 //! call stack.
 
 use glam::{DMat4, DQuat, DVec3, DVec4};
-use gltf::scene::Transform as NodeTransform;
 
+use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
 use crate::model::{Bone, InheritMode, Skeleton, Transform};
 
@@ -17,30 +17,28 @@ pub(super) struct SceneBones {
     pub bone_of_node: Vec<Option<usize>>,
 }
 
-pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<SceneBones> {
-    let parents = parents(doc)?;
+pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
+    let parents = parents(root)?;
     check_acyclic(&parents)?;
-    let roots = scene_roots(doc, &parents, notes)?;
-    let nodes: Vec<gltf::Node> = doc.nodes().collect();
-    let mut bone_of_node = vec![None; nodes.len()];
+    let roots = scene_roots(root, &parents, notes)?;
+    let mut bone_of_node = vec![None; root.nodes.len()];
     let mut bones = Vec::new();
     // Depth-first: (node, parent bone), children pushed in reverse so they come out in file order.
     let mut stack: Vec<(usize, Option<usize>)> = roots.iter().rev().map(|&r| (r, None)).collect();
     while let Some((index, parent)) = stack.pop() {
-        let node = &nodes[index];
+        let node = &root.nodes[index];
         let bone = bones.len();
         bone_of_node[index] = Some(bone);
         bones.push(Bone {
-            name: node.name().map_or_else(|| format!("node{index}"), str::to_owned),
+            name: node.name.clone().unwrap_or_else(|| format!("node{index}")),
             node: index,
             parent,
-            rest: rest_transform(node)?,
+            rest: rest_transform(node, index)?,
             inherit: InheritMode::Full,
         });
-        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
-        stack.extend(children.into_iter().rev().map(|c| (c, Some(bone))));
+        stack.extend(node.children.iter().rev().map(|c| (c.0, Some(bone))));
     }
-    let outside = nodes.len() - bones.len();
+    let outside = root.nodes.len() - bones.len();
     if outside > 0 {
         notes.push(format!("{outside} nodes outside the scene are not bones"));
     }
@@ -49,14 +47,15 @@ pub(super) fn read(doc: &gltf::Document, notes: &mut Vec<String>) -> Result<Scen
     Ok(SceneBones { skeleton, bone_of_node })
 }
 
-/// Each node's parent; a node listed as a child twice is an error.
-fn parents(doc: &gltf::Document) -> Result<Vec<Option<usize>>> {
-    let mut parents = vec![None; doc.nodes().len()];
-    for node in doc.nodes() {
-        for child in node.children() {
-            if let Some(first) = parents[child.index()].replace(node.index()) {
-                let message = format!("has two parents: nodes[{first}] and nodes[{}]", node.index());
-                return Err(Failure::at(format!("nodes[{}]", child.index()), message));
+/// Each node's parent; a child that does not exist, or a node listed as a child twice, is an error.
+fn parents(root: &Root) -> Result<Vec<Option<usize>>> {
+    let mut parents = vec![None; root.nodes.len()];
+    for (index, node) in root.nodes.iter().enumerate() {
+        for (c, &child) in node.children.iter().enumerate() {
+            schema::item(&root.nodes, child, "nodes", format_args!("nodes[{index}].children[{c}]"))?;
+            if let Some(first) = parents[child.0].replace(index) {
+                let message = format!("has two parents: nodes[{first}] and nodes[{index}]");
+                return Err(Failure::at(format!("nodes[{}]", child.0), message));
             }
         }
     }
@@ -96,49 +95,54 @@ fn check_acyclic(parents: &[Option<usize>]) -> Result<()> {
 }
 
 /// The root nodes of the default scene, else of scene 0, else every node without a parent.
-fn scene_roots(doc: &gltf::Document, parents: &[Option<usize>], notes: &mut Vec<String>) -> Result<Vec<usize>> {
-    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
-        return Ok((0..parents.len()).filter(|&n| parents[n].is_none()).collect());
+fn scene_roots(root: &Root, parents: &[Option<usize>], notes: &mut Vec<String>) -> Result<Vec<usize>> {
+    let index = match root.scene {
+        Some(scene) => schema::item(&root.scenes, scene, "scenes", "scene").map(|_| scene.0)?,
+        None if root.scenes.is_empty() => {
+            return Ok((0..parents.len()).filter(|&n| parents[n].is_none()).collect());
+        }
+        None => 0,
     };
-    if doc.scenes().len() > 1 {
-        notes.push(format!("{} scenes; bones come from scene {}", doc.scenes().len(), scene.index()));
+    if root.scenes.len() > 1 {
+        notes.push(format!("{} scenes; bones come from scene {index}", root.scenes.len()));
     }
-    let place = || format!("scenes[{}]", scene.index());
+    let place = format!("scenes[{index}]");
     let mut roots: Vec<usize> = Vec::new();
-    for node in scene.nodes() {
-        let index = node.index();
-        if let Some(parent) = parents[index] {
-            return Err(Failure::at(place(), format!("lists nodes[{index}], a child of nodes[{parent}]")));
+    for (i, &node) in root.scenes[index].nodes.iter().enumerate() {
+        schema::item(&root.nodes, node, "nodes", format_args!("{place}.nodes[{i}]"))?;
+        let Uint(node) = node;
+        if let Some(parent) = parents[node] {
+            return Err(Failure::at(&place, format!("lists nodes[{node}], a child of nodes[{parent}]")));
         }
-        if roots.contains(&index) {
-            return Err(Failure::at(place(), format!("lists nodes[{index}] twice")));
+        if roots.contains(&node) {
+            return Err(Failure::at(&place, format!("lists nodes[{node}] twice")));
         }
-        roots.push(index);
+        roots.push(node);
     }
     Ok(roots)
 }
 
-/// The node's local transform: TRS as given, or its matrix decomposed.
-fn rest_transform(node: &gltf::Node) -> Result<Transform> {
-    let place = || format!("nodes[{}]", node.index());
-    let rest = match node.transform() {
-        NodeTransform::Decomposed { translation, rotation, scale } => Transform::from_trs(
-            DVec3::from_array(translation.map(f64::from)),
-            // Exporters write unit quaternions in single precision; renormalise in double (zero stays zero and
-            // is rejected below as not finite).
-            DQuat::from_array(rotation.map(f64::from)).normalize(),
-            DVec3::from_array(scale.map(f64::from)),
-        ),
-        NodeTransform::Matrix { matrix } => {
-            let m = DMat4::from_cols_array_2d(&matrix.map(|column| column.map(f64::from)));
+/// The node's local transform: its `matrix` decomposed, or its TRS with the spec's defaults.
+fn rest_transform(node: &schema::Node, index: usize) -> Result<Transform> {
+    let place = || format!("nodes[{index}]");
+    let rest = match &node.matrix {
+        Some(matrix) => {
+            let m = DMat4::from_cols_array(matrix);
+            if !matrix.iter().all(|c| c.is_finite()) {
+                return Err(Failure::at(place(), "matrix is not finite"));
+            }
             if m.row(3) != DVec4::W {
                 return Err(Failure::at(place(), "matrix is not affine (its last row is not 0, 0, 0, 1)"));
             }
-            if !m.is_finite() {
-                return Err(Failure::at(place(), "matrix is not finite"));
-            }
             matrix_to_transform(&m)
         }
+        None => Transform::from_trs(
+            node.translation.map_or(DVec3::ZERO, DVec3::from_array),
+            // Exporters write unit quaternions in single precision; renormalise in double (zero stays zero and
+            // is rejected below as not finite).
+            node.rotation.map_or(DQuat::IDENTITY, |r| DQuat::from_array(r).normalize()),
+            node.scale.map_or(DVec3::ONE, DVec3::from_array),
+        ),
     };
     let finite =
         rest.translation.is_finite() && rest.rotation.is_finite() && rest.scale.is_finite() && rest.stretch.is_finite();
