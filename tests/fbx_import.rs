@@ -603,3 +603,21 @@ fn the_synthetic_chain_is_read_as_written() {
     let expected = glam::DQuat::from_rotation_z(z) * glam::DQuat::from_rotation_y(y) * glam::DQuat::from_rotation_x(x);
     assert!(n1.rotation.abs_diff_eq(expected, 1e-12) || n1.rotation.abs_diff_eq(-expected, 1e-12));
 }
+
+#[test]
+fn meshes_with_non_finite_vertices_load_without_them() {
+    // ufbx's corpus: a cube with one NaN corner of 8 (counted in the file's text), and meshes of NaN and infinite
+    // vertices; the skeleton and animation are fine.
+    for file in ["synthetic_cube_nan_6100_ascii.fbx", "synthetic_inf_nan_7700_ascii.fbx"] {
+        let rig = load(&format!("fbx-ufbx-corpus/{file}"));
+        let note = rig.notes.iter().find(|n| n.contains("not finite")).unwrap_or_else(|| panic!("{file}: no note"));
+        if file.starts_with("synthetic_cube") {
+            assert!(note.starts_with("1 vertices "), "{file}: {note}");
+            assert_eq!(rig.meshes[0].positions.len(), 7);
+        }
+        for mesh in &rig.meshes {
+            assert!(mesh.positions.iter().all(|p| p.is_finite()), "{file}: {}", mesh.name);
+            assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()), "{file}: {}", mesh.name);
+        }
+    }
+}

@@ -28,3 +28,62 @@ pub struct Mesh {
     /// Triangle list.
     pub indices: Vec<u32>,
 }
+
+impl Mesh {
+    /// Removes the vertices whose position is not finite (NaN or infinite: a broken export), with their skinning and
+    /// every triangle that uses one, so the rest can be skinned and drawn; how many were removed.
+    pub fn remove_non_finite_vertices(&mut self) -> usize {
+        let keep: Vec<bool> = self.positions.iter().map(|p| p.is_finite()).collect();
+        let removed = keep.iter().filter(|&&k| !k).count();
+        if removed == 0 {
+            return 0;
+        }
+        let mut new_index = Vec::with_capacity(keep.len());
+        let mut next = 0u32;
+        for &k in &keep {
+            new_index.push(next);
+            next += u32::from(k);
+        }
+        retain_kept(&mut self.positions, &keep);
+        retain_kept(&mut self.joints, &keep);
+        retain_kept(&mut self.weights, &keep);
+        let kept = |i: &u32| keep.get(*i as usize).copied().unwrap_or(false);
+        self.indices = self
+            .indices
+            .chunks_exact(3)
+            .filter(|triangle| triangle.iter().all(kept))
+            .flat_map(|triangle| triangle.iter().map(|&i| new_index[i as usize]))
+            .collect();
+        removed
+    }
+}
+
+/// Keeps the elements whose `keep` flag is set (a per-vertex array may be empty: then nothing to do).
+fn retain_kept<T>(values: &mut Vec<T>, keep: &[bool]) {
+    if values.len() == keep.len() {
+        let mut flags = keep.iter();
+        values.retain(|_| flags.next().copied().unwrap_or(false));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn non_finite_vertices_leave_with_their_triangles() {
+        let mut mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::NAN, Vec3::X, Vec3::Y, Vec3::new(f32::INFINITY, 0.0, 0.0)],
+            joints: vec![[0; 4], [1; 4], [2; 4], [3; 4], [4; 4]],
+            weights: vec![[1.0, 0.0, 0.0, 0.0]; 5],
+            indices: vec![0, 2, 3, 0, 1, 2, 3, 2, 4, 3, 2, 0],
+            ..Mesh::default()
+        };
+        assert_eq!(mesh.remove_non_finite_vertices(), 2);
+        assert_eq!(mesh.positions, [Vec3::ZERO, Vec3::X, Vec3::Y]);
+        assert_eq!(mesh.joints, [[0; 4], [2; 4], [3; 4]]);
+        assert_eq!(mesh.weights.len(), 3);
+        assert_eq!(mesh.indices, [0, 1, 2, 2, 1, 0], "the triangles without a bad vertex, renumbered");
+        assert_eq!(mesh.remove_non_finite_vertices(), 0);
+    }
+}

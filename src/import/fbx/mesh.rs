@@ -64,9 +64,7 @@ pub(super) fn read(
                     .collect();
             }
         }
-        if let Some(v) = read.positions.iter().position(|p| !p.is_finite()) {
-            return Err(Failure::at(place, format!("vertex {v} is not finite")));
-        }
+        tally.non_finite += read.remove_non_finite_vertices();
         if !mesh.blend_deformers.is_empty() {
             tally.blend_shapes += 1;
         }
@@ -85,6 +83,7 @@ struct Tally {
     skipped_faces: usize,
     trimmed_weights: usize,
     unweighted: usize,
+    non_finite: usize,
 }
 
 impl Tally {
@@ -96,6 +95,7 @@ impl Tally {
             (self.skipped_faces, "faces with fewer than 3 corners (points, lines) were skipped"),
             (self.trimmed_weights, "vertices have more than 4 weights; the 4 strongest are kept, renormalised"),
             (self.unweighted, "skinned vertices have no weights and follow their mesh's node"),
+            (self.non_finite, "vertices are not finite (NaN or infinite), left out of skinning and drawing"),
         ];
         notes.extend(lines.iter().filter(|(n, _)| *n > 0).map(|(n, what)| format!("{n} {what}")));
     }
