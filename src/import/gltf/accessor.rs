@@ -167,7 +167,7 @@ impl<'a> Accessors<'a> {
     fn read<T: Decode, const N: usize>(&self, index: Uint, user: &str, usage: &Use) -> Result<Vec<[T; N]>> {
         let accessor = schema::item(&self.root.accessors, index, "accessors", user)?;
         let place = format!("accessors[{}]", index.0);
-        let data_type = check_type(accessor, usage, N, &place)?;
+        let data_type = check_type(accessor, usage, &place)?;
         let count = accessor.count.0;
         let mut elements = match accessor.buffer_view {
             Some(view) => {
@@ -282,9 +282,8 @@ impl<'a> Accessors<'a> {
     }
 }
 
-/// Checks the accessor's `type` and component type against `usage`; `components` is what the reader decodes.
-fn check_type(accessor: &schema::Accessor, usage: &Use, components: usize, place: &str) -> Result<DataType> {
-    debug_assert_eq!(components_of(usage.kind), Some(components));
+/// Checks the accessor's `type` and component type against `usage`.
+fn check_type(accessor: &schema::Accessor, usage: &Use, place: &str) -> Result<DataType> {
     let data_type = DataType::from_code(accessor.component_type);
     let allowed = data_type.is_some_and(|t| usage.components.contains(&(t, accessor.normalized)));
     match data_type {
@@ -299,18 +298,6 @@ fn check_type(accessor: &schema::Accessor, usage: &Use, components: usize, place
                 format!("{} must be {} of {expected}, found {} of {found_type}", usage.what, usage.kind, accessor.kind);
             Err(Failure::at(place, message))
         }
-    }
-}
-
-/// Components per element of an accessor `type` this reader decodes (matrices other than `MAT4` are never read).
-fn components_of(kind: &str) -> Option<usize> {
-    match kind {
-        "SCALAR" => Some(1),
-        "VEC2" => Some(2),
-        "VEC3" => Some(3),
-        "VEC4" => Some(4),
-        "MAT4" => Some(16),
-        _ => None,
     }
 }
 

@@ -124,14 +124,11 @@ impl Reader<'_, '_> {
                 continue;
             };
             let sampler = self.sampler(animation, channel.sampler, &channel_place)?;
-            if property == Property::Weights {
-                morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?);
-                continue;
-            }
             let place = format!("animations[{index}].samplers[{}]", channel.sampler.0);
             let times = self.times(sampler.input, &place)?;
             let interpolation = interpolation(sampler, &place)?;
             let output = sampler.output;
+            // A bone whose only channels are morph weights gets an empty entry, dropped below.
             let bone_tracks = tracks.entry(bone).or_insert_with(|| BoneTracks::new(bone));
             match property {
                 Property::Translation => {
@@ -146,11 +143,10 @@ impl Reader<'_, '_> {
                     let values = self.accessors.rotations(output, &place)?;
                     bone_tracks.rotation = Some(track(times, values, interpolation, &place)?);
                 }
-                Property::Weights => unreachable!("handled above"),
+                Property::Weights => morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?),
             }
         }
         self.tally.morph_channels += morph_channels.len();
-        // A bone whose only channels were morph weights has an empty entry.
         let tracks = tracks
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
