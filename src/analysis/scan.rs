@@ -267,13 +267,16 @@ impl ClipAnalysis {
     }
 }
 
+/// The most frames of the scan rate a clip is visited at every one of; a longer clip is visited at its key times and
+/// a bounded number of times between sparse keys ([`crate::model::sample_times`]).
+const MAX_FRAMES: usize = 1 << 20;
+
 /// The times a scan visits: every key time, plus `0, 1/rate, 2/rate, …` up to the duration, plus the duration;
-/// sorted, without duplicates. Just `[0]` without a clip.
+/// sorted, without duplicates (thinned between sparse keys for a clip of more than [`MAX_FRAMES`] frames). Just
+/// `[0]` without a clip.
 pub fn sample_times(clip: Option<&Clip>, rate: f64) -> Vec<f64> {
     let Some(clip) = clip else { return vec![0.0] };
-    let mut times = clip.key_times();
-    add_grid(&mut times, clip.duration(), rate);
-    times
+    crate::model::sample_times(clip.key_times(), 0.0, clip.duration(), rate, MAX_FRAMES).times
 }
 
 /// The times a layered scan visits: [`sample_times`] of the main clip, unless the layers change the timeline (a
@@ -284,21 +287,7 @@ pub fn layered_sample_times(rig: &Rig, clip: Option<&Clip>, layers: &LayerStack,
     if layers.synced_cycle(rig, clip).is_none() && duration == clip.map_or(0.0, Clip::duration) {
         return sample_times(clip, rate);
     }
-    let mut times = Vec::new();
-    add_grid(&mut times, duration, rate);
-    times
-}
-
-/// Adds `0, 1/rate, …` up to `duration`, `0` and `duration` to `times`, then sorts them and drops duplicates.
-fn add_grid(times: &mut Vec<f64>, duration: f64, rate: f64) {
-    if rate > 0.0 && rate.is_finite() && duration.is_finite() {
-        let steps = (duration * rate).floor() as usize;
-        times.extend((0..=steps).map(|i| i as f64 / rate));
-    }
-    times.push(0.0);
-    times.push(duration);
-    times.sort_by(f64::total_cmp);
-    times.dedup();
+    crate::model::sample_times([], 0.0, duration, rate, MAX_FRAMES).times
 }
 
 /// A rig evaluated through layers.

@@ -4,12 +4,14 @@ mod clip;
 mod inherit;
 mod skeleton;
 mod skin;
+mod timeline;
 mod transform;
 
 pub use clip::{BoneTracks, Clip, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphChannel, Track, TrackError};
 pub use inherit::{InheritMode, UnknownInheritMode};
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, Skin};
+pub use timeline::{SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
 
 /// Everything bonescope knows about one file.

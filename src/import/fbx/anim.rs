@@ -10,7 +10,8 @@
 //!
 //! A clip covers its stack's time span (the take's start and stop, which is what DCCs play); keys outside it are
 //! not sampled. Times are the file's, in seconds; a stack that starts before t = 0 is shifted to start at 0 (and
-//! says so). The grid's size is checked against the file's size before anything is evaluated. (The key times are
+//! says so). A long stack with sparse keys is thinned between keys ([`sample_times`]), so the samples stay bounded by
+//! the keys, and the grid's size is checked against the file's size before anything is evaluated. (The key times are
 //! read from the curves here rather than from `ufbx_bake_anim`, whose run time a hostile file can make unbounded.)
 
 use std::sync::Arc;
@@ -18,13 +19,14 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::{Failure, Result, memory_limit, node_name};
-use crate::model::{BoneTracks, Clip, Interpolation, Track};
+use crate::model::{BoneTracks, Clip, Interpolation, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
 
 /// Frames per second assumed when the file states none that makes sense.
 const DEFAULT_FPS: f64 = 30.0;
 
-/// Two times closer than this are the same time (ufbx computes both from the same integer ticks).
-const SAME_TIME: f64 = 1e-9;
+/// The most frames a stack is sampled at every one of (9.7 hours at 30 fps); longer spans are thinned where keys are
+/// sparse.
+const MAX_FRAMES: usize = 1 << 20;
 
 /// How long before a stepped key's jump the value before it is sampled (as ufbx's baker does).
 const STEP: f64 = 1e-3;
@@ -82,7 +84,7 @@ impl StackReader<'_> {
             .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref())))
             .collect();
         let (begin, end) = self.span(keys.iter().copied());
-        let grid = self.grid(begin, end, keys.into_iter(), animated.len())?;
+        let grid = self.grid(begin, end, keys, animated.len(), notes)?;
         let shift = if begin < 0.0 { -begin } else { 0.0 };
         if shift > 0.0 {
             notes.push(format!("{} starts at t = {begin} s; its clip is shifted to start at 0", self.place()));
@@ -150,33 +152,26 @@ impl StackReader<'_> {
         if min.is_finite() && max.is_finite() { (min, max) } else { (0.0, 0.0) }
     }
 
-    /// Every frame in `[begin, end]`, the ends, and every key time in between; sorted, without near-duplicates.
-    fn grid(&self, begin: f64, end: f64, keys: impl Iterator<Item = f64>, nodes: usize) -> Result<Vec<f64>> {
-        let first = (begin * self.fps - SAME_TIME).ceil();
-        let last = (end * self.fps + SAME_TIME).floor();
-        let frames = if last >= first { last - first + 1.0 } else { 0.0 };
-        if frames * nodes.max(1) as f64 > self.budget as f64 {
-            let message = format!(
-                "spans {} s ({frames} frames at {} fps) for {nodes} animated nodes: more than the file's size can \
-                 justify",
+    /// The times to sample: [`sample_times`] of the keys over `[begin, end]` at the file's frame rate, thinned where
+    /// keys are sparse when every frame for every node would exceed the budget.
+    fn grid(&self, begin: f64, end: f64, keys: Vec<f64>, nodes: usize, notes: &mut Vec<String>) -> Result<Vec<f64>> {
+        let max_frames = (self.budget / nodes.max(1)).min(MAX_FRAMES);
+        let sampled = sample_times(keys, begin, end, self.fps, max_frames);
+        if sampled.times.len().saturating_mul(nodes) > self.budget {
+            return Err(Failure::at(self.place(), "more keys than the file's size can justify"));
+        }
+        if sampled.thinned {
+            notes.push(format!(
+                "{} spans {} s ({} frames at {} fps) with few keys: sampled at its key times, every frame where keys \
+                 are dense and {SAMPLES_PER_SPARSE_GAP} times across each longer gap ({} samples)",
+                self.place(),
                 end - begin,
-                self.fps
-            );
-            return Err(Failure::at(self.place(), message));
+                sampled.frames,
+                self.fps,
+                sampled.times.len()
+            ));
         }
-        let mut grid: Vec<f64> = Vec::with_capacity(frames as usize + 2);
-        grid.push(begin);
-        grid.extend((0..frames as u64).map(|k| (first + k as f64) / self.fps));
-        grid.push(end);
-        for time in keys.filter(|t| (begin..=end).contains(t)) {
-            grid.push(time);
-            if grid.len().saturating_mul(nodes) > self.budget {
-                return Err(Failure::at(self.place(), "more keys than the file's size can justify"));
-            }
-        }
-        grid.sort_by(f64::total_cmp);
-        grid.dedup_by(|later, earlier| *later - *earlier < SAME_TIME);
-        Ok(grid)
+        Ok(sampled.times)
     }
 
     /// One animated node at every grid time (`times`: the grid as the clip's times).

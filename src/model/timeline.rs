@@ -1,0 +1,121 @@
+//! Which times to sample a clip at: every frame of a rate and every key time, with a bound for long, sparse clips.
+//!
+//! A clip may legally span millions of frames with a few dozen keys (Maya's long-keyframe tests: 41 keys over
+//! ±166,666 s). Sampling every frame of such a clip costs memory and time out of all proportion to its content, so
+//! when the frames exceed a limit, the grid is thinned where keys are sparse: every key time stays, a gap between two
+//! keys keeps all its frames when it has at most [`SAMPLES_PER_SPARSE_GAP`] of them, and that many evenly spaced
+//! times otherwise. The result is bounded by the number of keys, whatever the span.
+
+/// Times closer than this are one sample (grid times and key times are computed from the same integers).
+const SAME_TIME: f64 = 1e-9;
+
+/// How many times a long gap between two keys is sampled at when the grid is thinned.
+pub const SAMPLES_PER_SPARSE_GAP: usize = 64;
+
+/// The sorted, distinct times to sample, and whether some frames were left out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleTimes {
+    pub times: Vec<f64>,
+    /// How many frames of the rate the span holds (whether or not all are in `times`).
+    pub frames: f64,
+    /// Whether long gaps between keys were sampled at [`SAMPLES_PER_SPARSE_GAP`] times instead of every frame.
+    pub thinned: bool,
+}
+
+/// Every frame `k / rate` in `[begin, end]`, both ends, and every key time in between (keys outside are ignored),
+/// sorted and without near-duplicates; thinned as the module says when the frames exceed `max_frames`.
+pub fn sample_times(
+    keys: impl IntoIterator<Item = f64>,
+    begin: f64,
+    end: f64,
+    rate: f64,
+    max_frames: usize,
+) -> SampleTimes {
+    let mut anchors: Vec<f64> = keys.into_iter().filter(|t| (begin..=end).contains(t)).collect();
+    anchors.push(begin);
+    anchors.push(end);
+    sort_distinct(&mut anchors);
+    let usable_rate = rate.is_finite() && rate > 0.0;
+    let (first, last) =
+        if usable_rate { ((begin * rate - SAME_TIME).ceil(), (end * rate + SAME_TIME).floor()) } else { (1.0, 0.0) };
+    let frames = if last >= first { last - first + 1.0 } else { 0.0 };
+    let frame = |k: f64| (k / rate).clamp(begin, end);
+    let thinned = frames > max_frames as f64;
+    let mut times = anchors.clone();
+    if !thinned {
+        times.extend((0..frames as u64).map(|k| frame(first + k as f64)));
+    } else {
+        for gap in anchors.windows(2) {
+            let (a, b) = (gap[0], gap[1]);
+            let (from, to) = ((a * rate).floor() + 1.0, (b * rate).ceil() - 1.0);
+            let inside = if to >= from { to - from + 1.0 } else { 0.0 };
+            if inside <= SAMPLES_PER_SPARSE_GAP as f64 {
+                times.extend((0..inside as u64).map(|k| frame(from + k as f64)));
+            } else {
+                let step = (b - a) / (SAMPLES_PER_SPARSE_GAP + 1) as f64;
+                times.extend((1..=SAMPLES_PER_SPARSE_GAP).map(|k| a + step * k as f64));
+            }
+        }
+    }
+    sort_distinct(&mut times);
+    SampleTimes { times, frames, thinned }
+}
+
+/// Sorts `times` and keeps the first of each run closer than [`SAME_TIME`].
+fn sort_distinct(times: &mut Vec<f64>) {
+    times.sort_by(f64::total_cmp);
+    times.dedup_by(|later, earlier| *later - *earlier < SAME_TIME);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_frame_and_key_when_within_the_limit() {
+        let s = sample_times([0.25, 0.5, 3.0], 0.0, 1.0, 2.0, 100);
+        assert_eq!(s.times, [0.0, 0.25, 0.5, 1.0]);
+        assert_eq!(s.frames, 3.0);
+        assert!(!s.thinned);
+    }
+
+    #[test]
+    fn frames_never_fall_outside_the_span() {
+        // A span that starts one tick after a frame: the frame before it is not sampled, the start is.
+        let tick = 1.0 / 46_186_158_000.0;
+        let begin = -1.0 / 24.0 + tick;
+        let s = sample_times([], begin, 1.0 / 24.0, 24.0, 100);
+        assert_eq!(s.times[0], begin);
+        assert!(s.times.iter().all(|&t| (begin..=1.0 / 24.0).contains(&t)), "{:?}", s.times);
+        assert_eq!(s.times.len(), 3, "{:?}", s.times);
+    }
+
+    #[test]
+    fn long_sparse_spans_keep_every_key_and_a_bounded_number_between() {
+        // 10 million frames at 30 fps, keys at the ends, in the middle, and a dense run of 5 frames.
+        let keys = [-166_666.0, 0.0, 1.0 / 30.0, 2.0 / 30.0, 3.0 / 30.0, 4.0 / 30.0, 166_666.0];
+        let s = sample_times(keys, -166_666.0, 166_666.0, 30.0, 1 << 20);
+        assert!(s.thinned);
+        assert_eq!(s.frames, 10_000_000.0 - 40.0 + 1.0);
+        for key in keys {
+            assert!(s.times.iter().any(|&t| (t - key).abs() < 1e-12), "key {key} kept");
+        }
+        // Two long gaps get 64 times each; the four gaps of the dense run have no frame inside.
+        assert_eq!(s.times.len(), keys.len() + 2 * SAMPLES_PER_SPARSE_GAP);
+        assert!(s.times.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn a_short_gap_keeps_its_frames_when_thinned() {
+        // Keys at 0 and 1 s and at 100 s, 1 Hz: frames 2..99 are too many for the gap, frames of 0..1 none.
+        let s = sample_times([0.0, 0.5, 100.0], 0.0, 100.0, 10.0, 10);
+        assert!(s.thinned);
+        // 0 → 0.5: frames 0.1..0.4 (4), 0.5 → 100: 64 evenly spaced.
+        assert_eq!(s.times.len(), 3 + 4 + SAMPLES_PER_SPARSE_GAP);
+    }
+
+    #[test]
+    fn no_rate_gives_the_anchors() {
+        assert_eq!(sample_times([0.5], 0.0, 1.0, 0.0, 10).times, [0.0, 0.5, 1.0]);
+    }
+}
