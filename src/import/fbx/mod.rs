@@ -35,7 +35,7 @@ pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result
 }
 
 impl Failure {
-    /// A ufbx error: its description as the message, its innermost frames as the place.
+    /// A ufbx error: its description and what it was reading as the message; `place` from [`locate`].
     fn ufbx(error: &ufbx::Error, place: Option<String>) -> Self {
         let mut message = error.description.to_string();
         let info = error.info();
@@ -45,21 +45,31 @@ impl Failure {
         if matches!(error.type_, ufbx::ErrorType::MemoryLimit | ufbx::ErrorType::AllocationLimit) {
             message = format!("{message}: the file asks for far more memory than its size can justify");
         }
-        // ufbx's error stack says what it was reading, innermost first: "Truncated file" while parsing a node.
-        let frames: Vec<String> = error
-            .stack
-            .iter()
-            .take(error.stack_size as usize)
-            .map(|f| f.description.to_string())
-            .filter(|d| !d.is_empty())
-            .collect();
-        let reading = (!frames.is_empty()).then(|| frames.join(" < "));
-        let place = match (place, reading) {
-            (Some(p), Some(r)) => Some(format!("{p}: {r}")),
-            (p, r) => p.or(r),
-        };
+        if let Some(reading) = reading(error) {
+            message = format!("{message} (ufbx: {reading})");
+        }
         Failure { place, message }
     }
+}
+
+/// What ufbx was doing when it failed, from its error stack (compiled in: `.cargo/config.toml`): the check that
+/// failed and the functions it was in, innermost first, e.g. "check `depth < 32` in ascii_parse_node <
+/// parse_toplevel_child_imp < read_objects".
+fn reading(error: &ufbx::Error) -> Option<String> {
+    const FUNCTIONS: usize = 4;
+    let frames: Vec<&ufbx::ErrorFrame> = error.stack.iter().take(error.stack_size as usize).collect();
+    let innermost = frames.first()?;
+    let mut functions: Vec<&str> = Vec::new();
+    for frame in &frames {
+        let function = frame.function.trim_start_matches("ufbxi_");
+        if functions.last() != Some(&function) && !function.is_empty() {
+            functions.push(function);
+        }
+    }
+    let check: &str = &innermost.description;
+    let within = functions.iter().take(FUNCTIONS).copied().collect::<Vec<_>>().join(" < ");
+    let more = if functions.len() > FUNCTIONS { " < …" } else { "" };
+    Some(if check.is_empty() { format!("in {within}{more}") } else { format!("check `{check}` in {within}{more}") })
 }
 
 /// The memory ufbx may use for one file of `file_size` bytes: generous for real files (a compressed binary FBX
