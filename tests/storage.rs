@@ -43,11 +43,11 @@ fn compensating_child() -> Rig {
         joints: vec![[0, 0, 0, 0]; 2],
         weights: vec![[1.0, 0.0, 0.0, 0.0]; 2],
         positions,
-        indices: vec![],
+        ..Mesh::default()
     };
     Rig {
         clips: vec![Clip::new(0, Some("held".into()), vec![tracks], vec![])],
-        skins: vec![Skin { name: None, joints: vec![1], inverse_bind: vec![child_rest.inverse()] }],
+        skins: vec![Skin { name: None, joints: vec![1], inverse_bind: vec![child_rest.inverse()], node_bind: None }],
         meshes: vec![mesh],
         skeleton,
         ..Rig::default()

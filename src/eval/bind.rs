@@ -87,7 +87,12 @@ mod tests {
     #[test]
     fn singular_inverse_bind_matrices_fall_back_to_the_rest_pose() {
         let mut rig = demo_rig();
-        rig.skins.push(Skin { name: None, joints: vec![0, 77], inverse_bind: vec![DMat4::ZERO, DMat4::IDENTITY] });
+        rig.skins.push(Skin {
+            name: None,
+            joints: vec![0, 77],
+            inverse_bind: vec![DMat4::ZERO, DMat4::IDENTITY],
+            node_bind: None,
+        });
         rig.skins.swap(0, 1);
         let pose = bind_pose(&rig);
         assert!(pose.iter().all(|t| t.translation.is_finite() && t.rotation.is_finite()));

@@ -1,26 +1,81 @@
 //! CPU skinning: a mesh's vertex positions at an evaluated pose.
 //!
-//! Linear blend skinning, as glTF and FBX define it: the joint matrix of joint `j` is `W_j · IBM_j` (model matrix
-//! of the joint's bone times its inverse bind matrix) and a vertex moves to `Σ w_j · (W_j · IBM_j) · v`. The
-//! skinned mesh's own node does not move it (glTF: "the skinned mesh node's own transform MUST be ignored"). An
-//! unskinned mesh is placed by its bone's model matrix.
+//! The joint matrix of joint `j` is `W_j · IBM_j` (model matrix of the joint's bone times its inverse bind matrix).
+//! - Linear blend skinning, as glTF and FBX define it: a vertex moves to `Σ w_j · (W_j · IBM_j) · v`.
+//! - Dual-quaternion skinning (Kavan et al. 2008), which FBX declares per skin (and per vertex, blended with linear):
+//!   each joint matrix is split by the polar decomposition into a rigid part `T_j · R_j` and a stretch
+//!   `S_j = R_jᵀ · A_j` (scale and shear, `A_j` the linear part); the rigid parts are blended as unit dual
+//!   quaternions, the stretches linearly, and the vertex moves to `T · R · (Σ w_j S_j) · v`. This is exact wherever
+//!   linear blending is (one influence, or influences that agree), keeps volume under twists where linear blending
+//!   collapses, and equals Maya's and ufbx's "dual quaternion with scale" whenever the joint matrices do not shear
+//!   (ufbx blends per-axis scales, which cannot carry shear; with shear, bonescope's blend keeps it).
+//!   A vertex with DQ weight `d` gets `(1 − d) · linear + d · dual quaternion`.
 //!
-//! Pure functions over slices, in `f64`, so the viewport and the exporter share them.
+//! The skinned mesh's own node does not move it (glTF: "the skinned mesh node's own transform MUST be ignored"),
+//! except for skins that follow their node ([`crate::model::NodeBind`], Maya). An unskinned mesh is placed by its
+//! bone's model matrix. Pure functions over slices, in `f64`, so the viewport and the exporter share them.
 
-use glam::{DMat4, DVec3};
+use glam::{DMat3, DMat4, DQuat, DVec3};
 
+use crate::math::decompose;
 use crate::model::{Mesh, Rig, Skin};
 
-/// `W_j · IBM_j` for every joint of `skin`, from the model matrices of all bones.
-pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
-    out.clear();
-    out.extend(skin.joints.iter().zip(&skin.inverse_bind).map(|(&bone, ibm)| model[bone] * *ibm));
+/// Which skinning to use: the file's (per skin and vertex), or one of them everywhere (engines differ).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// What the file declares: linear, dual quaternion, or a per-vertex blend of both.
+    #[default]
+    AsFile,
+    Linear,
+    DualQuaternion,
 }
 
-/// The positions of `mesh` in model space, given the model matrices of all bones (`out` is reused).
+impl Method {
+    pub const ALL: [Method; 3] = [Method::AsFile, Method::Linear, Method::DualQuaternion];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Method::AsFile => "as the file says",
+            Method::Linear => "linear blend",
+            Method::DualQuaternion => "dual quaternion",
+        }
+    }
+
+    /// The blend towards dual quaternions of vertex `v` of `mesh`.
+    fn dq_weight(self, mesh: &Mesh, v: usize) -> f64 {
+        match self {
+            Method::AsFile => mesh.dq_weights.get(v).map_or(0.0, |&d| f64::from(d.clamp(0.0, 1.0))),
+            Method::Linear => 0.0,
+            Method::DualQuaternion => 1.0,
+        }
+    }
+}
+
+/// `W_j · IBM_j` for every joint of `skin`, from the model matrices of all bones; premultiplied by the mesh node's
+/// motion since the bind where the skin follows its node ([`crate::model::NodeBind`]).
+pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
+    out.clear();
+    let joints = skin.joints.iter().zip(&skin.inverse_bind).map(|(&bone, ibm)| model[bone] * *ibm);
+    match skin.node_bind {
+        Some(node) => {
+            let moved = model[node.bone] * node.inverse_bind;
+            out.extend(joints.map(|joint| moved * joint));
+        }
+        None => out.extend(joints),
+    }
+}
+
+/// The positions of `mesh` in model space, given the model matrices of all bones (`out` is reused), skinned as the
+/// file says.
 ///
 /// Weights are used as stored (importers keep them normalised); joints whose weight is zero are skipped.
 pub fn skin_positions(mesh: &Mesh, skins: &[Skin], model: &[DMat4], out: &mut Vec<DVec3>) {
+    skin_positions_with(mesh, skins, model, Method::AsFile, out);
+}
+
+/// [`skin_positions`] with the skinning `method` chosen.
+pub fn skin_positions_with(mesh: &Mesh, skins: &[Skin], model: &[DMat4], method: Method, out: &mut Vec<DVec3>) {
     out.clear();
     let skin = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len());
     let Some(skin) = skin else {
@@ -30,25 +85,77 @@ pub fn skin_positions(mesh: &Mesh, skins: &[Skin], model: &[DMat4], out: &mut Ve
     };
     let mut joints = Vec::with_capacity(skin.joints.len());
     joint_matrices(skin, model, &mut joints);
-    for ((position, indices), weights) in mesh.positions.iter().zip(&mesh.joints).zip(&mesh.weights) {
-        let v = position.as_dvec3();
-        let mut sum = DVec3::ZERO;
-        for (&joint, &weight) in indices.iter().zip(weights) {
-            if weight != 0.0 {
-                sum += joints[usize::from(joint)].transform_point3(v) * f64::from(weight);
-            }
-        }
-        out.push(sum);
+    let any_dq = (0..mesh.positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
+    let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
+    for (v, ((position, indices), weights)) in mesh.positions.iter().zip(&mesh.joints).zip(&mesh.weights).enumerate() {
+        let p = position.as_dvec3();
+        let influences =
+            indices.iter().zip(weights).filter(|(_, w)| **w != 0.0).map(|(&j, &w)| (usize::from(j), f64::from(w)));
+        let dq = method.dq_weight(mesh, v);
+        let linear = || influences.clone().map(|(j, w)| joints[j].transform_point3(p) * w).sum::<DVec3>();
+        out.push(match dq {
+            0.0 => linear(),
+            1.0 => dual_quaternion(&rigid, influences, p),
+            d => linear() * (1.0 - d) + dual_quaternion(&rigid, influences, p) * d,
+        });
     }
 }
 
-/// Every mesh of the rig skinned at the pose `model` (one vector of positions per mesh).
+/// A joint matrix split for dual-quaternion blending: rotation `R`, the dual part `½·t·R`, and the stretch `Rᵀ·A`.
+struct RigidStretch {
+    real: DQuat,
+    dual: DQuat,
+    stretch: DMat3,
+}
+
+impl RigidStretch {
+    fn of(m: &DMat4) -> Self {
+        let linear = DMat3::from_mat4(*m);
+        let real = decompose(m).rotation.normalize();
+        let t = m.w_axis.truncate();
+        let dual = DQuat::from_xyzw(0.5 * t.x, 0.5 * t.y, 0.5 * t.z, 0.0) * real;
+        RigidStretch { real, dual, stretch: DMat3::from_quat(real).transpose() * linear }
+    }
+}
+
+/// Kavan's blend of the rigid parts (signs aligned with the first influence, so the blend takes the short way) with
+/// the stretches blended linearly, applied to `p`.
+fn dual_quaternion(joints: &[RigidStretch], influences: impl Iterator<Item = (usize, f64)>, p: DVec3) -> DVec3 {
+    let (mut real, mut dual, mut stretch) =
+        (DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DMat3::ZERO);
+    let (mut first, mut total): (Option<DQuat>, f64) = (None, 0.0);
+    for (j, w) in influences {
+        total += w;
+        let joint = &joints[j];
+        let reference = *first.get_or_insert(joint.real);
+        let w_signed = if reference.dot(joint.real) < 0.0 { -w } else { w };
+        real += joint.real * w_signed;
+        dual += joint.dual * w_signed;
+        stretch += joint.stretch * w;
+    }
+    let length = real.length();
+    if length == 0.0 || total == 0.0 {
+        return p;
+    }
+    // Unit dual quaternion, and the stretch over the weights' sum (stored weights may sum to 1 ± 1e-7).
+    let (real, dual, stretch) = (real / length, dual / length, stretch / total);
+    // t = 2 · dual · real*, the translation of a unit dual quaternion.
+    let t = dual * real.conjugate() * 2.0;
+    real * (stretch * p) + DVec3::new(t.x, t.y, t.z)
+}
+
+/// Every mesh of the rig skinned at the pose `model` (one vector of positions per mesh), as the file says.
 pub fn skin_meshes(rig: &Rig, model: &[DMat4]) -> Vec<Vec<DVec3>> {
+    skin_meshes_with(rig, model, Method::AsFile)
+}
+
+/// [`skin_meshes`] with the skinning `method` chosen.
+pub fn skin_meshes_with(rig: &Rig, model: &[DMat4], method: Method) -> Vec<Vec<DVec3>> {
     rig.meshes
         .iter()
         .map(|mesh| {
             let mut out = Vec::new();
-            skin_positions(mesh, &rig.skins, model, &mut out);
+            skin_positions_with(mesh, &rig.skins, model, method, &mut out);
             out
         })
         .collect()
@@ -78,6 +185,7 @@ mod tests {
             name: None,
             joints: vec![0, 1],
             inverse_bind: vec![DMat4::IDENTITY, DMat4::from_translation(DVec3::new(0.0, -1.0, 0.0))],
+            node_bind: None,
         };
         let mesh = Mesh {
             bone: 0,
@@ -94,5 +202,90 @@ mod tests {
         let mut out = Vec::new();
         skin_positions(&mesh, &[skin], &model, &mut out);
         assert!(out[0].abs_diff_eq(DVec3::new(0.75, 1.0, 0.0), 1e-12), "{:?}", out[0]);
+    }
+
+    /// One vertex at `p` bound to two joints (bones 0 and 1, bound at the origin) with weights `w0`, `w1`.
+    fn two_joints(p: DVec3, w0: f32, w1: f32, dq_weights: Vec<f32>) -> (Skin, Mesh) {
+        let skin = Skin { joints: vec![0, 1], inverse_bind: vec![DMat4::IDENTITY; 2], ..Skin::default() };
+        let mesh = Mesh {
+            skin: Some(0),
+            positions: vec![p.as_vec3()],
+            joints: vec![[0, 1, 0, 0]],
+            weights: vec![[w0, w1, 0.0, 0.0]],
+            dq_weights,
+            ..Mesh::default()
+        };
+        (skin, mesh)
+    }
+
+    fn skinned(skin: Skin, mesh: &Mesh, model: &[DMat4], method: Method) -> DVec3 {
+        let mut out = Vec::new();
+        skin_positions_with(mesh, &[skin], model, method, &mut out);
+        out[0]
+    }
+
+    #[test]
+    fn dual_quaternions_keep_a_twisted_vertex_on_its_circle() {
+        // Halfway between no turn and 90° about Z, DQ turns (1, 0, 0) by 45°; linear blending pulls it inwards to
+        // (0.5, 0.5, 0), 0.707 from the axis (the candy-wrapper collapse).
+        let model = [DMat4::IDENTITY, DMat4::from_quat(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2))];
+        let (skin, mesh) = two_joints(DVec3::X, 0.5, 0.5, vec![]);
+        let half = std::f64::consts::FRAC_1_SQRT_2;
+        let dq = skinned(skin.clone(), &mesh, &model, Method::DualQuaternion);
+        assert!(dq.abs_diff_eq(DVec3::new(half, half, 0.0), 1e-12), "{dq:?}");
+        let linear = skinned(skin.clone(), &mesh, &model, Method::Linear);
+        assert!(linear.abs_diff_eq(DVec3::new(0.5, 0.5, 0.0), 1e-12), "{linear:?}");
+        assert_eq!(skinned(skin, &mesh, &model, Method::AsFile), linear, "the file declares no DQ weights");
+    }
+
+    #[test]
+    fn dual_quaternions_blend_translations_linearly() {
+        let model =
+            [DMat4::from_translation(DVec3::new(2.0, 0.0, 0.0)), DMat4::from_translation(DVec3::new(0.0, 2.0, 0.0))];
+        let (skin, mesh) = two_joints(DVec3::new(0.0, 0.0, 1.0), 0.25, 0.75, vec![1.0]);
+        let p = skinned(skin, &mesh, &model, Method::AsFile);
+        assert!(p.abs_diff_eq(DVec3::new(0.5, 1.5, 1.0), 1e-12), "{p:?}");
+    }
+
+    #[test]
+    fn dual_quaternions_are_exact_where_linear_blending_is() {
+        // Both joints carry the same sheared, scaled, turned and moved matrix (and a mirrored one): any blend of
+        // them is that matrix, in either method.
+        let sheared =
+            DMat4::from_cols_array(&[1.5, 0.2, 0.0, 0.0, 0.7, 0.9, 0.1, 0.0, -0.3, 0.0, 2.0, 0.0, 4.0, -1.0, 0.5, 1.0])
+                * DMat4::from_quat(DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0));
+        for m in [sheared, sheared * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0))] {
+            let p = DVec3::new(0.25, -0.75, 1.5);
+            let (skin, mesh) = two_joints(p, 0.25, 0.75, vec![1.0]);
+            let dq = skinned(skin, &mesh, &[m, m], Method::AsFile);
+            assert!(dq.abs_diff_eq(m.transform_point3(p), 1e-12), "{dq:?} vs {:?}", m.transform_point3(p));
+        }
+    }
+
+    #[test]
+    fn dq_weights_blend_the_two_methods() {
+        let model = [DMat4::IDENTITY, DMat4::from_quat(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2))];
+        let (skin, mesh) = two_joints(DVec3::X, 0.5, 0.5, vec![0.25]);
+        let p = skinned(skin.clone(), &mesh, &model, Method::AsFile);
+        let expected = skinned(skin.clone(), &mesh, &model, Method::Linear) * 0.75
+            + skinned(skin, &mesh, &model, Method::DualQuaternion) * 0.25;
+        assert!(p.abs_diff_eq(expected, 1e-12), "{p:?} vs {expected:?}");
+    }
+
+    #[test]
+    fn a_skin_that_follows_its_node_moves_with_it() {
+        // The mesh node (bone 1) was bound at x = 1 and is now at x = 3: the result moves by +2.
+        let mut skin = Skin { joints: vec![0], inverse_bind: vec![DMat4::IDENTITY], ..Skin::default() };
+        skin.node_bind =
+            Some(crate::model::NodeBind { bone: 1, inverse_bind: DMat4::from_translation(DVec3::new(-1.0, 0.0, 0.0)) });
+        let mesh = Mesh {
+            skin: Some(0),
+            positions: vec![Vec3::Y],
+            joints: vec![[0; 4]],
+            weights: vec![[1.0, 0.0, 0.0, 0.0]],
+            ..Mesh::default()
+        };
+        let model = [DMat4::IDENTITY, DMat4::from_translation(DVec3::new(3.0, 0.0, 0.0))];
+        assert_eq!(skinned(skin, &mesh, &model, Method::AsFile), DVec3::new(2.0, 1.0, 0.0));
     }
 }

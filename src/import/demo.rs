@@ -135,8 +135,18 @@ fn skinned_tube(skeleton: &Skeleton) -> (Skin, Mesh) {
         name: Some("arm".into()),
         joints: joints_of_skin.to_vec(),
         inverse_bind: joints_of_skin.iter().map(|&j| rest[j].inverse()).collect(),
+        node_bind: None,
     };
-    let mesh = Mesh { name: "tube".into(), bone: SHOULDER, skin: Some(0), positions, joints, weights, indices };
+    let mesh = Mesh {
+        name: "tube".into(),
+        bone: SHOULDER,
+        skin: Some(0),
+        positions,
+        joints,
+        weights,
+        indices,
+        ..Mesh::default()
+    };
     (skin, mesh)
 }
 

@@ -3,13 +3,27 @@
 use glam::{DMat4, Vec3};
 
 /// A set of joints with the inverse bind matrix of each.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct Skin {
     pub name: Option<String>,
     /// Bone index of each joint.
     pub joints: Vec<usize>,
     /// One per joint; the identity where the file gives none.
     pub inverse_bind: Vec<DMat4>,
+    /// Where the skinned result also follows its mesh's node (Maya), that node and its bind; `None` where the node
+    /// does not move the result (glTF, which says so, and the FBX SDK's own evaluation).
+    pub node_bind: Option<NodeBind>,
+}
+
+/// How a skin's result follows the mesh node it is on, as Maya shows it: the skin cluster deforms the mesh as it
+/// was bound, and the mesh node's transform since the bind then moves the result, i.e. every joint matrix is
+/// premultiplied by `W_node · inverse_bind` (the identity while the node stays where it was bound).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeBind {
+    /// The bone (node) the mesh is on.
+    pub bone: usize,
+    /// The geometric transform times the inverse of the node's model matrix at bind.
+    pub inverse_bind: DMat4,
 }
 
 /// A triangle mesh attached to a bone, optionally skinned (linear blend skinning, four influences per vertex).
@@ -25,6 +39,9 @@ pub struct Mesh {
     pub joints: Vec<[u16; 4]>,
     /// Per vertex, four weights matching `joints` (empty when not skinned).
     pub weights: Vec<[f32; 4]>,
+    /// Per vertex, how far it is skinned with dual quaternions rather than linearly (FBX's skinning method and
+    /// blend weights: 0 linear, 1 dual quaternion); empty when the whole mesh is skinned linearly.
+    pub dq_weights: Vec<f32>,
     /// Triangle list.
     pub indices: Vec<u32>,
 }
@@ -47,6 +64,7 @@ impl Mesh {
         retain_kept(&mut self.positions, &keep);
         retain_kept(&mut self.joints, &keep);
         retain_kept(&mut self.weights, &keep);
+        retain_kept(&mut self.dq_weights, &keep);
         let kept = |i: &u32| keep.get(*i as usize).copied().unwrap_or(false);
         self.indices = self
             .indices

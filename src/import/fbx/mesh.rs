@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::scene::SceneBones;
 use super::{Failure, Result, matrix, memory_limit, node_name};
-use crate::model::{Mesh, Skin};
+use crate::model::{Mesh, NodeBind, Skin};
 
 pub(super) fn read(
     scene: &ufbx::Scene,
@@ -24,6 +24,7 @@ pub(super) fn read(
     let mut skins = Vec::new();
     let mut meshes = Vec::new();
     let mut tally = Tally::default();
+    let follows_node = skins_follow_their_node(scene);
     // An instanced mesh is copied per node: a small file could otherwise ask for any amount of memory.
     let mut budget = memory_limit(file_size);
     for (bone, bone_data) in bones.skeleton.bones().iter().enumerate() {
@@ -48,10 +49,13 @@ pub(super) fn read(
                 }
                 // ufbx sets a per-vertex blend towards dual-quaternion skinning for DQ and blended skins.
                 if skin.vertices.iter().any(|v| v.dq_weight > 0.0) {
-                    tally.not_linear += 1;
+                    tally.dual_quaternion += 1;
+                    read.dq_weights = (0..mesh.vertices.len())
+                        .map(|v| skin.vertices.get(v).map_or(0.0, |s| s.dq_weight as f32))
+                        .collect();
                 }
                 read.positions = mesh.vertices.iter().map(|v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)).collect();
-                let skin = read_skin(skin, node, bones, &mut read, &place, &mut tally)?;
+                let skin = read_skin(skin, node, bones, follows_node, &mut read, &place, &mut tally)?;
                 read.skin = Some(skins.len());
                 skins.push(skin);
             }
@@ -78,7 +82,7 @@ pub(super) fn read(
 #[derive(Default)]
 struct Tally {
     extra_skins: usize,
-    not_linear: usize,
+    dual_quaternion: usize,
     blend_shapes: usize,
     skipped_faces: usize,
     trimmed_weights: usize,
@@ -90,7 +94,7 @@ impl Tally {
     fn notes(&self, notes: &mut Vec<String>) {
         let lines = [
             (self.extra_skins, "meshes have more than one skin deformer; only the first is used"),
-            (self.not_linear, "skins ask for (partly) dual-quaternion skinning; bonescope skins linearly"),
+            (self.dual_quaternion, "skins use (partly) dual-quaternion skinning, as the file declares"),
             (self.blend_shapes, "meshes have blend shapes, not evaluated"),
             (self.skipped_faces, "faces with fewer than 3 corners (points, lines) were skipped"),
             (self.trimmed_weights, "vertices have more than 4 weights; the 4 strongest are kept, renormalised"),
@@ -134,6 +138,7 @@ fn read_skin(
     skin: &ufbx::SkinDeformer,
     mesh_node: &ufbx::Node,
     bones: &SceneBones,
+    follows_node: bool,
     mesh: &mut Mesh,
     place: &str,
     tally: &mut Tally,
@@ -202,5 +207,31 @@ fn read_skin(
         mesh.weights.push(w);
     }
     let name: &str = &skin.element.name;
-    Ok(Skin { name: (!name.is_empty()).then(|| name.to_owned()), joints, inverse_bind })
+    let node_bind = follows_node.then(|| node_bind(skin, mesh_node, mesh_bone)).flatten();
+    Ok(Skin { name: (!name.is_empty()).then(|| name.to_owned()), joints, inverse_bind, node_bind })
+}
+
+/// Whether the scene's skinned meshes also follow their node, as Maya shows them (its skin cluster deforms in the
+/// mesh's space as bound; the mesh's transform then applies). 3ds Max, Blender and the FBX SDK leave the mesh node
+/// out, as glTF does; the corpus's OBJ references of each tool agree (`ufbx:transform_skin` on Maya's).
+fn skins_follow_their_node(scene: &ufbx::Scene) -> bool {
+    scene.metadata.original_application.name.contains("Maya")
+}
+
+/// The mesh node's bind for a skin that follows it: the node's model matrix in the file's bind pose (that of the
+/// node, or of another instance of its mesh, as ufbx's runner looks it up), else from a cluster (the cluster's bone
+/// at bind times the mesh node relative to that bone); `None` when neither is there.
+fn node_bind(skin: &ufbx::SkinDeformer, mesh_node: &ufbx::Node, bone: usize) -> Option<NodeBind> {
+    let posed = |node: &ufbx::Node| {
+        let pose = node.bind_pose.as_ref()?;
+        ufbx::get_bone_pose(pose, node).map(|p| matrix(&p.bone_to_world))
+    };
+    let instances = || mesh_node.mesh.as_ref()?.element.instances.iter().find_map(|n| posed(n));
+    let from_cluster = || {
+        let cluster = skin.clusters.first()?;
+        Some(matrix(&cluster.bind_to_world) * matrix(&cluster.mesh_node_to_bone))
+    };
+    let node_at_bind = posed(mesh_node).or_else(instances).or_else(from_cluster)?;
+    let inverse_bind = matrix(&mesh_node.geometry_to_node) * node_at_bind.inverse();
+    inverse_bind.is_finite().then_some(NodeBind { bone, inverse_bind })
 }

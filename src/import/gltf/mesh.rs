@@ -70,7 +70,7 @@ fn read_skin(
             matrices
         }
     };
-    Ok(Skin { name: skin.name.clone(), joints, inverse_bind })
+    Ok(Skin { name: skin.name.clone(), joints, inverse_bind, node_bind: None })
 }
 
 /// One [`Mesh`] per triangle primitive of each scene node with a mesh, named after the mesh (or the node).
