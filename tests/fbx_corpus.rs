@@ -62,20 +62,6 @@ const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[
     ("maya_instanced_skin_4", "maya_instanced_skin_6100_binary", INSTANCED_6100),
     ("maya_instanced_skin_8", "maya_instanced_skin_6100_ascii", INSTANCED_6100),
     ("maya_instanced_skin_8", "maya_instanced_skin_6100_binary", INSTANCED_6100),
-    ("blender440_shape_weight_anim_5", "", BLEND_SHAPES),
-    ("blender440_shape_weight_anim_15", "", BLEND_SHAPES),
-    ("blender440_shape_weight_anim_25", "", BLEND_SHAPES),
-    ("blender_331_static_blend_shape", "", BLEND_SHAPES),
-    ("max7_blend_cube_8", "", BLEND_SHAPES),
-    ("max7_blend_cube_24", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_1", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_30", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_60", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_65", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_71", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_80", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_89", "", BLEND_SHAPES),
-    ("maya_blend_inbetween_120", "", BLEND_SHAPES),
     ("maya_anim_layers_over_acc_orders_18", "", "animation layers: under investigation"),
     ("maya_axes_anim_5", "", "under investigation"),
     ("maya_axes_anim_8", "", "under investigation"),
@@ -83,8 +69,6 @@ const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[
 
 /// ufbx's own test skips these: in FBX 6.1 the skin is attached to the first instance only.
 const INSTANCED_6100: &str = "FBX 6.1 attaches the skin to one instance only (ufbx's own test skips 6100 files)";
-
-const BLEND_SHAPES: &str = "blend shapes are not evaluated yet";
 
 /// One OBJ reference: which scene, which frame, and what its markers say.
 struct Reference {
@@ -204,7 +188,7 @@ fn evaluated(fbx: &Path, rig: &Rig, reference: &Reference) -> Vec<DVec3> {
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
     let mut pose = Pose::default();
     pose.evaluate(&rig.skeleton, clip.map(|c| &rig.clips[c]), &hierarchy, time);
-    skin_meshes(rig, &pose.model.model).concat()
+    skin_meshes(rig, &pose.model.model, &pose.morph).concat()
 }
 
 struct Comparison {

@@ -307,7 +307,7 @@ fn exported(path: &Path, time: f64) -> Vec<DVec3> {
     let mut all = Vec::new();
     for mesh in &rig.meshes {
         let mut positions = Vec::new();
-        skin_positions(mesh, &rig.skins, &pose.model.model, &mut positions);
+        skin_positions(mesh, &rig.skins, &pose.model.model, &pose.morph, &mut positions);
         all.extend(positions);
     }
     all

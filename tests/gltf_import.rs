@@ -5,8 +5,9 @@ use std::collections::{BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
+use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
-use bonescope::model::{Interpolation, Rig};
+use bonescope::model::{Clip, Interpolation, Rig};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -605,7 +606,7 @@ fn animation_pointers_animate_nodes_and_mesh_weights_and_list_the_rest() {
     let translation = clip.tracks_of(0).unwrap().translation.as_ref().unwrap();
     assert_eq!(translation.values(), TRANSLATIONS.map(Vec3::from_array));
     assert_eq!(clip.tracks_of(1).unwrap().rotation.as_ref().unwrap().interpolation(), Interpolation::Step);
-    assert_eq!(clip.morph_channels.iter().map(|m| m.bone).collect::<Vec<_>>(), [2], "the node showing mesh 0");
+    assert_eq!(clip.morph().iter().map(|m| m.bone).collect::<Vec<_>>(), [2], "the node showing mesh 0");
     let note = "2 animation channels animate properties bonescope does not evaluate: `/materials/0/alphaCutoff`, \
                 `/materials/1/alphaCutoff`";
     assert!(rig.notes.iter().any(|n| n == note), "{:?}", rig.notes);
@@ -761,7 +762,7 @@ fn skins_and_meshes_are_checked() {
 }
 
 #[test]
-fn nodes_outside_the_scene_and_morph_channels_become_notes() {
+fn nodes_outside_the_scene_become_notes_and_morph_channels_weight_tracks() {
     let mut sample = sample();
     let nodes = sample.json["nodes"].as_array_mut().unwrap();
     nodes.push(json!({}));
@@ -778,10 +779,10 @@ fn nodes_outside_the_scene_and_morph_channels_become_notes() {
     assert_eq!(rig.skeleton.bone(3).name, "node3", "unnamed nodes are named by index");
     assert_eq!(rig.skeleton.find_node(4), None);
     assert!(rig.notes.iter().any(|n| n == "1 animation channels target nodes outside the scene, ignored"));
-    assert!(rig.notes.iter().any(|n| n == "1 morph-weight channels listed, not evaluated"));
     assert!(rig.notes.iter().any(|n| n == "1 nodes outside the scene are not bones"));
-    let morph = &rig.clips[0].morph_channels;
-    assert_eq!((morph[0].bone, morph[0].keys, morph[0].last_time), (2, 3, 1.0));
+    let morph = &rig.clips[0].morph()[0];
+    assert_eq!((morph.bone, morph.weights.len()), (2, 1), "one weight per key: one target");
+    assert_eq!(morph.weights[0].times(), [0.0, 0.5, 1.0]);
 }
 
 #[test]
@@ -937,4 +938,47 @@ fn set_number(value: &mut Value, skip: &mut usize, new: f64) -> bool {
         Value::Object(fields) => fields.values_mut().any(|v| set_number(v, skip, new)),
         _ => false,
     }
+}
+
+#[test]
+fn morph_targets_displace_vertices_with_their_default_and_animated_weights() {
+    // Two targets on the triangle: "up" moves every vertex +1 in Z, "out" moves vertex 1 by +2 in X. Default weights
+    // (0.5, 0) on the mesh; the node's weights animate them from (0, 0) over (1, 1) at 0.5 s to (1, 0.5) at 1 s,
+    // one accessor holding both targets' weights per key.
+    let mut sample = sample();
+    let up = sample.push_view(bytes(&[0.0f32, 0.0, 1.0].repeat(3), f32::to_le_bytes));
+    let out = sample.push_view(bytes(&[0.0f32, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0], f32::to_le_bytes));
+    let up = sample.push_accessor(json!({ "bufferView": up, "componentType": 5126, "count": 3, "type": "VEC3" }));
+    let out = sample.push_accessor(json!({ "bufferView": out, "componentType": 5126, "count": 3, "type": "VEC3" }));
+    let weights = sample.push_view(bytes(&[0.0f32, 0.0, 1.0, 1.0, 1.0, 0.5], f32::to_le_bytes));
+    let weights =
+        sample.push_accessor(json!({ "bufferView": weights, "componentType": 5126, "count": 6, "type": "SCALAR" }));
+    let mesh = &mut sample.json["meshes"][0];
+    mesh["primitives"][0]["targets"] = json!([{ "POSITION": up }, { "POSITION": out }]);
+    mesh["weights"] = json!([0.5, 0.0]);
+    let animation = &mut sample.json["animations"][0];
+    animation["samplers"].as_array_mut().unwrap().push(json!({ "input": 0, "output": weights }));
+    let channels = animation["channels"].as_array_mut().unwrap();
+    channels.push(json!({ "sampler": 2, "target": { "node": 2, "path": "weights" } }));
+    let rig = load_glb(&sample).unwrap();
+    assert_eq!(rig.meshes[0].morph_targets.len(), 2);
+    assert_eq!(rig.meshes[0].morph_weights, [0.5, 0.0]);
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let positions = |clip: Option<&Clip>, time: f64| {
+        let mut pose = Pose::default();
+        pose.evaluate(&rig.skeleton, clip, &hierarchy, time);
+        // Only the morph, not the skinning: the weights alone.
+        pose.morph.positions(&rig.meshes[0]).into_owned()
+    };
+    let base = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let expect = |[up, out]: [f32; 2]| {
+        let mut moved = base.map(|p| p + Vec3::Z * up);
+        moved[1] += Vec3::X * 2.0 * out;
+        moved.to_vec()
+    };
+    assert_eq!(positions(None, 0.0), expect([0.5, 0.0]), "the mesh's default weights at rest");
+    let clip = Some(&rig.clips[0]);
+    assert_eq!(positions(clip, 0.25), expect([0.5, 0.5]), "halfway to the second key");
+    assert_eq!(positions(clip, 0.75), expect([1.0, 0.75]));
+    assert_eq!(positions(clip, 2.0), expect([1.0, 0.5]), "the last key holds");
 }

@@ -238,9 +238,9 @@ impl<'a> Runtime<'a> {
     fn measure_vertices(&mut self, errors: &mut Errors) {
         let [evaluated, seed, trs] = &mut self.vertices;
         for mesh in &self.rig.meshes {
-            skin_positions(mesh, &self.rig.skins, &self.pose.model.model, evaluated);
-            skin_positions(mesh, &self.rig.skins, &self.seed, seed);
-            skin_positions(mesh, &self.rig.skins, &self.trs, trs);
+            skin_positions(mesh, &self.rig.skins, &self.pose.model.model, &self.pose.morph, evaluated);
+            skin_positions(mesh, &self.rig.skins, &self.seed, &self.pose.morph, seed);
+            skin_positions(mesh, &self.rig.skins, &self.trs, &self.pose.morph, trs);
             for ((at, s), t) in evaluated.iter().zip(seed.iter()).zip(trs.iter()) {
                 errors.seed.vertices.add(s.distance(*at));
                 errors.trs.vertices.add(t.distance(*at));

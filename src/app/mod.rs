@@ -45,9 +45,10 @@ impl Frame {
     fn evaluate(doc: &Document, time: f64, tolerances: &Tolerances) -> Frame {
         let rig = &doc.rig;
         let pose = doc.evaluate(&doc.modes, time, true);
-        let primary = Layer::from_model(rig, pose.model.model.clone(), tolerances);
+        let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, tolerances);
         let ghost = doc.ghost_evaluation().map(|(modes, layered)| {
-            Layer::from_model(rig, doc.evaluate(&modes, time, layered).model.model, tolerances)
+            let ghost = doc.evaluate(&modes, time, layered);
+            Layer::from_model(rig, ghost.model.model, &ghost.morph, tolerances)
         });
         Frame { pose, primary, ghost }
     }

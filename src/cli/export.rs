@@ -55,7 +55,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|mesh| {
             let mut out = Vec::new();
-            skin_positions(mesh, &rig.skins, &pose.model.model, &mut out);
+            skin_positions(mesh, &rig.skins, &pose.model.model, &pose.morph, &mut out);
             out
         })
         .collect();

@@ -1,7 +1,7 @@
 //! One evaluation step from a clip and a time to local and model matrices, with reusable buffers.
 
 use super::sample::{rest_pose_into, sample_clip_near};
-use super::{Hierarchy, LayerStack, ModelPose};
+use super::{Hierarchy, LayerStack, ModelPose, MorphPose};
 use crate::model::{Clip, Rig, Skeleton, Transform};
 
 /// The local transforms and model matrices of every bone at one time. Reuse it across times to avoid allocating,
@@ -10,6 +10,8 @@ use crate::model::{Clip, Rig, Skeleton, Transform};
 pub struct Pose {
     pub local: Vec<Transform>,
     pub model: ModelPose,
+    /// The morph-target weights the clip animates (layers do not blend them: the main clip's hold).
+    pub morph: MorphPose,
     /// Where each track's keys were found last time (see `sample_clip_near`).
     hints: Vec<usize>,
 }
@@ -22,6 +24,7 @@ impl Pose {
             None => rest_pose_into(skeleton, &mut self.local),
         }
         hierarchy.evaluate(&self.local, &mut self.model);
+        self.morph.evaluate(clip, time);
     }
 
     /// Like [`Pose::evaluate`], through `layers` (built for `rig`).
@@ -35,5 +38,6 @@ impl Pose {
     ) {
         layers.evaluate(rig, clip, time, &mut self.local);
         hierarchy.evaluate(&self.local, &mut self.model);
+        self.morph.evaluate(clip, time);
     }
 }

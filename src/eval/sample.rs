@@ -40,6 +40,22 @@ impl Interpolate for Vec3 {
     }
 }
 
+impl Interpolate for f32 {
+    type Wide = f64;
+
+    fn widen(self) -> f64 {
+        f64::from(self)
+    }
+
+    fn linear(a: f64, b: f64, t: f64) -> f64 {
+        a * (1.0 - t) + b * t
+    }
+
+    fn hermite(v0: f64, b0: f64, v1: f64, a1: f64, h: [f64; 4]) -> f64 {
+        v0 * h[0] + b0 * h[1] + v1 * h[2] + a1 * h[3]
+    }
+}
+
 impl Interpolate for Quat {
     type Wide = DQuat;
 

@@ -17,6 +17,7 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
+use super::MorphPose;
 use crate::math::decompose;
 use crate::model::{Mesh, Rig, Skin};
 
@@ -70,24 +71,32 @@ pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
 /// file says.
 ///
 /// Weights are used as stored (importers keep them normalised); joints whose weight is zero are skipped.
-pub fn skin_positions(mesh: &Mesh, skins: &[Skin], model: &[DMat4], out: &mut Vec<DVec3>) {
-    skin_positions_with(mesh, skins, model, Method::AsFile, out);
+pub fn skin_positions(mesh: &Mesh, skins: &[Skin], model: &[DMat4], morph: &MorphPose, out: &mut Vec<DVec3>) {
+    skin_positions_with(mesh, skins, model, morph, Method::AsFile, out);
 }
 
 /// [`skin_positions`] with the skinning `method` chosen.
-pub fn skin_positions_with(mesh: &Mesh, skins: &[Skin], model: &[DMat4], method: Method, out: &mut Vec<DVec3>) {
+pub fn skin_positions_with(
+    mesh: &Mesh,
+    skins: &[Skin],
+    model: &[DMat4],
+    morph: &MorphPose,
+    method: Method,
+    out: &mut Vec<DVec3>,
+) {
     out.clear();
-    let skin = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len());
+    let positions = morph.positions(mesh);
+    let skin = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == positions.len());
     let Some(skin) = skin else {
         let placement = model[mesh.bone];
-        out.extend(mesh.positions.iter().map(|p| placement.transform_point3(p.as_dvec3())));
+        out.extend(positions.iter().map(|p| placement.transform_point3(p.as_dvec3())));
         return;
     };
     let mut joints = Vec::with_capacity(skin.joints.len());
     joint_matrices(skin, model, &mut joints);
-    let any_dq = (0..mesh.positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
+    let any_dq = (0..positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
     let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
-    for (v, ((position, indices), weights)) in mesh.positions.iter().zip(&mesh.joints).zip(&mesh.weights).enumerate() {
+    for (v, ((position, indices), weights)) in positions.iter().zip(&mesh.joints).zip(&mesh.weights).enumerate() {
         let p = position.as_dvec3();
         let influences =
             indices.iter().zip(weights).filter(|(_, w)| **w != 0.0).map(|(&j, &w)| (usize::from(j), f64::from(w)));
@@ -144,18 +153,19 @@ fn dual_quaternion(joints: &[RigidStretch], influences: impl Iterator<Item = (us
     real * (stretch * p) + DVec3::new(t.x, t.y, t.z)
 }
 
-/// Every mesh of the rig skinned at the pose `model` (one vector of positions per mesh), as the file says.
-pub fn skin_meshes(rig: &Rig, model: &[DMat4]) -> Vec<Vec<DVec3>> {
-    skin_meshes_with(rig, model, Method::AsFile)
+/// Every mesh of the rig morphed and skinned at the pose `model` (one vector of positions per mesh), as the file
+/// says.
+pub fn skin_meshes(rig: &Rig, model: &[DMat4], morph: &MorphPose) -> Vec<Vec<DVec3>> {
+    skin_meshes_with(rig, model, morph, Method::AsFile)
 }
 
 /// [`skin_meshes`] with the skinning `method` chosen.
-pub fn skin_meshes_with(rig: &Rig, model: &[DMat4], method: Method) -> Vec<Vec<DVec3>> {
+pub fn skin_meshes_with(rig: &Rig, model: &[DMat4], morph: &MorphPose, method: Method) -> Vec<Vec<DVec3>> {
     rig.meshes
         .iter()
         .map(|mesh| {
             let mut out = Vec::new();
-            skin_positions_with(mesh, &rig.skins, model, method, &mut out);
+            skin_positions_with(mesh, &rig.skins, model, morph, method, &mut out);
             out
         })
         .collect()
@@ -172,7 +182,7 @@ mod tests {
         let mesh = Mesh { bone: 1, positions: vec![Vec3::new(1.0, 0.0, 0.0)], ..Mesh::default() };
         let model = [DMat4::IDENTITY, DMat4::from_translation(DVec3::new(0.0, 2.0, 0.0))];
         let mut out = Vec::new();
-        skin_positions(&mesh, &[], &model, &mut out);
+        skin_positions(&mesh, &[], &model, &MorphPose::default(), &mut out);
         assert_eq!(out, vec![DVec3::new(1.0, 2.0, 0.0)]);
     }
 
@@ -200,7 +210,7 @@ mod tests {
             DMat4::from_quat(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2)),
         ];
         let mut out = Vec::new();
-        skin_positions(&mesh, &[skin], &model, &mut out);
+        skin_positions(&mesh, &[skin], &model, &MorphPose::default(), &mut out);
         assert!(out[0].abs_diff_eq(DVec3::new(0.75, 1.0, 0.0), 1e-12), "{:?}", out[0]);
     }
 
@@ -220,7 +230,7 @@ mod tests {
 
     fn skinned(skin: Skin, mesh: &Mesh, model: &[DMat4], method: Method) -> DVec3 {
         let mut out = Vec::new();
-        skin_positions_with(mesh, &[skin], model, method, &mut out);
+        skin_positions_with(mesh, &[skin], model, &MorphPose::default(), method, &mut out);
         out[0]
     }
 

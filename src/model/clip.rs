@@ -68,6 +68,16 @@ impl KeyValue for Vec3 {
     }
 }
 
+impl KeyValue for f32 {
+    fn is_finite(&self) -> bool {
+        f32::is_finite(*self)
+    }
+
+    fn is_zero(&self) -> bool {
+        *self == 0.0
+    }
+}
+
 impl KeyValue for Quat {
     fn is_finite(&self) -> bool {
         Quat::is_finite(*self)
@@ -179,14 +189,18 @@ impl BoneTracks {
     }
 }
 
-/// A morph-weight channel: listed so a user knows it is there, not evaluated.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct MorphChannel {
+/// The animated morph-target weights of the meshes on one bone: one track per target (glTF's `weights` of a node,
+/// FBX's blend-shape weights), sharing their times.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MorphWeights {
     pub bone: usize,
-    pub keys: usize,
-    pub interpolation: Interpolation,
-    /// The last key time, which counts towards the clip's duration.
-    pub last_time: f64,
+    pub weights: Vec<Track<f32>>,
+}
+
+impl MorphWeights {
+    fn last_time(&self) -> f64 {
+        self.weights.iter().map(Track::last_time).fold(0.0, f64::max)
+    }
 }
 
 /// One animation.
@@ -197,26 +211,29 @@ pub struct Clip {
     pub name: Option<String>,
     /// Tracks sorted by bone, at most one entry per bone.
     tracks: Vec<BoneTracks>,
-    pub morph_channels: Vec<MorphChannel>,
+    /// Sorted by bone, at most one entry per bone.
+    morph: Vec<MorphWeights>,
     duration: f64,
 }
 
 impl Clip {
-    /// Sorts the tracks by bone; the duration is the last key time of any track (glTF clips start at t = 0).
-    pub fn new(
-        index: usize,
-        name: Option<String>,
-        mut tracks: Vec<BoneTracks>,
-        morph_channels: Vec<MorphChannel>,
-    ) -> Self {
+    /// Sorts the tracks and morph weights by bone; the duration is the last key time of any track (glTF clips start
+    /// at t = 0).
+    pub fn new(index: usize, name: Option<String>, mut tracks: Vec<BoneTracks>, mut morph: Vec<MorphWeights>) -> Self {
         tracks.sort_by_key(|t| t.bone);
+        morph.sort_by_key(|m| m.bone);
         let duration = tracks.iter().flat_map(BoneTracks::time_arrays).map(|t| t[t.len() - 1]).fold(0.0, f64::max);
-        let duration = morph_channels.iter().map(|m| m.last_time).fold(duration, f64::max);
-        Clip { index, name, tracks, morph_channels, duration }
+        let duration = morph.iter().map(MorphWeights::last_time).fold(duration, f64::max);
+        Clip { index, name, tracks, morph, duration }
     }
 
     pub fn tracks(&self) -> &[BoneTracks] {
         &self.tracks
+    }
+
+    /// The animated morph weights, by bone.
+    pub fn morph(&self) -> &[MorphWeights] {
+        &self.morph
     }
 
     /// Seconds from t = 0 to the last key.

@@ -7,10 +7,10 @@ mod skin;
 mod timeline;
 mod transform;
 
-pub use clip::{BoneTracks, Clip, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphChannel, Track, TrackError};
+pub use clip::{BoneTracks, Clip, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError};
 pub use inherit::{InheritMode, UnknownInheritMode};
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
-pub use skin::{Mesh, NodeBind, Skin};
+pub use skin::{Mesh, MorphTarget, NodeBind, Skin};
 pub use timeline::{SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
 

@@ -42,8 +42,20 @@ pub struct Mesh {
     /// Per vertex, how far it is skinned with dual quaternions rather than linearly (FBX's skinning method and
     /// blend weights: 0 linear, 1 dual quaternion); empty when the whole mesh is skinned linearly.
     pub dq_weights: Vec<f32>,
+    /// Morph targets (blend shapes), added to the positions with their weights before skinning.
+    pub morph_targets: Vec<MorphTarget>,
+    /// One per morph target: the weights when no clip animates them (glTF's default weights, FBX's stored ones).
+    pub morph_weights: Vec<f32>,
     /// Triangle list.
     pub indices: Vec<u32>,
+}
+
+/// One morph target: a displacement of every vertex, applied with a weight.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct MorphTarget {
+    pub name: String,
+    /// One per vertex of the mesh.
+    pub offsets: Vec<Vec3>,
 }
 
 impl Mesh {
@@ -65,6 +77,9 @@ impl Mesh {
         retain_kept(&mut self.joints, &keep);
         retain_kept(&mut self.weights, &keep);
         retain_kept(&mut self.dq_weights, &keep);
+        for target in &mut self.morph_targets {
+            retain_kept(&mut target.offsets, &keep);
+        }
         let kept = |i: &u32| keep.get(*i as usize).copied().unwrap_or(false);
         self.indices = self
             .indices

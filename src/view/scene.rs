@@ -5,7 +5,7 @@ use glam::{DMat4, DVec3};
 
 use super::camera::Bounds;
 use crate::analysis::{Assessment, Findings, Tolerances};
-use crate::eval::skin_meshes;
+use crate::eval::{MorphPose, skin_meshes};
 use crate::model::{Clip, Rig};
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
@@ -104,9 +104,9 @@ pub struct Layer {
 }
 
 impl Layer {
-    pub fn from_model(rig: &Rig, model: Vec<DMat4>, tolerances: &Tolerances) -> Layer {
+    pub fn from_model(rig: &Rig, model: Vec<DMat4>, morph: &MorphPose, tolerances: &Tolerances) -> Layer {
         let findings = Assessment::all(&model, tolerances).into_iter().map(|a| a.findings).collect();
-        let meshes = skin_meshes(rig, &model);
+        let meshes = skin_meshes(rig, &model, morph);
         Layer { model, findings, meshes }
     }
 
@@ -205,10 +205,13 @@ pub fn motion_bounds(
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
 ) -> Option<Bounds> {
     let framed = framed_bones(rig, clip);
+    let mut morph = MorphPose::default();
     let bounds = (0..samples.max(1))
         .filter_map(|i| {
-            let model = pose_at(duration * i as f64 / (samples.max(2) - 1) as f64);
-            let meshes = skin_meshes(rig, &model);
+            let time = duration * i as f64 / (samples.max(2) - 1) as f64;
+            let model = pose_at(time);
+            morph.evaluate(clip, time);
+            let meshes = skin_meshes(rig, &model, &morph);
             let heads = model.iter().zip(&framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
             Bounds::of(heads.chain(meshes.into_iter().flatten()))
         })
@@ -238,7 +241,7 @@ fn framed_bones(rig: &Rig, clip: Option<&Clip>) -> Vec<bool> {
 /// The bounds of the rest pose's joints and meshes.
 pub fn rest_bounds(rig: &Rig) -> Option<Bounds> {
     let model = rig.skeleton.rest_model_matrices();
-    let meshes = skin_meshes(rig, &model);
+    let meshes = skin_meshes(rig, &model, &MorphPose::default());
     Bounds::of(model.iter().map(|m| m.w_axis.truncate()).chain(meshes.into_iter().flatten()))
 }
 

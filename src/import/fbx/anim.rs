@@ -18,8 +18,9 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
+use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
-use crate::model::{BoneTracks, Clip, Interpolation, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
+use crate::model::{BoneTracks, Clip, Interpolation, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
 
 /// Frames per second assumed when the file states none that makes sense.
 const DEFAULT_FPS: f64 = 30.0;
@@ -78,7 +79,7 @@ impl StackReader<'_> {
 
     /// The clip, and how many node samples it holds.
     fn clip(&self, bone_of_node: &[Option<usize>], notes: &mut Vec<String>) -> Result<(Clip, usize)> {
-        let (nodes, keys) = self.keys()?;
+        let (nodes, keys, channels) = self.keys()?;
         let animated: Vec<(usize, &ufbx::Node)> = nodes
             .into_iter()
             .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref())))
@@ -94,28 +95,46 @@ impl StackReader<'_> {
         for (bone, node) in animated {
             tracks.push(self.sample(bone, node, &grid, &times)?);
         }
-        let samples = grid.len() * tracks.len();
+        let morph = self.morph_weights(bone_of_node, &channels, &grid, &times)?;
+        let samples = grid.len() * (tracks.len() + morph.len());
         let name: &str = &self.stack.element.name;
-        Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, Vec::new()), samples))
+        Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, morph), samples))
     }
 
-    /// The nodes (typed ids) whose properties the stack animates, in order of appearance, and every key time of
-    /// their curves, with a time just before each step.
-    fn keys(&self) -> Result<(Vec<usize>, Vec<f64>)> {
+    /// The nodes (typed ids) whose properties the stack animates, in order of appearance, every key time of their
+    /// curves and of the blend channels' (with a time just before each step), and whether each blend channel (by
+    /// typed id) is animated.
+    fn keys(&self) -> Result<(Vec<usize>, Vec<f64>, Vec<bool>)> {
         let mut seen = vec![false; self.scene.nodes.len()];
+        let mut channels = vec![false; self.scene.blend_channels.len()];
         let (mut nodes, mut times) = (Vec::new(), Vec::new());
         for layer in self.stack.layers.iter() {
             for prop in layer.anim_props.iter() {
                 let element = &prop.element;
-                if element.type_ != ufbx::ElementType::Node {
-                    continue;
-                }
                 let id = element.typed_id as usize;
-                if let Some(flag) = seen.get_mut(id)
-                    && !*flag
-                {
-                    *flag = true;
-                    nodes.push(id);
+                match element.type_ {
+                    ufbx::ElementType::Node => {
+                        if let Some(flag) = seen.get_mut(id)
+                            && !*flag
+                        {
+                            *flag = true;
+                            nodes.push(id);
+                        }
+                    }
+                    ufbx::ElementType::BlendChannel => {
+                        if let Some(flag) = channels.get_mut(id) {
+                            *flag = true;
+                        }
+                    }
+                    // Older exporters (3ds Max 7, Blender) animate a shape's weight as a property of the mesh.
+                    ufbx::ElementType::Mesh => {
+                        for channel in self.scene.meshes.get(id).into_iter().flat_map(|m| blend_channels(m)) {
+                            if let Some(flag) = channels.get_mut(channel.element.typed_id as usize) {
+                                *flag = true;
+                            }
+                        }
+                    }
+                    _ => continue,
                 }
                 for curve in prop.anim_value.curves.iter().flatten() {
                     let keys = &curve.keyframes;
@@ -139,7 +158,7 @@ impl StackReader<'_> {
             }
         }
         times.retain(|t| t.is_finite());
-        Ok((nodes, times))
+        Ok((nodes, times, channels))
     }
 
     /// The stack's time span, or that of its keys when the stack states none (or a reversed one).
@@ -172,6 +191,45 @@ impl StackReader<'_> {
             ));
         }
         Ok(sampled.times)
+    }
+
+    /// The morph weights of every mesh with an animated blend channel, at every grid time: each channel's weight
+    /// as ufbx evaluates it, split among its shapes by the in-between rule ([`shape_weights`]).
+    fn morph_weights(
+        &self,
+        bone_of_node: &[Option<usize>],
+        animated: &[bool],
+        grid: &[f64],
+        times: &Arc<[f64]>,
+    ) -> Result<Vec<MorphWeights>> {
+        let mut morph = Vec::new();
+        for node in self.scene.nodes.iter() {
+            let Some(mesh) = node.mesh.as_ref() else { continue };
+            let channels: Vec<&ufbx::BlendChannel> = blend_channels(mesh).collect();
+            let is_animated = |c: &&ufbx::BlendChannel| animated.get(c.element.typed_id as usize) == Some(&true);
+            let Some(bone) = bone_of_node.get(node.element.typed_id as usize).copied().flatten() else { continue };
+            if !channels.iter().any(is_animated) {
+                continue;
+            }
+            let mut weights = Vec::new();
+            for channel in channels {
+                let mut shares: Vec<Vec<f32>> = vec![Vec::with_capacity(grid.len()); channel.keyframes.len()];
+                for &time in grid {
+                    let weight = ufbx::evaluate_blend_weight(&self.stack.anim, channel, time);
+                    for (share, value) in shares.iter_mut().zip(shape_weights(channel, weight)) {
+                        share.push(value as f32);
+                    }
+                }
+                for values in shares {
+                    let place = || format!("{}, blend channel `{}`", self.place(), &*channel.element.name);
+                    let track = Track::new(times.clone(), values, Interpolation::Linear)
+                        .map_err(|e| Failure::at(place(), format!("weight: {e}")))?;
+                    weights.push(track);
+                }
+            }
+            morph.push(MorphWeights { bone, weights });
+        }
+        Ok(morph)
     }
 
     /// One animated node at every grid time (`times`: the grid as the clip's times).

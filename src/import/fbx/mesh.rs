@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::scene::SceneBones;
 use super::{Failure, Result, matrix, memory_limit, node_name};
-use crate::model::{Mesh, NodeBind, Skin};
+use crate::model::{Mesh, MorphTarget, NodeBind, Skin};
 
 pub(super) fn read(
     scene: &ufbx::Scene,
@@ -42,6 +42,8 @@ pub(super) fn read(
         })?;
         let mut read = Mesh { name: mesh_name(mesh, node), bone, ..Mesh::default() };
         read.indices = triangles(mesh, &place, &mut tally)?;
+        // Unskinned positions (and their displacements) are placed in the node's space.
+        let mut to_space = glam::DMat4::IDENTITY;
         match mesh.skin_deformers.first() {
             Some(skin) => {
                 if mesh.skin_deformers.len() > 1 {
@@ -60,22 +62,95 @@ pub(super) fn read(
                 skins.push(skin);
             }
             None => {
-                let to_node = matrix(&node.geometry_to_node);
+                to_space = matrix(&node.geometry_to_node);
                 read.positions = mesh
                     .vertices
                     .iter()
-                    .map(|v| to_node.transform_point3(glam::DVec3::new(v.x, v.y, v.z)).as_vec3())
+                    .map(|v| to_space.transform_point3(glam::DVec3::new(v.x, v.y, v.z)).as_vec3())
                     .collect();
             }
         }
-        tally.non_finite += read.remove_non_finite_vertices();
-        if !mesh.blend_deformers.is_empty() {
+        read_blend_shapes(mesh, &to_space, &mut read);
+        if !read.morph_targets.is_empty() {
             tally.blend_shapes += 1;
         }
+        tally.non_finite += read.remove_non_finite_vertices();
         meshes.push(read);
     }
     tally.notes(notes);
     Ok((skins, meshes))
+}
+
+/// Every shape of the mesh's blend channels as a morph target (displacements in the mesh's `to_space`), in the order
+/// of [`blend_channels`], weighted as the file stores them.
+fn read_blend_shapes(mesh: &ufbx::Mesh, to_space: &glam::DMat4, read: &mut Mesh) {
+    for channel in blend_channels(mesh) {
+        read.morph_weights.extend(shape_weights(channel, channel.weight).into_iter().map(|w| w as f32));
+        for keyframe in channel.keyframes.iter() {
+            let shape = &keyframe.shape;
+            let mut offsets = vec![Vec3::ZERO; mesh.vertices.len()];
+            // A shape may weight each of its offsets (Blender's vertex group of a shape key).
+            let weight = |i: usize| shape.offset_weights.get(i).copied().unwrap_or(1.0);
+            for (i, (&vertex, offset)) in shape.offset_vertices.iter().zip(shape.position_offsets.iter()).enumerate() {
+                if let Some(slot) = offsets.get_mut(vertex as usize) {
+                    let offset = glam::DVec3::new(offset.x, offset.y, offset.z) * weight(i);
+                    *slot = to_space.transform_vector3(offset).as_vec3();
+                }
+            }
+            read.morph_targets.push(MorphTarget { name: shape.element.name.to_string(), offsets });
+        }
+    }
+}
+
+/// The blend channels of a mesh, in the order their shapes become morph targets (deformers, then channels, then
+/// each channel's shapes by target weight).
+pub(super) fn blend_channels(mesh: &ufbx::Mesh) -> impl Iterator<Item = &ufbx::BlendChannel> {
+    mesh.blend_deformers.iter().flat_map(|deformer| deformer.channels.iter().map(|c| c.as_ref()))
+}
+
+/// Each shape's share of a channel at `weight` (0 to 1), by [`split_among_shapes`].
+pub(super) fn shape_weights(channel: &ufbx::BlendChannel, weight: f64) -> Vec<f64> {
+    let targets: Vec<f64> = channel.keyframes.iter().map(|k| k.target_weight).collect();
+    split_among_shapes(&targets, weight)
+}
+
+/// FBX's in-between rule as ufbx evaluates it: given the shapes' target weights (ascending), `weight` falls between
+/// two of them (or one and zero, the base shape) and is split linearly between those two.
+fn split_among_shapes(targets: &[f64], weight: f64) -> Vec<f64> {
+    let mut shares = vec![0.0; targets.len()];
+    // `None` is the base shape at target weight 0.
+    let target = |k: Option<usize>| k.map_or(0.0, |k| targets[k]);
+    let last_negative = targets.iter().rposition(|&t| t < 0.0);
+    let first_positive = last_negative.map_or(0, |n| n + 1);
+    let mut next = None;
+    let mut prev =
+        if weight > 0.0 { last_negative } else { (first_positive < targets.len()).then_some(first_positive) };
+    if weight > 0.0 {
+        for (k, &target) in targets.iter().enumerate().skip(first_positive) {
+            (prev, next) = (next, Some(k));
+            if target > weight {
+                break;
+            }
+        }
+    } else {
+        for (k, &target) in targets.iter().enumerate().take(first_positive).rev() {
+            (prev, next) = (next, Some(k));
+            if target < weight {
+                break;
+            }
+        }
+    }
+    let delta = target(next) - target(prev);
+    if delta != 0.0 {
+        let t = (weight - target(prev)) / delta;
+        if let Some(p) = prev {
+            shares[p] = 1.0 - t;
+        }
+        if let Some(n) = next {
+            shares[n] = t;
+        }
+    }
+    shares
 }
 
 /// What the notes say about all meshes together.
@@ -95,7 +170,10 @@ impl Tally {
         let lines = [
             (self.extra_skins, "meshes have more than one skin deformer; only the first is used"),
             (self.dual_quaternion, "skins use (partly) dual-quaternion skinning, as the file declares"),
-            (self.blend_shapes, "meshes have blend shapes, not evaluated"),
+            (
+                self.blend_shapes,
+                "meshes have blend shapes (each in-between shape a morph target, applied before skinning)",
+            ),
             (self.skipped_faces, "faces with fewer than 3 corners (points, lines) were skipped"),
             (self.trimmed_weights, "vertices have more than 4 weights; the 4 strongest are kept, renormalised"),
             (self.unweighted, "skinned vertices have no weights and follow their mesh's node"),
@@ -234,4 +312,24 @@ fn node_bind(skin: &ufbx::SkinDeformer, mesh_node: &ufbx::Node, bone: usize) -> 
     let node_at_bind = posed(mesh_node).or_else(instances).or_else(from_cluster)?;
     let inverse_bind = matrix(&mesh_node.geometry_to_node) * node_at_bind.inverse();
     inverse_bind.is_finite().then_some(NodeBind { bone, inverse_bind })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_among_shapes;
+
+    #[test]
+    fn a_weight_between_in_between_shapes_is_split_between_them() {
+        // Maya's in-between shapes at 0.5 and 1: 0.25 is half the first; 0.75 half of each; 1 the last alone.
+        assert_eq!(split_among_shapes(&[0.5, 1.0], 0.25), [0.5, 0.0]);
+        assert_eq!(split_among_shapes(&[0.5, 1.0], 0.75), [0.5, 0.5]);
+        assert_eq!(split_among_shapes(&[0.5, 1.0], 1.0), [0.0, 1.0]);
+        // Past the last target the last shape is extrapolated, as ufbx does.
+        assert_eq!(split_among_shapes(&[0.5, 1.0], 1.5), [-1.0, 2.0]);
+        // A plain shape scales with the weight; zero is the base.
+        assert_eq!(split_among_shapes(&[1.0], 0.3), [0.3]);
+        assert_eq!(split_among_shapes(&[1.0], 0.0), [0.0]);
+        // Negative targets take negative weights.
+        assert_eq!(split_among_shapes(&[-1.0, 1.0], -0.5), [0.5, 0.0]);
+    }
 }

@@ -1,5 +1,5 @@
-//! Animations as [`Clip`]s: translation, rotation and scale channels become tracks, morph-weight channels are
-//! listed.
+//! Animations as [`Clip`]s: translation, rotation and scale channels become tracks, morph-weight channels one
+//! weight track per morph target.
 //!
 //! A channel names its target by `node` and `path`, or with `KHR_animation_pointer` by a JSON pointer: pointers to a
 //! node's `translation`, `rotation`, `scale` or `weights`, or a mesh's `weights`, are read like ordinary channels;
@@ -13,12 +13,11 @@ use std::sync::Arc;
 use super::accessor::Accessors;
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
-use crate::model::{BoneTracks, Clip, Interpolation, KeyValue, MorphChannel, Track};
+use crate::model::{BoneTracks, Clip, Interpolation, KeyValue, MorphWeights, Track};
 
 /// What the channels of all clips add up to, for the notes.
 #[derive(Default)]
 struct Tally {
-    morph_channels: usize,
     outside_scene: usize,
     /// `KHR_animation_pointer` targets bonescope does not evaluate, by pointer.
     other_pointers: BTreeMap<String, usize>,
@@ -33,9 +32,6 @@ pub(super) fn read_clips(
     let mut reader = Reader { root, accessors, bone_of_node, times: HashMap::new(), tally: Tally::default() };
     let clips = root.animations.iter().enumerate().map(|(i, a)| reader.clip(i, a)).collect::<Result<Vec<_>>>()?;
     let tally = reader.tally;
-    if tally.morph_channels > 0 {
-        notes.push(format!("{} morph-weight channels listed, not evaluated", tally.morph_channels));
-    }
     if tally.outside_scene > 0 {
         notes.push(format!("{} animation channels target nodes outside the scene, ignored", tally.outside_scene));
     }
@@ -97,7 +93,7 @@ struct Reader<'a, 'd> {
 impl Reader<'_, '_> {
     fn clip(&mut self, index: usize, animation: &schema::Animation) -> Result<Clip> {
         let mut tracks: BTreeMap<usize, BoneTracks> = BTreeMap::new();
-        let mut morph_channels = Vec::new();
+        let mut morph = Vec::new();
         let mut targets = HashSet::new();
         for (c, channel) in animation.channels.iter().enumerate() {
             let channel_place = format!("animations[{index}].channels[{c}]");
@@ -106,7 +102,7 @@ impl Reader<'_, '_> {
                 Target::MeshWeights(mesh) => {
                     let sampler = self.sampler(animation, channel.sampler, &channel_place)?;
                     for bone in self.bones_showing(mesh) {
-                        morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?);
+                        morph.push(self.morph_weights(bone, sampler, channel.sampler, index)?);
                     }
                     continue;
                 }
@@ -143,15 +139,14 @@ impl Reader<'_, '_> {
                     let values = self.accessors.rotations(output, &place)?;
                     bone_tracks.rotation = Some(track(times, values, interpolation, &place)?);
                 }
-                Property::Weights => morph_channels.push(self.morph_channel(bone, sampler, channel.sampler, index)?),
+                Property::Weights => morph.push(self.morph_weights(bone, sampler, channel.sampler, index)?),
             }
         }
-        self.tally.morph_channels += morph_channels.len();
         let tracks = tracks
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
             .collect();
-        Ok(Clip::new(index, animation.name.clone(), tracks, morph_channels))
+        Ok(Clip::new(index, animation.name.clone(), tracks, morph))
     }
 
     /// What `target` animates, checked to exist.
@@ -206,19 +201,20 @@ impl Reader<'_, '_> {
         schema::item(&animation.samplers, index, "samplers", format!("{place}.sampler"))
     }
 
-    /// A morph-weight channel of `bone`, with its times and outputs checked.
-    fn morph_channel(
+    /// The morph weights of `bone` a sampler animates: one track per target.
+    fn morph_weights(
         &mut self,
         bone: usize,
         sampler: &schema::AnimationSampler,
         sampler_index: Uint,
         animation: usize,
-    ) -> Result<MorphChannel> {
+    ) -> Result<MorphWeights> {
         let place = format!("animations[{animation}].samplers[{}]", sampler_index.0);
         let times = self.times(sampler.input, &place)?;
         let interpolation = interpolation(sampler, &place)?;
-        let outputs = self.accessors.morph_weights(sampler.output, &place)?.len();
-        morph_channel(bone, &times, interpolation, outputs, &place)
+        let outputs = self.accessors.morph_weights(sampler.output, &place)?;
+        let weights = weight_tracks(&times, interpolation, &outputs, &place)?;
+        Ok(MorphWeights { bone, weights })
     }
 
     /// The key times of an input accessor, read on first use.
@@ -240,28 +236,28 @@ fn track<T: KeyValue>(
     Track::new(times, values, interpolation).map_err(|e| Failure::at(place, e.to_string()))
 }
 
-/// A morph-weight channel, with the checks [`Track::new`] does for the others: valid times, and an output
-/// count that is a whole number of weights per stored key.
-fn morph_channel(
-    bone: usize,
-    times: &[f64],
+/// A morph-weight sampler's outputs as one track per target: glTF stores, per key, every target's weight (for cubic
+/// splines every target's in-tangent, then values, then out-tangents), so the count must be a whole number of
+/// weights per stored key.
+fn weight_tracks(
+    times: &Arc<[f64]>,
     interpolation: Interpolation,
-    outputs: usize,
+    outputs: &[f32],
     place: &str,
-) -> Result<MorphChannel> {
-    let valid_times = times.first().is_some_and(|&t| t >= 0.0)
-        && times.windows(2).all(|w| w[0] <= w[1])
-        && times.iter().all(|t| t.is_finite());
-    if !valid_times {
-        return Err(Failure::at(place, "key times are not finite, non-negative and increasing"));
-    }
+) -> Result<Vec<Track<f32>>> {
     let stored = times.len() * interpolation.values_per_key();
-    if !outputs.is_multiple_of(stored) {
-        let message = format!("{outputs} morph-weight outputs are not a whole number per key ({stored} stored keys)");
+    if stored == 0 || !outputs.len().is_multiple_of(stored) {
+        let message =
+            format!("{} morph-weight outputs are not a whole number per key ({stored} stored keys)", outputs.len());
         return Err(Failure::at(place, message));
     }
-    let last_time = times.last().copied().unwrap_or_default();
-    Ok(MorphChannel { bone, keys: times.len(), interpolation, last_time })
+    let targets = outputs.len() / stored;
+    (0..targets)
+        .map(|target| {
+            let values = outputs.iter().skip(target).step_by(targets).copied().collect();
+            track(times.clone(), values, interpolation, place)
+        })
+        .collect()
 }
 
 /// The sampler's interpolation (`LINEAR` when absent).

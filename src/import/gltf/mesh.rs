@@ -6,7 +6,7 @@ use super::accessor::Accessors;
 use super::scene::SceneBones;
 use super::schema::{self, Root};
 use super::{Failure, Result};
-use crate::model::{Mesh, Skin};
+use crate::model::{Mesh, MorphTarget, Skin};
 
 /// How far the last row of an inverse bind matrix, stored in single precision, may be from `0, 0, 0, 1`.
 const AFFINE_TOLERANCE: f64 = 1e-6;
@@ -120,6 +120,10 @@ pub(super) fn read_meshes(
                 }
             }
             read.indices = triangle_indices(primitive, accessors, read.positions.len(), &place)?;
+            read.morph_targets = morph_targets(primitive, accessors, read.positions.len(), &place)?;
+            let weights = node.weights.as_ref().unwrap_or(&mesh.weights);
+            read.morph_weights =
+                (0..read.morph_targets.len()).map(|k| weights.get(k).map_or(0.0, |&w| w as f32)).collect();
             meshes.push(read);
         }
     }
@@ -147,6 +151,31 @@ fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Op
 fn positions(primitive: &schema::Primitive, accessors: &Accessors, place: &str) -> Result<Vec<glam::Vec3>> {
     let accessor = primitive.attributes.get("POSITION").ok_or_else(|| Failure::at(place, "has no POSITION"))?;
     accessors.positions(*accessor, &format!("{place}.attributes.POSITION"), "POSITION")
+}
+
+/// The primitive's morph targets (their `POSITION` displacements; a target without one displaces nothing).
+fn morph_targets(
+    primitive: &schema::Primitive,
+    accessors: &Accessors,
+    vertices: usize,
+    place: &str,
+) -> Result<Vec<MorphTarget>> {
+    let target = |(k, attributes): (usize, &schema::Attributes)| {
+        let offsets = match attributes.get("POSITION") {
+            Some(&accessor) => {
+                let place = format!("{place}.targets[{k}].POSITION");
+                let offsets = accessors.positions(accessor, &place, "morph target POSITION")?;
+                if offsets.len() != vertices {
+                    let message = format!("{} displacements for {vertices} vertices", offsets.len());
+                    return Err(Failure::at(place, message));
+                }
+                offsets
+            }
+            None => vec![glam::Vec3::ZERO; vertices],
+        };
+        Ok(MorphTarget { name: format!("target {k}"), offsets })
+    };
+    primitive.targets.iter().enumerate().map(target).collect()
 }
 
 /// Reads `JOINTS_0` and `WEIGHTS_0` into `mesh`; `false` when the primitive lacks either.
