@@ -85,10 +85,16 @@ const KNOWN_DIFFERENCES: &[(&str, &str, &str)] = &[
     ("maya_instanced_skin_4", "maya_instanced_skin_6100_binary", INSTANCED_6100),
     ("maya_instanced_skin_8", "maya_instanced_skin_6100_ascii", INSTANCED_6100),
     ("maya_instanced_skin_8", "maya_instanced_skin_6100_binary", INSTANCED_6100),
-    ("maya_anim_layers_over_acc_orders_18", "", "animation layers: under investigation"),
-    ("maya_axes_anim_5", "", "under investigation"),
-    ("maya_axes_anim_8", "", "under investigation"),
+    ("maya_anim_layers_over_acc_orders_18", "", UFBX_DIFFERS),
+    ("maya_axes_anim_5", "", UFBX_DIFFERS),
+    ("maya_axes_anim_8", "", UFBX_DIFFERS),
 ];
+
+/// Measured (ufbx 0.23.1): bonescope's vertices equal ufbx's own `evaluate_scene` with skinning to 7e-7 of the
+/// model at the reference's frame, and both differ from the OBJ by 0.1 of the model at every frame near it: the gap
+/// lies in ufbx's reading of these files (an animation-layer stack over several rotation orders; a Z-up scene),
+/// which bonescope takes as it is, not in bonescope's evaluation, frame convention or comparison.
+const UFBX_DIFFERS: &str = "ufbx's own evaluation differs from the OBJ as much as bonescope's (which equals ufbx's)";
 
 /// ufbx's own test skips these: in FBX 6.1 the skin is attached to the first instance only.
 const INSTANCED_6100: &str = "FBX 6.1 attaches the skin to one instance only (ufbx's own test skips 6100 files)";
