@@ -200,3 +200,14 @@ fn the_storage_report_is_measured_off_the_ui_thread_and_shown() {
     harness.get_by_label("TRS + stretch");
     harness.get_by_label("TRS only");
 }
+
+#[test]
+fn the_skinning_method_is_chosen_in_the_viewport_toolbar() {
+    let mut harness = demo_app();
+    assert_eq!(harness.state().settings.scene.skinning, bonescope::eval::SkinningMethod::AsFile);
+    harness.get_by_role_and_label(Role::ComboBox, "Skinning").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "dual quaternion").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().settings.scene.skinning, bonescope::eval::SkinningMethod::DualQuaternion);
+}

@@ -101,3 +101,25 @@ fn demo_layers_blend_additive_shake() {
     settings.scene.boxes = true;
     window(settings, doc, 0.4, Some("forearm")).snapshot("demo_layers_blend_additive_shake");
 }
+
+/// A file of ufbx's corpus (`../shared/assets/fbx-ufbx-corpus`) as a document.
+fn corpus_document(name: &str) -> Document {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-ufbx-corpus").join(name);
+    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    Document::new(Some(path), rig)
+}
+
+/// Maya's dual-quaternion skin mid-twist: the mesh keeps its volume where linear blending would pinch it.
+#[test]
+fn fbx_dual_quaternion_skin_twisted() {
+    let doc = corpus_document("maya_dual_quaternion_7500_ascii.fbx");
+    window(Settings::default(), doc, 2.5, Some("joint2")).snapshot("fbx_dual_quaternion_skin_twisted");
+}
+
+/// Maya's in-between blend shapes at 2.5 s: the cube's top lifted and moved aside, the Inspector listing every
+/// shape's weight in effect.
+#[test]
+fn fbx_blend_shapes_with_inbetweens() {
+    let doc = corpus_document("maya_blend_inbetween_7500_ascii.fbx");
+    window(Settings::default(), doc, 2.5, Some("pCube1")).snapshot("fbx_blend_shapes_with_inbetweens");
+}

@@ -1,5 +1,5 @@
-//! The selected bone at the current time: local and model matrices, every decomposed part, the findings, and a
-//! button that copies the same JSON `bonescope inspect` prints.
+//! The selected bone at the current time: local and model matrices, every decomposed part, the findings, the
+//! morph-target weights of the meshes it carries, and a button that copies the same JSON `bonescope inspect` prints.
 
 use egui::{Grid, RichText, Ui};
 use glam::DMat4;
@@ -43,10 +43,29 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
         }
     }
     egui::ScrollArea::vertical().show(ui, |ui| {
+        morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts);
         section(ui, "Local", &local, &crate::math::decompose(&local));
     });
+}
+
+/// The morph-target weights in effect on the meshes the bone carries (animated by the clip, or the meshes' own).
+fn morph_weights(ui: &mut Ui, shared: &Shared, bone: usize) {
+    let morph = &shared.frame.pose.morph;
+    for mesh in shared.doc.rig.meshes.iter().filter(|m| m.bone == bone && !m.morph_targets.is_empty()) {
+        ui.separator();
+        ui.label(RichText::new(format!("Morph weights · {}", mesh.name)).strong());
+        let weights = morph.weights(mesh);
+        Grid::new(("morph", &mesh.name)).striped(true).show(ui, |ui| {
+            for (target, weight) in mesh.morph_targets.iter().zip(weights.iter()) {
+                ui.label(&target.name);
+                ui.label(RichText::new(format!("{weight:>7.3}")).monospace());
+                ui.add(egui::ProgressBar::new(weight.clamp(0.0, 1.0) as f32).desired_width(80.0));
+                ui.end_row();
+            }
+        });
+    }
 }
 
 fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts) {

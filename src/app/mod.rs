@@ -26,7 +26,7 @@ pub use document::{Document, Ghost, ModeScope};
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Tolerances};
-use crate::eval::Pose;
+use crate::eval::{Pose, SkinningMethod};
 use crate::view::Layer;
 use job::{AnalysisJob, JobKey};
 use notifications::Notifications;
@@ -42,13 +42,13 @@ pub struct Frame {
 }
 
 impl Frame {
-    fn evaluate(doc: &Document, time: f64, tolerances: &Tolerances) -> Frame {
+    fn evaluate(doc: &Document, time: f64, skinning: SkinningMethod, tolerances: &Tolerances) -> Frame {
         let rig = &doc.rig;
         let pose = doc.evaluate(&doc.modes, time, true);
-        let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, tolerances);
+        let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
         let ghost = doc.ghost_evaluation().map(|(modes, layered)| {
             let ghost = doc.evaluate(&modes, time, layered);
-            Layer::from_model(rig, ghost.model.model, &ghost.morph, tolerances)
+            Layer::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
         });
         Frame { pose, primary, ghost }
     }
@@ -282,7 +282,7 @@ impl BonescopeApp {
         self.poll_background(&ctx);
         self.handle_input(&ctx);
         self.advance_playback(&ctx);
-        let frame = Frame::evaluate(&self.doc, self.time, &self.tolerances);
+        let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
         let progress = self.job.progress();
         let stretched = self.spans.get(latest.as_ref(), self.selection.last().copied());

@@ -8,7 +8,8 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use crate::eval::skinning::skin_positions;
+use crate::eval::SkinningMethod;
+use crate::eval::skinning::skin_meshes_with;
 use crate::eval::{Hierarchy, Pose};
 use crate::export::{EvaluatedMesh, write_obj};
 use crate::import::{self, Options, Space};
@@ -31,6 +32,10 @@ pub struct ExportArgs {
     pub time: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: ExportFormat,
+    /// How meshes are skinned: as the file declares (FBX: linear, dual quaternion or a per-vertex blend), or one
+    /// method everywhere.
+    #[arg(long, value_enum, default_value_t)]
+    pub skinning: SkinningMethod,
     /// Where to write.
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
@@ -50,15 +55,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
     let mut pose = Pose::default();
     pose.evaluate(&rig.skeleton, clip, &hierarchy, args.time);
-    let positions: Vec<Vec<glam::DVec3>> = rig
-        .meshes
-        .iter()
-        .map(|mesh| {
-            let mut out = Vec::new();
-            skin_positions(mesh, &rig.skins, &pose.model.model, &pose.morph, &mut out);
-            out
-        })
-        .collect();
+    let positions = skin_meshes_with(&rig, &pose.model.model, &pose.morph, args.skinning);
     let meshes: Vec<EvaluatedMesh> = rig
         .meshes
         .iter()
@@ -68,7 +65,12 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     let animation = clip.map_or_else(|| "rest pose".to_owned(), |c| format!("animation {} `{}`", c.index, c.label()));
     let mut header = vec![
         format!("bonescope export of {}", args.file.display()),
-        format!("{animation} at t = {} s, inherit: {}", args.time, args.eval.inherit_label()),
+        format!(
+            "{animation} at t = {} s, inherit: {}, skinning: {}",
+            args.time,
+            args.eval.inherit_label(),
+            args.skinning.label()
+        ),
     ];
     header.extend(rig.notes.iter().cloned());
     let file = std::fs::File::create(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;

@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use super::EvalArgs;
 use super::layers::LayerArgs;
 use crate::app::{BonescopeApp, Chrome, Document, Ghost, Settings};
+use crate::eval::SkinningMethod;
 use crate::import;
 use crate::render::{Background, Difference, Renderer, compare};
 use crate::view::{SceneOptions, ViewKind};
@@ -48,6 +49,10 @@ pub struct RenderArgs {
     /// axes, boxes, mesh, wireframe, bind-pose, names, grid, legend.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = SceneOptions::parse_list)]
     pub show: Option<SceneOptions>,
+    /// How meshes are skinned: as the file declares (FBX: linear, dual quaternion or a per-vertex blend), or one
+    /// method everywhere.
+    #[arg(long, value_enum, default_value_t)]
+    pub skinning: SkinningMethod,
     /// The 3D camera: yaw and pitch in degrees, distance in model units (default: frames the whole animation).
     #[arg(long, value_name = "YAW,PITCH,DISTANCE", allow_hyphen_values = true, value_parser = parse_camera)]
     pub camera: Option<[f64; 3]>,
@@ -239,7 +244,7 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
     // With layers, the whole window shows the panel that describes them.
     let show_layers = !doc.layers().is_empty();
     let mut settings = Settings { dark: args.theme == Theme::Dark, show_layers, ..Settings::default() };
-    settings.scene = args.show.unwrap_or_default();
+    settings.scene = SceneOptions { skinning: args.skinning, ..args.show.unwrap_or_default() };
     settings.camera.view = args.view;
     if let Some([yaw, pitch, _]) = args.camera {
         (settings.camera.yaw, settings.camera.pitch) = (yaw.to_radians(), pitch.to_radians());

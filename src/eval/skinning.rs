@@ -22,7 +22,7 @@ use crate::math::decompose;
 use crate::model::{Mesh, Rig, Skin};
 
 /// Which skinning to use: the file's (per skin and vertex), or one of them everywhere (engines differ).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// What the file declares: linear, dual quaternion, or a per-vertex blend of both.

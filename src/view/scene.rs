@@ -5,7 +5,8 @@ use glam::{DMat4, DVec3};
 
 use super::camera::Bounds;
 use crate::analysis::{Assessment, Findings, Tolerances};
-use crate::eval::{MorphPose, skin_meshes};
+use crate::eval::skinning::skin_meshes_with;
+use crate::eval::{MorphPose, SkinningMethod, skin_meshes};
 use crate::model::{Clip, Rig};
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
@@ -23,6 +24,8 @@ pub struct SceneOptions {
     pub names: bool,
     pub bind_pose: bool,
     pub legend: bool,
+    /// How meshes are skinned: as the file declares, or linear / dual quaternion everywhere (engines differ).
+    pub skinning: SkinningMethod,
 }
 
 impl Default for SceneOptions {
@@ -37,6 +40,7 @@ impl Default for SceneOptions {
             names: false,
             bind_pose: false,
             legend: true,
+            skinning: SkinningMethod::AsFile,
         }
     }
 }
@@ -90,6 +94,7 @@ impl SceneOptions {
             names: false,
             bind_pose: false,
             legend: false,
+            skinning: SkinningMethod::AsFile,
         }
     }
 }
@@ -104,9 +109,16 @@ pub struct Layer {
 }
 
 impl Layer {
-    pub fn from_model(rig: &Rig, model: Vec<DMat4>, morph: &MorphPose, tolerances: &Tolerances) -> Layer {
+    /// The findings of `model` and the meshes morphed by `morph` and skinned by `skinning` at it.
+    pub fn from_model(
+        rig: &Rig,
+        model: Vec<DMat4>,
+        morph: &MorphPose,
+        skinning: SkinningMethod,
+        tolerances: &Tolerances,
+    ) -> Layer {
         let findings = Assessment::all(&model, tolerances).into_iter().map(|a| a.findings).collect();
-        let meshes = skin_meshes(rig, &model, morph);
+        let meshes = skin_meshes_with(rig, &model, morph, skinning);
         Layer { model, findings, meshes }
     }
 
