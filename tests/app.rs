@@ -211,3 +211,21 @@ fn the_skinning_method_is_chosen_in_the_viewport_toolbar() {
     settle(&mut harness);
     assert_eq!(harness.state().settings.scene.skinning, bonescope::eval::SkinningMethod::DualQuaternion);
 }
+
+#[test]
+fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
+    // Maya's long-keyframe test: 41 keys over ±166,666 s at 30 fps (10 million frames), sampled at its keys.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets/fbx-ufbx-corpus/maya_long_keyframes_7700_ascii.fbx");
+    let rig = bonescope::import::load(&path).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(Some(path), rig)));
+    harness.get_by_label("pCube1").click();
+    settle(&mut harness);
+    assert!(harness.state().doc.clip().unwrap().duration() > 333_000.0);
+    harness.get_by_label("time bar");
+    harness.get_by_label("Next frame").click();
+    settle(&mut harness);
+    assert!((harness.state().time - 1.0 / 30.0).abs() < 1e-9, "one frame on: {}", harness.state().time);
+}
