@@ -104,9 +104,7 @@ fn demo_layers_blend_additive_shake() {
 
 /// A file of ufbx's corpus (`../shared/assets/fbx-ufbx-corpus`) as a document.
 fn corpus_document(name: &str) -> Document {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-ufbx-corpus").join(name);
-    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
-    Document::new(Some(path), rig)
+    asset_document(&format!("fbx-ufbx-corpus/{name}"))
 }
 
 /// Maya's dual-quaternion skin mid-twist: the mesh keeps its volume where linear blending would pinch it.
@@ -122,4 +120,30 @@ fn fbx_dual_quaternion_skin_twisted() {
 fn fbx_blend_shapes_with_inbetweens() {
     let doc = corpus_document("maya_blend_inbetween_7500_ascii.fbx");
     window(Settings::default(), doc, 2.5, Some("pCube1")).snapshot("fbx_blend_shapes_with_inbetweens");
+}
+
+/// A shared asset (`../shared/assets/FOLDER/NAME`) as a document.
+fn asset_document(path: &str) -> Document {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path);
+    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    Document::new(Some(path), rig)
+}
+
+/// Maya's centimetre rig (converted by a 0.01 scale at its top) at 0.5 s, seen from the side where its shear lies:
+/// triads and boxes at the rig's size, the boxes of the segment-compensated bones slanted.
+#[test]
+fn maya_centimetre_rig_sheared_gizmos() {
+    let mut settings = Settings::default();
+    settings.scene.boxes = true;
+    settings.camera.view = ViewKind::Side;
+    let doc = asset_document("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
+    window(settings, doc, 0.5, None).snapshot("maya_centimetre_rig_sheared_gizmos");
+}
+
+/// CMU mocap in centimetres, not converted: gizmos at the rig's size too.
+#[test]
+fn cmu_walk_gizmos() {
+    let mut settings = Settings::default();
+    settings.scene.boxes = true;
+    window(settings, asset_document("bvh/cmu_12_01_walk.bvh"), 1.0, None).snapshot("cmu_walk_gizmos");
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use egui::RichText;
 
 use super::{Ghost, ModeScope, Shared};
+use crate::eval::SkinningMethod;
 use crate::model::InheritMode;
 
 /// What the toolbar asks the app to do after the frame (things that replace the document).
@@ -31,6 +32,10 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         ui.separator();
         ghost_picker(ui, shared);
         ui.separator();
+        if !shared.doc.rig.skins.is_empty() {
+            skinning_picker(ui, shared);
+            ui.separator();
+        }
         ui.toggle_value(&mut shared.settings.show_layers, "Layers")
             .on_hover_text("blend, additive, crossfade, shake, targets, interpolation, bind pose, storage");
     });
@@ -118,6 +123,21 @@ fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     if let Some(mode) = chosen {
         shared.doc.set_mode(0, ModeScope::All, mode);
     }
+}
+
+fn skinning_picker(ui: &mut egui::Ui, shared: &mut Shared) {
+    let label = ui.label("Skinning");
+    let skinning = &mut shared.settings.scene.skinning;
+    egui::ComboBox::from_id_salt("skinning")
+        .selected_text(skinning.label())
+        .show_ui(ui, |ui| {
+            for method in SkinningMethod::ALL {
+                ui.selectable_value(skinning, method, method.label());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text("how meshes are skinned: as the file declares, or one method everywhere (engines differ)");
 }
 
 fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {

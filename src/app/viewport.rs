@@ -7,7 +7,7 @@ use egui::{Sense, Ui};
 use glam::DVec2;
 
 use super::{Document, Shared};
-use crate::eval::{SkinningMethod, bind_model_matrices};
+use crate::eval::bind_model_matrices;
 use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
@@ -143,18 +143,5 @@ fn toolbar(ui: &mut Ui, shared: &mut Shared) {
         ui.toggle_value(&mut o.names, "Names");
         ui.toggle_value(&mut o.grid, "Grid");
         ui.toggle_value(&mut o.legend, "Legend");
-        if shared.doc.rig.skins.is_empty() {
-            return;
-        }
-        ui.separator();
-        egui::ComboBox::from_label("Skinning")
-            .selected_text(o.skinning.label())
-            .show_ui(ui, |ui| {
-                for method in SkinningMethod::ALL {
-                    ui.selectable_value(&mut o.skinning, method, method.label());
-                }
-            })
-            .response
-            .on_hover_text("how meshes are skinned: as the file declares, or one method everywhere (engines differ)");
     });
 }

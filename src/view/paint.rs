@@ -43,18 +43,23 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
             bone_triangles(&mut ghost_triangles, &projection, scene, ghost, palette, camera, Some(palette.ghost));
         }
         paint_sorted(&painter, ghost_triangles);
+        let faded = |c: Color32| c.gamma_multiply(0.45);
+        if options.boxes {
+            paint_boxes(&painter, &projection, ghost, scene.gizmo_unit, |bone| faded(box_color(ghost, bone, palette)));
+        }
         if options.axes {
-            paint_axes(&painter, &projection, ghost, scene.gizmo_size, |c| c.gamma_multiply(0.45));
+            paint_axes(&painter, &projection, ghost, scene.gizmo_unit, faded);
         }
     }
     if options.wireframe {
         paint_wireframe(&painter, &projection, scene, palette);
     }
     if options.boxes {
-        paint_boxes(&painter, &projection, scene, palette);
+        let layer = &scene.primary;
+        paint_boxes(&painter, &projection, layer, scene.gizmo_unit, |bone| box_color(layer, bone, palette));
     }
     if options.axes {
-        paint_axes(&painter, &projection, &scene.primary, scene.gizmo_size, |c| c);
+        paint_axes(&painter, &projection, &scene.primary, scene.gizmo_unit, |c| c);
     }
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
@@ -263,30 +268,41 @@ fn paint_wireframe(painter: &Painter, projection: &Projection, scene: &Scene, pa
     }
 }
 
-/// Each bone's matrix applied to a cube of side `gizmo_size` centred on the joint: shear slants it.
-fn paint_boxes(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
-    let h = scene.gizmo_size * 0.5;
-    let layer = &scene.primary;
+/// A bone's box colour: its most important finding's, else the bone colour, faded.
+fn box_color(layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
+    Badge::primary(&layer.findings[bone]).map_or(palette.bone.gamma_multiply(0.6), Badge::color)
+}
+
+/// Each bone's matrix applied to a cube of side `unit` (in the bone's own units, see [`Scene::gizmo_unit`])
+/// centred on the joint: shear slants it, non-uniform scale stretches it.
+fn paint_boxes(
+    painter: &Painter,
+    projection: &Projection,
+    layer: &Layer,
+    unit: f64,
+    color_of: impl Fn(usize) -> Color32,
+) {
+    let h = unit * 0.5;
     for (bone, model) in layer.model.iter().enumerate() {
         let corner = |i: usize| {
             let pick = |bit: usize| if i & bit == 0 { -h } else { h };
             model.transform_point3(DVec3::new(pick(1), pick(2), pick(4)))
         };
-        let color = Badge::primary(&layer.findings[bone]).map_or(palette.bone.gamma_multiply(0.6), Badge::color);
+        let color = color_of(bone);
         for (a, b) in [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)] {
             line(painter, projection, corner(a), corner(b), Stroke::new(1.2, color));
         }
     }
 }
 
-/// Axis triads from the model matrix columns, scaled by the gizmo size: their lengths show scale, their angles
-/// show shear.
-fn paint_axes(painter: &Painter, projection: &Projection, layer: &Layer, size: f64, tint: impl Fn(Color32) -> Color32) {
+/// Axis triads from the model matrix columns times `unit` (see [`Scene::gizmo_unit`]): their lengths show scale,
+/// their angles show shear.
+fn paint_axes(painter: &Painter, projection: &Projection, layer: &Layer, unit: f64, tint: impl Fn(Color32) -> Color32) {
     let palette_axes = Palette::new(true).axes;
     for model in &layer.model {
         let origin = model.w_axis.truncate();
         for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
-            line(painter, projection, origin, origin + axis.truncate() * size, Stroke::new(2.0, tint(color)));
+            line(painter, projection, origin, origin + axis.truncate() * unit, Stroke::new(2.0, tint(color)));
         }
     }
 }

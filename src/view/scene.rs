@@ -142,8 +142,12 @@ pub struct Scene<'a> {
     pub bind_pose: Option<Vec<DMat4>>,
     pub selected: Vec<usize>,
     pub options: SceneOptions,
-    /// How long axis triads and boxes are drawn, in model units.
+    /// How long axis triads and boxes are drawn, in model units, for a bone of the rig's typical scale.
     pub gizmo_size: f64,
+    /// The same length in the units of a bone of the rig's typical scale: a triad is `model`'s columns times this,
+    /// so a centimetre rig under a 0.01 conversion gets triads of `gizmo_size`, while a bone scaled or sheared
+    /// relative to the rest shows it in the lengths and angles of its axes.
+    pub gizmo_unit: f64,
     /// Each bone's first child, found once (the tail of every bone is asked for each frame).
     first_child: Vec<Option<usize>>,
 }
@@ -151,6 +155,7 @@ pub struct Scene<'a> {
 impl<'a> Scene<'a> {
     pub fn new(rig: &'a Rig, primary: Layer, options: SceneOptions) -> Self {
         let gizmo_size = gizmo_size(rig);
+        let gizmo_unit = gizmo_size / typical_scale(rig);
         let mut first_child = vec![None; rig.skeleton.len()];
         for (bone, b) in rig.skeleton.bones().iter().enumerate().rev() {
             if let Some(parent) = b.parent {
@@ -167,6 +172,7 @@ impl<'a> Scene<'a> {
             selected: Vec::new(),
             options,
             gizmo_size,
+            gizmo_unit,
             first_child,
         }
     }
@@ -203,6 +209,20 @@ fn gizmo_size(rig: &Rig) -> f64 {
         .collect();
     lengths.sort_by(f64::total_cmp);
     lengths.get(lengths.len() / 2).map_or_else(|| rest_bounds(rig).map_or(0.1, |b| b.radius() * 0.1), |l| l * 0.4)
+}
+
+/// The rig's typical uniform scale: the median over bones of the cube root of `|det|` of the rest model matrices
+/// (0.01 for a centimetre file converted to metres at its top node, 1 for most rigs); 1 when none is usable.
+pub fn typical_scale(rig: &Rig) -> f64 {
+    let mut scales: Vec<f64> = rig
+        .skeleton
+        .rest_model_matrices()
+        .iter()
+        .map(|m| glam::DMat3::from_mat4(*m).determinant().abs().cbrt())
+        .filter(|s| s.is_finite() && *s > 1e-12)
+        .collect();
+    scales.sort_by(f64::total_cmp);
+    scales.get(scales.len() / 2).copied().unwrap_or(1.0)
 }
 
 /// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `duration` by `pose_at`
@@ -270,5 +290,28 @@ mod tests {
         assert_eq!(SceneOptions::parse_list("").unwrap(), SceneOptions::default());
         let error = SceneOptions::parse_list("bones,shear").unwrap_err();
         assert!(error.contains("`shear`") && error.contains("bind-pose"), "{error}");
+    }
+
+    #[test]
+    fn the_typical_scale_is_the_median_uniform_scale_of_the_rest_pose() {
+        use crate::model::{Bone, InheritMode, Skeleton, Transform};
+        // A centimetre rig under a 0.01 conversion at its top: every bone's model matrix scales by 0.01, one bone
+        // is stretched (2, 1, 0.5: cube root of the determinant 1) relative to it.
+        let bone = |name: &str, parent: Option<usize>, scale: glam::DVec3| Bone {
+            name: name.into(),
+            node: 0,
+            parent,
+            rest: Transform::from_trs(glam::DVec3::X, glam::DQuat::IDENTITY, scale),
+            inherit: InheritMode::Full,
+        };
+        let skeleton = Skeleton::new(vec![
+            bone("root", None, glam::DVec3::splat(0.01)),
+            bone("a", Some(0), glam::DVec3::ONE),
+            bone("b", Some(1), glam::DVec3::new(2.0, 1.0, 0.5)),
+        ])
+        .unwrap();
+        let rig = Rig { skeleton, ..Rig::default() };
+        assert!((typical_scale(&rig) - 0.01).abs() < 1e-12, "{}", typical_scale(&rig));
+        assert_eq!(typical_scale(&Rig::default()), 1.0);
     }
 }
