@@ -1,11 +1,15 @@
 //! Does a skin's bind pose agree with the skeleton's rest pose? Keys are stored relative to one of them (seed 001);
 //! when the two disagree, engines that start from the rest pose and engines that start from the bind pose show
 //! different things. The check names the joints and says by how much.
+//!
+//! Bind matrices live in the skin's bind space, which may differ from the model space by the mesh node's transform
+//! and any unit or axis conversion ([`crate::eval::skin_bind_spaces`]); so a joint is bound elsewhere when its bind
+//! matrix, carried into model space by its skin's common bind space `S`, is not its rest model matrix.
 
 use glam::DMat4;
 use serde::Serialize;
 
-use crate::eval::{Hierarchy, ModelPose, bind_model_matrices};
+use crate::eval::{Hierarchy, ModelPose, invert, skin_bind_spaces};
 use crate::math::decompose;
 use crate::model::Rig;
 
@@ -26,7 +30,7 @@ impl Default for BindTolerance {
     }
 }
 
-/// One joint whose bind matrix `IBM⁻¹` is not its rest model matrix.
+/// One joint whose bind matrix `S · IBM⁻¹` (in model space) is not its rest model matrix.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BindMismatch {
     pub bone: usize,
@@ -39,22 +43,29 @@ pub struct BindMismatch {
     pub scale_change: f64,
 }
 
-/// Every skin joint whose bind matrix differs from its rest model matrix (evaluated by `hierarchy`) by more than
-/// `tolerance`, in bone order.
+/// Every skin joint whose bind matrix in model space differs from its rest model matrix (evaluated by `hierarchy`)
+/// by more than `tolerance`, in bone order (a joint of several skins once, with its first skin's bind; a joint whose
+/// inverse bind matrix cannot be inverted has no bind to compare).
 pub fn bind_mismatches(rig: &Rig, hierarchy: &Hierarchy, tolerance: &BindTolerance) -> Vec<BindMismatch> {
     let mut rest = ModelPose::default();
     hierarchy.evaluate(&rig.skeleton.rest_pose(), &mut rest);
-    let bind = bind_model_matrices(rig);
-    let mut joints: Vec<usize> = rig.skins.iter().flat_map(|s| s.joints.iter().copied()).collect();
-    joints.sort_unstable();
-    joints.dedup();
-    joints
+    let spaces = skin_bind_spaces(rig, &rest.model);
+    let mut bound: Vec<Option<DMat4>> = vec![None; rig.skeleton.len()];
+    for (skin, space) in rig.skins.iter().zip(&spaces) {
+        for (&joint, ibm) in skin.joints.iter().zip(&skin.inverse_bind) {
+            if let Some(slot @ None) = bound.get_mut(joint) {
+                *slot = invert(ibm).map(|bind| *space * bind);
+            }
+        }
+    }
+    bound
         .into_iter()
-        .filter_map(|bone| {
-            let mismatch = compare(bone, rig.skeleton.bones().get(bone)?.name.clone(), &bind[bone], &rest.model[bone]);
-            let off = mismatch.distance > tolerance.distance
-                || mismatch.angle_deg > tolerance.angle_deg
-                || mismatch.scale_change > tolerance.scale;
+        .enumerate()
+        .filter_map(|(bone, bind)| {
+            let mismatch = compare(bone, rig.skeleton.bone(bone).name.clone(), &bind?, &rest.model[bone]);
+            let off = !(mismatch.distance <= tolerance.distance
+                && mismatch.angle_deg <= tolerance.angle_deg
+                && mismatch.scale_change <= tolerance.scale);
             off.then_some(mismatch)
         })
         .collect()

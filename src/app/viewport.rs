@@ -8,7 +8,7 @@ use glam::DVec2;
 
 use super::{Document, Shared};
 use crate::eval::bind_model_matrices;
-use crate::view::{Bounds, Camera, Palette, Scene, ViewKind, motion_bounds, paint};
+use crate::view::{Bounds, Camera, Layer, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
@@ -59,7 +59,7 @@ impl Viewport {
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {
-            scene.bind_pose = Some(bind_model_matrices(&rig));
+            scene.bind_pose = Some(Layer { model: bind_model_matrices(&rig), ..Layer::default() });
         }
         self.frame_now(&mut shared.settings.camera, aspect(rect));
         navigate(ui, &response, rect, &mut shared.settings.camera);

@@ -1,21 +1,64 @@
 //! The bind pose (seed 001): where each joint was when the mesh was bound to the skeleton, read back from the
 //! skin's inverse bind matrices.
+//!
+//! An inverse bind matrix maps model space to the joint's space *in the skin's bind space*, which need not be the
+//! model space: a glTF skin may hang under a Z-up→Y-up node, an FBX mesh may be bound in centimetres under a 0.01
+//! conversion, the mesh node may be moved. What holds at rest is that `S_j = W_j · IBM_j` (rest model matrix times
+//! inverse bind matrix) is one matrix `S` for every joint of a skin: the bind-space-to-model transform. So the bind
+//! pose in model space is `S · IBM_j⁻¹`, and a joint is bound elsewhere when its `S_j` differs from the skin's `S`.
 
 use glam::DMat4;
 
+use super::{Hierarchy, ModelPose};
 use crate::math::decompose;
 use crate::model::{Rig, Transform};
 
-/// Model matrices of the bind pose: `IBM⁻¹` for every joint (of the first skin that lists it); any other bone sits
-/// at its rest transform below its parent's bind matrix. An inverse bind matrix that cannot be inverted counts as
-/// missing.
+/// Per skin, its bind-space-to-model transform `S` at the rest pose `rest_model`: the entry-wise median of its
+/// joints' `W_j · IBM_j`, so that a few joints bound elsewhere do not move it (when most joints agree, it is their
+/// matrix exactly). The identity for a skin without joints.
+pub fn skin_bind_spaces(rig: &Rig, rest_model: &[DMat4]) -> Vec<DMat4> {
+    rig.skins
+        .iter()
+        .map(|skin| {
+            let spaces: Vec<[f64; 16]> = skin
+                .joints
+                .iter()
+                .zip(&skin.inverse_bind)
+                .filter_map(|(&joint, ibm)| Some((*rest_model.get(joint)? * *ibm).to_cols_array()))
+                .filter(|m| m.iter().all(|x| x.is_finite()))
+                .collect();
+            if spaces.is_empty() {
+                return DMat4::IDENTITY;
+            }
+            let mut median = [0.0; 16];
+            for (entry, out) in median.iter_mut().enumerate() {
+                let mut values: Vec<f64> = spaces.iter().map(|m| m[entry]).collect();
+                values.sort_by(f64::total_cmp);
+                *out = values[values.len() / 2];
+            }
+            DMat4::from_cols_array(&median)
+        })
+        .collect()
+}
+
+/// The rest pose's model matrices under the file's own modes.
+pub fn rest_model_matrices(rig: &Rig) -> Vec<DMat4> {
+    let mut rest = ModelPose::default();
+    Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).evaluate(&rig.skeleton.rest_pose(), &mut rest);
+    rest.model
+}
+
+/// Model matrices of the bind pose: `S · IBM⁻¹` for every joint (of the first skin that lists it, `S` that skin's
+/// bind space at the file's rest pose); any other bone sits at its rest transform below its parent's bind matrix.
+/// An inverse bind matrix that cannot be inverted counts as missing.
 pub fn bind_model_matrices(rig: &Rig) -> Vec<DMat4> {
+    let spaces = skin_bind_spaces(rig, &rest_model_matrices(rig));
     let bones = rig.skeleton.bones();
     let mut bound: Vec<Option<DMat4>> = vec![None; bones.len()];
-    for skin in &rig.skins {
+    for (skin, space) in rig.skins.iter().zip(&spaces) {
         for (&joint, ibm) in skin.joints.iter().zip(&skin.inverse_bind) {
             if let Some(slot @ None) = bound.get_mut(joint) {
-                *slot = invert(ibm);
+                *slot = invert(ibm).map(|bind| *space * bind);
             }
         }
     }
@@ -46,7 +89,7 @@ pub fn bind_pose(rig: &Rig) -> Vec<Transform> {
 }
 
 /// The inverse of an affine matrix, if it has a finite one.
-fn invert(m: &DMat4) -> Option<DMat4> {
+pub(crate) fn invert(m: &DMat4) -> Option<DMat4> {
     let determinant = m.determinant();
     let inverse = m.inverse();
     (determinant != 0.0 && determinant.is_finite() && inverse.is_finite()).then_some(inverse)

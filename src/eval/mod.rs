@@ -12,7 +12,8 @@ mod pose;
 mod sample;
 pub mod skinning;
 
-pub use bind::{bind_model_matrices, bind_pose};
+pub(crate) use bind::invert;
+pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
 pub use cursor::BoneCursor;
 pub use hierarchy::{Hierarchy, ModelPose};
 pub use layers::{LayerStack, Layers};

@@ -6,7 +6,7 @@
 
 use egui::epaint::Mesh as EguiMesh;
 use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke};
-use glam::{DMat4, DVec2, DVec3};
+use glam::{DVec2, DVec3};
 
 use super::camera::{Camera, Projection};
 use super::scene::{Layer, Scene};
@@ -24,7 +24,9 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
     if options.bind_pose
         && let Some(bind) = &scene.bind_pose
     {
-        paint_skeleton_lines(&painter, &projection, scene, bind, Stroke::new(1.5, palette.bind_pose));
+        let mut triangles = Vec::new();
+        bone_triangles(&mut triangles, &projection, scene, bind, palette, camera, Some(palette.bind_pose));
+        paint_sorted(&painter, triangles);
     }
     // The mesh is translucent and the bones are drawn over it (x-ray), so the skeleton is never hidden.
     if options.mesh {
@@ -137,14 +139,6 @@ fn paint_grid(painter: &Painter, projection: &Projection, scene: &Scene, palette
 fn nice_step(x: f64) -> f64 {
     let power = 10f64.powf(x.max(1e-6).log10().floor());
     [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= x).unwrap_or(10.0 * power)
-}
-
-fn paint_skeleton_lines(painter: &Painter, projection: &Projection, scene: &Scene, model: &[DMat4], stroke: Stroke) {
-    for (bone, b) in scene.rig.skeleton.bones().iter().enumerate() {
-        if let Some(parent) = b.parent {
-            line(painter, projection, model[parent].w_axis.truncate(), model[bone].w_axis.truncate(), stroke);
-        }
-    }
 }
 
 /// A screen-space triangle with its depth and colour.

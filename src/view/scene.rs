@@ -138,8 +138,9 @@ pub struct Scene<'a> {
     pub ghost_label: String,
     /// Lines naming what is shown (file, clip, time, modes, layers), drawn in the corner opposite the legend.
     pub caption: Vec<String>,
-    /// Model matrices of the bind pose (from the skins' inverse bind matrices, the rest pose elsewhere).
-    pub bind_pose: Option<Vec<DMat4>>,
+    /// The bind pose (from the skins' inverse bind matrices in model space, the rest pose elsewhere), drawn as a
+    /// translucent skeleton where the character is.
+    pub bind_pose: Option<Layer>,
     pub selected: Vec<usize>,
     pub options: SceneOptions,
     /// How long axis triads and boxes are drawn, in model units, for a bone of the rig's typical scale.
