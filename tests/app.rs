@@ -229,3 +229,41 @@ fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
     settle(&mut harness);
     assert!((harness.state().time - 1.0 / 30.0).abs() < 1e-9, "one frame on: {}", harness.state().time);
 }
+
+#[test]
+fn declared_modes_are_one_click_away_after_any_edit() {
+    let mut harness = demo_app();
+    let declared = harness.state().doc.rig.skeleton.declared_modes();
+    harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "segment-compensate").click();
+    settle(&mut harness);
+    assert_ne!(harness.state().doc.modes, declared);
+    harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "declared").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.modes, declared);
+}
+
+#[test]
+fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
+    let mut harness = demo_app();
+    let hand = bone(&harness, "hand");
+    harness.get_by_label("hand").click_secondary();
+    harness.run();
+    assert_eq!(harness.state().selection, vec![hand], "right-clicking a row selects it");
+    harness.get_by_label("Set mode of this bone").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "componentwise").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.modes[hand], InheritMode::Componentwise);
+    // The Inspector now names the bone too: the outliner's row is the button.
+    harness.get_by_role_and_label(Role::Button, "hand").click_secondary();
+    harness.run();
+    harness.get_by_label("Set mode of this bone").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "declared").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.modes[hand], harness.state().doc.rig.skeleton.bone(hand).inherit);
+}

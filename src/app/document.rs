@@ -7,13 +7,15 @@ use std::sync::Arc;
 use crate::eval::layers::LayerError;
 use crate::eval::{Hierarchy, LayerStack, Layers, Pose};
 use crate::import::{self, ImportError};
-use crate::model::{Clip, InheritMode, Rig};
+use crate::model::{Bone, Clip, InheritMode, Rig, Skeleton};
 
 /// A second pose drawn translucent over the first and plotted dashed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ghost {
     /// Every bone under this mode (with the same layers).
     Mode(InheritMode),
+    /// Every bone under the mode its file declares (with the same layers).
+    Declared,
     /// The clip as authored: the document's modes without the layers.
     Unlayered,
 }
@@ -22,7 +24,54 @@ impl Ghost {
     pub fn label(self) -> &'static str {
         match self {
             Ghost::Mode(mode) => mode.id(),
+            Ghost::Declared => "declared",
             Ghost::Unlayered => "without layers",
+        }
+    }
+
+    /// The ghost's modes (given the document's `modes` and the skeleton's declared ones), and whether it goes
+    /// through the layers.
+    pub fn evaluation(self, modes: &[InheritMode], skeleton: &Skeleton) -> (Vec<InheritMode>, bool) {
+        match self {
+            Ghost::Mode(mode) => (vec![mode; modes.len()], true),
+            Ghost::Declared => (skeleton.declared_modes(), true),
+            Ghost::Unlayered => (modes.to_vec(), false),
+        }
+    }
+}
+
+/// What a mode edit sets: one of the modes, or each bone's own as its file declares it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeChoice {
+    Declared,
+    Mode(InheritMode),
+}
+
+impl ModeChoice {
+    /// "declared" first, then every mode.
+    pub fn all() -> impl Iterator<Item = ModeChoice> {
+        std::iter::once(ModeChoice::Declared).chain(InheritMode::ALL.into_iter().map(ModeChoice::Mode))
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ModeChoice::Declared => "declared",
+            ModeChoice::Mode(mode) => mode.id(),
+        }
+    }
+
+    pub fn description(self) -> &'static str {
+        match self {
+            ModeChoice::Declared => "each bone as its file declares it",
+            ModeChoice::Mode(mode) => mode.description(),
+        }
+    }
+
+    /// The mode this choice gives `bone`.
+    fn mode_of(self, bone: &Bone) -> InheritMode {
+        match self {
+            ModeChoice::Declared => bone.inherit,
+            ModeChoice::Mode(mode) => mode,
         }
     }
 }
@@ -108,10 +157,7 @@ impl Document {
 
     /// How the ghost pose is evaluated, when a ghost is shown: its modes, and whether through the layers.
     pub fn ghost_evaluation(&self) -> Option<(Vec<InheritMode>, bool)> {
-        self.ghost.map(|ghost| match ghost {
-            Ghost::Mode(mode) => (vec![mode; self.modes.len()], true),
-            Ghost::Unlayered => (self.modes.clone(), false),
-        })
+        self.ghost.map(|ghost| ghost.evaluation(&self.modes, &self.rig.skeleton))
     }
 
     /// The pose at `time` under `modes`, through the layers when `layered`.
@@ -127,18 +173,22 @@ impl Document {
     }
 
     /// Sets the mode of one bone, of its subtree, or of all bones.
-    pub fn set_mode(&mut self, bone: usize, scope: ModeScope, mode: InheritMode) {
+    pub fn set_mode(&mut self, bone: usize, scope: ModeScope, choice: ModeChoice) {
         let skeleton = &self.rig.skeleton;
         for (b, m) in self.modes.iter_mut().enumerate() {
-            let applies = match scope {
-                ModeScope::Bone => b == bone,
-                ModeScope::Subtree => skeleton.is_in_subtree(b, bone),
-                ModeScope::All => true,
-            };
-            if applies {
-                *m = mode;
+            if scope.applies(skeleton, b, bone) {
+                *m = choice.mode_of(skeleton.bone(b));
             }
         }
+    }
+
+    /// The choice every bone of `scope` (around `bone`) matches: declared when each has its own, a mode when all
+    /// share it (declared wins when both hold), `None` when they differ.
+    pub fn current_choice(&self, bone: usize, scope: ModeScope) -> Option<ModeChoice> {
+        let skeleton = &self.rig.skeleton;
+        let in_scope = || (0..self.modes.len()).filter(move |&b| scope.applies(skeleton, b, bone));
+        let matches = |choice: ModeChoice| in_scope().all(|b| self.modes[b] == choice.mode_of(skeleton.bone(b)));
+        ModeChoice::all().find(|&choice| matches(choice))
     }
 
     /// The mode every bone shares, if they all share one.
@@ -156,6 +206,17 @@ pub enum ModeScope {
     All,
 }
 
+impl ModeScope {
+    /// Whether bone `b` is in this scope around `bone`.
+    fn applies(self, skeleton: &Skeleton, b: usize, bone: usize) -> bool {
+        match self {
+            ModeScope::Bone => b == bone,
+            ModeScope::Subtree => skeleton.is_in_subtree(b, bone),
+            ModeScope::All => true,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,7 +225,7 @@ mod tests {
     fn mode_edits_reach_the_chosen_scope() {
         let mut doc = Document::demo();
         let forearm = doc.rig.skeleton.find("forearm").unwrap();
-        doc.set_mode(forearm, ModeScope::Subtree, InheritMode::SegmentCompensate);
+        doc.set_mode(forearm, ModeScope::Subtree, ModeChoice::Mode(InheritMode::SegmentCompensate));
         let names: Vec<&str> = doc
             .modes
             .iter()
@@ -174,15 +235,40 @@ mod tests {
             .collect();
         assert_eq!(names, ["forearm", "hand"]);
         assert_eq!(doc.common_mode(), None);
-        doc.set_mode(0, ModeScope::All, InheritMode::Componentwise);
+        assert_eq!(
+            doc.current_choice(forearm, ModeScope::Subtree),
+            Some(ModeChoice::Mode(InheritMode::SegmentCompensate))
+        );
+        assert_eq!(doc.current_choice(0, ModeScope::All), None);
+        doc.set_mode(0, ModeScope::All, ModeChoice::Mode(InheritMode::Componentwise));
         assert_eq!(doc.common_mode(), Some(InheritMode::Componentwise));
+        assert_eq!(doc.current_choice(0, ModeScope::All), Some(ModeChoice::Mode(InheritMode::Componentwise)));
+    }
+
+    #[test]
+    fn declared_sets_each_bone_back_to_its_file() {
+        // The file's own modes differ per bone; any edit can be undone by choosing declared.
+        let mut rig = import::demo_rig();
+        let mut bones = rig.skeleton.bones().to_vec();
+        bones[2].inherit = InheritMode::SegmentCompensate;
+        rig.skeleton = Skeleton::new(bones).unwrap();
+        let mut doc = Document::new(None, rig);
+        let declared = doc.rig.skeleton.declared_modes();
+        doc.set_mode(0, ModeScope::All, ModeChoice::Mode(InheritMode::Full));
+        assert_ne!(doc.modes, declared);
+        doc.set_mode(0, ModeScope::All, ModeChoice::Declared);
+        assert_eq!(doc.modes, declared);
+        assert_eq!(doc.current_choice(0, ModeScope::All), Some(ModeChoice::Declared));
+        assert_eq!(doc.current_choice(2, ModeScope::Bone), Some(ModeChoice::Declared), "declared wins over its mode");
+        let (modes, layered) = Ghost::Declared.evaluation(&doc.modes, &doc.rig.skeleton);
+        assert_eq!((modes, layered), (declared, true));
     }
 
     #[test]
     fn reloading_keeps_the_choices() {
         let mut doc = Document::demo();
         doc.clip = Some(1);
-        doc.set_mode(2, ModeScope::Bone, InheritMode::BlenderAligned);
+        doc.set_mode(2, ModeScope::Bone, ModeChoice::Mode(InheritMode::BlenderAligned));
         let blend = crate::eval::layers::Blend { clip: 0, weight: 0.3, sync: true, rotation: Default::default() };
         doc.set_layers(&Layers { blend: Some(blend), ..Layers::default() }).unwrap();
         let again = doc.reloaded(import::demo_rig());

@@ -93,9 +93,10 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
     let (job_key, job_done, job_total, job_cancel) = (key.clone(), done.clone(), total.clone(), cancel.clone());
     std::thread::spawn(move || {
         let hierarchy = Hierarchy::new(&rig.skeleton, &job_key.modes);
-        let ghost_modes = job_key.ghost.map(|ghost| match ghost {
-            Ghost::Mode(mode) => (vec![mode; rig.skeleton.len()], false),
-            Ghost::Unlayered => (job_key.modes.clone(), true),
+        // `(modes, unlayered)`.
+        let ghost_modes = job_key.ghost.map(|ghost| {
+            let (modes, layered) = ghost.evaluation(&job_key.modes, &rig.skeleton);
+            (modes, !layered)
         });
         let ghost_hierarchy = ghost_modes.as_ref().map(|(modes, _)| Hierarchy::new(&rig.skeleton, modes));
         let ghost = ghost_hierarchy

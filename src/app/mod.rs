@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
-pub use document::{Document, Ghost, ModeScope};
+pub use document::{Document, Ghost, ModeChoice, ModeScope};
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Tolerances};

@@ -5,9 +5,8 @@ use std::collections::HashSet;
 
 use egui::{RichText, Sense, vec2};
 
-use super::{ModeScope, Shared};
+use super::{ModeChoice, ModeScope, Shared};
 use crate::analysis::Findings;
-use crate::model::InheritMode;
 use crate::view::Badge;
 
 #[derive(Default)]
@@ -93,6 +92,10 @@ impl Outliner {
                 let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
                 shared.select(bone, extend);
             }
+            // The menu works on the row it was opened on: that row is selected first.
+            if label.secondary_clicked() && !selected {
+                shared.select(bone, false);
+            }
             label.context_menu(|ui| mode_menu(ui, shared, bone));
             ui.label(RichText::new(shared.doc.modes[bone].id()).weak().small());
             if let Some(summary) = shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched()) {
@@ -140,7 +143,7 @@ fn legend(ui: &mut egui::Ui) {
     });
 }
 
-/// Sets a mode for the bone, its subtree or all bones.
+/// Sets a mode (or the declared ones) for the bone, its subtree or all bones; each list marks what its scope has.
 fn mode_menu(ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
     for (scope, title) in [
         (ModeScope::Bone, "Set mode of this bone"),
@@ -148,9 +151,11 @@ fn mode_menu(ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
         (ModeScope::All, "Set mode of all bones"),
     ] {
         ui.menu_button(title, |ui| {
-            for mode in InheritMode::ALL {
-                if ui.button(mode.id()).on_hover_text(mode.description()).clicked() {
-                    shared.doc.set_mode(bone, scope, mode);
+            let current = shared.doc.current_choice(bone, scope);
+            for choice in ModeChoice::all() {
+                let marked = ui.selectable_label(current == Some(choice), choice.label());
+                if marked.on_hover_text(choice.description()).clicked() {
+                    shared.doc.set_mode(bone, scope, choice);
                     ui.close();
                 }
             }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use egui::RichText;
 
-use super::{Ghost, ModeScope, Shared};
+use super::{Ghost, ModeChoice, ModeScope, Shared};
 use crate::eval::SkinningMethod;
 use crate::model::InheritMode;
 
@@ -99,29 +99,29 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     }
 }
 
-/// The mode of every bone at once (per-bone edits live in the outliner).
+/// The mode of every bone at once, or each bone's declared one (per-bone edits live in the outliner).
 fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Inherit scale");
-    let text = shared.doc.common_mode().map_or("mixed", InheritMode::id);
+    let current = shared.doc.current_choice(0, ModeScope::All);
     let mut chosen = None;
     egui::ComboBox::from_id_salt("inherit-all")
-        .selected_text(text)
+        .selected_text(current.map_or("mixed", ModeChoice::label))
         .width(170.0)
         .show_ui(ui, |ui| {
-            for mode in InheritMode::ALL {
+            for choice in ModeChoice::all() {
                 if ui
-                    .selectable_label(shared.doc.common_mode() == Some(mode), mode.id())
-                    .on_hover_text(mode.description())
+                    .selectable_label(current == Some(choice), choice.label())
+                    .on_hover_text(choice.description())
                     .clicked()
                 {
-                    chosen = Some(mode);
+                    chosen = Some(choice);
                 }
             }
         })
         .response
         .labelled_by(label.id);
-    if let Some(mode) = chosen {
-        shared.doc.set_mode(0, ModeScope::All, mode);
+    if let Some(choice) = chosen {
+        shared.doc.set_mode(0, ModeScope::All, choice);
     }
 }
 
@@ -148,8 +148,12 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .width(170.0)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
-            ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
-                .on_hover_text("the clip as authored, without the layers");
+            if !shared.doc.layers().is_empty() {
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
+                    .on_hover_text("the clip as authored, without the layers");
+            }
+            ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Declared), Ghost::Declared.label())
+                .on_hover_text("each bone under the mode its file declares");
             for mode in InheritMode::ALL {
                 ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Mode(mode)), mode.id())
                     .on_hover_text(mode.description());

@@ -38,9 +38,9 @@ pub struct RenderArgs {
     /// Picture size in pixels.
     #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Draw a second pose translucent over the first: under this mode, or `unlayered` (the clip without the
-    /// layers); `none`: no ghost (the demo rig has one).
-    #[arg(long, value_name = "MODE|unlayered|none", value_parser = parse_ghost)]
+    /// Draw a second pose translucent over the first: under this mode, `declared` (each bone's own mode), or
+    /// `unlayered` (the clip without the layers); `none`: no ghost (the demo rig has one).
+    #[arg(long, value_name = "MODE|declared|unlayered|none", value_parser = parse_ghost)]
     pub ghost: Option<GhostArg>,
     /// Select a bone by name (repeatable): highlighted in the viewport, plotted and inspected with --ui.
     #[arg(long, value_name = "NAME")]
@@ -128,7 +128,11 @@ fn parse_ghost(s: &str) -> Result<GhostArg, String> {
     match s {
         "none" => Ok(GhostArg(None)),
         "unlayered" => Ok(GhostArg(Some(Ghost::Unlayered))),
-        mode => mode.parse().map(|m| GhostArg(Some(Ghost::Mode(m)))).map_err(|e| format!("{e}, `unlayered` or `none`")),
+        "declared" => Ok(GhostArg(Some(Ghost::Declared))),
+        mode => mode
+            .parse()
+            .map(|m| GhostArg(Some(Ghost::Mode(m))))
+            .map_err(|e| format!("{e}, `declared`, `unlayered` or `none`")),
     }
 }
 
@@ -319,6 +323,7 @@ mod tests {
         assert!(parse_camera("30,10,0").is_err());
         assert_eq!(parse_ghost("none"), Ok(GhostArg(None)));
         assert_eq!(parse_ghost("unlayered"), Ok(GhostArg(Some(Ghost::Unlayered))));
+        assert_eq!(parse_ghost("declared"), Ok(GhostArg(Some(Ghost::Declared))));
         assert_eq!(parse_ghost("segment-compensate"), Ok(GhostArg(Some(Ghost::Mode(InheritMode::SegmentCompensate)))));
         assert!(parse_ghost("sideways").is_err());
     }
