@@ -51,7 +51,7 @@ fn clip_analysis(c: &mut Criterion) {
     let modes = rig.skeleton.declared_modes();
     let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
     let plotted: Vec<usize> = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
-    let options = ScanOptions { rate: Settings::default().frame_rate, ..ScanOptions::default() };
+    let options = ScanOptions { rate: bonescope::model::DEFAULT_FRAME_RATE, ..ScanOptions::default() };
     let never = std::sync::atomic::AtomicBool::new(false);
     let mut group = c.benchmark_group("whole-clip analysis");
     group.sample_size(10);

@@ -267,3 +267,85 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
     settle(&mut harness);
     assert_eq!(harness.state().doc.modes[hand], harness.state().doc.rig.skeleton.bone(hand).inherit);
 }
+
+fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path);
+    let doc = Document::load(&path).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+    settle(&mut harness);
+    harness
+}
+
+#[test]
+fn frames_are_the_clips_own_and_whole() {
+    // CMU mocap at 120 Hz: one press steps one source frame, and the rate is shown.
+    let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
+    assert!((harness.state().doc.frame_rate() - 120.0).abs() < 0.01, "{}", harness.state().doc.frame_rate());
+    harness.key_press(egui::Key::ArrowRight);
+    harness.run();
+    assert!((harness.state().time - 0.008_333_3).abs() < 1e-9, "{}", harness.state().time);
+    // From between two frames (a click on the time bar), a step lands on the next whole frame.
+    harness.state_mut().time = 17.98 / 120.005;
+    harness.get_by_label("Next frame").click();
+    harness.run();
+    let frames = harness.state().time * harness.state().doc.frame_rate();
+    assert!((frames - 18.0).abs() < 1e-9, "frame {frames}");
+    // End and Home go to the ends; Play at the end without Loop starts again.
+    harness.key_press(egui::Key::End);
+    harness.run();
+    assert_eq!(harness.state().time, harness.state().doc.duration());
+    harness.get_by_label("Loop").click();
+    harness.run();
+    harness.get_by_label("Play").click();
+    harness.step();
+    assert!(harness.state().playing && harness.state().time < 0.1, "{}", harness.state().time);
+    harness.key_press(egui::Key::Space);
+    harness.run();
+    assert!(!harness.state().playing);
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    assert_eq!(harness.state().time, 0.0);
+}
+
+#[test]
+fn the_time_readout_takes_a_typed_time() {
+    let mut harness = demo_app();
+    harness.get_by_role_and_label(Role::SpinButton, "current time").click();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_role_and_label(Role::SpinButton, "current time").type_text("1.25");
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    assert!((harness.state().time - 1.25).abs() < 1e-12, "{}", harness.state().time);
+}
+
+#[test]
+fn clicking_a_bones_worst_shear_goes_there() {
+    let mut harness = demo_app();
+    // The forearm and the hand both peak at 38.1°: the hand's label is the second.
+    harness.get_all_by_label_contains("max 38.1°").nth(1).unwrap().click();
+    harness.run();
+    let hand = bone(&harness, "hand");
+    assert_eq!(harness.state().selection, vec![hand]);
+    let worst = harness.state().analysis().unwrap().scan.bones[hand].worst_shear_time;
+    assert_eq!(harness.state().time, worst);
+}
+
+#[test]
+fn playback_follows_the_wall_clock_when_frames_are_slow() {
+    // Frames 0.25 s apart (a heavy scene): the clip advances by the time that passed, skipping frames, instead of
+    // playing in slow motion.
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_step_dt(0.25)
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    settle(&mut harness);
+    harness.key_press(egui::Key::Space);
+    harness.step();
+    let start = harness.state().time;
+    harness.step();
+    harness.step();
+    assert!((harness.state().time - start - 0.5).abs() < 1e-6, "{} after {start}", harness.state().time);
+}

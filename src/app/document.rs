@@ -7,7 +7,7 @@ use std::sync::Arc;
 use crate::eval::layers::LayerError;
 use crate::eval::{Hierarchy, LayerStack, Layers, Pose};
 use crate::import::{self, ImportError};
-use crate::model::{Bone, Clip, InheritMode, Rig, Skeleton};
+use crate::model::{Bone, Clip, DEFAULT_FRAME_RATE, InheritMode, Rig, Skeleton};
 
 /// A second pose drawn translucent over the first and plotted dashed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,6 +89,8 @@ pub struct Document {
     pub clip: Option<usize>,
     /// The runtime techniques layered on the clip, prepared for the rig.
     layers: LayerStack,
+    /// A frame rate the user chose instead of the clip's own.
+    pub frame_rate_override: Option<f64>,
 }
 
 impl Document {
@@ -107,7 +109,15 @@ impl Document {
     pub fn new(path: Option<PathBuf>, rig: Rig) -> Self {
         let modes = rig.skeleton.declared_modes();
         let clip = (!rig.clips.is_empty()).then_some(0);
-        Document { path, rig: Arc::new(rig), modes, ghost: None, clip, layers: LayerStack::default() }
+        Document {
+            path,
+            rig: Arc::new(rig),
+            modes,
+            ghost: None,
+            clip,
+            layers: LayerStack::default(),
+            frame_rate_override: None,
+        }
     }
 
     /// The same file re-read (after it changed on disk), keeping clip, modes and ghost where they still fit.
@@ -117,6 +127,7 @@ impl Document {
             doc.modes.clone_from(&self.modes);
         }
         doc.ghost = self.ghost;
+        doc.frame_rate_override = self.frame_rate_override;
         doc.clip = self.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.clip);
         // Layers naming clips or bones the new file lacks are dropped rather than kept half-valid.
         let _ = doc.set_layers(self.layers());
@@ -147,6 +158,12 @@ impl Document {
 
     pub fn clip(&self) -> Option<&Clip> {
         self.clip.and_then(|c| self.rig.clips.get(c))
+    }
+
+    /// Frames per second of the timeline: the user's choice, else the clip's own (the file's rate, or its key
+    /// spacing), else 30.
+    pub fn frame_rate(&self) -> f64 {
+        self.frame_rate_override.or_else(|| self.clip().map(Clip::frame_rate)).unwrap_or(DEFAULT_FRAME_RATE)
     }
 
     /// How long the timeline runs: the clip's duration, or what the layers make of it (a synced blend's cycle, a

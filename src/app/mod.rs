@@ -243,7 +243,7 @@ impl BonescopeApp {
             ghost: self.doc.ghost,
             layers: self.doc.layers().clone(),
             plotted: self.plotted(),
-            rate: self.settings.frame_rate,
+            rate: self.doc.frame_rate(),
         }
     }
 
@@ -383,18 +383,28 @@ impl BonescopeApp {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let step = 1.0 / self.settings.frame_rate.max(1.0);
-        let (space, left, right) = ctx.input(|i| {
-            (i.key_pressed(egui::Key::Space), i.key_pressed(egui::Key::ArrowLeft), i.key_pressed(egui::Key::ArrowRight))
-        });
-        if space {
-            self.playing = !self.playing;
+        let pressed = |key| ctx.input(|i| i.key_pressed(key));
+        let duration = self.doc.duration();
+        if pressed(egui::Key::Space) {
+            self.toggle_play();
         }
-        if left || right {
-            self.playing = false;
-            let delta = if right { step } else { -step };
-            self.time = (self.time + delta).clamp(0.0, self.doc.duration());
+        for (key, forward) in [(egui::Key::ArrowLeft, false), (egui::Key::ArrowRight, true)] {
+            if pressed(key) {
+                self.playing = false;
+                self.time = timeline::step_frame(self.time, self.doc.frame_rate(), forward, duration);
+            }
         }
+        for (key, to) in [(egui::Key::Home, 0.0), (egui::Key::End, duration)] {
+            if pressed(key) {
+                self.playing = false;
+                self.time = to;
+            }
+        }
+    }
+
+    /// Play or pause (see [`timeline::toggle_play`]).
+    pub fn toggle_play(&mut self) {
+        timeline::toggle_play(&mut self.playing, &mut self.time, self.settings.looping, self.doc.duration());
     }
 
     fn advance_playback(&mut self, ctx: &egui::Context) {
@@ -402,7 +412,9 @@ impl BonescopeApp {
             return;
         }
         let duration = self.doc.duration();
-        let dt = f64::from(ctx.input(|i| i.stable_dt).min(0.1)) * self.settings.speed;
+        // The wall clock, not a smoothed frame time: when frames are slow the clip skips frames rather than playing
+        // in slow motion (a longer pause, a hidden window or a debugger, counts as one second).
+        let dt = f64::from(ctx.input(|i| i.unstable_dt).min(1.0)) * self.settings.speed;
         self.time += dt;
         if self.time > duration {
             if self.settings.looping && duration > 0.0 {

@@ -99,19 +99,25 @@ impl Outliner {
             label.context_menu(|ui| mode_menu(ui, shared, bone));
             ui.label(RichText::new(shared.doc.modes[bone].id()).weak().small());
             if let Some(summary) = shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched()) {
-                ui.label(
+                let worst = egui::Label::new(
                     RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
                         .small()
                         .color(Badge::Stretched.color()),
                 )
-                .on_hover_text(format!(
-                    "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s",
+                .sense(Sense::click());
+                let worst = ui.add(worst).on_hover_text(format!(
+                    "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s (click to go there)",
                     summary.flagged_samples,
                     shared.analysis.map_or(0, |a| a.scan.samples),
                     summary.first_flagged_time.unwrap_or_default(),
                     summary.worst_shear_deg,
                     summary.worst_shear_time
                 ));
+                if worst.clicked() {
+                    shared.select(bone, false);
+                    *shared.playing = false;
+                    *shared.time = summary.worst_shear_time;
+                }
             }
         });
     }

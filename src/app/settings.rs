@@ -10,7 +10,7 @@ use crate::view::{Camera, SceneOptions};
 pub enum TimeUnit {
     #[default]
     Seconds,
-    /// Frames at `Settings::frame_rate`.
+    /// Frames at the document's frame rate.
     Frames,
     /// 3ds Max ticks, 4800 per second.
     Ticks,
@@ -35,6 +35,20 @@ impl TimeUnit {
             TimeUnit::Ticks => format!("{:.0} ticks", seconds * TICKS_PER_SECOND),
         }
     }
+
+    /// Seconds from text in this unit, as typed or as [`TimeUnit::format`] wrote it (`1.5`, `1.5 s`, `frame 45`,
+    /// `7200 ticks`); `None` when no number is there.
+    pub fn parse(self, text: &str, frame_rate: f64) -> Option<f64> {
+        let value = text
+            .split_whitespace()
+            .find_map(|word| word.trim_matches(char::is_alphabetic).parse::<f64>().ok())
+            .filter(|v| v.is_finite())?;
+        Some(match self {
+            TimeUnit::Seconds => value,
+            TimeUnit::Frames => value / frame_rate,
+            TimeUnit::Ticks => value / TICKS_PER_SECOND,
+        })
+    }
 }
 
 /// Which plotted quantity, and how rotations are shown.
@@ -57,7 +71,6 @@ pub struct Settings {
     pub camera: Camera,
     pub scene: SceneOptions,
     pub time_unit: TimeUnit,
-    pub frame_rate: f64,
     pub speed: f64,
     pub looping: bool,
     pub rotation_format: RotationFormat,
@@ -77,7 +90,6 @@ impl Default for Settings {
             camera: Camera::default(),
             scene: SceneOptions::default(),
             time_unit: TimeUnit::Seconds,
-            frame_rate: 30.0,
             speed: 1.0,
             looping: true,
             rotation_format: RotationFormat::Quaternion,

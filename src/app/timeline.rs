@@ -15,26 +15,39 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared) {
     ui.add_space(4.0);
 }
 
+/// The whole frame before or after `time` at `rate` (from between two frames, the nearer one in that direction;
+/// from a frame, the next), within `[0, duration]`.
+pub fn step_frame(time: f64, rate: f64, forward: bool, duration: f64) -> f64 {
+    // Times within a millionth of a frame of a frame are on it.
+    const ON_FRAME: f64 = 1e-6;
+    let rate = if rate.is_finite() && rate > 0.0 { rate } else { 30.0 };
+    let frame = time * rate;
+    let next = if forward { (frame + ON_FRAME).floor() + 1.0 } else { (frame - ON_FRAME).ceil() - 1.0 };
+    (next / rate).clamp(0.0, duration.max(0.0))
+}
+
+/// Play or pause; playing at the end of a clip that does not loop starts it again.
+pub fn toggle_play(playing: &mut bool, time: &mut f64, looping: bool, duration: f64) {
+    *playing = !*playing;
+    if *playing && !looping && *time >= duration {
+        *time = 0.0;
+    }
+}
+
 fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     let duration = shared.doc.duration();
-    let step = 1.0 / shared.settings.frame_rate.max(1.0);
-    if ui.button("Previous frame").on_hover_text("← key").clicked() {
-        *shared.playing = false;
-        *shared.time = (*shared.time - step).max(0.0);
-    }
+    let rate = shared.doc.frame_rate();
+    frame_button(ui, shared, "Previous frame", "← key", false, rate, duration);
     let play_label = if *shared.playing { "Pause" } else { "Play" };
-    if ui.button(play_label).on_hover_text("Space").clicked() {
-        *shared.playing = !*shared.playing;
+    if ui.button(play_label).on_hover_text("Space; Home and End go to the ends").clicked() {
+        toggle_play(shared.playing, shared.time, shared.settings.looping, duration);
     }
-    if ui.button("Next frame").on_hover_text("→ key").clicked() {
-        *shared.playing = false;
-        *shared.time = (*shared.time + step).min(duration);
-    }
+    frame_button(ui, shared, "Next frame", "→ key", true, rate, duration);
     ui.checkbox(&mut shared.settings.looping, "Loop");
     ui.add(egui::DragValue::new(&mut shared.settings.speed).range(0.01..=10.0).speed(0.01).prefix("speed ×"));
     ui.separator();
-    let (unit, rate) = (shared.settings.time_unit, shared.settings.frame_rate);
-    ui.label(egui::RichText::new(unit.format(*shared.time, rate)).monospace().strong());
+    let unit = shared.settings.time_unit;
+    time_field(ui, shared, unit, rate, duration);
     ui.label(format!("of {}", unit.format(duration, rate)));
     let label = ui.label("in");
     egui::ComboBox::from_id_salt("time-unit")
@@ -46,11 +59,46 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
         })
         .response
         .labelled_by(label.id);
-    ui.add(egui::DragValue::new(&mut shared.settings.frame_rate).range(1.0..=1000.0).suffix(" fps"));
+    frame_rate_field(ui, shared, rate);
     if let Some((done, total)) = shared.progress {
         ui.separator();
         let fraction = if total > 0 { done as f32 / total as f32 } else { 0.0 };
         ui.add(egui::ProgressBar::new(fraction).desired_width(140.0).text("analysing clip"));
+    }
+}
+
+fn frame_button(ui: &mut egui::Ui, shared: &mut Shared, label: &str, key: &str, forward: bool, rate: f64, end: f64) {
+    if ui.button(label).on_hover_text(key).clicked() {
+        *shared.playing = false;
+        *shared.time = step_frame(*shared.time, rate, forward, end);
+    }
+}
+
+/// The current time in the chosen unit, editable: type a time, frame or tick (or drag to scrub).
+fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64, duration: f64) {
+    let field = egui::DragValue::new(shared.time)
+        .range(0.0..=duration)
+        .speed(duration.max(1e-3) / 500.0)
+        .custom_formatter(move |seconds, _| unit.format(seconds, rate))
+        .custom_parser(move |text| unit.parse(text, rate));
+    let response = ui.add(field).on_hover_text("type a time, a frame or a tick in the chosen unit");
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::SpinButton, true, "current time"));
+    if response.changed() {
+        *shared.playing = false;
+    }
+}
+
+/// The timeline's frame rate: the clip's own (from its file), or one the user types; "file's rate" goes back.
+fn frame_rate_field(ui: &mut egui::Ui, shared: &mut Shared, rate: f64) {
+    let mut chosen = rate;
+    let response = ui.add(egui::DragValue::new(&mut chosen).range(1.0..=1000.0).max_decimals(3).suffix(" fps"));
+    let source = if shared.doc.frame_rate_override.is_some() { "chosen here" } else { "the clip's own" };
+    let response = response.on_hover_text(format!("frames per second of stepping and frame numbers ({source})"));
+    if response.changed() {
+        shared.doc.frame_rate_override = Some(chosen);
+    }
+    if shared.doc.frame_rate_override.is_some() && ui.small_button("file's rate").clicked() {
+        shared.doc.frame_rate_override = None;
     }
 }
 
@@ -155,5 +203,39 @@ fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: imp
             0.0,
             Badge::Stretched.color(),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_steps_land_on_whole_frames() {
+        // 120 Hz mocap: one press is one source frame.
+        assert_eq!(step_frame(0.0, 120.0, true, 10.0), 1.0 / 120.0);
+        // From between frames (a click at 17.98 frames of 30 fps), the next whole frame each way.
+        let between = 17.98 / 30.0;
+        assert_eq!(step_frame(between, 30.0, true, 10.0), 18.0 / 30.0);
+        assert_eq!(step_frame(between, 30.0, false, 10.0), 17.0 / 30.0);
+        // From a frame (up to rounding), the neighbours.
+        let on = 18.0 / 30.0 + 1e-12;
+        assert_eq!(step_frame(on, 30.0, true, 10.0), 19.0 / 30.0);
+        assert_eq!(step_frame(on, 30.0, false, 10.0), 17.0 / 30.0);
+        // Within the clip.
+        assert_eq!(step_frame(0.0, 30.0, false, 10.0), 0.0);
+        assert_eq!(step_frame(9.99, 30.0, true, 10.0), 10.0);
+    }
+
+    #[test]
+    fn play_at_the_end_without_loop_starts_again() {
+        let (mut playing, mut time) = (false, 2.0);
+        toggle_play(&mut playing, &mut time, false, 2.0);
+        assert_eq!((playing, time), (true, 0.0));
+        let (mut playing, mut time) = (false, 2.0);
+        toggle_play(&mut playing, &mut time, true, 2.0);
+        assert_eq!((playing, time), (true, 2.0), "a looping clip goes on from where it is");
+        toggle_play(&mut playing, &mut time, false, 2.0);
+        assert_eq!((playing, time), (false, 2.0));
     }
 }

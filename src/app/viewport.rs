@@ -92,7 +92,7 @@ fn caption(shared: &Shared) -> Vec<String> {
     let settings = &*shared.settings;
     let modes = doc.common_mode().map_or_else(|| "mixed modes".to_owned(), |m| format!("mode: {}", m.id()));
     let mut lines =
-        vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, settings.frame_rate), modes];
+        vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, doc.frame_rate()), modes];
     let layers = doc.layers().summary(&doc.rig, doc.clip());
     lines.extend(layers.split("; ").filter(|l| !l.is_empty()).map(str::to_owned));
     lines

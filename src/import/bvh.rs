@@ -480,7 +480,7 @@ fn clip(joints: &[Joint], values: &[f64], frames: usize, frame_time: f64) -> Res
         }
         tracks.push(bone);
     }
-    Ok(Clip::new(0, None, tracks, Vec::new()))
+    Ok(Clip::new(0, None, tracks, Vec::new()).with_frame_rate(1.0 / frame_time))
 }
 
 #[cfg(test)]

@@ -148,6 +148,21 @@ impl<T> Track<T> {
     }
 }
 
+/// Frames per second assumed for a clip whose keys show no rate.
+pub const DEFAULT_FRAME_RATE: f64 = 30.0;
+
+/// The rate of the most common spacing between consecutive key times, rounded to 1/1000 fps (at least a quarter of
+/// the spacings, and at least two, must agree, so scattered keys give none): 24 for keys 1/24 s apart, even with some keys missing.
+fn key_rate(times: &[f64]) -> Option<f64> {
+    let mut counts: std::collections::BTreeMap<u64, usize> = std::collections::BTreeMap::new();
+    let gaps = times.windows(2).map(|w| w[1] - w[0]).filter(|&gap| gap > 1e-6);
+    for gap in gaps.clone() {
+        *counts.entry((1000.0 / gap).round() as u64).or_default() += 1;
+    }
+    let (&rate, &count) = counts.iter().max_by_key(|(rate, count)| (**count, std::cmp::Reverse(**rate)))?;
+    (count >= 2 && count * 4 >= gaps.count() && rate > 0).then(|| rate as f64 / 1000.0)
+}
+
 /// Key times closer than this are one key: one FBX tick (1/46,186,158,000 s), the finest time any supported
 /// format stores.
 pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
@@ -214,6 +229,9 @@ pub struct Clip {
     /// Sorted by bone, at most one entry per bone.
     morph: Vec<MorphWeights>,
     duration: f64,
+    /// Frames per second: the rate the file states (FBX, BVH), else the most common key spacing (see
+    /// [`Clip::frame_rate`]).
+    frame_rate: Option<f64>,
 }
 
 impl Clip {
@@ -224,7 +242,23 @@ impl Clip {
         morph.sort_by_key(|m| m.bone);
         let duration = tracks.iter().flat_map(BoneTracks::time_arrays).map(|t| t[t.len() - 1]).fold(0.0, f64::max);
         let duration = morph.iter().map(MorphWeights::last_time).fold(duration, f64::max);
-        Clip { index, name, tracks, morph, duration }
+        let mut clip = Clip { index, name, tracks, morph, duration, frame_rate: None };
+        clip.frame_rate = key_rate(&clip.key_times());
+        clip
+    }
+
+    /// The clip with the frame rate its file states (finite and positive, else the key spacing's stays).
+    pub fn with_frame_rate(mut self, rate: f64) -> Self {
+        if rate.is_finite() && rate > 0.0 {
+            self.frame_rate = Some(rate);
+        }
+        self
+    }
+
+    /// Frames per second of the clip: the file's own rate where it states one (FBX, BVH), else the rate of its
+    /// most common key spacing (a glTF exported at 24 fps has keys 1/24 s apart), else 30.
+    pub fn frame_rate(&self) -> f64 {
+        self.frame_rate.unwrap_or(DEFAULT_FRAME_RATE)
     }
 
     pub fn tracks(&self) -> &[BoneTracks] {
@@ -275,6 +309,24 @@ impl Clip {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_frame_rate_is_the_files_or_the_key_spacing() {
+        let track = |times: Vec<f64>| {
+            let n = times.len();
+            let mut tracks = BoneTracks::new(0);
+            tracks.translation = Some(Track::new(times.into(), vec![Vec3::ZERO; n], Interpolation::Linear).unwrap());
+            Clip::new(0, None, vec![tracks], vec![])
+        };
+        // Keys 1/24 s apart with one missing: 24 fps (to 1/1000 fps).
+        let mut times: Vec<f64> = (0..48).map(|k| f64::from(k) / 24.0).collect();
+        times.remove(7);
+        assert_eq!(track(times.clone()).frame_rate(), 24.0);
+        // Scattered keys: no rate, 30 assumed; a stated rate wins over the spacing.
+        assert_eq!(track(vec![0.0, 0.3, 0.35, 1.1, 1.7]).frame_rate(), DEFAULT_FRAME_RATE);
+        assert_eq!(track(times).with_frame_rate(120.0).frame_rate(), 120.0);
+        assert_eq!(track(vec![0.0]).with_frame_rate(f64::NAN).frame_rate(), DEFAULT_FRAME_RATE);
+    }
 
     fn times(t: &[f64]) -> Arc<[f64]> {
         t.into()

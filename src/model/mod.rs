@@ -7,7 +7,9 @@ mod skin;
 mod timeline;
 mod transform;
 
-pub use clip::{BoneTracks, Clip, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError};
+pub use clip::{
+    BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
+};
 pub use inherit::{InheritMode, UnknownInheritMode};
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin};

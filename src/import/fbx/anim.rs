@@ -98,7 +98,8 @@ impl StackReader<'_> {
         let morph = self.morph_weights(bone_of_node, &channels, &grid, &times)?;
         let samples = grid.len() * (tracks.len() + morph.len());
         let name: &str = &self.stack.element.name;
-        Ok((Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, morph), samples))
+        let clip = Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, morph);
+        Ok((clip.with_frame_rate(self.fps), samples))
     }
 
     /// The nodes (typed ids) whose properties the stack animates, in order of appearance, every key time of their
