@@ -8,19 +8,23 @@ use crate::math::{
 };
 
 /// The tolerances behind the verdicts.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct Tolerances {
     /// Scale factors count as unequal when `max/min − 1` exceeds this (default 1e-4, i.e. 0.01 %).
     pub min_anisotropy: f64,
     /// A stretch rotation counts as not the identity when its angle exceeds this many degrees (default 0.01°).
     pub min_stretch_deg: f64,
+    /// A stretched bone is flagged only when it shears by more than this many degrees (default 0.01°): at the first
+    /// frames of a squash a stretch frame may turn while the shear it makes is numerically invisible.
+    pub min_shear_deg: f64,
     /// A matrix is degenerate when its smallest scale factor is below this fraction of its largest (default 1e-9).
     pub degenerate_ratio: f64,
 }
 
 impl Default for Tolerances {
     fn default() -> Self {
-        Tolerances { min_anisotropy: 1e-4, min_stretch_deg: 0.01, degenerate_ratio: 1e-9 }
+        Tolerances { min_anisotropy: 1e-4, min_stretch_deg: 0.01, min_shear_deg: 0.01, degenerate_ratio: 1e-9 }
     }
 }
 
@@ -98,12 +102,15 @@ pub(crate) struct Judge {
     tolerances: Tolerances,
     /// `cos(θ/2)` at `θ = min_stretch_deg`: stretch frames turned further have a smaller half-angle cosine.
     stretch_half_cosine: f64,
+    /// `sin²(min_shear_deg)`: a shear of angle `φ` has a largest column cosine of `sin φ`.
+    shear_cosine_squared: f64,
 }
 
 impl Judge {
     pub fn new(tolerances: &Tolerances) -> Self {
         let stretch_half_cosine = (tolerances.min_stretch_deg.to_radians() * 0.5).cos();
-        Judge { tolerances: *tolerances, stretch_half_cosine }
+        let shear_cosine_squared = tolerances.min_shear_deg.to_radians().sin().powi(2);
+        Judge { tolerances: *tolerances, stretch_half_cosine, shear_cosine_squared }
     }
 
     /// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`), whose
@@ -117,7 +124,8 @@ impl Judge {
         let anisotropic = max > min * (1.0 + tolerances.min_anisotropy);
         let stretch_half_cosine =
             if anisotropic { stretch_half_cosine_within(stretch, scale, tolerances.min_anisotropy) } else { 1.0 };
-        let stretched = stretch_half_cosine < self.stretch_half_cosine;
+        let stretched =
+            stretch_half_cosine < self.stretch_half_cosine && shear_cosine_squared > self.shear_cosine_squared;
         let findings = Findings {
             stretched,
             non_uniform: anisotropic && !stretched,
@@ -177,5 +185,21 @@ mod tests {
             * DMat4::from_scale(DVec3::new(1.0, 1.000001, 0.5))
             * DMat4::from_quat(DQuat::from_rotation_z(-0.5));
         assert_eq!(assess(twisted), Findings { non_uniform: true, ..Findings::default() });
+    }
+
+    #[test]
+    fn shear_below_the_minimum_angle_is_not_flagged() {
+        // A unit shear of tan φ: φ = 0.005° is below the default 0.01°, φ = 0.02° above it.
+        let shear = |deg: f64| {
+            let t = deg.to_radians().tan();
+            DMat4::from_cols(glam::DVec4::X, glam::DVec4::new(t, 1.0, 0.0, 0.0), glam::DVec4::Z, glam::DVec4::W)
+        };
+        let tolerances = Tolerances { min_anisotropy: 0.0, min_stretch_deg: 0.0, ..Tolerances::default() };
+        let assess = |m: DMat4| Assessment::of(&m, &tolerances);
+        let faint = assess(shear(0.005));
+        assert!(!faint.findings.stretched && faint.findings.non_uniform, "{faint:?}");
+        assert!(assess(shear(0.02)).findings.stretched);
+        let lenient = Tolerances { min_shear_deg: 0.0, ..tolerances };
+        assert!(Assessment::of(&shear(0.005), &lenient).findings.stretched);
     }
 }

@@ -15,7 +15,8 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
         ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
         return;
     };
-    let reports = BoneReport::all(&shared.doc.rig.skeleton, &shared.doc.modes, &shared.frame.pose, shared.tolerances);
+    let reports =
+        BoneReport::all(&shared.doc.rig.skeleton, &shared.doc.modes, &shared.frame.pose, &shared.settings.tolerances);
     let report = &reports[bone];
     ui.label(RichText::new(&report.name).strong().size(16.0));
     ui.label(format!("bone {} · node {} · inherit {}", report.index, report.node, report.inherit.id()));
@@ -45,8 +46,9 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
     egui::ScrollArea::vertical().show(ui, |ui| {
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
-        section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts);
-        section(ui, "Local", &local, &crate::math::decompose(&local));
+        let tolerance = shared.settings.tolerances.min_anisotropy;
+        section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts, tolerance);
+        section(ui, "Local", &local, &crate::math::decompose(&local), tolerance);
     });
 }
 
@@ -68,7 +70,9 @@ fn morph_weights(ui: &mut Ui, shared: &Shared, bone: usize) {
     }
 }
 
-fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts) {
+/// A matrix and its parts. Where the scale factors are equal within `anisotropy` the stretch rotation `U` is
+/// undetermined (any frame diagonalises a uniform scale), so it is shown as the identity it is equivalent to.
+fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts, anisotropy: f64) {
     ui.separator();
     ui.label(RichText::new(title).strong());
     Grid::new(format!("{title}-matrix")).striped(true).show(ui, |ui| {
@@ -88,7 +92,9 @@ fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts) {
         ui.label(v(&parts.rotation.to_array()));
         ui.end_row();
         ui.label("stretch U");
-        ui.label(format!("{}  ({:.3}°)", v(&parts.stretch.to_array()), parts.stretch_angle_deg()));
+        let uniform = parts.anisotropy() <= anisotropy;
+        let stretch = if uniform { glam::DQuat::IDENTITY } else { parts.stretch };
+        ui.label(format!("{}  ({:.3}°)", v(&stretch.to_array()), parts.stretch_angle_deg_within(anisotropy)));
         ui.end_row();
         ui.label("scale k");
         ui.label(v(&parts.scale.to_array()));

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
 use super::Ghost;
-use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, Subject, analyze};
+use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, Subject, Tolerances, analyze};
 use crate::eval::{Hierarchy, LayerStack, Layers};
 use crate::model::{InheritMode, Rig};
 
@@ -21,6 +21,7 @@ pub struct JobKey {
     pub layers: Layers,
     pub plotted: Vec<usize>,
     pub rate: f64,
+    pub tolerances: Tolerances,
 }
 
 struct Running {
@@ -104,7 +105,7 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
             .zip(ghost_modes.as_ref())
             .map(|(hierarchy, (_, unlayered))| GhostRequest { hierarchy, unlayered: *unlayered });
         let clip = job_key.clip.and_then(|c| rig.clips.get(c));
-        let options = ScanOptions { rate: job_key.rate, ..ScanOptions::default() };
+        let options = ScanOptions { rate: job_key.rate, tolerances: job_key.tolerances };
         let request = CurveRequest { bones: &job_key.plotted, ghost };
         let progress = |d: usize, t: usize| {
             job_done.store(d, Ordering::Relaxed);

@@ -68,7 +68,6 @@ pub struct Shared<'a> {
     pub stretched: &'a [(f64, f64)],
     /// `(done, total)` samples while the whole-clip analysis runs.
     pub progress: Option<(usize, usize)>,
-    pub tolerances: &'a Tolerances,
 }
 
 impl Shared<'_> {
@@ -128,7 +127,6 @@ pub struct BonescopeApp {
     pub time: f64,
     pub playing: bool,
     pub selection: Vec<usize>,
-    pub tolerances: Tolerances,
     generation: u64,
     job: AnalysisJob,
     notifications: Notifications,
@@ -153,7 +151,6 @@ impl BonescopeApp {
             time: 0.0,
             playing: false,
             selection: Vec::new(),
-            tolerances: Tolerances::default(),
             generation: 0,
             job: AnalysisJob::default(),
             notifications: Notifications::default(),
@@ -244,6 +241,7 @@ impl BonescopeApp {
             layers: self.doc.layers().clone(),
             plotted: self.plotted(),
             rate: self.doc.frame_rate(),
+            tolerances: self.settings.tolerances,
         }
     }
 
@@ -282,7 +280,7 @@ impl BonescopeApp {
         self.poll_background(&ctx);
         self.handle_input(&ctx);
         self.advance_playback(&ctx);
-        let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.tolerances);
+        let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.settings.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
         let progress = self.job.progress();
         let stretched = self.spans.get(latest.as_ref(), self.selection.last().copied());
@@ -298,7 +296,6 @@ impl BonescopeApp {
                 analysis: latest.as_ref(),
                 stretched,
                 progress,
-                tolerances: &self.tolerances,
             };
             if self.chrome == Chrome::ViewportOnly {
                 egui::CentralPanel::default()

@@ -102,7 +102,7 @@ impl Outliner {
                 let worst = egui::Label::new(
                     RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
                         .small()
-                        .color(Badge::Stretched.color()),
+                        .color(Badge::Stretched.color_for_shear(summary.worst_shear_deg)),
                 )
                 .sense(Sense::click());
                 let worst = ui.add(worst).on_hover_text(format!(

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::analysis::Tolerances;
 use crate::eval::layers::TICKS_PER_SECOND;
 use crate::view::{Camera, SceneOptions};
 
@@ -70,6 +71,8 @@ pub struct Settings {
     pub recent: Vec<PathBuf>,
     pub camera: Camera,
     pub scene: SceneOptions,
+    /// The thresholds of the verdicts (View → Thresholds).
+    pub tolerances: Tolerances,
     pub time_unit: TimeUnit,
     pub speed: f64,
     pub looping: bool,
@@ -89,6 +92,7 @@ impl Default for Settings {
             recent: Vec::new(),
             camera: Camera::default(),
             scene: SceneOptions::default(),
+            tolerances: Tolerances::default(),
             time_unit: TimeUnit::Seconds,
             speed: 1.0,
             looping: true,

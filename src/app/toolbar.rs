@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use egui::RichText;
 
 use super::{Ghost, ModeChoice, ModeScope, Shared};
+use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
 use crate::model::InheritMode;
 
@@ -64,11 +65,56 @@ fn file_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     }
 }
 
+/// The verdicts' thresholds (persisted with the settings; README, "What the verdicts mean").
+fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances) {
+    egui::Grid::new("thresholds").num_columns(2).show(ui, |ui| {
+        let rows = [
+            (
+                "min anisotropy",
+                "scale factors differ when max/min exceeds 1 + this",
+                &mut tolerances.min_anisotropy,
+                1.0,
+                "",
+            ),
+            (
+                "min stretch angle",
+                "the stretch rotation U must turn by more than this",
+                &mut tolerances.min_stretch_deg,
+                90.0,
+                "°",
+            ),
+            (
+                "min shear angle",
+                "a stretched bone must shear by more than this",
+                &mut tolerances.min_shear_deg,
+                90.0,
+                "°",
+            ),
+        ];
+        for (name, hint, value, max, suffix) in rows {
+            ui.label(name).on_hover_text(hint);
+            let field = egui::DragValue::new(value).range(0.0..=max).speed(max * 1e-5).max_decimals(6).suffix(suffix);
+            let field = ui.add(field).on_hover_text(hint);
+            field.widget_info(|| egui::WidgetInfo::labeled(egui::Role::SpinButton, true, name));
+            ui.end_row();
+        }
+    });
+    if ui.button("Defaults").clicked() {
+        *tolerances = Tolerances::default();
+    }
+}
+
 fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     ui.checkbox(&mut shared.settings.dark, "Dark theme");
     ui.checkbox(&mut shared.settings.show_plots, "Plots");
     ui.checkbox(&mut shared.settings.show_inspector, "Inspector");
     ui.checkbox(&mut shared.settings.show_layers, "Layers");
+    // Editing a number is a click inside the menu: it stays open until a click outside.
+    let config =
+        egui::containers::menu::MenuConfig::new().close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside);
+    egui::containers::menu::SubMenuButton::new("Thresholds")
+        .config(config)
+        .ui(ui, |ui| thresholds(ui, &mut shared.settings.tolerances));
     if ui.button("Frame all").clicked() {
         actions.frame_all = true;
     }

@@ -124,11 +124,19 @@ pub struct ToleranceArgs {
     /// ...and its stretch rotation U turns by more than this many degrees.
     #[arg(long, value_name = "DEGREES", default_value_t = Tolerances::default().min_stretch_deg)]
     pub min_stretch_deg: f64,
+    /// ...and it shears by more than this many degrees (the largest deviation from 90° between two axes).
+    #[arg(long, value_name = "DEGREES", default_value_t = Tolerances::default().min_shear_deg)]
+    pub min_shear_deg: f64,
 }
 
 impl ToleranceArgs {
     pub fn tolerances(&self) -> anyhow::Result<Tolerances> {
-        for (name, value) in [("--min-anisotropy", self.min_anisotropy), ("--min-stretch-deg", self.min_stretch_deg)] {
+        let values = [
+            ("--min-anisotropy", self.min_anisotropy),
+            ("--min-stretch-deg", self.min_stretch_deg),
+            ("--min-shear-deg", self.min_shear_deg),
+        ];
+        for (name, value) in values {
             if !(value >= 0.0 && value.is_finite()) {
                 bail!("{name} must be a finite number ≥ 0, got {value}");
             }
@@ -136,6 +144,7 @@ impl ToleranceArgs {
         Ok(Tolerances {
             min_anisotropy: self.min_anisotropy,
             min_stretch_deg: self.min_stretch_deg,
+            min_shear_deg: self.min_shear_deg,
             ..Tolerances::default()
         })
     }

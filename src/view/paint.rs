@@ -34,11 +34,7 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         mesh_triangles(&mut triangles, &projection, scene, &scene.primary, palette.mesh, camera);
         paint_sorted(&painter, triangles);
     }
-    if options.bones {
-        let mut triangles = Vec::new();
-        bone_triangles(&mut triangles, &projection, scene, &scene.primary, palette, camera, None);
-        paint_sorted(&painter, triangles);
-    }
+    // The ghost goes under the pose, so the pose's colour coding reads on top and the ghost shows where they part.
     if let Some(ghost) = &scene.ghost {
         let mut ghost_triangles = Vec::new();
         if options.bones {
@@ -52,6 +48,11 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         if options.axes {
             paint_axes(&painter, &projection, ghost, scene.gizmo_unit, faded);
         }
+    }
+    if options.bones {
+        let mut triangles = Vec::new();
+        bone_triangles(&mut triangles, &projection, scene, &scene.primary, palette, camera, None);
+        paint_sorted(&painter, triangles);
     }
     if options.wireframe {
         paint_wireframe(&painter, &projection, scene, palette);
@@ -203,11 +204,7 @@ fn mesh_triangles(
 
 /// The colour of a bone: selection first, then its most serious finding.
 fn bone_color(scene: &Scene, layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
-    if scene.selected.contains(&bone) {
-        palette.selected
-    } else {
-        Badge::primary(&layer.findings[bone]).map_or(palette.bone, Badge::color)
-    }
+    if scene.selected.contains(&bone) { palette.selected } else { layer.finding_color(bone).unwrap_or(palette.bone) }
 }
 
 /// Octahedral bones from head to tail: a waist at a fifth of the length, a tenth as wide as long, oriented by the
@@ -264,7 +261,7 @@ fn paint_wireframe(painter: &Painter, projection: &Projection, scene: &Scene, pa
 
 /// A bone's box colour: its most important finding's, else the bone colour, faded.
 fn box_color(layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
-    Badge::primary(&layer.findings[bone]).map_or(palette.bone.gamma_multiply(0.6), Badge::color)
+    layer.finding_color(bone).unwrap_or(palette.bone.gamma_multiply(0.6))
 }
 
 /// Each bone's matrix applied to a cube of side `unit` (in the bone's own units, see [`Scene::gizmo_unit`])

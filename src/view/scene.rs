@@ -4,6 +4,7 @@
 use glam::{DMat4, DVec3};
 
 use super::camera::Bounds;
+use super::style::Badge;
 use crate::analysis::{Assessment, Findings, Tolerances};
 use crate::eval::skinning::skin_meshes_with;
 use crate::eval::{MorphPose, SkinningMethod, skin_meshes};
@@ -104,6 +105,8 @@ impl SceneOptions {
 pub struct Layer {
     pub model: Vec<DMat4>,
     pub findings: Vec<Findings>,
+    /// Per bone, its shear angle in degrees (how severe a stretched bone is).
+    pub shear_deg: Vec<f64>,
     /// Per mesh of the rig, vertex positions in model space.
     pub meshes: Vec<Vec<DVec3>>,
 }
@@ -117,9 +120,17 @@ impl Layer {
         skinning: SkinningMethod,
         tolerances: &Tolerances,
     ) -> Layer {
-        let findings = Assessment::all(&model, tolerances).into_iter().map(|a| a.findings).collect();
+        let assessments = Assessment::all(&model, tolerances);
+        let findings = assessments.iter().map(|a| a.findings).collect();
+        let shear_deg = assessments.iter().map(|a| a.shear_deg).collect();
         let meshes = skin_meshes_with(rig, &model, morph, skinning);
-        Layer { model, findings, meshes }
+        Layer { model, findings, shear_deg, meshes }
+    }
+
+    /// The colour of the bone's most important finding, stretched bones by their shear; `None` without one.
+    pub fn finding_color(&self, bone: usize) -> Option<egui::Color32> {
+        let badge = Badge::primary(self.findings.get(bone)?)?;
+        Some(badge.color_for_shear(self.shear_deg.get(bone).copied().unwrap_or(0.0)))
     }
 
     pub fn head(&self, bone: usize) -> DVec3 {

@@ -25,6 +25,18 @@ impl Badge {
         }
     }
 
+    /// The colour of a finding of this severity: for a stretched bone, its shear angle on a ramp from pale (at or
+    /// below 0.1°, barely visible) to the full colour (10° and more), logarithmic in between; other findings have
+    /// one colour.
+    pub fn color_for_shear(self, shear_deg: f64) -> Color32 {
+        if self != Badge::Stretched {
+            return self.color();
+        }
+        let t = ((shear_deg.max(1e-12).log10() + 1.0) / 2.0).clamp(0.0, 1.0) as f32;
+        let pale = Color32::from_rgb(250, 200, 210);
+        pale.lerp_to_gamma(self.color(), t)
+    }
+
     pub fn label(self) -> &'static str {
         match self {
             Badge::Stretched => "stretched (shear)",
