@@ -371,3 +371,19 @@ fn thresholds_are_edited_in_the_view_menu_and_decide_the_flags() {
     // The demo's worst shear is 38.1°: nothing is flagged any more, in the whole-clip analysis either.
     assert!(harness.state().analysis().unwrap().scan.bones.iter().all(|b| !b.stretched()));
 }
+
+#[test]
+fn selecting_a_bone_does_not_move_the_viewport() {
+    // At 1000×700 with the Layers panel open, the Inspector's matrices are wider than its panel: they scroll, the
+    // panels keep their widths and the viewport stays where it was.
+    let settings = Settings { show_layers: true, ..Settings::default() };
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
+    settle(&mut harness);
+    let before = harness.get_by_label("viewport").rect();
+    assert!(before.width() >= 0.4 * 1000.0, "the viewport keeps 40 % of the window: {before:?}");
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    assert_eq!(harness.get_by_label("viewport").rect(), before);
+}

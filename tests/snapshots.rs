@@ -147,3 +147,19 @@ fn cmu_walk_gizmos() {
     settings.scene.boxes = true;
     window(settings, asset_document("bvh/cmu_12_01_walk.bvh"), 1.0, None).snapshot("cmu_walk_gizmos");
 }
+
+/// A small laptop window, 1000×700, with the Layers panel and the Inspector open: the side panels keep their widths
+/// (at most a fifth of the window each), the viewport keeps the rest, its toolbar one row.
+#[test]
+fn small_window_with_layers_and_inspector() {
+    let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .with_render_cursor(false)
+        .wgpu()
+        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
+    harness.state_mut().time = 0.5;
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    harness.snapshot("small_window_with_layers_and_inspector");
+}

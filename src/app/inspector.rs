@@ -43,7 +43,7 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
             ui.ctx().copy_text(json);
         }
     }
-    egui::ScrollArea::vertical().show(ui, |ui| {
+    egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;
@@ -84,23 +84,21 @@ fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts, anisot
         }
     });
     Grid::new(format!("{title}-parts")).show(ui, |ui| {
-        let v = |values: &[f64]| values.iter().map(|x| format!("{:.4}", x + 0.0)).collect::<Vec<_>>().join(", ");
-        ui.label("translation");
-        ui.label(v(&parts.translation.to_array()));
-        ui.end_row();
-        ui.label("rotation q");
-        ui.label(v(&parts.rotation.to_array()));
-        ui.end_row();
-        ui.label("stretch U");
+        // Fixed-width numbers, so columns line up and nothing shifts as values change.
+        let v = |values: &[f64]| values.iter().map(|x| format!("{:>8.4}", x + 0.0)).collect::<Vec<_>>().join(" ");
         let uniform = parts.anisotropy() <= anisotropy;
         let stretch = if uniform { glam::DQuat::IDENTITY } else { parts.stretch };
-        ui.label(format!("{}  ({:.3}°)", v(&stretch.to_array()), parts.stretch_angle_deg_within(anisotropy)));
-        ui.end_row();
-        ui.label("scale k");
-        ui.label(v(&parts.scale.to_array()));
-        ui.end_row();
-        ui.label("sign f");
-        ui.label(format!("{}", parts.sign));
-        ui.end_row();
+        let rows = [
+            ("translation", v(&parts.translation.to_array())),
+            ("rotation q", v(&parts.rotation.to_array())),
+            ("stretch U", format!("{}  ({:.3}°)", v(&stretch.to_array()), parts.stretch_angle_deg_within(anisotropy))),
+            ("scale k", v(&parts.scale.to_array())),
+            ("sign f", format!("{:>8}", parts.sign)),
+        ];
+        for (name, value) in rows {
+            ui.label(name);
+            ui.label(RichText::new(value).monospace());
+            ui.end_row();
+        }
     });
 }

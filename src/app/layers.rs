@@ -55,7 +55,7 @@ impl LayersPanel {
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         ui.heading("Layers");
         let mut layers = shared.doc.layers().clone();
-        egui::ScrollArea::vertical().show(ui, |ui| {
+        egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
             bind_section(ui, shared, &mut layers);
             interpolation_section(ui, shared, &mut layers);
             blend_section(ui, shared, &mut layers);

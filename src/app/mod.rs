@@ -311,18 +311,16 @@ impl BonescopeApp {
                         .min_size(160.0)
                         .show(ui, |ui| self.plots.ui(ui, &mut shared));
                 }
-                egui::Panel::left("outliner").resizable(true).default_size(250.0).show(ui, |ui| {
-                    self.outliner.ui(ui, &mut shared);
-                });
+                let width = ui.available_width();
+                side_panel(egui::Panel::left("outliner"), 250.0, width)
+                    .show(ui, |ui| self.outliner.ui(ui, &mut shared));
                 if shared.settings.show_inspector {
-                    egui::Panel::right("inspector").resizable(true).default_size(300.0).show(ui, |ui| {
-                        inspector::ui(ui, &mut shared);
-                    });
+                    side_panel(egui::Panel::right("inspector"), 300.0, width)
+                        .show(ui, |ui| inspector::ui(ui, &mut shared));
                 }
                 if shared.settings.show_layers {
-                    egui::Panel::right("layers").resizable(true).default_size(290.0).show(ui, |ui| {
-                        self.layers.ui(ui, &mut shared);
-                    });
+                    side_panel(egui::Panel::right("layers"), 290.0, width)
+                        .show(ui, |ui| self.layers.ui(ui, &mut shared));
                 }
                 egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));
             }
@@ -423,6 +421,21 @@ impl BonescopeApp {
         }
         ctx.request_repaint();
     }
+}
+
+/// The narrowest a side panel may be made, in points.
+const MIN_SIDE_PANEL: f32 = 160.0;
+
+/// The largest share of the window one side panel may take: with all three open (and their margins) the viewport
+/// keeps at least 40 %.
+const MAX_SIDE_SHARE: f32 = 0.19;
+
+/// A side panel of a stable width: `default` (within its range), resizable by the user between
+/// [`MIN_SIDE_PANEL`] and [`MAX_SIDE_SHARE`] of the window, remembered with egui's memory. Its contents scroll
+/// rather than widen it (see the panels' scroll areas), so selecting a bone never moves the viewport.
+fn side_panel(panel: egui::Panel, default: f32, window_width: f32) -> egui::Panel {
+    let max = (window_width * MAX_SIDE_SHARE).max(MIN_SIDE_PANEL);
+    panel.resizable(true).default_size(default.min(max)).size_range(MIN_SIDE_PANEL..=max)
 }
 
 /// Runs the native file dialog on its own thread so the UI keeps drawing.

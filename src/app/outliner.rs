@@ -35,7 +35,7 @@ impl Outliner {
             ui.label(RichText::new("no bone matches").weak());
         }
         let depths = shared.doc.rig.skeleton.depths();
-        egui::ScrollArea::vertical().auto_shrink([false, false]).show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
+        egui::ScrollArea::both().auto_shrink([false, false]).show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
             for &bone in &rows[range] {
                 self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 });
             }

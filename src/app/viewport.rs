@@ -127,21 +127,28 @@ fn aspect(rect: egui::Rect) -> f64 {
     f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0))
 }
 
+/// One row of view and display toggles; in a narrow window it scrolls sideways (wheel or drag) instead of wrapping
+/// onto a second row that would push the picture down.
 fn toolbar(ui: &mut Ui, shared: &mut Shared) {
-    ui.horizontal_wrapped(|ui| {
-        for view in ViewKind::ALL {
-            ui.selectable_value(&mut shared.settings.camera.view, view, view.label());
-        }
-        ui.separator();
-        let o = &mut shared.settings.scene;
-        ui.toggle_value(&mut o.bones, "Bones");
-        ui.toggle_value(&mut o.axes, "Axes");
-        ui.toggle_value(&mut o.boxes, "Boxes").on_hover_text("a unit box per bone: shear slants it");
-        ui.toggle_value(&mut o.mesh, "Mesh");
-        ui.toggle_value(&mut o.wireframe, "Wireframe");
-        ui.toggle_value(&mut o.bind_pose, "Bind pose");
-        ui.toggle_value(&mut o.names, "Names");
-        ui.toggle_value(&mut o.grid, "Grid");
-        ui.toggle_value(&mut o.legend, "Legend");
-    });
+    let row = egui::ScrollArea::horizontal()
+        .id_salt("viewport-toolbar")
+        .scroll_bar_visibility(egui::scroll_area::ScrollBarVisibility::AlwaysHidden);
+    row.show(ui, |ui| ui.horizontal(|ui| toggles(ui, shared)));
+}
+
+fn toggles(ui: &mut Ui, shared: &mut Shared) {
+    for view in ViewKind::ALL {
+        ui.selectable_value(&mut shared.settings.camera.view, view, view.label());
+    }
+    ui.separator();
+    let o = &mut shared.settings.scene;
+    ui.toggle_value(&mut o.bones, "Bones");
+    ui.toggle_value(&mut o.axes, "Axes");
+    ui.toggle_value(&mut o.boxes, "Boxes").on_hover_text("a unit box per bone: shear slants it");
+    ui.toggle_value(&mut o.mesh, "Mesh");
+    ui.toggle_value(&mut o.wireframe, "Wireframe");
+    ui.toggle_value(&mut o.bind_pose, "Bind pose");
+    ui.toggle_value(&mut o.names, "Names");
+    ui.toggle_value(&mut o.grid, "Grid");
+    ui.toggle_value(&mut o.legend, "Legend");
 }
