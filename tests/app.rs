@@ -387,3 +387,18 @@ fn selecting_a_bone_does_not_move_the_viewport() {
     settle(&mut harness);
     assert_eq!(harness.get_by_label("viewport").rect(), before);
 }
+
+#[test]
+fn f_frames_a_selected_bone_with_room_around_it() {
+    let mut harness = demo_app();
+    harness.get_by_label("hand").click();
+    settle(&mut harness);
+    harness.get_by_label("viewport").hover();
+    harness.run();
+    harness.key_press(egui::Key::F);
+    harness.run();
+    // A leaf bone is one point: framed with a few gizmo sizes around it (the demo's are 0.4 long), not zoomed
+    // into the joint.
+    let camera = harness.state().settings.camera;
+    assert!(camera.distance > 0.5, "distance {}", camera.distance);
+}

@@ -205,10 +205,14 @@ impl BonescopeApp {
         let Some(path) = self.doc.path.clone() else { return };
         match crate::import::load(&path) {
             Ok(rig) => {
+                // A file rewritten with another rig is framed anew; the same rig keeps the camera.
+                let names =
+                    |rig: &crate::model::Rig| rig.skeleton.bones().iter().map(|b| b.name.clone()).collect::<Vec<_>>();
+                let same_rig = names(&rig) == names(&self.doc.rig);
                 self.doc = self.doc.reloaded(rig);
                 let bones = self.doc.rig.skeleton.len();
                 self.selection.retain(|&b| b < bones);
-                self.document_replaced(false);
+                self.document_replaced(!same_rig);
                 self.notifications.info(format!("reloaded {}", path.display()));
             }
             Err(error) => self.notifications.error(format!("not reloaded: {error}")),

@@ -111,14 +111,27 @@ fn navigate(ui: &Ui, response: &egui::Response, rect: egui::Rect, camera: &mut C
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            camera.zoom((f64::from(scroll) * 0.003).exp());
+            // Towards the pointer, about 14 % per wheel notch (a notch scrolls 50 points).
+            let at = response.hover_pos().map_or(DVec2::ZERO, |p| {
+                let d = (p - rect.center()) / rect.height().max(1.0);
+                DVec2::new(f64::from(d.x), f64::from(d.y))
+            });
+            camera.zoom_at((f64::from(scroll) * 0.0026).exp(), at);
         }
     }
 }
 
+/// Frames the selected bones with their children (a bone is its head and where its children start), at least a few
+/// gizmo sizes across so a single joint does not fill the picture; everything when nothing is selected.
 fn frame_selection(scene: &Scene, selection: &[usize], camera: &mut Camera, aspect: f64) {
-    let selected = Bounds::of(selection.iter().map(|&b| scene.primary.head(b)));
-    if let Some(bounds) = selected.filter(|_| !selection.is_empty()).or_else(|| scene.bounds()) {
+    let skeleton = &scene.rig.skeleton;
+    let children = |bone: usize| (0..skeleton.len()).filter(move |&c| skeleton.parent(c) == Some(bone));
+    let points = selection.iter().flat_map(|&b| std::iter::once(b).chain(children(b))).map(|b| scene.primary.head(b));
+    let selected = Bounds::of(points).map(|b| {
+        let half = glam::DVec3::splat(scene.gizmo_size * 2.0);
+        Bounds { min: b.min.min(b.center() - half), max: b.max.max(b.center() + half) }
+    });
+    if let Some(bounds) = selected.or_else(|| scene.bounds()) {
         camera.frame(&bounds, aspect);
     }
 }

@@ -114,6 +114,9 @@ impl Default for Camera {
 /// Vertical field of view of the perspective view.
 const FOV_Y: f64 = 0.8;
 
+/// The highest elevation of the orbit camera (just short of straight down, where "up" is undefined).
+const MAX_PITCH: f64 = 1.55;
+
 impl Camera {
     /// Moves the target to the centre of `bounds` and the eye back (or, in a 2D view, the zoom out) until every
     /// corner of them is inside a viewport of this aspect ratio (width / height), with a margin: the whole box
@@ -170,11 +173,16 @@ impl Camera {
         projection * view
     }
 
-    /// Turns the 3D camera by a drag of `delta` radians (x: yaw, y: pitch); switches a 2D view to 3D.
+    /// Turns the 3D camera by a drag of `delta` radians (x: yaw, y: pitch); a 2D view becomes 3D from its own
+    /// direction, so the picture turns rather than jumps.
     pub fn orbit(&mut self, delta: DVec2) {
-        self.view = ViewKind::Persp;
+        if let Some((direction, _)) = self.view.fixed_direction() {
+            self.yaw = direction.x.atan2(direction.z);
+            self.pitch = direction.y.clamp(-1.0, 1.0).asin();
+            self.view = ViewKind::Persp;
+        }
         self.yaw -= delta.x;
-        self.pitch = (self.pitch + delta.y).clamp(-1.55, 1.55);
+        self.pitch = (self.pitch + delta.y).clamp(-MAX_PITCH, MAX_PITCH);
     }
 
     /// Moves the target in the view plane by a fraction of the visible height.
@@ -188,9 +196,19 @@ impl Camera {
 
     /// Zooms by a factor (> 1 moves closer).
     pub fn zoom(&mut self, factor: f64) {
-        if factor.is_finite() && factor > 0.0 {
-            self.distance = (self.distance / factor).clamp(1e-3, 1e6);
+        self.zoom_at(factor, DVec2::ZERO);
+    }
+
+    /// Zooms by a factor towards a point of the picture, `at` from its centre in fractions of its height (x right,
+    /// y down): that point stays under the pointer, as in DCC viewports.
+    pub fn zoom_at(&mut self, factor: f64, at: DVec2) {
+        if !(factor.is_finite() && factor > 0.0) {
+            return;
         }
+        let before = self.distance;
+        self.distance = (self.distance / factor).clamp(1e-3, 1e6);
+        // The pointer's point on the target plane moves by the change of the visible extent; pan it back.
+        self.pan(-at * (before / self.distance - 1.0));
     }
 }
 
@@ -270,5 +288,37 @@ mod tests {
             assert!(filled > tight, "{view:?}: the box fills only {filled} of the picture");
         }
         assert!(Bounds::of([DVec3::NAN]).is_none());
+    }
+
+    #[test]
+    fn orbiting_a_fixed_view_starts_from_its_direction() {
+        for view in [ViewKind::Front, ViewKind::Side, ViewKind::Top] {
+            let fixed = Camera { view, ..Camera::default() };
+            let mut orbited = fixed;
+            orbited.orbit(DVec2::ZERO);
+            assert_eq!(orbited.view, ViewKind::Persp);
+            // The eye stays where the fixed view had it (Top within the orbit's highest elevation).
+            let (a, b) = (fixed.eye() - fixed.target, orbited.eye() - orbited.target);
+            assert!(a.angle_between(b) < 0.03, "{view:?}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn zooming_towards_the_pointer_keeps_its_point_under_it() {
+        // A point on the target plane, a quarter of the picture's height right of and above the centre.
+        for view in [ViewKind::Front, ViewKind::Persp] {
+            let mut camera = Camera { view, yaw: 0.0, pitch: 0.0, ..Camera::default() };
+            let size = DVec2::new(200.0, 100.0);
+            let screen = size * 0.5 + DVec2::new(25.0, -25.0);
+            let at = (screen - size * 0.5) / size.y;
+            let height = camera.distance * (FOV_Y * 0.5).tan() * 2.0;
+            let point = camera.target + DVec3::new(at.x, -at.y, 0.0) * height;
+            let (before, _) = projection(&camera).project(point).unwrap();
+            assert!(before.abs_diff_eq(screen, 1e-9), "{view:?}: {before}");
+            camera.zoom_at(1.5, at);
+            let (after, _) = projection(&camera).project(point).unwrap();
+            assert!(after.abs_diff_eq(screen, 1e-9), "{view:?}: {after} vs {screen}");
+            assert!((camera.distance - 5.0 / 1.5).abs() < 1e-12);
+        }
     }
 }
