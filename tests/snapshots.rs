@@ -163,3 +163,10 @@ fn small_window_with_layers_and_inspector() {
     settle(&mut harness);
     harness.snapshot("small_window_with_layers_and_inspector");
 }
+
+/// Axis-angle curves: the angle in degrees and the unit axis in two plots sharing the time axis, the legend above
+/// them.
+#[test]
+fn demo_axis_angle_in_two_plots() {
+    app(|s| s.rotation_format = bonescope::app::RotationFormat::AxisAngle).snapshot("demo_axis_angle_in_two_plots");
+}

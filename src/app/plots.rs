@@ -109,9 +109,29 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
 pub struct Plots {
     pub component: Component,
     pub show_ghost: bool,
-    /// The curves and their value range.
-    cache: Option<(SeriesKey, Vec<Series>, (f64, f64))>,
+    /// The curves, split into plots of one unit each (an angle in degrees and a unit axis never share an axis).
+    cache: Option<(SeriesKey, Vec<Group>)>,
+    /// Set by "Reset view": the next frame fits the plots to the whole clip again.
+    reset: bool,
+}
+
+/// The curves of one plot: all in one unit, with their value range and their reduction to the visible range.
+struct Group {
+    series: Vec<Series>,
+    range: (f64, f64),
     reduced: Option<(ReducedKey, Vec<Drawn>)>,
+}
+
+impl Group {
+    /// The series split by unit: angles (names ending in `°`) apart from the rest, in their order.
+    fn split(series: Vec<Series>) -> Vec<Group> {
+        let (degrees, other): (Vec<Series>, Vec<Series>) = series.into_iter().partition(|s| s.name.ends_with('°'));
+        [degrees, other]
+            .into_iter()
+            .filter(|s| !s.is_empty())
+            .map(|series| Group { range: value_range(&series), series, reduced: None })
+            .collect()
+    }
 }
 
 /// A reduced curve in the plot's own types, kept across frames.
@@ -186,6 +206,10 @@ impl Plots {
                 ui.separator();
                 ui.checkbox(&mut self.show_ghost, "ghost");
             }
+            ui.separator();
+            if ui.button("Reset view").on_hover_text("the whole clip again (or double-click a plot)").clicked() {
+                self.reset = true;
+            }
         });
         let plotted = plotted_bones(shared);
         if plotted.is_empty() {
@@ -204,83 +228,120 @@ impl Plots {
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
         };
-        if self.cache.as_ref().is_none_or(|(k, _, _)| *k != key) {
-            let series = build_series(&key, &shared.doc.rig.skeleton);
-            let range = value_range(&series);
-            self.cache = Some((key, series, range));
-            self.reduced = None;
+        if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
+            let groups = Group::split(build_series(&key, &shared.doc.rig.skeleton));
+            self.cache = Some((key, groups));
         }
-        self.plot(ui, shared);
+        let reset = std::mem::take(&mut self.reset);
+        let Some((key, groups)) = &mut self.cache else { return };
+        legend(ui, groups);
+        let height = (ui.available_height() / groups.len() as f32).max(100.0);
+        let (count, link) = (groups.len(), ui.scope_id().with("component-plots"));
+        for (index, group) in groups.iter_mut().enumerate() {
+            plot(ui, shared, key, group, PlotPlace { index, last: index + 1 == count, height, reset, link });
+        }
     }
+}
 
-    fn plot(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        let Some((key, series, (y_min, y_max))) = &self.cache else { return };
-        let (y_min, y_max) = (*y_min, *y_max);
-        let reduced_cache = &mut self.reduced;
-        let times = &key.analysis.times;
-        let time = *shared.time;
-        let stretched = shared.stretched;
-        let response = Plot::new("components")
-            .height(ui.available_height().max(120.0))
-            // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
-            .include_x(0.0)
-            .include_x(shared.doc.duration())
-            .legend(egui_plot::Legend::default())
-            .x_axis_label("time (s)")
-            .allow_double_click_reset(true)
-            .show(ui, |plot_ui| {
-                let bounds = plot_ui.plot_bounds();
-                let rect = plot_ui.response().rect;
-                let reduced_key = ReducedKey {
-                    x_min: bounds.min()[0],
-                    x_max: bounds.max()[0],
-                    columns: rect.width().max(1.0) as usize,
-                };
-                if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
-                    let range = reduced_key.x_min..=reduced_key.x_max;
-                    let drawn = series
-                        .iter()
-                        .map(|s| reduce(times, |i| s.values[i], range.clone(), reduced_key.columns).into())
-                        .collect();
-                    *reduced_cache = Some((reduced_key, drawn));
-                }
-                let drawn = reduced_cache.as_ref().map(|(_, d)| d.as_slice()).unwrap_or_default();
-                // Half a pixel in plot units either side of an envelope keeps flat stretches visible.
-                let half_pixel = 0.5 * (bounds.max()[1] - bounds.min()[1]) / f64::from(rect.height().max(1.0));
-                for (s, drawn) in series.iter().zip(drawn) {
-                    match drawn {
-                        Drawn::Line(points) => {
-                            let line = Line::new(s.name.clone(), PlotPoints::Borrowed(points)).color(s.color);
-                            plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
-                        }
-                        Drawn::Envelope { xs, lows, highs } => {
-                            let lows: Vec<f64> = lows.iter().map(|v| v - half_pixel).collect();
-                            let highs: Vec<f64> = highs.iter().map(|v| v + half_pixel).collect();
-                            plot_ui.add(FilledArea::new(s.name.clone(), xs, &lows, &highs).fill_color(s.color));
-                        }
-                    }
-                }
-                // When the inspected bone is stretched, in the colour the viewport and outliner use for it. The
-                // bands span the curves' own range: spanning the plot's bounds would feed back into auto-bounds.
-                let pixel = (bounds.max()[0] - bounds.min()[0]) / f64::from(rect.width().max(1.0));
-                for (i, (from, to)) in merge_spans(stretched, pixel).into_iter().enumerate() {
-                    let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
-                    let name = if i == 0 { "stretched" } else { "" };
-                    plot_ui.polygon(
-                        egui_plot::Polygon::new(name, PlotPoints::from(corners))
-                            .fill_color(Badge::Stretched.color().gamma_multiply(0.12))
-                            .stroke(egui::Stroke::NONE),
-                    );
-                }
-                plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
-                plot_ui.pointer_coordinate()
-            });
-        if response.response.clicked()
-            && let Some(at) = response.inner
-        {
-            *shared.playing = false;
-            *shared.time = at.x.clamp(0.0, shared.doc.duration());
+/// Where one plot of the stack goes: its index, whether it carries the time axis, its height.
+#[derive(Clone, Copy)]
+struct PlotPlace {
+    index: usize,
+    last: bool,
+    height: f32,
+    reset: bool,
+    /// Shared by the plots of the stack: their time axes and cursors move together.
+    link: egui::Id,
+}
+
+/// The curves' names in their colours, in a row above the plots so no curve is hidden under a legend.
+fn legend(ui: &mut Ui, groups: &[Group]) {
+    ui.horizontal_wrapped(|ui| {
+        for s in groups.iter().flat_map(|g| &g.series) {
+            ui.label(RichText::new(&s.name).color(s.color).small());
         }
+        ui.label(RichText::new("now").color(ui_cursor_color()).small());
+    });
+}
+
+/// One plot of the stack: its curves reduced to the visible range, the stretched bands, the cursor. The wheel
+/// zooms time about the pointer (all plots together, their time axes linked); a click seeks.
+fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, place: PlotPlace) {
+    let (y_min, y_max) = group.range;
+    let (series, reduced_cache) = (&group.series, &mut group.reduced);
+    let times = &key.analysis.times;
+    let time = *shared.time;
+    let stretched = shared.stretched;
+    let mut plot = Plot::new(("components", place.index))
+        .height(place.height)
+        // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
+        .include_x(0.0)
+        .include_x(shared.doc.duration())
+        .link_axis(place.link, egui::Vec2b::new(true, false))
+        .link_cursor(place.link, egui::Vec2b::new(true, false))
+        .allow_scroll(false)
+        .allow_zoom(false)
+        .show_x(place.last)
+        .allow_double_click_reset(true);
+    if place.last {
+        plot = plot.x_axis_label("time (s)");
+    }
+    if place.reset {
+        plot = plot.reset();
+    }
+    let response = plot.show(ui, |plot_ui| {
+        let scroll = plot_ui.ctx().input(|i| i.smooth_scroll_delta.y);
+        if plot_ui.response().hovered() && scroll != 0.0 {
+            plot_ui.zoom_bounds_around_hovered(egui::Vec2::new((scroll * 0.0026).exp(), 1.0));
+            plot_ui.set_auto_bounds(egui::Vec2b::new(false, true));
+        }
+        let bounds = plot_ui.plot_bounds();
+        let rect = plot_ui.response().rect;
+        let reduced_key =
+            ReducedKey { x_min: bounds.min()[0], x_max: bounds.max()[0], columns: rect.width().max(1.0) as usize };
+        if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
+            let range = reduced_key.x_min..=reduced_key.x_max;
+            let drawn = series
+                .iter()
+                .map(|s| reduce(times, |i| s.values[i], range.clone(), reduced_key.columns).into())
+                .collect();
+            *reduced_cache = Some((reduced_key, drawn));
+        }
+        let drawn = reduced_cache.as_ref().map(|(_, d)| d.as_slice()).unwrap_or_default();
+        // Half a pixel in plot units either side of an envelope keeps flat stretches visible.
+        let half_pixel = 0.5 * (bounds.max()[1] - bounds.min()[1]) / f64::from(rect.height().max(1.0));
+        for (s, drawn) in series.iter().zip(drawn) {
+            match drawn {
+                Drawn::Line(points) => {
+                    let line = Line::new(s.name.clone(), PlotPoints::Borrowed(points)).color(s.color);
+                    plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
+                }
+                Drawn::Envelope { xs, lows, highs } => {
+                    let lows: Vec<f64> = lows.iter().map(|v| v - half_pixel).collect();
+                    let highs: Vec<f64> = highs.iter().map(|v| v + half_pixel).collect();
+                    plot_ui.add(FilledArea::new(s.name.clone(), xs, &lows, &highs).fill_color(s.color));
+                }
+            }
+        }
+        // When the inspected bone is stretched, in the colour the viewport and outliner use for it. The bands span
+        // the curves' own range: spanning the plot's bounds would feed back into auto-bounds.
+        let pixel = (bounds.max()[0] - bounds.min()[0]) / f64::from(rect.width().max(1.0));
+        for (from, to) in merge_spans(stretched, pixel) {
+            let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
+            plot_ui.polygon(
+                egui_plot::Polygon::new("stretched", PlotPoints::from(corners))
+                    .fill_color(Badge::Stretched.color().gamma_multiply(0.12))
+                    .stroke(egui::Stroke::NONE),
+            );
+        }
+        plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
+        plot_ui.pointer_coordinate()
+    });
+    if response.response.clicked()
+        && let Some(at) = response.inner
+    {
+        *shared.playing = false;
+        *shared.time = at.x.clamp(0.0, shared.doc.duration());
     }
 }
 
@@ -365,4 +426,24 @@ fn channel_color(index: usize) -> Color32 {
         Color32::from_rgb(160, 160, 160),
     ];
     COLORS[index % COLORS.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(name: &str) -> Series {
+        Series { name: name.to_owned(), color: Color32::WHITE, ghost: false, values: vec![0.0, 90.0] }
+    }
+
+    #[test]
+    fn angles_and_unit_values_get_their_own_plots() {
+        // Axis-angle: degrees in one plot, the unit axis in another (on one axis the axis curves would be flat).
+        let groups = Group::split(["hand angle°", "hand axis x", "hand axis y", "hand axis z"].map(series).into());
+        let names: Vec<Vec<&str>> = groups.iter().map(|g| g.series.iter().map(|s| s.name.as_str()).collect()).collect();
+        assert_eq!(names, [vec!["hand angle°"], vec!["hand axis x", "hand axis y", "hand axis z"]]);
+        // One unit: one plot.
+        assert_eq!(Group::split(["hand x", "hand y"].map(series).into()).len(), 1);
+        assert_eq!(Group::split(["hand X°", "hand Y°"].map(series).into()).len(), 1);
+    }
 }

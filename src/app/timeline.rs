@@ -182,10 +182,12 @@ fn key_ticks(
         }
         let run = keyed[column..].iter().take_while(|&&k| k).count();
         let x0 = rect.left() + column as f32 - 0.5;
+        // Keys on every pixel (a baked clip) read as a thin band, so single keys around it stay distinct.
+        let (rows, shade) = if run > 3 { (4.0..=7.0, color.gamma_multiply(0.5)) } else { (2.0..=9.0, color) };
         painter.rect_filled(
-            Rect::from_x_y_ranges(x0..=x0 + run as f32, rect.top() + 2.0..=rect.top() + 9.0),
+            Rect::from_x_y_ranges(x0..=x0 + run as f32, rect.top() + rows.start()..=rect.top() + rows.end()),
             0.0,
-            color,
+            shade,
         );
         column += run;
     }
@@ -193,8 +195,8 @@ fn key_ticks(
 
 /// Stretched spans of the inspected bone (or of any bone) as a coloured strip, merged to what the pixels show.
 fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: impl Fn(f64) -> f32) {
-    let strip =
-        Rect::from_min_size(pos2(rect.left(), rect.center().y - STRIP_HEIGHT / 2.0), vec2(rect.width(), STRIP_HEIGHT));
+    // Between the key ticks (top) and the seconds labels (bottom), so neither is painted over.
+    let strip = Rect::from_min_size(pos2(rect.left(), rect.top() + 11.0), vec2(rect.width(), STRIP_HEIGHT));
     let pixel = shared.doc.duration() / f64::from(rect.width().max(1.0));
     for (from, to) in merge_spans(shared.stretched, pixel) {
         let (x0, x1) = (x_of(from), x_of(to));
