@@ -402,3 +402,33 @@ fn f_frames_a_selected_bone_with_room_around_it() {
     let camera = harness.state().settings.camera;
     assert!(camera.distance > 0.5, "distance {}", camera.distance);
 }
+
+#[test]
+fn copy_as_json_is_what_inspect_prints_and_says_so() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let mut harness = asset_app("blender/stretchy_full.glb");
+    harness.state_mut().time = 0.5;
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    harness.get_by_label("Copy as JSON").click();
+    harness.step();
+    let copied = harness
+        .output()
+        .platform_output
+        .commands
+        .iter()
+        .find_map(|c| match c {
+            egui::OutputCommand::CopyText(text) => Some(text.clone()),
+            _ => None,
+        })
+        .expect("copied");
+    harness.run();
+    harness.get_by_label("copied to the clipboard");
+    let cli = std::process::Command::new(env!("CARGO_BIN_EXE_bonescope"))
+        .args(["inspect", &path.display().to_string(), "--time", "0.5", "--format", "json"])
+        .output()
+        .unwrap();
+    assert!(cli.status.success());
+    let parse = |text: &str| serde_json::from_str::<serde_json::Value>(text).unwrap();
+    assert_eq!(parse(&copied), parse(&String::from_utf8(cli.stdout).unwrap()));
+}

@@ -5,7 +5,9 @@ use egui::{Grid, RichText, Ui};
 use glam::DMat4;
 
 use super::Shared;
-use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, SampleReport};
+use super::{ModeChoice, ModeScope};
+use crate::analysis::report::{BoneReport, InspectSubject, LayeredInspectReport, SampleReport};
+use crate::eval::Hierarchy;
 use crate::math::AffineParts;
 use crate::view::Badge;
 
@@ -31,18 +33,21 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
     let explanation = badges.iter().map(|b| b.explanation()).collect::<Vec<_>>().join("; ");
     ui.label(RichText::new(text).color(color).strong()).on_hover_text(explanation);
     ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
-    if ui.button("Copy as JSON").on_hover_text("the same JSON as `bonescope inspect --format json`").clicked() {
-        let inspect = InspectReport {
-            file: shared.doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string()),
-            animation: shared.doc.clip().map(AnimationInfo::of),
-            inherit: shared.doc.common_mode().map_or_else(|| "declared".to_owned(), |m| m.id().to_owned()),
-            notes: shared.doc.rig.notes.clone(),
-            samples: vec![SampleReport { time: *shared.time, bones: vec![report.clone()] }],
-        };
-        if let Ok(json) = serde_json::to_string_pretty(&inspect) {
+    ui.horizontal(|ui| {
+        let copied_at = ui.scope_id().with("copied-at");
+        let now = ui.input(|i| i.time);
+        let hint = "every bone now, as `bonescope inspect FILE --time T --format json` prints it";
+        if ui.button("Copy as JSON").on_hover_text(hint).clicked()
+            && let Ok(json) = serde_json::to_string_pretty(&inspect_report(shared, reports.clone()))
+        {
             ui.ctx().copy_text(json);
+            ui.data_mut(|d| d.insert_temp(copied_at, now));
         }
-    }
+        if ui.data(|d| d.get_temp::<f64>(copied_at)).is_some_and(|t| now - t < 3.0) {
+            ui.label(RichText::new("copied to the clipboard").weak());
+            ui.ctx().request_repaint_after(std::time::Duration::from_millis(500));
+        }
+    });
     egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
@@ -50,6 +55,22 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
         section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts, tolerance);
         section(ui, "Local", &local, &crate::math::decompose(&local), tolerance);
     });
+}
+
+/// What `inspect --format json` prints for the document at the current time: every bone, the layers, the bind check.
+fn inspect_report(shared: &Shared, bones: Vec<BoneReport>) -> LayeredInspectReport {
+    let doc = &*shared.doc;
+    let inherit = doc.current_choice(0, ModeScope::All).map_or("mixed", ModeChoice::label).to_owned();
+    let hierarchy = Hierarchy::new(&doc.rig.skeleton, &doc.modes);
+    let subject = InspectSubject {
+        file: doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string()),
+        rig: &doc.rig,
+        clip: doc.clip(),
+        inherit,
+        hierarchy: &hierarchy,
+        layers: doc.layers().clone(),
+    };
+    LayeredInspectReport::new(subject, vec![SampleReport { time: *shared.time, bones }])
 }
 
 /// The morph-target weights in effect on the meshes the bone carries (animated by the clip, or the meshes' own).

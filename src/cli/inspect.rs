@@ -8,8 +8,7 @@ use clap::Args;
 use super::layers::LayerArgs;
 use super::table::{Table, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
-use crate::analysis::report::{AnimationInfo, BoneReport, InspectReport, LayeredInspectReport, SampleReport};
-use crate::analysis::{BindTolerance, bind_mismatches};
+use crate::analysis::report::{AnimationInfo, BoneReport, InspectSubject, LayeredInspectReport, SampleReport};
 use crate::eval::{Hierarchy, LayerStack, Pose};
 use crate::import;
 
@@ -50,19 +49,16 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
             SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, &pose, &tolerances) }
         })
         .collect();
-    let report = InspectReport {
-        file: args.file.display().to_string(),
-        notes: rig.notes.clone(),
-        animation: clip.map(AnimationInfo::of),
-        inherit: args.eval.inherit_label(),
-        samples,
-    };
     let summary = layers.summary(&rig, clip);
-    let report = LayeredInspectReport {
-        report,
+    let subject = InspectSubject {
+        file: args.file.display().to_string(),
+        rig: &rig,
+        clip,
+        inherit: args.eval.inherit_label(),
+        hierarchy: &hierarchy,
         layers,
-        bind_mismatches: bind_mismatches(&rig, &hierarchy, &BindTolerance::default()),
     };
+    let report = LayeredInspectReport::new(subject, samples);
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
         Format::Table => print!("{}", render_table(&report, &summary)),
