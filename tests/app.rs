@@ -432,3 +432,51 @@ fn copy_as_json_is_what_inspect_prints_and_says_so() {
     let parse = |text: &str| serde_json::from_str::<serde_json::Value>(text).unwrap();
     assert_eq!(parse(&copied), parse(&String::from_utf8(cli.stdout).unwrap()));
 }
+
+#[test]
+fn a_broken_file_is_remembered_watched_and_opens_once_fixed() {
+    let mut harness = demo_app();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("character.bvh");
+    std::fs::write(&file, b"HIERARCHY\nROOT hips\n{").unwrap();
+    harness.state_mut().open(&file);
+    harness.state_mut().open(&file);
+    harness.run();
+    assert!(harness.state().doc.path.is_none(), "still the demo");
+    assert_eq!(harness.state().settings.recent.first(), Some(&file), "listed in the recent files");
+    let errors = harness.state().errors();
+    assert_eq!((errors.len(), errors[0].1), (1, 2), "the same error twice is one message: {errors:?}");
+    // Fixed on disk: the watcher opens it, and the error goes.
+    let good =
+        std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/bvh_test2.bvh"))
+            .unwrap();
+    std::fs::write(&file, good).unwrap();
+    for _ in 0..100 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        harness.step();
+        if harness.state().doc.path.is_some() {
+            break;
+        }
+    }
+    assert_eq!(harness.state().doc.path.as_deref(), Some(file.as_path()));
+    assert!(harness.state().errors().is_empty(), "{:?}", harness.state().errors());
+}
+
+#[test]
+fn a_message_under_the_pointer_holds_still() {
+    let mut harness = demo_app();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/bvh_test2.bvh");
+    harness.state_mut().open(&path);
+    harness.run();
+    harness.get_by_label_contains("opened").hover();
+    // Five seconds (20 steps of 0.25 s) with the pointer on it: it does not fade, so nothing moves under a click.
+    for _ in 0..20 {
+        harness.step();
+    }
+    harness.get_by_label_contains("opened");
+    harness.get_by_label("viewport").hover();
+    for _ in 0..20 {
+        harness.step();
+    }
+    assert!(harness.query_by_label_contains("opened").is_none(), "faded once the pointer left");
+}

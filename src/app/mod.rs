@@ -131,6 +131,8 @@ pub struct BonescopeApp {
     job: AnalysisJob,
     notifications: Notifications,
     watcher: Option<watch::FileWatcher>,
+    /// A file that failed to open, watched so that fixing it opens it.
+    broken: Option<(PathBuf, watch::FileWatcher)>,
     open_dialog: Option<Receiver<Option<PathBuf>>>,
     /// For waking the UI from background threads (the file watcher).
     repaint: Option<egui::Context>,
@@ -155,6 +157,7 @@ impl BonescopeApp {
             job: AnalysisJob::default(),
             notifications: Notifications::default(),
             watcher: None,
+            broken: None,
             open_dialog: None,
             repaint: None,
             outliner: outliner::Outliner::default(),
@@ -179,18 +182,31 @@ impl BonescopeApp {
         app
     }
 
-    /// Loads `path`; on failure the current document stays and the error becomes a notification.
+    /// Loads `path`; on failure the current document stays, the error becomes a notification, and the file is
+    /// listed in the recent files and watched, so that fixing it on disk opens it.
     pub fn open(&mut self, path: &Path) {
+        let topic = path.display().to_string();
+        self.settings.remember(path.to_owned());
         match Document::load(path) {
             Ok(doc) => {
-                self.settings.remember(path.to_owned());
+                self.notifications.resolved(&topic);
+                self.broken = None;
                 self.doc = doc;
                 self.selection.clear();
                 self.time = 0.0;
                 self.document_replaced(true);
                 self.notifications.info(format!("opened {}", path.display()));
             }
-            Err(error) => self.notifications.error(error.to_string()),
+            Err(error) => {
+                self.notifications.error_about(&topic, error.to_string());
+                let ctx = self.repaint.clone();
+                let watcher = watch::FileWatcher::new(path, move |after| {
+                    if let Some(ctx) = &ctx {
+                        ctx.request_repaint_after(after);
+                    }
+                });
+                self.broken = watcher.map(|w| (path.to_owned(), w));
+            }
         }
     }
 
@@ -213,9 +229,10 @@ impl BonescopeApp {
                 let bones = self.doc.rig.skeleton.len();
                 self.selection.retain(|&b| b < bones);
                 self.document_replaced(!same_rig);
+                self.notifications.resolved(&path.display().to_string());
                 self.notifications.info(format!("reloaded {}", path.display()));
             }
-            Err(error) => self.notifications.error(format!("not reloaded: {error}")),
+            Err(error) => self.notifications.error_about(&path.display().to_string(), format!("not reloaded: {error}")),
         }
     }
 
@@ -275,6 +292,11 @@ impl BonescopeApp {
     pub fn analysis(&self) -> Option<&ClipAnalysis> {
         let key = self.job_key();
         self.job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
+    }
+
+    /// The errors shown, with how many times each was said.
+    pub fn errors(&self) -> Vec<(String, usize)> {
+        self.notifications.errors()
     }
 
     /// The whole window.
@@ -362,6 +384,12 @@ impl BonescopeApp {
         }
         if self.watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
             self.reload();
+        }
+        if let Some((path, watcher)) = &self.broken
+            && watcher.changed()
+        {
+            let path = path.clone();
+            self.open(&path);
         }
         // The viewport alone shows nothing of the whole-clip analysis.
         if self.chrome == Chrome::ViewportOnly {

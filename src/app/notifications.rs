@@ -1,4 +1,9 @@
-//! Short messages in the corner: errors stay until dismissed, information fades after a few seconds.
+//! Short messages in the corner: errors stay until dismissed (or until what they were about is fixed), information
+//! fades after a few seconds.
+//!
+//! They are built not to get in the way: nothing fades or moves while the pointer is over them (so a click meant
+//! for Dismiss never lands on the timeline behind), a message repeated collapses into one with a count, and at
+//! most a few are shown, the rest counted.
 
 use std::time::Duration;
 
@@ -6,38 +11,78 @@ use egui::{Align2, Color32, RichText};
 
 const INFO_SECONDS: f64 = 4.0;
 
+/// The most messages shown at once; older ones are summarised.
+const MAX_SHOWN: usize = 4;
+
 struct Notification {
     text: String,
     error: bool,
-    /// Set on the first frame it is shown.
+    /// What the message is about (a file's path), so that fixing it can clear it.
+    topic: Option<String>,
+    /// How many times it was said.
+    count: usize,
+    /// When it was last said or last hovered, on the first frame after.
     shown_at: Option<f64>,
 }
 
 #[derive(Default)]
 pub struct Notifications {
     items: Vec<Notification>,
+    /// Where they were drawn last frame: while the pointer is there they hold still.
+    area: Option<egui::Rect>,
 }
 
 impl Notifications {
-    pub fn error(&mut self, text: String) {
-        self.items.push(Notification { text, error: true, shown_at: None });
+    /// An error about `topic` (a file), kept until dismissed or [`Notifications::resolved`].
+    pub fn error_about(&mut self, topic: &str, text: String) {
+        self.push(text, true, Some(topic.to_owned()));
     }
 
     pub fn info(&mut self, text: String) {
-        self.items.push(Notification { text, error: false, shown_at: None });
+        self.push(text, false, None);
+    }
+
+    /// Drops the errors about `topic`: it loaded after all.
+    pub fn resolved(&mut self, topic: &str) {
+        self.items.retain(|n| !(n.error && n.topic.as_deref() == Some(topic)));
+    }
+
+    /// The errors kept, each with how many times it was said.
+    pub fn errors(&self) -> Vec<(String, usize)> {
+        self.items.iter().filter(|n| n.error).map(|n| (n.text.clone(), n.count)).collect()
+    }
+
+    fn push(&mut self, text: String, error: bool, topic: Option<String>) {
+        if let Some(same) = self.items.iter_mut().find(|n| n.text == text && n.error == error) {
+            same.count += 1;
+            same.shown_at = None;
+            return;
+        }
+        self.items.push(Notification { text, error, topic, count: 1, shown_at: None });
     }
 
     pub fn ui(&mut self, ctx: &egui::Context) {
         let now = ctx.input(|i| i.time);
-        self.items.retain(|n| n.error || n.shown_at.is_none_or(|t| now - t < INFO_SECONDS));
+        let hovered =
+            self.area.is_some_and(|area| ctx.input(|i| i.pointer.hover_pos()).is_some_and(|p| area.contains(p)));
+        if hovered {
+            self.items.iter_mut().for_each(|n| n.shown_at = Some(now));
+        } else {
+            self.items.retain(|n| n.error || n.shown_at.is_none_or(|t| now - t < INFO_SECONDS));
+        }
         if self.items.is_empty() {
+            self.area = None;
             return;
         }
         let mut dismissed = None;
-        egui::Area::new(egui::Id::unique("notifications")).anchor(Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -60.0)).show(
-            ctx,
-            |ui| {
-                for (i, n) in self.items.iter_mut().enumerate() {
+        let hidden = self.items.len().saturating_sub(MAX_SHOWN);
+        let response = egui::Area::new(egui::Id::unique("notifications"))
+            .anchor(Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -60.0))
+            .show(ctx, |ui| {
+                if hidden > 0 {
+                    ui.label(RichText::new(format!("{hidden} older messages")).weak());
+                }
+                for (i, n) in self.items.iter_mut().enumerate().skip(hidden) {
                     n.shown_at.get_or_insert(now);
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
                         ui.set_max_width(520.0);
@@ -48,20 +93,41 @@ impl Notifications {
                                 ("Info", ui.visuals().text_color())
                             };
                             ui.label(RichText::new(label).strong().color(color));
-                            ui.label(&n.text);
+                            let times = if n.count > 1 { format!(" (×{})", n.count) } else { String::new() };
+                            ui.label(format!("{}{times}", n.text));
                             if ui.small_button("Dismiss").clicked() {
                                 dismissed = Some(i);
                             }
                         });
                     });
                 }
-            },
-        );
+            });
+        self.area = Some(response.response.rect);
         if let Some(i) = dismissed {
             self.items.remove(i);
         }
         if self.items.iter().any(|n| !n.error) {
             ctx.request_repaint_after(Duration::from_millis(500));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn repeats_collapse_and_fixed_files_clear_their_errors() {
+        let mut notifications = Notifications::default();
+        for _ in 0..70 {
+            notifications.error_about("a.glb", "not reloaded: a.glb: truncated".to_owned());
+        }
+        notifications.error_about("b.glb", "b.glb: bad".to_owned());
+        assert_eq!(
+            notifications.errors(),
+            [("not reloaded: a.glb: truncated".to_owned(), 70), ("b.glb: bad".to_owned(), 1)]
+        );
+        notifications.resolved("a.glb");
+        assert_eq!(notifications.errors(), [("b.glb: bad".to_owned(), 1)]);
     }
 }
