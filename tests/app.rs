@@ -480,3 +480,20 @@ fn a_message_under_the_pointer_holds_still() {
     }
     assert!(harness.query_by_label_contains("opened").is_none(), "faded once the pointer left");
 }
+
+#[test]
+fn the_outliner_scrolls_to_a_bone_picked_elsewhere() {
+    let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
+    let skeleton = &harness.state().doc.rig.skeleton;
+    let (last, name) = (skeleton.len() - 1, skeleton.bone(skeleton.len() - 1).name.clone());
+    assert!(harness.query_by_label(&name).is_none(), "{name} starts below the fold");
+    // As a click in the viewport does.
+    harness.state_mut().selection = vec![last];
+    harness.step();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+    // The list scrolls smoothly: a few frames.
+    harness.run_steps(12);
+    // The outliner's row (the Inspector names the bone too).
+    harness.get_by_role_and_label(Role::Button, &name);
+}

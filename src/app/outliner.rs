@@ -14,6 +14,9 @@ pub struct Outliner {
     pub filter: String,
     pub only_flagged: bool,
     collapsed: HashSet<usize>,
+    /// The inspected bone the list last showed: when another one is picked elsewhere (the viewport), the list
+    /// scrolls to it.
+    shown: Option<usize>,
 }
 
 const ROW_HEIGHT: f32 = 20.0;
@@ -35,11 +38,26 @@ impl Outliner {
             ui.label(RichText::new("no bone matches").weak());
         }
         let depths = shared.doc.rig.skeleton.depths();
-        egui::ScrollArea::both().auto_shrink([false, false]).show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
+        let mut list = egui::ScrollArea::both().auto_shrink([false, false]);
+        let inspected = shared.selection.last().copied();
+        if inspected != self.shown {
+            self.shown = inspected;
+            // Rows are drawn only when visible, so the list scrolls by row: the picked bone a few rows from the top.
+            if let Some(row) = inspected.and_then(|bone| rows.iter().position(|&b| b == bone)) {
+                list = list.vertical_scroll_offset(
+                    (row.saturating_sub(3) as f32) * (ROW_HEIGHT + ui.spacing().item_spacing.y),
+                );
+            }
+        }
+        list.show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
             for &bone in &rows[range] {
                 self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 });
             }
         });
+        // A bone picked in the list itself is in view already: the list stays where it is.
+        if ui.ui_contains_pointer() && ui.input(|i| i.pointer.any_click()) {
+            self.shown = shared.selection.last().copied();
+        }
     }
 
     /// Findings now, or at any time of the clip when the analysis is there.

@@ -61,8 +61,9 @@ impl Viewport {
         if shared.settings.scene.bind_pose {
             scene.bind_pose = Some(Layer { model: bind_model_matrices(&rig), ..Layer::default() });
         }
-        self.frame_now(&mut shared.settings.camera, aspect(rect));
-        navigate(ui, &response, rect, &mut shared.settings.camera);
+        let picture = paint::picture_rect(rect, &scene);
+        self.frame_now(&mut shared.settings.camera, aspect(picture));
+        navigate(ui, &response, picture, &mut shared.settings.camera);
         if response.clicked()
             && let Some(at) = response.interact_pointer_pos()
         {
@@ -74,7 +75,7 @@ impl Viewport {
             }
         }
         if response.hovered() && ui.input(|i| i.key_pressed(egui::Key::F)) {
-            frame_selection(&scene, shared.selection, &mut shared.settings.camera, aspect(rect));
+            frame_selection(&scene, shared.selection, &mut shared.settings.camera, aspect(picture));
         }
         let camera = &shared.settings.camera;
         let mut palette = Palette::new(ui.visuals().dark_mode);

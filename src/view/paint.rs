@@ -12,10 +12,25 @@ use super::camera::{Camera, Projection};
 use super::scene::{Layer, Scene};
 use super::style::{Badge, Palette};
 
-/// Paints `scene` into `rect` as seen by `camera`.
+/// Height of one caption line, in points.
+const CAPTION_LINE: f32 = 17.0;
+
+/// Where the model is drawn inside a canvas `rect`: all of it, less a strip at the bottom for the caption when it
+/// is shown, so the caption never covers the model. Framing and picking use the same rectangle.
+pub fn picture_rect(rect: Rect, scene: &Scene) -> Rect {
+    if !scene.options.legend || scene.caption.is_empty() {
+        return rect;
+    }
+    let strip = scene.caption.len() as f32 * CAPTION_LINE + 8.0;
+    Rect::from_min_max(rect.min, Pos2::new(rect.max.x, (rect.max.y - strip).max(rect.min.y + rect.height() * 0.5)))
+}
+
+/// Paints `scene` into `rect` as seen by `camera` (the model in [`picture_rect`], the caption below it).
 pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, palette: &Palette) {
-    let projection = projection(camera, rect);
     painter.rect_filled(rect, 0.0, palette.background);
+    let (canvas, whole) = (painter.with_clip_rect(rect), rect);
+    let rect = picture_rect(rect, scene);
+    let projection = projection(camera, rect);
     let painter = painter.with_clip_rect(rect);
     let options = &scene.options;
     if options.grid {
@@ -67,7 +82,7 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
         paint_legend(&painter, rect, scene, palette);
-        paint_caption(&painter, rect, &scene.caption, palette);
+        paint_caption(&canvas, whole, &scene.caption, palette);
     }
 }
 
@@ -96,7 +111,7 @@ fn line(painter: &Painter, projection: &Projection, a: DVec3, b: DVec3, stroke: 
 
 /// The bone a click at `at` hits: the nearest bone segment (or joint) within 10 points.
 pub fn pick(scene: &Scene, camera: &Camera, rect: Rect, at: Pos2) -> Option<usize> {
-    let projection = projection(camera, rect);
+    let projection = projection(camera, picture_rect(rect, scene));
     let at = glam::Vec2::new(at.x, at.y);
     let mut best: Option<(f32, usize)> = None;
     for bone in 0..scene.primary.model.len() {
@@ -337,6 +352,25 @@ fn paint_caption(painter: &Painter, rect: Rect, caption: &[String], palette: &Pa
     let mut at = Pos2::new(rect.max.x - 14.0, rect.max.y - 14.0);
     for text in caption.iter().rev() {
         painter.text(at, Align2::RIGHT_CENTER, text, FontId::proportional(12.0), palette.text);
-        at.y -= 17.0;
+        at.y -= CAPTION_LINE;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::view::{Layer, SceneOptions};
+
+    #[test]
+    fn the_caption_has_its_own_strip_below_the_model() {
+        let rig = demo_rig();
+        let mut scene = Scene::new(&rig, Layer::default(), SceneOptions::default());
+        let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
+        assert_eq!(picture_rect(rect, &scene), rect, "no caption, the whole canvas");
+        scene.caption = vec!["demo rig · stretch".into(), "0.500 s".into(), "mode: full".into()];
+        assert_eq!(picture_rect(rect, &scene).max.y, 300.0 - 3.0 * CAPTION_LINE - 8.0);
+        scene.options.legend = false;
+        assert_eq!(picture_rect(rect, &scene), rect, "captions hidden with the legend");
     }
 }
