@@ -497,3 +497,28 @@ fn the_outliner_scrolls_to_a_bone_picked_elsewhere() {
     // The outliner's row (the Inspector names the bone too).
     harness.get_by_role_and_label(Role::Button, &name);
 }
+
+#[test]
+fn file_open_without_a_desktop_dialog_uses_the_apps_own_browser() {
+    let mut harness = demo_app();
+    harness.state_mut().native_dialog = bonescope::app::NativeDialog::Unavailable;
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("Open…").click();
+    harness.run();
+    harness.get_by_label_contains("no desktop file dialog here");
+    harness.get_by_label("Open a file");
+    // Type a folder: the browser enters it and lists its animation files; click one to open it.
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh");
+    let field = harness.get_by_label("Path");
+    field.click();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("Path").type_text(&folder.display().to_string());
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    harness.get_by_label("cmu_12_01_walk.bvh").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.path.as_deref(), Some(folder.join("cmu_12_01_walk.bvh").as_path()));
+    assert!(harness.query_by_label("Open a file").is_none(), "the browser closes once a file is chosen");
+}

@@ -5,6 +5,7 @@
 //! notifications.
 
 mod document;
+mod file_browser;
 mod inspector;
 mod job;
 mod layers;
@@ -23,11 +24,13 @@ use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
 pub use document::{Document, Ghost, ModeChoice, ModeScope};
+pub use file_browser::NativeDialog;
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Tolerances};
 use crate::eval::{Pose, SkinningMethod};
 use crate::view::Layer;
+use file_browser::{DialogOutcome, FileBrowser};
 use job::{AnalysisJob, JobKey};
 use notifications::Notifications;
 
@@ -133,7 +136,11 @@ pub struct BonescopeApp {
     watcher: Option<watch::FileWatcher>,
     /// A file that failed to open, watched so that fixing it opens it.
     broken: Option<(PathBuf, watch::FileWatcher)>,
-    open_dialog: Option<Receiver<Option<PathBuf>>>,
+    open_dialog: Option<Receiver<DialogOutcome>>,
+    /// Whether File → Open… may use the desktop's dialog (detected at start; tests set it).
+    pub native_dialog: NativeDialog,
+    /// bonescope's own file browser, when open.
+    browser: Option<FileBrowser>,
     /// For waking the UI from background threads (the file watcher).
     repaint: Option<egui::Context>,
     outliner: outliner::Outliner,
@@ -159,6 +166,8 @@ impl BonescopeApp {
             watcher: None,
             broken: None,
             open_dialog: None,
+            native_dialog: NativeDialog::detect(),
+            browser: None,
             repaint: None,
             outliner: outliner::Outliner::default(),
             plots: plots::Plots::default(),
@@ -352,12 +361,25 @@ impl BonescopeApp {
             }
         }
         self.notifications.ui(&ctx);
+        if let Some(browser) = &mut self.browser {
+            let mut open = true;
+            let chosen = browser.ui(&ctx, &mut open);
+            if !open {
+                self.browser = None;
+            }
+            if let Some(path) = chosen {
+                self.open(&path);
+            }
+        }
         self.apply(actions, &ctx);
     }
 
     fn apply(&mut self, actions: toolbar::Actions, ctx: &egui::Context) {
         if actions.open_dialog {
-            self.open_dialog = Some(spawn_open_dialog(ctx.clone()));
+            match self.native_dialog {
+                NativeDialog::Available => self.open_dialog = Some(spawn_open_dialog(ctx.clone())),
+                NativeDialog::Unavailable => self.open_browser(),
+            }
         }
         if let Some(path) = actions.open {
             self.open(&path);
@@ -373,13 +395,28 @@ impl BonescopeApp {
         }
     }
 
+    /// Shows bonescope's own file browser (the desktop has no dialog), in the open file's folder or the most
+    /// recent one's.
+    pub fn open_browser(&mut self) {
+        self.notifications.info("no desktop file dialog here (no XDG portal): using bonescope's own".to_owned());
+        let recent = self.doc.path.as_ref().or(self.settings.recent.first());
+        let folder = recent.and_then(|p| p.parent()).filter(|p| p.is_dir()).map(Path::to_owned);
+        let folder = folder.or_else(|| std::env::current_dir().ok()).unwrap_or_else(|| PathBuf::from("."));
+        self.browser = Some(FileBrowser::new(&folder));
+    }
+
     fn poll_background(&mut self, ctx: &egui::Context) {
         if let Some(dialog) = &self.open_dialog
-            && let Ok(choice) = dialog.try_recv()
+            && let Ok(outcome) = dialog.try_recv()
         {
             self.open_dialog = None;
-            if let Some(path) = choice {
-                self.open(&path);
+            match outcome {
+                DialogOutcome::Chosen(path) => self.open(&path),
+                DialogOutcome::Cancelled => {}
+                DialogOutcome::Failed => {
+                    self.native_dialog = NativeDialog::Unavailable;
+                    self.open_browser();
+                }
             }
         }
         if self.watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
@@ -471,14 +508,10 @@ fn side_panel(panel: egui::Panel, default: f32, window_width: f32) -> egui::Pane
 }
 
 /// Runs the native file dialog on its own thread so the UI keeps drawing.
-fn spawn_open_dialog(ctx: egui::Context) -> Receiver<Option<PathBuf>> {
+fn spawn_open_dialog(ctx: egui::Context) -> Receiver<DialogOutcome> {
     let (sender, receiver) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
-        let choice = rfd::FileDialog::new()
-            .add_filter("animation", &["glb", "gltf", "fbx", "bvh"])
-            .add_filter("any file", &["*"])
-            .pick_file();
-        let _ = sender.send(choice);
+        let _ = sender.send(file_browser::run_native_dialog());
         ctx.request_repaint();
     });
     receiver

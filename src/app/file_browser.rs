@@ -1,0 +1,196 @@
+//! File → Open… that always does something: the desktop's own dialog where there is one, else bonescope's.
+//!
+//! On Linux the native dialog goes through the XDG desktop portal over D-Bus; on a workstation without a full
+//! desktop (or in CI) there is none, and the dialog silently returns nothing. So the app asks for the native dialog
+//! only where a session bus exists, treats an answer faster than a person can cancel as a failure, and falls back
+//! to this browser: a path field (type or paste a path, Enter opens it), the folder's sub-folders and animation
+//! files to click, and Up.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// File extensions bonescope reads, shown in the browser.
+const EXTENSIONS: [&str; 4] = ["glb", "gltf", "fbx", "bvh"];
+
+/// A native dialog that answers sooner than this without a file did not really open.
+const TOO_FAST: Duration = Duration::from_millis(300);
+
+/// Whether a native file dialog can be shown here.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NativeDialog {
+    Available,
+    Unavailable,
+}
+
+impl NativeDialog {
+    /// What this machine offers: on Linux and the BSDs a D-Bus session is needed for the portal.
+    pub fn detect() -> Self {
+        let needs_portal = cfg!(all(unix, not(target_os = "macos")));
+        if needs_portal && std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_none() {
+            NativeDialog::Unavailable
+        } else {
+            NativeDialog::Available
+        }
+    }
+}
+
+/// How a native dialog ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DialogOutcome {
+    Chosen(PathBuf),
+    Cancelled,
+    /// It returned at once with nothing: no portal answered.
+    Failed,
+}
+
+impl DialogOutcome {
+    /// The outcome of a dialog that returned `choice` after `elapsed`.
+    pub fn of(choice: Option<PathBuf>, elapsed: Duration) -> Self {
+        match choice {
+            Some(path) => DialogOutcome::Chosen(path),
+            None if elapsed < TOO_FAST => DialogOutcome::Failed,
+            None => DialogOutcome::Cancelled,
+        }
+    }
+}
+
+/// Runs the native dialog and times it.
+pub fn run_native_dialog() -> DialogOutcome {
+    let started = Instant::now();
+    let choice = rfd::FileDialog::new().add_filter("animation", &EXTENSIONS).add_filter("any file", &["*"]).pick_file();
+    DialogOutcome::of(choice, started.elapsed())
+}
+
+/// bonescope's own file browser, shown in a window.
+pub struct FileBrowser {
+    folder: PathBuf,
+    /// What the path field holds.
+    typed: String,
+    /// Sub-folders first, then animation files, each sorted by name.
+    entries: Vec<(String, bool)>,
+    error: Option<String>,
+}
+
+impl FileBrowser {
+    /// A browser showing `folder`.
+    pub fn new(folder: &Path) -> Self {
+        let mut browser =
+            FileBrowser { folder: PathBuf::new(), typed: String::new(), entries: Vec::new(), error: None };
+        browser.enter(folder);
+        browser
+    }
+
+    fn enter(&mut self, folder: &Path) {
+        match list(folder) {
+            Ok(entries) => {
+                self.folder = folder.to_owned();
+                self.typed = folder.display().to_string();
+                self.entries = entries;
+                self.error = None;
+            }
+            Err(e) => self.error = Some(format!("{}: {e}", folder.display())),
+        }
+    }
+
+    /// Follows a typed path: a folder is entered, anything else is the file to open.
+    fn follow(&mut self, path: PathBuf) -> Option<PathBuf> {
+        if path.is_dir() {
+            self.enter(&path);
+            None
+        } else {
+            Some(path)
+        }
+    }
+
+    /// Draws the window; the file to open when one was chosen. `open` turns false when the window is closed.
+    pub fn ui(&mut self, ctx: &egui::Context, open: &mut bool) -> Option<PathBuf> {
+        let mut chosen = None;
+        let mut still_open = *open;
+        egui::Window::new("Open a file").open(&mut still_open).collapsible(false).default_width(480.0).show(
+            ctx,
+            |ui| {
+                ui.horizontal(|ui| {
+                    if ui.button("Up").on_hover_text("the parent folder").clicked()
+                        && let Some(parent) = self.folder.parent().map(Path::to_owned)
+                    {
+                        self.enter(&parent);
+                    }
+                    let label = ui.label("Path");
+                    let field =
+                        ui.add(egui::TextEdit::singleline(&mut self.typed).desired_width(360.0)).labelled_by(label.id);
+                    if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                        chosen = self.follow(PathBuf::from(self.typed.trim()));
+                    }
+                });
+                if let Some(error) = &self.error {
+                    ui.colored_label(egui::Color32::from_rgb(235, 64, 100), error);
+                }
+                ui.separator();
+                egui::ScrollArea::vertical().max_height(320.0).show(ui, |ui| {
+                    for (name, is_folder) in self.entries.clone() {
+                        let text = if is_folder { format!("{name}/") } else { name.clone() };
+                        if ui.selectable_label(false, text).clicked() {
+                            chosen = self.follow(self.folder.join(&name));
+                        }
+                    }
+                    if self.entries.is_empty() {
+                        ui.label(egui::RichText::new("no folders or animation files here").weak());
+                    }
+                });
+                ui.separator();
+                if ui.button("Cancel").clicked() {
+                    *open = false;
+                }
+            },
+        );
+        *open &= still_open;
+        if chosen.is_some() {
+            *open = false;
+        }
+        chosen
+    }
+}
+
+/// A folder's sub-folders and animation files (hidden ones left out), folders first, each sorted.
+fn list(folder: &Path) -> std::io::Result<Vec<(String, bool)>> {
+    let mut entries = Vec::new();
+    for entry in std::fs::read_dir(folder)? {
+        let Ok(entry) = entry else { continue };
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue;
+        }
+        let is_folder = entry.path().is_dir();
+        let readable =
+            Path::new(&name).extension().is_some_and(|e| EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)));
+        if is_folder || readable {
+            entries.push((name, is_folder));
+        }
+    }
+    entries.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.to_lowercase().cmp(&b.0.to_lowercase())));
+    Ok(entries)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_dialog_gone_at_once_failed_and_one_left_open_was_cancelled() {
+        assert_eq!(DialogOutcome::of(None, Duration::from_millis(5)), DialogOutcome::Failed);
+        assert_eq!(DialogOutcome::of(None, Duration::from_secs(3)), DialogOutcome::Cancelled);
+        let path = PathBuf::from("a.glb");
+        assert_eq!(DialogOutcome::of(Some(path.clone()), Duration::ZERO), DialogOutcome::Chosen(path));
+    }
+
+    #[test]
+    fn folders_first_then_animation_files() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["b.fbx", "a.GLB", "notes.txt", ".hidden.bvh"] {
+            std::fs::write(dir.path().join(name), b"").unwrap();
+        }
+        std::fs::create_dir(dir.path().join("takes")).unwrap();
+        let names: Vec<(String, bool)> = list(dir.path()).unwrap();
+        assert_eq!(names, [("takes".into(), true), ("a.GLB".into(), false), ("b.fbx".into(), false)]);
+    }
+}
