@@ -1,11 +1,15 @@
 //! The app's frame on a big rig: 500 bones, a 100,000-frame clip, 8 plotted bones. Measures the CPU time of one
 //! frame (layout, painting, plot reduction, tessellation) and the whole-clip analysis behind the plots.
 //! Targets (issue "The desktop app"): a frame under 8 ms, the analysis under 2 s on 2 cores, memory under 1 GiB.
+//!
+//! And the curves of a newly selected bone on long mocap (issue "The app on real production files"): the CMU walk
+//! (`../shared/assets/bvh`, 120 Hz) repeated 40 times, 175 s, judged down the selected bone's chain only (what the
+//! app computes on a click, beside the rig-wide summary it keeps): target under 50 ms.
 
 use std::hint::black_box;
 use std::time::Instant;
 
-use bonescope::analysis::{CurveRequest, ScanOptions, Subject, analyze};
+use bonescope::analysis::{CurveRequest, Judged, ScanOptions, Subject, analyze};
 use bonescope::app::{BonescopeApp, Document, Settings};
 use bonescope::eval::Hierarchy;
 use bonescope::import::stress_rig;
@@ -57,7 +61,7 @@ fn clip_analysis(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("500 bones, 100k frames, 8 curves (rayon, all cores)", |b| {
         b.iter(|| {
-            let request = CurveRequest { bones: &plotted, ghost: None };
+            let request = CurveRequest { bones: &plotted, ghost: None, ..Default::default() };
             black_box(analyze(
                 Subject::clip(&rig.skeleton, rig.clips.first()),
                 &hierarchy,
@@ -71,5 +75,47 @@ fn clip_analysis(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, app_frame, clip_analysis);
+/// The CMU walk with its motion repeated `times` times (the frame count and lines of the file's MOTION part).
+fn repeated_cmu_walk(times: usize) -> bonescope::model::Rig {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/cmu_12_01_walk.bvh");
+    let text = std::fs::read_to_string(&path).expect("../shared/assets/bvh/cmu_12_01_walk.bvh");
+    let (header, motion) = text.split_once("MOTION").unwrap();
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let frames: usize = lines.next().unwrap().trim().trim_start_matches("Frames:").trim().parse().unwrap();
+    let frame_time = lines.next().unwrap();
+    let values: Vec<&str> = lines.collect();
+    let repeated = vec![values.join("\n"); times].join("\n");
+    let bytes = format!("{header}MOTION\nFrames: {}\n{frame_time}\n{repeated}\n", frames * times);
+    bonescope::import::load_bytes(&path, bytes.as_bytes()).unwrap()
+}
+
+fn selection_curves(c: &mut Criterion) {
+    let rig = repeated_cmu_walk(40);
+    let clip = rig.clips.first();
+    eprintln!("repeated CMU walk: {:.1} s, {} bones", clip.map_or(0.0, |c| c.duration()), rig.skeleton.len());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hand = rig.skeleton.bones().iter().position(|b| b.name.contains("Hand")).unwrap_or(rig.skeleton.len() - 1);
+    let options = ScanOptions { rate: clip.map_or(30.0, |c| c.frame_rate()), ..ScanOptions::default() };
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let mut group = c.benchmark_group("selection curves");
+    group.sample_size(10);
+    for (name, judged) in [("chain only (the app on a click)", Judged::CurveChains), ("every bone", Judged::Every)] {
+        group.bench_function(format!("CMU walk ×40 (175 s, 120 Hz), one bone, {name}"), |b| {
+            b.iter(|| {
+                let request = CurveRequest { bones: &[hand], ghost: None, judged };
+                black_box(analyze(
+                    Subject::clip(&rig.skeleton, clip),
+                    &hierarchy,
+                    request,
+                    &options,
+                    &|_, _| {},
+                    &never,
+                ))
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, app_frame, clip_analysis, selection_curves);
 criterion_main!(benches);

@@ -33,7 +33,7 @@ fn main() {
         let started = Instant::now();
         let analysis = pool.install(|| {
             let subject = Subject::clip(&rig.skeleton, rig.clips.first());
-            let request = CurveRequest { bones: &plotted, ghost };
+            let request = CurveRequest { bones: &plotted, ghost, ..Default::default() };
             analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).expect("never cancelled")
         });
         let seconds = started.elapsed().as_secs_f64();

@@ -113,7 +113,9 @@ fn the_timeline_strip_and_plots_follow_the_analysis() {
     let app = harness.state();
     let analysis = app.analysis().expect("analysis for the current state");
     let forearm = bone(&harness, "forearm");
-    let curves = analysis.curves_of(forearm).expect("curves of the plotted bone");
+    let plotted = app.curves().expect("curves for the selection");
+    let curves = plotted.curves_of(forearm).expect("curves of the plotted bone");
+    assert_eq!(plotted.times, analysis.times, "the curves and the summary share their samples");
     assert_eq!(curves.model.len(), analysis.times.len());
     assert_eq!(curves.ghost_model.len(), analysis.times.len(), "the demo opens with a ghost");
     // Stretched while the upper arm is scaled, not at t = 0.

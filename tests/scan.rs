@@ -4,7 +4,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use bonescope::analysis::{
-    Assessment, Components, CurveRequest, GhostRequest, ScanOptions, Subject, analyze, sample_times, scan,
+    Assessment, Components, CurveRequest, GhostRequest, Judged, ScanOptions, Subject, analyze, sample_times, scan,
 };
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
@@ -74,7 +74,7 @@ fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
     let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
     let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
     let never = std::sync::atomic::AtomicBool::new(false);
-    let request = bonescope::analysis::CurveRequest { bones: &[1], ghost: None };
+    let request = bonescope::analysis::CurveRequest { bones: &[1], ghost: None, ..Default::default() };
     let analysis = bonescope::analysis::analyze(
         Subject::clip(&skeleton, Some(&clip)),
         &hierarchy,
@@ -255,7 +255,7 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
     for mode in InheritMode::ALL {
         let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]);
         let ghost = GhostRequest { hierarchy: &ghost_hierarchy, unlayered: false };
-        let request = CurveRequest { bones: &plotted, ghost: Some(ghost) };
+        let request = CurveRequest { bones: &plotted, ghost: Some(ghost), ..Default::default() };
         let subject = Subject::clip(skeleton, Some(clip));
         let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
         let (mut pose, mut ghost_pose) = (Pose::default(), Pose::default());
@@ -295,10 +295,43 @@ fn empty_rigs_single_keys_rest_poses_and_missing_bones_scan() {
     let rest = scan(Subject::clip(&skeleton, None), &hierarchy, &options, &|_, _| {});
     assert_eq!((rest.samples, rest.bones[1].flagged_samples), (1, 0));
     // Curves asked for a bone the skeleton does not have (a selection kept across a reload) are left out.
-    let request = CurveRequest { bones: &[1, 7], ghost: None };
+    let request = CurveRequest { bones: &[1, 7], ghost: None, ..Default::default() };
     let never = AtomicBool::new(false);
     let subject = Subject::clip(&skeleton, Some(&clip));
     let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
     assert_eq!(analysis.curves_of(1).map(|c| c.model.len()), Some(analysis.times.len()));
     assert!(analysis.curves_of(7).is_none());
+}
+
+/// The curves of a selection, judged down its chains only, are the curves of the whole-rig analysis exactly, and
+/// so are the summaries of the bones on those chains: by bone (full inheritance) and by pose (other modes).
+#[test]
+fn curves_of_the_chains_alone_equal_those_of_the_whole_analysis() {
+    let rig = stress_rig(30, 150, 5);
+    let (skeleton, clip) = (&rig.skeleton, &rig.clips[0]);
+    let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
+    let plotted = [7, 16, 25];
+    let never = AtomicBool::new(false);
+    for modes in [skeleton.declared_modes(), vec![InheritMode::SegmentCompensate; skeleton.len()]] {
+        let hierarchy = Hierarchy::new(skeleton, &modes);
+        let subject = Subject::clip(skeleton, Some(clip));
+        let analysis = |judged| {
+            let request = CurveRequest { bones: &plotted, ghost: None, judged };
+            analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap()
+        };
+        let (whole, chains) = (analysis(Judged::Every), analysis(Judged::CurveChains));
+        assert_eq!(chains.times, whole.times);
+        assert_eq!(chains.curves, whole.curves);
+        let mut on_chains: Vec<usize> = plotted.to_vec();
+        for &bone in &plotted {
+            let mut at = bone;
+            while let Some(parent) = skeleton.parent(at) {
+                on_chains.push(parent);
+                at = parent;
+            }
+        }
+        for bone in on_chains {
+            assert_eq!(chains.scan.bones[bone], whole.scan.bones[bone], "bone {bone}");
+        }
+    }
 }

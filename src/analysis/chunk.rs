@@ -10,7 +10,7 @@
 use glam::{DMat4, DQuat};
 
 use super::findings::{Judge, Verdict};
-use super::scan::{BoneSummary, Components, CurveRequest, GhostRequest, ScanOptions, Subject};
+use super::scan::{BoneSummary, Components, CurveRequest, GhostRequest, Judged, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
 use crate::math::{decompose_near, decompose_with_stretch};
@@ -32,10 +32,12 @@ pub(super) struct Plan<'a> {
     varying_rotation: Vec<bool>,
     /// The plotted bones and their ancestors, parents first: their local and model matrices are evaluated.
     modelled: Vec<usize>,
+    /// The bones judged, parents first: every bone, or the modelled ones ([`Judged`]).
+    judged: Vec<usize>,
 }
 
 impl<'a> Plan<'a> {
-    pub fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize]) -> Self {
+    pub fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize], judged: Judged) -> Self {
         let skeleton = subject.skeleton;
         let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
         let by_bone = subject.clip.filter(|_| subject.layered.is_none() && all_full);
@@ -58,6 +60,10 @@ impl<'a> Plan<'a> {
             varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
             varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
             modelled: with_ancestors(skeleton, plotted),
+            judged: match judged {
+                Judged::Every => (0..skeleton.len()).collect(),
+                Judged::CurveChains => with_ancestors(skeleton, plotted),
+            },
         }
     }
 }
@@ -170,7 +176,7 @@ impl Chunk<'_> {
         let mut runs: Vec<Run> = (0..skeleton.len()).map(|_| Run::Done).collect();
         let mut pending_children = plan.children.clone();
         let mut spare: Vec<Vec<Stretch>> = Vec::new();
-        for bone in 0..skeleton.len() {
+        for &bone in &plan.judged {
             let mut cursor = BoneCursor::new(skeleton, clip, bone);
             let above = plan.parents[bone].map_or(&ROOT, |p| &runs[p]);
             // A bone the clip does not scale, under a fixed stretch that is uniform or with a rotation that does
@@ -268,7 +274,7 @@ impl Chunk<'_> {
         let mut plot = Plotter::new(plotted.len());
         for (sample, &time) in self.times.iter().enumerate() {
             self.subject.evaluate(&mut pose, plan.hierarchy, layers, time);
-            for bone in 0..bones {
+            for &bone in &plan.judged {
                 let start = stretches[bone].frame;
                 let stretch = match plan.parents[bone] {
                     _ if !plan.inherits[bone] => Stretch::of_matrix(&pose.model.model[bone], start),

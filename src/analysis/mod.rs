@@ -14,6 +14,6 @@ pub use bind::{BindMismatch, BindTolerance, bind_mismatches};
 pub use compare::{BoneDifference, ClipComparison, compare};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use scan::{
-    BoneSummary, ClipAnalysis, ClipScan, Components, CurveRequest, Curves, GhostRequest, Layered, ScanOptions, Subject,
-    analyze, layered_sample_times, sample_times, scan,
+    BoneSummary, ClipAnalysis, ClipScan, Components, CurveRequest, Curves, GhostRequest, Judged, Layered, ScanOptions,
+    Subject, analyze, layered_sample_times, sample_times, scan,
 };

@@ -204,6 +204,19 @@ pub struct CurveRequest<'a> {
     pub bones: &'a [usize],
     /// A second evaluation of those bones, kept as their ghost curves.
     pub ghost: Option<GhostRequest<'a>>,
+    /// Which bones are judged.
+    pub judged: Judged,
+}
+
+/// Which bones an analysis judges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Judged {
+    /// Every bone: the whole-clip summary of the rig.
+    #[default]
+    Every,
+    /// Only the bones whose curves are asked for and their ancestors: the curves of a newly selected bone, without
+    /// waiting for the rest of the rig (the other bones' summaries stay empty).
+    CurveChains,
 }
 
 /// How the ghost curves are evaluated: under other modes, and with or without the analysis's layers.
@@ -371,7 +384,7 @@ pub fn analyze(
     let times = subject.times(options.rate);
     let in_range: Vec<usize> = request.bones.iter().copied().filter(|&b| b < skeleton.len()).collect();
     let request = CurveRequest { bones: &in_range, ..request };
-    let plan = Plan::new(subject, hierarchy, request.bones);
+    let plan = Plan::new(subject, hierarchy, request.bones, request.judged);
     let done = AtomicUsize::new(0);
     let words = times.len().div_ceil(64);
     let chunk_len = 64 * (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);

@@ -6,7 +6,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
 use super::Ghost;
-use crate::analysis::{ClipAnalysis, CurveRequest, GhostRequest, Layered, ScanOptions, Subject, Tolerances, analyze};
+use crate::analysis::{
+    ClipAnalysis, CurveRequest, GhostRequest, Judged, Layered, ScanOptions, Subject, Tolerances, analyze,
+};
 use crate::eval::{Hierarchy, LayerStack, Layers};
 use crate::model::{InheritMode, Rig};
 
@@ -22,6 +24,8 @@ pub struct JobKey {
     pub plotted: Vec<usize>,
     pub rate: f64,
     pub tolerances: Tolerances,
+    /// Every bone (the summary), or only the plotted bones' chains (their curves).
+    pub judged: Judged,
 }
 
 struct Running {
@@ -106,7 +110,7 @@ fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Run
             .map(|(hierarchy, (_, unlayered))| GhostRequest { hierarchy, unlayered: *unlayered });
         let clip = job_key.clip.and_then(|c| rig.clips.get(c));
         let options = ScanOptions { rate: job_key.rate, tolerances: job_key.tolerances };
-        let request = CurveRequest { bones: &job_key.plotted, ghost };
+        let request = CurveRequest { bones: &job_key.plotted, ghost, judged: job_key.judged };
         let progress = |d: usize, t: usize| {
             job_done.store(d, Ordering::Relaxed);
             job_total.store(t, Ordering::Relaxed);

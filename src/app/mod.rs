@@ -27,7 +27,7 @@ pub use document::{Document, Ghost, ModeChoice, ModeScope};
 pub use file_browser::NativeDialog;
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
-use crate::analysis::{ClipAnalysis, Tolerances};
+use crate::analysis::{ClipAnalysis, Judged, Tolerances};
 use crate::eval::{Pose, SkinningMethod};
 use crate::view::Layer;
 use file_browser::{DialogOutcome, FileBrowser};
@@ -66,7 +66,10 @@ pub struct Shared<'a> {
     /// Selected bones; the last one is the inspected one.
     pub selection: &'a mut Vec<usize>,
     pub frame: &'a Frame,
+    /// The rig-wide analysis: every bone's summary and stretched samples.
     pub analysis: Option<&'a Arc<ClipAnalysis>>,
+    /// The plotted bones' curves (a separate, quick analysis of their chains).
+    pub curves: Option<&'a Arc<ClipAnalysis>>,
     /// When the inspected bone (or, with none, any bone) is stretched, per the analysis.
     pub stretched: &'a [(f64, f64)],
     /// `(done, total)` samples while the whole-clip analysis runs.
@@ -132,6 +135,7 @@ pub struct BonescopeApp {
     pub selection: Vec<usize>,
     generation: u64,
     job: AnalysisJob,
+    curves_job: AnalysisJob,
     notifications: Notifications,
     watcher: Option<watch::FileWatcher>,
     /// A file that failed to open, watched so that fixing it opens it.
@@ -162,6 +166,7 @@ impl BonescopeApp {
             selection: Vec::new(),
             generation: 0,
             job: AnalysisJob::default(),
+            curves_job: AnalysisJob::default(),
             notifications: Notifications::default(),
             watcher: None,
             broken: None,
@@ -261,17 +266,41 @@ impl BonescopeApp {
         self.time = self.time.clamp(0.0, self.doc.duration());
     }
 
-    /// The whole-clip analysis the UI wants now.
+    /// The rig-wide analysis the UI wants now: every bone judged over the clip, no curves. It does not change with
+    /// the selection, so selecting a bone never waits for it.
     fn job_key(&self) -> JobKey {
         JobKey {
             generation: self.generation,
             clip: self.doc.clip,
             modes: self.doc.modes.clone(),
-            ghost: self.doc.ghost,
+            ghost: None,
             layers: self.doc.layers().clone(),
-            plotted: self.plotted(),
+            plotted: Vec::new(),
             rate: self.doc.frame_rate(),
             tolerances: self.settings.tolerances,
+            judged: Judged::Every,
+        }
+    }
+
+    /// The curves the plots want now: the plotted bones (and the ghost's), only their chains evaluated; `None`
+    /// with nothing selected.
+    fn curves_key(&self) -> Option<JobKey> {
+        let plotted = self.plotted();
+        (!plotted.is_empty()).then(|| JobKey {
+            plotted,
+            ghost: self.doc.ghost,
+            judged: Judged::CurveChains,
+            ..self.job_key()
+        })
+    }
+
+    /// Starts the analyses the current state wants (each only when its key changed).
+    fn request_analyses(&mut self, ctx: &egui::Context) {
+        let waker = ctx.clone();
+        self.job.update(self.job_key(), &self.doc.rig, move || waker.request_repaint());
+        if let Some(key) = self.curves_key() {
+            let waker = ctx.clone();
+            self.curves_job.update(key, &self.doc.rig, move || waker.request_repaint());
         }
     }
 
@@ -291,16 +320,21 @@ impl BonescopeApp {
 
     /// Waits for the background analysis to finish (for tests and headless renders).
     pub fn settle(&mut self, ctx: &egui::Context) {
-        let key = self.job_key();
-        let waker = ctx.clone();
-        self.job.update(key, &self.doc.rig, move || waker.request_repaint());
+        self.request_analyses(ctx);
         self.job.wait();
+        self.curves_job.wait();
     }
 
     /// The latest whole-clip analysis, if it matches the current state.
     pub fn analysis(&self) -> Option<&ClipAnalysis> {
         let key = self.job_key();
         self.job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
+    }
+
+    /// The latest curves of the plotted bones, if they match the current state.
+    pub fn curves(&self) -> Option<&ClipAnalysis> {
+        let key = self.curves_key()?;
+        self.curves_job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
     }
 
     /// The errors shown, with how many times each was said.
@@ -317,6 +351,7 @@ impl BonescopeApp {
         self.advance_playback(&ctx);
         let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.settings.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
+        let curves = self.curves_job.latest().map(|(_, a)| a.clone());
         let progress = self.job.progress();
         let stretched = self.spans.get(latest.as_ref(), self.selection.last().copied());
         let mut actions = toolbar::Actions::default();
@@ -329,6 +364,7 @@ impl BonescopeApp {
                 selection: &mut self.selection,
                 frame: &frame,
                 analysis: latest.as_ref(),
+                curves: curves.as_ref(),
                 stretched,
                 progress,
             };
@@ -432,9 +468,8 @@ impl BonescopeApp {
         if self.chrome == Chrome::ViewportOnly {
             return;
         }
-        let waker = ctx.clone();
-        self.job.update(self.job_key(), &self.doc.rig, move || waker.request_repaint());
-        if self.job.progress().is_some() {
+        self.request_analyses(ctx);
+        if self.job.progress().is_some() || self.curves_job.progress().is_some() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
     }

@@ -216,7 +216,7 @@ impl Plots {
             ui.label(RichText::new("Select bones to plot their components over the clip.").weak());
             return;
         }
-        let Some(analysis) = shared.analysis.filter(|a| plotted.iter().all(|b| a.curves_of(*b).is_some())) else {
+        let Some(analysis) = shared.curves.filter(|a| plotted.iter().all(|b| a.curves_of(*b).is_some())) else {
             ui.label(RichText::new("analysing the clip…").weak());
             return;
         };
