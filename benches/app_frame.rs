@@ -56,20 +56,12 @@ fn clip_analysis(c: &mut Criterion) {
     let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
     let plotted: Vec<usize> = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
     let options = ScanOptions { rate: bonescope::model::DEFAULT_FRAME_RATE, ..ScanOptions::default() };
-    let never = std::sync::atomic::AtomicBool::new(false);
     let mut group = c.benchmark_group("whole-clip analysis");
     group.sample_size(10);
     group.bench_function("500 bones, 100k frames, 8 curves (rayon, all cores)", |b| {
         b.iter(|| {
             let request = CurveRequest { bones: &plotted, ghost: None, ..Default::default() };
-            black_box(analyze(
-                Subject::clip(&rig.skeleton, rig.clips.first()),
-                &hierarchy,
-                request,
-                &options,
-                &|_, _| {},
-                &never,
-            ))
+            black_box(analyze_clip(&rig, &hierarchy, request, &options))
         })
     });
     group.finish();
@@ -96,25 +88,28 @@ fn selection_curves(c: &mut Criterion) {
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
     let hand = rig.skeleton.bones().iter().position(|b| b.name.contains("Hand")).unwrap_or(rig.skeleton.len() - 1);
     let options = ScanOptions { rate: clip.map_or(30.0, |c| c.frame_rate()), ..ScanOptions::default() };
-    let never = std::sync::atomic::AtomicBool::new(false);
     let mut group = c.benchmark_group("selection curves");
     group.sample_size(10);
     for (name, judged) in [("chain only (the app on a click)", Judged::CurveChains), ("every bone", Judged::Every)] {
         group.bench_function(format!("CMU walk ×40 (175 s, 120 Hz), one bone, {name}"), |b| {
             b.iter(|| {
                 let request = CurveRequest { bones: &[hand], ghost: None, judged };
-                black_box(analyze(
-                    Subject::clip(&rig.skeleton, clip),
-                    &hierarchy,
-                    request,
-                    &options,
-                    &|_, _| {},
-                    &never,
-                ))
+                black_box(analyze_clip(&rig, &hierarchy, request, &options))
             })
         });
     }
     group.finish();
+}
+
+/// The whole-clip analysis of the rig's first clip, never cancelled.
+fn analyze_clip(
+    rig: &bonescope::model::Rig,
+    hierarchy: &Hierarchy,
+    request: CurveRequest,
+    options: &ScanOptions,
+) -> Option<bonescope::analysis::ClipAnalysis> {
+    let never = std::sync::atomic::AtomicBool::new(false);
+    analyze(Subject::clip(&rig.skeleton, rig.clips.first()), hierarchy, request, options, &|_, _| {}, &never)
 }
 
 criterion_group!(benches, app_frame, clip_analysis, selection_curves);

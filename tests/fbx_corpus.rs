@@ -11,6 +11,8 @@
 //! The measure is the symmetric nearest-vertex distance (Hausdorff distance between the vertex sets) over the
 //! reference's bounding-box diagonal: the OBJs do not always keep the FBX's vertex order.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -18,6 +20,7 @@ use bonescope::eval::skinning::skin_meshes;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, Options, Space};
 use bonescope::model::Rig;
+use common::{hausdorff, size};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -192,27 +195,6 @@ fn scene_of(fbx_stem: &str) -> Option<&str> {
     let (name, version) = rest.rsplit_once('_')?;
     let numeric = !version.is_empty() && version.bytes().all(|b| b.is_ascii_digit());
     (numeric && matches!(format, "ascii" | "binary")).then_some(name)
-}
-
-/// The diagonal of the bounding box.
-fn size(points: &[DVec3]) -> f64 {
-    let lo = points.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
-    let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
-    (hi - lo).length()
-}
-
-/// The largest distance from a point of either set to the nearest point of the other.
-fn hausdorff(a: &[DVec3], b: &[DVec3]) -> f64 {
-    let one_way = |from: &[DVec3], to: &[DVec3]| {
-        from.par_iter()
-            .map(|p| to.iter().map(|q| p.distance_squared(*q)).fold(f64::INFINITY, f64::min))
-            .reduce(|| 0.0, f64::max)
-            .sqrt()
-    };
-    if a.is_empty() || b.is_empty() {
-        return if a.len() == b.len() { 0.0 } else { f64::INFINITY };
-    }
-    one_way(a, b).max(one_way(b, a))
 }
 
 /// The clip and time of `when` in bonescope's rig of `fbx`: the take ufbx evaluates (the one named, else the stack

@@ -2,12 +2,15 @@
 //! `node_to_world` as an oracle for every node at every sampled time, the authoring tools' own OBJ exports, and
 //! broken or hostile files that must fail cleanly, naming the place.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use bonescope::eval::skinning::skin_positions;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError, Options, Space};
 use bonescope::model::{InheritMode, Rig};
+use common::{hausdorff, size};
 use glam::{DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -281,21 +284,6 @@ fn obj_positions(path: &Path) -> Vec<DVec3> {
             DVec3::new(v[0], v[1], v[2])
         })
         .collect()
-}
-
-/// The diagonal of the bounding box.
-fn size(points: &[DVec3]) -> f64 {
-    let lo = points.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
-    let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
-    (hi - lo).length()
-}
-
-/// The largest distance from a point of either set to the nearest point of the other (Hausdorff distance).
-fn hausdorff(a: &[DVec3], b: &[DVec3]) -> f64 {
-    let one_way = |from: &[DVec3], to: &[DVec3]| {
-        from.iter().map(|p| to.iter().map(|q| p.distance(*q)).fold(f64::INFINITY, f64::min)).fold(0.0, f64::max)
-    };
-    one_way(a, b).max(one_way(b, a))
 }
 
 /// Every mesh of the file at `time` (first clip), as `export` evaluates it, in the file's own space.
