@@ -9,9 +9,10 @@
 
 use glam::{DMat4, DQuat};
 
+use super::clip_analysis::{BoneSummary, Components};
 use super::findings::{Judge, Verdict};
-use super::scan::{BoneSummary, Components, CurveRequest, GhostRequest, Judged, ScanOptions, Subject};
 use super::stretch::{CursorAt, Stretch};
+use super::subject::{CurveRequest, GhostRequest, Judged, ScanOptions, Subject};
 use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
 use crate::math::{decompose_near, decompose_with_stretch};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};

@@ -24,7 +24,7 @@ use glam::{DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::scan::{Layered, layered_sample_times};
+use super::subject::{Layered, layered_sample_times};
 use super::{Assessment, Tolerances};
 use crate::eval::skinning::skin_positions;
 use crate::eval::{Hierarchy, LayerStack, Pose};
