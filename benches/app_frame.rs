@@ -21,16 +21,25 @@ const FRAMES: usize = 100_000;
 const KEY_STEP: usize = 5;
 const PLOTTED: usize = 8;
 
-fn input() -> egui::RawInput {
+fn input(width: f32, height: f32) -> egui::RawInput {
     egui::RawInput {
-        screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1600.0, 1000.0))),
+        screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(width, height))),
         ..Default::default()
     }
 }
 
 fn app_frame(c: &mut Criterion) {
+    // 1600×1000 with the default panels, and a small laptop window with Layers and Inspector open.
+    let windows = [("", 1600.0, 1000.0, false), (", 1000×700 with Layers", 1000.0, 700.0, true)];
+    for (name, width, height, show_layers) in windows {
+        let settings = Settings { show_layers, ..Settings::default() };
+        frame_in(c, &format!("app frame, 500 bones, 100k frames, 8 curves{name}"), settings, input(width, height));
+    }
+}
+
+fn frame_in(c: &mut Criterion, name: &str, settings: Settings, input: egui::RawInput) {
     let rig = stress_rig(BONES, FRAMES, KEY_STEP);
-    let mut app = BonescopeApp::new(Settings::default(), Document::new(None, rig));
+    let mut app = BonescopeApp::new(settings, Document::new(None, rig));
     // The eight plotted bones sit below scaled bones, so they shear.
     app.selection = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
     app.time = 1234.5;
@@ -40,11 +49,11 @@ fn app_frame(c: &mut Criterion) {
     eprintln!("whole-clip analysis in the app (settle): {:.2} s", started.elapsed().as_secs_f64());
     // Two warm-up frames: fonts, layout caches, the plot's first reduction.
     for _ in 0..2 {
-        let _ = ctx.run_ui(input(), |ui| app.ui(ui));
+        let _ = ctx.run_ui(input.clone(), |ui| app.ui(ui));
     }
-    c.bench_function("app frame, 500 bones, 100k frames, 8 curves", |b| {
+    c.bench_function(name, |b| {
         b.iter(|| {
-            let output = ctx.run_ui(input(), |ui| app.ui(ui));
+            let output = ctx.run_ui(input.clone(), |ui| app.ui(ui));
             black_box(ctx.tessellate(output.shapes, output.pixels_per_point))
         })
     });
