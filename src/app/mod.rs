@@ -276,7 +276,8 @@ impl BonescopeApp {
             ghost: None,
             layers: self.doc.layers().clone(),
             plotted: Vec::new(),
-            rate: self.doc.frame_rate(),
+            // The clip's own frames, and at least 30 a second, so a clip keyed sparsely is examined between keys.
+            rate: self.doc.frame_rate().max(crate::model::DEFAULT_FRAME_RATE),
             tolerances: self.settings.tolerances,
             judged: Judged::Every,
         }
