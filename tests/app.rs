@@ -524,3 +524,32 @@ fn file_open_without_a_desktop_dialog_uses_the_apps_own_browser() {
     assert_eq!(harness.state().doc.path.as_deref(), Some(folder.join("cmu_12_01_walk.bvh").as_path()));
     assert!(harness.query_by_label("Open a file").is_none(), "the browser closes once a file is chosen");
 }
+
+#[test]
+fn the_wheel_zooms_the_plots_time_about_the_pointer() {
+    let mut harness = demo_app();
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    let ctx = harness.ctx.clone();
+    let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
+    let (before, frame) = (memory().bounds().clone(), *memory().transform().frame());
+    // The pointer a quarter of the way in, one wheel notch up.
+    let at = frame.lerp_inside(egui::vec2(0.25, 0.5));
+    let x_at = memory().transform().value_from_position(at).x;
+    harness.event(egui::Event::PointerMoved(at));
+    harness.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, 50.0),
+        phase: egui::TouchPhase::Move,
+        source: egui::MouseWheelSource::Wheel,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run_steps(10);
+    let after = memory().bounds().clone();
+    let (width_before, width_after) = (before.width(), after.width());
+    assert!(width_after < 0.95 * width_before, "zoomed in: {width_before} → {width_after}");
+    // About the pointer: the time under it stays where it was on screen.
+    let still = memory().transform().value_from_position(at).x;
+    assert!((still - x_at).abs() < 0.02 * width_before, "{x_at} → {still}");
+    assert_eq!(harness.state().time, 0.0, "the wheel does not seek");
+}

@@ -25,6 +25,7 @@ use std::sync::mpsc::Receiver;
 
 pub use document::{Document, Ghost, ModeChoice, ModeScope};
 pub use file_browser::NativeDialog;
+pub use plots::plot_id;
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Judged, Tolerances};

@@ -243,6 +243,11 @@ impl Plots {
     }
 }
 
+/// The egui id of the `index`-th plot of the stack (its `egui_plot::PlotMemory` holds the visible range).
+pub fn plot_id(index: usize) -> egui::Id {
+    egui::Id::unique(("bonescope component plot", index))
+}
+
 /// Where one plot of the stack goes: its index, whether it carries the time axis, its height.
 #[derive(Clone, Copy)]
 struct PlotPlace {
@@ -273,6 +278,7 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
     let time = *shared.time;
     let stretched = shared.stretched;
     let mut plot = Plot::new(("components", place.index))
+        .id(plot_id(place.index))
         .height(place.height)
         // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
         .include_x(0.0)
