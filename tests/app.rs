@@ -532,7 +532,7 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
     settle(&mut harness);
     let ctx = harness.ctx.clone();
     let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
-    let (before, frame) = (memory().bounds().clone(), *memory().transform().frame());
+    let (before, frame) = (*memory().bounds(), *memory().transform().frame());
     // The pointer a quarter of the way in, one wheel notch up.
     let at = frame.lerp_inside(egui::vec2(0.25, 0.5));
     let x_at = memory().transform().value_from_position(at).x;
@@ -545,7 +545,7 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
         modifiers: egui::Modifiers::NONE,
     });
     harness.run_steps(10);
-    let after = memory().bounds().clone();
+    let after = *memory().bounds();
     let (width_before, width_after) = (before.width(), after.width());
     assert!(width_after < 0.95 * width_before, "zoomed in: {width_before} → {width_after}");
     // About the pointer: the time under it stays where it was on screen.
