@@ -15,6 +15,7 @@ pub mod cli;
 pub mod eval;
 pub mod export;
 pub mod import;
+pub mod library;
 pub mod math;
 pub mod model;
 pub mod render;

@@ -476,3 +476,21 @@ fn scan_storage_reports_marked_bones_bytes_and_errors() {
     let err = stderr_of(&["scan", &stretchy(), "--storage", "--probe-distance", "0"]);
     assert!(err.contains("--probe-distance"), "{err}");
 }
+
+#[test]
+fn scan_walks_folders_by_content_with_include_globs() {
+    // A folder (not "Is a directory"): its animations by content, filtered, in sorted order.
+    let folder = asset("blender").display().to_string();
+    let output = bonescope(&["scan", &folder, "--include", "*.glb", "--format", "json"]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let files: Vec<String> =
+        json(&output).as_array().unwrap().iter().map(|f| f["file"].as_str().unwrap().to_owned()).collect();
+    let names: Vec<&str> = files.iter().map(|f| f.rsplit('/').next().unwrap()).collect();
+    assert_eq!(names, ["stretchy_full.glb", "stretchy_noinherit.glb"]);
+    // A glob that matches nothing is a warning, and the other inputs are still scanned.
+    let missing = asset("nowhere").join("*.fbx").display().to_string();
+    let output = bonescope(&["scan", &folder, &missing, "--include", "*.bvh"]);
+    assert!(output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("matches no file"));
+    assert!(String::from_utf8_lossy(&output.stdout).contains("stretchy_full.bvh"));
+}

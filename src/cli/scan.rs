@@ -17,13 +17,22 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
+use crate::library::{Filter, collect};
 use crate::model::{Clip, Rig};
 
 #[derive(Debug, Args)]
 pub struct ScanArgs {
-    /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content), folders (walked: every file in them
+    /// that is an animation), globs (`'exports/**/*.fbx'`), or `-` for a list of paths on standard input.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// In folders, scan only files matching this glob (by name, or by path below the folder when it has a `/`;
+    /// case-insensitive; repeatable), e.g. `--include '*.fbx'`.
+    #[arg(long, value_name = "GLOB")]
+    pub include: Vec<String>,
+    /// In folders, skip files matching this glob (as --include; repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub exclude: Vec<String>,
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Samples per second, on top of every key time.
@@ -90,7 +99,7 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     if args.storage {
         return run_storage(args, &options);
     }
-    let files: Vec<FileScan> = args.files.iter().map(|path| scan_file(path, args, &options)).collect();
+    let files: Vec<FileScan> = inputs(args)?.iter().map(|path| scan_file(path, args, &options)).collect();
     let loaded = print_files(&files, args.format, render_animation)?;
     let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
     Ok(if !loaded {
@@ -100,6 +109,17 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The files the arguments name ([`crate::library::collect`]); what could not be read on the way is reported on
+/// standard error, and the scan goes on.
+fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
+    let filter = Filter::new(&args.include, &args.exclude).map_err(anyhow::Error::msg)?;
+    let inputs = collect(&args.files, &filter, &mut std::io::stdin().lock());
+    for problem in &inputs.problems {
+        eprintln!("warning: {}: {}", problem.path.display(), problem.message);
+    }
+    Ok(inputs.files)
 }
 
 /// Prints the reports (JSON, or per file its clips as `animation` renders them) and, on standard error, every
@@ -172,8 +192,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     }
     let storage =
         StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
-    let files: Vec<FileStorage> = args
-        .files
+    let files: Vec<FileStorage> = inputs(args)?
         .iter()
         .map(|path| {
             let file = path.display().to_string();
@@ -224,8 +243,7 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 }
 
 fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {
-    let files: Vec<FileComparison> = args
-        .files
+    let files: Vec<FileComparison> = inputs(args)?
         .iter()
         .map(|path| {
             let file = path.display().to_string();

@@ -1,0 +1,231 @@
+//! The files a scan covers, from what the command line names.
+//!
+//! - A file is scanned as named, whatever its content (a file that is not an animation then fails to load, which
+//!   the report says).
+//! - A folder is walked recursively (symbolic links followed, loops detected by walkdir) and the files in it whose
+//!   content bonescope recognises ([`crate::import::detect`] on their first 64 KiB, never their name) are scanned;
+//!   `--include`/`--exclude` globs narrow that down by path relative to the folder (a pattern without a `/`
+//!   matches the file name, as `*.fbx`).
+//! - A pattern with glob characters that names nothing as written (`'exports/**/*.fbx'`, quoted so the shell left it)
+//!   is expanded.
+//! - `-` reads one path per line from standard input (each as above).
+//!
+//! Unreadable entries, symlink loops and names that match nothing are problems the scan reports, not reasons to stop.
+//! The files come out sorted and without duplicates, so reports do not depend on the order the file system or the
+//! threads deliver them in.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// How much of a file is read to recognise its format.
+const SNIFF_BYTES: u64 = 64 * 1024;
+
+/// Which files found in folders are scanned.
+#[derive(Clone, Debug, Default)]
+pub struct Filter {
+    include: Vec<glob::Pattern>,
+    exclude: Vec<glob::Pattern>,
+}
+
+impl Filter {
+    /// From `--include` and `--exclude` patterns; an invalid pattern is an error naming it.
+    pub fn new(include: &[String], exclude: &[String]) -> Result<Self, String> {
+        let parse = |patterns: &[String]| {
+            patterns
+                .iter()
+                .map(|p| glob::Pattern::new(p).map_err(|e| format!("invalid pattern `{p}`: {e}")))
+                .collect::<Result<Vec<_>, _>>()
+        };
+        Ok(Filter { include: parse(include)?, exclude: parse(exclude)? })
+    }
+
+    /// Whether `relative` (a path below a walked folder) passes: some include pattern matches (or there is none),
+    /// and no exclude pattern does.
+    fn admits(&self, relative: &Path) -> bool {
+        let matches = |pattern: &glob::Pattern| {
+            let name = relative.file_name().map(Path::new).unwrap_or(relative);
+            let options = glob::MatchOptions { case_sensitive: false, ..glob::MatchOptions::new() };
+            let subject = if pattern.as_str().contains('/') { relative } else { name };
+            pattern.matches_path_with(subject, options)
+        };
+        (self.include.is_empty() || self.include.iter().any(matches)) && !self.exclude.iter().any(matches)
+    }
+}
+
+/// Something the inputs could not give: a path and what went wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InputProblem {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// The files to scan, sorted and distinct, and what could not be read on the way.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Inputs {
+    pub files: Vec<PathBuf>,
+    pub problems: Vec<InputProblem>,
+}
+
+/// The files `names` stand for (see the module's rules); `stdin` is read for a `-`.
+pub fn collect(names: &[PathBuf], filter: &Filter, stdin: &mut dyn Read) -> Inputs {
+    let mut inputs = Inputs::default();
+    for name in names {
+        if name.as_os_str() == "-" {
+            let mut list = String::new();
+            if let Err(e) = stdin.read_to_string(&mut list) {
+                inputs.problem(name, format!("cannot read the list of paths: {e}"));
+            }
+            for line in list.lines().map(str::trim).filter(|l| !l.is_empty()) {
+                inputs.add(Path::new(line), filter);
+            }
+        } else {
+            inputs.add(name, filter);
+        }
+    }
+    inputs.files.sort();
+    inputs.files.dedup();
+    inputs
+}
+
+impl Inputs {
+    fn problem(&mut self, path: &Path, message: String) {
+        self.problems.push(InputProblem { path: path.to_owned(), message });
+    }
+
+    /// One name: a folder, a file, or a glob.
+    fn add(&mut self, name: &Path, filter: &Filter) {
+        if name.is_dir() {
+            self.walk(name, filter);
+        } else if name.exists() || !is_glob(name) {
+            // A file as named; a missing one fails to load in the report, naming it.
+            self.files.push(name.to_owned());
+        } else {
+            self.expand(name, filter);
+        }
+    }
+
+    fn expand(&mut self, pattern: &Path, filter: &Filter) {
+        let text = pattern.to_string_lossy();
+        match glob::glob(&text) {
+            Err(e) => self.problem(pattern, format!("invalid pattern: {e}")),
+            Ok(paths) => {
+                let before = self.files.len();
+                for path in paths {
+                    match path {
+                        Ok(path) if path.is_dir() => self.walk(&path, filter),
+                        Ok(path) => self.files.push(path),
+                        Err(e) => self.problem(e.path(), format!("cannot read: {}", e.error())),
+                    }
+                }
+                if self.files.len() == before {
+                    self.problem(pattern, "matches no file".to_owned());
+                }
+            }
+        }
+    }
+
+    fn walk(&mut self, folder: &Path, filter: &Filter) {
+        for entry in walkdir::WalkDir::new(folder).follow_links(true).sort_by_file_name() {
+            match entry {
+                Err(e) => {
+                    let path = e.path().map_or_else(|| folder.to_owned(), Path::to_owned);
+                    let message = if e.loop_ancestor().is_some() {
+                        "a symbolic link loop: not followed".to_owned()
+                    } else {
+                        format!("cannot read: {}", e.io_error().map_or_else(|| e.to_string(), ToString::to_string))
+                    };
+                    self.problem(&path, message);
+                }
+                Ok(entry) if entry.file_type().is_file() => {
+                    let relative = entry.path().strip_prefix(folder).unwrap_or(entry.path());
+                    if filter.admits(relative) && recognised(entry.path()) {
+                        self.files.push(entry.into_path());
+                    }
+                }
+                Ok(_) => {}
+            }
+        }
+    }
+}
+
+/// Whether `path` has glob characters.
+fn is_glob(path: &Path) -> bool {
+    path.to_string_lossy().contains(['*', '?', '['])
+}
+
+/// Whether a file's first bytes are a format bonescope reads.
+fn recognised(path: &Path) -> bool {
+    let mut head = Vec::new();
+    let read = std::fs::File::open(path).and_then(|f| f.take(SNIFF_BYTES).read_to_end(&mut head));
+    read.is_ok() && crate::import::detect(&head).is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder of exports: animations in sub-folders, a text file, and an FBX named `.txt`.
+    fn library() -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path();
+        std::fs::create_dir_all(root.join("chars/hero")).unwrap();
+        std::fs::create_dir_all(root.join("mocap")).unwrap();
+        std::fs::write(root.join("chars/hero/run.fbx"), b"; FBX 7.4.0 project file\n").unwrap();
+        std::fs::write(root.join("chars/hero/walk.glb"), b"glTF\x02\0\0\0").unwrap();
+        std::fs::write(root.join("mocap/take1.bvh"), b"HIERARCHY\nROOT hips\n").unwrap();
+        std::fs::write(root.join("mocap/notes.txt"), b"not an animation").unwrap();
+        std::fs::write(root.join("mocap/renamed.txt"), b"Kaydara FBX Binary  \0rest").unwrap();
+        dir
+    }
+
+    fn names(inputs: &Inputs, root: &Path) -> Vec<String> {
+        inputs.files.iter().map(|f| f.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/")).collect()
+    }
+
+    #[test]
+    fn folders_give_their_animations_by_content_sorted() {
+        let dir = library();
+        let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
+        let expected = ["chars/hero/run.fbx", "chars/hero/walk.glb", "mocap/renamed.txt", "mocap/take1.bvh"];
+        assert_eq!(names(&inputs, dir.path()), expected);
+        assert!(inputs.problems.is_empty(), "{:?}", inputs.problems);
+    }
+
+    #[test]
+    fn include_and_exclude_narrow_the_walk() {
+        let dir = library();
+        let only_fbx = Filter::new(&["*.FBX".into()], &[]).unwrap();
+        let inputs = collect(&[dir.path().to_owned()], &only_fbx, &mut std::io::empty());
+        assert_eq!(names(&inputs, dir.path()), ["chars/hero/run.fbx"], "case-insensitive, by name");
+        let no_mocap = Filter::new(&[], &["mocap/*".into()]).unwrap();
+        let inputs = collect(&[dir.path().to_owned()], &no_mocap, &mut std::io::empty());
+        assert_eq!(names(&inputs, dir.path()), ["chars/hero/run.fbx", "chars/hero/walk.glb"], "by relative path");
+        assert!(Filter::new(&["[".into()], &[]).unwrap_err().contains("invalid pattern `[`"));
+    }
+
+    #[test]
+    fn globs_lists_and_files_as_named() {
+        let dir = library();
+        let root = dir.path();
+        let pattern = root.join("**/*.bvh");
+        let list = format!("{}\n\n{}\n", root.join("chars/hero/run.fbx").display(), root.join("mocap").display());
+        let named = [pattern, PathBuf::from("-"), root.join("mocap/notes.txt"), root.join("missing/*.fbx")];
+        let inputs = collect(&named, &Filter::default(), &mut list.as_bytes());
+        // The glob's BVH, the listed FBX and folder (its animations), the text file named on its own.
+        let expected = ["chars/hero/run.fbx", "mocap/notes.txt", "mocap/renamed.txt", "mocap/take1.bvh"];
+        assert_eq!(names(&inputs, root), expected);
+        assert_eq!(inputs.problems.len(), 1);
+        assert_eq!(inputs.problems[0].message, "matches no file");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn symlink_loops_are_reported_not_followed() {
+        let dir = library();
+        std::os::unix::fs::symlink(dir.path(), dir.path().join("mocap/back")).unwrap();
+        let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
+        assert_eq!(names(&inputs, dir.path()).len(), 4);
+        assert_eq!(inputs.problems.len(), 1, "{:?}", inputs.problems);
+        assert!(inputs.problems[0].message.contains("loop"));
+    }
+}
