@@ -171,9 +171,10 @@ fn scan_exit_codes() {
     let out = bonescope(&["scan", "no-such-file.glb", &stretchy(), "--format", "json"]);
     assert_eq!(out.status.code(), Some(2));
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert!(report[0]["error"].as_str().unwrap().contains("no-such-file.glb"));
-    assert_eq!(report[1]["error"], Value::Null);
-    assert_eq!(report[1]["animations"].as_array().unwrap().len(), 2);
+    // Files are reported in sorted order (the absolute asset path before the relative name).
+    assert_eq!(report[0]["error"], Value::Null);
+    assert_eq!(report[0]["animations"].as_array().unwrap().len(), 2);
+    assert!(report[1]["error"].as_str().unwrap().contains("no-such-file.glb"));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-file.glb"));
 }
 
