@@ -495,3 +495,50 @@ fn scan_walks_folders_by_content_with_include_globs() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("matches no file"));
     assert!(String::from_utf8_lossy(&output.stdout).contains("stretchy_full.bvh"));
 }
+
+/// Element names of an XML document, in order, with their attributes.
+fn xml_elements(xml: &str) -> Vec<(String, std::collections::HashMap<String, String>)> {
+    let mut reader = quick_xml::Reader::from_str(xml);
+    let mut elements = Vec::new();
+    loop {
+        match reader.read_event().expect("well-formed XML") {
+            quick_xml::events::Event::Start(e) | quick_xml::events::Event::Empty(e) => {
+                let attributes = e
+                    .attributes()
+                    .map(|a| {
+                        let a = a.unwrap();
+                        (String::from_utf8_lossy(a.key.as_ref()).into_owned(), a.unescape_value().unwrap().into_owned())
+                    })
+                    .collect();
+                elements.push((String::from_utf8_lossy(e.name().as_ref()).into_owned(), attributes));
+            }
+            quick_xml::events::Event::Eof => break,
+            _ => {}
+        }
+    }
+    elements
+}
+
+#[test]
+fn scan_reports_for_ci_junit_and_json_lines() {
+    let folder = asset("blender").display().to_string();
+    let args = ["scan", folder.as_str(), "no-such-file.fbx", "--include", "*.glb"];
+    // JUnit: a suite per file, a case per clip, a failure per stretched bone, the missing file an error.
+    let junit = bonescope(&[&args[..], &["--format", "junit"]].concat());
+    assert_eq!(junit.status.code(), Some(2), "a file did not load");
+    let elements = xml_elements(&String::from_utf8(junit.stdout).unwrap());
+    let count = |name: &str| elements.iter().filter(|(n, _)| n == name).count();
+    assert_eq!((count("testsuites"), count("testsuite"), count("testcase")), (1, 3, 5));
+    assert_eq!((count("failure"), count("error")), (8, 1));
+    let total = &elements[0].1;
+    assert_eq!((total["tests"].as_str(), total["failures"].as_str(), total["errors"].as_str()), ("5", "2", "1"));
+    let failure = elements.iter().find(|(n, _)| n == "failure").unwrap();
+    assert!(failure.1["message"].contains("stretched: worst shear"), "{:?}", failure.1);
+    // JSON lines: one object per file, the same as the JSON array's elements.
+    let lines = bonescope(&[&args[..], &["--format", "jsonl"]].concat());
+    let array = bonescope(&[&args[..], &["--format", "json"]].concat());
+    let array: Value = serde_json::from_slice(&array.stdout).unwrap();
+    let lines: Vec<Value> =
+        String::from_utf8(lines.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(Value::Array(lines), array);
+}

@@ -1,15 +1,16 @@
 //! `bonescope scan`: whole clips of several files, the stretched bones of each; or, with `--compare-inherit`, how
 //! far every bone moves between two sets of inheritance modes.
 
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::layers::LayerArgs;
 use super::options::parse_comparison;
 use super::table::Table;
-use super::{EvalArgs, Format, ModeSet, ToleranceArgs};
+use super::{EvalArgs, ModeSet, ToleranceArgs};
 use crate::analysis::report::{
     AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileReport, FileScan,
 };
@@ -17,7 +18,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
-use crate::library::{Filter, collect};
+use crate::library::{Filter, collect, junit};
 use crate::model::{Clip, Rig};
 
 #[derive(Debug, Args)]
@@ -39,7 +40,7 @@ pub struct ScanArgs {
     #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
-    pub format: Format,
+    pub format: ScanFormat,
     /// Exit with status 1 when any bone is stretched.
     #[arg(long)]
     pub fail_on_stretch: bool,
@@ -72,6 +73,22 @@ pub struct ScanArgs {
     pub layers: LayerArgs,
 }
 
+/// How `scan` reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ScanFormat {
+    /// Aligned columns for people; flagged bones marked.
+    #[default]
+    Table,
+    /// One JSON array of every file's report, at the end.
+    Json,
+    /// One JSON object per line and file, written as soon as that file is done (a huge library streams; a crash
+    /// loses nothing already written).
+    Jsonl,
+    /// JUnit XML for CI test reporters: a suite per file, a case per clip, a failure per stretched bone, an error
+    /// per file that does not load (the stretch scan only).
+    Junit,
+}
+
 /// One clip of one file, as `scan --storage` reports it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AnimationStorage {
@@ -99,8 +116,13 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     if args.storage {
         return run_storage(args, &options);
     }
-    let files: Vec<FileScan> = inputs(args)?.iter().map(|path| scan_file(path, args, &options)).collect();
-    let loaded = print_files(&files, args.format, render_animation)?;
+    let (files, loaded) = report_files(
+        &inputs(args)?,
+        args.format,
+        |path| scan_file(path, args, &options),
+        render_animation,
+        Some(junit),
+    )?;
     let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
     Ok(if !loaded {
         ExitCode::from(2)
@@ -122,21 +144,41 @@ fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
     Ok(inputs.files)
 }
 
-/// Prints the reports (JSON, or per file its clips as `animation` renders them) and, on standard error, every
-/// file's error; whether all loaded.
-fn print_files<T: serde::Serialize>(
-    files: &[FileReport<T>],
-    format: Format,
+/// Reports every file of `paths` as `report` makes it, in `format`: JSON lines as each file is done, the other
+/// formats at the end (tables per file by `animation`, JUnit by `junit` where the report has one); every file's
+/// error also on standard error as it happens. The reports, and whether all files loaded.
+fn report_files<T: serde::Serialize>(
+    paths: &[PathBuf],
+    format: ScanFormat,
+    report: impl Fn(&Path) -> FileReport<T>,
     animation: fn(&str, &T) -> String,
-) -> anyhow::Result<bool> {
+    junit: Option<fn(&[FileReport<T>]) -> String>,
+) -> anyhow::Result<(Vec<FileReport<T>>, bool)> {
+    let junit = match (format, junit) {
+        (ScanFormat::Junit, None) => anyhow::bail!("--format junit reports stretched bones: not with this mode"),
+        (_, junit) => junit,
+    };
+    let mut files = Vec::with_capacity(paths.len());
+    let mut out = std::io::stdout().lock();
+    for path in paths {
+        let file = report(path);
+        if let Some(error) = &file.error {
+            eprintln!("error: {error}");
+        }
+        if format == ScanFormat::Jsonl {
+            writeln!(out, "{}", serde_json::to_string(&file)?)?;
+            out.flush()?;
+        }
+        files.push(file);
+    }
     match format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(files)?),
-        Format::Table => print!("{}", render_files(files, animation)),
+        ScanFormat::Json => writeln!(out, "{}", serde_json::to_string_pretty(&files)?)?,
+        ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
+        ScanFormat::Junit => writeln!(out, "{}", junit.map_or_else(String::new, |junit| junit(&files)))?,
+        ScanFormat::Jsonl => {}
     }
-    for error in files.iter().filter_map(|f| f.error.as_deref()) {
-        eprintln!("error: {error}");
-    }
-    Ok(files.iter().all(|f| f.error.is_none()))
+    let loaded = files.iter().all(|f| f.error.is_none());
+    Ok((files, loaded))
 }
 
 /// 0 when every file loaded, 2 when one did not.
@@ -192,22 +234,20 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     }
     let storage =
         StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
-    let files: Vec<FileStorage> = inputs(args)?
-        .iter()
-        .map(|path| {
-            let file = path.display().to_string();
-            let measured = load_layered(path, args).map(|loaded| {
-                loaded.each_clip(|layered, clip, hierarchy| AnimationStorage {
-                    animation: clip.map(AnimationInfo::of),
-                    inherit: args.eval.inherit_label(),
-                    rate: storage.rate,
-                    report: storage_report(layered, clip, hierarchy, &storage),
-                })
-            });
-            FileReport::new(file, measured)
-        })
-        .collect();
-    Ok(loaded_code(print_files(&files, args.format, render_storage)?))
+    let measure = |path: &Path| {
+        let file = path.display().to_string();
+        let measured = load_layered(path, args).map(|loaded| {
+            loaded.each_clip(|layered, clip, hierarchy| AnimationStorage {
+                animation: clip.map(AnimationInfo::of),
+                inherit: args.eval.inherit_label(),
+                rate: storage.rate,
+                report: storage_report(layered, clip, hierarchy, &storage),
+            })
+        });
+        FileStorage::new(file, measured)
+    };
+    let (_, loaded) = report_files(&inputs(args)?, args.format, measure, render_storage, None)?;
+    Ok(loaded_code(loaded))
 }
 
 fn render_storage(file: &str, a: &AnimationStorage) -> String {
@@ -243,14 +283,11 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 }
 
 fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {
-    let files: Vec<FileComparison> = inputs(args)?
-        .iter()
-        .map(|path| {
-            let file = path.display().to_string();
-            FileReport::new(file, compare_animations(path, &args.eval, sides, args.rate))
-        })
-        .collect();
-    Ok(loaded_code(print_files(&files, args.format, render_comparison)?))
+    let compare = |path: &Path| {
+        FileComparison::new(path.display().to_string(), compare_animations(path, &args.eval, sides, args.rate))
+    };
+    let (_, loaded) = report_files(&inputs(args)?, args.format, compare, render_comparison, None)?;
+    Ok(loaded_code(loaded))
 }
 
 fn compare_animations(

@@ -1,6 +1,8 @@
 //! A studio's export library as one scan: which files it covers (folders walked, globs expanded, lists read), in an
-//! order that does not depend on the file system or thread timing.
+//! order that does not depend on the file system or thread timing, and the reports CI systems read.
 
 mod inputs;
+mod junit;
 
 pub use inputs::{Filter, InputProblem, Inputs, collect};
+pub use junit::junit;
