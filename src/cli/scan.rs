@@ -144,6 +144,9 @@ fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
     Ok(inputs.files)
 }
 
+/// How a kind of report is written as JUnit XML.
+type JunitOf<T> = fn(&[FileReport<T>]) -> String;
+
 /// Reports every file of `paths` as `report` makes it, in `format`: JSON lines as each file is done, the other
 /// formats at the end (tables per file by `animation`, JUnit by `junit` where the report has one); every file's
 /// error also on standard error as it happens. The reports, and whether all files loaded.
@@ -152,7 +155,7 @@ fn report_files<T: serde::Serialize>(
     format: ScanFormat,
     report: impl Fn(&Path) -> FileReport<T>,
     animation: fn(&str, &T) -> String,
-    junit: Option<fn(&[FileReport<T>]) -> String>,
+    junit: Option<JunitOf<T>>,
 ) -> anyhow::Result<(Vec<FileReport<T>>, bool)> {
     let junit = match (format, junit) {
         (ScanFormat::Junit, None) => anyhow::bail!("--format junit reports stretched bones: not with this mode"),
