@@ -507,7 +507,10 @@ fn xml_elements(xml: &str) -> Vec<(String, std::collections::HashMap<String, Str
                     .attributes()
                     .map(|a| {
                         let a = a.unwrap();
-                        (String::from_utf8_lossy(a.key.as_ref()).into_owned(), a.unescape_value().unwrap().into_owned())
+                        (
+                            String::from_utf8_lossy(a.key.as_ref()).into_owned(),
+                            a.normalized_value(quick_xml::XmlVersion::Explicit1_0).unwrap().into_owned(),
+                        )
                     })
                     .collect();
                 elements.push((String::from_utf8_lossy(e.name().as_ref()).into_owned(), attributes));
