@@ -545,3 +545,20 @@ fn scan_reports_for_ci_junit_and_json_lines() {
         String::from_utf8(lines.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     assert_eq!(Value::Array(lines), array);
 }
+
+#[test]
+fn the_shards_of_a_folder_partition_it() {
+    let folder = asset("bvh").display().to_string();
+    let files = |extra: &[&str]| -> Vec<String> {
+        let output = bonescope(&[&["scan", folder.as_str(), "--format", "jsonl"][..], extra].concat());
+        let text = String::from_utf8(output.stdout).unwrap();
+        text.lines().map(|l| serde_json::from_str::<Value>(l).unwrap()["file"].as_str().unwrap().to_owned()).collect()
+    };
+    let whole = files(&[]);
+    let mut union: Vec<String> = (1..=3).flat_map(|k| files(&["--shard", &format!("{k}/3")])).collect();
+    union.sort();
+    assert_eq!(union, whole);
+    let bad = bonescope(&["scan", &folder, "--shard", "4/3"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("expected K/N"));
+}

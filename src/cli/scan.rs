@@ -34,6 +34,11 @@ pub struct ScanArgs {
     /// In folders, skip files matching this glob (as --include; repeatable).
     #[arg(long, value_name = "GLOB")]
     pub exclude: Vec<String>,
+    /// Scan only the K-th of N stable parts of the files (by their path below the folder given, so N machines
+    /// running the same command with K = 1..N split the library without talking; `cat` their JSON lines for the
+    /// whole report).
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<(usize, usize)>,
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Samples per second, on top of every key time.
@@ -141,7 +146,19 @@ fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
     for problem in &inputs.problems {
         eprintln!("warning: {}: {}", problem.path.display(), problem.message);
     }
-    Ok(inputs.files)
+    Ok(match args.shard {
+        Some((part, parts)) => inputs.shard(part, parts),
+        None => inputs.paths(),
+    })
+}
+
+/// `K/N` with `1 ≤ K ≤ N`.
+fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let parts = text.split_once('/').and_then(|(k, n)| Some((k.trim().parse().ok()?, n.trim().parse().ok()?)));
+    match parts {
+        Some((k, n)) if (1..=n).contains(&k) => Ok((k, n)),
+        _ => Err(format!("expected K/N with 1 ≤ K ≤ N, e.g. 2/8, got `{text}`")),
+    }
 }
 
 /// How a kind of report is written as JUnit XML.

@@ -59,11 +59,33 @@ pub struct InputProblem {
     pub message: String,
 }
 
-/// The files to scan, sorted and distinct, and what could not be read on the way.
+/// One file to scan, and the name that places it in a shard: its path below the folder it was found in, or the
+/// path as given (the same on every machine that checks out the library, wherever it lies).
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Found {
+    pub path: PathBuf,
+    pub key: String,
+}
+
+/// The files to scan, sorted by path and distinct, and what could not be read on the way.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Inputs {
-    pub files: Vec<PathBuf>,
+    pub files: Vec<Found>,
     pub problems: Vec<InputProblem>,
+}
+
+impl Inputs {
+    /// The paths of the files.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        self.files.iter().map(|f| f.path.clone()).collect()
+    }
+
+    /// The paths of the `part`-th of `parts` (1-based) stable parts: a file belongs to part `1 + crc32(key) mod
+    /// parts`, so machines scanning the same library agree without talking, and the parts partition it.
+    pub fn shard(&self, part: usize, parts: usize) -> Vec<PathBuf> {
+        let of = |f: &&Found| (crc32fast::hash(f.key.as_bytes()) as usize % parts.max(1)) + 1 == part;
+        self.files.iter().filter(of).map(|f| f.path.clone()).collect()
+    }
 }
 
 /// The files `names` stand for (see the module's rules); `stdin` is read for a `-`.
@@ -83,11 +105,16 @@ pub fn collect(names: &[PathBuf], filter: &Filter, stdin: &mut dyn Read) -> Inpu
         }
     }
     inputs.files.sort();
-    inputs.files.dedup();
+    inputs.files.dedup_by(|a, b| a.path == b.path);
     inputs
 }
 
 impl Inputs {
+    /// A file named (or listed, or matched by a glob): its key is the path as given.
+    fn push_named(&mut self, path: &Path) {
+        self.files.push(Found { path: path.to_owned(), key: key_of(path) });
+    }
+
     fn problem(&mut self, path: &Path, message: String) {
         self.problems.push(InputProblem { path: path.to_owned(), message });
     }
@@ -98,7 +125,7 @@ impl Inputs {
             self.walk(name, filter);
         } else if name.exists() || !is_glob(name) {
             // A file as named; a missing one fails to load in the report, naming it.
-            self.files.push(name.to_owned());
+            self.push_named(name);
         } else {
             self.expand(name, filter);
         }
@@ -113,7 +140,7 @@ impl Inputs {
                 for path in paths {
                     match path {
                         Ok(path) if path.is_dir() => self.walk(&path, filter),
-                        Ok(path) => self.files.push(path),
+                        Ok(path) => self.push_named(&path),
                         Err(e) => self.problem(e.path(), format!("cannot read: {}", e.error())),
                     }
                 }
@@ -139,13 +166,19 @@ impl Inputs {
                 Ok(entry) if entry.file_type().is_file() => {
                     let relative = entry.path().strip_prefix(folder).unwrap_or(entry.path());
                     if filter.admits(relative) && recognised(entry.path()) {
-                        self.files.push(entry.into_path());
+                        let key = key_of(relative);
+                        self.files.push(Found { path: entry.into_path(), key });
                     }
                 }
                 Ok(_) => {}
             }
         }
     }
+}
+
+/// A path as a shard key: its components joined by `/`, whatever the platform writes.
+fn key_of(path: &Path) -> String {
+    path.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/")
 }
 
 /// Whether `path` has glob characters.
@@ -179,7 +212,30 @@ mod tests {
     }
 
     fn names(inputs: &Inputs, root: &Path) -> Vec<String> {
-        inputs.files.iter().map(|f| f.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/")).collect()
+        inputs.files.iter().map(|f| f.path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/")).collect()
+    }
+
+    #[test]
+    fn shards_partition_the_library_by_relative_path() {
+        let dir = tempfile::tempdir().unwrap();
+        for i in 0..40 {
+            std::fs::write(dir.path().join(format!("take{i:02}.bvh")), b"HIERARCHY\n").unwrap();
+        }
+        let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
+        let parts: Vec<Vec<PathBuf>> = (1..=3).map(|k| inputs.shard(k, 3)).collect();
+        let mut union: Vec<PathBuf> = parts.concat();
+        union.sort();
+        assert_eq!(union, inputs.paths(), "every file in exactly one part");
+        assert!(parts.iter().all(|p| !p.is_empty()), "{:?}", parts.iter().map(Vec::len).collect::<Vec<_>>());
+        // The same library elsewhere (another checkout) gives the same parts: keys are relative.
+        let elsewhere = tempfile::tempdir().unwrap();
+        for i in 0..40 {
+            std::fs::write(elsewhere.path().join(format!("take{i:02}.bvh")), b"HIERARCHY\n").unwrap();
+        }
+        let there = collect(&[elsewhere.path().to_owned()], &Filter::default(), &mut std::io::empty());
+        let file_names =
+            |paths: Vec<PathBuf>| paths.iter().map(|p| p.file_name().unwrap().to_owned()).collect::<Vec<_>>();
+        assert_eq!(file_names(there.shard(2, 3)), file_names(inputs.shard(2, 3)));
     }
 
     #[test]

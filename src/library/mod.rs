@@ -4,5 +4,5 @@
 mod inputs;
 mod junit;
 
-pub use inputs::{Filter, InputProblem, Inputs, collect};
+pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
 pub use junit::junit;
