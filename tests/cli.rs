@@ -562,3 +562,26 @@ fn the_shards_of_a_folder_partition_it() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("expected K/N"));
 }
+
+#[test]
+fn report_merges_the_shards_json_lines_into_the_whole_scan() {
+    let folder = asset("blender").display().to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let mut shards = Vec::new();
+    for k in 1..=2 {
+        let output =
+            bonescope(&["scan", &folder, "--include", "*.glb", "--shard", &format!("{k}/2"), "--format", "jsonl"]);
+        let path = dir.path().join(format!("shard{k}.jsonl"));
+        std::fs::write(&path, output.stdout).unwrap();
+        shards.push(path.display().to_string());
+    }
+    let whole = json(&bonescope(&["scan", &folder, "--include", "*.glb", "--format", "json"]));
+    let merged = json(&bonescope(&["report", &shards[0], &shards[1], "--format", "json"]));
+    assert_eq!(merged, whole, "the shards' reports, merged, are the whole scan's");
+    let gate = bonescope(&["report", &shards[0], &shards[1], "--fail-on-stretch"]);
+    assert_eq!(gate.status.code(), Some(1), "stretchy_full.glb has stretched bones");
+    std::fs::write(dir.path().join("bad.jsonl"), "not json\n").unwrap();
+    let bad = bonescope(&["report", &dir.path().join("bad.jsonl").display().to_string()]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("bad.jsonl: line 1"));
+}

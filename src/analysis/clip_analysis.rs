@@ -8,7 +8,7 @@ use super::findings::{Verdict, shear_cosine};
 use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg_of_cosine};
 
 /// One bone over a whole clip. Times are in seconds.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BoneSummary {
     pub index: usize,
     pub worst_shear_deg: f64,

@@ -37,7 +37,7 @@ impl Parts {
 }
 
 /// Which clip a report is about.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct AnimationInfo {
     pub index: usize,
     pub name: Option<String>,
@@ -128,7 +128,7 @@ pub struct InspectReport {
 }
 
 /// One bone's whole-clip summary, with its name.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct BoneScanReport {
     pub name: String,
     #[serde(flatten)]
@@ -136,7 +136,7 @@ pub struct BoneScanReport {
 }
 
 /// One clip of one file, scanned.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct AnimationScan {
     /// `null` for a file without animations, whose rest pose is scanned instead.
     pub animation: Option<AnimationInfo>,
@@ -182,7 +182,7 @@ impl AnimationScan {
 
 /// One file of `bonescope scan` (plain, `--compare-inherit` or `--storage`): a report per clip, or why the file
 /// could not be loaded.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct FileReport<T> {
     pub file: String,
     pub error: Option<String>,

@@ -9,6 +9,7 @@ mod inspect;
 mod layers;
 mod options;
 mod render;
+mod report;
 mod scan;
 mod table;
 
@@ -38,6 +39,8 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Scan whole clips of one or more files and report the stretched bones.
     Scan(scan::ScanArgs),
+    /// Merge the JSON lines of several scans (a library's shards) into one report and exit code.
+    Report(report::ReportArgs),
     /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
     Export(export::ExportArgs),
     /// Render the viewport (or the whole window) to PNG without a display, optionally checked against a reference.
@@ -50,6 +53,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Inspect(args)) => inspect::run(&args),
         Some(Command::Scan(args)) => scan::run(&args),
+        Some(Command::Report(args)) => report::run(&args),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),

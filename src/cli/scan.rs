@@ -121,21 +121,22 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     if args.storage {
         return run_storage(args, &options);
     }
-    let (files, loaded) = report_files(
-        &inputs(args)?,
-        args.format,
-        |path| scan_file(path, args, &options),
-        render_animation,
-        Some(junit),
-    )?;
+    let report = |path: &Path| scan_file(path, args, &options);
+    let (files, _) = report_files(&inputs(args)?, args.format, report, render_animation, Some(junit))?;
+    Ok(verdict(&files, args.fail_on_stretch))
+}
+
+/// The exit code of a stretch scan: 2 when a file did not load, else 1 when `fail_on_stretch` and a bone is
+/// stretched, else 0.
+pub(super) fn verdict(files: &[FileScan], fail_on_stretch: bool) -> ExitCode {
     let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
-    Ok(if !loaded {
+    if files.iter().any(|f| f.error.is_some()) {
         ExitCode::from(2)
-    } else if stretched && args.fail_on_stretch {
+    } else if stretched && fail_on_stretch {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
-    })
+    }
 }
 
 /// The files the arguments name ([`crate::library::collect`]); what could not be read on the way is reported on
@@ -365,7 +366,7 @@ fn render_comparison(file: &str, comparison: &AnimationComparison) -> String {
 }
 
 /// The table form: per file its clips, or why it could not be loaded.
-fn render_files<T>(files: &[FileReport<T>], animation: fn(&str, &T) -> String) -> String {
+pub(super) fn render_files<T>(files: &[FileReport<T>], animation: fn(&str, &T) -> String) -> String {
     let mut out = String::new();
     for file in files {
         if let Some(error) = &file.error {
@@ -379,7 +380,7 @@ fn render_files<T>(files: &[FileReport<T>], animation: fn(&str, &T) -> String) -
     out
 }
 
-fn render_animation(file: &str, scan: &AnimationScan) -> String {
+pub(super) fn render_animation(file: &str, scan: &AnimationScan) -> String {
     let what = AnimationInfo::describe(scan.animation.as_ref());
     let mut out = format!("{file}  {what}  {} samples, inherit: {}\n", scan.samples, scan.inherit);
     if scan.stretched.is_empty() {

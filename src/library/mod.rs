@@ -3,6 +3,8 @@
 
 mod inputs;
 mod junit;
+mod merged;
 
 pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
 pub use junit::junit;
+pub use merged::{merge, read_json_lines};

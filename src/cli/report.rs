@@ -1,0 +1,52 @@
+//! `bonescope report`: the JSON lines of several scans (a library scanned in shards on many machines) as one
+//! report and one exit code.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+
+use super::scan::{render_animation, render_files, verdict};
+use crate::library::{junit, merge, read_json_lines};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ReportFormat {
+    /// Aligned columns for people, as `scan` prints them.
+    #[default]
+    Table,
+    /// One JSON array of every file's report.
+    Json,
+    /// JUnit XML for CI test reporters.
+    Junit,
+}
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Files of `scan --format jsonl` output (one per shard, or `cat`-ed together).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: ReportFormat,
+    /// Exit with status 1 when any bone is stretched.
+    #[arg(long)]
+    pub fail_on_stretch: bool,
+}
+
+pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
+    let mut files = Vec::new();
+    for path in &args.files {
+        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+        files.extend(read_json_lines(path, &text).map_err(anyhow::Error::msg)?);
+    }
+    let files = merge(files);
+    match args.format {
+        ReportFormat::Table => print!("{}", render_files(&files, render_animation)),
+        ReportFormat::Json => println!("{}", serde_json::to_string_pretty(&files)?),
+        ReportFormat::Junit => println!("{}", junit(&files)),
+    }
+    for error in files.iter().filter_map(|f| f.error.as_deref()) {
+        eprintln!("error: {error}");
+    }
+    Ok(verdict(&files, args.fail_on_stretch))
+}
