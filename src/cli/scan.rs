@@ -1,9 +1,10 @@
 //! `bonescope scan`: whole clips of several files, the stretched bones of each; or, with `--compare-inherit`, how
 //! far every bone moves between two sets of inheritance modes.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Args, ValueEnum};
 
@@ -18,7 +19,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
-use crate::library::{Filter, collect, junit};
+use crate::library::{Filter, collect, in_order, junit};
 use crate::model::{Clip, Rig};
 
 #[derive(Debug, Args)]
@@ -39,6 +40,13 @@ pub struct ScanArgs {
     /// whole report).
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<(usize, usize)>,
+    /// Files scanned at once (default: one per core); reports still come in the files' sorted order.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+    /// Report progress on standard error even when it is not a terminal (a line per file; on a terminal a bar is
+    /// always shown).
+    #[arg(long)]
+    pub progress: bool,
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Samples per second, on top of every key time.
@@ -122,7 +130,7 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         return run_storage(args, &options);
     }
     let report = |path: &Path| scan_file(path, args, &options);
-    let (files, _) = report_files(&inputs(args)?, args.format, report, render_animation, Some(junit))?;
+    let (files, _) = report_files(&inputs(args)?, args, report, render_animation, Some(junit))?;
     Ok(verdict(&files, args.fail_on_stretch))
 }
 
@@ -168,38 +176,103 @@ type JunitOf<T> = fn(&[FileReport<T>]) -> String;
 /// Reports every file of `paths` as `report` makes it, in `format`: JSON lines as each file is done, the other
 /// formats at the end (tables per file by `animation`, JUnit by `junit` where the report has one); every file's
 /// error also on standard error as it happens. The reports, and whether all files loaded.
-fn report_files<T: serde::Serialize>(
+fn report_files<T: serde::Serialize + Send>(
     paths: &[PathBuf],
-    format: ScanFormat,
-    report: impl Fn(&Path) -> FileReport<T>,
+    args: &ScanArgs,
+    report: impl Fn(&Path) -> FileReport<T> + Sync,
     animation: fn(&str, &T) -> String,
     junit: Option<JunitOf<T>>,
 ) -> anyhow::Result<(Vec<FileReport<T>>, bool)> {
+    let format = args.format;
     let junit = match (format, junit) {
         (ScanFormat::Junit, None) => anyhow::bail!("--format junit reports stretched bones: not with this mode"),
         (_, junit) => junit,
     };
+    // Ctrl-C stops starting files; what is done is still written (a second handler, in tests, is refused: fine).
+    let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::Relaxed));
+    let mut progress = Progress::new(paths.len(), args.progress);
     let mut files = Vec::with_capacity(paths.len());
     let mut out = std::io::stdout().lock();
-    for path in paths {
-        let file = report(path);
+    let mut written = Ok(());
+    let jobs = args.jobs.map_or_else(|| std::thread::available_parallelism().map_or(1, usize::from), usize::from);
+    let done = |path: &Path, file: FileReport<T>| {
+        progress.file_done(path);
         if let Some(error) = &file.error {
-            eprintln!("error: {error}");
+            progress.println(&format!("error: {error}"));
         }
-        if format == ScanFormat::Jsonl {
-            writeln!(out, "{}", serde_json::to_string(&file)?)?;
-            out.flush()?;
+        if format == ScanFormat::Jsonl && written.is_ok() {
+            written = serde_json::to_string(&file).map_err(anyhow::Error::from).and_then(|line| {
+                writeln!(out, "{line}")?;
+                Ok(out.flush()?)
+            });
         }
         files.push(file);
-    }
+    };
+    let count = in_order(paths, jobs, report, done, &INTERRUPTED);
+    progress.finish();
+    written?;
     match format {
         ScanFormat::Json => writeln!(out, "{}", serde_json::to_string_pretty(&files)?)?,
         ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
         ScanFormat::Junit => writeln!(out, "{}", junit.map_or_else(String::new, |junit| junit(&files)))?,
         ScanFormat::Jsonl => {}
     }
+    if count < paths.len() {
+        anyhow::bail!("interrupted: {count} of {} files scanned (their reports are above)", paths.len());
+    }
     let loaded = files.iter().all(|f| f.error.is_none());
     Ok((files, loaded))
+}
+
+/// Set by Ctrl-C: no more files are started.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Progress on standard error: a bar (files done of total, files per second, time left, the current file) when it
+/// is a terminal; with `--progress` elsewhere (CI logs), a line per file; nothing otherwise.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    lines: bool,
+    total: usize,
+    done: usize,
+}
+
+impl Progress {
+    fn new(total: usize, forced: bool) -> Self {
+        let terminal = std::io::stderr().is_terminal();
+        let bar = terminal.then(|| {
+            let style =
+                indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} files  {per_sec}  ETA {eta}  {wide_msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+            indicatif::ProgressBar::new(total as u64).with_style(style)
+        });
+        Progress { bar, lines: forced && !terminal, total, done: 0 }
+    }
+
+    fn file_done(&mut self, path: &Path) {
+        self.done += 1;
+        match &self.bar {
+            Some(bar) => {
+                bar.set_message(path.display().to_string());
+                bar.inc(1);
+            }
+            None if self.lines => eprintln!("[{}/{}] {}", self.done, self.total, path.display()),
+            None => {}
+        }
+    }
+
+    /// A line on standard error that does not garble the bar.
+    fn println(&self, line: &str) {
+        match &self.bar {
+            Some(bar) => bar.println(line),
+            None => eprintln!("{line}"),
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 /// 0 when every file loaded, 2 when one did not.
@@ -267,7 +340,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
         });
         FileStorage::new(file, measured)
     };
-    let (_, loaded) = report_files(&inputs(args)?, args.format, measure, render_storage, None)?;
+    let (_, loaded) = report_files(&inputs(args)?, args, measure, render_storage, None)?;
     Ok(loaded_code(loaded))
 }
 
@@ -307,7 +380,7 @@ fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCo
     let compare = |path: &Path| {
         FileComparison::new(path.display().to_string(), compare_animations(path, &args.eval, sides, args.rate))
     };
-    let (_, loaded) = report_files(&inputs(args)?, args.format, compare, render_comparison, None)?;
+    let (_, loaded) = report_files(&inputs(args)?, args, compare, render_comparison, None)?;
     Ok(loaded_code(loaded))
 }
 

@@ -186,11 +186,19 @@ fn is_glob(path: &Path) -> bool {
     path.to_string_lossy().contains(['*', '?', '['])
 }
 
-/// Whether a file's first bytes are a format bonescope reads.
+/// Whether a file's first bytes are a format bonescope reads. JSON counts as glTF only with an `"asset"` key in
+/// view (every glTF has one), so the other JSON of a library (tool reports, configuration) is left out; a JSON file
+/// larger than what is read is given the benefit of the doubt.
 fn recognised(path: &Path) -> bool {
     let mut head = Vec::new();
     let read = std::fs::File::open(path).and_then(|f| f.take(SNIFF_BYTES).read_to_end(&mut head));
-    read.is_ok() && crate::import::detect(&head).is_some()
+    match (read, crate::import::detect(&head)) {
+        (Ok(_), Some(crate::import::Format::Gltf)) if !head.starts_with(b"glTF") => {
+            head.len() as u64 == SNIFF_BYTES || head.windows(7).any(|w| w == b"\"asset\"")
+        }
+        (Ok(_), format) => format.is_some(),
+        (Err(_), _) => false,
+    }
 }
 
 #[cfg(test)]
@@ -208,6 +216,8 @@ mod tests {
         std::fs::write(root.join("mocap/take1.bvh"), b"HIERARCHY\nROOT hips\n").unwrap();
         std::fs::write(root.join("mocap/notes.txt"), b"not an animation").unwrap();
         std::fs::write(root.join("mocap/renamed.txt"), b"Kaydara FBX Binary  \0rest").unwrap();
+        std::fs::write(root.join("mocap/report.json"), b"{ \"issues\": [] }").unwrap();
+        std::fs::write(root.join("chars/hero/idle.gltf"), b"{ \"asset\": { \"version\": \"2.0\" } }").unwrap();
         dir
     }
 
@@ -242,8 +252,14 @@ mod tests {
     fn folders_give_their_animations_by_content_sorted() {
         let dir = library();
         let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
-        let expected = ["chars/hero/run.fbx", "chars/hero/walk.glb", "mocap/renamed.txt", "mocap/take1.bvh"];
-        assert_eq!(names(&inputs, dir.path()), expected);
+        let expected = [
+            "chars/hero/idle.gltf",
+            "chars/hero/run.fbx",
+            "chars/hero/walk.glb",
+            "mocap/renamed.txt",
+            "mocap/take1.bvh",
+        ];
+        assert_eq!(names(&inputs, dir.path()), expected, "not the JSON report");
         assert!(inputs.problems.is_empty(), "{:?}", inputs.problems);
     }
 
@@ -255,7 +271,8 @@ mod tests {
         assert_eq!(names(&inputs, dir.path()), ["chars/hero/run.fbx"], "case-insensitive, by name");
         let no_mocap = Filter::new(&[], &["mocap/*".into()]).unwrap();
         let inputs = collect(&[dir.path().to_owned()], &no_mocap, &mut std::io::empty());
-        assert_eq!(names(&inputs, dir.path()), ["chars/hero/run.fbx", "chars/hero/walk.glb"], "by relative path");
+        let chars = ["chars/hero/idle.gltf", "chars/hero/run.fbx", "chars/hero/walk.glb"];
+        assert_eq!(names(&inputs, dir.path()), chars, "by relative path");
         assert!(Filter::new(&["[".into()], &[]).unwrap_err().contains("invalid pattern `[`"));
     }
 
@@ -280,7 +297,7 @@ mod tests {
         let dir = library();
         std::os::unix::fs::symlink(dir.path(), dir.path().join("mocap/back")).unwrap();
         let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
-        assert_eq!(names(&inputs, dir.path()).len(), 4);
+        assert_eq!(names(&inputs, dir.path()).len(), 5);
         assert_eq!(inputs.problems.len(), 1, "{:?}", inputs.problems);
         assert!(inputs.problems[0].message.contains("loop"));
     }

@@ -4,7 +4,9 @@
 mod inputs;
 mod junit;
 mod merged;
+mod pool;
 
 pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
 pub use junit::junit;
 pub use merged::{merge, read_json_lines};
+pub use pool::in_order;
