@@ -585,3 +585,21 @@ fn report_merges_the_shards_json_lines_into_the_whole_scan() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("bad.jsonl: line 1"));
 }
+
+/// The CI examples the README points to run `scan` and `report` with options that exist.
+#[test]
+fn the_ci_examples_use_real_options() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/examples");
+    for (file, options) in [
+        ("github-actions-scan.yml", &["--include", "--shard", "--format", "--progress", "--fail-on-stretch"][..]),
+        ("kubernetes-indexed-job.yaml", &["--shard", "--format", "--progress"][..]),
+    ] {
+        let text = std::fs::read_to_string(root.join(file)).unwrap();
+        let help = |command: &str| String::from_utf8(bonescope(&[command, "--help"]).stdout).unwrap();
+        let known = format!("{}{}", help("scan"), help("report"));
+        for option in options {
+            assert!(text.contains(option), "{file} uses {option}");
+            assert!(known.contains(option), "{option} is an option of scan or report");
+        }
+    }
+}
