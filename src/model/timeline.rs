@@ -6,8 +6,10 @@
 //! keys keeps all its frames when it has at most [`SAMPLES_PER_SPARSE_GAP`] of them, and that many evenly spaced
 //! times otherwise. The result is bounded by the number of keys, whatever the span.
 
-/// Times closer than this are one sample (grid times and key times are computed from the same integers).
-const SAME_TIME: f64 = 1e-9;
+/// Times closer than this are one sample: a microsecond, or single precision's rounding at that time when larger.
+/// Key times stored as `f32` (glTF) miss the frame grid by up to half an `f32` step (4e-6 s at 100 s); counted apart,
+/// a 6,000-key clip at 60 Hz would be sampled twice as often as it has frames.
+const SAME_TIME: f64 = 1e-6;
 
 /// How many times a long gap between two keys is sampled at when the grid is thinned.
 pub const SAMPLES_PER_SPARSE_GAP: usize = 64;
@@ -61,10 +63,10 @@ pub fn sample_times(
     SampleTimes { times, frames, thinned }
 }
 
-/// Sorts `times` and keeps the first of each run closer than [`SAME_TIME`].
+/// Sorts `times` and keeps the first of each run closer than [`SAME_TIME`] (or an `f32` step there).
 fn sort_distinct(times: &mut Vec<f64>) {
     times.sort_by(f64::total_cmp);
-    times.dedup_by(|later, earlier| *later - *earlier < SAME_TIME);
+    times.dedup_by(|later, earlier| *later - *earlier < SAME_TIME.max(later.abs() * f64::from(f32::EPSILON)));
 }
 
 #[cfg(test)]
@@ -117,5 +119,14 @@ mod tests {
     #[test]
     fn no_rate_gives_the_anchors() {
         assert_eq!(sample_times([0.5], 0.0, 1.0, 0.0, 10).times, [0.0, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn single_precision_key_times_meet_the_frame_grid() {
+        // 6,000 keys at 60 Hz stored as f32 (glTF's key times), sampled at 60 Hz: one sample per frame.
+        let keys: Vec<f64> = (0..6000).map(|k| f64::from((k as f64 / 60.0) as f32)).collect();
+        let end = keys[keys.len() - 1];
+        let s = sample_times(keys.iter().copied(), 0.0, end, 60.0, 1 << 20);
+        assert_eq!(s.times.len(), 6000, "not {} (key times and frames counted apart)", s.times.len());
     }
 }
