@@ -603,3 +603,15 @@ fn the_ci_examples_use_real_options() {
         }
     }
 }
+
+#[test]
+fn comparisons_and_storage_reports_come_as_junit_too() {
+    let maya = asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx").display().to_string();
+    for mode in [&["--compare-inherit", "declared,full"][..], &["--storage"][..]] {
+        let output = bonescope(&[&["scan", maya.as_str(), "--format", "junit"][..], mode].concat());
+        assert!(output.status.success(), "{mode:?}: {}", String::from_utf8_lossy(&output.stderr));
+        let elements = xml_elements(&String::from_utf8(output.stdout).unwrap());
+        let count = |name: &str| elements.iter().filter(|(n, _)| n == name).count();
+        assert_eq!((count("testcase"), count("failure"), count("system-out")), (1, 0, 1), "{mode:?}");
+    }
+}

@@ -19,7 +19,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
-use crate::library::{Filter, collect, in_order, junit};
+use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
 use crate::model::{Clip, Rig};
 
 #[derive(Debug, Args)]
@@ -130,7 +130,7 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         return run_storage(args, &options);
     }
     let report = |path: &Path| scan_file(path, args, &options);
-    let (files, _) = report_files(&inputs(args)?, args, report, render_animation, Some(junit))?;
+    let (files, _) = report_files(&inputs(args)?, args, report, render_animation, junit)?;
     Ok(verdict(&files, args.fail_on_stretch))
 }
 
@@ -170,6 +170,24 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
     }
 }
 
+/// `--compare-inherit` as JUnit: it judges nothing, so each clip passes with its table as output.
+fn junit_comparison(files: &[FileComparison]) -> String {
+    junit_of(files, |file, clip| Case {
+        name: AnimationInfo::describe(clip.animation.as_ref()),
+        failures: Vec::new(),
+        output: Some(render_comparison(file, clip)),
+    })
+}
+
+/// `--storage` as JUnit: each clip passes with its storage report as output.
+fn junit_storage(files: &[FileStorage]) -> String {
+    junit_of(files, |file, clip| Case {
+        name: AnimationInfo::describe(clip.animation.as_ref()),
+        failures: Vec::new(),
+        output: Some(render_storage(file, clip)),
+    })
+}
+
 /// How a kind of report is written as JUnit XML.
 type JunitOf<T> = fn(&[FileReport<T>]) -> String;
 
@@ -181,13 +199,9 @@ fn report_files<T: serde::Serialize + Send>(
     args: &ScanArgs,
     report: impl Fn(&Path) -> FileReport<T> + Sync,
     animation: fn(&str, &T) -> String,
-    junit: Option<JunitOf<T>>,
+    junit: JunitOf<T>,
 ) -> anyhow::Result<(Vec<FileReport<T>>, bool)> {
     let format = args.format;
-    let junit = match (format, junit) {
-        (ScanFormat::Junit, None) => anyhow::bail!("--format junit reports stretched bones: not with this mode"),
-        (_, junit) => junit,
-    };
     // Ctrl-C stops starting files; what is done is still written (a second handler, in tests, is refused: fine).
     let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::Relaxed));
     let mut progress = Progress::new(paths.len(), args.progress);
@@ -214,7 +228,7 @@ fn report_files<T: serde::Serialize + Send>(
     match format {
         ScanFormat::Json => writeln!(out, "{}", serde_json::to_string_pretty(&files)?)?,
         ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
-        ScanFormat::Junit => writeln!(out, "{}", junit.map_or_else(String::new, |junit| junit(&files)))?,
+        ScanFormat::Junit => writeln!(out, "{}", junit(&files))?,
         ScanFormat::Jsonl => {}
     }
     if count < paths.len() {
@@ -340,7 +354,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
         });
         FileStorage::new(file, measured)
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, measure, render_storage, None)?;
+    let (_, loaded) = report_files(&inputs(args)?, args, measure, render_storage, junit_storage)?;
     Ok(loaded_code(loaded))
 }
 
@@ -380,7 +394,7 @@ fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCo
     let compare = |path: &Path| {
         FileComparison::new(path.display().to_string(), compare_animations(path, &args.eval, sides, args.rate))
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, compare, render_comparison, None)?;
+    let (_, loaded) = report_files(&inputs(args)?, args, compare, render_comparison, junit_comparison)?;
     Ok(loaded_code(loaded))
 }
 

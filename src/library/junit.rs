@@ -1,19 +1,47 @@
 //! A scan as JUnit XML, the report CI systems show (GitLab, Jenkins, Azure DevOps, GitHub test reporters): one test
 //! suite per file, one test case per clip, a failure per stretched bone (its worst shear and when), and a file that
-//! could not be loaded as an error.
+//! could not be loaded as an error. Scans that judge nothing (`--compare-inherit`, `--storage`) give passing cases
+//! with their table as the case's output.
 
 use std::io;
 
 use quick_xml::Writer;
 use quick_xml::events::{BytesDecl, BytesText, Event};
 
-use crate::analysis::report::{AnimationInfo, AnimationScan, FileScan};
+use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 
-/// The JUnit XML of `files`.
+/// One clip as a JUnit test case: its name, its failures (message and details), and text for its `system-out`.
+pub struct Case {
+    pub name: String,
+    pub failures: Vec<(String, String)>,
+    pub output: Option<String>,
+}
+
+/// The JUnit XML of a stretch scan: a failure per stretched bone.
 pub fn junit(files: &[FileScan]) -> String {
+    junit_of(files, |_, clip| stretch_case(clip))
+}
+
+/// The JUnit XML of any scan's `files`, each clip made a test case by `case` (given the file's name and the clip).
+pub fn junit_of<T>(files: &[FileReport<T>], case: impl Fn(&str, &T) -> Case) -> String {
+    let suites: Vec<Suite> = files
+        .iter()
+        .map(|file| Suite {
+            name: &file.file,
+            error: file.error.as_deref(),
+            cases: file.animations.iter().map(|clip| case(&file.file, clip)).collect(),
+        })
+        .collect();
     let mut writer = Writer::new_with_indent(Vec::new(), b' ', 2);
-    write(&mut writer, files).expect("writing to memory does not fail");
+    write(&mut writer, &suites).expect("writing to memory does not fail");
     String::from_utf8(writer.into_inner()).expect("quick-xml writes UTF-8")
+}
+
+/// One file: its clips' cases, or the error that kept it from loading.
+struct Suite<'a> {
+    name: &'a str,
+    error: Option<&'a str>,
+    cases: Vec<Case>,
 }
 
 /// Counts of one suite or of all: test cases, failed ones, errors.
@@ -25,12 +53,12 @@ struct Counts {
 }
 
 impl Counts {
-    fn of(file: &FileScan) -> Self {
-        match file.error {
+    fn of(suite: &Suite) -> Self {
+        match suite.error {
             Some(_) => Counts { tests: 1, failures: 0, errors: 1 },
             None => Counts {
-                tests: file.animations.len(),
-                failures: file.animations.iter().filter(|a| !a.stretched.is_empty()).count(),
+                tests: suite.cases.len(),
+                failures: suite.cases.iter().filter(|c| !c.failures.is_empty()).count(),
                 errors: 0,
             },
         }
@@ -53,51 +81,68 @@ impl Counts {
     }
 }
 
-fn write(writer: &mut Writer<Vec<u8>>, files: &[FileScan]) -> io::Result<()> {
+fn write(writer: &mut Writer<Vec<u8>>, suites: &[Suite]) -> io::Result<()> {
     writer.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
-    let total = files.iter().map(Counts::of).fold(Counts::default(), Counts::add);
+    let total = suites.iter().map(Counts::of).fold(Counts::default(), Counts::add);
     let attributes = total.attributes();
-    let suites = writer
+    let element = writer
         .create_element("testsuites")
         .with_attribute(("name", "bonescope scan"))
         .with_attributes(attributes.iter().map(|(k, v)| (*k, v.as_str())));
-    suites.write_inner_content(|writer| files.iter().try_for_each(|file| suite(writer, file)))?;
+    element.write_inner_content(|writer| suites.iter().try_for_each(|suite| write_suite(writer, suite)))?;
     Ok(())
 }
 
-fn suite(writer: &mut Writer<Vec<u8>>, file: &FileScan) -> io::Result<()> {
-    let attributes = Counts::of(file).attributes();
+fn write_suite(writer: &mut Writer<Vec<u8>>, suite: &Suite) -> io::Result<()> {
+    let attributes = Counts::of(suite).attributes();
     let element = writer
         .create_element("testsuite")
-        .with_attribute(("name", file.file.as_str()))
+        .with_attribute(("name", suite.name))
         .with_attributes(attributes.iter().map(|(k, v)| (*k, v.as_str())));
-    element.write_inner_content(|writer| match &file.error {
+    element.write_inner_content(|writer| match suite.error {
         Some(error) => {
-            let case = writer
-                .create_element("testcase")
-                .with_attributes([("classname", file.file.as_str()), ("name", "load")]);
+            let case = writer.create_element("testcase").with_attributes([("classname", suite.name), ("name", "load")]);
             case.write_inner_content(|writer| {
-                let problem =
-                    writer.create_element("error").with_attributes([("message", error.as_str()), ("type", "load")]);
+                let problem = writer.create_element("error").with_attributes([("message", error), ("type", "load")]);
                 problem.write_text_content(BytesText::new(error))?;
                 Ok(())
             })?;
             Ok(())
         }
-        None => file.animations.iter().try_for_each(|clip| case(writer, &file.file, clip)),
+        None => suite.cases.iter().try_for_each(|case| write_case(writer, suite.name, case)),
     })?;
     Ok(())
 }
 
-fn case(writer: &mut Writer<Vec<u8>>, file: &str, clip: &AnimationScan) -> io::Result<()> {
-    let name = format!("{} (inherit {})", AnimationInfo::describe(clip.animation.as_ref()), clip.inherit);
-    let element = writer.create_element("testcase").with_attributes([("classname", file), ("name", name.as_str())]);
-    if clip.stretched.is_empty() {
+fn write_case(writer: &mut Writer<Vec<u8>>, file: &str, case: &Case) -> io::Result<()> {
+    let element =
+        writer.create_element("testcase").with_attributes([("classname", file), ("name", case.name.as_str())]);
+    if case.failures.is_empty() && case.output.is_none() {
         element.write_empty()?;
         return Ok(());
     }
     element.write_inner_content(|writer| {
-        for bone in &clip.stretched {
+        for (message, details) in &case.failures {
+            let failure = writer
+                .create_element("failure")
+                .with_attributes([("message", message.as_str()), ("type", "stretched")]);
+            failure.write_text_content(BytesText::new(details))?;
+        }
+        if let Some(output) = &case.output {
+            writer.create_element("system-out").write_text_content(BytesText::new(output))?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
+/// A clip of a stretch scan: a failure per stretched bone, with its worst shear and when.
+fn stretch_case(clip: &AnimationScan) -> Case {
+    let name = format!("{} (inherit {})", AnimationInfo::describe(clip.animation.as_ref()), clip.inherit);
+    let failures = clip
+        .stretched
+        .iter()
+        .map(|bone| {
             let summary = &bone.summary;
             let message = format!(
                 "`{}` stretched: worst shear {:.2}° at {:.3} s",
@@ -110,12 +155,8 @@ fn case(writer: &mut Writer<Vec<u8>>, file: &str, clip: &AnimationScan) -> io::R
                 summary.first_flagged_time.unwrap_or_default(),
                 summary.worst_stretch_deg
             );
-            let failure = writer
-                .create_element("failure")
-                .with_attributes([("message", message.as_str()), ("type", "stretched")]);
-            failure.write_text_content(BytesText::new(&details))?;
-        }
-        Ok(())
-    })?;
-    Ok(())
+            (message, details)
+        })
+        .collect();
+    Case { name, failures, output: None }
 }

@@ -7,6 +7,6 @@ mod merged;
 mod pool;
 
 pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
-pub use junit::junit;
+pub use junit::{Case, junit, junit_of};
 pub use merged::{merge, read_json_lines};
 pub use pool::in_order;
