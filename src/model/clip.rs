@@ -151,16 +151,18 @@ impl<T> Track<T> {
 /// Frames per second assumed for a clip whose keys show no rate.
 pub const DEFAULT_FRAME_RATE: f64 = 30.0;
 
-/// The rate of the most common spacing between consecutive key times, rounded to 1/1000 fps (at least a quarter of
-/// the spacings, and at least two, must agree, so scattered keys give none): 24 for keys 1/24 s apart, even with some keys missing.
-fn key_rate(times: &[f64]) -> Option<f64> {
+/// The rate of the most common spacing between consecutive key times of each array, rounded to 1/1000 fps (at least
+/// a quarter of the spacings, and at least two, must agree, so scattered keys give none): 24 for keys 1/24 s apart,
+/// even with some keys missing.
+fn key_rate(arrays: Vec<&[f64]>) -> Option<f64> {
     let mut counts: std::collections::BTreeMap<u64, usize> = std::collections::BTreeMap::new();
-    let gaps = times.windows(2).map(|w| w[1] - w[0]).filter(|&gap| gap > 1e-6);
-    for gap in gaps.clone() {
+    let mut total = 0;
+    for gap in arrays.iter().flat_map(|times| times.windows(2)).map(|w| w[1] - w[0]).filter(|&gap| gap > 1e-6) {
         *counts.entry((1000.0 / gap).round() as u64).or_default() += 1;
+        total += 1;
     }
     let (&rate, &count) = counts.iter().max_by_key(|(rate, count)| (**count, std::cmp::Reverse(**rate)))?;
-    (count >= 2 && count * 4 >= gaps.count() && rate > 0).then(|| rate as f64 / 1000.0)
+    (count >= 2 && count * 4 >= total && rate > 0).then(|| rate as f64 / 1000.0)
 }
 
 /// Key times closer than this are one key: one FBX tick (1/46,186,158,000 s), the finest time any supported
@@ -242,9 +244,15 @@ impl Clip {
         morph.sort_by_key(|m| m.bone);
         let duration = tracks.iter().flat_map(BoneTracks::time_arrays).map(|t| t[t.len() - 1]).fold(0.0, f64::max);
         let duration = morph.iter().map(MorphWeights::last_time).fold(duration, f64::max);
-        let mut clip = Clip { index, name, tracks, morph, duration, frame_rate: None };
-        clip.frame_rate = key_rate(&clip.key_times());
-        clip
+        Clip { index, name, tracks, morph, duration, frame_rate: None }
+    }
+
+    /// The clip with the rate of its most common key spacing as its frame rate, for a format that states none
+    /// (glTF): a file exported at 24 fps has keys 1/24 s apart. Gaps are counted within each time array, so no
+    /// merge of the arrays is needed.
+    pub fn with_key_spacing_rate(mut self) -> Self {
+        self.frame_rate = key_rate(self.time_arrays());
+        self
     }
 
     /// The clip with the frame rate its file states (finite and positive, else the key spacing's stays).
@@ -256,7 +264,7 @@ impl Clip {
     }
 
     /// Frames per second of the clip: the file's own rate where it states one (FBX, BVH), else the rate of its
-    /// most common key spacing (a glTF exported at 24 fps has keys 1/24 s apart), else 30.
+    /// most common key spacing where the importer measured it ([`Clip::with_key_spacing_rate`]), else 30.
     pub fn frame_rate(&self) -> f64 {
         self.frame_rate.unwrap_or(DEFAULT_FRAME_RATE)
     }
@@ -285,12 +293,7 @@ impl Clip {
     /// Tracks that read the same input share one time array (a glTF sampler input, or one array for a whole clip),
     /// and each array is sorted already: only the distinct arrays are merged, and one alone is the answer as is.
     pub fn key_times(&self) -> Vec<f64> {
-        let mut arrays: Vec<&[f64]> = Vec::new();
-        for times in self.tracks.iter().flat_map(BoneTracks::time_arrays) {
-            if !arrays.iter().any(|seen| std::ptr::eq(*seen, times)) {
-                arrays.push(times);
-            }
-        }
+        let arrays = self.time_arrays();
         if let [only] = arrays[..] {
             return only.to_vec();
         }
@@ -298,6 +301,17 @@ impl Clip {
         times.sort_unstable_by(f64::total_cmp);
         times.dedup();
         times
+    }
+
+    /// The distinct time arrays of the tracks (tracks that read the same input share one).
+    fn time_arrays(&self) -> Vec<&[f64]> {
+        let mut arrays: Vec<&[f64]> = Vec::new();
+        for times in self.tracks.iter().flat_map(BoneTracks::time_arrays) {
+            if !arrays.iter().any(|seen| std::ptr::eq(*seen, times)) {
+                arrays.push(times);
+            }
+        }
+        arrays
     }
 
     /// The tracks of one bone, if the clip animates it.
@@ -316,7 +330,7 @@ mod tests {
             let n = times.len();
             let mut tracks = BoneTracks::new(0);
             tracks.translation = Some(Track::new(times.into(), vec![Vec3::ZERO; n], Interpolation::Linear).unwrap());
-            Clip::new(0, None, vec![tracks], vec![])
+            Clip::new(0, None, vec![tracks], vec![]).with_key_spacing_rate()
         };
         // Keys 1/24 s apart with one missing: 24 fps (to 1/1000 fps).
         let mut times: Vec<f64> = (0..48).map(|k| f64::from(k) / 24.0).collect();
