@@ -11,7 +11,9 @@
 
 pub mod analysis;
 pub mod app;
+pub mod bake;
 pub mod cli;
+pub mod diff;
 pub mod eval;
 pub mod export;
 pub mod import;

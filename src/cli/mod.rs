@@ -1,9 +1,13 @@
 //! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
-//! inheritance modes), `export` writes the evaluated meshes of one time, `render` draws the viewport to PNG.
+//! inheritance modes), `export` writes the evaluated meshes of one time, `render` draws the viewport to PNG, `bake`
+//! writes any inheritance as plain glTF, `diff` compares two evaluations.
 //!
-//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone, or `render --reference` found a
-//! picture over its threshold; 2 bad usage or a file that cannot be loaded (after reporting every file that could).
+//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone, `render --reference` found a
+//! picture over its threshold, `bake --max-error` or `diff --fail-above` a difference over its limit; 2 bad usage
+//! or a file that cannot be loaded (after reporting every file that could).
 
+mod bake;
+mod diff;
 mod export;
 mod inspect;
 mod layers;
@@ -43,6 +47,10 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
     Export(export::ExportArgs),
+    /// Bake any scale inheritance into a plain glTF binary that every engine plays exactly (or as the closest TRS).
+    Bake(bake::BakeArgs),
+    /// Compare two evaluations (two files, or one under two sets of modes) over time, bone by bone.
+    Diff(diff::DiffArgs),
     /// Render the viewport (or the whole window) to PNG without a display, optionally checked against a reference.
     Render(render::RenderArgs),
 }
@@ -56,6 +64,8 @@ pub fn main() -> ExitCode {
         Some(Command::Report(args)) => report::run(&args),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Bake(args)) => bake::run(&args),
+        Some(Command::Diff(args)) => diff::run(&args),
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
     };
     match result {

@@ -213,6 +213,15 @@ fn shortcut(gram: &Gram) -> bool {
         && orthogonal(yz, y, z)
 }
 
+/// Among the frames that give the same `U·K·Uᵀ` as `stretch` with factors `scale` (axis permutations, and free
+/// turns between factors within [`EQUAL_SCALE_TOLERANCE`] of each other), the one closest to `reference`, with the
+/// factors permuted to match. Choosing each time's frame nearest the previous one gives a stretch rotation that
+/// moves continuously over time instead of jumping between equivalent frames.
+pub fn stretch_nearest(stretch: DQuat, scale: DVec3, reference: DQuat) -> (DQuat, DVec3) {
+    let (relative, scale) = canonical_stretch(reference.conjugate() * stretch, scale, EQUAL_SCALE_TOLERANCE);
+    ((reference * relative).normalize(), scale)
+}
+
 /// The stretch frame closest to the identity that gives the same `U·K·Uᵀ`, with `K` permuted to match; factors
 /// within `relative_tolerance` of the largest count as equal.
 fn canonical_stretch(u: DQuat, k: DVec3, relative_tolerance: f64) -> (DQuat, DVec3) {
@@ -370,6 +379,35 @@ mod tests {
         }
         let flat = DMat4::from_scale(DVec3::new(1.0, 1e-4, 1.0));
         assert_eq!(decompose_with_stretch(&flat, DQuat::IDENTITY, DVec3::new(1.0, 1e-4, 1.0), 1.0), None);
+    }
+
+    /// The nearest equivalent frame keeps the stretch and lies within the symmetry's reach of the reference.
+    #[test]
+    fn the_nearest_stretch_frame_follows_the_reference() {
+        let mut rng = XorShiftRng::seed_from_u64(17);
+        let stretch_of = |u: DQuat, k: DVec3| {
+            let m = DMat3::from_quat(u);
+            m * DMat3::from_diagonal(k) * m.transpose()
+        };
+        for case in 0..500 {
+            let (u, reference) = (random_quat(&mut rng), random_quat(&mut rng));
+            let k = match case % 3 {
+                0 => DVec3::new(1.0, 2.0, 3.0),
+                1 => DVec3::new(2.0, 1.0, 2.0),
+                _ => DVec3::splat(1.5),
+            };
+            let (near, scale) = stretch_nearest(u, k, reference);
+            assert!(stretch_of(near, scale).abs_diff_eq(stretch_of(u, k), 1e-12), "{case}: the same U·K·Uᵀ");
+            // No axis permutation of the result is closer to the reference.
+            let w = (reference.conjugate() * near).w.abs();
+            assert!(w >= closest_axis_permutation_w(reference.conjugate() * near) - 1e-12, "{case}");
+        }
+        // A frame one permutation away from the reference comes back to it exactly.
+        let reference = DQuat::from_rotation_y(0.4);
+        let permuted = reference * DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
+        let (near, scale) = stretch_nearest(permuted, DVec3::new(1.0, 2.0, 3.0), reference);
+        assert!(near.abs_diff_eq(reference, 1e-12) || near.abs_diff_eq(-reference, 1e-12));
+        assert!(scale.abs_diff_eq(DVec3::new(2.0, 1.0, 3.0), 1e-12));
     }
 
     /// `stretch_angle_deg_within` gives the angle of the frame `canonical_stretch` would choose.

@@ -35,6 +35,8 @@ pub struct Mesh {
     /// Index into `Rig::skins`.
     pub skin: Option<usize>,
     pub positions: Vec<Vec3>,
+    /// Per vertex, the normal the file gives (empty where it gives none, or none per vertex).
+    pub normals: Vec<Vec3>,
     /// Per vertex, four indices into the skin's joint list (empty when not skinned).
     pub joints: Vec<[u16; 4]>,
     /// Per vertex, four weights matching `joints` (empty when not skinned).
@@ -74,6 +76,7 @@ impl Mesh {
             next += u32::from(k);
         }
         retain_kept(&mut self.positions, &keep);
+        retain_kept(&mut self.normals, &keep);
         retain_kept(&mut self.joints, &keep);
         retain_kept(&mut self.weights, &keep);
         retain_kept(&mut self.dq_weights, &keep);

@@ -239,7 +239,7 @@ pub fn typical_scale(rig: &Rig) -> f64 {
 
 /// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `duration` by `pose_at`
 /// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
-/// matter count (see [`framed_bones`]), and the skinned meshes; the bounds grow by the size of the axis triads and
+/// matter count ([`Rig::character_bones`]), and the skinned meshes; the bounds grow by the size of the axis triads and
 /// boxes drawn around the joints.
 pub fn motion_bounds(
     rig: &Rig,
@@ -248,7 +248,7 @@ pub fn motion_bounds(
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
 ) -> Option<Bounds> {
-    let framed = framed_bones(rig, clip);
+    let framed = rig.character_bones(clip);
     let mut morph = MorphPose::default();
     let bounds = (0..samples.max(1))
         .filter_map(|i| {
@@ -262,24 +262,6 @@ pub fn motion_bounds(
         .reduce(Bounds::union)?;
     let gizmo = DVec3::splat(gizmo_size(rig));
     Some(Bounds { min: bounds.min - gizmo, max: bounds.max + gizmo })
-}
-
-/// The bones a camera frames: those the clip animates and the skins' joints, so that a file's cameras, lights and
-/// helpers far from the character (FBX exports often carry six "Producer" cameras 150 m out) stay out of the
-/// picture; every bone when that leaves none.
-fn framed_bones(rig: &Rig, clip: Option<&Clip>) -> Vec<bool> {
-    let mut framed = vec![false; rig.skeleton.len()];
-    let animated = clip.into_iter().flat_map(|c| c.tracks().iter().map(|t| t.bone));
-    let joints = rig.skins.iter().flat_map(|s| s.joints.iter().copied());
-    for bone in animated.chain(joints) {
-        if let Some(f) = framed.get_mut(bone) {
-            *f = true;
-        }
-    }
-    if !framed.contains(&true) {
-        framed.fill(true);
-    }
-    framed
 }
 
 /// The bounds of the rest pose's joints and meshes.

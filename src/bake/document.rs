@@ -1,0 +1,78 @@
+//! The baked scene as plain data, before it is encoded: nodes with their default TRS, meshes, skins and
+//! animations of sampled channels. [`super::glb`] turns it into a glTF binary.
+
+use glam::DMat4;
+
+use crate::model::Mesh;
+
+/// One glTF node. Parents come before their children.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    pub name: String,
+    pub parent: Option<usize>,
+    pub translation: [f32; 3],
+    /// A unit quaternion `[x, y, z, w]`.
+    pub rotation: [f32; 4],
+    pub scale: [f32; 3],
+    /// Index into [`Document::meshes`].
+    pub mesh: Option<usize>,
+    /// Index into [`Document::skins`].
+    pub skin: Option<usize>,
+}
+
+/// One glTF mesh: the source meshes that become its primitives (one node shows one mesh).
+#[derive(Clone, Debug)]
+pub struct MeshGroup<'a> {
+    pub name: String,
+    pub primitives: Vec<&'a Mesh>,
+    /// The default morph-target weights (one per target; every primitive has as many targets).
+    pub weights: Vec<f32>,
+}
+
+/// One glTF skin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinOut {
+    pub name: Option<String>,
+    /// Node indices.
+    pub joints: Vec<usize>,
+    pub inverse_bind: Vec<DMat4>,
+}
+
+/// What a channel animates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Property {
+    Translation,
+    Rotation,
+    Scale,
+    /// The morph-target weights of the node's mesh.
+    Weights,
+}
+
+/// Linearly interpolated keys of one property of one node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    pub node: usize,
+    pub property: Property,
+    /// Strictly increasing.
+    pub times: Vec<f32>,
+    /// `times.len() × width` numbers.
+    pub values: Vec<f32>,
+}
+
+/// One glTF animation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Animation {
+    pub name: String,
+    pub channels: Vec<Channel>,
+}
+
+/// The whole baked scene.
+#[derive(Clone, Debug, Default)]
+pub struct Document<'a> {
+    pub nodes: Vec<Node>,
+    pub meshes: Vec<MeshGroup<'a>>,
+    pub skins: Vec<SkinOut>,
+    pub animations: Vec<Animation>,
+    /// Written as the asset's generator.
+    pub generator: String,
+}

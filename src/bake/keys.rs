@@ -1,0 +1,156 @@
+//! Which samples become keys: the fewest, greedily, such that linear interpolation (slerp for rotations) between
+//! neighbouring keys reproduces every dropped sample within a tolerance.
+//!
+//! From each key the next one is pushed as far as it goes: the span doubles while every sample inside it is
+//! reproduced, then a binary search finds the farthest span that still is. Every span chosen has been checked
+//! sample by sample, so the result always holds; a whole clip costs `O(n log L)` checks for spans of `L` samples.
+
+use glam::DMat3;
+
+use super::nodes::{NodeSample, Sampled};
+use crate::math::slerp;
+
+/// The indices of the samples to keep among `count` (the first and last always), such that
+/// `error(i, j, k) ≤ tolerance` for every dropped `k` between its kept neighbours `i < k < j`.
+pub fn reduce(count: usize, tolerance: f64, error: impl Fn(usize, usize, usize) -> f64) -> Vec<usize> {
+    if count <= 2 {
+        return (0..count).collect();
+    }
+    let spans = |from: usize, to: usize| (from + 1..to).all(|k| error(from, to, k) <= tolerance);
+    let last = count - 1;
+    let mut keys = vec![0];
+    let mut from = 0;
+    while from < last {
+        let (mut good, mut step) = (from + 1, 1);
+        let mut bad = None;
+        while good < last {
+            let candidate = (good + step).min(last);
+            if spans(from, candidate) {
+                good = candidate;
+                step *= 2;
+            } else {
+                bad = Some(candidate);
+                break;
+            }
+        }
+        if let Some(mut bad) = bad {
+            while bad - good > 1 {
+                let middle = good + (bad - good) / 2;
+                if spans(from, middle) { good = middle } else { bad = middle }
+            }
+        }
+        keys.push(good);
+        from = good;
+    }
+    keys
+}
+
+/// How far one bone's nodes may be from its samples between keys, and how that distance is measured.
+///
+/// Interpolating the nodes between keys `i` and `j` gives a local matrix `L'` at sample `k` where the sample says
+/// `L`; a point of the bone's subtree at local position `y` then moves by `W'_parent·(L' − L)·y` in model space. The
+/// bound used is `gain·(|ΔT| + ‖ΔA‖_F·reach)`: `gain` bounds how much the parent scales lengths, `reach` how far
+/// the subtree's points lie from the bone's origin in its own units.
+#[derive(Clone, Copy, Debug)]
+pub struct BoneMetric {
+    pub gain: f64,
+    pub reach: f64,
+}
+
+impl BoneMetric {
+    /// The model-space distance bound for sample `k` interpolated between `i` and `j` of `bone`, its nodes as
+    /// baked with or without a `helper`.
+    pub fn error(&self, sampled: &Sampled, times: &[f64], bone: usize, helper: bool, (i, j, k): (usize, usize, usize)) -> f64 {
+        let t = (times[k] - times[i]) / (times[j] - times[i]);
+        let node = |s: usize| sampled.at(s, bone).as_baked(helper);
+        self.distance(&interpolate(&node(i), &node(j), t), &node(k))
+    }
+
+    /// The model-space distance bound between the nodes `interpolated` and `exact`.
+    pub fn distance(&self, interpolated: &NodeSample, exact: &NodeSample) -> f64 {
+        let (interpolated, exact) = (interpolated.matrix(), exact.matrix());
+        let linear = DMat3::from_mat4(interpolated) - DMat3::from_mat4(exact);
+        let offset = (interpolated.w_axis - exact.w_axis).truncate().length();
+        let frobenius = linear.to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.gain * (offset + frobenius * self.reach)
+    }
+}
+
+/// The nodes a fraction `t` of the way from `a` to `b`, as a glTF player computes them.
+pub fn interpolate(a: &NodeSample, b: &NodeSample, t: f64) -> NodeSample {
+    NodeSample {
+        translation: a.translation.lerp(b.translation, t),
+        rotation: slerp(a.rotation, b.rotation, t),
+        scale: a.scale.lerp(b.scale, t),
+        stretch: if a.stretch == b.stretch { a.stretch } else { slerp(a.stretch, b.stretch, t) },
+    }
+}
+
+/// The model-space distance bound of morph weights interpolated between keys: each weight's change times how far
+/// its target can move a vertex (`amplitude`).
+pub fn weights_error(samples: &[Vec<f64>], times: &[f64], amplitude: &[f64], (i, j, k): (usize, usize, usize)) -> f64 {
+    let t = (times[k] - times[i]) / (times[j] - times[i]);
+    let (a, b, exact) = (&samples[i], &samples[j], &samples[k]);
+    (0..exact.len()).map(|w| ((a[w] + (b[w] - a[w]) * t) - exact[w]).abs() * amplitude[w]).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+
+    #[test]
+    fn a_line_keeps_its_ends_and_a_corner_keeps_the_corner() {
+        let line: Vec<f64> = (0..50).map(f64::from).collect();
+        let linear = |values: &[f64]| {
+            let values = values.to_vec();
+            move |i: usize, j: usize, k: usize| {
+                let t = (k - i) as f64 / (j - i) as f64;
+                (values[i] + (values[j] - values[i]) * t - values[k]).abs()
+            }
+        };
+        assert_eq!(reduce(50, 1e-12, linear(&line)), [0, 49]);
+        let corner: Vec<f64> = (0..50).map(|k| f64::from((k as i32 - 20).abs())).collect();
+        assert_eq!(reduce(50, 1e-12, linear(&corner)), [0, 20, 49]);
+        assert_eq!(reduce(1, 0.0, linear(&[1.0])), [0]);
+        assert_eq!(reduce(0, 0.0, linear(&[])), Vec::<usize>::new());
+    }
+
+    #[test]
+    fn every_dropped_sample_is_within_the_tolerance() {
+        // A sine over 20 radians, sampled every 0.05: the kept keys reproduce every sample, and no more are kept than
+        // keys spaced evenly by √(8·tolerance) (linear interpolation's error bound for a curvature of 1), rounded
+        // down to whole samples, would need.
+        let values: Vec<f64> = (0..400).map(|k| (f64::from(k) * 0.05).sin()).collect();
+        let error = |i: usize, j: usize, k: usize| {
+            let t = (k - i) as f64 / (j - i) as f64;
+            (values[i] + (values[j] - values[i]) * t - values[k]).abs()
+        };
+        for tolerance in [1e-1, 1e-2, 1e-3] {
+            let keys = reduce(values.len(), tolerance, error);
+            for pair in keys.windows(2) {
+                assert!((pair[0] + 1..pair[1]).all(|k| error(pair[0], pair[1], k) <= tolerance));
+            }
+            let spacing = ((8.0 * tolerance).sqrt() / 0.05).floor().max(1.0) * 0.05;
+            let even = (20.0 / spacing).ceil() as usize + 2;
+            assert!(keys.len() <= even, "{tolerance}: {} keys, evenly spaced ones need {even}", keys.len());
+        }
+    }
+
+    #[test]
+    fn interpolation_is_gltfs() {
+        let axis = DVec3::new(0.0, 1.0, 1.0).normalize();
+        let a = NodeSample { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
+        let b = NodeSample {
+            translation: DVec3::new(2.0, 0.0, 0.0),
+            rotation: DQuat::from_axis_angle(axis, 1.0),
+            scale: DVec3::splat(3.0),
+            stretch: DQuat::IDENTITY,
+        };
+        let half = interpolate(&a, &b, 0.5);
+        assert_eq!(half.translation, DVec3::X);
+        assert_eq!(half.scale, DVec3::splat(2.0));
+        assert!(half.rotation.abs_diff_eq(DQuat::from_axis_angle(axis, 0.5), 1e-15));
+    }
+}

@@ -1,0 +1,371 @@
+//! What each bone's glTF nodes hold at each sampled time.
+//!
+//! A bone's baked local matrix is `L = W'_parent⁻¹ · W_bone`: what it needs under its already-baked parent so that
+//! plain glTF composition (full inheritance) gives back the source's model matrix `W_bone`. Its polar decomposition
+//! `L = T·F·R·U·K·Uᵀ` becomes a [`NodeSample`] `T · Q · S · Vᵀ`:
+//! - [`Strategy::Exact`]: `Q = R·U`, `S = F·K`, `V = U`. A bone that ever needs `U` (a stretched local matrix) gets a
+//!   helper node carrying `T, Q, S` above itself, and carries `Vᵀ = Uᵀ` (a rotation) itself: exact, since
+//!   `T·(R·U)·(F·K)·Uᵀ = L`. The others carry `T, R, F·K` (their `U` changes nothing).
+//! - [`Strategy::Trs`]: one node per bone, `Q = R`, `S = F·diag(U·K·Uᵀ)` (the part of the stretch along the bone's
+//!   own axes, the closest a TRS can come with that rotation), `V = I`; `W'` is the baked product, so each bone is
+//!   solved against its parent as baked and the errors do not add up down the chain.
+//!
+//! Where a parent's matrix is singular (a bone scaled to zero) `L` is taken from the source's own local transform.
+//! Samples are stored time-major (`samples × bones`), computed in parallel over chunks of time; [`follow_frames`]
+//! then makes each helper bone's `U` continuous over time.
+
+use glam::{DMat3, DMat4, DQuat, DVec3};
+use rayon::prelude::*;
+
+use super::Strategy;
+use crate::diff::Side;
+use crate::eval::{LayerStack, Pose};
+use crate::math::{AffineParts, decompose_near, stretch_nearest};
+use crate::model::affine;
+
+/// A stretch rotation matters when dropping it moves `U·K·Uᵀ` by more than this fraction of the largest factor.
+const STRETCH_MATTERS: f64 = 1e-12;
+
+/// A parent matrix counts as singular below this `|det|` relative to its size cubed.
+const SINGULAR: f64 = 1e-12;
+
+/// One bone's nodes at one time: the local matrix `T · Q · S · Vᵀ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeSample {
+    pub translation: DVec3,
+    /// `R·U` with a helper, else `R`.
+    pub rotation: DQuat,
+    /// The factors with the mirror's sign.
+    pub scale: DVec3,
+    /// `U` with a helper (the bone node carries its inverse), else the identity in effect.
+    pub stretch: DQuat,
+}
+
+impl NodeSample {
+    /// The local matrix the bone's nodes give.
+    pub fn matrix(&self) -> DMat4 {
+        let stretch = DMat3::from_quat(self.stretch);
+        let linear = DMat3::from_quat(self.rotation) * DMat3::from_diagonal(self.scale) * stretch.transpose();
+        affine(linear, self.translation)
+    }
+
+    /// The rotation of the single node of a bone without a helper: `R = Q·Vᵀ`.
+    pub fn plain_rotation(&self) -> DQuat {
+        (self.rotation * self.stretch.conjugate()).normalize()
+    }
+
+    /// The nodes of a bone without a helper: `T, R, S` (its `U` changes nothing).
+    pub fn plain(&self) -> NodeSample {
+        NodeSample { rotation: self.plain_rotation(), stretch: DQuat::IDENTITY, ..*self }
+    }
+
+    /// As the nodes of a bone with a helper (`helper`) or without.
+    pub fn as_baked(&self, helper: bool) -> NodeSample {
+        if helper { *self } else { self.plain() }
+    }
+
+    fn exact(parts: &AffineParts) -> Self {
+        NodeSample {
+            translation: parts.translation,
+            rotation: (parts.rotation * parts.stretch).normalize(),
+            scale: parts.scale * parts.sign,
+            stretch: parts.stretch,
+        }
+    }
+
+    fn trs(parts: &AffineParts) -> Self {
+        let u = DMat3::from_quat(parts.stretch);
+        let symmetric = u * DMat3::from_diagonal(parts.scale) * u.transpose();
+        let along_axes = DVec3::new(symmetric.x_axis.x, symmetric.y_axis.y, symmetric.z_axis.z);
+        NodeSample {
+            translation: parts.translation,
+            rotation: parts.rotation,
+            scale: along_axes * parts.sign,
+            stretch: DQuat::IDENTITY,
+        }
+    }
+}
+
+/// Every bone's nodes at every time of one evaluation.
+#[derive(Clone, Debug)]
+pub struct Sampled {
+    pub bones: usize,
+    /// `samples × bones`, time-major.
+    pub samples: Vec<NodeSample>,
+    pub stats: Stats,
+}
+
+impl Sampled {
+    pub fn times(&self) -> usize {
+        self.samples.len() / self.bones.max(1)
+    }
+
+    pub fn at(&self, sample: usize, bone: usize) -> &NodeSample {
+        &self.samples[sample * self.bones + bone]
+    }
+
+    /// The samples of one time, one per bone.
+    pub fn row(&self, sample: usize) -> &[NodeSample] {
+        &self.samples[sample * self.bones..(sample + 1) * self.bones]
+    }
+
+    /// `self`'s rows followed by `other`'s, with what both learnt about the bones.
+    pub fn append(mut self, other: Sampled) -> Sampled {
+        self.samples.extend(other.samples);
+        Sampled { stats: self.stats.merge(other.stats), ..self }
+    }
+
+    /// The rows in the order of `times` (one per row), and the times sorted.
+    pub fn sorted_by(self, times: &[f64]) -> (Vec<f64>, Sampled) {
+        let mut order: Vec<usize> = (0..times.len()).collect();
+        order.sort_by(|&a, &b| times[a].total_cmp(&times[b]));
+        let samples = order.iter().flat_map(|&row| self.row(row).iter().copied()).collect();
+        let sorted = order.iter().map(|&row| times[row]).collect();
+        (sorted, Sampled { samples, ..self })
+    }
+}
+
+/// Samples `side` at `times` for `strategy`.
+pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
+    let bones = side.rig.skeleton.len();
+    let parents: Vec<Option<usize>> = side.rig.skeleton.bones().iter().map(|b| b.parent).collect();
+    let mut samples = vec![IDENTITY_SAMPLE; times.len() * bones];
+    let chunk = 64;
+    let stats = samples
+        .par_chunks_mut(chunk * bones.max(1))
+        .zip(times.par_chunks(chunk))
+        .map(|(out, times)| {
+            let mut worker = Worker::new(side.layers.clone(), bones);
+            for (row, &time) in out.chunks_mut(bones.max(1)).zip(times) {
+                side.evaluate(&mut worker.pose, &mut worker.layers, time);
+                worker.solve(&parents, strategy, row);
+            }
+            worker.stats
+        })
+        .reduce(|| Stats::new(bones), Stats::merge);
+    Sampled { bones, samples, stats }
+}
+
+const IDENTITY_SAMPLE: NodeSample =
+    NodeSample { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
+
+/// What sampling learns about the bones.
+#[derive(Clone, Debug)]
+pub struct Stats {
+    /// Per bone: whether its `U` matters at some time.
+    pub stretched: Vec<bool>,
+    /// Per bone: an upper bound of how much its parent's baked matrix scales lengths (the largest Frobenius norm of
+    /// the 3×3 part over time; 1 for roots).
+    pub parent_gain: Vec<f64>,
+    /// How many samples took a local transform from the source because the parent was singular.
+    pub singular: usize,
+}
+
+impl Stats {
+    fn new(bones: usize) -> Self {
+        Stats { stretched: vec![false; bones], parent_gain: vec![0.0; bones], singular: 0 }
+    }
+
+    fn merge(mut self, other: Stats) -> Self {
+        for (s, o) in self.stretched.iter_mut().zip(other.stretched) {
+            *s |= o;
+        }
+        for (g, o) in self.parent_gain.iter_mut().zip(other.parent_gain) {
+            *g = g.max(o);
+        }
+        self.singular += other.singular;
+        self
+    }
+}
+
+/// One thread's pose, layers, baked model matrices and findings.
+struct Worker {
+    pose: Pose,
+    layers: Option<LayerStack>,
+    /// `W'`: the model matrices the baked nodes give.
+    baked: Vec<DMat4>,
+    /// The previous time's stretch of each bone, where the search for this time's starts.
+    previous: Vec<DQuat>,
+    stats: Stats,
+}
+
+impl Worker {
+    fn new(layers: Option<LayerStack>, bones: usize) -> Self {
+        Worker {
+            pose: Pose::default(),
+            layers,
+            baked: vec![DMat4::IDENTITY; bones],
+            previous: vec![DQuat::IDENTITY; bones],
+            stats: Stats::new(bones),
+        }
+    }
+
+    /// Fills `row` with every bone's nodes for the pose just evaluated.
+    fn solve(&mut self, parents: &[Option<usize>], strategy: Strategy, row: &mut [NodeSample]) {
+        for (bone, &parent) in parents.iter().enumerate() {
+            let source = self.pose.model.model[bone];
+            let local = match parent {
+                None => source,
+                Some(p) => match affine_inverse(&self.baked[p]) {
+                    Some(inverse) => inverse * source,
+                    None => {
+                        self.stats.singular += 1;
+                        self.pose.local[bone].matrix()
+                    }
+                },
+            };
+            let parts = decompose_near(&local, self.previous[bone]);
+            self.previous[bone] = parts.stretch;
+            let gain = parent.map_or(1.0, |p| frobenius(&self.baked[p]));
+            self.stats.parent_gain[bone] = self.stats.parent_gain[bone].max(gain);
+            let sample = match strategy {
+                Strategy::Exact => {
+                    self.stats.stretched[bone] |= stretch_matters(&parts);
+                    self.baked[bone] = source;
+                    NodeSample::exact(&parts)
+                }
+                Strategy::Trs => {
+                    let sample = NodeSample::trs(&parts);
+                    self.baked[bone] = parent.map_or(DMat4::IDENTITY, |p| self.baked[p]) * sample.matrix();
+                    sample
+                }
+            };
+            row[bone] = sample;
+        }
+    }
+}
+
+/// The nodes of the rest pose (no clip), one per bone: what the nodes hold where no animation says otherwise.
+pub fn rest(side: &Side, strategy: Strategy) -> Sampled {
+    let rest = Side { clip: None, layers: None, ..side.clone() };
+    sample(&rest, &[0.0], strategy)
+}
+
+/// Whether dropping `U` would change `U·K·Uᵀ` by more than rounding.
+fn stretch_matters(parts: &AffineParts) -> bool {
+    if parts.stretch == DQuat::IDENTITY {
+        return false;
+    }
+    let u = DMat3::from_quat(parts.stretch);
+    let difference = u * DMat3::from_diagonal(parts.scale) * u.transpose() - DMat3::from_diagonal(parts.scale);
+    let largest = difference.to_cols_array().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    largest > STRETCH_MATTERS * parts.scale.abs().max_element()
+}
+
+/// The inverse of an affine matrix, or `None` when it is singular (or not finite).
+fn affine_inverse(m: &DMat4) -> Option<DMat4> {
+    let linear = DMat3::from_mat4(*m);
+    let size = frobenius(m);
+    let determinant = linear.determinant();
+    if !(determinant.abs() > SINGULAR * size * size * size) || !determinant.is_finite() {
+        return None;
+    }
+    let inverse = linear.inverse();
+    Some(affine(inverse, -(inverse * m.w_axis.truncate())))
+}
+
+/// The Frobenius norm of the 3×3 part: at least the largest factor by which the matrix scales a length.
+fn frobenius(m: &DMat4) -> f64 {
+    let linear = DMat3::from_mat4(*m);
+    (linear.x_axis.length_squared() + linear.y_axis.length_squared() + linear.z_axis.length_squared()).sqrt()
+}
+
+/// Makes every bone's nodes continuous over time ([`align`] each sample to the one before).
+pub fn follow_frames(sampled: &mut Sampled) {
+    let bones = sampled.bones;
+    for s in 1..sampled.times() {
+        let (before, after) = sampled.samples.split_at_mut(s * bones);
+        let previous = &before[(s - 1) * bones..];
+        for (current, previous) in after[..bones].iter_mut().zip(previous) {
+            align(current, previous);
+        }
+    }
+}
+
+/// Makes `current` continue from `previous`: its stretch frame becomes the equivalent one nearest the previous
+/// sample's (the decomposition's canonical frame may swap axes between two samples), `Q = R·U` following it, and
+/// both rotations move to the hemisphere of the previous ones, so slerp between keys takes the path the samples
+/// mean.
+pub fn align(current: &mut NodeSample, previous: &NodeSample) {
+    let rotation = current.plain_rotation();
+    let sign = if current.scale.x.is_sign_negative() { -1.0 } else { 1.0 };
+    let (stretch, factors) = stretch_nearest(current.stretch, current.scale * sign, previous.stretch);
+    current.stretch = same_hemisphere(stretch, previous.stretch);
+    current.scale = factors * sign;
+    current.rotation = same_hemisphere((rotation * current.stretch).normalize(), previous.rotation);
+}
+
+/// `q` or `−q`, whichever is nearer `reference`.
+fn same_hemisphere(q: DQuat, reference: DQuat) -> DQuat {
+    if q.dot(reference) < 0.0 { -q } else { q }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::model::InheritMode;
+
+    #[test]
+    fn exact_samples_give_back_every_model_matrix() {
+        let rig = demo_rig();
+        let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
+        let side = Side::new(&rig, rig.clips.first(), &modes);
+        let times: Vec<f64> = (0..=20).map(|k| f64::from(k) * side.duration() / 20.0).collect();
+        let mut sampled = sample(&side, &times, Strategy::Exact);
+        let helper = sampled.stats.stretched.clone();
+        assert!(helper.contains(&true), "the demo's compensated forearm is stretched in its local matrix");
+        follow_frames(&mut sampled);
+        let mut pose = Pose::default();
+        for (s, &time) in times.iter().enumerate() {
+            side.evaluate(&mut pose, &mut None, time);
+            let mut baked: Vec<DMat4> = Vec::new();
+            for (bone, b) in rig.skeleton.bones().iter().enumerate() {
+                let local = sampled.at(s, bone).as_baked(helper[bone]).matrix();
+                baked.push(b.parent.map_or(local, |p| baked[p] * local));
+                assert!(baked[bone].abs_diff_eq(pose.model.model[bone], 1e-12), "{} at {time}", b.name);
+            }
+        }
+    }
+
+    #[test]
+    fn frames_follow_the_previous_sample() {
+        // One bone whose stretch frame is handed over swapped at every other sample.
+        let swap = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
+        let frame = DQuat::from_rotation_x(0.3);
+        let k = DVec3::new(1.0, 2.0, 3.0);
+        let mut samples: Vec<NodeSample> = (0..6)
+            .map(|s| {
+                let (stretch, scale) = if s % 2 == 0 { (frame, k) } else { (frame * swap, DVec3::new(2.0, 1.0, 3.0)) };
+                let parts = AffineParts { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, stretch, scale, sign: 1.0 };
+                NodeSample::exact(&parts)
+            })
+            .collect();
+        let matrices: Vec<DMat4> = samples.iter().map(NodeSample::matrix).collect();
+        let stats = Stats { stretched: vec![true], parent_gain: vec![1.0], singular: 0 };
+        let mut sampled = Sampled { bones: 1, samples: std::mem::take(&mut samples), stats };
+        follow_frames(&mut sampled);
+        for (s, m) in matrices.iter().enumerate() {
+            let node = sampled.at(s, 0);
+            assert!(node.matrix().abs_diff_eq(*m, 1e-12), "sample {s} keeps its matrix");
+            assert!(node.stretch.abs_diff_eq(frame, 1e-12), "sample {s}: {:?}", node.stretch);
+            assert_eq!(node.scale, k);
+        }
+    }
+
+    #[test]
+    fn trs_nodes_keep_the_stretch_along_the_axes() {
+        // A 45° stretch frame about Z with factors (2, 1, 1): U·K·Uᵀ has 1.5 on the X and Y diagonal.
+        let parts = AffineParts {
+            translation: DVec3::X,
+            rotation: DQuat::from_rotation_y(0.2),
+            stretch: DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4),
+            scale: DVec3::new(2.0, 1.0, 1.0),
+            sign: -1.0,
+        };
+        let node = NodeSample::trs(&parts);
+        assert!(node.scale.abs_diff_eq(DVec3::new(-1.5, -1.5, -1.0), 1e-12));
+        assert_eq!((node.rotation, node.stretch), (parts.rotation, DQuat::IDENTITY));
+        assert_eq!(affine_inverse(&DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0))), None);
+    }
+}

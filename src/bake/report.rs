@@ -1,0 +1,138 @@
+//! How close a bake came to its source: the source's evaluation against the baked file's, read back by bonescope's
+//! own glTF importer and compared at every sampled time ([`crate::diff::compare`]), so the report measures the file
+//! that was written, not the intentions behind it.
+
+use super::{Baked, Request, Strategy};
+use crate::diff::{Extreme, Pairs, Side, compare};
+use crate::model::Rig;
+
+/// How one bone was baked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoneNodes {
+    /// A helper node carries `T, R·U, K` and the bone `Uᵀ` (exact).
+    Helper,
+    /// One node: the bone's `U` never mattered (exact).
+    Plain,
+    /// One node, the closest TRS ([`Strategy::Trs`]).
+    Trs,
+}
+
+/// One bone's error over an animation, in model units.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BoneError {
+    pub name: String,
+    pub nodes: BoneNodes,
+    /// At the bone's origin.
+    pub origin: Extreme,
+    /// At the origin and the probe points on its axes (a tenth of the rig's size out).
+    pub probe: Extreme,
+}
+
+/// One skinned mesh's error over an animation.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MeshError {
+    pub name: String,
+    pub vertices: usize,
+    /// The largest vertex distance, model units, with its time.
+    pub max: Extreme,
+    pub mean: f64,
+    /// The same as a percentage of the rig's size.
+    pub max_percent: f64,
+    pub mean_percent: f64,
+}
+
+/// One baked animation against its source.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AnimationReport {
+    pub name: String,
+    pub samples: usize,
+    pub keys: usize,
+    pub bones: Vec<BoneError>,
+    pub meshes: Vec<MeshError>,
+    /// The largest error anywhere (a probe or a vertex), model units.
+    pub worst: Extreme,
+    /// Source bones the baked file lacks, and the reverse (none when the bake is sound).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub unmatched: Vec<String>,
+}
+
+/// The whole report.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BakeReport {
+    pub strategy: Strategy,
+    pub rig_size: f64,
+    /// The key tolerance, model units.
+    pub tolerance: f64,
+    /// The bones that got a helper node.
+    pub helpers: Vec<String>,
+    pub animations: Vec<AnimationReport>,
+    pub notes: Vec<String>,
+}
+
+impl BakeReport {
+    /// The largest error of any animation.
+    pub fn worst(&self) -> Extreme {
+        self.animations.iter().map(|a| a.worst).fold(Extreme::default(), |w, a| if a.max > w.max { a } else { w })
+    }
+}
+
+/// Compares every animation of `request` with the same animation of `baked_rig` (the bake read back).
+pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
+    let skeleton = &request.rig.skeleton;
+    let animations = baked
+        .animations
+        .iter()
+        .enumerate()
+        .map(|(k, animation)| {
+            let source = request.side(k);
+            let result = Side::new(baked_rig, baked_rig.clips.get(k), &baked_rig.skeleton.declared_modes());
+            let pairs = Pairs::of(&source, &result, &[]).unwrap_or_default();
+            let comparison = compare(&source, &result, &pairs, &animation.times);
+            let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {
+                (Strategy::Trs, _) => BoneNodes::Trs,
+                (Strategy::Exact, true) => BoneNodes::Helper,
+                (Strategy::Exact, false) => BoneNodes::Plain,
+            };
+            let bones = comparison
+                .bones
+                .iter()
+                .map(|d| BoneError { name: d.name.clone(), nodes: nodes(d.a), origin: d.position, probe: d.probe })
+                .collect();
+            let percent = |v: f64| 100.0 * v / baked.rig_size;
+            let meshes = comparison
+                .meshes
+                .iter()
+                .map(|m| MeshError {
+                    name: m.name.clone(),
+                    vertices: m.vertices,
+                    max: m.distance,
+                    mean: m.mean,
+                    max_percent: percent(m.distance.max),
+                    mean_percent: percent(m.mean),
+                })
+                .collect();
+            let unmatched_source = pairs.bones.only_a.iter().map(|&b| format!("{} (only in the source)", skeleton.bone(b).name));
+            let unmatched_baked =
+                pairs.bones.only_b.iter().map(|&b| format!("{} (only in the bake)", baked_rig.skeleton.bone(b).name));
+            AnimationReport {
+                name: animation.name.clone(),
+                samples: comparison.samples,
+                keys: animation.keys,
+                bones,
+                meshes,
+                worst: comparison.worst_distance(),
+                unmatched: unmatched_source.chain(unmatched_baked).collect(),
+            }
+        })
+        .collect();
+    let helpers = skeleton.bones().iter().zip(&baked.helpers).filter(|(_, h)| **h).map(|(b, _)| b.name.clone());
+    BakeReport {
+        strategy: request.strategy,
+        rig_size: baked.rig_size,
+        tolerance: baked.tolerance,
+        helpers: helpers.collect(),
+        animations,
+        notes: baked.notes.clone(),
+    }
+}

@@ -1,0 +1,204 @@
+//! `bonescope bake`: any scale inheritance baked into a plain glTF binary, with a report of how exact it is.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use clap::Args;
+
+use super::layers::LayerArgs;
+use super::table::Table;
+use super::{EvalArgs, Format};
+use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
+use crate::eval::LayerStack;
+use crate::import;
+
+#[derive(Debug, Args)]
+pub struct BakeArgs {
+    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    pub file: PathBuf,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Where to write the glTF binary (written whole or not at all).
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
+    /// exact: a helper node `<bone>.stretch` above each bone that needs its stretch rotation; trs: one TRS node per
+    /// bone, the closest to what it needs (for runtimes that cannot shear).
+    #[arg(long, value_enum, default_value_t)]
+    pub strategy: Strategy,
+    /// Between keys the result stays within this fraction of the rig's size of the source (0 keeps every sample).
+    #[arg(long, value_name = "FRACTION", default_value_t = bake::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    /// Exit with status 1 when any probe point or vertex is farther than this from the source: a distance in model
+    /// units (metres), or a percentage of the rig's size (`0.01%`).
+    #[arg(long, value_name = "D", value_parser = parse_distance)]
+    pub max_error: Option<Distance>,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    #[command(flatten)]
+    pub layers: LayerArgs,
+}
+
+/// A distance in model units or relative to the rig's size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Distance {
+    Units(f64),
+    Percent(f64),
+}
+
+impl Distance {
+    pub fn units(self, rig_size: f64) -> f64 {
+        match self {
+            Distance::Units(d) => d,
+            Distance::Percent(p) => p / 100.0 * rig_size,
+        }
+    }
+}
+
+pub fn parse_distance(s: &str) -> Result<Distance, String> {
+    let (number, percent) = match s.trim().strip_suffix('%') {
+        Some(number) => (number, true),
+        None => (s.trim(), false),
+    };
+    let value: f64 = number.trim().parse().map_err(|_| format!("`{s}` is not a distance (a number, or a number and %)"))?;
+    if !(value.is_finite() && value >= 0.0) {
+        return Err(format!("the distance must be finite and ≥ 0, got `{s}`"));
+    }
+    Ok(if percent { Distance::Percent(value) } else { Distance::Units(value) })
+}
+
+pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
+    if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
+        bail!("--tolerance must be a finite fraction ≥ 0, got {}", args.tolerance);
+    }
+    let rig = import::load(&args.file)?;
+    if rig.skeleton.is_empty() {
+        bail!("{}: no nodes to bake", args.file.display());
+    }
+    let modes = args.eval.modes(&rig)?;
+    let layers = args.layers.layers(&rig)?;
+    let clips = if layers.is_empty() {
+        let only = match &args.eval.anim {
+            Some(_) => args.eval.clip(&rig)?,
+            None => None,
+        };
+        bake::every_clip(&rig, only)
+    } else {
+        // A layered result is one new clip, named after its main clip and what was layered on it.
+        let clip = args.eval.clip(&rig)?;
+        let stack = LayerStack::new(&rig, &layers)?;
+        let main = clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
+        let name = format!("{main} + {}", layers.summary(&rig, clip));
+        vec![ClipToBake { name, clip, layers: Some(stack) }]
+    };
+    let request = Request { rig: &rig, modes, clips, strategy: args.strategy, tolerance: args.tolerance };
+    let baked = bake::bake(&request);
+    let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
+    let report = bake::report(&request, &baked, &baked_rig);
+    bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        Format::Table => print!("{}", render_table(args, &report, baked.glb.len())),
+    }
+    let worst = report.worst();
+    let over = args.max_error.is_some_and(|limit| worst.max > limit.units(report.rig_size));
+    Ok(if over { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
+    let size = report.rig_size;
+    let percent = |v: f64| format!("{:.6} %", 100.0 * v / size);
+    let mut out = format!(
+        "{} → {} ({bytes} bytes)  strategy: {}  inherit: {}\n",
+        args.file.display(),
+        args.out.display(),
+        match report.strategy {
+            Strategy::Exact => "exact",
+            Strategy::Trs => "trs",
+        },
+        args.eval.inherit_label()
+    );
+    out.push_str(&format!(
+        "  rig size {size:.6}; keys within {:.3e} ({} of the rig size)\n",
+        report.tolerance, args.tolerance
+    ));
+    if report.strategy == Strategy::Exact {
+        let helpers = if report.helpers.is_empty() { "none".to_owned() } else { report.helpers.join(", ") };
+        out.push_str(&format!("  helper nodes for: {helpers}\n"));
+    }
+    for note in &report.notes {
+        out.push_str(&format!("  note: {note}\n"));
+    }
+    for animation in &report.animations {
+        out.push_str(&format!(
+            "\nanimation `{}`: {} samples, {} keys; worst {:.3e} ({}) at {:.4} s\n",
+            animation.name,
+            animation.samples,
+            animation.keys,
+            animation.worst.max,
+            percent(animation.worst.max),
+            animation.worst.time
+        ));
+        let mut bones = Table::new(&[
+            ("bone", false),
+            ("nodes", false),
+            ("origin max", true),
+            ("at s", true),
+            ("probe max", true),
+            ("of rig", true),
+            ("at s", true),
+        ]);
+        for bone in &animation.bones {
+            bones.row(vec![
+                bone.name.clone(),
+                format!("{:?}", bone.nodes).to_lowercase(),
+                format!("{:.3e}", bone.origin.max),
+                format!("{:.4}", bone.origin.time),
+                format!("{:.3e}", bone.probe.max),
+                percent(bone.probe.max),
+                format!("{:.4}", bone.probe.time),
+            ]);
+        }
+        out.push_str(&bones.to_string());
+        if !animation.meshes.is_empty() {
+            let mut meshes = Table::new(&[
+                ("mesh", false),
+                ("vertices", true),
+                ("max", true),
+                ("of rig", true),
+                ("mean", true),
+                ("of rig", true),
+                ("at s", true),
+            ]);
+            for mesh in &animation.meshes {
+                meshes.row(vec![
+                    mesh.name.clone(),
+                    mesh.vertices.to_string(),
+                    format!("{:.3e}", mesh.max.max),
+                    percent(mesh.max.max),
+                    format!("{:.3e}", mesh.mean),
+                    percent(mesh.mean),
+                    format!("{:.4}", mesh.max.time),
+                ]);
+            }
+            out.push_str(&meshes.to_string());
+        }
+        for unmatched in &animation.unmatched {
+            out.push_str(&format!("  warning: {unmatched}\n"));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distances_in_units_or_percent() {
+        assert_eq!(parse_distance("0.5"), Ok(Distance::Units(0.5)));
+        assert_eq!(parse_distance("0.01%"), Ok(Distance::Percent(0.01)));
+        assert_eq!(parse_distance("2 %").map(|d| d.units(3.0)), Ok(0.06));
+        assert!(parse_distance("-1").is_err() && parse_distance("far").is_err() && parse_distance("inf").is_err());
+    }
+}

@@ -1,0 +1,163 @@
+//! `bonescope diff`: two evaluations compared over time, bone by bone and vertex by vertex.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+
+use super::Format;
+use super::bake::{Distance, parse_distance};
+use super::options::ModeSet;
+use super::table::Table;
+use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
+use crate::import;
+use crate::model::Rig;
+
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// The first file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    pub a: PathBuf,
+    /// The second file.
+    pub b: PathBuf,
+    /// The first file's animation (name or index); without --anim-a/--anim-b every animation is compared with the
+    /// other file's animation of the same name.
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub anim_a: Option<String>,
+    /// The second file's animation (name or index).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub anim_b: Option<String>,
+    /// The first file's inheritance: `declared` (what its file says) or one mode for every bone.
+    #[arg(long, value_name = "MODE", default_value = "declared")]
+    pub inherit_a: ModeSet,
+    /// The second file's inheritance.
+    #[arg(long, value_name = "MODE", default_value = "declared")]
+    pub inherit_b: ModeSet,
+    /// Pair a bone of the first file with one of the second explicitly (repeatable); the rest pair by name, exactly,
+    /// then ignoring case and namespace prefixes such as `mixamorig:` or `Armature|`.
+    #[arg(long = "map", value_name = "A=B", value_parser = parse_pair)]
+    pub map: Vec<(String, String)>,
+    /// Samples per second over the shorter clip, on top of both files' key times.
+    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    pub rate: f64,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    /// Exit with status 1 when a bone's origin or axis probe, or a vertex, differs by more than this: a distance in
+    /// model units (metres), or a percentage of the first rig's size (`0.01%`).
+    #[arg(long, value_name = "DIST", value_parser = parse_distance)]
+    pub fail_above: Option<Distance>,
+}
+
+fn parse_pair(s: &str) -> Result<(String, String), String> {
+    let (a, b) = s.split_once('=').ok_or_else(|| format!("expected A=B, got `{s}`"))?;
+    Ok((a.to_owned(), b.to_owned()))
+}
+
+pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
+    if !(args.rate.is_finite() && args.rate >= 0.0) {
+        anyhow::bail!("--rate must be a finite number of samples per second ≥ 0, got {}", args.rate);
+    }
+    let (rig_a, rig_b) = (import::load(&args.a)?, import::load(&args.b)?);
+    let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
+    let b = side(&args.b, &rig_b, args.inherit_b, &args.anim_b);
+    let diff = diff_files(&a, &b, &args.map, args.rate).map_err(anyhow::Error::msg)?;
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
+        Format::Table => print!("{}", render_table(&diff)),
+    }
+    let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
+    Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn side<'a>(path: &PathBuf, rig: &'a Rig, modes: ModeSet, anim: &Option<String>) -> FileSide<'a> {
+    FileSide { file: path.display().to_string(), rig, modes: modes.modes(rig), inherit: modes.label(), anim: anim.clone() }
+}
+
+fn render_table(diff: &FileDiff) -> String {
+    let mut out = format!(
+        "A: {}  inherit: {}\nB: {}  inherit: {}\n",
+        diff.a, diff.inherit_a, diff.b, diff.inherit_b
+    );
+    for clip in &diff.clips_only_a {
+        out.push_str(&format!("  animation only in A: {clip}\n"));
+    }
+    for clip in &diff.clips_only_b {
+        out.push_str(&format!("  animation only in B: {clip}\n"));
+    }
+    for animation in &diff.animations {
+        let percent = |v: f64| format!("{:.4} %", 100.0 * v / animation.rig_size);
+        out.push_str(&format!(
+            "\n`{}` against `{}`: {} samples, rig size {:.4}; worst distance {:.3e} ({}) at {:.4} s\n",
+            animation.a,
+            animation.b,
+            animation.samples,
+            animation.rig_size,
+            animation.worst.max,
+            percent(animation.worst.max),
+            animation.worst.time
+        ));
+        let mut bones = Table::new(&[
+            ("bone", false),
+            ("position", true),
+            ("at s", true),
+            ("probe", true),
+            ("at s", true),
+            ("orientation°", true),
+            ("at s", true),
+            ("scale ratio", true),
+            ("at s", true),
+            ("stretch°", true),
+            ("at s", true),
+        ]);
+        for bone in &animation.bones {
+            let name = match &bone.name_b {
+                Some(other) => format!("{} = {other}", bone.name),
+                None => bone.name.clone(),
+            };
+            bones.row(vec![
+                name,
+                format!("{:.3e}", bone.position.max),
+                format!("{:.4}", bone.position.time),
+                format!("{:.3e}", bone.probe.max),
+                format!("{:.4}", bone.probe.time),
+                format!("{:.4}", bone.orientation_deg.max),
+                format!("{:.4}", bone.orientation_deg.time),
+                format!("{:.6}", bone.scale_ratio.max),
+                format!("{:.4}", bone.scale_ratio.time),
+                format!("{:.4}", bone.stretch_deg.max),
+                format!("{:.4}", bone.stretch_deg.time),
+            ]);
+        }
+        out.push_str(&bones.to_string());
+        if !animation.meshes.is_empty() {
+            let mut meshes = Table::new(&[
+                ("mesh", false),
+                ("vertices", true),
+                ("max", true),
+                ("of rig", true),
+                ("at s", true),
+                ("mean", true),
+            ]);
+            for mesh in &animation.meshes {
+                meshes.row(vec![
+                    mesh.name.clone(),
+                    mesh.vertices.to_string(),
+                    format!("{:.3e}", mesh.distance.max),
+                    percent(mesh.distance.max),
+                    format!("{:.4}", mesh.distance.time),
+                    format!("{:.3e}", mesh.mean),
+                ]);
+            }
+            out.push_str(&meshes.to_string());
+        }
+        if !animation.only_a.is_empty() {
+            out.push_str(&format!("  bones only in A: {}\n", animation.only_a.join(", ")));
+        }
+        if !animation.only_b.is_empty() {
+            out.push_str(&format!("  bones only in B: {}\n", animation.only_b.join(", ")));
+        }
+        if animation.helpers > 0 {
+            out.push_str(&format!("  {} bake helper nodes (`*.stretch`) left out\n", animation.helpers));
+        }
+    }
+    out
+}

@@ -1,0 +1,186 @@
+//! Which bone, mesh and clip of one file is which of another's.
+//!
+//! Bones are matched by name in three passes, each over what the earlier ones left: the user's explicit pairs
+//! (`--map a=b`), exact names, then names compared without case and without a namespace prefix (`mixamorig:Hips`,
+//! `Armature|Hips` and `hips` are one name). Repeated names pair up in file order. The helper nodes a bake inserts
+//! (`<name>.stretch`, whose child is the bone `<name>`) are not bones of the rig and are left out of both sides.
+
+use std::collections::{HashMap, HashSet, VecDeque};
+
+use crate::model::{Clip, Mesh, Skeleton};
+
+/// The suffix of the helper node a bake puts above a stretched bone.
+pub const HELPER_SUFFIX: &str = ".stretch";
+
+/// Bones of two skeletons paired up.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BoneMatching {
+    /// `(bone in A, bone in B)`, in A's bone order.
+    pub pairs: Vec<(usize, usize)>,
+    /// Bones of A with no partner, in bone order (helper nodes not included).
+    pub only_a: Vec<usize>,
+    pub only_b: Vec<usize>,
+    /// How many helper nodes were left out, on both sides together.
+    pub helpers: usize,
+}
+
+/// For each bone, whether it is a bake's helper node: named `<name>.stretch` with a child named `<name>`.
+pub fn helpers(skeleton: &Skeleton) -> Vec<bool> {
+    let bones = skeleton.bones();
+    let mut helper = vec![false; bones.len()];
+    for bone in bones {
+        if let Some(p) = bone.parent
+            && bones[p].name.strip_suffix(HELPER_SUFFIX) == Some(bone.name.as_str())
+        {
+            helper[p] = true;
+        }
+    }
+    helper
+}
+
+/// The name without case and without a namespace prefix (everything up to the last `:` or `|`).
+pub fn loose_name(name: &str) -> String {
+    name.rsplit([':', '|']).next().unwrap_or(name).to_lowercase()
+}
+
+/// Pairs the bones of `a` and `b` (see the module's documentation); `map` holds explicit `(name in A, name in B)`
+/// pairs, tried first. A pair in `map` that names no bone is an error naming it.
+pub fn match_bones(a: &Skeleton, b: &Skeleton, map: &[(String, String)]) -> Result<BoneMatching, String> {
+    let candidates = |s: &Skeleton| {
+        let helper = helpers(s);
+        (0..s.len()).filter(|&i| !helper[i]).collect::<Vec<_>>()
+    };
+    let (mut left_a, mut left_b) = (candidates(a), candidates(b));
+    let helpers = (a.len() - left_a.len()) + (b.len() - left_b.len());
+    let mut pairs = Vec::new();
+    for (name_a, name_b) in map {
+        let take = |left: &mut Vec<usize>, s: &Skeleton, name: &str, side: &str| {
+            let at = left.iter().position(|&i| s.bone(i).name == name);
+            at.map(|at| left.remove(at)).ok_or_else(|| format!("--map {name_a}={name_b}: no unmatched bone `{name}` in {side}"))
+        };
+        let i = take(&mut left_a, a, name_a, "the first file")?;
+        let j = take(&mut left_b, b, name_b, "the second file")?;
+        pairs.push((i, j));
+    }
+    let exact = |s: &Skeleton, i: usize| s.bone(i).name.clone();
+    pair_by_key(a, b, &mut left_a, &mut left_b, &mut pairs, exact);
+    let loose = |s: &Skeleton, i: usize| loose_name(&s.bone(i).name);
+    pair_by_key(a, b, &mut left_a, &mut left_b, &mut pairs, loose);
+    pairs.sort_unstable();
+    Ok(BoneMatching { pairs, only_a: left_a, only_b: left_b, helpers })
+}
+
+/// Pairs the bones left on each side whose `key` agrees, the k-th of a key in A with the k-th in B, and removes
+/// them from what is left.
+fn pair_by_key(
+    a: &Skeleton,
+    b: &Skeleton,
+    left_a: &mut Vec<usize>,
+    left_b: &mut Vec<usize>,
+    pairs: &mut Vec<(usize, usize)>,
+    key: impl Fn(&Skeleton, usize) -> String,
+) {
+    let mut by_key: HashMap<String, VecDeque<usize>> = HashMap::new();
+    for &j in left_b.iter() {
+        by_key.entry(key(b, j)).or_default().push_back(j);
+    }
+    let mut matched_b = HashSet::new();
+    left_a.retain(|&i| match by_key.get_mut(&key(a, i)).and_then(VecDeque::pop_front) {
+        Some(j) => {
+            pairs.push((i, j));
+            matched_b.insert(j);
+            false
+        }
+        None => true,
+    });
+    left_b.retain(|j| !matched_b.contains(j));
+}
+
+/// Meshes paired by name and vertex count (repeated names in file order): `(mesh in A, mesh in B)`.
+pub fn match_meshes(a: &[Mesh], b: &[Mesh]) -> Vec<(usize, usize)> {
+    let mut taken = vec![false; b.len()];
+    let mut pairs = Vec::new();
+    for (i, mesh) in a.iter().enumerate() {
+        let partner = b.iter().enumerate().position(|(j, other)| {
+            !taken[j] && other.name == mesh.name && other.positions.len() == mesh.positions.len()
+        });
+        if let Some(j) = partner {
+            taken[j] = true;
+            pairs.push((i, j));
+        }
+    }
+    pairs
+}
+
+/// Clips paired by name, then by index among the unnamed ones: `(clip in A, clip in B)`, and the clips of each side
+/// left without a partner.
+pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, Vec<usize>) {
+    let mut taken = vec![false; b.len()];
+    let mut pairs = Vec::new();
+    let mut only_a = Vec::new();
+    for (i, clip) in a.iter().enumerate() {
+        let same = |j: usize| match (&clip.name, &b[j].name) {
+            (Some(x), Some(y)) => x == y,
+            (None, None) => clip.index == b[j].index,
+            _ => false,
+        };
+        match (0..b.len()).find(|&j| !taken[j] && same(j)) {
+            Some(j) => {
+                taken[j] = true;
+                pairs.push((i, j));
+            }
+            None => only_a.push(i),
+        }
+    }
+    let only_b = (0..b.len()).filter(|&j| !taken[j]).collect();
+    (pairs, only_a, only_b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Bone, InheritMode, Transform};
+
+    fn skeleton(bones: &[(&str, Option<usize>)]) -> Skeleton {
+        let bone = |(name, parent): &(&str, Option<usize>)| Bone {
+            name: (*name).to_owned(),
+            node: 0,
+            parent: *parent,
+            rest: Transform::IDENTITY,
+            inherit: InheritMode::Full,
+        };
+        Skeleton::new(bones.iter().map(bone).collect()).unwrap()
+    }
+
+    #[test]
+    fn exact_then_loose_then_mapped() {
+        let a = skeleton(&[("Hips", None), ("mixamorig:Spine", Some(0)), ("Armature|Head", Some(1)), ("Tail", None)]);
+        let b = skeleton(&[("hips", None), ("Hips", None), ("spine", Some(1)), ("HEAD", Some(2)), ("Cape", None)]);
+        let m = match_bones(&a, &b, &[]).unwrap();
+        assert_eq!(m.pairs, [(0, 1), (1, 2), (2, 3)], "exact `Hips` wins over the loose `hips`");
+        assert_eq!((m.only_a, m.only_b), (vec![3], vec![0, 4]));
+        let mapped = match_bones(&a, &b, &[("Tail".into(), "Cape".into())]).unwrap();
+        assert!(mapped.pairs.contains(&(3, 4)));
+        assert!(match_bones(&a, &b, &[("Nope".into(), "Cape".into())]).unwrap_err().contains("`Nope`"));
+    }
+
+    #[test]
+    fn repeated_names_pair_in_order_and_helpers_are_left_out() {
+        let a = skeleton(&[("root", None), ("joint", Some(0)), ("joint", Some(1))]);
+        let b = skeleton(&[("root", None), ("joint.stretch", Some(0)), ("joint", Some(1)), ("joint", Some(2))]);
+        let m = match_bones(&a, &b, &[]).unwrap();
+        assert_eq!(m.pairs, [(0, 0), (1, 2), (2, 3)]);
+        assert_eq!(m.helpers, 1);
+        assert!(m.only_a.is_empty() && m.only_b.is_empty());
+        // A bone merely named like a helper, without the matching child, is a bone.
+        let lone = skeleton(&[("arm.stretch", None), ("hand", Some(0))]);
+        assert_eq!(helpers(&lone), [false, false]);
+    }
+
+    #[test]
+    fn loose_names() {
+        assert_eq!(loose_name("mixamorig:LeftArm"), "leftarm");
+        assert_eq!(loose_name("Armature|Bone.001"), "bone.001");
+        assert_eq!(loose_name("a:b|C"), "c");
+    }
+}

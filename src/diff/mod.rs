@@ -1,0 +1,392 @@
+//! Two evaluations compared over time, bone by bone and vertex by vertex: two files (an export and its source, a
+//! bake and what it baked), or one file under two sets of modes.
+//!
+//! Bones are paired by name ([`matching`]); at every time both poses are evaluated and each pair's model matrices
+//! `W_a`, `W_b` are compared through their polar decompositions:
+//! - **position**: the distance between the two origins;
+//! - **probe**: the largest distance of a point of the bone's frame — its origin and one point on each of its axes,
+//!   [`PROBE_FRACTION`] of the rig's size from the origin in A — between where A and B put it (rotation, scale and
+//!   shear errors all show here, in model units);
+//! - **orientation**: the angle between the two polar rotations `R`;
+//! - **scale**: the largest ratio between corresponding stretch factors `K` (sorted, so the frame does not matter);
+//! - **stretch**: the angle between the two stretch frames `U`, ignoring turns that leave `U·K·Uᵀ` the same.
+//!
+//! Meshes are paired by name and vertex count; each pair is skinned on both sides and the vertex distances kept
+//! (largest, and mean over every vertex and time). Every largest value comes with the first time it happens.
+
+mod matching;
+mod report;
+mod side;
+
+pub use matching::{BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_clips, match_meshes};
+pub use report::{AnimationDiff, FileDiff, FileSide, diff_files};
+pub use side::{Side, comparison_times, rig_size};
+
+use glam::{DMat4, DQuat, DVec3};
+use rayon::prelude::*;
+
+use crate::eval::{LayerStack, Pose};
+use crate::math::{AffineParts, decompose_all};
+
+/// How far along each axis the probe points lie, as a fraction of the rig's size.
+pub const PROBE_FRACTION: f64 = 0.1;
+
+/// Stretch factors within this fraction of each other count as equal when stretch frames are compared (the frame
+/// of equal factors is free, so its turn is no difference).
+const EQUAL_FACTORS: f64 = 1e-4;
+
+/// The largest value of a quantity over time, and the first time it happens.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Extreme {
+    pub max: f64,
+    pub time: f64,
+}
+
+impl Extreme {
+    /// Starting from `floor` (no difference) at t = 0.
+    fn from(floor: f64) -> Self {
+        Extreme { max: floor, time: 0.0 }
+    }
+
+    fn add(&mut self, value: f64, time: f64) {
+        // NaN (a degenerate matrix) counts as the largest difference there is.
+        if value > self.max || (value.is_nan() && !self.max.is_nan()) {
+            *self = Extreme { max: value, time };
+        }
+    }
+
+    /// Combines an earlier stretch of time with a later one (ties keep the earlier time).
+    fn merge(mut self, later: Extreme) -> Self {
+        self.add(later.max, later.time);
+        self
+    }
+}
+
+/// One pair of bones over the compared times.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BoneDifference {
+    /// The bone in A and in B.
+    pub a: usize,
+    pub b: usize,
+    pub name: String,
+    /// B's name where it differs from A's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name_b: Option<String>,
+    /// Distance between the origins, model units.
+    pub position: Extreme,
+    /// Largest distance between the origins and the probe points on the axes, model units.
+    pub probe: Extreme,
+    /// Angle between the polar rotations, degrees.
+    pub orientation_deg: Extreme,
+    /// Largest ratio between corresponding stretch factors (1: equal).
+    pub scale_ratio: Extreme,
+    /// Angle between the stretch frames, degrees.
+    pub stretch_deg: Extreme,
+}
+
+impl BoneDifference {
+    fn new(a: usize, b: usize, name: &str, name_b: &str) -> Self {
+        BoneDifference {
+            a,
+            b,
+            name: name.to_owned(),
+            name_b: (name != name_b).then(|| name_b.to_owned()),
+            position: Extreme::default(),
+            probe: Extreme::default(),
+            orientation_deg: Extreme::default(),
+            scale_ratio: Extreme::from(1.0),
+            stretch_deg: Extreme::default(),
+        }
+    }
+
+    fn merge(self, later: BoneDifference) -> Self {
+        BoneDifference {
+            position: self.position.merge(later.position),
+            probe: self.probe.merge(later.probe),
+            orientation_deg: self.orientation_deg.merge(later.orientation_deg),
+            scale_ratio: self.scale_ratio.merge(later.scale_ratio),
+            stretch_deg: self.stretch_deg.merge(later.stretch_deg),
+            ..self
+        }
+    }
+}
+
+/// One pair of meshes over the compared times.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MeshDifference {
+    pub a: usize,
+    pub b: usize,
+    pub name: String,
+    pub vertices: usize,
+    /// The largest distance between a vertex in A and the same vertex in B, model units.
+    pub distance: Extreme,
+    /// The mean of that distance over every vertex and time.
+    pub mean: f64,
+    /// The sum behind `mean` (merged across workers before dividing).
+    #[serde(skip)]
+    sum: f64,
+}
+
+impl MeshDifference {
+    fn merge(self, later: MeshDifference) -> Self {
+        MeshDifference { distance: self.distance.merge(later.distance), sum: self.sum + later.sum, ..self }
+    }
+}
+
+/// What is compared: the pairs of bones and meshes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Pairs {
+    pub bones: BoneMatching,
+    pub meshes: Vec<(usize, usize)>,
+}
+
+impl Pairs {
+    /// Bones by name (with the explicit `map` first) and meshes by name and vertex count.
+    pub fn of(a: &Side, b: &Side, map: &[(String, String)]) -> Result<Self, String> {
+        let bones = match_bones(&a.rig.skeleton, &b.rig.skeleton, map)?;
+        Ok(Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) })
+    }
+}
+
+/// The result of comparing two evaluations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// How many times were compared.
+    pub samples: usize,
+    /// The size of A's rig ([`rig_size`]), which relative figures are fractions of.
+    pub rig_size: f64,
+    /// One per pair of bones, in A's bone order.
+    pub bones: Vec<BoneDifference>,
+    pub meshes: Vec<MeshDifference>,
+}
+
+impl Comparison {
+    /// The largest probe distance of any bone and vertex distance of any mesh: how far anything moved.
+    pub fn worst_distance(&self) -> Extreme {
+        let bones = self.bones.iter().map(|b| b.probe);
+        let meshes = self.meshes.iter().map(|m| m.distance);
+        bones.chain(meshes).fold(Extreme::default(), Extreme::merge)
+    }
+}
+
+/// Compares `a` and `b` at `times` (sorted).
+pub fn compare(a: &Side, b: &Side, pairs: &Pairs, times: &[f64]) -> Comparison {
+    let rig_size = rig_size(a, times);
+    let probe_length = rig_size * PROBE_FRACTION;
+    let empty = || Differences::new(a, b, pairs);
+    let totals = times
+        .par_chunks(32)
+        .map(|chunk| {
+            let mut worker = Worker::new(a, b);
+            let mut differences = empty();
+            for &time in chunk {
+                worker.evaluate(a, b, &pairs.meshes, time);
+                differences.add(&worker, probe_length, time);
+            }
+            differences
+        })
+        .reduce(empty, Differences::merge);
+    let count = times.len().max(1) as f64;
+    let meshes = totals
+        .meshes
+        .into_iter()
+        .map(|m| MeshDifference { mean: m.sum / (count * m.vertices.max(1) as f64), ..m })
+        .collect();
+    Comparison { samples: times.len(), rig_size, bones: totals.bones, meshes }
+}
+
+/// The differences found over some of the times.
+struct Differences {
+    bones: Vec<BoneDifference>,
+    meshes: Vec<MeshDifference>,
+}
+
+impl Differences {
+    fn new(a: &Side, b: &Side, pairs: &Pairs) -> Self {
+        let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
+        let bones = pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
+        let meshes = pairs.meshes.iter().map(|&(i, j)| {
+            let mesh = &a.rig.meshes[i];
+            let (distance, sum) = (Extreme::default(), 0.0);
+            MeshDifference { a: i, b: j, name: mesh.name.clone(), vertices: mesh.positions.len(), distance, mean: 0.0, sum }
+        });
+        Differences { bones: bones.collect(), meshes: meshes.collect() }
+    }
+
+    fn merge(self, later: Differences) -> Self {
+        let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
+        let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
+        Differences { bones, meshes }
+    }
+
+    fn add(&mut self, worker: &Worker, probe_length: f64, time: f64) {
+        let (model_a, model_b) = (&worker.pose_a.model.model, &worker.pose_b.model.model);
+        for difference in &mut self.bones {
+            let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
+            let (pa, pb) = (&worker.parts_a[difference.a], &worker.parts_b[difference.b]);
+            difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
+            difference.probe.add(probe_distance(wa, wb, probe_length), time);
+            difference.orientation_deg.add(angle_between(pa.rotation, pb.rotation).to_degrees(), time);
+            difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
+            difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
+        }
+        for (k, difference) in self.meshes.iter_mut().enumerate() {
+            let (va, vb) = (&worker.skinned_a[k], &worker.skinned_b[k]);
+            let mut largest: f64 = 0.0;
+            for (p, q) in va.iter().zip(vb) {
+                let d = p.distance(*q);
+                largest = largest.max(d);
+                difference.sum += d;
+            }
+            difference.distance.add(largest, time);
+        }
+    }
+}
+
+/// One thread's poses and buffers.
+struct Worker {
+    pose_a: Pose,
+    pose_b: Pose,
+    layers_a: Option<LayerStack>,
+    layers_b: Option<LayerStack>,
+    parts_a: Vec<AffineParts>,
+    parts_b: Vec<AffineParts>,
+    /// The paired meshes, skinned, in the order of the pairs.
+    skinned_a: Vec<Vec<DVec3>>,
+    skinned_b: Vec<Vec<DVec3>>,
+}
+
+impl Worker {
+    fn new(a: &Side, b: &Side) -> Self {
+        Worker {
+            pose_a: Pose::default(),
+            pose_b: Pose::default(),
+            layers_a: a.layers.clone(),
+            layers_b: b.layers.clone(),
+            parts_a: Vec::new(),
+            parts_b: Vec::new(),
+            skinned_a: Vec::new(),
+            skinned_b: Vec::new(),
+        }
+    }
+
+    /// Evaluates both sides at `time`, skinning the paired `meshes`.
+    fn evaluate(&mut self, a: &Side, b: &Side, meshes: &[(usize, usize)], time: f64) {
+        a.evaluate(&mut self.pose_a, &mut self.layers_a, time);
+        b.evaluate(&mut self.pose_b, &mut self.layers_b, time);
+        self.parts_a = decompose_all(&self.pose_a.model.model);
+        self.parts_b = decompose_all(&self.pose_b.model.model);
+        self.skinned_a.resize_with(meshes.len(), Vec::new);
+        self.skinned_b.resize_with(meshes.len(), Vec::new);
+        for (k, &(i, j)) in meshes.iter().enumerate() {
+            a.skin(&self.pose_a, i, &mut self.skinned_a[k]);
+            b.skin(&self.pose_b, j, &mut self.skinned_b[k]);
+        }
+    }
+}
+
+/// The largest distance between where `wa` and `wb` put the origin and the points `probe_length` along each of
+/// `wa`'s axes (axes of zero length have no probe).
+fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
+    let difference = *wa - *wb;
+    let origin = difference.w_axis.truncate().length();
+    (0..3).fold(origin, |largest, axis| {
+        let length = wa.col(axis).truncate().length();
+        if length == 0.0 {
+            return largest;
+        }
+        let point = DVec3::AXES[axis] * (probe_length / length);
+        largest.max(difference.transform_point3(point).length())
+    })
+}
+
+/// The angle between two rotations, in radians (accurate for tiny angles too).
+fn angle_between(a: DQuat, b: DQuat) -> f64 {
+    let d = a.conjugate() * b;
+    2.0 * d.xyz().length().atan2(d.w.abs())
+}
+
+/// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other
+/// not).
+fn scale_ratio(a: DVec3, b: DVec3) -> f64 {
+    let sorted = |v: DVec3| {
+        let mut k = v.to_array();
+        k.sort_by(f64::total_cmp);
+        k
+    };
+    let (ka, kb) = (sorted(a), sorted(b));
+    (0..3)
+        .map(|i| if ka[i] == kb[i] { 1.0 } else { (ka[i] / kb[i]).max(kb[i] / ka[i]) })
+        .fold(1.0, |worst, r| if r.is_nan() { f64::INFINITY } else { worst.max(r) })
+}
+
+/// The angle between the stretch frames, up to the turns that change neither side's `U·K·Uᵀ` (axis permutations,
+/// free turns between equal factors), seen from both sides: a sheared bone against an unsheared one differs by its
+/// own stretch angle.
+fn stretch_difference_deg(a: &AffineParts, b: &AffineParts) -> f64 {
+    let relative = a.stretch.conjugate() * b.stretch;
+    if relative.xyz().length() <= NEARLY_SAME_FRAME {
+        // Frames this close: their angle (the symmetries could only make it smaller), free of the inverse
+        // cosine's loss of precision near 0.
+        return angle_between(DQuat::IDENTITY, relative).to_degrees();
+    }
+    let seen_from = |relative: DQuat, parts: &AffineParts| {
+        AffineParts { stretch: relative, ..*parts }.stretch_angle_deg_within(EQUAL_FACTORS)
+    };
+    seen_from(relative, b).max(seen_from(relative.conjugate(), a))
+}
+
+/// The sine of half the angle below which two stretch frames are compared directly (about 1e-4°).
+const NEARLY_SAME_FRAME: f64 = 1e-6;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::model::InheritMode;
+
+    #[test]
+    fn a_file_against_itself_differs_by_nothing() {
+        let rig = demo_rig();
+        let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
+        let pairs = Pairs::of(&side, &side, &[]).unwrap();
+        assert_eq!(pairs.bones.pairs.len(), rig.skeleton.len());
+        let times = comparison_times(&side, &side, 30.0);
+        let comparison = compare(&side, &side, &pairs, &times);
+        assert_eq!(comparison.samples, times.len());
+        assert!(comparison.worst_distance().max < 1e-15);
+        for bone in &comparison.bones {
+            assert!(bone.orientation_deg.max < 1e-12 && bone.stretch_deg.max < 1e-12, "{bone:?}");
+            assert_eq!(bone.scale_ratio.max, 1.0);
+        }
+        assert_eq!(comparison.meshes.len(), rig.meshes.len());
+    }
+
+    #[test]
+    fn two_modes_differ_where_the_shear_goes() {
+        // The demo's forearm shears under full inheritance and not under segment scale compensate.
+        let rig = demo_rig();
+        let full = Side::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
+        let compensated = Side::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]);
+        let pairs = Pairs::of(&full, &compensated, &[]).unwrap();
+        let comparison = compare(&full, &compensated, &pairs, &comparison_times(&full, &compensated, 30.0));
+        let root = &comparison.bones[0];
+        assert_eq!(root.probe.max, 0.0, "the root is the same in every mode");
+        let forearm = comparison.bones.iter().find(|b| b.name == "forearm").unwrap();
+        assert!(forearm.stretch_deg.max > 1.0 && forearm.scale_ratio.max > 1.01, "{forearm:?}");
+        assert!(comparison.meshes[0].distance.max > 0.0 && comparison.meshes[0].mean > 0.0);
+    }
+
+    #[test]
+    fn measures_of_hand_made_matrices() {
+        // B turns A a quarter about Z and moves it 1 along X. Probes 2 along each axis: X's (2, 0, 0) goes to
+        // (1, 2, 0) and Y's (0, 2, 0) to (−1, 0, 0), both √5 away; Z's and the origin move 1.
+        let a = DMat4::IDENTITY;
+        let b = DMat4::from_rotation_translation(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2), DVec3::X);
+        assert!((probe_distance(&a, &b, 2.0) - 5f64.sqrt()).abs() < 1e-12);
+        assert!((angle_between(DQuat::IDENTITY, DQuat::from_rotation_y(0.3)) - 0.3).abs() < 1e-15);
+        assert_eq!(scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(4.0, 1.0, 2.0)), 1.0, "order does not matter");
+        assert!((scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(1.0, 2.5, 4.0)) - 1.25).abs() < 1e-15);
+        assert_eq!(scale_ratio(DVec3::ZERO, DVec3::ONE), f64::INFINITY);
+    }
+}
