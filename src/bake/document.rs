@@ -3,9 +3,10 @@
 
 use glam::DMat4;
 
+pub use crate::model::Interpolation;
 use crate::model::Mesh;
 
-/// One glTF node. Parents come before their children.
+/// One glTF node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Node {
     pub name: String,
@@ -18,6 +19,21 @@ pub struct Node {
     pub mesh: Option<usize>,
     /// Index into [`Document::skins`].
     pub skin: Option<usize>,
+}
+
+impl Node {
+    /// A node with the identity transform, no mesh and no name.
+    pub fn identity(parent: Option<usize>) -> Self {
+        Node {
+            name: String::new(),
+            parent,
+            translation: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            scale: [1.0; 3],
+            mesh: None,
+            skin: None,
+        }
+    }
 }
 
 /// One glTF mesh: the source meshes that become its primitives (one node shows one mesh).
@@ -36,6 +52,8 @@ pub struct SkinOut {
     /// Node indices.
     pub joints: Vec<usize>,
     pub inverse_bind: Vec<DMat4>,
+    /// For each joint of the source skin, its index here (joints no vertex uses are left out).
+    pub joint_map: Vec<u16>,
 }
 
 /// What a channel animates.
@@ -48,11 +66,13 @@ pub enum Property {
     Weights,
 }
 
-/// Linearly interpolated keys of one property of one node.
+/// Keys of one property of one node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Channel {
     pub node: usize,
     pub property: Property,
+    /// Linear (slerp for rotations) or step; never cubic.
+    pub interpolation: Interpolation,
     /// Strictly increasing.
     pub times: Vec<f32>,
     /// `times.len() × width` numbers.

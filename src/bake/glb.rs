@@ -12,14 +12,14 @@ use gltf::json::{self, Index, validation::Checked::Valid, validation::USize64};
 use json::accessor::{ComponentType, GenericComponentType, Type};
 use serde_json::Value;
 
-use super::document::{Animation, Document, MeshGroup, Node, Property};
+use super::document::{Animation, Document, Interpolation, MeshGroup, Node, Property, SkinOut};
 use crate::model::Mesh;
 
 /// The GLB bytes of `document`.
 pub fn encode(document: &Document) -> Vec<u8> {
     let mut writer = Writer::default();
     writer.root.asset = json::Asset { generator: Some(document.generator.clone()), ..json::Asset::default() };
-    let meshes: Vec<_> = document.meshes.iter().map(|m| writer.mesh(m)).collect();
+    let meshes: Vec<_> = document.meshes.iter().map(|m| writer.mesh(m, &document.skins)).collect();
     let skins: Vec<_> = document.skins.iter().map(|s| writer.skin(s)).collect();
     writer.nodes(&document.nodes, &meshes, &skins);
     for animation in &document.animations {
@@ -88,39 +88,57 @@ impl Writer {
     }
 
     /// `values` as float elements of `kind`, with min/max when `bounded`.
-    fn floats(&mut self, values: &[f32], kind: Type, target: Option<json::buffer::Target>, bounded: bool) -> Index<json::Accessor> {
+    fn floats(
+        &mut self,
+        values: &[f32],
+        kind: Type,
+        target: Option<json::buffer::Target>,
+        bounded: bool,
+    ) -> Index<json::Accessor> {
         let width = kind.multiplicity();
         let bounds = bounded.then(|| bounds(values, width));
         self.accessor(&le_bytes(values), values.len() / width, ComponentType::F32, kind, target, bounds)
     }
 
-    fn mesh(&mut self, group: &MeshGroup) -> Index<json::Mesh> {
-        let primitives = group.primitives.iter().map(|mesh| self.primitive(mesh)).collect();
+    fn mesh(&mut self, group: &MeshGroup, skins: &[SkinOut]) -> Index<json::Mesh> {
+        let primitives = group.primitives.iter().map(|mesh| self.primitive(mesh, skins)).collect();
         let weights = (!group.weights.is_empty()).then(|| group.weights.clone());
-        self.root.push(json::Mesh { extensions: None, extras: Default::default(), name: Some(group.name.clone()), primitives, weights })
+        self.root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some(group.name.clone()),
+            primitives,
+            weights,
+        })
     }
 
-    fn primitive(&mut self, mesh: &Mesh) -> json::mesh::Primitive {
+    fn primitive(&mut self, mesh: &Mesh, skins: &[SkinOut]) -> json::mesh::Primitive {
         use json::mesh::Semantic;
         let array = Some(json::buffer::Target::ArrayBuffer);
         let mut attributes = BTreeMap::new();
         let positions: Vec<f32> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
         attributes.insert(Valid(Semantic::Positions), self.floats(&positions, Type::Vec3, array, true));
         if mesh.normals.len() == mesh.positions.len() && !mesh.normals.is_empty() {
-            let normals: Vec<f32> = mesh.normals.iter().flat_map(|n| n.normalize_or(glam::Vec3::Y).to_array()).collect();
+            let normals: Vec<f32> =
+                mesh.normals.iter().flat_map(|n| n.normalize_or(glam::Vec3::Y).to_array()).collect();
             attributes.insert(Valid(Semantic::Normals), self.floats(&normals, Type::Vec3, array, false));
         }
-        if mesh.skin.is_some() && mesh.joints.len() == mesh.positions.len() {
-            let (joints, weights) = skin_attributes(mesh);
+        if let Some(skin) = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len()) {
+            let (joints, weights) = skin_attributes(mesh, &skin.joint_map);
             let joint_bytes: Vec<u8> = joints.iter().flat_map(|j| j.to_le_bytes()).collect();
-            let joint_accessor = self.accessor(&joint_bytes, mesh.joints.len(), ComponentType::U16, Type::Vec4, array, None);
+            let joint_accessor =
+                self.accessor(&joint_bytes, mesh.joints.len(), ComponentType::U16, Type::Vec4, array, None);
             attributes.insert(Valid(Semantic::Joints(0)), joint_accessor);
             attributes.insert(Valid(Semantic::Weights(0)), self.floats(&weights, Type::Vec4, array, false));
         }
         let indices = self.indices(&mesh.indices);
         let targets = mesh.morph_targets.iter().map(|target| {
             let offsets: Vec<f32> = target.offsets.iter().flat_map(|o| o.to_array()).collect();
-            json::mesh::MorphTarget { positions: Some(self.floats(&offsets, Type::Vec3, array, true)), normals: None, tangents: None }
+            json::mesh::MorphTarget {
+                positions: Some(self.floats(&offsets, Type::Vec3, array, true)),
+                normals: None,
+                tangents: None,
+            }
         });
         let targets: Vec<_> = targets.collect();
         json::mesh::Primitive {
@@ -145,7 +163,7 @@ impl Writer {
         }
     }
 
-    fn skin(&mut self, skin: &super::document::SkinOut) -> Index<json::Skin> {
+    fn skin(&mut self, skin: &SkinOut) -> Index<json::Skin> {
         let matrices: Vec<f32> = skin.inverse_bind.iter().flat_map(|m| m.to_cols_array().map(|v| v as f32)).collect();
         let inverse_bind_matrices = Some(self.floats(&matrices, Type::Mat4, None, false));
         self.root.push(json::Skin {
@@ -179,7 +197,8 @@ impl Writer {
                 ..json::Node::default()
             });
         }
-        let scene = self.root.push(json::Scene { extensions: None, extras: Default::default(), name: None, nodes: roots });
+        let scene =
+            self.root.push(json::Scene { extensions: None, extras: Default::default(), name: None, nodes: roots });
         self.root.scene = Some(scene);
     }
 
@@ -194,13 +213,20 @@ impl Writer {
             };
             let input = self.input(&channel.times);
             let output = self.floats(&channel.values, kind, None, false);
-            let sampler = Index::push(&mut samplers, json::animation::Sampler {
-                extensions: None,
-                extras: Default::default(),
-                input,
-                interpolation: Valid(json::animation::Interpolation::Linear),
-                output,
-            });
+            let sampler = Index::push(
+                &mut samplers,
+                json::animation::Sampler {
+                    extensions: None,
+                    extras: Default::default(),
+                    input,
+                    interpolation: Valid(match channel.interpolation {
+                        Interpolation::Step => json::animation::Interpolation::Step,
+                        Interpolation::Linear => json::animation::Interpolation::Linear,
+                        Interpolation::CubicSpline => json::animation::Interpolation::CubicSpline,
+                    }),
+                    output,
+                },
+            );
             let path = match channel.property {
                 Property::Translation => json::animation::Property::Translation,
                 Property::Rotation => json::animation::Property::Rotation,
@@ -244,7 +270,13 @@ impl Writer {
             self.bin.push(0);
         }
         if !self.bin.is_empty() {
-            self.root.push(json::Buffer { byte_length: USize64::from(self.bin.len()), name: None, uri: None, extensions: None, extras: Default::default() });
+            self.root.push(json::Buffer {
+                byte_length: USize64::from(self.bin.len()),
+                name: None,
+                uri: None,
+                extensions: None,
+                extras: Default::default(),
+            });
         }
         let json = self.root.to_vec().expect("glTF JSON of plain numbers and strings serialises");
         let glb = gltf::binary::Glb {
@@ -256,16 +288,17 @@ impl Writer {
     }
 }
 
-/// Per vertex: four joint indices and four weights as glTF wants them (see the module's documentation).
-fn skin_attributes(mesh: &Mesh) -> (Vec<u16>, Vec<f32>) {
+/// Per vertex: four joint indices (renumbered by `joint_map`) and four weights as glTF wants them (see the module's
+/// documentation).
+fn skin_attributes(mesh: &Mesh, joint_map: &[u16]) -> (Vec<u16>, Vec<f32>) {
     let mut joints = Vec::with_capacity(mesh.joints.len() * 4);
     let mut weights = Vec::with_capacity(mesh.joints.len() * 4);
     for (indices, values) in mesh.joints.iter().zip(&mesh.weights) {
         let mut merged: Vec<(u16, f32)> = Vec::with_capacity(4);
         for (&joint, &weight) in indices.iter().zip(values) {
-            if weight <= 0.0 || !weight.is_finite() {
+            let Some(&joint) = joint_map.get(usize::from(joint)).filter(|_| weight > 0.0 && weight.is_finite()) else {
                 continue;
-            }
+            };
             match merged.iter_mut().find(|(j, _)| *j == joint) {
                 Some(entry) => entry.1 += weight,
                 None => merged.push((joint, weight)),

@@ -5,9 +5,11 @@
 //! reproduced, then a binary search finds the farthest span that still is. Every span chosen has been checked
 //! sample by sample, so the result always holds; a whole clip costs `O(n log L)` checks for spans of `L` samples.
 
-use glam::DMat3;
+use glam::{DMat3, DMat4};
 
 use super::nodes::{NodeSample, Sampled};
+use crate::diff::Side;
+use crate::eval::Pose;
 use crate::math::slerp;
 
 /// The indices of the samples to keep among `count` (the first and last always), such that
@@ -45,6 +47,44 @@ pub fn reduce(count: usize, tolerance: f64, error: impl Fn(usize, usize, usize) 
     keys
 }
 
+/// How far each bone's nodes may stray between keys, and how it is measured ([`BoneMetric`]).
+pub struct Metrics {
+    /// How far a bone's interpolated nodes may be from a sample, and its samples from the source's curve between
+    /// them: each bone's share of the tolerance (the errors of a chain's bones add up at its end, so the tolerance
+    /// over the longest chain), halved, since keys that stay within it of the samples, which stay within it of
+    /// the source, stay within twice it of the source.
+    pub budget: f64,
+    /// Per bone: how far its subtree reaches in its own units (the rig's size over the bone's scale at rest).
+    reach: Vec<f64>,
+    /// How far a morph target's displacement reaches in model units per unit of offset.
+    pub model_scale: f64,
+}
+
+impl Metrics {
+    /// For the rig of `rest` (its rest pose under the bake's modes), `size` and `tolerance` in model units.
+    pub fn new(rest: &Side, size: f64, tolerance: f64) -> Self {
+        let mut pose = Pose::default();
+        rest.evaluate(&mut pose, &mut None, 0.0);
+        let scales: Vec<f64> = pose.model.model.iter().map(uniform_scale).collect();
+        let mut sorted: Vec<f64> = scales.iter().copied().filter(|s| *s > 0.0).collect();
+        sorted.sort_by(f64::total_cmp);
+        let typical = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
+        let reach = scales.iter().map(|&s| size / if s > 1e-6 * typical { s } else { typical }).collect();
+        let chain = rest.rig.skeleton.depths().into_iter().max().map_or(1, |d| d + 1);
+        Metrics { budget: 0.5 * tolerance / chain as f64, reach, model_scale: typical }
+    }
+
+    /// The metric of `bone`, whose parent scales lengths by at most `gains[bone]`.
+    pub fn bone(&self, gains: &[f64], bone: usize) -> BoneMetric {
+        BoneMetric { gain: gains[bone].max(f64::MIN_POSITIVE), reach: self.reach[bone] }
+    }
+}
+
+/// `|det|^(1/3)` of the 3×3 part: how much the matrix scales lengths on average.
+fn uniform_scale(m: &DMat4) -> f64 {
+    DMat3::from_mat4(*m).determinant().abs().cbrt()
+}
+
 /// How far one bone's nodes may be from its samples between keys, and how that distance is measured.
 ///
 /// Interpolating the nodes between keys `i` and `j` gives a local matrix `L'` at sample `k` where the sample says
@@ -60,7 +100,14 @@ pub struct BoneMetric {
 impl BoneMetric {
     /// The model-space distance bound for sample `k` interpolated between `i` and `j` of `bone`, its nodes as
     /// baked with or without a `helper`.
-    pub fn error(&self, sampled: &Sampled, times: &[f64], bone: usize, helper: bool, (i, j, k): (usize, usize, usize)) -> f64 {
+    pub fn error(
+        &self,
+        sampled: &Sampled,
+        times: &[f64],
+        bone: usize,
+        helper: bool,
+        (i, j, k): (usize, usize, usize),
+    ) -> f64 {
         let t = (times[k] - times[i]) / (times[j] - times[i]);
         let node = |s: usize| sampled.at(s, bone).as_baked(helper);
         self.distance(&interpolate(&node(i), &node(j), t), &node(k))
@@ -141,7 +188,12 @@ mod tests {
     #[test]
     fn interpolation_is_gltfs() {
         let axis = DVec3::new(0.0, 1.0, 1.0).normalize();
-        let a = NodeSample { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
+        let a = NodeSample {
+            translation: DVec3::ZERO,
+            rotation: DQuat::IDENTITY,
+            scale: DVec3::ONE,
+            stretch: DQuat::IDENTITY,
+        };
         let b = NodeSample {
             translation: DVec3::new(2.0, 0.0, 0.0),
             rotation: DQuat::from_axis_angle(axis, 1.0),

@@ -42,6 +42,9 @@ pub struct NodeSample {
 }
 
 impl NodeSample {
+    pub const IDENTITY: NodeSample =
+        NodeSample { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
+
     /// The local matrix the bone's nodes give.
     pub fn matrix(&self) -> DMat4 {
         let stretch = DMat3::from_quat(self.stretch);
@@ -129,7 +132,7 @@ impl Sampled {
 pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
     let bones = side.rig.skeleton.len();
     let parents: Vec<Option<usize>> = side.rig.skeleton.bones().iter().map(|b| b.parent).collect();
-    let mut samples = vec![IDENTITY_SAMPLE; times.len() * bones];
+    let mut samples = vec![NodeSample::IDENTITY; times.len() * bones];
     let chunk = 64;
     let stats = samples
         .par_chunks_mut(chunk * bones.max(1))
@@ -145,9 +148,6 @@ pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
         .reduce(|| Stats::new(bones), Stats::merge);
     Sampled { bones, samples, stats }
 }
-
-const IDENTITY_SAMPLE: NodeSample =
-    NodeSample { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, scale: DVec3::ONE, stretch: DQuat::IDENTITY };
 
 /// What sampling learns about the bones.
 #[derive(Clone, Debug)]
@@ -270,7 +270,8 @@ fn frobenius(m: &DMat4) -> f64 {
     (linear.x_axis.length_squared() + linear.y_axis.length_squared() + linear.z_axis.length_squared()).sqrt()
 }
 
-/// Makes every bone's nodes continuous over time ([`align`] each sample to the one before).
+/// Makes every bone's nodes continuous over time ([`align`] each sample to the one before); a bone scaled to
+/// nothing from the start takes its rotations from the first sample where it is not.
 pub fn follow_frames(sampled: &mut Sampled) {
     let bones = sampled.bones;
     for s in 1..sampled.times() {
@@ -280,13 +281,28 @@ pub fn follow_frames(sampled: &mut Sampled) {
             align(current, previous);
         }
     }
+    for s in (0..sampled.times().saturating_sub(1)).rev() {
+        let (before, after) = sampled.samples.split_at_mut((s + 1) * bones);
+        for (current, next) in before[s * bones..].iter_mut().zip(&after[..bones]) {
+            if current.scale == DVec3::ZERO {
+                (current.rotation, current.stretch) = (next.rotation, next.stretch);
+            }
+        }
+    }
 }
 
 /// Makes `current` continue from `previous`: its stretch frame becomes the equivalent one nearest the previous
 /// sample's (the decomposition's canonical frame may swap axes between two samples), `Q = R·U` following it, and
 /// both rotations move to the hemisphere of the previous ones, so slerp between keys takes the path the samples
 /// mean.
+///
+/// A bone scaled to nothing has no rotation of its own (any gives the same matrix): it keeps the previous ones, so
+/// that keys on either side of it do not turn the bone for nothing.
 pub fn align(current: &mut NodeSample, previous: &NodeSample) {
+    if current.scale == DVec3::ZERO {
+        (current.rotation, current.stretch) = (previous.rotation, previous.stretch);
+        return;
+    }
     let rotation = current.plain_rotation();
     let sign = if current.scale.x.is_sign_negative() { -1.0 } else { 1.0 };
     let (stretch, factors) = stretch_nearest(current.stretch, current.scale * sign, previous.stretch);
@@ -337,7 +353,8 @@ mod tests {
         let mut samples: Vec<NodeSample> = (0..6)
             .map(|s| {
                 let (stretch, scale) = if s % 2 == 0 { (frame, k) } else { (frame * swap, DVec3::new(2.0, 1.0, 3.0)) };
-                let parts = AffineParts { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, stretch, scale, sign: 1.0 };
+                let parts =
+                    AffineParts { translation: DVec3::ZERO, rotation: DQuat::IDENTITY, stretch, scale, sign: 1.0 };
                 NodeSample::exact(&parts)
             })
             .collect();

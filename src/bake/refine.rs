@@ -17,23 +17,27 @@ use crate::diff::Side;
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
 
-/// Intervals shorter than this (seconds) are not split: their times would no longer be distinct as `f32`.
+/// Intervals this short (seconds) are not split, so that their times remain distinct as `f32`.
 fn min_gap(time: f64) -> f64 {
-    (8.0 * f64::from(f32::EPSILON) * time.abs()).max(1e-6)
+    (64.0 * f64::from(f32::EPSILON) * time.abs()).max(1e-6)
 }
 
 /// `sampled` (at `times`, sorted) with midpoints added wherever `misses(bone, interpolated, exact)` says the
-/// interpolation of an interval's ends misses its midpoint; the times and samples sorted, frames followed.
+/// interpolation of an interval's ends misses its midpoint; the times and samples sorted, frames followed. The
+/// interval after a stepped key's lead (`leads`, per time) holds the key's jump, which no halving brings closer: it
+/// is left as it is.
 pub fn refine(
     side: &Side,
     strategy: Strategy,
     times: Vec<f64>,
+    leads: &[bool],
     sampled: Sampled,
     misses: &(impl Fn(usize, &NodeSample, &NodeSample) -> bool + Sync),
 ) -> (Vec<f64>, Sampled) {
     let mut pool_times = times;
     let mut pool = sampled;
-    let mut intervals: Vec<(usize, usize)> = (1..pool_times.len()).map(|i| (i - 1, i)).collect();
+    let mut intervals: Vec<(usize, usize)> =
+        (1..pool_times.len()).filter(|&i| !leads[i - 1]).map(|i| (i - 1, i)).collect();
     for _ in 0..MAX_DEPTH {
         intervals.retain(|&(a, b)| pool_times[b] - pool_times[a] > min_gap(pool_times[b]));
         if intervals.is_empty() {

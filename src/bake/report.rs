@@ -112,7 +112,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
                     mean_percent: percent(m.mean),
                 })
                 .collect();
-            let unmatched_source = pairs.bones.only_a.iter().map(|&b| format!("{} (only in the source)", skeleton.bone(b).name));
+            let unmatched_source =
+                pairs.bones.only_a.iter().map(|&b| format!("{} (only in the source)", skeleton.bone(b).name));
             let unmatched_baked =
                 pairs.bones.only_b.iter().map(|&b| format!("{} (only in the bake)", baked_rig.skeleton.bone(b).name));
             AnimationReport {

@@ -1,6 +1,7 @@
-//! The times a clip is baked at first: every frame of the clip's rate, every key time, and a moment before every
-//! stepped key (so a jump stays a jump instead of a ramp over a frame). [`super::refine`] adds what lies between
-//! where the source needs it.
+//! The times a clip is baked at first: every frame of the clip's rate, every key time, a moment before every
+//! stepped key (its lead: the value just before the jump), and the quarter points between the keys of cubic-spline
+//! tracks (a Hermite curve with equal tangents passes through the middle of its chord, so a midpoint alone would not
+//! show that it bends). [`super::refine`] adds what else lies between where the source needs it.
 
 use crate::diff::Side;
 use crate::model::{Clip, DEFAULT_FRAME_RATE, Interpolation, sample_times};
@@ -11,39 +12,61 @@ pub const STEP_LEAD: f64 = 1e-3;
 /// The most frames baked at every one of; longer clips are thinned between sparse keys.
 const MAX_FRAMES: usize = 1 << 20;
 
-/// The sorted, distinct times to bake `side` at.
-pub fn bake_times(side: &Side) -> Vec<f64> {
-    let rate = side.clip.map_or(DEFAULT_FRAME_RATE, Clip::frame_rate);
-    let mut keys = side.key_times();
-    if side.layers.is_none() {
-        keys.extend(side.clip.into_iter().flat_map(step_leads));
-    }
-    sample_times(keys, 0.0, side.duration(), rate, MAX_FRAMES).times
+/// The times to bake a clip at first, and which of them lead a stepped key.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakeTimes {
+    /// Sorted and distinct.
+    pub times: Vec<f64>,
+    /// The leads of stepped keys, sorted.
+    pub leads: Vec<f64>,
 }
 
-/// A moment before every key of a stepped track, but the first.
-fn step_leads(clip: &Clip) -> Vec<f64> {
-    let stepped = |times: &[f64], interpolation: Interpolation| {
-        if interpolation == Interpolation::Step { times[1..].iter().map(|t| (t - STEP_LEAD).max(0.0)).collect() } else { Vec::new() }
-    };
-    let mut leads = Vec::new();
+impl BakeTimes {
+    /// Per time of `times` (sorted): whether it is one of the leads.
+    pub fn lead_flags(&self, times: &[f64]) -> Vec<bool> {
+        times.iter().map(|t| self.leads.binary_search_by(|l| l.total_cmp(t)).is_ok()).collect()
+    }
+}
+
+/// The times to bake `side` at first.
+pub fn bake_times(side: &Side) -> BakeTimes {
+    let rate = side.clip.map_or(DEFAULT_FRAME_RATE, Clip::frame_rate);
+    let mut keys = side.key_times();
+    let (mut leads, mut inside) = (Vec::new(), Vec::new());
+    if let (Some(clip), None) = (side.clip, &side.layers) {
+        for (times, interpolation) in track_times(clip) {
+            match interpolation {
+                Interpolation::Step => leads.extend(times[1..].iter().map(|t| (t - STEP_LEAD).max(0.0))),
+                Interpolation::CubicSpline => inside.extend(quarter_points(times)),
+                Interpolation::Linear => {}
+            }
+        }
+    }
+    keys.extend(&leads);
+    keys.extend(inside);
+    let times = sample_times(keys, 0.0, side.duration(), rate, MAX_FRAMES).times;
+    leads.sort_by(f64::total_cmp);
+    leads.retain(|l| times.binary_search_by(|t| t.total_cmp(l)).is_ok());
+    BakeTimes { times, leads }
+}
+
+/// The time array and interpolation of every track of `clip`, morph weights included.
+fn track_times(clip: &Clip) -> Vec<(&[f64], Interpolation)> {
+    let mut all = Vec::new();
     for tracks in clip.tracks() {
-        if let Some(t) = &tracks.translation {
-            leads.extend(stepped(t.times(), t.interpolation()));
-        }
-        if let Some(r) = &tracks.rotation {
-            leads.extend(stepped(r.times(), r.interpolation()));
-        }
-        if let Some(s) = &tracks.scale {
-            leads.extend(stepped(s.times(), s.interpolation()));
-        }
+        all.extend(tracks.translation.iter().map(|t| (t.times(), t.interpolation())));
+        all.extend(tracks.rotation.iter().map(|t| (t.times(), t.interpolation())));
+        all.extend(tracks.scale.iter().map(|t| (t.times(), t.interpolation())));
     }
     for morph in clip.morph() {
-        for w in &morph.weights {
-            leads.extend(stepped(w.times(), w.interpolation()));
-        }
+        all.extend(morph.weights.iter().map(|t| (t.times(), t.interpolation())));
     }
-    leads
+    all
+}
+
+/// The points a quarter, half and three quarters of the way between consecutive times.
+fn quarter_points(times: &[f64]) -> impl Iterator<Item = f64> + '_ {
+    times.windows(2).flat_map(|w| [0.25, 0.5, 0.75].map(|f| w[0] + (w[1] - w[0]) * f))
 }
 
 #[cfg(test)]
@@ -54,7 +77,19 @@ mod tests {
 
     use super::*;
     use crate::import::demo_rig;
-    use crate::model::{BoneTracks, Rig, Track};
+    use crate::model::{BoneTracks, Track};
+
+    #[test]
+    fn cubic_tracks_are_sampled_between_their_keys() {
+        let mut rig = demo_rig();
+        let times: Arc<[f64]> = vec![0.0, 1.0].into();
+        let mut tracks = BoneTracks::new(0);
+        let values = vec![Vec3::ZERO, Vec3::ZERO, Vec3::X, Vec3::ZERO, Vec3::Y, Vec3::X];
+        tracks.translation = Some(Track::new(times, values, Interpolation::CubicSpline).unwrap());
+        rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(1.0)];
+        let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
+        assert_eq!(bake_times(&side).times, [0.0, 0.25, 0.5, 0.75, 1.0]);
+    }
 
     #[test]
     fn frames_keys_and_leads() {
@@ -63,12 +98,12 @@ mod tests {
         let mut tracks = BoneTracks::new(0);
         tracks.translation = Some(Track::new(times, vec![Vec3::ZERO, Vec3::X, Vec3::Y], Interpolation::Step).unwrap());
         rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(2.0)];
-        let rig: Rig = rig;
         let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
         // Frames 0, 0.5, 1; keys 0.25; leads 0.249, 0.999.
         let expected = [0.0, 0.249, 0.25, 0.5, 0.999, 1.0];
         let got = bake_times(&side);
-        assert_eq!(got.len(), expected.len(), "{got:?}");
-        assert!(got.iter().zip(expected).all(|(g, e)| (g - e).abs() < 1e-12), "{got:?}");
+        assert_eq!(got.times.len(), expected.len(), "{got:?}");
+        assert!(got.times.iter().zip(expected).all(|(g, e)| (g - e).abs() < 1e-12), "{got:?}");
+        assert_eq!(got.lead_flags(&got.times), [false, true, false, false, true, false]);
     }
 }

@@ -60,7 +60,8 @@ pub fn parse_distance(s: &str) -> Result<Distance, String> {
         Some(number) => (number, true),
         None => (s.trim(), false),
     };
-    let value: f64 = number.trim().parse().map_err(|_| format!("`{s}` is not a distance (a number, or a number and %)"))?;
+    let value: f64 =
+        number.trim().parse().map_err(|_| format!("`{s}` is not a distance (a number, or a number and %)"))?;
     if !(value.is_finite() && value >= 0.0) {
         return Err(format!("the distance must be finite and ≥ 0, got `{s}`"));
     }

@@ -69,14 +69,17 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn side<'a>(path: &PathBuf, rig: &'a Rig, modes: ModeSet, anim: &Option<String>) -> FileSide<'a> {
-    FileSide { file: path.display().to_string(), rig, modes: modes.modes(rig), inherit: modes.label(), anim: anim.clone() }
+    FileSide {
+        file: path.display().to_string(),
+        rig,
+        modes: modes.modes(rig),
+        inherit: modes.label(),
+        anim: anim.clone(),
+    }
 }
 
 fn render_table(diff: &FileDiff) -> String {
-    let mut out = format!(
-        "A: {}  inherit: {}\nB: {}  inherit: {}\n",
-        diff.a, diff.inherit_a, diff.b, diff.inherit_b
-    );
+    let mut out = format!("A: {}  inherit: {}\nB: {}  inherit: {}\n", diff.a, diff.inherit_a, diff.b, diff.inherit_b);
     for clip in &diff.clips_only_a {
         out.push_str(&format!("  animation only in A: {clip}\n"));
     }

@@ -56,7 +56,8 @@ pub fn match_bones(a: &Skeleton, b: &Skeleton, map: &[(String, String)]) -> Resu
     for (name_a, name_b) in map {
         let take = |left: &mut Vec<usize>, s: &Skeleton, name: &str, side: &str| {
             let at = left.iter().position(|&i| s.bone(i).name == name);
-            at.map(|at| left.remove(at)).ok_or_else(|| format!("--map {name_a}={name_b}: no unmatched bone `{name}` in {side}"))
+            at.map(|at| left.remove(at))
+                .ok_or_else(|| format!("--map {name_a}={name_b}: no unmatched bone `{name}` in {side}"))
         };
         let i = take(&mut left_a, a, name_a, "the first file")?;
         let j = take(&mut left_b, b, name_b, "the second file")?;
@@ -112,19 +113,15 @@ pub fn match_meshes(a: &[Mesh], b: &[Mesh]) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// Clips paired by name, then by index among the unnamed ones: `(clip in A, clip in B)`, and the clips of each side
-/// left without a partner.
+/// Clips paired by label (their name, or `animation N` for the N-th unnamed one, which is what a bake names it):
+/// `(clip in A, clip in B)`, and the clips of each side left without a partner.
 pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, Vec<usize>) {
     let mut taken = vec![false; b.len()];
     let mut pairs = Vec::new();
     let mut only_a = Vec::new();
     for (i, clip) in a.iter().enumerate() {
-        let same = |j: usize| match (&clip.name, &b[j].name) {
-            (Some(x), Some(y)) => x == y,
-            (None, None) => clip.index == b[j].index,
-            _ => false,
-        };
-        match (0..b.len()).find(|&j| !taken[j] && same(j)) {
+        let label = clip.label();
+        match (0..b.len()).find(|&j| !taken[j] && b[j].label() == label) {
             Some(j) => {
                 taken[j] = true;
                 pairs.push((i, j));

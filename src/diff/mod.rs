@@ -204,11 +204,20 @@ struct Differences {
 impl Differences {
     fn new(a: &Side, b: &Side, pairs: &Pairs) -> Self {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
-        let bones = pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
+        let bones =
+            pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
         let meshes = pairs.meshes.iter().map(|&(i, j)| {
             let mesh = &a.rig.meshes[i];
             let (distance, sum) = (Extreme::default(), 0.0);
-            MeshDifference { a: i, b: j, name: mesh.name.clone(), vertices: mesh.positions.len(), distance, mean: 0.0, sum }
+            MeshDifference {
+                a: i,
+                b: j,
+                name: mesh.name.clone(),
+                vertices: mesh.positions.len(),
+                distance,
+                mean: 0.0,
+                sum,
+            }
         });
         Differences { bones: bones.collect(), meshes: meshes.collect() }
     }

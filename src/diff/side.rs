@@ -87,7 +87,11 @@ pub fn rig_size(side: &Side, times: &[f64]) -> f64 {
     for (i, &time) in times.iter().enumerate() {
         side.evaluate(&mut pose, &mut layers, time);
         let origins = pose.model.model.iter().zip(&character).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
-        let vertices = if i == 0 { skin_meshes_with(side.rig, &pose.model.model, &pose.morph, side.skinning).concat() } else { Vec::new() };
+        let vertices = if i == 0 {
+            skin_meshes_with(side.rig, &pose.model.model, &pose.morph, side.skinning).concat()
+        } else {
+            Vec::new()
+        };
         size = size.max(diagonal(origins.chain(vertices)));
     }
     if size > 0.0 && size.is_finite() { size } else { 1.0 }

@@ -12,7 +12,7 @@ pub use clip::{
 };
 pub use inherit::{InheritMode, UnknownInheritMode};
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
-pub use skin::{Mesh, MorphTarget, NodeBind, Skin};
+pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
 

@@ -60,7 +60,31 @@ pub struct MorphTarget {
     pub offsets: Vec<Vec3>,
 }
 
+/// How far the weights of a vertex may sum from 1 before they count as not normalised (a few `f32` roundings of
+/// four numbers stay well inside it).
+pub const WEIGHT_SUM_TOLERANCE: f32 = 1e-5;
+
+/// The weights divided by their sum, when that sum is positive and further from 1 than [`WEIGHT_SUM_TOLERANCE`];
+/// `None` for weights that need nothing (or cannot be helped: all zero).
+pub fn normalized_weights(weights: [f32; 4]) -> Option<[f32; 4]> {
+    let total: f32 = weights.iter().sum();
+    ((total - 1.0).abs() > WEIGHT_SUM_TOLERANCE && total > 0.0 && total.is_finite()).then(|| weights.map(|w| w / total))
+}
+
 impl Mesh {
+    /// Makes every vertex's skin weights sum to 1 (glTF requires it, DCCs do it, engines do it when a file does not);
+    /// how many vertices changed.
+    pub fn normalize_weights(&mut self) -> usize {
+        let mut changed = 0;
+        for weights in &mut self.weights {
+            if let Some(normalized) = normalized_weights(*weights) {
+                *weights = normalized;
+                changed += 1;
+            }
+        }
+        changed
+    }
+
     /// Removes the vertices whose position is not finite (NaN or infinite: a broken export), with their skinning and
     /// every triangle that uses one, so the rest can be skinned and drawn; how many were removed.
     pub fn remove_non_finite_vertices(&mut self) -> usize {
@@ -105,6 +129,18 @@ fn retain_kept<T>(values: &mut Vec<T>, keep: &[bool]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn weights_are_normalised_only_when_off() {
+        let mut mesh = Mesh {
+            weights: vec![[0.5, 0.25, 0.0, 0.0], [0.5, 0.5, 0.0, 0.0], [0.25, 0.25, 0.25, 0.250001], [0.0; 4]],
+            ..Mesh::default()
+        };
+        assert_eq!(mesh.normalize_weights(), 1);
+        assert_eq!(mesh.weights[0], [2.0 / 3.0, 1.0 / 3.0, 0.0, 0.0]);
+        assert_eq!(mesh.weights[2], [0.25, 0.25, 0.25, 0.250001], "within the tolerance: as stored");
+        assert_eq!(mesh.weights[3], [0.0; 4], "nothing to divide");
+    }
 
     #[test]
     fn non_finite_vertices_leave_with_their_triangles() {

@@ -43,7 +43,7 @@ pub fn sample_times(
     let frames = if last >= first { last - first + 1.0 } else { 0.0 };
     let frame = |k: f64| (k / rate).clamp(begin, end);
     let thinned = frames > max_frames as f64;
-    let mut times = anchors.clone();
+    let mut times = Vec::new();
     if !thinned {
         times.extend((0..frames as u64).map(|k| frame(first + k as f64)));
     } else {
@@ -59,14 +59,33 @@ pub fn sample_times(
             }
         }
     }
-    sort_distinct(&mut times);
-    SampleTimes { times, frames, thinned }
+    SampleTimes { times: keep_anchors(anchors, times), frames, thinned }
 }
 
 /// Sorts `times` and keeps the first of each run closer than [`SAME_TIME`] (or an `f32` step there).
 fn sort_distinct(times: &mut Vec<f64>) {
     times.sort_by(f64::total_cmp);
-    times.dedup_by(|later, earlier| *later - *earlier < SAME_TIME.max(later.abs() * f64::from(f32::EPSILON)));
+    times.dedup_by(|later, earlier| same_time(*earlier, *later));
+}
+
+/// Whether two sorted times count as one.
+fn same_time(earlier: f64, later: f64) -> bool {
+    later - earlier < SAME_TIME.max(later.abs() * f64::from(f32::EPSILON))
+}
+
+/// `anchors` (sorted, distinct) and `others` in one sorted list where a time of `others` as good as equal to an
+/// anchor gives way to it: a stepped key jumps exactly at its own time, so the frame a hair before it must not
+/// stand in for it.
+fn keep_anchors(anchors: Vec<f64>, mut others: Vec<f64>) -> Vec<f64> {
+    others.retain(|&t| {
+        let next = anchors.partition_point(|&a| a < t);
+        let near = |i: usize| anchors.get(i).is_some_and(|&a| same_time(a.min(t), a.max(t)));
+        !(near(next) || next.checked_sub(1).is_some_and(near))
+    });
+    let mut times = anchors;
+    times.extend(others);
+    sort_distinct(&mut times);
+    times
 }
 
 #[cfg(test)]
@@ -114,6 +133,15 @@ mod tests {
         assert!(s.thinned);
         // 0 → 0.5: frames 0.1..0.4 (4), 0.5 → 100: 64 evenly spaced.
         assert_eq!(s.times.len(), 3 + 4 + SAMPLES_PER_SPARSE_GAP);
+    }
+
+    #[test]
+    fn a_key_a_hair_after_a_frame_stands_for_it() {
+        // 11/24 s as an f32 key time lies 1e-8 s after the frame: the key's own time is sampled.
+        let key = f64::from((11.0f64 / 24.0) as f32);
+        let s = sample_times([key], 0.0, 1.0, 24.0, 100);
+        assert!(s.times.contains(&key) && !s.times.contains(&(11.0 / 24.0)), "{:?}", s.times);
+        assert_eq!(s.times.len(), 25);
     }
 
     #[test]

@@ -82,7 +82,7 @@ pub(super) fn read_meshes(
     notes: &mut Vec<String>,
 ) -> Result<Vec<Mesh>> {
     let mut meshes = Vec::new();
-    let (mut other_modes, mut unweighted) = (0, 0);
+    let (mut other_modes, mut unweighted, mut unnormalized) = (0, 0, 0);
     let mut unsupplied = Vec::new();
     for (bone, node_of_bone) in scene.skeleton.bones().iter().enumerate() {
         let node = &root.nodes[node_of_bone.node];
@@ -115,6 +115,7 @@ pub(super) fn read_meshes(
             if let Some(skin) = skin {
                 if read_skinning(&mut read, primitive, accessors, &skins[skin], &place)? {
                     read.skin = Some(skin);
+                    unnormalized += read.normalize_weights();
                 } else {
                     unweighted += 1;
                 }
@@ -132,6 +133,9 @@ pub(super) fn read_meshes(
     }
     if unweighted > 0 {
         notes.push(format!("{unweighted} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned"));
+    }
+    if unnormalized > 0 {
+        notes.push(format!("{unnormalized} vertices' skin weights did not sum to 1; normalised, as glTF requires"));
     }
     if !unsupplied.is_empty() {
         notes.push(format!(

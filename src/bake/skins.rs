@@ -1,0 +1,135 @@
+//! Skins as glTF requires them: only the joints the meshes use (FBX skins also list the mesh's own node, for
+//! vertices no cluster weights), and every skin's joints under one root node (the validator's `SKIN_NO_COMMON_ROOT`);
+//! where the joints lie under several roots, one new root node takes them all in.
+
+use super::document::{Document, Node, SkinOut};
+use crate::model::Rig;
+
+/// The skins of `rig` over the nodes `bone_node` gives each bone; adds a common root node to `document` where a skin
+/// needs one, saying so in `notes`.
+pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut Document, notes: &mut Vec<String>) {
+    let mut skins = Vec::with_capacity(rig.skins.len());
+    for (s, skin) in rig.skins.iter().enumerate() {
+        let used = used_joints(rig, s, skin.joints.len());
+        let mut joint_map = vec![0u16; skin.joints.len()];
+        let (mut joints, mut inverse_bind) = (Vec::new(), Vec::new());
+        for (j, (&bone, ibm)) in skin.joints.iter().zip(&skin.inverse_bind).enumerate() {
+            if used[j] {
+                joint_map[j] = joints.len() as u16;
+                joints.push(bone_node[bone]);
+                inverse_bind.push(*ibm);
+            }
+        }
+        skins.push(SkinOut { name: skin.name.clone(), joints, inverse_bind, joint_map });
+    }
+    let roots = |joints: &[usize]| joints.iter().map(|&n| root_of(&document.nodes, n)).collect::<Vec<_>>();
+    let apart = skins.iter().any(|skin| roots(&skin.joints).windows(2).any(|w| w[0] != w[1]));
+    if apart {
+        let name = unique_name(&document.nodes, "root");
+        let wrapper = document.nodes.len();
+        for node in document.nodes.iter_mut().filter(|n| n.parent.is_none()) {
+            node.parent = Some(wrapper);
+        }
+        document.nodes.push(Node { name: name.clone(), ..Node::identity(None) });
+        notes.push(format!("a skin's joints lie under several root nodes; a new root `{name}` holds them all"));
+    }
+    document.skins = skins;
+}
+
+/// Which joints of skin `s` some vertex of a mesh weights (a vertex with no positive weight falls back on joint 0).
+fn used_joints(rig: &Rig, s: usize, count: usize) -> Vec<bool> {
+    let mut used = vec![false; count];
+    for mesh in rig.meshes.iter().filter(|m| m.skin == Some(s)) {
+        for (joints, weights) in mesh.joints.iter().zip(&mesh.weights) {
+            let mut any = false;
+            for (&j, &w) in joints.iter().zip(weights) {
+                if w > 0.0 && w.is_finite() && usize::from(j) < count {
+                    used[usize::from(j)] = true;
+                    any = true;
+                }
+            }
+            if !any && count > 0 {
+                used[0] = true;
+            }
+        }
+    }
+    if !used.contains(&true) && count > 0 {
+        // A skin no vertex uses still needs a joint.
+        used[0] = true;
+    }
+    used
+}
+
+/// The root above `node`.
+fn root_of(nodes: &[Node], mut node: usize) -> usize {
+    while let Some(parent) = nodes[node].parent {
+        node = parent;
+    }
+    node
+}
+
+/// `base`, or `base.1`, `base.2`, … whichever no node is called yet.
+fn unique_name(nodes: &[Node], base: &str) -> String {
+    let taken = |name: &str| nodes.iter().any(|n| n.name == name);
+    if !taken(base) {
+        return base.to_owned();
+    }
+    (1..).map(|k| format!("{base}.{k}")).find(|name| !taken(name)).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DMat4, Vec3};
+
+    use super::*;
+    use crate::model::{Bone, InheritMode, Mesh, Skeleton, Skin, Transform};
+
+    fn rig(bones: &[(&str, Option<usize>)], joints: Vec<usize>, weights: Vec<[f32; 4]>) -> Rig {
+        let bone = |(name, parent): &(&str, Option<usize>)| Bone {
+            name: (*name).to_owned(),
+            node: 0,
+            parent: *parent,
+            rest: Transform::IDENTITY,
+            inherit: InheritMode::Full,
+        };
+        let skeleton = Skeleton::new(bones.iter().map(bone).collect()).unwrap();
+        let count = joints.len();
+        let skin = Skin { name: None, joints, inverse_bind: vec![DMat4::IDENTITY; count], node_bind: None };
+        let vertices = weights.len();
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO; vertices],
+            skin: Some(0),
+            joints: (0..vertices).map(|v| [0, 1, 2, v as u16 % 3]).collect(),
+            weights,
+            ..Mesh::default()
+        };
+        Rig { skeleton, skins: vec![skin], meshes: vec![mesh], ..Rig::default() }
+    }
+
+    fn document(rig: &Rig) -> Document<'static> {
+        let nodes = rig.skeleton.bones().iter().map(|b| Node { name: b.name.clone(), ..Node::identity(b.parent) });
+        Document { nodes: nodes.collect(), ..Document::default() }
+    }
+
+    #[test]
+    fn unused_joints_leave_and_the_rest_are_renumbered() {
+        // Joints: root, arm, and the mesh's own node (a second root) that no vertex weights.
+        let rig = rig(&[("root", None), ("arm", Some(0)), ("mesh", None)], vec![0, 1, 2], vec![[0.5, 0.5, 0.0, 0.0]]);
+        let (mut doc, mut notes) = (document(&rig), Vec::new());
+        skins(&rig, &[0, 1, 2], &mut doc, &mut notes);
+        assert_eq!(doc.skins[0].joints, [0, 1]);
+        assert_eq!(doc.skins[0].joint_map, [0, 1, 0]);
+        assert!(notes.is_empty() && doc.nodes.len() == 3, "no new root needed");
+    }
+
+    #[test]
+    fn joints_under_two_roots_get_a_common_one() {
+        let rig = rig(&[("root", None), ("mesh", None)], vec![0, 1], vec![[0.5, 0.5, 0.0, 0.0]]);
+        let (mut doc, mut notes) = (document(&rig), Vec::new());
+        skins(&rig, &[0, 1], &mut doc, &mut notes);
+        assert_eq!(doc.nodes.len(), 3);
+        assert_eq!((doc.nodes[0].parent, doc.nodes[1].parent, doc.nodes[2].parent), (Some(2), Some(2), None));
+        assert_eq!(doc.nodes[2].name, "root.1", "`root` is taken");
+        assert_eq!(notes.len(), 1);
+    }
+}
