@@ -10,7 +10,7 @@ use bonescope::eval::skinning::skin_positions;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError, Options, Space};
 use bonescope::model::{InheritMode, Rig};
-use common::{hausdorff, size};
+use common::{hausdorff, obj_positions, size};
 use glam::{DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -273,18 +273,6 @@ fn model_matrices_equal_ufbx_node_to_world_for_every_fbx_file() {
 
 // ---------------------------------------------------------------------------------------------------------------
 // The authoring tools' own OBJ exports
-
-/// The `v` lines of an OBJ file.
-fn obj_positions(path: &Path) -> Vec<DVec3> {
-    let text = std::fs::read_to_string(path).unwrap();
-    text.lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            DVec3::new(v[0], v[1], v[2])
-        })
-        .collect()
-}
 
 /// Every mesh of the file at `time` (first clip), as `export` evaluates it, in the file's own space.
 fn exported(path: &Path, time: f64) -> Vec<DVec3> {

@@ -1,9 +1,9 @@
 //! One clip's samples as animation channels: each bone's nodes at the keys that reproduce its samples, and the
 //! morph weights the clip animates.
 //!
-//! A bone whose nodes only ever change across a stepped key of the source (between the lead [`super::times`] puts
-//! a moment before the key, and the key) holds still between keys: its channels are written with STEP
-//! interpolation, keyed where the value changes, which reproduces the jump exactly. The others are linear (slerp for
+//! A bone whose nodes only ever change at a stepped key of the source (between the sample before the key and the
+//! key) holds still between keys: its channels are written with STEP interpolation, keyed where the value changes,
+//! which reproduces the jump exactly. The others are linear (slerp for
 //! rotations), keyed by [`reduce`]. A channel that only repeats its node's default is left out; one that holds a
 //! single value keeps two keys.
 
@@ -24,8 +24,8 @@ pub struct ClipSamples<'a> {
     /// Sorted.
     pub times: &'a [f64],
     pub sampled: &'a Sampled,
-    /// Per sample: whether it is the lead of a stepped key (the next sample is the key).
-    pub leads: &'a [bool],
+    /// Per sample: whether a stepped key is at it.
+    pub steps: &'a [bool],
 }
 
 /// The channels of `clip` for the nodes of `layout` in `document`.
@@ -59,7 +59,7 @@ fn bone_channels(
 ) -> Vec<Channel> {
     let helper = layout.helper_node[bone].is_some();
     let values = NodeValues::of(clip, bone, helper);
-    let (keys, interpolation) = match values.steps(clip.leads) {
+    let (keys, interpolation) = match values.steps(clip.steps) {
         Some(keys) => (keys, Interpolation::Step),
         None => {
             let metric = metrics.bone(&clip.sampled.stats.parent_gain, bone);
@@ -117,16 +117,15 @@ impl NodeValues {
         equal(&self.translation, 3) && equal(&self.rotation, 4) && equal(&self.scale, 3) && equal(&self.own_rotation, 4)
     }
 
-    /// The samples to key with STEP interpolation (the first, and every key after which the values change), when
-    /// the values only ever change from a stepped key's lead to its key; `None` otherwise.
-    fn steps(&self, leads: &[bool]) -> Option<Vec<usize>> {
-        let count = leads.len();
+    /// The samples to key with STEP interpolation (the first, and every stepped key where the values change), when
+    /// the values only ever change at stepped keys; `None` otherwise.
+    fn steps(&self, steps: &[bool]) -> Option<Vec<usize>> {
         let mut keys = vec![0];
-        for s in 0..count.saturating_sub(1) {
+        for s in 0..steps.len().saturating_sub(1) {
             if self.same(s) {
                 continue;
             }
-            if !leads[s] {
+            if !steps[s + 1] {
                 return None;
             }
             keys.push(s + 1);
@@ -252,10 +251,10 @@ mod tests {
     #[test]
     fn values_that_change_only_at_stepped_keys_are_steps() {
         // Samples: 0, lead, key, frame, lead, key.
-        let leads = [false, true, false, false, true, false];
-        assert_eq!(values(&[1.0, 1.0, 2.0, 2.0, 2.0, 3.0]).steps(&leads), Some(vec![0, 2, 5]));
-        assert_eq!(values(&[1.0, 1.5, 2.0, 2.0, 2.0, 3.0]).steps(&leads), None, "a change that is not a jump");
-        assert_eq!(values(&[1.0; 6]).steps(&leads), None, "nothing to step");
+        let steps = [false, false, true, false, false, true];
+        assert_eq!(values(&[1.0, 1.0, 2.0, 2.0, 2.0, 3.0]).steps(&steps), Some(vec![0, 2, 5]));
+        assert_eq!(values(&[1.0, 1.5, 2.0, 2.0, 2.0, 3.0]).steps(&steps), None, "a change that is not a jump");
+        assert_eq!(values(&[1.0; 6]).steps(&steps), None, "nothing to step");
     }
 
     #[test]
@@ -266,6 +265,6 @@ mod tests {
         assert_eq!(channel(0, Property::Translation, linear, &times, vec![0.0; 9], &default), None);
         let held = channel(0, Property::Translation, linear, &times, [1.0, 2.0, 3.0].repeat(3), &default).unwrap();
         assert_eq!((held.times, held.values), (vec![0.0, 1.0], [1.0, 2.0, 3.0].repeat(2)));
-        assert_eq!(distinct_f32_times(&[0, 1, 2], &[0.0, 1e-12, 1.0]), [0, 2]);
+        assert_eq!(distinct_f32_times(&[0, 1, 2], &[0.5, 0.5 + 1e-12, 1.0]), [0, 2], "one f32 time");
     }
 }

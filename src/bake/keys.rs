@@ -5,11 +5,11 @@
 //! reproduced, then a binary search finds the farthest span that still is. Every span chosen has been checked
 //! sample by sample, so the result always holds; a whole clip costs `O(n log L)` checks for spans of `L` samples.
 
-use glam::{DMat3, DMat4};
+use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::nodes::{NodeSample, Sampled};
-use crate::diff::Side;
-use crate::eval::Pose;
+use crate::diff::{PROBE_FRACTION, Side};
+use crate::eval::{Pose, skin_meshes};
 use crate::math::slerp;
 
 /// The indices of the samples to keep among `count` (the first and last always), such that
@@ -54,7 +54,7 @@ pub struct Metrics {
     /// over the longest chain), halved, since keys that stay within it of the samples, which stay within it of
     /// the source, stay within twice it of the source.
     pub budget: f64,
-    /// Per bone: how far its subtree reaches in its own units (the rig's size over the bone's scale at rest).
+    /// Per bone: how far from its origin the points it moves lie, in its own units ([`reaches`]).
     reach: Vec<f64>,
     /// How far a morph target's displacement reaches in model units per unit of offset.
     pub model_scale: f64,
@@ -69,7 +69,11 @@ impl Metrics {
         let mut sorted: Vec<f64> = scales.iter().copied().filter(|s| *s > 0.0).collect();
         sorted.sort_by(f64::total_cmp);
         let typical = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
-        let reach = scales.iter().map(|&s| size / if s > 1e-6 * typical { s } else { typical }).collect();
+        let reach = reaches(rest, &pose, size * PROBE_FRACTION)
+            .iter()
+            .zip(&scales)
+            .map(|(&r, &s)| r / if s > 1e-6 * typical { s } else { typical })
+            .collect();
         let chain = rest.rig.skeleton.depths().into_iter().max().map_or(1, |d| d + 1);
         Metrics { budget: 0.5 * tolerance / chain as f64, reach, model_scale: typical }
     }
@@ -78,6 +82,43 @@ impl Metrics {
     pub fn bone(&self, gains: &[f64], bone: usize) -> BoneMetric {
         BoneMetric { gain: gains[bone].max(f64::MIN_POSITIVE), reach: self.reach[bone] }
     }
+}
+
+/// How far from each bone's origin, at rest, the points it moves lie: its descendants' origins, the vertices skinned
+/// to them or to it, and the probe points the report measures (`probe` out), with half as much again for the motion
+/// of the descendants' own animation.
+fn reaches(rest: &Side, pose: &Pose, probe: f64) -> Vec<f64> {
+    let skeleton = &rest.rig.skeleton;
+    let origins: Vec<DVec3> = pose.model.model.iter().map(|m| m.w_axis.truncate()).collect();
+    let mut reach = vec![probe; skeleton.len()];
+    let mut reach_up = |bone: usize, point: DVec3| {
+        let mut current = Some(bone);
+        while let Some(b) = current {
+            reach[b] = reach[b].max(point.distance(origins[b]));
+            current = skeleton.parent(b);
+        }
+    };
+    for (bone, &origin) in origins.iter().enumerate() {
+        reach_up(bone, origin);
+    }
+    let rig = rest.rig;
+    for (mesh, positions) in rig.meshes.iter().zip(skin_meshes(rig, &pose.model.model, &pose.morph)) {
+        for (v, position) in positions.into_iter().enumerate() {
+            let bones = match mesh.skin.and_then(|s| rig.skins.get(s)) {
+                Some(skin) => mesh.joints[v]
+                    .iter()
+                    .zip(&mesh.weights[v])
+                    .filter(|(_, w)| **w > 0.0)
+                    .filter_map(|(&j, _)| skin.joints.get(usize::from(j)).copied())
+                    .collect(),
+                None => vec![mesh.bone],
+            };
+            for bone in bones {
+                reach_up(bone, position);
+            }
+        }
+    }
+    reach.iter().map(|r| 1.5 * r).collect()
 }
 
 /// `|det|^(1/3)` of the 3×3 part: how much the matrix scales lengths on average.
@@ -123,6 +164,14 @@ impl BoneMetric {
     }
 }
 
+/// Whether a rotation of the nodes turns by more than a quarter turn from `a` to `b`. Keys that far apart are
+/// never interpolated: near a half turn, which way slerp goes hangs on the last bits of the numbers, and a helper
+/// node and its bone could then turn opposite ways.
+pub fn too_far(a: &NodeSample, b: &NodeSample) -> bool {
+    let apart = |p: DQuat, q: DQuat| p.dot(q).abs() < std::f64::consts::FRAC_1_SQRT_2;
+    apart(a.rotation, b.rotation) || apart(a.stretch, b.stretch)
+}
+
 /// The nodes a fraction `t` of the way from `a` to `b`, as a glTF player computes them.
 pub fn interpolate(a: &NodeSample, b: &NodeSample, t: f64) -> NodeSample {
     NodeSample {
@@ -143,8 +192,6 @@ pub fn weights_error(samples: &[Vec<f64>], times: &[f64], amplitude: &[f64], (i,
 
 #[cfg(test)]
 mod tests {
-    use glam::{DQuat, DVec3};
-
     use super::*;
 
     #[test]
@@ -158,7 +205,7 @@ mod tests {
             }
         };
         assert_eq!(reduce(50, 1e-12, linear(&line)), [0, 49]);
-        let corner: Vec<f64> = (0..50).map(|k| f64::from((k as i32 - 20).abs())).collect();
+        let corner: Vec<f64> = (0..50).map(|k: i32| f64::from((k - 20).abs())).collect();
         assert_eq!(reduce(50, 1e-12, linear(&corner)), [0, 20, 49]);
         assert_eq!(reduce(1, 0.0, linear(&[1.0])), [0]);
         assert_eq!(reduce(0, 0.0, linear(&[])), Vec::<usize>::new());

@@ -25,16 +25,15 @@ pub struct Layout {
 
 impl Layout {
     pub fn new(rig: &Rig, helpers: &[bool]) -> Self {
+        // A helper node comes just before its bone's node.
         let mut bone_node = Vec::with_capacity(helpers.len());
         let mut helper_node = Vec::with_capacity(helpers.len());
-        let mut next = 0;
+        let mut nodes = 0;
         for &helper in helpers {
-            helper_node.push(helper.then(|| {
-                next += 1;
-                next - 1
-            }));
-            bone_node.push(next);
-            next += 1;
+            helper_node.push(helper.then_some(nodes));
+            nodes += usize::from(helper);
+            bone_node.push(nodes);
+            nodes += 1;
         }
         let mut layout = Layout { bone_node, helper_node, groups: Vec::new(), extra: Vec::new(), notes: Vec::new() };
         layout.place_meshes(rig);

@@ -136,8 +136,13 @@ pub fn bake(request: &Request) -> Baked {
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
     for (((clip, side), base), (times, sampled)) in request.clips.iter().zip(&sides).zip(&base).zip(&sampled) {
-        let leads = base.lead_flags(times);
-        let samples = ClipSamples { name: &clip.name, side, times, sampled, leads: &leads };
+        let steps = base.step_flags(times);
+        let samples = ClipSamples { name: &clip.name, side, times, sampled, steps: &steps };
+        if clip.clip.is_none() && clip.layers.is_none() {
+            // The rest pose is what the nodes hold without an animation.
+            animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys: 0 });
+            continue;
+        }
         let animation = channels::animation(&layout, &samples, &metrics, &document);
         let keys = animation.channels.iter().map(|c| c.times.len()).sum();
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
@@ -159,7 +164,7 @@ fn sample_densely(side: &Side, strategy: Strategy, base: &BakeTimes, metrics: &M
     let misses = |bone: usize, interpolated: &NodeSample, exact: &NodeSample| {
         metrics.bone(&gains, bone).distance(interpolated, exact) > metrics.budget
     };
-    refine(side, strategy, base.times.clone(), &base.lead_flags(&base.times), sampled, &misses)
+    refine(side, strategy, base.times.clone(), &base.step_flags(&base.times), sampled, &misses)
 }
 
 /// What the source has that glTF says differently.
@@ -187,7 +192,8 @@ fn source_notes(rig: &Rig, singular: usize) -> Vec<String> {
     notes
 }
 
-/// The animations to bake for `rig`: every clip (or the one `only` names), or the rest pose for a file without any.
+/// The animations to bake for `rig`: every clip (or the one `only` names), or the rest pose for a file without any
+/// (which the baked nodes then hold, with no animation in the file).
 pub fn every_clip<'a>(rig: &'a Rig, only: Option<&'a Clip>) -> Vec<ClipToBake<'a>> {
     let clips: Vec<&Clip> = match only {
         Some(clip) => vec![clip],

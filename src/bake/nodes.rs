@@ -23,8 +23,10 @@ use crate::eval::{LayerStack, Pose};
 use crate::math::{AffineParts, decompose_near, stretch_nearest};
 use crate::model::affine;
 
-/// A stretch rotation matters when dropping it moves `U·K·Uᵀ` by more than this fraction of the largest factor.
-const STRETCH_MATTERS: f64 = 1e-12;
+/// A stretch rotation matters when dropping it moves `U·K·Uᵀ` by more than this fraction of the largest factor: a
+/// few single-precision roundings. Less is the noise of a file's `f32` numbers (factors 1e-7 apart, whose frame
+/// turns at random), which a helper node, itself stored in `f32`, could not carry anyway.
+const STRETCH_MATTERS: f64 = 4.0 * f32::EPSILON as f64;
 
 /// A parent matrix counts as singular below this `|det|` relative to its size cubed.
 const SINGULAR: f64 = 1e-12;
@@ -257,7 +259,8 @@ fn affine_inverse(m: &DMat4) -> Option<DMat4> {
     let linear = DMat3::from_mat4(*m);
     let size = frobenius(m);
     let determinant = linear.determinant();
-    if !(determinant.abs() > SINGULAR * size * size * size) || !determinant.is_finite() {
+    let regular = determinant.abs() > SINGULAR * size * size * size && determinant.is_finite();
+    if !regular {
         return None;
     }
     let inverse = linear.inverse();

@@ -10,40 +10,43 @@
 use rayon::prelude::*;
 
 use super::Strategy;
-use super::keys::interpolate;
+use super::keys::{interpolate, too_far};
 use super::nodes::{NodeSample, Sampled, align, follow_frames, sample};
+use super::times::in_single_precision;
 use crate::diff::Side;
 
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
 
-/// Intervals this short (seconds) are not split, so that their times remain distinct as `f32`.
-fn min_gap(time: f64) -> f64 {
-    (64.0 * f64::from(f32::EPSILON) * time.abs()).max(1e-6)
-}
-
 /// `sampled` (at `times`, sorted) with midpoints added wherever `misses(bone, interpolated, exact)` says the
 /// interpolation of an interval's ends misses its midpoint; the times and samples sorted, frames followed. The
-/// interval after a stepped key's lead (`leads`, per time) holds the key's jump, which no halving brings closer: it
+/// interval that ends at a stepped key (`steps`, per time) holds the key's jump, which no halving brings closer: it
 /// is left as it is.
 pub fn refine(
     side: &Side,
     strategy: Strategy,
     times: Vec<f64>,
-    leads: &[bool],
+    steps: &[bool],
     sampled: Sampled,
     misses: &(impl Fn(usize, &NodeSample, &NodeSample) -> bool + Sync),
 ) -> (Vec<f64>, Sampled) {
+    // Bones whose stretch rotation never matters at the first samples are judged without it (it turns at random
+    // where the factors are nearly equal, and it will be dropped).
+    let helper = sampled.stats.stretched.clone();
     let mut pool_times = times;
     let mut pool = sampled;
-    let mut intervals: Vec<(usize, usize)> =
-        (1..pool_times.len()).filter(|&i| !leads[i - 1]).map(|i| (i - 1, i)).collect();
+    let mut intervals: Vec<(usize, usize)> = (1..pool_times.len()).filter(|&i| !steps[i]).map(|i| (i - 1, i)).collect();
     for _ in 0..MAX_DEPTH {
-        intervals.retain(|&(a, b)| pool_times[b] - pool_times[a] > min_gap(pool_times[b]));
+        // Midpoints are taken in single precision, where their keys will be; an interval with no such time strictly
+        // inside it is as fine as glTF can store.
+        let middle = |&(a, b): &(usize, usize)| in_single_precision(0.5 * (pool_times[a] + pool_times[b]));
+        intervals.retain(|interval| {
+            (pool_times[interval.0] < middle(interval)) && (middle(interval) < pool_times[interval.1])
+        });
         if intervals.is_empty() {
             break;
         }
-        let middles: Vec<f64> = intervals.iter().map(|&(a, b)| 0.5 * (pool_times[a] + pool_times[b])).collect();
+        let middles: Vec<f64> = intervals.iter().map(middle).collect();
         let mut new = sample(side, &middles, strategy);
         let failed: Vec<bool> = new
             .samples
@@ -54,7 +57,8 @@ pub fn refine(
                 let mut missed = false;
                 for (bone, exact) in middle.iter_mut().enumerate() {
                     align(exact, &left[bone]);
-                    missed |= misses(bone, &interpolate(&left[bone], &right[bone], 0.5), exact);
+                    let [a, b, middle] = [&left[bone], &right[bone], &*exact].map(|n| n.as_baked(helper[bone]));
+                    missed |= too_far(&a, &b) || misses(bone, &interpolate(&a, &b, 0.5), &middle);
                 }
                 missed
             })

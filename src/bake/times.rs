@@ -12,19 +12,19 @@ pub const STEP_LEAD: f64 = 1e-3;
 /// The most frames baked at every one of; longer clips are thinned between sparse keys.
 const MAX_FRAMES: usize = 1 << 20;
 
-/// The times to bake a clip at first, and which of them lead a stepped key.
+/// The times to bake a clip at first, and which of them are stepped keys.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakeTimes {
     /// Sorted and distinct.
     pub times: Vec<f64>,
-    /// The leads of stepped keys, sorted.
-    pub leads: Vec<f64>,
+    /// The times of stepped keys (where a value jumps), sorted.
+    pub steps: Vec<f64>,
 }
 
 impl BakeTimes {
-    /// Per time of `times` (sorted): whether it is one of the leads.
-    pub fn lead_flags(&self, times: &[f64]) -> Vec<bool> {
-        times.iter().map(|t| self.leads.binary_search_by(|l| l.total_cmp(t)).is_ok()).collect()
+    /// Per time of `times`: whether a stepped key is at it.
+    pub fn step_flags(&self, times: &[f64]) -> Vec<bool> {
+        times.iter().map(|t| self.steps.binary_search_by(|s| s.total_cmp(t)).is_ok()).collect()
     }
 }
 
@@ -32,22 +32,32 @@ impl BakeTimes {
 pub fn bake_times(side: &Side) -> BakeTimes {
     let rate = side.clip.map_or(DEFAULT_FRAME_RATE, Clip::frame_rate);
     let mut keys = side.key_times();
-    let (mut leads, mut inside) = (Vec::new(), Vec::new());
+    let (mut steps, mut inside) = (Vec::new(), Vec::new());
     if let (Some(clip), None) = (side.clip, &side.layers) {
         for (times, interpolation) in track_times(clip) {
             match interpolation {
-                Interpolation::Step => leads.extend(times[1..].iter().map(|t| (t - STEP_LEAD).max(0.0))),
+                Interpolation::Step => steps.extend_from_slice(&times[1..]),
                 Interpolation::CubicSpline => inside.extend(quarter_points(times)),
                 Interpolation::Linear => {}
             }
         }
     }
-    keys.extend(&leads);
+    keys.extend(steps.iter().map(|t| (t - STEP_LEAD).max(0.0)));
     keys.extend(inside);
-    let times = sample_times(keys, 0.0, side.duration(), rate, MAX_FRAMES).times;
-    leads.sort_by(f64::total_cmp);
-    leads.retain(|l| times.binary_search_by(|t| t.total_cmp(l)).is_ok());
-    BakeTimes { times, leads }
+    let mut times = sample_times(keys, 0.0, side.duration(), rate, MAX_FRAMES).times;
+    times.iter_mut().chain(&mut steps).for_each(|t| *t = in_single_precision(*t));
+    times.dedup();
+    steps.sort_by(f64::total_cmp);
+    steps.dedup();
+    steps.retain(|s| times.binary_search_by(|t| t.total_cmp(s)).is_ok());
+    BakeTimes { times, steps }
+}
+
+/// `time` rounded to the nearest `f32`: glTF stores key times in single precision, so a sample taken at exactly such
+/// a time is where its key will be (within a step's lead, where the source moves a whole jump in a millisecond, the
+/// 1e-8 s a time moves in rounding would otherwise show).
+pub fn in_single_precision(time: f64) -> f64 {
+    f64::from(time as f32)
 }
 
 /// The time array and interpolation of every track of `clip`, morph weights included.
@@ -99,11 +109,11 @@ mod tests {
         tracks.translation = Some(Track::new(times, vec![Vec3::ZERO, Vec3::X, Vec3::Y], Interpolation::Step).unwrap());
         rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(2.0)];
         let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
-        // Frames 0, 0.5, 1; keys 0.25; leads 0.249, 0.999.
+        // Frames 0, 0.5, 1; keys 0.25; leads 0.249, 0.999 (in single precision, where glTF keeps them).
         let expected = [0.0, 0.249, 0.25, 0.5, 0.999, 1.0];
         let got = bake_times(&side);
         assert_eq!(got.times.len(), expected.len(), "{got:?}");
-        assert!(got.times.iter().zip(expected).all(|(g, e)| (g - e).abs() < 1e-12), "{got:?}");
-        assert_eq!(got.lead_flags(&got.times), [false, true, false, false, true, false]);
+        assert!(got.times.iter().zip(expected).all(|(&g, e)| g == in_single_precision(e)), "{got:?}");
+        assert_eq!(got.step_flags(&got.times), [false, false, true, false, false, true]);
     }
 }

@@ -15,8 +15,8 @@ use crate::import;
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
-    pub file: PathBuf,
+    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content); without one, the built-in demo rig.
+    pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Where to write the glTF binary (written whole or not at all).
@@ -72,9 +72,12 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
         bail!("--tolerance must be a finite fraction ≥ 0, got {}", args.tolerance);
     }
-    let rig = import::load(&args.file)?;
+    let rig = match &args.file {
+        Some(path) => import::load(path)?,
+        None => import::demo_rig(),
+    };
     if rig.skeleton.is_empty() {
-        bail!("{}: no nodes to bake", args.file.display());
+        bail!("{}: no nodes to bake", source_name(args));
     }
     let modes = args.eval.modes(&rig)?;
     let layers = args.layers.layers(&rig)?;
@@ -106,12 +109,17 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     Ok(if over { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
+/// The source file's name, or the demo rig's.
+fn source_name(args: &BakeArgs) -> String {
+    args.file.as_ref().map_or_else(|| "the demo rig".to_owned(), |path| path.display().to_string())
+}
+
 fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
     let size = report.rig_size;
     let percent = |v: f64| format!("{:.6} %", 100.0 * v / size);
     let mut out = format!(
         "{} → {} ({bytes} bytes)  strategy: {}  inherit: {}\n",
-        args.file.display(),
+        source_name(args),
         args.out.display(),
         match report.strategy {
             Strategy::Exact => "exact",

@@ -1,6 +1,6 @@
 //! `bonescope diff`: two evaluations compared over time, bone by bone and vertex by vertex.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
@@ -68,7 +68,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
-fn side<'a>(path: &PathBuf, rig: &'a Rig, modes: ModeSet, anim: &Option<String>) -> FileSide<'a> {
+fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeSet, anim: &Option<String>) -> FileSide<'a> {
     FileSide {
         file: path.display().to_string(),
         rig,

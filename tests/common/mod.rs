@@ -1,7 +1,28 @@
-//! Helpers shared by the integration tests that compare evaluated geometry with the authoring tools' own.
+//! Helpers shared by the integration tests that compare evaluated geometry with the authoring tools' own. (Each
+//! test crate uses some of them.)
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use rayon::prelude::*;
+
+/// A file of the shared assets beside the repository.
+pub fn asset(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path)
+}
+
+/// The vertex positions (`v` lines) of a Wavefront OBJ file.
+pub fn obj_positions(path: &Path) -> Vec<DVec3> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            DVec3::new(v[0], v[1], v[2])
+        })
+        .collect()
+}
 
 /// The diagonal of the bounding box.
 pub fn size(points: &[DVec3]) -> f64 {

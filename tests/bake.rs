@@ -1,0 +1,353 @@
+//! `bake` against every shared asset under every inheritance mode, with `diff` and the Khronos glTF-Validator as
+//! the judges: the baked glTF read back by bonescope's own importer must reproduce the source's evaluation (exactly
+//! at the sampled times when every sample is kept, within the tolerance anywhere with the default key reduction),
+//! its skinned vertices must equal the source's, Maya's own geometry must come out of the baked Maya file, and the
+//! validator must find no error in any file written.
+//!
+//! Tolerances: "exact" is 1e-6 of the rig's size (glTF stores single precision: 6e-8 relative per number, a few
+//! times that down a chain of bones); between samples the bake's own `--tolerance` (1e-4 of the rig's size).
+
+mod common;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::LazyLock;
+
+use bonescope::bake::{self, Request, Strategy};
+use bonescope::diff::{Pairs, Side, compare, comparison_times};
+use bonescope::import;
+use bonescope::model::{InheritMode, Rig};
+use common::{asset, obj_positions, size};
+use rayon::prelude::*;
+use serde_json::Value;
+
+/// Every shared asset with animation or skins (the corpus and the validator's suite have their own tests).
+const SOURCES: &[&str] = &[
+    "blender/stretchy_full.glb",
+    "blender/stretchy_noinherit.glb",
+    "blender/stretchy_full.fbx",
+    "blender/stretchy_noinherit.fbx",
+    "blender/stretchy_full.bvh",
+    "gltf-khronos/Fox.glb",
+    "gltf-khronos/SimpleSkin.gltf",
+    "gltf-khronos/box_animated.gltf",
+    "gltf-khronos/cesium_man.gltf",
+    "gltf-khronos/interpolation_test.gltf",
+    "gltf-khronos/rigged_simple.gltf",
+    "fbx-proanimationbank/locomotions.fbx",
+    "fbx-proanimationbank/skeleton.fbx",
+    "fbx-proanimationbank/walk.fbx",
+    "fbx-proanimationbank/crossarms.fbx",
+    "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_6100_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_step_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_static_no_inherit_scale_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_advanced_skinned_pivot_7700_binary.fbx",
+    "fbx-ufbx-data/max7_skin_5000_binary.fbx",
+    "fbx-ufbx-data/max_transformed_skin_7500_binary.fbx",
+    "fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx",
+    "bvh/cmu_12_01_walk.bvh",
+    "bvh/bvh_test2.bvh",
+    "bvh/standard_skeleton.bvh",
+    "bvh/rotation_first_root.bvh",
+    "bvh/full_precision_frame_time.bvh",
+];
+
+/// The demo rig stands beside the files.
+const DEMO: &str = "demo";
+
+/// Exact: 1e-6 of the rig's size.
+const EXACT: f64 = 1e-6;
+
+/// `None` is each bone's declared mode.
+fn modes() -> Vec<Option<InheritMode>> {
+    std::iter::once(None).chain(InheritMode::ALL.into_iter().map(Some)).collect()
+}
+
+fn label(mode: Option<InheritMode>) -> &'static str {
+    mode.map_or("declared", InheritMode::id)
+}
+
+static RIGS: LazyLock<HashMap<&'static str, Rig>> = LazyLock::new(|| {
+    let mut rigs: HashMap<&str, Rig> = SOURCES.par_iter().map(|&f| (f, import::load(&asset(f)).unwrap())).collect();
+    rigs.insert(DEMO, import::demo_rig());
+    rigs
+});
+
+fn sources() -> Vec<&'static str> {
+    SOURCES.iter().copied().chain([DEMO]).collect()
+}
+
+/// One bake of one source under one mode.
+struct Baked {
+    source: &'static str,
+    mode: Option<InheritMode>,
+    baked: bake::Baked,
+    rig: Rig,
+}
+
+fn request(source: &'static str, mode: Option<InheritMode>, strategy: Strategy, tolerance: f64) -> Request<'static> {
+    let rig = &RIGS[source];
+    let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
+    Request { rig, modes, clips: bake::every_clip(rig, None), strategy, tolerance }
+}
+
+fn bake_all(strategy: Strategy, tolerance: f64) -> Vec<Baked> {
+    let jobs: Vec<(&str, Option<InheritMode>)> =
+        sources().into_iter().flat_map(|s| modes().into_iter().map(move |m| (s, m))).collect();
+    jobs.into_par_iter()
+        .map(|(source, mode)| {
+            let baked = bake::bake(&request(source, mode, strategy, tolerance));
+            let rig = import::load_bytes(Path::new("baked.glb"), &baked.glb)
+                .unwrap_or_else(|e| panic!("{source} ({}): the bake does not read back: {e}", label(mode)));
+            Baked { source, mode, baked, rig }
+        })
+        .collect()
+}
+
+static DEFAULT: LazyLock<Vec<Baked>> = LazyLock::new(|| bake_all(Strategy::Exact, bake::DEFAULT_TOLERANCE));
+static EVERY_SAMPLE: LazyLock<Vec<Baked>> = LazyLock::new(|| bake_all(Strategy::Exact, 0.0));
+static TRS: LazyLock<Vec<Baked>> = LazyLock::new(|| bake_all(Strategy::Trs, 0.0));
+
+/// The largest distance (bone probes and vertices) over every clip between the source and its bake, at the times
+/// `times` gives for each clip's pair of sides; with the rig size.
+fn worst(b: &Baked, strategy: Strategy, times: impl Fn(usize, &Side, &Side) -> Vec<f64>) -> (f64, f64) {
+    let request = request(b.source, b.mode, strategy, 0.0);
+    let mut worst: f64 = 0.0;
+    for k in 0..request.clips.len() {
+        let source = request.side(k);
+        let baked = Side::new(&b.rig, b.rig.clips.get(k), &b.rig.skeleton.declared_modes());
+        let pairs = Pairs::of(&source, &baked, &[]).unwrap();
+        let added: Vec<&str> = pairs.bones.only_b.iter().map(|&i| b.rig.skeleton.bone(i).name.as_str()).collect();
+        let common_root = b.baked.notes.iter().any(|n| n.contains("a new root"));
+        assert!(pairs.bones.only_a.is_empty(), "{}: every source bone is in the bake", b.source);
+        assert!(added.is_empty() || (common_root && added.len() == 1), "{}: only in the bake: {added:?}", b.source);
+        assert_eq!(pairs.meshes.len(), request.rig.meshes.len(), "{}: every mesh pairs up", b.source);
+        worst = worst.max(compare(&source, &baked, &pairs, &times(k, &source, &baked)).worst_distance().max);
+    }
+    (worst, b.baked.rig_size)
+}
+
+/// A dense grid: four times the clip's frame rate, at least 240 a second.
+fn dense(source: &Side) -> f64 {
+    (4.0 * source.clip.map_or(30.0, |c| c.frame_rate())).max(240.0)
+}
+
+#[test]
+fn every_sample_kept_is_exact() {
+    let failures: Vec<String> = EVERY_SAMPLE
+        .par_iter()
+        .filter_map(|b| {
+            let (worst, size) = worst(b, Strategy::Exact, |k, _, _| b.baked.animations[k].times.clone());
+            (worst > EXACT * size)
+                .then(|| format!("{} ({}): {:.2e} of the rig size", b.source, label(b.mode), worst / size))
+        })
+        .collect();
+    assert!(failures.is_empty(), "not exact at the sampled times:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn default_keys_stay_within_the_tolerance_between_samples() {
+    let failures: Vec<String> = DEFAULT
+        .par_iter()
+        .filter_map(|b| {
+            let (worst, size) =
+                worst(b, Strategy::Exact, |_, source, baked| comparison_times(source, baked, dense(source)));
+            let relative = worst / size;
+            (relative > bake::DEFAULT_TOLERANCE)
+                .then(|| format!("{} ({}): {relative:.2e} of the rig size on a dense grid", b.source, label(b.mode)))
+        })
+        .collect();
+    assert!(failures.is_empty(), "over the tolerance:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn reduction_keeps_far_fewer_keys_than_samples_on_smooth_mocap() {
+    // The CMU walk at 120 Hz: every bone keyed every frame in the file.
+    let b = DEFAULT.iter().find(|b| b.source == "bvh/cmu_12_01_walk.bvh" && b.mode.is_none()).unwrap();
+    let animation = &b.baked.animations[0];
+    let bones = RIGS[b.source].skeleton.len();
+    let every_sample = animation.times.len() * bones * 3;
+    assert!(animation.keys * 3 < every_sample, "{} keys of {every_sample} sample values", animation.keys);
+}
+
+#[test]
+fn helpers_go_exactly_where_a_local_matrix_shears() {
+    // Maya's file as declared: its compensating bones' parents scale along axes their rotations keep, so no local
+    // matrix shears and no bone needs a helper; under unscaled-parent the middle bone's does.
+    let maya = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
+    let helpers = |mode: Option<InheritMode>| {
+        let b = DEFAULT.iter().find(|b| b.source == maya && b.mode == mode).unwrap();
+        let skeleton = &RIGS[maya].skeleton;
+        b.baked
+            .helpers
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| **h)
+            .map(|(i, _)| skeleton.bone(i).name.clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(helpers(None), Vec::<String>::new());
+    assert_eq!(helpers(Some(InheritMode::UnscaledParent)), ["Mid"]);
+    assert_eq!(helpers(Some(InheritMode::Full)), Vec::<String>::new(), "full inheritance is glTF's own");
+    // The demo under segment scale compensate: the forearm's local matrix shears.
+    let demo = DEFAULT.iter().find(|b| b.source == DEMO && b.mode == Some(InheritMode::SegmentCompensate)).unwrap();
+    let forearm = RIGS[DEMO].skeleton.find("forearm").unwrap();
+    assert!(demo.baked.helpers[forearm]);
+    let helper_node = demo.rig.skeleton.find("forearm.stretch").expect("the helper node is in the file");
+    assert_eq!(demo.rig.skeleton.parent(demo.rig.skeleton.find("forearm").unwrap()), Some(helper_node));
+}
+
+/// Writes every bake of `bakes` into `folder`, returns the paths.
+fn write_all(bakes: &[Baked], folder: &Path, tag: &str) -> Vec<PathBuf> {
+    bakes
+        .iter()
+        .map(|b| {
+            let name = format!("{}_{}_{tag}.glb", b.source.replace('/', "_"), label(b.mode));
+            let path = folder.join(name);
+            bake::save(&path, &b.baked.glb).unwrap();
+            path
+        })
+        .collect()
+}
+
+/// The validator's report of each file, as JSON lines (`tests/gltf-validator/validate.mjs`); installs the npm
+/// package first when it is missing.
+fn validate(files: &[PathBuf]) -> Vec<Value> {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf-validator");
+    if !folder.join("node_modules/gltf-validator").exists() {
+        let npm = Command::new("npm").args(["ci", "--no-audit", "--no-fund"]).current_dir(&folder).output();
+        let npm = npm.expect("npm (Node.js) runs the glTF-Validator: install nodejs and npm");
+        assert!(npm.status.success(), "npm ci failed: {}", String::from_utf8_lossy(&npm.stderr));
+    }
+    let mut reports = Vec::new();
+    for chunk in files.chunks(64) {
+        let out = Command::new("node").arg(folder.join("validate.mjs")).args(chunk).output().expect("node runs");
+        assert!(out.status.success(), "the validator failed: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        reports.extend(text.lines().map(|line| serde_json::from_str::<Value>(line).unwrap()));
+    }
+    reports
+}
+
+#[test]
+fn every_baked_file_passes_the_khronos_validator() {
+    let folder = tempfile::tempdir().unwrap();
+    let mut files = write_all(&DEFAULT, folder.path(), "exact");
+    files.extend(write_all(&TRS, folder.path(), "trs"));
+    let reports = validate(&files);
+    assert_eq!(reports.len(), files.len());
+    let failing: Vec<String> = reports
+        .iter()
+        .filter(|r| r["errors"].as_u64() != Some(0))
+        .map(|r| format!("{}: {}", r["file"], r["messages"]))
+        .collect();
+    assert!(failing.is_empty(), "{} files with errors:\n{}", failing.len(), failing.join("\n"));
+}
+
+fn bonescope(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
+}
+
+/// The vertices `bonescope export` writes for `file` at `time`.
+fn exported(file: &Path, time: f64, folder: &Path) -> Vec<glam::DVec3> {
+    let out = folder.join(format!("{}_{time}.obj", file.file_stem().unwrap().to_string_lossy()));
+    let run = bonescope(&[
+        "export",
+        &file.display().to_string(),
+        "--time",
+        &time.to_string(),
+        "--out",
+        &out.display().to_string(),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    obj_positions(&out)
+}
+
+#[test]
+fn baked_skinned_vertices_equal_the_sources_in_export() {
+    // Skinned meshes from each tool, at key times of their first clip, as `export` writes them.
+    let folder = tempfile::tempdir().unwrap();
+    for (source, time) in [
+        ("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", 5.0 / 24.0),
+        ("fbx-ufbx-data/max7_skin_5000_binary.fbx", 0.5),
+        ("blender/stretchy_full.fbx", 1.0),
+        ("gltf-khronos/cesium_man.gltf", 1.0),
+        ("gltf-khronos/Fox.glb", 0.5),
+    ] {
+        let b = EVERY_SAMPLE.iter().find(|b| b.source == source && b.mode.is_none()).unwrap();
+        let baked = folder.path().join(format!("{}.glb", source.replace('/', "_")));
+        bake::save(&baked, &b.baked.glb).unwrap();
+        let theirs = exported(&asset(source), time, folder.path());
+        let ours = exported(&baked, time, folder.path());
+        assert_eq!(ours.len(), theirs.len(), "{source}: vertex count");
+        // `export` writes the file's own units (FBX in centimetres here, the bake in metres).
+        let scale = size(&theirs) / size(&ours);
+        assert!((scale - 1.0).abs() < 1e-6 || (scale - 100.0).abs() < 1e-4, "{source}: units {scale}");
+        let worst = ours.iter().zip(&theirs).map(|(a, b)| a.distance(*b / scale.round())).fold(0.0, f64::max);
+        assert!(worst <= EXACT * size(&ours), "{source}: {worst:.2e} against a size of {:.3}", size(&ours));
+    }
+}
+
+#[test]
+fn the_baked_maya_file_gives_mayas_own_geometry() {
+    // Maya's OBJ of frames 0–7 (24 fps, centimetres) against `export` of the baked glTF (metres).
+    let maya = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
+    let b = DEFAULT.iter().find(|b| b.source == maya && b.mode.is_none()).unwrap();
+    let folder = tempfile::tempdir().unwrap();
+    let baked = folder.path().join("maya.glb");
+    bake::save(&baked, &b.baked.glb).unwrap();
+    for frame in 0..8 {
+        let reference: Vec<glam::DVec3> =
+            obj_positions(&asset(&format!("fbx-ufbx-data/maya_mixed_inherit_mode_{frame}.obj")))
+                .iter()
+                .map(|p| *p * 0.01)
+                .collect();
+        let ours = exported(&baked, f64::from(frame) / 24.0, folder.path());
+        assert_eq!(ours.len(), reference.len());
+        let worst = ours.iter().zip(&reference).map(|(a, b)| a.distance(*b)).fold(0.0, f64::max);
+        assert!(worst <= 1e-4 * size(&reference), "frame {frame}: {:.2e} of the model", worst / size(&reference));
+    }
+}
+
+/// `bonescope diff A B` as JSON, and the largest worst distance of its animations.
+fn diff_worst(args: &[&str]) -> f64 {
+    let out = bonescope(&[&["diff", "--format", "json"], args].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: Value = serde_json::from_slice(&out.stdout).unwrap();
+    json["animations"].as_array().unwrap().iter().map(|a| a["worst"]["max"].as_f64().unwrap()).fold(0.0, f64::max)
+}
+
+#[test]
+fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
+    let folder = tempfile::tempdir().unwrap();
+    let cases = [
+        ("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", None),
+        ("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", Some(InheritMode::UnscaledParent)),
+        ("blender/stretchy_noinherit.fbx", None),
+        ("blender/stretchy_full.glb", Some(InheritMode::BlenderFixShear)),
+        ("fbx-ufbx-data/maya_scale_no_inherit_7700_ascii.fbx", None),
+    ];
+    for (source, mode) in cases {
+        let b = TRS.iter().find(|b| b.source == source && b.mode == mode).unwrap();
+        let baked = folder.path().join("trs.glb");
+        bake::save(&baked, &b.baked.glb).unwrap();
+        let report = bake::report(&request(source, mode, Strategy::Trs, 0.0), &b.baked, &b.rig);
+        let reported = report.worst().max;
+        // Every sample is a key, so diff at the clip's own rate visits exactly the sampled times.
+        let rate = RIGS[source].clips[0].frame_rate().to_string();
+        let (path, inherit) = (asset(source).display().to_string(), label(mode));
+        let measured = diff_worst(&[&path, &baked.display().to_string(), "--inherit-a", inherit, "--rate", &rate]);
+        assert!(
+            (reported - measured).abs() <= EXACT * b.baked.rig_size,
+            "{source} ({inherit}): {reported} vs {measured}"
+        );
+        // Keeping each bone's own local TRS is the source evaluated with glTF's full inheritance.
+        let local_trs = diff_worst(&[&path, &path, "--inherit-a", inherit, "--inherit-b", "full", "--rate", &rate]);
+        assert!(reported <= local_trs + EXACT * b.baked.rig_size, "{source} ({inherit}): {reported} > {local_trs}");
+    }
+}
