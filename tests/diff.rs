@@ -1,0 +1,242 @@
+//! `bonescope diff` and `bonescope bake` as a user runs them: how bones pair up, what the reports hold, exit codes,
+//! and what a failed bake leaves behind (nothing).
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use common::asset;
+use serde_json::Value;
+
+fn bonescope(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
+}
+
+fn json(output: &Output) -> Value {
+    assert!(output.status.success(), "stderr: {}", String::from_utf8_lossy(&output.stderr));
+    serde_json::from_slice(&output.stdout).expect("valid JSON")
+}
+
+fn path(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// `rigged_simple.gltf` with its nodes renamed by `rename` (the names of the original's nodes in, new names out).
+fn renamed(folder: &Path, rename: impl Fn(&str) -> String) -> String {
+    let mut gltf: Value =
+        serde_json::from_slice(&std::fs::read(asset("gltf-khronos/rigged_simple.gltf")).unwrap()).unwrap();
+    for node in gltf["nodes"].as_array_mut().unwrap() {
+        let name = node["name"].as_str().unwrap().to_owned();
+        node["name"] = Value::from(rename(&name));
+    }
+    let out = folder.join("renamed.gltf");
+    std::fs::write(&out, serde_json::to_vec(&gltf).unwrap()).unwrap();
+    path(&out)
+}
+
+fn names(list: &Value) -> Vec<&str> {
+    list.as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect()
+}
+
+#[test]
+fn a_file_against_itself_differs_by_nothing() {
+    let file = path(&asset("blender/stretchy_full.glb"));
+    let out = bonescope(&["diff", &file, &file, "--format", "json", "--fail-above", "0"]);
+    assert_eq!(out.status.code(), Some(0));
+    let report = json(&out);
+    let keys: Vec<&str> = report.as_object().unwrap().keys().map(String::as_str).collect();
+    assert_eq!(keys, ["a", "animations", "b", "clips_only_a", "clips_only_b", "inherit_a", "inherit_b", "rate"]);
+    let animations = report["animations"].as_array().unwrap();
+    assert_eq!(animations.len(), 2, "both clips, paired by name");
+    for animation in animations {
+        assert_eq!(animation["a"], animation["b"]);
+        assert_eq!(animation["worst"]["max"], 0.0);
+        assert_eq!(animation["bones"].as_array().unwrap().len(), 10);
+        assert_eq!(animation["meshes"][0]["vertices"], 648);
+        let bone = &animation["bones"][4];
+        let fields: Vec<&str> = bone.as_object().unwrap().keys().map(String::as_str).collect();
+        assert_eq!(fields, ["a", "b", "name", "orientation_deg", "position", "probe", "scale_ratio", "stretch_deg"]);
+    }
+}
+
+#[test]
+fn two_modes_of_one_file_differ_where_the_modes_do_and_fail_the_gate() {
+    // Segment scale compensate moves every bone below the squashing spine.
+    let file = path(&asset("blender/stretchy_full.glb"));
+    let run = |limit: &str| {
+        bonescope(&[
+            "diff",
+            &file,
+            &file,
+            "--inherit-b",
+            "segment-compensate",
+            "--anim-a",
+            "squash_stretch",
+            "--fail-above",
+            limit,
+        ])
+    };
+    let out = run("1e-6");
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        table.contains("inherit: segment-compensate") && table.contains("`squash_stretch` against `squash_stretch`")
+    );
+    assert_eq!(run("100%").status.code(), Some(0), "a limit of the whole rig's size passes");
+    let report = json(&bonescope(&[
+        "diff",
+        &file,
+        &file,
+        "--inherit-b",
+        "segment-compensate",
+        "--anim-a",
+        "squash_stretch",
+        "--format",
+        "json",
+    ]));
+    let bones = report["animations"][0]["bones"].as_array().unwrap();
+    let by_name = |n: &str| bones.iter().find(|b| b["name"] == n).unwrap();
+    assert_eq!(by_name("hips")["probe"]["max"], 0.0, "above the squash nothing changes");
+    assert!(by_name("hand")["probe"]["max"].as_f64().unwrap() > 1e-3);
+}
+
+#[test]
+fn bones_pair_by_name_without_case_or_namespace_and_by_map() {
+    let folder = tempfile::tempdir().unwrap();
+    let original = path(&asset("gltf-khronos/rigged_simple.gltf"));
+    // `Bone` becomes `mixamorig:BONE`, `Armature` becomes `Rig|armature`, `Cylinder` becomes `Tube`.
+    let other = renamed(folder.path(), |name| match name {
+        "Bone" => "mixamorig:BONE".to_owned(),
+        "Armature" => "Rig|armature".to_owned(),
+        "Cylinder" => "Tube".to_owned(),
+        other => other.to_owned(),
+    });
+    let report = json(&bonescope(&["diff", &original, &other, "--format", "json"]));
+    let animation = &report["animations"][0];
+    assert_eq!(names(&animation["only_a"]), ["Cylinder"]);
+    assert_eq!(names(&animation["only_b"]), ["Tube"]);
+    let bone = animation["bones"].as_array().unwrap().iter().find(|b| b["name"] == "Bone").unwrap();
+    assert_eq!(bone["name_b"], "mixamorig:BONE");
+    let mapped = json(&bonescope(&["diff", &original, &other, "--map", "Cylinder=Tube", "--format", "json"]));
+    let animation = &mapped["animations"][0];
+    assert!(names(&animation["only_a"]).is_empty() && names(&animation["only_b"]).is_empty());
+    assert_eq!(animation["worst"]["max"], 0.0, "renaming moves nothing");
+    // A map that names no bone is an error naming it.
+    let out = bonescope(&["diff", &original, &other, "--map", "Nope=Tube"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`Nope`"));
+}
+
+#[test]
+fn a_missing_file_is_an_error_naming_it() {
+    let out = bonescope(&["diff", "no-such-file.glb", &path(&asset("blender/stretchy_full.glb"))]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-file.glb"));
+}
+
+#[test]
+fn bake_reports_json_and_diff_pairs_its_helpers_away() {
+    // The demo arm under segment scale compensate: the forearm needs a helper node.
+    let folder = tempfile::tempdir().unwrap();
+    let out = path(&folder.path().join("demo.glb"));
+    let report = json(&bonescope(&["bake", "--inherit", "segment-compensate", "--out", &out, "--format", "json"]));
+    let keys: Vec<&str> = report.as_object().unwrap().keys().map(String::as_str).collect();
+    assert_eq!(keys, ["animations", "helpers", "notes", "rig_size", "strategy", "tolerance"]);
+    assert_eq!(names(&report["helpers"]), ["forearm"]);
+    assert_eq!(report["strategy"], "exact");
+    let animation = &report["animations"][0];
+    let forearm = animation["bones"].as_array().unwrap().iter().find(|b| b["name"] == "forearm").unwrap();
+    assert_eq!(forearm["nodes"], "helper");
+    let worst = animation["worst"]["max"].as_f64().unwrap();
+    assert!(worst < 1e-4 * report["rig_size"].as_f64().unwrap());
+    // Against the demo's own evaluation the bake pairs every bone and leaves its helper out.
+    let demo = folder.path().join("demo_source.glb");
+    json(&bonescope(&[
+        "bake",
+        "--out",
+        &path(&demo),
+        "--inherit",
+        "segment-compensate",
+        "--tolerance",
+        "0",
+        "--format",
+        "json",
+    ]));
+    let diff = json(&bonescope(&["diff", &path(&demo), &out, "--format", "json"]));
+    let animation = &diff["animations"][0];
+    assert_eq!(animation["helpers"], 2, "one helper node in each file");
+    assert!(names(&animation["only_a"]).is_empty() && names(&animation["only_b"]).is_empty());
+}
+
+#[test]
+fn bake_gates_on_the_largest_error_and_writes_the_file_anyway() {
+    let folder = tempfile::tempdir().unwrap();
+    let out = path(&folder.path().join("gate.glb"));
+    let file = path(&asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx"));
+    let strict = bonescope(&[
+        "bake",
+        &file,
+        "--strategy",
+        "trs",
+        "--inherit",
+        "unscaled-parent",
+        "--out",
+        &out,
+        "--max-error",
+        "1e-9",
+    ]);
+    assert_eq!(strict.status.code(), Some(1), "{}", String::from_utf8_lossy(&strict.stderr));
+    assert!(Path::new(&out).exists(), "the file is written; the exit code is the gate");
+    let table = String::from_utf8(strict.stdout).unwrap();
+    assert!(table.contains("strategy: trs") && table.contains("Mid"));
+    let loose = bonescope(&[
+        "bake",
+        &file,
+        "--strategy",
+        "trs",
+        "--inherit",
+        "unscaled-parent",
+        "--out",
+        &out,
+        "--max-error",
+        "50%",
+    ]);
+    assert_eq!(loose.status.code(), Some(0));
+}
+
+#[test]
+fn a_failed_bake_leaves_the_output_as_it_was() {
+    let folder = tempfile::tempdir().unwrap();
+    let out = folder.path().join("kept.glb");
+    std::fs::write(&out, b"the previous bake").unwrap();
+    let broken = folder.path().join("broken.gltf");
+    std::fs::write(&broken, b"{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [{\"children\": [0]}]}").unwrap();
+    let run = bonescope(&["bake", &path(&broken), "--out", &path(&out)]);
+    assert_eq!(run.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("broken.gltf") && stderr.contains("nodes[0]"), "{stderr}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"the previous bake");
+    let unwritable = bonescope(&["bake", "--out", &path(&folder.path().join("no/such/folder/x.glb"))]);
+    assert_eq!(unwritable.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unwritable.stderr).contains("cannot write"));
+    let leftovers: Vec<_> = std::fs::read_dir(folder.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(leftovers.len(), 2, "no temporary file left behind: {leftovers:?}");
+}
+
+#[test]
+fn a_layered_bake_is_one_new_clip() {
+    let folder = tempfile::tempdir().unwrap();
+    let out = path(&folder.path().join("blend.glb"));
+    let file = path(&asset("fbx-proanimationbank/locomotions.fbx"));
+    let args = [
+        "bake", &file, "--anim", "walk", "--blend", "run", "--weight", "0.5", "--sync", "--out", &out, "--format",
+        "json",
+    ];
+    let report = json(&bonescope(&args));
+    let animations = report["animations"].as_array().unwrap();
+    assert_eq!(animations.len(), 1);
+    assert!(animations[0]["name"].as_str().unwrap().starts_with("walk + blend `run` a = 0.5, synced"));
+    let baked = json(&bonescope(&["inspect", &out, "--format", "json"]));
+    assert!((baked["animation"]["duration"].as_f64().unwrap() - 1.0).abs() < 1e-6, "the synced cycle lasts 1 s");
+}
