@@ -553,3 +553,100 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
     assert!((still - x_at).abs() < 0.02 * width_before, "{x_at} → {still}");
     assert_eq!(harness.state().time, 0.0, "the wheel does not seek");
 }
+
+/// Maya's mixed-inheritance file baked as the closest TRS under unscaled-parent, written to `folder`.
+fn maya_trs_bake(folder: &std::path::Path) -> std::path::PathBuf {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets/fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
+    let rig = bonescope::import::load(&path).unwrap();
+    let request = bonescope::bake::Request {
+        rig: &rig,
+        modes: vec![InheritMode::UnscaledParent; rig.skeleton.len()],
+        clips: bonescope::bake::every_clip(&rig, None),
+        strategy: bonescope::bake::Strategy::Trs,
+        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
+    };
+    let out = folder.join("maya_trs.glb");
+    bonescope::bake::save(&out, &bonescope::bake::bake(&request).glb).unwrap();
+    out
+}
+
+#[test]
+fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged() {
+    let folder = tempfile::tempdir().unwrap();
+    let baked = maya_trs_bake(folder.path());
+    let mut harness = asset_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
+    let bones = harness.state().doc.rig.skeleton.len();
+    harness.state_mut().doc.modes = vec![InheritMode::UnscaledParent; bones];
+    harness.state_mut().compare(&baked);
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.ghost, Some(bonescope::app::Ghost::Compared));
+    harness.get_by_label_contains("comparing with");
+    // The TRS bake drops the stretch of `Mid` (it needed a helper): `Mid` and what hangs below it differ, the root
+    // does not.
+    let differences = harness.state().differences().expect("differences over the clip").clone();
+    let mid = bone(&harness, "Mid");
+    assert!(differences.bones[mid].unwrap() > 1e-4, "{:?}", differences.bones);
+    assert!(differences.bones[0].unwrap() < 1e-6, "{:?}", differences.bones);
+    assert!(harness.query_all_by_label_contains("Δ ").count() >= 2, "Mid and what hangs below it are badged");
+    // Plotting a bone with the ghost on shows the compared file's curves beside the document's.
+    harness.get_by_label("Left_Tip").click();
+    settle(&mut harness);
+    harness.get_by_role_and_label(Role::CheckBox, "ghost").click();
+    settle(&mut harness);
+    let compared = harness.query_all_by_label_contains("(compared)").count();
+    let all = harness.query_all_by_label_contains("Left_Tip ").count();
+    assert!(compared > 0 && 2 * compared == all, "one compared curve beside each of the bone's: {compared} of {all}");
+    // Stop comparing: the ghost goes with it.
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label_contains("Stop comparing with").click();
+    settle(&mut harness);
+    assert!(harness.state().doc.compared.is_none() && harness.state().doc.ghost.is_none());
+}
+
+#[test]
+fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
+    let folder = tempfile::tempdir().unwrap();
+    let copy = folder.path().join("copy.glb");
+    let source = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    std::fs::copy(&source, &copy).unwrap();
+    let mut harness = asset_app("blender/stretchy_full.glb");
+    harness.state_mut().native_dialog = bonescope::app::NativeDialog::Unavailable;
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("Compare with…").click();
+    harness.run();
+    harness.get_by_label("Compare with a file");
+    harness.get_by_label("Path").click();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("Path").type_text(&folder.path().display().to_string());
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    harness.get_by_label("copy.glb").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().doc.compared.as_ref().map(|c| c.path.clone()), Some(copy.clone()));
+    assert!(harness.state().differences().unwrap().bones.iter().all(|d| d.unwrap() == 0.0), "a file against its copy");
+    // The copy changes on disk (rewritten as the same clip under segment scale compensate): the comparison follows.
+    let rig = bonescope::import::load(&source).unwrap();
+    let request = bonescope::bake::Request {
+        rig: &rig,
+        modes: vec![InheritMode::SegmentCompensate; rig.skeleton.len()],
+        clips: bonescope::bake::every_clip(&rig, None),
+        strategy: bonescope::bake::Strategy::Exact,
+        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
+    };
+    bonescope::bake::save(&copy, &bonescope::bake::bake(&request).glb).unwrap();
+    for _ in 0..100 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        harness.step();
+        if harness.state().differences().is_none() {
+            break;
+        }
+    }
+    settle(&mut harness);
+    let differences = harness.state().differences().expect("the reloaded file's differences");
+    assert!(differences.bones.iter().any(|d| d.is_some_and(|d| d > 1e-3)), "{differences:?}");
+    harness.get_by_label_contains("reloaded");
+}

@@ -170,3 +170,33 @@ fn small_window_with_layers_and_inspector() {
 fn demo_axis_angle_in_two_plots() {
     app(|s| s.rotation_format = bonescope::app::RotationFormat::AxisAngle).snapshot("demo_axis_angle_in_two_plots");
 }
+
+/// The demo under segment scale compensate, compared with its own bake as the closest TRS per bone (what a runtime
+/// that cannot shear plays): the ghost parts from the pose at the forearm, whose stretch the TRS lost, and the
+/// outliner badges the bones that stray; the plots show the bake's curves dashed.
+#[test]
+fn demo_compared_with_its_trs_bake() {
+    use bonescope::model::InheritMode;
+    let folder = tempfile::tempdir().unwrap();
+    let rig = bonescope::import::demo_rig();
+    let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
+    let request = bonescope::bake::Request {
+        rig: &rig,
+        modes: modes.clone(),
+        clips: bonescope::bake::every_clip(&rig, None),
+        strategy: bonescope::bake::Strategy::Trs,
+        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
+    };
+    let baked = folder.path().join("demo_trs.glb");
+    bonescope::bake::save(&baked, &bonescope::bake::bake(&request).glb).unwrap();
+    let mut doc = Document::demo();
+    doc.modes = modes;
+    doc.compare_with(bonescope::app::Compared::load(&baked, &doc.rig).unwrap());
+    let mut settings = Settings::default();
+    settings.scene.boxes = true;
+    settings.camera.view = ViewKind::Front;
+    let mut harness = window(settings, doc, 0.5, Some("forearm"));
+    harness.get_by_label("ghost").click();
+    settle(&mut harness);
+    harness.snapshot("demo_compared_with_its_trs_bake");
+}

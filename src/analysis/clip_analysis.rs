@@ -131,7 +131,7 @@ impl Components {
 
     /// The components of `m`, its decomposition searching from `start` (see [`decompose_near`]; the previous
     /// sample's stretch makes a curve faster).
-    pub(super) fn of_matrix(m: &DMat4, start: DQuat) -> Self {
+    pub fn of_matrix(m: &DMat4, start: DQuat) -> Self {
         Components::of_parts(&decompose_near(m, start), m)
     }
 

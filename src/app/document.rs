@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use super::compare::Compared;
 use crate::eval::layers::LayerError;
 use crate::eval::{Hierarchy, LayerStack, Layers, Pose};
 use crate::import::{self, ImportError};
@@ -18,6 +19,8 @@ pub enum Ghost {
     Declared,
     /// The clip as authored: the document's modes without the layers.
     Unlayered,
+    /// The file compared with the document (File → Compare with…).
+    Compared,
 }
 
 impl Ghost {
@@ -26,16 +29,18 @@ impl Ghost {
             Ghost::Mode(mode) => mode.id(),
             Ghost::Declared => "declared",
             Ghost::Unlayered => "without layers",
+            Ghost::Compared => "compared file",
         }
     }
 
-    /// The ghost's modes (given the document's `modes` and the skeleton's declared ones), and whether it goes
-    /// through the layers.
-    pub fn evaluation(self, modes: &[InheritMode], skeleton: &Skeleton) -> (Vec<InheritMode>, bool) {
+    /// For a ghost of the document's own rig, its modes (given the document's `modes` and the skeleton's declared
+    /// ones) and whether it goes through the layers; `None` for the compared file, another rig.
+    pub fn evaluation(self, modes: &[InheritMode], skeleton: &Skeleton) -> Option<(Vec<InheritMode>, bool)> {
         match self {
-            Ghost::Mode(mode) => (vec![mode; modes.len()], true),
-            Ghost::Declared => (skeleton.declared_modes(), true),
-            Ghost::Unlayered => (modes.to_vec(), false),
+            Ghost::Mode(mode) => Some((vec![mode; modes.len()], true)),
+            Ghost::Declared => Some((skeleton.declared_modes(), true)),
+            Ghost::Unlayered => Some((modes.to_vec(), false)),
+            Ghost::Compared => None,
         }
     }
 }
@@ -91,6 +96,8 @@ pub struct Document {
     layers: LayerStack,
     /// A frame rate the user chose instead of the clip's own.
     pub frame_rate_override: Option<f64>,
+    /// A second file compared with this one.
+    pub compared: Option<Arc<Compared>>,
 }
 
 impl Document {
@@ -117,6 +124,7 @@ impl Document {
             clip,
             layers: LayerStack::default(),
             frame_rate_override: None,
+            compared: None,
         }
     }
 
@@ -128,6 +136,7 @@ impl Document {
         }
         doc.ghost = self.ghost;
         doc.frame_rate_override = self.frame_rate_override;
+        doc.compared = self.compared.as_ref().map(|c| Arc::new(c.repaired(&doc.rig)));
         doc.clip = self.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.clip);
         // Layers naming clips or bones the new file lacks are dropped rather than kept half-valid.
         let _ = doc.set_layers(self.layers());
@@ -172,9 +181,23 @@ impl Document {
         self.layers.duration(&self.rig, self.clip())
     }
 
-    /// How the ghost pose is evaluated, when a ghost is shown: its modes, and whether through the layers.
+    /// How a ghost of this rig is evaluated, when one is shown: its modes, and whether through the layers.
     pub fn ghost_evaluation(&self) -> Option<(Vec<InheritMode>, bool)> {
-        self.ghost.map(|ghost| ghost.evaluation(&self.modes, &self.rig.skeleton))
+        self.ghost.and_then(|ghost| ghost.evaluation(&self.modes, &self.rig.skeleton))
+    }
+
+    /// Compares this document with `compared`, drawn as the ghost.
+    pub fn compare_with(&mut self, compared: Compared) {
+        self.compared = Some(Arc::new(compared));
+        self.ghost = Some(Ghost::Compared);
+    }
+
+    /// Stops comparing (a compared ghost goes too).
+    pub fn stop_comparing(&mut self) {
+        self.compared = None;
+        if self.ghost == Some(Ghost::Compared) {
+            self.ghost = None;
+        }
     }
 
     /// The pose at `time` under `modes`, through the layers when `layered`.
@@ -277,7 +300,7 @@ mod tests {
         assert_eq!(doc.modes, declared);
         assert_eq!(doc.current_choice(0, ModeScope::All), Some(ModeChoice::Declared));
         assert_eq!(doc.current_choice(2, ModeScope::Bone), Some(ModeChoice::Declared), "declared wins over its mode");
-        let (modes, layered) = Ghost::Declared.evaluation(&doc.modes, &doc.rig.skeleton);
+        let (modes, layered) = Ghost::Declared.evaluation(&doc.modes, &doc.rig.skeleton).unwrap();
         assert_eq!((modes, layered), (declared, true));
     }
 

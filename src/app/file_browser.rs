@@ -63,6 +63,8 @@ pub fn run_native_dialog() -> DialogOutcome {
 
 /// bonescope's own file browser, shown in a window.
 pub struct FileBrowser {
+    /// The window's title: what the file is for.
+    title: &'static str,
     folder: PathBuf,
     /// What the path field holds.
     typed: String,
@@ -73,9 +75,10 @@ pub struct FileBrowser {
 
 impl FileBrowser {
     /// A browser showing `folder`.
-    pub fn new(folder: &Path) -> Self {
-        let mut browser =
-            FileBrowser { folder: PathBuf::new(), typed: String::new(), entries: Vec::new(), error: None };
+    /// A browser titled `title` (what the file is for), in `folder`.
+    pub fn new(title: &'static str, folder: &Path) -> Self {
+        let (folder_now, typed, entries, error) = (PathBuf::new(), String::new(), Vec::new(), None);
+        let mut browser = FileBrowser { title, folder: folder_now, typed, entries, error };
         browser.enter(folder);
         browser
     }
@@ -106,43 +109,40 @@ impl FileBrowser {
     pub fn ui(&mut self, ctx: &egui::Context, open: &mut bool) -> Option<PathBuf> {
         let mut chosen = None;
         let mut still_open = *open;
-        egui::Window::new("Open a file").open(&mut still_open).collapsible(false).default_width(480.0).show(
-            ctx,
-            |ui| {
-                ui.horizontal(|ui| {
-                    if ui.button("Up").on_hover_text("the parent folder").clicked()
-                        && let Some(parent) = self.folder.parent().map(Path::to_owned)
-                    {
-                        self.enter(&parent);
-                    }
-                    let label = ui.label("Path");
-                    let field =
-                        ui.add(egui::TextEdit::singleline(&mut self.typed).desired_width(360.0)).labelled_by(label.id);
-                    if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
-                        chosen = self.follow(PathBuf::from(self.typed.trim()));
-                    }
-                });
-                if let Some(error) = &self.error {
-                    ui.colored_label(egui::Color32::from_rgb(235, 64, 100), error);
+        egui::Window::new(self.title).open(&mut still_open).collapsible(false).default_width(480.0).show(ctx, |ui| {
+            ui.horizontal(|ui| {
+                if ui.button("Up").on_hover_text("the parent folder").clicked()
+                    && let Some(parent) = self.folder.parent().map(Path::to_owned)
+                {
+                    self.enter(&parent);
                 }
-                ui.separator();
-                egui::ScrollArea::vertical().max_height(320.0).show(ui, |ui| {
-                    for (name, is_folder) in self.entries.clone() {
-                        let text = if is_folder { format!("{name}/") } else { name.clone() };
-                        if ui.selectable_label(false, text).clicked() {
-                            chosen = self.follow(self.folder.join(&name));
-                        }
-                    }
-                    if self.entries.is_empty() {
-                        ui.label(egui::RichText::new("no folders or animation files here").weak());
-                    }
-                });
-                ui.separator();
-                if ui.button("Cancel").clicked() {
-                    *open = false;
+                let label = ui.label("Path");
+                let field =
+                    ui.add(egui::TextEdit::singleline(&mut self.typed).desired_width(360.0)).labelled_by(label.id);
+                if field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                    chosen = self.follow(PathBuf::from(self.typed.trim()));
                 }
-            },
-        );
+            });
+            if let Some(error) = &self.error {
+                ui.colored_label(egui::Color32::from_rgb(235, 64, 100), error);
+            }
+            ui.separator();
+            egui::ScrollArea::vertical().max_height(320.0).show(ui, |ui| {
+                for (name, is_folder) in self.entries.clone() {
+                    let text = if is_folder { format!("{name}/") } else { name.clone() };
+                    if ui.selectable_label(false, text).clicked() {
+                        chosen = self.follow(self.folder.join(&name));
+                    }
+                }
+                if self.entries.is_empty() {
+                    ui.label(egui::RichText::new("no folders or animation files here").weak());
+                }
+            });
+            ui.separator();
+            if ui.button("Cancel").clicked() {
+                *open = false;
+            }
+        });
         *open &= still_open;
         if chosen.is_some() {
             *open = false;

@@ -1,5 +1,5 @@
-//! The whole-clip analysis, computed off the UI thread and cached until the file, clip, modes or plotted bones
-//! change.
+//! Work computed off the UI thread and cached until what it depends on changes: the whole-clip analysis, and the
+//! comparison with a second file.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -12,7 +12,112 @@ use crate::analysis::{
 use crate::eval::{Hierarchy, LayerStack, Layers};
 use crate::model::{InheritMode, Rig};
 
-/// Everything the result depends on.
+/// How far a piece of work has come, and whether it should stop (a newer one replaced it).
+#[derive(Clone, Default)]
+pub struct Progress {
+    done: Arc<AtomicUsize>,
+    total: Arc<AtomicUsize>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Progress {
+    pub fn report(&self, done: usize, total: usize) {
+        self.done.store(done, Ordering::Relaxed);
+        self.total.store(total, Ordering::Relaxed);
+    }
+
+    /// Set when the work is no longer wanted.
+    pub fn cancelled(&self) -> &AtomicBool {
+        &self.cancel
+    }
+}
+
+struct Running<K, T> {
+    key: K,
+    progress: Progress,
+    result: Receiver<Option<T>>,
+}
+
+/// The latest finished result of a piece of work keyed by `K`, and the one being computed, if any.
+pub struct Job<K, T> {
+    finished: Option<(K, Arc<T>)>,
+    running: Option<Running<K, T>>,
+}
+
+impl<K, T> Default for Job<K, T> {
+    fn default() -> Self {
+        Job { finished: None, running: None }
+    }
+}
+
+impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> {
+    /// Starts `work` on a thread when `key` differs from the finished or running one (a running one is cancelled);
+    /// collects a finished result. `on_done` is called from the worker when it finishes (to wake the UI). `work`
+    /// returns `None` when it was cancelled.
+    pub fn update(
+        &mut self,
+        key: K,
+        work: impl FnOnce(&Progress) -> Option<T> + Send + 'static,
+        on_done: impl Fn() + Send + 'static,
+    ) {
+        self.collect();
+        let current = self.running.as_ref().map(|r| &r.key).or(self.finished.as_ref().map(|(k, _)| k));
+        if current == Some(&key) {
+            return;
+        }
+        if let Some(old) = self.running.take() {
+            old.progress.cancel.store(true, Ordering::Relaxed);
+        }
+        let (sender, result) = channel();
+        let progress = Progress::default();
+        let worker_progress = progress.clone();
+        std::thread::spawn(move || {
+            // The receiver may be gone (a newer job replaced this one): nothing to do then.
+            let _ = sender.send(work(&worker_progress));
+            on_done();
+        });
+        self.running = Some(Running { key, progress, result });
+    }
+
+    fn collect(&mut self) {
+        let Some(running) = &self.running else { return };
+        match running.result.try_recv() {
+            Ok(Some(result)) => {
+                let running = self.running.take().expect("checked above");
+                self.finished = Some((running.key, Arc::new(result)));
+            }
+            Ok(None) | Err(std::sync::mpsc::TryRecvError::Disconnected) => self.running = None,
+            Err(std::sync::mpsc::TryRecvError::Empty) => {}
+        }
+    }
+
+    /// The latest finished result (possibly for an older key while a new one runs).
+    pub fn latest(&self) -> Option<&(K, Arc<T>)> {
+        self.finished.as_ref()
+    }
+
+    /// The latest finished result if it is for `key`.
+    pub fn for_key(&self, key: &K) -> Option<&Arc<T>> {
+        self.finished.as_ref().filter(|(k, _)| k == key).map(|(_, result)| result)
+    }
+
+    /// `(done, total)` of the running work.
+    pub fn progress(&self) -> Option<(usize, usize)> {
+        let progress = &self.running.as_ref()?.progress;
+        Some((progress.done.load(Ordering::Relaxed), progress.total.load(Ordering::Relaxed)))
+    }
+
+    /// Waits for the running work (tests and headless renders want a settled state).
+    pub fn wait(&mut self) {
+        if let Some(running) = self.running.take()
+            && let Ok(Some(result)) = running.result.recv()
+        {
+            self.finished = Some((running.key, Arc::new(result)));
+        }
+    }
+}
+
+/// Everything a whole-clip analysis depends on.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JobKey {
     /// Changes whenever a (re)loaded rig replaces the document's.
@@ -28,103 +133,31 @@ pub struct JobKey {
     pub judged: Judged,
 }
 
-struct Running {
-    key: JobKey,
-    done: Arc<AtomicUsize>,
-    total: Arc<AtomicUsize>,
-    cancel: Arc<AtomicBool>,
-    result: Receiver<Option<ClipAnalysis>>,
-}
+/// The whole-clip analysis of the document.
+pub type AnalysisJob = Job<JobKey, ClipAnalysis>;
 
-/// The latest finished analysis and the one being computed, if any.
-#[derive(Default)]
-pub struct AnalysisJob {
-    finished: Option<(JobKey, Arc<ClipAnalysis>)>,
-    running: Option<Running>,
-}
-
-impl AnalysisJob {
-    /// Starts a new analysis when `key` differs from the finished or running one; collects a finished result.
-    /// `on_done` is called from the worker when it finishes (to wake the UI).
-    pub fn update(&mut self, key: JobKey, rig: &Arc<Rig>, on_done: impl Fn() + Send + 'static) {
-        self.collect();
-        let current = self.running.as_ref().map(|r| &r.key).or(self.finished.as_ref().map(|(k, _)| k));
-        if current == Some(&key) {
-            return;
-        }
-        if let Some(old) = self.running.take() {
-            old.cancel.store(true, Ordering::Relaxed);
-        }
-        self.running = Some(spawn(key, rig.clone(), on_done));
-    }
-
-    fn collect(&mut self) {
-        let Some(running) = &self.running else { return };
-        match running.result.try_recv() {
-            Ok(Some(analysis)) => {
-                let running = self.running.take().expect("checked above");
-                self.finished = Some((running.key, Arc::new(analysis)));
-            }
-            Ok(None) | Err(std::sync::mpsc::TryRecvError::Disconnected) => self.running = None,
-            Err(std::sync::mpsc::TryRecvError::Empty) => {}
-        }
-    }
-
-    /// The latest finished analysis (possibly for an older key while a new one runs).
-    pub fn latest(&self) -> Option<&(JobKey, Arc<ClipAnalysis>)> {
-        self.finished.as_ref()
-    }
-
-    /// `(done, total)` samples of the running analysis.
-    pub fn progress(&self) -> Option<(usize, usize)> {
-        self.running.as_ref().map(|r| (r.done.load(Ordering::Relaxed), r.total.load(Ordering::Relaxed)))
-    }
-
-    /// Waits for the running analysis (tests and headless renders want a settled state).
-    pub fn wait(&mut self) {
-        if let Some(running) = self.running.take()
-            && let Ok(Some(analysis)) = running.result.recv()
-        {
-            self.finished = Some((running.key, Arc::new(analysis)));
-        }
-    }
-}
-
-fn spawn(key: JobKey, rig: Arc<Rig>, on_done: impl Fn() + Send + 'static) -> Running {
-    let (sender, result) = channel();
-    let done = Arc::new(AtomicUsize::new(0));
-    let total = Arc::new(AtomicUsize::new(0));
-    let cancel = Arc::new(AtomicBool::new(false));
-    let (job_key, job_done, job_total, job_cancel) = (key.clone(), done.clone(), total.clone(), cancel.clone());
-    std::thread::spawn(move || {
-        let hierarchy = Hierarchy::new(&rig.skeleton, &job_key.modes);
-        // `(modes, unlayered)`.
-        let ghost_modes = job_key.ghost.map(|ghost| {
-            let (modes, layered) = ghost.evaluation(&job_key.modes, &rig.skeleton);
-            (modes, !layered)
-        });
+/// The analysis `key` asks of `rig`, as work for a [`Job`].
+pub fn analysis(key: JobKey, rig: Arc<Rig>) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
+    move |progress| {
+        let hierarchy = Hierarchy::new(&rig.skeleton, &key.modes);
+        // `(modes, unlayered)`; a compared file's ghost is another file's evaluation, not the analysis's.
+        let ghost_modes = key.ghost.and_then(|ghost| ghost.evaluation(&key.modes, &rig.skeleton));
+        let ghost_modes = ghost_modes.map(|(modes, layered)| (modes, !layered));
         let ghost_hierarchy = ghost_modes.as_ref().map(|(modes, _)| Hierarchy::new(&rig.skeleton, modes));
         let ghost = ghost_hierarchy
             .as_ref()
             .zip(ghost_modes.as_ref())
             .map(|(hierarchy, (_, unlayered))| GhostRequest { hierarchy, unlayered: *unlayered });
-        let clip = job_key.clip.and_then(|c| rig.clips.get(c));
-        let options = ScanOptions { rate: job_key.rate, tolerances: job_key.tolerances };
-        let request = CurveRequest { bones: &job_key.plotted, ghost, judged: job_key.judged };
-        let progress = |d: usize, t: usize| {
-            job_done.store(d, Ordering::Relaxed);
-            job_total.store(t, Ordering::Relaxed);
-        };
+        let clip = key.clip.and_then(|c| rig.clips.get(c));
+        let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
+        let request = CurveRequest { bones: &key.plotted, ghost, judged: key.judged };
+        let report = |done: usize, total: usize| progress.report(done, total);
         // The document checked the layers against this rig; without layers the plain analysis is the same.
-        let stack = LayerStack::new(&rig, &job_key.layers).ok().filter(|_| !job_key.layers.is_empty());
+        let stack = LayerStack::new(&rig, &key.layers).ok().filter(|_| !key.layers.is_empty());
         let subject = match &stack {
             Some(layers) => Subject::layered(Layered { rig: &rig, layers }, clip),
             None => Subject::clip(&rig.skeleton, clip),
         };
-        let analysis = analyze(subject, &hierarchy, request, &options, &progress, &job_cancel);
-        // The receiver may be gone (a newer job replaced this one): nothing to do then.
-        let _ = sender.send(analysis);
-        on_done();
-    });
-    Running { key, done, total, cancel, result }
+        analyze(subject, &hierarchy, request, &options, &report, progress.cancelled())
+    }
 }

@@ -4,6 +4,7 @@
 //! the viewport in the middle. Loading never replaces the document unless it succeeded; errors become
 //! notifications.
 
+mod compare;
 mod document;
 mod file_browser;
 mod inspector;
@@ -23,6 +24,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
+pub use compare::Compared;
 pub use document::{Document, Ghost, ModeChoice, ModeScope};
 pub use file_browser::NativeDialog;
 pub use plots::plot_id;
@@ -31,6 +33,7 @@ pub use settings::{RotationFormat, Settings, TimeUnit};
 use crate::analysis::{ClipAnalysis, Judged, Tolerances};
 use crate::eval::{Pose, SkinningMethod};
 use crate::view::Layer;
+use compare::{CompareJobs, CompareKey, ComparedCurves, CurvesKey, Differences};
 use file_browser::{DialogOutcome, FileBrowser};
 use job::{AnalysisJob, JobKey};
 use notifications::Notifications;
@@ -50,10 +53,15 @@ impl Frame {
         let rig = &doc.rig;
         let pose = doc.evaluate(&doc.modes, time, true);
         let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
-        let ghost = doc.ghost_evaluation().map(|(modes, layered)| {
-            let ghost = doc.evaluate(&modes, time, layered);
-            Layer::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
-        });
+        let ghost = match (doc.ghost, &doc.compared) {
+            (Some(Ghost::Compared), Some(compared)) => {
+                Some(compared.ghost(doc.clip(), &primary, time, skinning, tolerances))
+            }
+            _ => doc.ghost_evaluation().map(|(modes, layered)| {
+                let ghost = doc.evaluate(&modes, time, layered);
+                Layer::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
+            }),
+        };
         Frame { pose, primary, ghost }
     }
 }
@@ -75,6 +83,10 @@ pub struct Shared<'a> {
     pub stretched: &'a [(f64, f64)],
     /// `(done, total)` samples while the whole-clip analysis runs.
     pub progress: Option<(usize, usize)>,
+    /// Each bone's largest difference from the compared file over the clip, once computed.
+    pub differences: Option<&'a Arc<Differences>>,
+    /// The compared file's curves of the plotted bones, once computed.
+    pub compared_curves: Option<&'a Arc<ComparedCurves>>,
 }
 
 impl Shared<'_> {
@@ -126,6 +138,13 @@ impl SpanCache {
     }
 }
 
+/// What a chosen file is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Purpose {
+    Open,
+    Compare,
+}
+
 /// The bonescope app.
 pub struct BonescopeApp {
     pub settings: Settings,
@@ -137,15 +156,20 @@ pub struct BonescopeApp {
     generation: u64,
     job: AnalysisJob,
     curves_job: AnalysisJob,
+    compare_jobs: CompareJobs,
+    /// Changes whenever a compared file is (re)loaded.
+    compared_generation: u64,
     notifications: Notifications,
     watcher: Option<watch::FileWatcher>,
+    compared_watcher: Option<watch::FileWatcher>,
     /// A file that failed to open, watched so that fixing it opens it.
     broken: Option<(PathBuf, watch::FileWatcher)>,
-    open_dialog: Option<Receiver<DialogOutcome>>,
+    /// The desktop's file dialog while it is open, and what its file is for.
+    open_dialog: Option<(Receiver<DialogOutcome>, Purpose)>,
     /// Whether File → Open… may use the desktop's dialog (detected at start; tests set it).
     pub native_dialog: NativeDialog,
-    /// bonescope's own file browser, when open.
-    browser: Option<FileBrowser>,
+    /// bonescope's own file browser, when open, and what its file is for.
+    browser: Option<(FileBrowser, Purpose)>,
     /// For waking the UI from background threads (the file watcher).
     repaint: Option<egui::Context>,
     outliner: outliner::Outliner,
@@ -168,8 +192,11 @@ impl BonescopeApp {
             generation: 0,
             job: AnalysisJob::default(),
             curves_job: AnalysisJob::default(),
+            compare_jobs: CompareJobs::default(),
+            compared_generation: 0,
             notifications: Notifications::default(),
             watcher: None,
+            compared_watcher: None,
             broken: None,
             open_dialog: None,
             native_dialog: NativeDialog::detect(),
@@ -214,15 +241,58 @@ impl BonescopeApp {
             }
             Err(error) => {
                 self.notifications.error_about(&topic, error.to_string());
-                let ctx = self.repaint.clone();
-                let watcher = watch::FileWatcher::new(path, move |after| {
-                    if let Some(ctx) = &ctx {
-                        ctx.request_repaint_after(after);
-                    }
-                });
-                self.broken = watcher.map(|w| (path.to_owned(), w));
+                self.broken = self.watch(path).map(|w| (path.to_owned(), w));
             }
         }
+    }
+
+    /// Compares the document with the file at `path`, shown as the ghost; on failure the document and any earlier
+    /// comparison stay, and the error becomes a notification.
+    pub fn compare(&mut self, path: &Path) {
+        let topic = path.display().to_string();
+        match Compared::load(path, &self.doc.rig) {
+            Ok(compared) => {
+                self.notifications.resolved(&topic);
+                let unpaired = compared.unpaired();
+                let mut message = format!("comparing with {}", path.display());
+                if unpaired > 0 {
+                    message.push_str(&format!(" ({unpaired} bones have no partner of the same name there)"));
+                }
+                self.doc.compare_with(compared);
+                self.compared_replaced();
+                self.notifications.info(message);
+            }
+            Err(error) => self.notifications.error_about(&topic, format!("not compared: {error}")),
+        }
+    }
+
+    /// Re-reads the compared file after it changed on disk.
+    fn reload_compared(&mut self) {
+        let Some(path) = self.doc.compared.as_ref().map(|c| c.path.clone()) else { return };
+        match Compared::load(&path, &self.doc.rig) {
+            Ok(compared) => {
+                self.doc.compared = Some(Arc::new(compared));
+                self.compared_replaced();
+                self.notifications.resolved(&path.display().to_string());
+                self.notifications.info(format!("reloaded {}", path.display()));
+            }
+            Err(error) => self.notifications.error_about(&path.display().to_string(), format!("not reloaded: {error}")),
+        }
+    }
+
+    fn compared_replaced(&mut self) {
+        self.compared_generation += 1;
+        self.compared_watcher = self.doc.compared.as_ref().and_then(|c| self.watch(&c.path));
+    }
+
+    /// A watcher of `path` that wakes the UI when it changes.
+    fn watch(&self, path: &Path) -> Option<watch::FileWatcher> {
+        let ctx = self.repaint.clone();
+        watch::FileWatcher::new(path, move |after| {
+            if let Some(ctx) = &ctx {
+                ctx.request_repaint_after(after);
+            }
+        })
     }
 
     pub fn open_demo(&mut self) {
@@ -253,14 +323,10 @@ impl BonescopeApp {
 
     fn document_replaced(&mut self, frame_camera: bool) {
         self.generation += 1;
-        self.watcher = self.doc.path.as_deref().and_then(|path| {
-            let ctx = self.repaint.clone();
-            watch::FileWatcher::new(path, move |after| {
-                if let Some(ctx) = &ctx {
-                    ctx.request_repaint_after(after);
-                }
-            })
-        });
+        self.watcher = self.doc.path.as_deref().and_then(|path| self.watch(path));
+        if self.doc.compared.is_none() {
+            self.compared_watcher = None;
+        }
         if frame_camera {
             self.viewport.frame_all(&self.doc);
         }
@@ -296,13 +362,45 @@ impl BonescopeApp {
         })
     }
 
+    /// What the comparison with the compared file depends on, when there is one.
+    fn compare_key(&self) -> Option<CompareKey> {
+        self.doc.compared.as_ref()?;
+        let key = self.job_key();
+        Some(CompareKey {
+            generations: (self.generation, self.compared_generation),
+            clip: key.clip,
+            modes: key.modes,
+            layers: key.layers,
+            rate: key.rate,
+        })
+    }
+
+    /// What the compared file's curves depend on: the comparison, the plotted bones, and the times of the
+    /// document's own curves (the dashed curves share their axis).
+    fn compared_curves_key(&self) -> Option<CurvesKey> {
+        let curves = self.curves()?;
+        Some(CurvesKey { compare: self.compare_key()?, plotted: self.plotted(), times: curves.times.clone() })
+    }
+
     /// Starts the analyses the current state wants (each only when its key changed).
     fn request_analyses(&mut self, ctx: &egui::Context) {
+        let rig = &self.doc.rig;
         let waker = ctx.clone();
-        self.job.update(self.job_key(), &self.doc.rig, move || waker.request_repaint());
+        self.job.update(self.job_key(), job::analysis(self.job_key(), rig.clone()), move || waker.request_repaint());
         if let Some(key) = self.curves_key() {
             let waker = ctx.clone();
-            self.curves_job.update(key, &self.doc.rig, move || waker.request_repaint());
+            self.curves_job.update(key.clone(), job::analysis(key, rig.clone()), move || waker.request_repaint());
+        }
+        let Some(compared) = self.doc.compared.clone() else { return };
+        if let Some(key) = self.compare_key() {
+            let work = compare::differences(key.clone(), rig.clone(), self.doc.layer_stack().clone(), compared.clone());
+            let waker = ctx.clone();
+            self.compare_jobs.differences.update(key, work, move || waker.request_repaint());
+        }
+        if let Some(key) = self.compared_curves_key() {
+            let work = compare::curves(key.clone(), rig.clone(), compared);
+            let waker = ctx.clone();
+            self.compare_jobs.curves.update(key, work, move || waker.request_repaint());
         }
     }
 
@@ -325,18 +423,25 @@ impl BonescopeApp {
         self.request_analyses(ctx);
         self.job.wait();
         self.curves_job.wait();
+        self.compare_jobs.differences.wait();
+        // The compared curves wait for the document's.
+        self.request_analyses(ctx);
+        self.compare_jobs.curves.wait();
+    }
+
+    /// Each bone's largest difference from the compared file, if computed for the current state.
+    pub fn differences(&self) -> Option<&Differences> {
+        self.compare_jobs.differences.for_key(&self.compare_key()?).map(Arc::as_ref)
     }
 
     /// The latest whole-clip analysis, if it matches the current state.
     pub fn analysis(&self) -> Option<&ClipAnalysis> {
-        let key = self.job_key();
-        self.job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
+        self.job.for_key(&self.job_key()).map(Arc::as_ref)
     }
 
     /// The latest curves of the plotted bones, if they match the current state.
     pub fn curves(&self) -> Option<&ClipAnalysis> {
-        let key = self.curves_key()?;
-        self.curves_job.latest().filter(|(k, _)| *k == key).map(|(_, a)| a.as_ref())
+        self.curves_job.for_key(&self.curves_key()?).map(Arc::as_ref)
     }
 
     /// The errors shown, with how many times each was said.
@@ -354,6 +459,9 @@ impl BonescopeApp {
         let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.settings.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
         let curves = self.curves_job.latest().map(|(_, a)| a.clone());
+        let comparing = self.doc.compared.is_some();
+        let differences = self.compare_jobs.differences.latest().filter(|_| comparing).map(|(_, d)| d.clone());
+        let compared_curves = self.compare_jobs.curves.latest().filter(|_| comparing).map(|(_, c)| c.clone());
         let progress = self.job.progress();
         let stretched = self.spans.get(latest.as_ref(), self.selection.last().copied());
         let mut actions = toolbar::Actions::default();
@@ -369,6 +477,8 @@ impl BonescopeApp {
                 curves: curves.as_ref(),
                 stretched,
                 progress,
+                differences: differences.as_ref(),
+                compared_curves: compared_curves.as_ref(),
             };
             if self.chrome == Chrome::ViewportOnly {
                 egui::CentralPanel::default()
@@ -399,14 +509,14 @@ impl BonescopeApp {
             }
         }
         self.notifications.ui(&ctx);
-        if let Some(browser) = &mut self.browser {
+        if let Some((browser, purpose)) = &mut self.browser {
             let mut open = true;
-            let chosen = browser.ui(&ctx, &mut open);
+            let chosen = browser.ui(&ctx, &mut open).map(|path| (path, *purpose));
             if !open {
                 self.browser = None;
             }
-            if let Some(path) = chosen {
-                self.open(&path);
+            if let Some((path, purpose)) = chosen {
+                self.chosen(&path, purpose);
             }
         }
         self.apply(actions, &ctx);
@@ -414,10 +524,14 @@ impl BonescopeApp {
 
     fn apply(&mut self, actions: toolbar::Actions, ctx: &egui::Context) {
         if actions.open_dialog {
-            match self.native_dialog {
-                NativeDialog::Available => self.open_dialog = Some(spawn_open_dialog(ctx.clone())),
-                NativeDialog::Unavailable => self.open_browser(),
-            }
+            self.choose_file(Purpose::Open, ctx);
+        }
+        if actions.compare_dialog {
+            self.choose_file(Purpose::Compare, ctx);
+        }
+        if actions.stop_comparing {
+            self.doc.stop_comparing();
+            self.compared_watcher = None;
         }
         if let Some(path) = actions.open {
             self.open(&path);
@@ -433,32 +547,56 @@ impl BonescopeApp {
         }
     }
 
+    /// Asks for a file (the desktop's dialog where there is one, else bonescope's own browser) for `purpose`.
+    fn choose_file(&mut self, purpose: Purpose, ctx: &egui::Context) {
+        match self.native_dialog {
+            NativeDialog::Available => self.open_dialog = Some((spawn_open_dialog(ctx.clone()), purpose)),
+            NativeDialog::Unavailable => self.open_browser(purpose),
+        }
+    }
+
+    /// Does with a chosen file what it was chosen for.
+    fn chosen(&mut self, path: &Path, purpose: Purpose) {
+        match purpose {
+            Purpose::Open => self.open(path),
+            Purpose::Compare => self.compare(path),
+        }
+    }
+
     /// Shows bonescope's own file browser (the desktop has no dialog), in the open file's folder or the most
     /// recent one's.
-    pub fn open_browser(&mut self) {
+    fn open_browser(&mut self, purpose: Purpose) {
         self.notifications.info("no desktop file dialog here (no XDG portal): using bonescope's own".to_owned());
         let recent = self.doc.path.as_ref().or(self.settings.recent.first());
         let folder = recent.and_then(|p| p.parent()).filter(|p| p.is_dir()).map(Path::to_owned);
         let folder = folder.or_else(|| std::env::current_dir().ok()).unwrap_or_else(|| PathBuf::from("."));
-        self.browser = Some(FileBrowser::new(&folder));
+        let title = match purpose {
+            Purpose::Open => "Open a file",
+            Purpose::Compare => "Compare with a file",
+        };
+        self.browser = Some((FileBrowser::new(title, &folder), purpose));
     }
 
     fn poll_background(&mut self, ctx: &egui::Context) {
-        if let Some(dialog) = &self.open_dialog
+        if let Some((dialog, purpose)) = &self.open_dialog
             && let Ok(outcome) = dialog.try_recv()
         {
+            let purpose = *purpose;
             self.open_dialog = None;
             match outcome {
-                DialogOutcome::Chosen(path) => self.open(&path),
+                DialogOutcome::Chosen(path) => self.chosen(&path, purpose),
                 DialogOutcome::Cancelled => {}
                 DialogOutcome::Failed => {
                     self.native_dialog = NativeDialog::Unavailable;
-                    self.open_browser();
+                    self.open_browser(purpose);
                 }
             }
         }
         if self.watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
             self.reload();
+        }
+        if self.compared_watcher.as_ref().is_some_and(watch::FileWatcher::changed) {
+            self.reload_compared();
         }
         if let Some((path, watcher)) = &self.broken
             && watcher.changed()
@@ -471,7 +609,9 @@ impl BonescopeApp {
             return;
         }
         self.request_analyses(ctx);
-        if self.job.progress().is_some() || self.curves_job.progress().is_some() {
+        let compare_running =
+            self.compare_jobs.differences.progress().is_some() || self.compare_jobs.curves.progress().is_some();
+        if self.job.progress().is_some() || self.curves_job.progress().is_some() || compare_running {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
     }

@@ -7,7 +7,7 @@ use egui::{RichText, Sense, vec2};
 
 use super::{ModeChoice, ModeScope, Shared};
 use crate::analysis::Findings;
-use crate::view::Badge;
+use crate::view::{Badge, Palette};
 
 #[derive(Default)]
 pub struct Outliner {
@@ -115,6 +115,7 @@ impl Outliner {
                 shared.select(bone, false);
             }
             label.context_menu(|ui| mode_menu(ui, shared, bone));
+            difference_badge(ui, shared, bone);
             ui.label(RichText::new(shared.doc.modes[bone].id()).weak().small());
             if let Some(summary) = shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched()) {
                 let worst = egui::Label::new(
@@ -138,6 +139,33 @@ impl Outliner {
                 }
             }
         });
+    }
+}
+
+/// How far the compared file's partner of `bone` strays from it over the clip, when that is more than the threshold
+/// (a percentage of the rig's size); a bone without a partner says so.
+fn difference_badge(ui: &mut egui::Ui, shared: &Shared, bone: usize) {
+    let (Some(differences), Some(compared)) = (shared.differences, &shared.doc.compared) else { return };
+    let threshold = shared.settings.compare_threshold_percent;
+    match differences.bones.get(bone).copied().flatten() {
+        Some(fraction) if 100.0 * fraction > threshold => {
+            // The ghost's colour: the badge says where the ghost parts from the pose.
+            let color = Palette::new(shared.settings.dark).ghost.to_opaque();
+            let text = RichText::new(format!("Δ {:.2}%", 100.0 * fraction)).small().color(color);
+            ui.label(text).on_hover_text(format!(
+                "{} strays from its partner in {} by up to {:.3e} over the clip ({:.4} % of the rig's size; badged \
+                 above {threshold} %, View → Thresholds)",
+                shared.doc.rig.skeleton.bone(bone).name,
+                compared.title(),
+                fraction * differences.rig_size,
+                100.0 * fraction,
+            ));
+        }
+        Some(_) => {}
+        None => {
+            ui.label(RichText::new("unpaired").small().weak())
+                .on_hover_text(format!("no bone of this name in {}", compared.title()));
+        }
     }
 }
 

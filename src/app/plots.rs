@@ -9,7 +9,8 @@ use egui::{Color32, RichText, Ui};
 use egui_plot::{FilledArea, Line, Plot, PlotPoint, PlotPoints, VLine};
 use glam::{EulerRot, Quat};
 
-use super::{RotationFormat, Shared};
+use super::compare::ComparedCurves;
+use super::{Ghost, RotationFormat, Shared};
 use std::sync::Arc;
 
 use super::reduce::{Reduced, merge_spans, reduce};
@@ -159,12 +160,19 @@ struct SeriesKey {
     format: RotationFormat,
     model_space: bool,
     ghost: bool,
+    /// A compared file's curves, which stand for the ghost's when it is the ghost.
+    compared: Option<Arc<ComparedCurves>>,
 }
 
 impl PartialEq for SeriesKey {
-    /// The analysis by identity: comparing its contents would cost more than rebuilding the curves.
+    /// The analyses by identity: comparing their contents would cost more than rebuilding the curves.
     fn eq(&self, other: &Self) -> bool {
+        let same_compared = match (&self.compared, &other.compared) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (a, b) => a.is_none() && b.is_none(),
+        };
         Arc::ptr_eq(&self.analysis, &other.analysis)
+            && same_compared
             && (&self.bones, self.component, self.format, self.model_space, self.ghost)
                 == (&other.bones, other.component, other.format, other.model_space, other.ghost)
     }
@@ -227,6 +235,7 @@ impl Plots {
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
+            compared: shared.compared_curves.filter(|_| shared.doc.ghost == Some(Ghost::Compared)).cloned(),
         };
         if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
             let groups = Group::split(build_series(&key, &shared.doc.rig.skeleton));
@@ -370,7 +379,12 @@ fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Serie
         let Some(curves) = key.analysis.curves_of(bone) else { continue };
         let name = &skeleton.bone(bone).name;
         let primary = continuous(if key.model_space { &curves.model } else { &curves.local });
-        let ghost = if key.ghost { continuous(&curves.ghost_model) } else { Vec::new() };
+        let ghost = match &key.compared {
+            // Only a compared curve of the same samples lines up with the document's.
+            Some(compared) => compared.iter().find(|(b, _)| *b == bone).map(|(_, c)| c.as_slice()).unwrap_or(&[]),
+            None => &curves.ghost_model,
+        };
+        let ghost = if key.ghost && ghost.len() == primary.len() { continuous(ghost) } else { Vec::new() };
         for (c, (channel, read)) in channels.iter().enumerate() {
             let color = channel_color(slot * channels.len() + c);
             out.push(Series {
@@ -379,10 +393,10 @@ fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Serie
                 ghost: false,
                 values: primary.iter().map(read).collect(),
             });
-            if key.ghost {
+            if !ghost.is_empty() {
                 let values = ghost.iter().map(read).collect();
                 out.push(Series {
-                    name: format!("{name} {channel} (ghost)"),
+                    name: format!("{name} {channel} ({})", if key.compared.is_some() { "compared" } else { "ghost" }),
                     color: color.gamma_multiply(0.5),
                     ghost: true,
                     values,

@@ -83,6 +83,8 @@ pub struct Settings {
     pub show_inspector: bool,
     /// The Layers panel (runtime techniques on the clip).
     pub show_layers: bool,
+    /// Bones farther than this percentage of the rig's size from their partner in a compared file are badged.
+    pub compare_threshold_percent: f64,
 }
 
 impl Default for Settings {
@@ -101,6 +103,7 @@ impl Default for Settings {
             show_plots: true,
             show_inspector: true,
             show_layers: false,
+            compare_threshold_percent: 0.01,
         }
     }
 }

@@ -13,6 +13,9 @@ use crate::model::InheritMode;
 #[derive(Default)]
 pub struct Actions {
     pub open_dialog: bool,
+    /// File → Compare with…
+    pub compare_dialog: bool,
+    pub stop_comparing: bool,
     pub open: Option<PathBuf>,
     pub open_demo: bool,
     pub frame_all: bool,
@@ -60,13 +63,23 @@ fn file_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         }
     });
     ui.separator();
+    let hint = "load a second file (an export, a bake) as the ghost: bones paired by name, its curves dashed";
+    if ui.button("Compare with…").on_hover_text(hint).clicked() {
+        actions.compare_dialog = true;
+    }
+    if let Some(compared) = &shared.doc.compared
+        && ui.button(format!("Stop comparing with {}", compared.title())).clicked()
+    {
+        actions.stop_comparing = true;
+    }
+    ui.separator();
     if ui.button("Quit").clicked() {
         ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
     }
 }
 
-/// The verdicts' thresholds (persisted with the settings; README, "What the verdicts mean").
-fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances) {
+/// The verdicts' thresholds (persisted with the settings; README, "What the verdicts mean"), and the compared file's.
+fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances, compare_percent: &mut f64) {
     egui::Grid::new("thresholds").num_columns(2).show(ui, |ui| {
         let rows = [
             (
@@ -91,7 +104,14 @@ fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances) {
                 "°",
             ),
         ];
-        for (name, hint, value, max, suffix) in rows {
+        let compared = (
+            "compared file",
+            "badge bones farther than this from their partner in a compared file, in % of the rig's size",
+            &mut *compare_percent,
+            100.0,
+            " %",
+        );
+        for (name, hint, value, max, suffix) in rows.into_iter().chain([compared]) {
             ui.label(name).on_hover_text(hint);
             let field = egui::DragValue::new(value).range(0.0..=max).speed(max * 1e-5).max_decimals(6).suffix(suffix);
             let field = ui.add(field).on_hover_text(hint);
@@ -101,6 +121,7 @@ fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances) {
     });
     if ui.button("Defaults").clicked() {
         *tolerances = Tolerances::default();
+        *compare_percent = crate::app::Settings::default().compare_threshold_percent;
     }
 }
 
@@ -114,7 +135,7 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         egui::containers::menu::MenuConfig::new().close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside);
     egui::containers::menu::SubMenuButton::new("Thresholds")
         .config(config)
-        .ui(ui, |ui| thresholds(ui, &mut shared.settings.tolerances));
+        .ui(ui, |ui| thresholds(ui, &mut shared.settings.tolerances, &mut shared.settings.compare_threshold_percent));
     if ui.button("Frame all").clicked() {
         actions.frame_all = true;
     }
@@ -194,6 +215,10 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .width(170.0)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
+            if let Some(compared) = &shared.doc.compared {
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Compared), Ghost::Compared.label())
+                    .on_hover_text(format!("{}, bones paired by name", compared.path.display()));
+            }
             if !shared.doc.layers().is_empty() {
                 ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
                     .on_hover_text("the clip as authored, without the layers");

@@ -6,7 +6,7 @@
 use egui::{Sense, Ui};
 use glam::DVec2;
 
-use super::{Document, Shared};
+use super::{Document, Ghost, Shared};
 use crate::eval::bind_model_matrices;
 use crate::view::{Bounds, Camera, Layer, Palette, Scene, ViewKind, motion_bounds, paint};
 
@@ -55,7 +55,10 @@ impl Viewport {
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
         scene.ghost = shared.frame.ghost.clone();
-        scene.ghost_label = shared.doc.ghost.map_or_else(String::new, |g| format!("ghost: {}", g.label()));
+        scene.ghost_label = match (shared.doc.ghost, &shared.doc.compared) {
+            (Some(Ghost::Compared), Some(compared)) => format!("ghost: {}", compared.title()),
+            (ghost, _) => ghost.map_or_else(String::new, |g| format!("ghost: {}", g.label())),
+        };
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
 use super::layers::LayerArgs;
-use crate::app::{BonescopeApp, Chrome, Document, Ghost, Settings};
+use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Settings};
 use crate::eval::SkinningMethod;
 use crate::import;
 use crate::render::{Background, Difference, Renderer, compare};
@@ -42,6 +42,10 @@ pub struct RenderArgs {
     /// `unlayered` (the clip without the layers); `none`: no ghost (the demo rig has one).
     #[arg(long, value_name = "MODE|declared|unlayered|none", value_parser = parse_ghost)]
     pub ghost: Option<GhostArg>,
+    /// Compare with a second file (an export, a bake): its pose is the ghost, its bones paired with this file's by
+    /// name, as `bonescope diff` pairs them (`--ghost` then picks another ghost instead).
+    #[arg(long, value_name = "FILE")]
+    pub compare: Option<PathBuf>,
     /// Select a bone by name (repeatable): highlighted in the viewport, plotted and inspected with --ui.
     #[arg(long, value_name = "NAME")]
     pub select: Vec<String>,
@@ -237,6 +241,9 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
     doc.clip = args.eval.clip(&rig)?.map(|c| c.index);
     doc.modes = args.eval.modes(&rig)?;
     doc.set_layers(&args.layers.layers(&rig)?)?;
+    if let Some(path) = &args.compare {
+        doc.compare_with(Compared::load(path, &doc.rig)?);
+    }
     if let Some(GhostArg(ghost)) = args.ghost {
         doc.ghost = ghost;
     }

@@ -25,6 +25,7 @@ pub use side::{Side, comparison_times, rig_size};
 use glam::{DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 
+use crate::analysis::Components;
 use crate::eval::{LayerStack, Pose};
 use crate::math::{AffineParts, decompose_all};
 
@@ -292,6 +293,29 @@ impl Worker {
             b.skin(&self.pose_b, j, &mut self.skinned_b[k]);
         }
     }
+}
+
+/// The model-space components of `bones` of `side` at `times`, one curve per bone: a second file's curves beside the
+/// first's (the app plots a compared file dashed).
+pub fn model_curves(side: &Side, bones: &[usize], times: &[f64]) -> Vec<Vec<Components>> {
+    let chunks: Vec<Vec<Vec<Components>>> = times
+        .par_chunks(256)
+        .map(|chunk| {
+            let (mut pose, mut layers) = (Pose::default(), side.layers.clone());
+            let mut starts = vec![DQuat::IDENTITY; bones.len()];
+            let mut curves = vec![Vec::with_capacity(chunk.len()); bones.len()];
+            for &time in chunk {
+                side.evaluate(&mut pose, &mut layers, time);
+                for ((curve, start), &bone) in curves.iter_mut().zip(&mut starts).zip(bones) {
+                    let components = Components::of_matrix(&pose.model.model[bone], *start);
+                    *start = components.stretch.as_dquat();
+                    curve.push(components);
+                }
+            }
+            curves
+        })
+        .collect();
+    (0..bones.len()).map(|b| chunks.iter().flat_map(|chunk| chunk[b].iter().copied()).collect()).collect()
 }
 
 /// The largest distance between where `wa` and `wb` put the origin and the points `probe_length` along each of

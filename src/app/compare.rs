@@ -1,0 +1,211 @@
+//! A second file compared with the document (File → Compare with…), as `bonescope diff` compares two files: its
+//! bones and meshes paired with the document's by name, its pose drawn as the ghost over the document's, its curves
+//! plotted dashed beside the document's, and each bone's largest difference over the clip, which the outliner badges
+//! above a threshold. The file is watched and reloaded like the document.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::job::{Job, Progress};
+use crate::analysis::{Assessment, Components, Tolerances};
+use crate::diff::{Pairs, Side, compare, comparison_times, match_bones, match_meshes, model_curves};
+use crate::eval::{LayerStack, Layers, Pose, SkinningMethod};
+use crate::import::{self, ImportError};
+use crate::model::{Clip, InheritMode, Rig};
+use crate::view::Layer;
+
+/// The compared file and how its bones and meshes stand for the document's.
+#[derive(Debug)]
+pub struct Compared {
+    pub path: PathBuf,
+    pub rig: Rig,
+    /// Per bone of the document: its partner here.
+    pub bones: Vec<Option<usize>>,
+    /// Per mesh of the document: its partner here (same name and vertex count).
+    pub meshes: Vec<Option<usize>>,
+}
+
+impl Compared {
+    /// Reads `path` and pairs it with the document's rig.
+    pub fn load(path: &Path, document: &Rig) -> Result<Self, ImportError> {
+        Ok(Compared::pair(path.to_owned(), import::load(path)?, document))
+    }
+
+    /// `rig` (read from `path`) paired with the document's rig.
+    pub fn pair(path: PathBuf, rig: Rig, document: &Rig) -> Self {
+        let mut bones = vec![None; document.skeleton.len()];
+        // Explicit pairs are `bonescope diff --map`'s; the app pairs by name alone, so this cannot fail.
+        for (a, b) in match_bones(&document.skeleton, &rig.skeleton, &[]).map(|m| m.pairs).unwrap_or_default() {
+            bones[a] = Some(b);
+        }
+        let mut meshes = vec![None; document.meshes.len()];
+        for (a, b) in match_meshes(&document.meshes, &rig.meshes) {
+            meshes[a] = Some(b);
+        }
+        Compared { path, rig, bones, meshes }
+    }
+
+    /// The same file paired with another document rig (the document was reloaded).
+    pub fn repaired(&self, document: &Rig) -> Self {
+        Compared::pair(self.path.clone(), self.rig.clone(), document)
+    }
+
+    /// The file's name, for labels.
+    pub fn title(&self) -> String {
+        self.path.file_name().map_or_else(|| self.path.display().to_string(), |n| n.to_string_lossy().into_owned())
+    }
+
+    /// How many of the document's bones have no partner here.
+    pub fn unpaired(&self) -> usize {
+        self.bones.iter().filter(|b| b.is_none()).count()
+    }
+
+    /// The clip here that stands for the document's: the one with its label, else the first.
+    pub fn clip_for(&self, clip: Option<&Clip>) -> Option<&Clip> {
+        let label = clip.map(Clip::label);
+        self.rig.clips.iter().find(|c| Some(c.label()) == label).or(self.rig.clips.first())
+    }
+
+    /// This file evaluated as it declares, for the document's clip.
+    pub fn side(&self, clip: Option<&Clip>) -> Side<'_> {
+        Side::new(&self.rig, self.clip_for(clip), &self.rig.skeleton.declared_modes())
+    }
+
+    /// The ghost at `time`: this file's pose on the document's bones (a bone without a partner stays where the
+    /// document puts it, under its pose), the paired meshes skinned (the others not drawn).
+    pub fn ghost(
+        &self,
+        clip: Option<&Clip>,
+        primary: &Layer,
+        time: f64,
+        skinning: SkinningMethod,
+        tolerances: &Tolerances,
+    ) -> Layer {
+        let mut side = self.side(clip);
+        side.skinning = skinning;
+        let mut pose = Pose::default();
+        side.evaluate(&mut pose, &mut None, time);
+        let model: Vec<_> =
+            self.bones.iter().zip(&primary.model).map(|(b, own)| b.map_or(*own, |b| pose.model.model[b])).collect();
+        let assessments = Assessment::all(&model, tolerances);
+        let meshes = self
+            .meshes
+            .iter()
+            .map(|m| {
+                let mut positions = Vec::new();
+                if let Some(m) = m {
+                    side.skin(&pose, *m, &mut positions);
+                }
+                positions
+            })
+            .collect();
+        Layer {
+            model,
+            findings: assessments.iter().map(|a| a.findings).collect(),
+            shear_deg: assessments.iter().map(|a| a.shear_deg).collect(),
+            meshes,
+        }
+    }
+}
+
+/// What the comparison over the clip depends on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompareKey {
+    /// The document's and the compared file's loads.
+    pub generations: (u64, u64),
+    pub clip: Option<usize>,
+    pub modes: Vec<InheritMode>,
+    pub layers: Layers,
+    pub rate: f64,
+}
+
+/// Each document bone's largest difference from the compared file over the clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Differences {
+    /// Per document bone: the largest distance of its origin and axis probes, as a fraction of the rig's size
+    /// (`None` without a partner).
+    pub bones: Vec<Option<f64>>,
+    pub rig_size: f64,
+}
+
+/// What the compared curves depend on: the comparison's, the plotted bones, and the times of the document's curves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvesKey {
+    pub compare: CompareKey,
+    pub plotted: Vec<usize>,
+    pub times: Vec<f64>,
+}
+
+/// `(document bone, its partner's model-space components at the curves' times)` for the plotted bones that have one.
+pub type ComparedCurves = Vec<(usize, Vec<Components>)>;
+
+/// The background work of a comparison.
+#[derive(Default)]
+pub struct CompareJobs {
+    pub differences: Job<CompareKey, Differences>,
+    pub curves: Job<CurvesKey, ComparedCurves>,
+}
+
+/// The differences `key` asks for, as work for a [`Job`]: the document (`rig`, through `layers`) against `compared`.
+pub fn differences(
+    key: CompareKey,
+    rig: Arc<Rig>,
+    layers: LayerStack,
+    compared: Arc<Compared>,
+) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
+    move |_| {
+        let clip = key.clip.and_then(|c| rig.clips.get(c));
+        let own = Side::new(&rig, clip, &key.modes);
+        let own = if key.layers.is_empty() { own } else { own.with_layers(layers) };
+        let other = compared.side(clip);
+        let pairs = Pairs::of(&own, &other, &[]).ok()?;
+        let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.rate));
+        let mut bones = vec![None; rig.skeleton.len()];
+        for difference in &comparison.bones {
+            bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
+        }
+        Some(Differences { bones, rig_size: comparison.rig_size })
+    }
+}
+
+/// The compared curves `key` asks for, as work for a [`Job`].
+pub fn curves(
+    key: CurvesKey,
+    rig: Arc<Rig>,
+    compared: Arc<Compared>,
+) -> impl FnOnce(&Progress) -> Option<ComparedCurves> + Send + 'static {
+    move |_| {
+        let clip = key.compare.clip.and_then(|c| rig.clips.get(c));
+        let paired: Vec<(usize, usize)> =
+            key.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
+        let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
+        let curves = model_curves(&compared.side(clip), &partners, &key.times);
+        Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_compared_with_itself_pairs_everything_and_ghosts_its_pose() {
+        let rig = import::demo_rig();
+        let compared = Compared::pair(PathBuf::from("demo.glb"), rig.clone(), &rig);
+        assert_eq!(compared.unpaired(), 0);
+        assert!(compared.meshes.iter().all(Option::is_some));
+        let doc = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
+        let mut pose = Pose::default();
+        doc.evaluate(&mut pose, &mut None, 0.5);
+        let primary = Layer::from_model(
+            &rig,
+            pose.model.model.clone(),
+            &pose.morph,
+            SkinningMethod::AsFile,
+            &Tolerances::default(),
+        );
+        let ghost = compared.ghost(rig.clips.first(), &primary, 0.5, SkinningMethod::AsFile, &Tolerances::default());
+        assert_eq!(ghost.model, primary.model);
+        assert_eq!(ghost.meshes, primary.meshes);
+    }
+}
