@@ -44,13 +44,22 @@ pub fn bake_times(side: &Side) -> BakeTimes {
     }
     keys.extend(steps.iter().map(|t| (t - STEP_LEAD).max(0.0)));
     keys.extend(inside);
-    let mut times = sample_times(keys, 0.0, side.duration(), rate, MAX_FRAMES).times;
+    let mut times = sample_times(keys, 0.0, end(side), rate, MAX_FRAMES).times;
     times.iter_mut().chain(&mut steps).for_each(|t| *t = in_single_precision(*t));
     times.dedup();
     steps.sort_by(f64::total_cmp);
     steps.dedup();
     steps.retain(|s| times.binary_search_by(|t| t.total_cmp(s)).is_ok());
     BakeTimes { times, steps }
+}
+
+/// Where sampling ends: the duration, or for a synced blend's cycle, which wraps to its start at its length, the
+/// last `f32` time before it (a player looping the baked clip wraps there too).
+fn end(side: &Side) -> f64 {
+    let duration = side.duration();
+    let wraps = side.layers.as_ref().is_some_and(|layers| layers.synced_cycle(side.rig, side.clip).is_some());
+    let just_before = f32::from_bits((duration as f32).to_bits().saturating_sub(1));
+    if wraps && duration > 0.0 { f64::from(just_before) } else { duration }
 }
 
 /// `time` rounded to the nearest `f32`: glTF stores key times in single precision, so a sample taken at exactly such

@@ -25,14 +25,9 @@ impl SyncedCycle {
         SyncedCycle { length, rates, durations }
     }
 
-    /// Where `time` (seconds of the blended cycle) falls in the cycle, in `[0, 1]`: the cycle repeats, and a time
-    /// at the end of a cycle is its end (1), as a clip's duration is its last key, not the next cycle's start.
+    /// Where `time` (seconds of the blended cycle) falls in the cycle, in `[0, 1)`: the cycle repeats.
     pub fn phase(&self, time: f64) -> f64 {
-        if !(self.length > 0.0 && time.is_finite()) {
-            return 0.0;
-        }
-        let within = time.rem_euclid(self.length);
-        if within == 0.0 && time > 0.0 { 1.0 } else { within / self.length }
+        if self.length > 0.0 && time.is_finite() { time.rem_euclid(self.length) / self.length } else { 0.0 }
     }
 
     /// The time of each clip at blended time `time`: the same phase of both, i.e. `rate · time` within a cycle.
@@ -61,8 +56,6 @@ mod tests {
         assert!((walk - cycle.rates[0] * 0.55).abs() < 1e-15);
         // The cycle repeats: 1.1 + 0.55 s is the same phase, and so is −0.55 s.
         assert!((cycle.phase(1.65) - 0.5).abs() < 1e-12 && (cycle.phase(-0.55) - 0.5).abs() < 1e-12);
-        // A cycle's end is its end, not the next one's start.
-        assert_eq!((cycle.phase(0.0), cycle.phase(1.1), cycle.phase(2.2)), (0.0, 1.0, 1.0));
         // The ends of the factor: only walk (a = 0), only run (a = 1).
         assert_eq!(SyncedCycle::new(1.2, 0.8, 0.0).rates, [1.0, 0.8 / 1.2]);
         assert_eq!(SyncedCycle::new(1.2, 0.8, 1.0).length, 0.8);
