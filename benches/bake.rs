@@ -1,0 +1,72 @@
+//! `bake` and `diff`, beside loading the same rig: ProAnimationBank's `locomotions.fbx` (three takes, 76 nodes) and
+//! a generated rig of 200 bones and 6,000 frames (`import::stress_rig`: a rotation key every frame on every bone, a
+//! scale key on every tenth), baked as the file declares and with every bone under segment scale compensate (its
+//! scaled bones' children then need helper nodes and densely sampled compensation).
+//!
+//! `cargo bench --locked --bench bake`; figures in BENCHMARKS.md (§8). `load` is `import::load` of the file (for
+//! the generated rig, of its exact bake, the same rig as a 6,000-frame glTF); `bake` the whole bake (sampling,
+//! keys, the GLB bytes), `report` the bake read back and compared at every sampled time (what `bonescope bake`
+//! prints), `diff` the source against the bake at its key times and 60 Hz (what `bonescope diff` does).
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use bonescope::bake::{self, Request, Strategy};
+use bonescope::diff::{Pairs, Side, compare, comparison_times};
+use bonescope::import;
+use bonescope::model::{InheritMode, Rig};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn request(rig: &Rig, mode: Option<InheritMode>) -> Request<'_> {
+    let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
+    Request {
+        rig,
+        modes,
+        clips: bake::every_clip(rig, None),
+        strategy: Strategy::Exact,
+        tolerance: bake::DEFAULT_TOLERANCE,
+    }
+}
+
+/// The source's first clip against the bake's, as `bonescope diff` compares them.
+fn diff(source: &Request, baked: &Rig) {
+    let a = source.side(0);
+    let b = Side::new(baked, baked.clips.first(), &baked.skeleton.declared_modes());
+    let pairs = Pairs::of(&a, &b, &[]).unwrap();
+    compare(&a, &b, &pairs, &comparison_times(&a, &b, 60.0));
+}
+
+fn benches(c: &mut Criterion, name: &str, rig: &Rig, file: &Path, mode: Option<InheritMode>) {
+    let mut group = c.benchmark_group(name);
+    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    group.bench_function("load", |b| b.iter(|| import::load(file).unwrap()));
+    let request = request(rig, mode);
+    let baked = bake::bake(&request);
+    let baked_rig = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+    group.bench_function("bake", |b| b.iter(|| bake::bake(&request)));
+    group.bench_function("report", |b| {
+        b.iter(|| {
+            let read = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+            bake::report(&request, &baked, &read)
+        })
+    });
+    group.bench_function("diff", |b| b.iter(|| diff(&request, &baked_rig)));
+    group.finish();
+}
+
+fn baking(c: &mut Criterion) {
+    let locomotions =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
+    let rig = import::load(&locomotions).expect("the shared assets are beside the repository");
+    benches(c, "locomotions.fbx", &rig, &locomotions, None);
+    let generated = import::stress_rig(200, 6000, 1);
+    let folder = tempfile::tempdir().unwrap();
+    let file: PathBuf = folder.path().join("generated.glb");
+    let exact = Request { tolerance: 0.0, ..request(&generated, None) };
+    bake::save(&file, &bake::bake(&exact).glb).unwrap();
+    benches(c, "generated_200x6000", &generated, &file, None);
+    benches(c, "generated_200x6000_compensate", &generated, &file, Some(InheritMode::SegmentCompensate));
+}
+
+criterion_group!(bench, baking);
+criterion_main!(bench);
