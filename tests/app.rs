@@ -554,20 +554,25 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
     assert_eq!(harness.state().time, 0.0, "the wheel does not seek");
 }
 
+/// The file at `source` baked with every bone under `mode` by `strategy`, written to `out`.
+fn bake(source: &std::path::Path, mode: InheritMode, strategy: bonescope::bake::Strategy, out: &std::path::Path) {
+    let rig = bonescope::import::load(source).unwrap();
+    let request = bonescope::bake::Request {
+        rig: &rig,
+        modes: vec![mode; rig.skeleton.len()],
+        clips: bonescope::bake::every_clip(&rig, None),
+        strategy,
+        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
+    };
+    bonescope::bake::save(out, &bonescope::bake::bake(&request).glb).unwrap();
+}
+
 /// Maya's mixed-inheritance file baked as the closest TRS under unscaled-parent, written to `folder`.
 fn maya_trs_bake(folder: &std::path::Path) -> std::path::PathBuf {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/assets/fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
-    let rig = bonescope::import::load(&path).unwrap();
-    let request = bonescope::bake::Request {
-        rig: &rig,
-        modes: vec![InheritMode::UnscaledParent; rig.skeleton.len()],
-        clips: bonescope::bake::every_clip(&rig, None),
-        strategy: bonescope::bake::Strategy::Trs,
-        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
-    };
     let out = folder.join("maya_trs.glb");
-    bonescope::bake::save(&out, &bonescope::bake::bake(&request).glb).unwrap();
+    bake(&path, InheritMode::UnscaledParent, bonescope::bake::Strategy::Trs, &out);
     out
 }
 
@@ -629,15 +634,7 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     assert_eq!(harness.state().doc.compared.as_ref().map(|c| c.path.clone()), Some(copy.clone()));
     assert!(harness.state().differences().unwrap().bones.iter().all(|d| d.unwrap() == 0.0), "a file against its copy");
     // The copy changes on disk (rewritten as the same clip under segment scale compensate): the comparison follows.
-    let rig = bonescope::import::load(&source).unwrap();
-    let request = bonescope::bake::Request {
-        rig: &rig,
-        modes: vec![InheritMode::SegmentCompensate; rig.skeleton.len()],
-        clips: bonescope::bake::every_clip(&rig, None),
-        strategy: bonescope::bake::Strategy::Exact,
-        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
-    };
-    bonescope::bake::save(&copy, &bonescope::bake::bake(&request).glb).unwrap();
+    bake(&source, InheritMode::SegmentCompensate, bonescope::bake::Strategy::Exact, &copy);
     for _ in 0..100 {
         std::thread::sleep(std::time::Duration::from_millis(20));
         harness.step();

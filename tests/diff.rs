@@ -64,37 +64,18 @@ fn a_file_against_itself_differs_by_nothing() {
 fn two_modes_of_one_file_differ_where_the_modes_do_and_fail_the_gate() {
     // Segment scale compensate moves every bone below the squashing spine.
     let file = path(&asset("blender/stretchy_full.glb"));
-    let run = |limit: &str| {
-        bonescope(&[
-            "diff",
-            &file,
-            &file,
-            "--inherit-b",
-            "segment-compensate",
-            "--anim-a",
-            "squash_stretch",
-            "--fail-above",
-            limit,
-        ])
+    let diff = |more: &[&str]| {
+        let modes = ["diff", &file, &file, "--inherit-b", "segment-compensate", "--anim-a", "squash_stretch"];
+        bonescope(&[&modes[..], more].concat())
     };
-    let out = run("1e-6");
+    let out = diff(&["--fail-above", "1e-6"]);
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     let table = String::from_utf8(out.stdout).unwrap();
     assert!(
         table.contains("inherit: segment-compensate") && table.contains("`squash_stretch` against `squash_stretch`")
     );
-    assert_eq!(run("100%").status.code(), Some(0), "a limit of the whole rig's size passes");
-    let report = json(&bonescope(&[
-        "diff",
-        &file,
-        &file,
-        "--inherit-b",
-        "segment-compensate",
-        "--anim-a",
-        "squash_stretch",
-        "--format",
-        "json",
-    ]));
+    assert_eq!(diff(&["--fail-above", "100%"]).status.code(), Some(0), "a limit of the whole rig's size passes");
+    let report = json(&diff(&["--format", "json"]));
     let bones = report["animations"][0]["bones"].as_array().unwrap();
     let by_name = |n: &str| bones.iter().find(|b| b["name"] == n).unwrap();
     assert_eq!(by_name("hips")["probe"]["max"], 0.0, "above the squash nothing changes");
@@ -174,34 +155,17 @@ fn bake_gates_on_the_largest_error_and_writes_the_file_anyway() {
     let folder = tempfile::tempdir().unwrap();
     let out = path(&folder.path().join("gate.glb"));
     let file = path(&asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx"));
-    let strict = bonescope(&[
-        "bake",
-        &file,
-        "--strategy",
-        "trs",
-        "--inherit",
-        "unscaled-parent",
-        "--out",
-        &out,
-        "--max-error",
-        "1e-9",
-    ]);
+    let bake = |limit: &str| {
+        let args =
+            ["bake", &file, "--strategy", "trs", "--inherit", "unscaled-parent", "--out", &out, "--max-error", limit];
+        bonescope(&args)
+    };
+    let strict = bake("1e-9");
     assert_eq!(strict.status.code(), Some(1), "{}", String::from_utf8_lossy(&strict.stderr));
     assert!(Path::new(&out).exists(), "the file is written; the exit code is the gate");
     let table = String::from_utf8(strict.stdout).unwrap();
     assert!(table.contains("strategy: trs") && table.contains("Mid"));
-    let loose = bonescope(&[
-        "bake",
-        &file,
-        "--strategy",
-        "trs",
-        "--inherit",
-        "unscaled-parent",
-        "--out",
-        &out,
-        "--max-error",
-        "50%",
-    ]);
+    let loose = bake("50%");
     assert_eq!(loose.status.code(), Some(0));
 }
 

@@ -3,7 +3,7 @@
 //! that was written, not the intentions behind it.
 
 use super::{Baked, Request, Strategy};
-use crate::diff::{Extreme, Pairs, Side, compare};
+use crate::diff::{Extreme, MeshDifference, Pairs, Side, compare};
 use crate::model::Rig;
 
 /// How one bone was baked.
@@ -29,19 +29,6 @@ pub struct BoneError {
     pub probe: Extreme,
 }
 
-/// One skinned mesh's error over an animation.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct MeshError {
-    pub name: String,
-    pub vertices: usize,
-    /// The largest vertex distance, model units, with its time.
-    pub max: Extreme,
-    pub mean: f64,
-    /// The same as a percentage of the rig's size.
-    pub max_percent: f64,
-    pub mean_percent: f64,
-}
-
 /// One baked animation against its source.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AnimationReport {
@@ -49,7 +36,8 @@ pub struct AnimationReport {
     pub samples: usize,
     pub keys: usize,
     pub bones: Vec<BoneError>,
-    pub meshes: Vec<MeshError>,
+    /// Per skinned mesh, its vertices' distances from the source's.
+    pub meshes: Vec<MeshDifference>,
     /// The largest error anywhere (a probe or a vertex), model units.
     pub worst: Extreme,
     /// Source bones the baked file lacks, and the reverse (none when the bake is sound).
@@ -99,19 +87,7 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
                 .iter()
                 .map(|d| BoneError { name: d.name.clone(), nodes: nodes(d.a), origin: d.position, probe: d.probe })
                 .collect();
-            let percent = |v: f64| 100.0 * v / baked.rig_size;
-            let meshes = comparison
-                .meshes
-                .iter()
-                .map(|m| MeshError {
-                    name: m.name.clone(),
-                    vertices: m.vertices,
-                    max: m.distance,
-                    mean: m.mean,
-                    max_percent: percent(m.distance.max),
-                    mean_percent: percent(m.mean),
-                })
-                .collect();
+            let meshes = comparison.meshes.clone();
             let unmatched_source =
                 pairs.bones.only_a.iter().map(|&b| format!("{} (only in the source)", skeleton.bone(b).name));
             let unmatched_baked =

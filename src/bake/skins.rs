@@ -82,17 +82,10 @@ mod tests {
     use glam::{DMat4, Vec3};
 
     use super::*;
-    use crate::model::{Bone, InheritMode, Mesh, Skeleton, Skin, Transform};
+    use crate::model::{Mesh, Skin, named_skeleton};
 
     fn rig(bones: &[(&str, Option<usize>)], joints: Vec<usize>, weights: Vec<[f32; 4]>) -> Rig {
-        let bone = |(name, parent): &(&str, Option<usize>)| Bone {
-            name: (*name).to_owned(),
-            node: 0,
-            parent: *parent,
-            rest: Transform::IDENTITY,
-            inherit: InheritMode::Full,
-        };
-        let skeleton = Skeleton::new(bones.iter().map(bone).collect()).unwrap();
+        let skeleton = named_skeleton(bones);
         let count = joints.len();
         let skin = Skin { name: None, joints, inverse_bind: vec![DMat4::IDENTITY; count], node_bind: None };
         let vertices = weights.len();

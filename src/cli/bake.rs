@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 
 use super::layers::LayerArgs;
-use super::table::Table;
+use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
 use crate::eval::LayerStack;
@@ -170,27 +170,7 @@ fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
         }
         out.push_str(&bones.to_string());
         if !animation.meshes.is_empty() {
-            let mut meshes = Table::new(&[
-                ("mesh", false),
-                ("vertices", true),
-                ("max", true),
-                ("of rig", true),
-                ("mean", true),
-                ("of rig", true),
-                ("at s", true),
-            ]);
-            for mesh in &animation.meshes {
-                meshes.row(vec![
-                    mesh.name.clone(),
-                    mesh.vertices.to_string(),
-                    format!("{:.3e}", mesh.max.max),
-                    percent(mesh.max.max),
-                    format!("{:.3e}", mesh.mean),
-                    percent(mesh.mean),
-                    format!("{:.4}", mesh.max.time),
-                ]);
-            }
-            out.push_str(&meshes.to_string());
+            out.push_str(&mesh_differences(&animation.meshes, report.rig_size).to_string());
         }
         for unmatched in &animation.unmatched {
             out.push_str(&format!("  warning: {unmatched}\n"));

@@ -8,7 +8,7 @@ use clap::Args;
 use super::Format;
 use super::bake::{Distance, parse_distance};
 use super::options::ModeSet;
-use super::table::Table;
+use super::table::{Table, mesh_differences};
 use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
 use crate::import;
 use crate::model::Rig;
@@ -132,25 +132,7 @@ fn render_table(diff: &FileDiff) -> String {
         }
         out.push_str(&bones.to_string());
         if !animation.meshes.is_empty() {
-            let mut meshes = Table::new(&[
-                ("mesh", false),
-                ("vertices", true),
-                ("max", true),
-                ("of rig", true),
-                ("at s", true),
-                ("mean", true),
-            ]);
-            for mesh in &animation.meshes {
-                meshes.row(vec![
-                    mesh.name.clone(),
-                    mesh.vertices.to_string(),
-                    format!("{:.3e}", mesh.distance.max),
-                    percent(mesh.distance.max),
-                    format!("{:.4}", mesh.distance.time),
-                    format!("{:.3e}", mesh.mean),
-                ]);
-            }
-            out.push_str(&meshes.to_string());
+            out.push_str(&mesh_differences(&animation.meshes, animation.rig_size).to_string());
         }
         if !animation.only_a.is_empty() {
             out.push_str(&format!("  bones only in A: {}\n", animation.only_a.join(", ")));

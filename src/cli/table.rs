@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use crate::diff::MeshDifference;
+
 /// Columns aligned by the widest cell; numbers (columns marked right-aligned) line up on the right.
 pub struct Table {
     headers: Vec<&'static str>,
@@ -51,6 +53,33 @@ impl fmt::Display for Table {
         }
         Ok(())
     }
+}
+
+/// Per mesh of a comparison: its vertices, the largest vertex distance (model units and percent of `rig_size`)
+/// with its time, and the mean distance.
+pub fn mesh_differences(meshes: &[MeshDifference], rig_size: f64) -> Table {
+    let percent = |v: f64| format!("{:.6} %", 100.0 * v / rig_size);
+    let mut table = Table::new(&[
+        ("mesh", false),
+        ("vertices", true),
+        ("max", true),
+        ("of rig", true),
+        ("at s", true),
+        ("mean", true),
+        ("of rig", true),
+    ]);
+    for mesh in meshes {
+        table.row(vec![
+            mesh.name.clone(),
+            mesh.vertices.to_string(),
+            format!("{:.3e}", mesh.distance.max),
+            percent(mesh.distance.max),
+            format!("{:.4}", mesh.distance.time),
+            format!("{:.3e}", mesh.mean),
+            percent(mesh.mean),
+        ]);
+    }
+    table
 }
 
 /// `(x, y, z)` with fixed decimals.

@@ -136,18 +136,7 @@ pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Bone, InheritMode, Transform};
-
-    fn skeleton(bones: &[(&str, Option<usize>)]) -> Skeleton {
-        let bone = |(name, parent): &(&str, Option<usize>)| Bone {
-            name: (*name).to_owned(),
-            node: 0,
-            parent: *parent,
-            rest: Transform::IDENTITY,
-            inherit: InheritMode::Full,
-        };
-        Skeleton::new(bones.iter().map(bone).collect()).unwrap()
-    }
+    use crate::model::named_skeleton as skeleton;
 
     #[test]
     fn exact_then_loose_then_mapped() {

@@ -11,6 +11,8 @@ pub use clip::{
     BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
 };
 pub use inherit::{InheritMode, UnknownInheritMode};
+#[cfg(test)]
+pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};

@@ -114,6 +114,19 @@ impl Skeleton {
     }
 }
 
+/// Skeletons for tests: bones named and parented, at rest at the origin, fully inheriting.
+#[cfg(test)]
+pub(crate) fn named(bones: &[(&str, Option<usize>)]) -> Skeleton {
+    let bone = |(name, parent): &(&str, Option<usize>)| Bone {
+        name: (*name).to_owned(),
+        node: 0,
+        parent: *parent,
+        rest: Transform::IDENTITY,
+        inherit: InheritMode::Full,
+    };
+    Skeleton::new(bones.iter().map(bone).collect()).expect("parents first")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
