@@ -351,3 +351,54 @@ fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
         assert!(reported <= local_trs + EXACT * b.baked.rig_size, "{source} ({inherit}): {reported} > {local_trs}");
     }
 }
+
+#[test]
+fn normals_morph_targets_and_their_weights_travel_with_the_meshes() {
+    // Maya's in-between blend shapes, animated: the baked file's morph targets and weights give the source's
+    // vertices within the tolerance on a dense grid; its normals are the source's.
+    let path = asset("fbx-ufbx-corpus/maya_blend_inbetween_7500_ascii.fbx");
+    let rig = import::load(&path).unwrap();
+    let request = Request {
+        rig: &rig,
+        modes: rig.skeleton.declared_modes(),
+        clips: bake::every_clip(&rig, None),
+        strategy: Strategy::Exact,
+        tolerance: bake::DEFAULT_TOLERANCE,
+    };
+    let baked = bake::bake(&request);
+    let back = import::load_bytes(Path::new("morph.glb"), &baked.glb).unwrap();
+    let (source, result) = (&rig.meshes[0], &back.meshes[0]);
+    assert_eq!(result.morph_targets.len(), source.morph_targets.len());
+    assert!(!source.normals.is_empty());
+    for (a, b) in source.normals.iter().zip(&result.normals) {
+        assert!(a.abs_diff_eq(*b, 1e-6), "{a} against {b}");
+    }
+    let a = request.side(0);
+    let b = Side::new(&back, back.clips.first(), &back.skeleton.declared_modes());
+    let pairs = Pairs::of(&a, &b, &[]).unwrap();
+    let comparison = compare(&a, &b, &pairs, &comparison_times(&a, &b, dense(&a)));
+    let vertices = comparison.meshes[0].distance.max;
+    assert!(vertices <= bake::DEFAULT_TOLERANCE * baked.rig_size, "{vertices:.2e} of {:.3}", baked.rig_size);
+}
+
+#[test]
+fn a_dual_quaternion_skin_is_baked_linear_and_the_report_says_what_it_costs() {
+    let path = asset("fbx-ufbx-corpus/maya_dual_quaternion_7500_ascii.fbx");
+    let rig = import::load(&path).unwrap();
+    let request = Request {
+        rig: &rig,
+        modes: rig.skeleton.declared_modes(),
+        clips: bake::every_clip(&rig, None),
+        strategy: Strategy::Exact,
+        tolerance: bake::DEFAULT_TOLERANCE,
+    };
+    let baked = bake::bake(&request);
+    assert!(baked.notes.iter().any(|n| n.contains("dual quaternions")), "{:?}", baked.notes);
+    let back = import::load_bytes(Path::new("dq.glb"), &baked.glb).unwrap();
+    let report = bake::report(&request, &baked, &back);
+    let animation = &report.animations[0];
+    let bones = animation.bones.iter().map(|b| b.probe.max).fold(0.0, f64::max);
+    assert!(bones <= bake::DEFAULT_TOLERANCE * baked.rig_size, "the joints are baked within the tolerance");
+    // The twisted mesh is where linear blending pinches what dual quaternions keep: the report shows it.
+    assert!(animation.meshes[0].distance.max > 0.01 * baked.rig_size, "{:?}", animation.meshes[0]);
+}

@@ -70,6 +70,8 @@ pub(super) fn read(
                     .collect();
             }
         }
+        read.normals = vertex_normals(mesh, &to_space);
+        tally.split_normals += usize::from(mesh.vertex_normal.exists && !mesh.vertex_normal.unique_per_vertex);
         read_blend_shapes(mesh, &to_space, &mut read);
         if !read.morph_targets.is_empty() {
             tally.blend_shapes += 1;
@@ -79,6 +81,26 @@ pub(super) fn read(
     }
     tally.notes(notes);
     Ok((skins, meshes))
+}
+
+/// One normal per vertex from the file's normals per face corner: the one its corners share, or, where the faces
+/// around a vertex disagree (a hard edge), their normalised sum; in the mesh's `to_space` (where its positions are);
+/// empty when the file has none.
+fn vertex_normals(mesh: &ufbx::Mesh, to_space: &glam::DMat4) -> Vec<Vec3> {
+    let normals = &mesh.vertex_normal;
+    if !normals.exists {
+        return Vec::new();
+    }
+    let mut sums = vec![glam::DVec3::ZERO; mesh.vertices.len()];
+    for (&vertex, &index) in mesh.vertex_indices.iter().zip(normals.indices.iter()) {
+        if let (Some(sum), Some(n)) = (sums.get_mut(vertex as usize), normals.values.get(index as usize)) {
+            *sum += glam::DVec3::new(n.x, n.y, n.z);
+        }
+    }
+    // Normals go by the inverse transpose; a singular placement leaves them as they are.
+    let linear = glam::DMat3::from_mat4(*to_space);
+    let linear = if linear.determinant() != 0.0 { linear.inverse().transpose() } else { glam::DMat3::IDENTITY };
+    sums.iter().map(|sum| (linear * *sum).normalize_or_zero().as_vec3()).collect()
 }
 
 /// Every shape of the mesh's blend channels as a morph target (displacements in the mesh's `to_space`), in the order
@@ -163,6 +185,7 @@ struct Tally {
     trimmed_weights: usize,
     unweighted: usize,
     non_finite: usize,
+    split_normals: usize,
 }
 
 impl Tally {
@@ -178,6 +201,10 @@ impl Tally {
             (self.trimmed_weights, "vertices have more than 4 weights; the 4 strongest are kept, renormalised"),
             (self.unweighted, "skinned vertices have no weights and follow their mesh's node"),
             (self.non_finite, "vertices are not finite (NaN or infinite), left out of skinning and drawing"),
+            (
+                self.split_normals,
+                "meshes have hard edges (normals that differ between faces at a vertex), averaged per vertex",
+            ),
         ];
         notes.extend(lines.iter().filter(|(n, _)| *n > 0).map(|(n, what)| format!("{n} {what}")));
     }

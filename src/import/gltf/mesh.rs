@@ -83,6 +83,8 @@ pub(super) fn read_meshes(
 ) -> Result<Vec<Mesh>> {
     let mut meshes = Vec::new();
     let (mut other_modes, mut unweighted, mut unnormalized) = (0, 0, 0);
+    // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
+    let mut unread_normals = Vec::new();
     let mut unsupplied = Vec::new();
     for (bone, node_of_bone) in scene.skeleton.bones().iter().enumerate() {
         let node = &root.nodes[node_of_bone.node];
@@ -112,6 +114,10 @@ pub(super) fn read_meshes(
             };
             let mut read = Mesh { name, bone, ..Mesh::default() };
             read.positions = positions(primitive, accessors, &place)?;
+            read.normals = normals(primitive, accessors, read.positions.len(), &place).unwrap_or_else(|failure| {
+                unread_normals.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
+                Vec::new()
+            });
             if let Some(skin) = skin {
                 if read_skinning(&mut read, primitive, accessors, &skins[skin], &place)? {
                     read.skin = Some(skin);
@@ -134,6 +140,9 @@ pub(super) fn read_meshes(
     if unweighted > 0 {
         notes.push(format!("{unweighted} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned"));
     }
+    if !unread_normals.is_empty() {
+        notes.push(format!("normals left out: {}", unread_normals.join("; ")));
+    }
     if unnormalized > 0 {
         notes.push(format!("{unnormalized} vertices' skin weights did not sum to 1; normalised, as glTF requires"));
     }
@@ -155,6 +164,22 @@ fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Op
 fn positions(primitive: &schema::Primitive, accessors: &Accessors, place: &str) -> Result<Vec<glam::Vec3>> {
     let accessor = primitive.attributes.get("POSITION").ok_or_else(|| Failure::at(place, "has no POSITION"))?;
     accessors.positions(*accessor, &format!("{place}.attributes.POSITION"), "POSITION")
+}
+
+/// The primitive's `NORMAL`s, one per vertex (empty without them).
+fn normals(
+    primitive: &schema::Primitive,
+    accessors: &Accessors,
+    vertices: usize,
+    place: &str,
+) -> Result<Vec<glam::Vec3>> {
+    let Some(&accessor) = primitive.attributes.get("NORMAL") else { return Ok(Vec::new()) };
+    let place = format!("{place}.attributes.NORMAL");
+    let normals = accessors.positions(accessor, &place, "NORMAL")?;
+    if normals.len() != vertices {
+        return Err(Failure::at(place, format!("{} normals for {vertices} vertices", normals.len())));
+    }
+    Ok(normals)
 }
 
 /// The primitive's morph targets (their `POSITION` displacements; a target without one displaces nothing).
