@@ -14,9 +14,11 @@
 //! no helper. That is [`Strategy::Exact`]; [`Strategy::Trs`] keeps one node per bone, each the closest TRS to what it
 //! needs under its already-baked parent, for runtimes whose transforms cannot shear.
 //!
-//! The steps: sample every clip at its frames, key times and the midpoints between ([`times`]); solve each bone's
-//! nodes at each sample ([`nodes`]); keep the fewest keys that reproduce the samples within the tolerance ([`keys`]);
-//! and write the scene ([`document`], [`glb`]). [`report`] measures the result against the source.
+//! The steps: sample every clip at its frames and key times (`times`), and wherever between them linear
+//! interpolation would miss the source (`refine`); solve each bone's nodes at each sample (`nodes`); keep the
+//! fewest keys that reproduce the samples within the tolerance (`keys`, `channels`); lay out nodes, meshes and
+//! skins (`layout`, `skins`) and write the scene (`document`, `glb`). [`report`] measures the written file
+//! against the source.
 
 mod channels;
 mod document;
