@@ -17,7 +17,7 @@
 //! The steps: sample every clip at its frames and key times (`times`), and wherever between them linear
 //! interpolation would miss the source (`refine`); solve each bone's nodes at each sample (`nodes`); keep the
 //! fewest keys that reproduce the samples within the tolerance (`keys`, `channels`); lay out nodes, meshes and
-//! skins (`layout`, `skins`) and write the scene (`document`, `glb`). [`report`] measures the written file
+//! skins (`layout`, `skins`) and write the scene (`document`, `glb`). [`report()`] measures the written file
 //! against the source.
 
 mod channels;

@@ -1,7 +1,7 @@
 //! Two evaluations compared over time, bone by bone and vertex by vertex: two files (an export and its source, a
 //! bake and what it baked), or one file under two sets of modes.
 //!
-//! Bones are paired by name ([`matching`]); at every time both poses are evaluated and each pair's model matrices
+//! Bones are paired by name ([`match_bones`]); at every time both poses are evaluated and each pair's model matrices
 //! `W_a`, `W_b` are compared through their polar decompositions:
 //! - **position**: the distance between the two origins;
 //! - **probe**: the largest distance of a point of the bone's frame — its origin and one point on each of its axes,
