@@ -20,13 +20,16 @@
 //! (nothing else ufbx's evaluation reads changes in time), is evaluated once and that transform kept at every grid
 //! time (ProAnimationBank's `skeleton.fbx` keys all 127 nodes that way over 151 frames). The other nodes are
 //! sampled in parallel (on the rayon pool, which `scan` shares between files): ufbx's evaluation only reads the
-//! loaded scene, which ufbx's `SceneRoot` declares safe to share between threads.
+//! loaded scene, which ufbx's `SceneRoot` declares safe to share between threads. A node whose transform is made of
+//! its translation, rotation and scale channels alone is evaluated from them directly ([`Channels`]), to the same
+//! bits as ufbx.
 
 use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
+use super::channels::Channels;
 use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
 use crate::model::{BoneTracks, Clip, Interpolation, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
@@ -298,13 +301,17 @@ impl NodeSampler<'_> {
     /// The tracks of `bone`, the node with typed id `node`: evaluated at every grid time, or, when it does not
     /// `move`, once and held.
     fn sample(&self, bone: usize, node: usize, moves: bool) -> Result<BoneTracks> {
-        let (node, anim) = (&self.scene.nodes[node], &self.scene.anim_stacks[self.stack].anim);
+        let (node, stack) = (&self.scene.nodes[node], &self.scene.anim_stacks[self.stack]);
         let (mut translations, mut rotations, mut scales) = (
             Vec::with_capacity(self.grid.len()),
             Vec::with_capacity(self.grid.len()),
             Vec::with_capacity(self.grid.len()),
         );
-        let evaluate = |time| ufbx::evaluate_transform(anim, node, time);
+        let channels = Channels::of(node, stack);
+        let evaluate = |time| match &channels {
+            Some(channels) => channels.at(time),
+            None => ufbx::evaluate_transform(&stack.anim, node, time),
+        };
         let held = if moves { None } else { self.grid.first().map(|&time| evaluate(time)) };
         for &time in self.grid {
             let t = held.unwrap_or_else(|| evaluate(time));

@@ -19,6 +19,7 @@
 //! ufbx says what is wrong but not where, so a failed file is walked by [`locate`] to name the place.
 
 mod anim;
+mod channels;
 mod locate;
 mod mesh;
 mod scene;
