@@ -1,5 +1,5 @@
-//! Buffer bytes: the GLB `BIN` chunk (read where it lies, as accessors need its bytes), base64 `data:` URIs, or
-//! files beside the glTF file, each read on first use.
+//! Buffer bytes: the GLB `BIN` chunk (read where it lies, as accessors need its bytes), base64 `data:` URIs (decoded
+//! as the JSON is read: [`Uri`]), or files beside the glTF file (read on first use).
 //!
 //! A buffer nothing reads is never opened, so a file whose unused buffer points at a missing file or an `http:` URI
 //! still loads; a buffer that is read and cannot be had fails naming who needed it. A URI may name a file in the
@@ -10,6 +10,7 @@
 
 use std::borrow::Cow;
 use std::cell::OnceCell;
+use std::fmt;
 use std::io::Read;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -17,6 +18,8 @@ use std::path::{Path, PathBuf};
 use base64::Engine as _;
 use base64::engine::DecodePaddingMode;
 use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
+use serde::Deserialize;
+use serde::de::{self, Deserializer, Visitor};
 
 use super::schema::{self, Uint};
 use super::source::Region;
@@ -36,11 +39,45 @@ pub(super) struct Buffers<'a> {
     loaded: Vec<OnceCell<std::result::Result<Data<'a>, String>>>,
 }
 
-/// A buffer's bytes: in memory (a `data:` URI or a file beside the glTF file), or the GLB `BIN` chunk, read where
-/// it lies as accessors need it.
+/// A buffer's bytes: in memory (a `data:` URI's, decoded as the JSON was read, or a file's beside the glTF file), or
+/// the GLB `BIN` chunk, read where it lies as accessors need it.
 enum Data<'a> {
-    Memory(Vec<u8>),
+    Memory(Cow<'a, [u8]>),
     Blob(Region<'a>),
+}
+
+/// A buffer's `uri` as the JSON is read: a `data:` URI is decoded on the spot, straight from the JSON text (a `.gltf`
+/// file's base64 buffer is most of its text, which is then never copied as a string), any other URI kept to be
+/// followed when the buffer is needed.
+#[derive(Debug)]
+pub(super) enum Uri {
+    /// The bytes of a `data:` URI, or why they cannot be had (said only if the buffer is needed).
+    Data(std::result::Result<Vec<u8>, String>),
+    /// A file, by its URI reference.
+    Reference(String),
+}
+
+impl<'de> Deserialize<'de> for Uri {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        struct UriVisitor;
+
+        impl Visitor<'_> for UriVisitor {
+            type Value = Uri;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a URI")
+            }
+
+            fn visit_str<E: de::Error>(self, uri: &str) -> std::result::Result<Uri, E> {
+                Ok(match strip_prefix_ignore_case(uri, "data:") {
+                    Some(data) => Uri::Data(decode_data_uri(data)),
+                    None => Uri::Reference(uri.to_owned()),
+                })
+            }
+        }
+
+        deserializer.deserialize_str(UriVisitor)
+    }
 }
 
 impl<'a> Buffers<'a> {
@@ -79,10 +116,11 @@ impl<'a> Buffers<'a> {
         }
     }
 
-    fn load(&self, index: usize, declared: &schema::Buffer) -> std::result::Result<Data<'a>, String> {
+    fn load(&self, index: usize, declared: &'a schema::Buffer) -> std::result::Result<Data<'a>, String> {
         let length = declared.byte_length.0;
         let data = match (&declared.uri, self.blob) {
-            (Some(uri), _) => Data::Memory(read_uri(uri, self.folder, length)?),
+            (Some(Uri::Data(decoded)), _) => Data::Memory(Cow::Borrowed(decoded.as_deref().map_err(Clone::clone)?)),
+            (Some(Uri::Reference(uri)), _) => Data::Memory(Cow::Owned(read_file(uri, self.folder, length)?)),
             (None, Some(blob)) if index == 0 => Data::Blob(blob),
             (None, _) if index == 0 => return Err("it has no uri, and the file has no GLB BIN chunk".into()),
             (None, _) => return Err("it has no uri (only buffers[0] can be the GLB BIN chunk)".into()),
@@ -98,11 +136,8 @@ impl<'a> Buffers<'a> {
     }
 }
 
-/// The bytes a buffer URI names (at most `length` of them for a file).
-fn read_uri(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
-    if let Some(data) = strip_prefix_ignore_case(uri, "data:") {
-        return decode_data_uri(data);
-    }
+/// At most `length` bytes of the file a buffer URI reference names.
+fn read_file(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
     let path = folder.join(relative_path(uri)?);
     let file = std::fs::File::open(&path).map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
     let mut data = Vec::new();
