@@ -20,7 +20,7 @@ use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 /// What the workers need to know about the subject, found once per analysis.
 pub(super) struct Plan<'a> {
     hierarchy: &'a Hierarchy,
-    /// The clip, when it is judged bone by bone: no layers, every bone inheriting fully.
+    /// The clip, when it is judged bone by bone: no layers, every bone inheriting fully (or a root).
     by_bone: Option<&'a Clip>,
     /// Each bone's parent, and whether its stretch passes down from it ([`Stretch::child`]: full inheritance, or a
     /// root) rather than coming from its model matrix.
@@ -40,22 +40,21 @@ pub(super) struct Plan<'a> {
 impl<'a> Plan<'a> {
     pub fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize], judged: Judged) -> Self {
         let skeleton = subject.skeleton;
-        let all_full = hierarchy.modes().iter().all(|&m| m == InheritMode::Full);
-        let by_bone = subject.clip.filter(|_| subject.layered.is_none() && all_full);
+        let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
+        // A root's mode changes nothing (it has no parent to inherit from): FBX files declare cameras and other
+        // top-level nodes componentwise, and that must not take the whole rig off the bone-by-bone path.
+        let inherits: Vec<bool> =
+            parents.iter().zip(hierarchy.modes()).map(|(p, &m)| p.is_none() || m == InheritMode::Full).collect();
+        let by_bone = subject.clip.filter(|_| subject.layered.is_none() && inherits.iter().all(|&full| full));
         let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
             (0..skeleton.len()).map(|b| by_bone.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
         };
-        let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
         let mut children = vec![0; parents.len()];
         parents.iter().flatten().for_each(|&p| children[p] += 1);
         Plan {
             hierarchy,
             by_bone,
-            inherits: parents
-                .iter()
-                .zip(hierarchy.modes())
-                .map(|(p, &m)| p.is_none() || m == InheritMode::Full)
-                .collect(),
+            inherits,
             parents,
             children,
             varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),

@@ -95,9 +95,11 @@ impl<'a> Subject<'a> {
         Subject { skeleton, clip, layered: None }
     }
 
-    /// The clip through layers (`clip` is their main clip).
+    /// The clip through layers (`clip` is their main clip). Layers that leave the clip as it is are no layers: the
+    /// clip is then sampled directly, which lets a fully inheriting rig be judged bone by bone (`chunk.rs`).
     pub fn layered(layered: Layered<'a>, clip: Option<&'a Clip>) -> Self {
-        Subject { skeleton: &layered.rig.skeleton, clip, layered: Some(layered) }
+        let layers = Some(layered).filter(|l| !l.layers.is_empty());
+        Subject { skeleton: &layered.rig.skeleton, clip, layered: layers }
     }
 }
 

@@ -13,6 +13,7 @@ mod gltf;
 pub use demo::{demo_rig, stress_rig};
 
 use std::fmt;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::model::Rig;
@@ -109,8 +110,24 @@ pub fn load(path: &Path) -> Result<Rig, ImportError> {
 }
 
 /// Reads and parses the file at `path` with `options`.
+///
+/// glTF and FBX are read from the file as they are needed (of a binary glTF, only its JSON and the bytes of the
+/// accessors that are decoded: `gltf::load_file`; FBX by ufbx through its own buffer: `fbx::load_file`), so a file
+/// is not copied into memory whole before it is parsed; BVH is read whole first.
 pub fn load_with(path: &Path, options: &Options) -> Result<Rig, ImportError> {
-    let bytes = std::fs::read(path).map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?;
+    let cannot_read = |e: std::io::Error| ImportError::new(path, None, format!("cannot read the file: {e}"));
+    let mut file = std::fs::File::open(path).map_err(cannot_read)?;
+    // As much as `detect` looks at; a recognised glTF or FBX file is read no further here.
+    let mut bytes = Vec::new();
+    (&mut file).take(FBX_ASCII_LOOKAHEAD as u64).read_to_end(&mut bytes).map_err(cannot_read)?;
+    match detect(&bytes) {
+        Some(Format::Gltf) => return gltf::load_file(path, &file),
+        Some(Format::Fbx) => return fbx::load_file(path, file, &bytes, options),
+        _ => {}
+    }
+    let size = file.metadata().map_or(0, |m| usize::try_from(m.len()).unwrap_or(0));
+    bytes.reserve(size.saturating_sub(bytes.len()));
+    file.read_to_end(&mut bytes).map_err(cannot_read)?;
     load_bytes_with(path, &bytes, options)
 }
 

@@ -1,19 +1,17 @@
-//! Many files, several at a time, reported in order: a library of thousands of exports is scanned with a bounded
-//! number of files in flight (memory follows the largest files being read, not the library), and each result is
-//! handed on as soon as it and every file before it are done, so reports stream in the files' sorted order whatever
-//! the thread timing.
+//! Many files, several at a time, reported in order: a library of thousands of exports is scanned by a fixed number
+//! of workers, each taking the next file as soon as it is done with one (so no core waits for a slow file beside
+//! it, and memory follows the few files being read, not the library), and each result is handed on as soon as it
+//! and every file before it are done, so reports stream in the files' sorted order whatever the thread timing.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
 
-use rayon::prelude::*;
-
-/// How many files per thread are in flight at most.
-const FILES_PER_JOB: usize = 2;
-
-/// Runs `work` on `paths` with `jobs` threads (their own pool; each file's own analysis shares it), and calls
-/// `done` with each path and its result in the paths' order. Files not yet started when `stop` is set are skipped;
-/// how many were done.
+/// Runs `work` on `paths` with `jobs` workers, and calls `done` with each path and its result in the paths'
+/// order. The workers are the threads of a pool of their own, which each file's own parallel work (a clip's
+/// analysis, an FBX file's sampling) shares, so `jobs` threads run in all. Files not yet started when `stop` is set
+/// are skipped; how many were done (in order, up to the first skipped one).
 pub fn in_order<T: Send>(
     paths: &[PathBuf],
     jobs: usize,
@@ -21,24 +19,45 @@ pub fn in_order<T: Send>(
     mut done: impl FnMut(&Path, T),
     stop: &AtomicBool,
 ) -> usize {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build();
-    let run = |window: &[PathBuf]| -> Vec<Option<T>> {
-        let each = |path: &PathBuf| (!stop.load(Ordering::Relaxed)).then(|| work(path));
-        match &pool {
-            Ok(pool) => pool.install(|| window.par_iter().map(each).collect()),
-            // A pool that cannot be built (no threads left): one file after another.
-            Err(_) => window.iter().map(each).collect(),
-        }
-    };
-    let mut count = 0;
-    for window in paths.chunks(jobs.max(1) * FILES_PER_JOB) {
-        for (path, result) in window.iter().zip(run(window)) {
-            let Some(result) = result else { return count };
-            done(path, result);
+    let jobs = jobs.max(1);
+    let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(jobs).build() else {
+        // A pool that cannot be built (no threads left): one file after another.
+        let mut count = 0;
+        for path in paths.iter().take_while(|_| !stop.load(Ordering::Relaxed)) {
+            done(path, work(path));
             count += 1;
         }
-    }
-    count
+        return count;
+    };
+    let next = AtomicUsize::new(0);
+    let (sender, results) = mpsc::channel();
+    let (work, next) = (&work, &next);
+    // The scope's own closure runs here, on the caller's thread (which `done` may need), and waits for the workers.
+    pool.in_place_scope(|scope| {
+        for _ in 0..jobs {
+            let sender = sender.clone();
+            scope.spawn(move |_| {
+                while !stop.load(Ordering::Relaxed) {
+                    let index = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(path) = paths.get(index) else { break };
+                    if sender.send((index, work(path))).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sender);
+        let mut waiting = BTreeMap::new();
+        let mut count = 0;
+        for (index, result) in results {
+            waiting.insert(index, result);
+            while let Some(result) = waiting.remove(&count) {
+                done(&paths[count], result);
+                count += 1;
+            }
+        }
+        count
+    })
 }
 
 #[cfg(test)]

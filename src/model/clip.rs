@@ -101,14 +101,12 @@ impl<T: KeyValue> Track<T> {
         if values.len() != expected {
             return Err(TrackError::CountMismatch { keys: times.len(), values: values.len(), expected, interpolation });
         }
-        let mut previous = f64::NEG_INFINITY;
-        for (index, &time) in times.iter().enumerate() {
-            if !time.is_finite() || time < 0.0 || time < previous {
-                return Err(TrackError::BadTime { index, time });
-            }
-            previous = time;
+        if let Some(index) = first_bad_time(&times) {
+            return Err(TrackError::BadTime { index, time: times[index] });
         }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        // Folded without stopping (vectorised, and every key is read anyway when all are good); searched on failure.
+        if !values.iter().fold(true, |finite, v| finite & v.is_finite()) {
+            let index = values.iter().position(|v| !v.is_finite()).unwrap_or_default();
             return Err(TrackError::NonFinite { index });
         }
         let (times, values) = merge_close_keys(times, values, interpolation.values_per_key());
@@ -165,6 +163,22 @@ fn key_rate(arrays: Vec<&[f64]>) -> Option<f64> {
     (count >= 2 && count * 4 >= total && rate > 0).then(|| rate as f64 / 1000.0)
 }
 
+/// The first time that is not finite, negative, or before the one before it.
+fn first_bad_time(times: &[f64]) -> Option<usize> {
+    // Folded without stopping, as the values are (the same array is checked for every track that shares it).
+    let finite = times.iter().fold(true, |finite, t| finite & t.is_finite());
+    let sorted = times.windows(2).fold(true, |sorted, w| sorted & (w[0] <= w[1]));
+    if finite && sorted && times.first().is_none_or(|&t| t >= 0.0) {
+        return None;
+    }
+    let mut previous = f64::NEG_INFINITY;
+    times.iter().position(|&time| {
+        let bad = !time.is_finite() || time < 0.0 || time < previous;
+        previous = time;
+        bad
+    })
+}
+
 /// Key times closer than this are one key: one FBX tick (1/46,186,158,000 s), the finest time any supported
 /// format stores.
 pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
@@ -173,7 +187,7 @@ pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
 /// [`KEY_TIME_RESOLUTION`] to the previous one reduced to its last key; the inputs themselves when there is none.
 fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Vec<T>, per_key: usize) -> (Arc<[f64]>, Vec<T>) {
     let close = |w: &[f64]| w[1] - w[0] < KEY_TIME_RESOLUTION;
-    if !times.windows(2).any(close) {
+    if !times.windows(2).fold(false, |any, w| any | close(w)) {
         return (times, values);
     }
     let keep = |k: usize| times.get(k + 1).is_none_or(|next| next - times[k] >= KEY_TIME_RESOLUTION);

@@ -166,6 +166,11 @@ pub struct LayerStack {
 }
 
 impl LayerStack {
+    /// Whether the stack leaves the clip exactly as sampled (see [`Layers::is_empty`]).
+    pub fn is_empty(&self) -> bool {
+        self.layers.is_empty()
+    }
+
     /// Checks every index against `rig` and prepares what does not change with time.
     pub fn new(rig: &Rig, layers: &Layers) -> Result<Self, LayerError> {
         let clips = rig.clips.len();

@@ -13,11 +13,23 @@
 //! says so). A long stack with sparse keys is thinned between keys ([`sample_times`]), so the samples stay bounded by
 //! the keys, and the grid's size is checked against the file's size before anything is evaluated. (The key times are
 //! read from the curves here rather than from `ufbx_bake_anim`, whose run time a hostile file can make unbounded.)
+//!
+//! Sampling is most of the time an FBX file takes to load (one `ufbx_evaluate_transform` per node and grid time,
+//! each looking up the node's transform properties), so it is done only where it can give a new value: a node
+//! whose curves all hold one value, in layers of constant weight, with no connected property and no scale helper
+//! (nothing else ufbx's evaluation reads changes in time), is evaluated once and that transform kept at every grid
+//! time (ProAnimationBank's `skeleton.fbx` keys all 127 nodes that way over 151 frames). The other nodes are
+//! sampled in parallel (on the rayon pool, which `scan` shares between files): ufbx's evaluation only reads the
+//! loaded scene, which ufbx's `SceneRoot` declares safe to share between threads. A node whose transform is made of
+//! its translation, rotation and scale channels alone is evaluated from them directly ([`Channels`]), to the same
+//! bits as ufbx.
 
 use std::sync::Arc;
 
 use glam::{Quat, Vec3};
+use rayon::prelude::*;
 
+use super::channels::Channels;
 use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
 use crate::model::{BoneTracks, Clip, Interpolation, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
@@ -36,7 +48,7 @@ const STEP: f64 = 1e-3;
 const SAMPLE_BYTES: usize = 8 + 12 + 16 + 12;
 
 pub(super) fn read_clips(
-    scene: &ufbx::Scene,
+    scene: &ufbx::SceneRoot,
     bone_of_node: &[Option<usize>],
     file_size: usize,
     notes: &mut Vec<String>,
@@ -63,8 +75,37 @@ pub(super) fn read_clips(
     Ok(clips)
 }
 
+/// What a stack animates.
+struct Animated {
+    /// The nodes (typed ids) whose properties it animates, in order of appearance.
+    nodes: Vec<usize>,
+    /// By node id: whether ufbx's evaluation of the node can change in time (see the module's documentation).
+    moving: Vec<bool>,
+    /// Every key time of their curves and of the blend channels' (with a time just before each step).
+    times: Vec<f64>,
+    /// By blend channel (typed id): whether it is animated.
+    channels: Vec<bool>,
+}
+
+/// Whether a curve holds one value at every time: all keys equal and every tangent flat, so that no interpolation
+/// (constant, linear or cubic) and no extrapolation (constant, slope or repetition) can leave that value.
+fn is_flat(curve: &ufbx::AnimCurve) -> bool {
+    let first = curve.keyframes.first().map(|k| k.value);
+    curve.keyframes.iter().all(|k| Some(k.value) == first && k.left.dy == 0.0 && k.right.dy == 0.0)
+}
+
+/// Whether `ufbx_evaluate_transform` of `node` depends on time only through the node's own animated properties: none
+/// of its properties takes its value from a connection, and no scale helper (whose scale ufbx evaluates too) is
+/// involved.
+fn evaluated_from_own_curves(node: &ufbx::Node) -> bool {
+    let connected = node.element.props.props.iter().any(|p| p.flags.has_any(ufbx::PropFlags::CONNECTED));
+    let parent_helpers =
+        node.parent.as_ref().is_some_and(|p| p.scale_helper.is_some() || p.inherit_scale_node.is_some());
+    !connected && !parent_helpers && node.scale_helper.is_none() && !node.is_scale_helper
+}
+
 struct StackReader<'a> {
-    scene: &'a ufbx::Scene,
+    scene: &'a ufbx::SceneRoot,
     index: usize,
     stack: &'a ufbx::AnimStack,
     fps: f64,
@@ -79,10 +120,12 @@ impl StackReader<'_> {
 
     /// The clip, and how many node samples it holds.
     fn clip(&self, bone_of_node: &[Option<usize>], notes: &mut Vec<String>) -> Result<(Clip, usize)> {
-        let (nodes, keys, channels) = self.keys()?;
-        let animated: Vec<(usize, &ufbx::Node)> = nodes
+        let Animated { nodes, moving, times: keys, channels } = self.keys()?;
+        // (bone, node id, whether it moves): what crosses threads is the scene and indices into it.
+        let animated: Vec<(usize, usize, bool)> = nodes
             .into_iter()
-            .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, self.scene.nodes.get(id)?.as_ref())))
+            .filter(|&id| id < self.scene.nodes.len())
+            .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, id, moving[id])))
             .collect();
         let (begin, end) = self.span(keys.iter().copied());
         let grid = self.grid(begin, end, keys, animated.len(), notes)?;
@@ -91,10 +134,12 @@ impl StackReader<'_> {
             notes.push(format!("{} starts at t = {begin} s; its clip is shifted to start at 0", self.place()));
         }
         let times: Arc<[f64]> = grid.iter().map(|t| t + shift).collect();
-        let mut tracks = Vec::with_capacity(animated.len());
-        for (bone, node) in animated {
-            tracks.push(self.sample(bone, node, &grid, &times)?);
-        }
+        let sampler =
+            NodeSampler { scene: self.scene, stack: self.index, place: self.place(), grid: &grid, times: &times };
+        let tracks = animated
+            .par_iter()
+            .map(|&(bone, node, moves)| sampler.sample(bone, node, moves))
+            .collect::<Result<Vec<_>>>()?;
         let morph = self.morph_weights(bone_of_node, &channels, &grid, &times)?;
         let samples = grid.len() * (tracks.len() + morph.len());
         let name: &str = &self.stack.element.name;
@@ -102,11 +147,10 @@ impl StackReader<'_> {
         Ok((clip.with_frame_rate(self.fps), samples))
     }
 
-    /// The nodes (typed ids) whose properties the stack animates, in order of appearance, every key time of their
-    /// curves and of the blend channels' (with a time just before each step), and whether each blend channel (by
-    /// typed id) is animated.
-    fn keys(&self) -> Result<(Vec<usize>, Vec<f64>, Vec<bool>)> {
+    /// What the stack animates, and every key time of it.
+    fn keys(&self) -> Result<Animated> {
         let mut seen = vec![false; self.scene.nodes.len()];
+        let mut moving = vec![false; self.scene.nodes.len()];
         let mut channels = vec![false; self.scene.blend_channels.len()];
         let (mut nodes, mut times) = (Vec::new(), Vec::new());
         for layer in self.stack.layers.iter() {
@@ -120,6 +164,10 @@ impl StackReader<'_> {
                         {
                             *flag = true;
                             nodes.push(id);
+                        }
+                        if let Some(moves) = moving.get_mut(id) {
+                            *moves |= layer.weight_is_animated
+                                || prop.anim_value.curves.iter().flatten().any(|c| !is_flat(c));
                         }
                     }
                     ufbx::ElementType::BlendChannel => {
@@ -159,7 +207,10 @@ impl StackReader<'_> {
             }
         }
         times.retain(|t| t.is_finite());
-        Ok((nodes, times, channels))
+        for &id in &nodes {
+            moving[id] |= self.scene.nodes.get(id).is_none_or(|node| !evaluated_from_own_curves(node));
+        }
+        Ok(Animated { nodes, moving, times, channels })
     }
 
     /// The stack's time span, or that of its keys when the stack states none (or a reversed one).
@@ -232,13 +283,38 @@ impl StackReader<'_> {
         }
         Ok(morph)
     }
+}
 
-    /// One animated node at every grid time (`times`: the grid as the clip's times).
-    fn sample(&self, bone: usize, node: &ufbx::Node, grid: &[f64], times: &Arc<[f64]>) -> Result<BoneTracks> {
-        let (mut translations, mut rotations, mut scales) =
-            (Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()), Vec::with_capacity(grid.len()));
-        for &time in grid {
-            let t = ufbx::evaluate_transform(&self.stack.anim, node, time);
+/// Samples nodes of one stack at every grid time; shared by the threads that sample.
+struct NodeSampler<'a> {
+    scene: &'a ufbx::SceneRoot,
+    /// The stack's index.
+    stack: usize,
+    /// The stack, for errors.
+    place: String,
+    grid: &'a [f64],
+    /// The grid as the clip's times.
+    times: &'a Arc<[f64]>,
+}
+
+impl NodeSampler<'_> {
+    /// The tracks of `bone`, the node with typed id `node`: evaluated at every grid time, or, when it does not
+    /// `move`, once and held.
+    fn sample(&self, bone: usize, node: usize, moves: bool) -> Result<BoneTracks> {
+        let (node, stack) = (&self.scene.nodes[node], &self.scene.anim_stacks[self.stack]);
+        let (mut translations, mut rotations, mut scales) = (
+            Vec::with_capacity(self.grid.len()),
+            Vec::with_capacity(self.grid.len()),
+            Vec::with_capacity(self.grid.len()),
+        );
+        let channels = Channels::of(node, stack);
+        let evaluate = |time| match &channels {
+            Some(channels) => channels.at(time),
+            None => ufbx::evaluate_transform(&stack.anim, node, time),
+        };
+        let held = if moves { None } else { self.grid.first().map(|&time| evaluate(time)) };
+        for &time in self.grid {
+            let t = held.unwrap_or_else(|| evaluate(time));
             translations.push(Vec3::new(t.translation.x as f32, t.translation.y as f32, t.translation.z as f32));
             rotations.push(Quat::from_xyzw(
                 t.rotation.x as f32,
@@ -248,15 +324,14 @@ impl StackReader<'_> {
             ));
             scales.push(Vec3::new(t.scale.x as f32, t.scale.y as f32, t.scale.z as f32));
         }
-        let fail = |what: &str, e| {
-            Failure::at(format!("{}, node `{}`", self.place(), node_name(node)), format!("{what}: {e}"))
-        };
+        let fail =
+            |what: &str, e| Failure::at(format!("{}, node `{}`", self.place, node_name(node)), format!("{what}: {e}"));
+        let times = || self.times.clone();
         let mut tracks = BoneTracks::new(bone);
         tracks.translation =
-            Some(Track::new(times.clone(), translations, Interpolation::Linear).map_err(|e| fail("translation", e))?);
-        tracks.rotation =
-            Some(Track::new(times.clone(), rotations, Interpolation::Linear).map_err(|e| fail("rotation", e))?);
-        tracks.scale = Some(Track::new(times.clone(), scales, Interpolation::Linear).map_err(|e| fail("scale", e))?);
+            Some(Track::new(times(), translations, Interpolation::Linear).map_err(|e| fail("translation", e))?);
+        tracks.rotation = Some(Track::new(times(), rotations, Interpolation::Linear).map_err(|e| fail("rotation", e))?);
+        tracks.scale = Some(Track::new(times(), scales, Interpolation::Linear).map_err(|e| fail("scale", e))?);
         Ok(tracks)
     }
 }

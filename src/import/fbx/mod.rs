@@ -19,10 +19,12 @@
 //! ufbx says what is wrong but not where, so a failed file is walked by [`locate`] to name the place.
 
 mod anim;
+mod channels;
 mod locate;
 mod mesh;
 mod scene;
 
+use std::fs::File;
 use std::path::Path;
 
 use super::failure::{Failure, Result};
@@ -31,7 +33,18 @@ use crate::model::Rig;
 
 /// Reads an FBX file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
-    read(bytes, options).map_err(|f| f.with_path(path))
+    let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len()))
+        .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)));
+    scene.and_then(|scene| read(&scene, bytes.len(), options)).map_err(|f| f.with_path(path))
+}
+
+/// Reads the FBX file at `path`, open as `file` after its first bytes `head`: ufbx reads the rest through a buffer of
+/// its own, so the file is never held in memory whole. (A file ufbx refuses is read whole to locate the break.)
+pub fn load_file(path: &Path, file: File, head: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
+    let size = file.metadata().map_or(head.len(), |m| usize::try_from(m.len()).unwrap_or(usize::MAX));
+    let scene = ufbx::load_stream_prefix(ufbx::Stream::File(file), head, ufbx_load_opts(options, size))
+        .map_err(|e| Failure::ufbx(&e, std::fs::read(path).ok().and_then(|bytes| locate::locate(&bytes))));
+    scene.and_then(|scene| read(&scene, size, options)).map_err(|f| f.with_path(path))
 }
 
 impl Failure {
@@ -103,13 +116,12 @@ pub fn ufbx_load_opts(options: &Options, file_size: usize) -> ufbx::LoadOpts<'st
     opts
 }
 
-fn read(bytes: &[u8], options: &Options) -> Result<Rig> {
-    let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len()))
-        .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)))?;
-    let mut notes = vec![space_note(&scene, options.space)];
-    let bones = scene::read(&scene, &mut notes)?;
-    let (skins, meshes) = mesh::read(&scene, &bones, bytes.len(), &mut notes)?;
-    let clips = anim::read_clips(&scene, &bones.bone_of_node, bytes.len(), &mut notes)?;
+/// The rig of a loaded scene from a file of `file_size` bytes (which bounds what may be sampled and copied).
+fn read(scene: &ufbx::SceneRoot, file_size: usize, options: &Options) -> Result<Rig> {
+    let mut notes = vec![space_note(scene, options.space)];
+    let bones = scene::read(scene, &mut notes)?;
+    let (skins, meshes) = mesh::read(scene, &bones, file_size, &mut notes)?;
+    let clips = anim::read_clips(scene, &bones.bone_of_node, file_size, &mut notes)?;
     Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, notes })
 }
 

@@ -7,6 +7,9 @@
 //! one element per `count`, which the range check ties to bytes present, except for zeros: those are capped at
 //! [`MAX_ZEROS`] bytes so a tiny hostile file cannot ask for gigabytes.
 
+use std::borrow::Cow;
+use std::ops::Range;
+
 use glam::{DMat4, Quat, Vec3};
 
 use super::buffers::Buffers;
@@ -106,51 +109,50 @@ impl<'a> Accessors<'a> {
 
     /// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
     pub fn times(&self, index: Uint, user: &str) -> Result<Vec<f64>> {
-        Ok(self.read::<f32, 1>(index, user, &TIMES)?.into_iter().map(|[t]| f64::from(t)).collect())
+        self.read(index, user, &TIMES, |[t]: [f32; 1]| f64::from(t))
     }
 
     /// `VEC3` float: translation and scale outputs.
     pub fn vec3s(&self, index: Uint, user: &str, what: &'static str) -> Result<Vec<Vec3>> {
         let vec3s = Use { what, kind: "VEC3", components: FLOAT };
-        Ok(self.read::<f32, 3>(index, user, &vec3s)?.into_iter().map(Vec3::from_array).collect())
+        self.read(index, user, &vec3s, Vec3::from_array)
     }
 
     /// `VEC3` positions or morph-target displacements, float or quantized.
     pub fn positions(&self, index: Uint, user: &str, what: &'static str) -> Result<Vec<Vec3>> {
         let positions = Use { what, kind: "VEC3", components: QUANTIZED };
-        Ok(self.read::<f32, 3>(index, user, &positions)?.into_iter().map(Vec3::from_array).collect())
+        self.read(index, user, &positions, Vec3::from_array)
     }
 
     /// `VEC4` quaternions `[x, y, z, w]`, float or normalized integers (decoded, not renormalized).
     pub fn rotations(&self, index: Uint, user: &str) -> Result<Vec<Quat>> {
-        Ok(self.read::<f32, 4>(index, user, &ROTATIONS)?.into_iter().map(Quat::from_array).collect())
+        self.read(index, user, &ROTATIONS, Quat::from_array)
     }
 
     /// Morph-target weights (`SCALAR`, float or normalized).
     pub fn morph_weights(&self, index: Uint, user: &str) -> Result<Vec<f32>> {
-        Ok(self.read::<f32, 1>(index, user, &MORPH_WEIGHTS)?.into_iter().map(|[w]| w).collect())
+        self.read(index, user, &MORPH_WEIGHTS, |[w]: [f32; 1]| w)
     }
 
     /// `MAT4` float, column-major as glTF stores it.
     pub fn matrices(&self, index: Uint, user: &str) -> Result<Vec<DMat4>> {
-        let matrices = self.read::<f32, 16>(index, user, &MATRICES)?;
-        Ok(matrices.into_iter().map(|m| DMat4::from_cols_array(&m.map(f64::from))).collect())
+        self.read(index, user, &MATRICES, |m: [f32; 16]| DMat4::from_cols_array(&m.map(f64::from)))
     }
 
     /// `JOINTS_0`: four unsigned byte or short joint indices per vertex.
     pub fn joints(&self, index: Uint, user: &str) -> Result<Vec<[u16; 4]>> {
         // Both allowed types fit in u16.
-        Ok(self.read::<u32, 4>(index, user, &JOINTS)?.into_iter().map(|j| j.map(|i| i as u16)).collect())
+        self.read(index, user, &JOINTS, |j: [u32; 4]| j.map(|i| i as u16))
     }
 
     /// `WEIGHTS_0`: four weights per vertex, float or unsigned normalized.
     pub fn weights(&self, index: Uint, user: &str) -> Result<Vec<[f32; 4]>> {
-        self.read::<f32, 4>(index, user, &WEIGHTS)
+        self.read(index, user, &WEIGHTS, |w: [f32; 4]| w)
     }
 
     /// Vertex indices (`SCALAR` unsigned byte, short or int).
     pub fn indices(&self, index: Uint, user: &str) -> Result<Vec<u32>> {
-        Ok(self.read::<u32, 1>(index, user, &INDICES)?.into_iter().map(|[i]| i).collect())
+        self.read(index, user, &INDICES, |[i]: [u32; 1]| i)
     }
 
     /// The first buffer that `accessors[index]` reads and that has no source in the file (see
@@ -163,8 +165,15 @@ impl<'a> Accessors<'a> {
         buffers.into_iter().find(|&b| !self.buffers.has_source(b))
     }
 
-    /// Every element of `accessors[index]`, used by `user` as `usage` allows, with its sparse substitutions.
-    fn read<T: Decode, const N: usize>(&self, index: Uint, user: &str, usage: &Use) -> Result<Vec<[T; N]>> {
+    /// Every element of `accessors[index]`, used by `user` as `usage` allows, with its sparse substitutions, each
+    /// made into what the caller keeps by `element` as it is decoded.
+    fn read<T: Decode, const N: usize, U: Clone>(
+        &self,
+        index: Uint,
+        user: &str,
+        usage: &Use,
+        element: impl Fn([T; N]) -> U,
+    ) -> Result<Vec<U>> {
         let accessor = schema::item(&self.root.accessors, index, "accessors", user)?;
         let place = format!("accessors[{}]", index.0);
         let data_type = check_type(accessor, usage, &place)?;
@@ -172,23 +181,24 @@ impl<'a> Accessors<'a> {
         let mut elements = match accessor.buffer_view {
             Some(view) => {
                 let layout = Layout { data_type, normalized: accessor.normalized, components: N };
-                self.elements(view, accessor.byte_offset.0, count, layout, true, &place)?.decode().collect()
+                self.elements(view, accessor.byte_offset.0, count, layout, true, &place)?.decode(&element)
             }
-            None => zeros(count, size_of::<[T; N]>(), &place)?,
+            None => zeros(count, size_of::<[T; N]>(), element([T::default(); N]), &place)?,
         };
         if let Some(sparse) = &accessor.sparse {
-            self.substitute(sparse, data_type, accessor.normalized, &mut elements, &format!("{place}.sparse"))?;
+            let layout = Layout { data_type, normalized: accessor.normalized, components: N };
+            self.substitute(sparse, layout, &element, &mut elements, &format!("{place}.sparse"))?;
         }
         Ok(elements)
     }
 
-    /// Replaces the elements that `sparse` lists by its values.
-    fn substitute<T: Decode, const N: usize>(
+    /// Replaces the elements that `sparse` lists by its values (laid out as `layout`).
+    fn substitute<T: Decode, const N: usize, U>(
         &self,
         sparse: &schema::Sparse,
-        data_type: DataType,
-        normalized: bool,
-        elements: &mut [[T; N]],
+        layout: Layout,
+        element: &impl Fn([T; N]) -> U,
+        elements: &mut [U],
         place: &str,
     ) -> Result<()> {
         let count = sparse.count.0;
@@ -205,14 +215,12 @@ impl<'a> Accessors<'a> {
         let index_place = format!("{place}.indices");
         let positions =
             self.elements(indices.buffer_view, indices.byte_offset.0, count, index_layout, false, &index_place)?;
-        let value_layout = Layout { data_type, normalized, components: N };
         let values = &sparse.values;
         let value_place = format!("{place}.values");
-        let values =
-            self.elements(values.buffer_view, values.byte_offset.0, count, value_layout, false, &value_place)?;
+        let values = self.elements(values.buffer_view, values.byte_offset.0, count, layout, false, &value_place)?;
         let mut previous = None;
-        for (k, ([position], value)) in positions.decode::<u32, 1>().zip(values.decode::<T, N>()).enumerate() {
-            let position = position as usize;
+        let positions = positions.decode(|[position]: [u32; 1]| position as usize);
+        for (k, (position, value)) in positions.into_iter().zip(values.decode(element)).enumerate() {
             if previous.is_some_and(|p| position <= p) || position >= elements.len() {
                 let message = format!(
                     "index {k} is {position}: indices must increase strictly and stay below count {}",
@@ -227,7 +235,7 @@ impl<'a> Accessors<'a> {
     }
 
     /// The checked bytes of `count` elements laid out as `layout` from `offset` in `bufferViews[view]`; `strided`
-    /// honours the view's `byteStride` (sparse data is always tightly packed).
+    /// honours the view's `byteStride` (sparse data is always tightly packed). Only those bytes are read.
     fn elements(
         &self,
         view_index: Uint,
@@ -239,7 +247,7 @@ impl<'a> Accessors<'a> {
     ) -> Result<Elements<'a>> {
         let view = schema::item(&self.root.buffer_views, view_index, "bufferViews", place)?;
         let view_place = format!("bufferViews[{}]", view_index.0);
-        let view_bytes = self.view_bytes(view, &view_place, place)?;
+        let view_range = self.view_range(view, &view_place, place)?;
         let element_size = layout.element_size();
         let stride = match view.byte_stride {
             Some(stride) if strided => stride.0,
@@ -255,27 +263,27 @@ impl<'a> Accessors<'a> {
                 last.checked_mul(stride).and_then(|n| n.checked_add(offset)).and_then(|n| n.checked_add(element_size))
             }
         };
-        let Some(bytes) = end.and_then(|end| view_bytes.get(offset..end)) else {
+        let Some(end) = end.filter(|&end| offset <= end && end <= view_range.len()) else {
             let message = format!(
                 "{count} elements of {element_size} bytes (stride {stride}) from byteOffset {offset} do not fit in \
                  {view_place} ({} bytes)",
-                view_bytes.len()
+                view_range.len()
             );
             return Err(Failure::at(place, message));
         };
+        let bytes = self.buffers.read(view.buffer, view_range.start + offset..view_range.start + end, place)?;
         Ok(Elements { bytes, stride, layout })
     }
 
-    /// The bytes of a buffer view (at `place`), checked to lie inside its buffer, which `user` needs.
-    fn view_bytes(&self, view: &schema::BufferView, place: &str, user: &str) -> Result<&'a [u8]> {
-        let buffer = self.buffers.bytes(view.buffer, user)?;
+    /// Where a buffer view (at `place`) lies in its buffer, checked to lie inside it; `user` needs it.
+    fn view_range(&self, view: &schema::BufferView, place: &str, user: &str) -> Result<Range<usize>> {
+        let buffer_len = self.buffers.len(view.buffer, user)?;
         let (offset, length) = (view.byte_offset.0, view.byte_length.0);
-        offset.checked_add(length).and_then(|end| buffer.get(offset..end)).ok_or_else(|| {
+        offset.checked_add(length).filter(|&end| end <= buffer_len).map(|end| offset..end).ok_or_else(|| {
             let message = format!(
-                "bytes {offset}..{} lie outside buffers[{}] ({} bytes)",
+                "bytes {offset}..{} lie outside buffers[{}] ({buffer_len} bytes)",
                 offset.saturating_add(length),
                 view.buffer.0,
-                buffer.len()
             );
             Failure::at(place, message)
         })
@@ -301,8 +309,8 @@ fn check_type(accessor: &schema::Accessor, usage: &Use, place: &str) -> Result<D
     }
 }
 
-/// `count` zero elements of `size` bytes each, within [`MAX_ZEROS`].
-fn zeros<T: Decode, const N: usize>(count: usize, size: usize, place: &str) -> Result<Vec<[T; N]>> {
+/// `count` copies of `zero`, elements of `size` bytes each in the file, within [`MAX_ZEROS`].
+fn zeros<U: Clone>(count: usize, size: usize, zero: U, place: &str) -> Result<Vec<U>> {
     if count.checked_mul(size).is_none_or(|bytes| bytes > MAX_ZEROS) {
         let message = format!(
             "{count} elements without a bufferView would take more than the {} MiB bonescope fills with zeros",
@@ -310,7 +318,7 @@ fn zeros<T: Decode, const N: usize>(count: usize, size: usize, place: &str) -> R
         );
         return Err(Failure::at(place, message));
     }
-    Ok(vec![[T::default(); N]; count])
+    Ok(vec![zero; count])
 }
 
 /// How one element is stored.
@@ -329,21 +337,42 @@ impl Layout {
 
 /// The checked bytes of some elements: `stride` apart, the last one ending the slice.
 struct Elements<'a> {
-    bytes: &'a [u8],
+    bytes: Cow<'a, [u8]>,
     stride: usize,
     layout: Layout,
 }
 
 impl Elements<'_> {
-    /// Each element's `N` components, decoded.
-    fn decode<T: Decode, const N: usize>(&self) -> impl Iterator<Item = [T; N]> + '_ {
-        let Layout { data_type, normalized, .. } = self.layout;
-        let size = data_type.size();
+    /// Each element's `N` components, decoded and made into what the reader keeps by `element`.
+    fn decode<T: Decode, const N: usize, U>(&self, element: impl Fn([T; N]) -> U) -> Vec<U> {
+        // A loop per component type, so that each knows how its components decode (the match inside
+        // `Decode::decode` folds away) and how wide they are.
+        match self.layout.data_type {
+            DataType::I8 => self.decode_as::<T, N, U, 1>(DataType::I8, element),
+            DataType::U8 => self.decode_as::<T, N, U, 1>(DataType::U8, element),
+            DataType::I16 => self.decode_as::<T, N, U, 2>(DataType::I16, element),
+            DataType::U16 => self.decode_as::<T, N, U, 2>(DataType::U16, element),
+            DataType::U32 => self.decode_as::<T, N, U, 4>(DataType::U32, element),
+            DataType::F32 => self.decode_as::<T, N, U, 4>(DataType::F32, element),
+        }
+    }
+
+    /// [`Elements::decode`] for components of `data_type`, `SIZE` bytes each.
+    #[inline(always)]
+    fn decode_as<T: Decode, const N: usize, U, const SIZE: usize>(
+        &self,
+        data_type: DataType,
+        element: impl Fn([T; N]) -> U,
+    ) -> Vec<U> {
+        let normalized = self.layout.normalized;
         // `bytes` ends with the last element: `chunks` yields each element, the last one possibly without padding.
-        self.bytes.chunks(self.stride).map(move |element| {
-            let mut components = element.chunks_exact(size);
-            std::array::from_fn(|_| T::decode(data_type, normalized, components.next().unwrap_or_default()))
-        })
+        let decode = |bytes: &[u8]| {
+            element(std::array::from_fn(|i| {
+                let component = bytes.get(i * SIZE..).and_then(<[u8]>::first_chunk::<SIZE>);
+                T::decode(data_type, normalized, component.unwrap_or(&[0; SIZE]))
+            }))
+        };
+        self.bytes.chunks(self.stride).map(decode).collect()
     }
 }
 
@@ -419,14 +448,14 @@ mod tests {
         // Two VEC2 u16 elements with stride 6: [1, 2, pad], [3, 4].
         let bytes = [1, 0, 2, 0, 0xEE, 0xEE, 3, 0, 4, 0];
         let layout = Layout { data_type: DataType::U16, normalized: false, components: 2 };
-        let elements = Elements { bytes: &bytes, stride: 6, layout };
-        assert_eq!(elements.decode::<u32, 2>().collect::<Vec<_>>(), vec![[1, 2], [3, 4]]);
+        let elements = Elements { bytes: Cow::Borrowed(&bytes), stride: 6, layout };
+        assert_eq!(elements.decode(|e: [u32; 2]| e), vec![[1, 2], [3, 4]]);
     }
 
     #[test]
     fn zeros_are_capped() {
-        assert_eq!(zeros::<f32, 3>(2, 12, "a").unwrap(), vec![[0.0; 3]; 2]);
-        assert!(zeros::<f32, 16>(usize::MAX / 2, 64, "a").is_err());
-        assert!(zeros::<f32, 16>(2_000_000, 64, "a").is_err());
+        assert_eq!(zeros(2, 12, [0.0; 3], "a").unwrap(), vec![[0.0; 3]; 2]);
+        assert!(zeros(usize::MAX / 2, 64, [0.0; 16], "a").is_err());
+        assert!(zeros(2_000_000, 64, [0.0; 16], "a").is_err());
     }
 }

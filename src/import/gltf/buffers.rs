@@ -1,22 +1,28 @@
-//! Buffer bytes: the GLB `BIN` chunk, base64 `data:` URIs, or files beside the glTF file, each read on first use.
+//! Buffer bytes: the GLB `BIN` chunk (read where it lies, as accessors need its bytes), base64 `data:` URIs (decoded
+//! as the JSON is read: [`Uri`]), or files beside the glTF file (read on first use).
 //!
 //! A buffer nothing reads is never opened, so a file whose unused buffer points at a missing file or an `http:` URI
 //! still loads; a buffer that is read and cannot be had fails naming who needed it. A URI may name a file in the
 //! glTF file's folder or below it, percent-encoded or not; absolute paths, `..` and every scheme but `data:` are
-//! refused, so a downloaded file cannot make bonescope read elsewhere on disk or reach the network. Each buffer is
-//! cut to its declared `byteLength` (a GLB chunk may carry padding), and an external file is read no further than
-//! that, so memory stays bounded by what the files actually hold.
+//! refused, so a downloaded file cannot make bonescope read elsewhere on disk or reach the network. No buffer is
+//! read beyond its declared `byteLength` (a GLB chunk may carry padding), an external file included, so memory
+//! stays bounded by what the files actually hold.
 
 use std::borrow::Cow;
 use std::cell::OnceCell;
+use std::fmt;
 use std::io::Read;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
 use base64::engine::DecodePaddingMode;
 use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
+use serde::Deserialize;
+use serde::de::{self, Deserializer, Visitor};
 
 use super::schema::{self, Uint};
+use super::source::Region;
 use super::{Failure, Result};
 
 /// Base64 as glTF writers produce it; some leave out the `=` padding.
@@ -28,23 +34,69 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
 /// The document's buffers, loaded when first asked for.
 pub(super) struct Buffers<'a> {
     declared: &'a [schema::Buffer],
-    blob: Option<&'a [u8]>,
+    blob: Option<Region<'a>>,
     folder: &'a Path,
-    loaded: Vec<OnceCell<std::result::Result<Cow<'a, [u8]>, String>>>,
+    loaded: Vec<OnceCell<std::result::Result<Data<'a>, String>>>,
+}
+
+/// A buffer's bytes: in memory (a `data:` URI's, decoded as the JSON was read, or a file's beside the glTF file), or
+/// the GLB `BIN` chunk, read where it lies as accessors need it.
+enum Data<'a> {
+    Memory(Cow<'a, [u8]>),
+    Blob(Region<'a>),
+}
+
+/// A buffer's `uri` as the JSON is read: a `data:` URI is decoded on the spot, straight from the JSON text (a `.gltf`
+/// file's base64 buffer is most of its text, which is then never copied as a string), any other URI kept to be
+/// followed when the buffer is needed.
+#[derive(Debug)]
+pub(super) enum Uri {
+    /// The bytes of a `data:` URI, or why they cannot be had (said only if the buffer is needed).
+    Data(std::result::Result<Vec<u8>, String>),
+    /// A file, by its URI reference.
+    Reference(String),
+}
+
+impl<'de> Deserialize<'de> for Uri {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
+        struct UriVisitor;
+
+        impl Visitor<'_> for UriVisitor {
+            type Value = Uri;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a URI")
+            }
+
+            fn visit_str<E: de::Error>(self, uri: &str) -> std::result::Result<Uri, E> {
+                Ok(match strip_prefix_ignore_case(uri, "data:") {
+                    Some(data) => Uri::Data(decode_data_uri(data)),
+                    None => Uri::Reference(uri.to_owned()),
+                })
+            }
+        }
+
+        deserializer.deserialize_str(UriVisitor)
+    }
 }
 
 impl<'a> Buffers<'a> {
-    pub fn new(declared: &'a [schema::Buffer], blob: Option<&'a [u8]>, folder: &'a Path) -> Self {
+    pub fn new(declared: &'a [schema::Buffer], blob: Option<Region<'a>>, folder: &'a Path) -> Self {
         Buffers { declared, blob, folder, loaded: declared.iter().map(|_| OnceCell::new()).collect() }
     }
 
-    /// The bytes of `buffers[index]`, exactly `byteLength` of them; `user` (`bufferViews[2]`) names who needs them.
-    pub fn bytes(&self, index: Uint, user: &str) -> Result<&[u8]> {
-        let declared = schema::item(self.declared, index, "buffers", user)?;
-        let loaded = self.loaded[index.0].get_or_init(|| self.load(index.0, declared));
-        match loaded {
-            Ok(bytes) => Ok(bytes),
-            Err(why) => Err(Failure::at(user, format!("needs buffers[{}]: {why}", index.0))),
+    /// The length of `buffers[index]` (its `byteLength`, which its data has been checked to hold); `user`
+    /// (`bufferViews[2]`) names who needs it.
+    pub fn len(&self, index: Uint, user: &str) -> Result<usize> {
+        Ok(self.data(index, user)?.1.byte_length.0)
+    }
+
+    /// The bytes of `buffers[index]` in `range`, which must lie within [`Buffers::len`].
+    pub fn read(&self, index: Uint, range: Range<usize>, user: &str) -> Result<Cow<'_, [u8]>> {
+        let fail = |why: String| Failure::at(user, format!("needs buffers[{}]: {why}", index.0));
+        match self.data(index, user)?.0 {
+            Data::Memory(bytes) => bytes.get(range).map(Cow::Borrowed).ok_or_else(|| fail("out of range".into())),
+            Data::Blob(region) => region.read(range).map_err(|e| fail(format!("cannot read the file: {e}"))),
         }
     }
 
@@ -54,32 +106,38 @@ impl<'a> Buffers<'a> {
         self.declared.get(index.0).is_some_and(|b| b.uri.is_some()) || (index.0 == 0 && self.blob.is_some())
     }
 
-    fn load(&self, index: usize, declared: &schema::Buffer) -> std::result::Result<Cow<'a, [u8]>, String> {
+    /// The loaded data of `buffers[index]` and its declaration.
+    fn data(&self, index: Uint, user: &str) -> Result<(&Data<'a>, &'a schema::Buffer)> {
+        let declared = schema::item(self.declared, index, "buffers", user)?;
+        let loaded = self.loaded[index.0].get_or_init(|| self.load(index.0, declared));
+        match loaded {
+            Ok(data) => Ok((data, declared)),
+            Err(why) => Err(Failure::at(user, format!("needs buffers[{}]: {why}", index.0))),
+        }
+    }
+
+    fn load(&self, index: usize, declared: &'a schema::Buffer) -> std::result::Result<Data<'a>, String> {
         let length = declared.byte_length.0;
         let data = match (&declared.uri, self.blob) {
-            (Some(uri), _) => Cow::Owned(read_uri(uri, self.folder, length)?),
-            (None, Some(blob)) if index == 0 => Cow::Borrowed(blob),
+            (Some(Uri::Data(decoded)), _) => Data::Memory(Cow::Borrowed(decoded.as_deref().map_err(Clone::clone)?)),
+            (Some(Uri::Reference(uri)), _) => Data::Memory(Cow::Owned(read_file(uri, self.folder, length)?)),
+            (None, Some(blob)) if index == 0 => Data::Blob(blob),
             (None, _) if index == 0 => return Err("it has no uri, and the file has no GLB BIN chunk".into()),
             (None, _) => return Err("it has no uri (only buffers[0] can be the GLB BIN chunk)".into()),
         };
-        if data.len() < length {
-            return Err(format!("its byteLength is {length} but the data holds {} bytes", data.len()));
+        let held = match &data {
+            Data::Memory(bytes) => bytes.len(),
+            Data::Blob(region) => region.len,
+        };
+        if held < length {
+            return Err(format!("its byteLength is {length} but the data holds {held} bytes"));
         }
-        Ok(match data {
-            Cow::Borrowed(bytes) => Cow::Borrowed(&bytes[..length]),
-            Cow::Owned(mut bytes) => {
-                bytes.truncate(length);
-                Cow::Owned(bytes)
-            }
-        })
+        Ok(data)
     }
 }
 
-/// The bytes a buffer URI names (at most `length` of them for a file).
-fn read_uri(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
-    if let Some(data) = strip_prefix_ignore_case(uri, "data:") {
-        return decode_data_uri(data);
-    }
+/// At most `length` bytes of the file a buffer URI reference names.
+fn read_file(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
     let path = folder.join(relative_path(uri)?);
     let file = std::fs::File::open(&path).map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
     let mut data = Vec::new();

@@ -1,12 +1,16 @@
 //! The container (JSON text or GLB) and the document inside it.
 //!
 //! GLB framing is read here rather than by the `gltf` crate, because the crate refuses what the specification
-//! allows (chunks of unknown types, which a loader must skip) and panics on a header length below 12. The JSON is
+//! allows (chunks of unknown types, which a loader must skip) and panics on a header length below 12. The JSON chunk
+//! is read from the [`Source`]; the `BIN` chunk is only located, its bytes read when accessors need them. The JSON is
 //! deserialized into [`schema::Root`], which declares only what bonescope reads; an error names its place as a
 //! JSON path (`accessors[3].count`). Extensions listed in `extensionsRequired` are refused unless bonescope
 //! evaluates them or they only change what bonescope neither reads nor draws (materials, textures, lights).
 
+use std::borrow::Cow;
+
 use super::schema::Root;
+use super::source::{Region, Source};
 use super::{Failure, Result};
 
 const GLB_MAGIC: &[u8] = b"glTF";
@@ -23,43 +27,48 @@ const NOT_DRAWN: &[&str] = &["KHR_materials_", "KHR_texture_", "EXT_texture_", "
 /// The parsed document with the GLB `BIN` chunk, if any.
 pub(super) struct Parsed<'a> {
     pub root: Root,
-    pub blob: Option<&'a [u8]>,
+    pub blob: Option<Region<'a>>,
     /// Facts worth telling the user (required extensions ignored, say).
     pub notes: Vec<String>,
 }
 
-pub(super) fn parse(bytes: &[u8]) -> Result<Parsed<'_>> {
-    let (json, blob) = if bytes.starts_with(GLB_MAGIC) {
-        split_glb(bytes)?
-    } else {
-        (bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes), None)
-    };
+pub(super) fn parse(source: Source<'_>) -> Result<Parsed<'_>> {
+    let glb = read(source, 0, GLB_MAGIC.len().min(source.len()))? == GLB_MAGIC;
+    let (json, blob) = if glb { split_glb(source)? } else { (read(source, 0, source.len())?, None) };
+    // A JSON file may start with a byte order mark (a GLB's JSON chunk may not).
+    let json = if glb { &json[..] } else { json.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&json) };
     let root = deserialize(json)?;
     check_version(&root)?;
     let notes = check_required_extensions(&root)?;
     Ok(Parsed { root, blob, notes })
 }
 
+/// `len` bytes of the file from `start` (which the caller has checked it holds).
+fn read(source: Source<'_>, start: usize, len: usize) -> Result<Cow<'_, [u8]>> {
+    source.read(start..start + len).map_err(|e| Failure::whole(format!("cannot read the file: {e}")))
+}
+
 /// The JSON chunk and the first `BIN` chunk of a GLB; chunks of other types are skipped, as the spec asks.
-fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
+fn split_glb(source: Source<'_>) -> Result<(Cow<'_, [u8]>, Option<Region<'_>>)> {
     let header = |message: String| Failure::at("GLB header", message);
-    let word = |bytes: &[u8], at: usize| bytes.get(at..at + 4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
-    let (Some(version), Some(length)) = (word(bytes, 4), word(bytes, 8)) else {
-        return Err(header(format!("truncated: {} of 12 bytes", bytes.len())));
+    let file_len = source.len();
+    let Some(bytes) = (file_len >= GLB_HEADER_LEN).then(|| read(source, 0, GLB_HEADER_LEN)).transpose()? else {
+        return Err(header(format!("truncated: {file_len} of 12 bytes")));
     };
+    let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let (version, length) = (word(4), word(8) as usize);
     if version != 2 {
         return Err(header(format!("version {version}, expected 2")));
     }
-    let length = length as usize;
     if length < GLB_HEADER_LEN {
         return Err(header(format!("declares a total length of {length} bytes")));
     }
-    let Some(body) = bytes.get(GLB_HEADER_LEN..length) else {
-        return Err(header(format!("declares {length} bytes but the file has {} (truncated?)", bytes.len())));
-    };
-    let mut chunks = Chunks { rest: body, index: 0 };
+    if length > file_len {
+        return Err(header(format!("declares {length} bytes but the file has {file_len} (truncated?)")));
+    }
+    let mut chunks = Chunks { source, at: GLB_HEADER_LEN, end: length, index: 0 };
     let json = match chunks.next().transpose()? {
-        Some((CHUNK_JSON, json)) => json,
+        Some((CHUNK_JSON, json)) => read(source, json.start, json.len)?,
         Some(_) => return Err(Failure::at("GLB chunks[0]", "is not the JSON chunk (JSON must come first)")),
         None => return Err(Failure::at("GLB chunks", "no JSON chunk")),
     };
@@ -71,34 +80,42 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
     Ok((json, None))
 }
 
-/// The chunks of a GLB body: `(type, data)`.
+/// The chunks of a GLB body, from `at` to `end`: `(type, where its data lies)`.
 struct Chunks<'a> {
-    rest: &'a [u8],
+    source: Source<'a>,
+    at: usize,
+    end: usize,
     index: usize,
 }
 
 impl<'a> Iterator for Chunks<'a> {
-    type Item = Result<(u32, &'a [u8])>;
+    type Item = Result<(u32, Region<'a>)>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        if self.rest.is_empty() {
+        if self.at >= self.end {
             return None;
         }
         let place = format!("GLB chunks[{}]", self.index);
         self.index += 1;
-        let Some((header, data)) = self.rest.split_first_chunk::<CHUNK_HEADER_LEN>() else {
-            self.rest = &[];
+        let (at, remaining) = (self.at, self.end - self.at);
+        self.at = self.end;
+        if remaining < CHUNK_HEADER_LEN {
             return Some(Err(Failure::at(place, "truncated chunk header")));
+        }
+        let header = match read(self.source, at, CHUNK_HEADER_LEN) {
+            Ok(header) => header,
+            Err(failure) => return Some(Err(failure)),
         };
         let length = u32::from_le_bytes([header[0], header[1], header[2], header[3]]) as usize;
         let kind = u32::from_le_bytes([header[4], header[5], header[6], header[7]]);
-        let Some((chunk, rest)) = data.split_at_checked(length) else {
-            self.rest = &[];
-            let message = format!("declares {length} bytes but only {} remain (truncated?)", data.len());
+        let start = at + CHUNK_HEADER_LEN;
+        let available = remaining - CHUNK_HEADER_LEN;
+        if length > available {
+            let message = format!("declares {length} bytes but only {available} remain (truncated?)");
             return Some(Err(Failure::at(place, message)));
-        };
-        self.rest = rest;
-        Some(Ok((kind, chunk)))
+        }
+        self.at = start + length;
+        Some(Ok((kind, Region { source: self.source, start, len: length })))
     }
 }
 
@@ -188,14 +205,15 @@ mod tests {
     #[test]
     fn glb_chunks_of_unknown_types_are_skipped() {
         let bytes = glb(&[(CHUNK_JSON, b"{}  "), (0x1234, b"xxxx"), (CHUNK_BIN, b"\x01\x02\x03\x04")]);
-        let (json, bin) = split_glb(&bytes).unwrap();
-        assert_eq!((json, bin), (&b"{}  "[..], Some(&b"\x01\x02\x03\x04"[..])));
-        assert_eq!(split_glb(&glb(&[(CHUNK_JSON, b"{}  ")])).unwrap().1, None);
+        let (json, bin) = split_glb(Source::Memory(&bytes)).unwrap();
+        assert_eq!(&json[..], b"{}  ");
+        assert_eq!(&bin.unwrap().read(0..4).unwrap()[..], b"\x01\x02\x03\x04");
+        assert!(split_glb(Source::Memory(&glb(&[(CHUNK_JSON, b"{}  ")]))).unwrap().1.is_none());
     }
 
     #[test]
     fn broken_glb_framing_is_placed() {
-        let place = |bytes: &[u8]| split_glb(bytes).unwrap_err().place.unwrap();
+        let place = |bytes: &[u8]| split_glb(Source::Memory(bytes)).unwrap_err().place.unwrap();
         assert_eq!(place(b"glTF\x02\0\0\0\x04\0\0\0"), "GLB header");
         assert_eq!(place(&glb(&[(CHUNK_BIN, b"")])), "GLB chunks[0]");
         let mut truncated = glb(&[(CHUNK_JSON, b"{}  "), (CHUNK_BIN, b"abcd")]);

@@ -3,7 +3,7 @@
 //! Read as leniently as the specification allows and exactly where it matters: [`document`] frames the GLB and
 //! deserializes only the parts of the JSON bonescope uses ([`schema`]), so materials, textures and unknown
 //! extensions can never stop a file from loading; references are checked where they are followed, and buffers are
-//! read when an accessor first needs them. Everything that touches binary data goes through the bounds-checked
+//! read when an accessor first needs them (from a file on disk, only the bytes accessors read: [`source`]). Everything that touches binary data goes through the bounds-checked
 //! reader in [`accessor`] (sparse accessors and accessors without a buffer view included). Every check fails with a
 //! [`Failure`] that names the place in the document (`accessors[5]`, `animations[0].samplers[2]`), which [`load`]
 //! turns into an [`ImportError`].
@@ -15,21 +15,31 @@ mod document;
 mod mesh;
 mod scene;
 mod schema;
+mod source;
 
+use std::fs::File;
 use std::path::Path;
 
 use super::ImportError;
 use crate::model::Rig;
+use source::Source;
 
 use super::failure::{Failure, Result};
 
-/// Reads a glTF 2.0 file (its bytes already in memory; external buffers are read from beside `path`).
+/// Reads a glTF 2.0 file whose bytes are in memory (external buffers are read from beside `path`).
 pub fn load(path: &Path, bytes: &[u8]) -> std::result::Result<Rig, ImportError> {
-    read(path, bytes).map_err(|f| f.with_path(path))
+    read(path, Source::Memory(bytes)).map_err(|f| f.with_path(path))
 }
 
-fn read(path: &Path, bytes: &[u8]) -> Result<Rig> {
-    let parsed = document::parse(bytes)?;
+/// Reads the glTF 2.0 file at `path`, open as `file`, reading only what it needs of it (see [`source`]).
+pub fn load_file(path: &Path, file: &File) -> std::result::Result<Rig, ImportError> {
+    let len = file.metadata().map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?.len();
+    let len = usize::try_from(len).unwrap_or(usize::MAX);
+    read(path, Source::File { file, len }).map_err(|f| f.with_path(path))
+}
+
+fn read(path: &Path, source: Source<'_>) -> Result<Rig> {
+    let parsed = document::parse(source)?;
     let mut notes = vec!["units: metres, Y-up (glTF)".to_owned()];
     notes.extend(parsed.notes);
     let root = &parsed.root;

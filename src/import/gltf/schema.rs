@@ -12,6 +12,7 @@ use std::fmt;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 
+use super::buffers::Uri;
 use super::{Failure, Result};
 
 /// A non-negative JSON integer: an index, a count, a byte offset. Written `1` or `1.0`.
@@ -241,7 +242,7 @@ pub(super) struct BufferView {
 pub(super) struct Buffer {
     /// Absent: the GLB `BIN` chunk (for `buffers[0]`) or data supplied some other way.
     #[serde(default)]
-    pub uri: Option<String>,
+    pub uri: Option<Uri>,
     pub byte_length: Uint,
 }
 
