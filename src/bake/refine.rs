@@ -52,13 +52,16 @@ pub fn refine(
             .samples
             .par_chunks_mut(pool.bones.max(1))
             .zip(&intervals)
-            .map(|(middle, &(a, b))| {
+            .zip(&middles)
+            .map(|((middle, &(a, b)), &time)| {
+                // The middle in single precision is not quite half way.
+                let fraction = (time - pool_times[a]) / (pool_times[b] - pool_times[a]);
                 let (left, right) = (pool.row(a), pool.row(b));
                 let mut missed = false;
                 for (bone, exact) in middle.iter_mut().enumerate() {
                     align(exact, &left[bone]);
                     let [a, b, middle] = [&left[bone], &right[bone], &*exact].map(|n| n.as_baked(helper[bone]));
-                    missed |= too_far(&a, &b) || misses(bone, &interpolate(&a, &b, 0.5), &middle);
+                    missed |= too_far(&a, &b) || misses(bone, &interpolate(&a, &b, fraction), &middle);
                 }
                 missed
             })
