@@ -1,12 +1,18 @@
-//! `bake` and `diff`, beside loading the same rig: ProAnimationBank's `locomotions.fbx` (three takes, 76 nodes) and
-//! a generated rig of 200 bones and 6,000 frames (`import::stress_rig`: a rotation key every frame on every bone, a
-//! scale key on every tenth), baked as the file declares and with every bone under segment scale compensate (its
-//! scaled bones' children then need helper nodes and densely sampled compensation).
+//! `bake` and `diff`, beside loading the same file: ProAnimationBank's `locomotions.fbx` (three takes, 76 nodes) and
+//! the generated glTF of the loading benchmarks (`support/generated_gltf.rs`: 200 bones, 6,000 frames at 60 Hz, a
+//! rotation key every frame on every bone, every 25th bone squashing), baked as the file declares and with every
+//! bone under segment scale compensate (the squashing bones' children then need helper nodes and densely sampled
+//! compensation).
 //!
-//! `cargo bench --locked --bench bake`; figures in BENCHMARKS.md (§8). `load` is `import::load` of the file (for
-//! the generated rig, of its exact bake, the same rig as a 6,000-frame glTF); `bake` the whole bake (sampling,
-//! keys, the GLB bytes), `report` the bake read back and compared at every sampled time (what `bonescope bake`
-//! prints), `diff` the source against the bake at its key times and 60 Hz (what `bonescope diff` does).
+//! `cargo bench --locked --bench bake`; figures in BENCHMARKS.md (§8). `load` is `import::load` of the file; `bake`
+//! the whole bake (sampling, keys, the GLB bytes), `report` the bake read back and compared at every sampled time
+//! (what `bonescope bake` prints), `diff` the source against the bake at its key times and 60 Hz (what `bonescope
+//! diff` does).
+
+// Shared with the loading benchmarks, which also load its base64 `.gltf` container.
+#[allow(dead_code)]
+#[path = "support/generated_gltf.rs"]
+mod generated_gltf;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -59,11 +65,10 @@ fn baking(c: &mut Criterion) {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
     let rig = import::load(&locomotions).expect("the shared assets are beside the repository");
     benches(c, "locomotions.fbx", &rig, &locomotions, None);
-    let generated = import::stress_rig(200, 6000, 1);
     let folder = tempfile::tempdir().unwrap();
-    let file: PathBuf = folder.path().join("generated.glb");
-    let exact = Request { tolerance: 0.0, ..request(&generated, None) };
-    bake::save(&file, &bake::bake(&exact).glb).unwrap();
+    let file: PathBuf = folder.path().join("generated_200x6000.glb");
+    std::fs::write(&file, generated_gltf::glb()).unwrap();
+    let generated = import::load(&file).unwrap();
     benches(c, "generated_200x6000", &generated, &file, None);
     benches(c, "generated_200x6000_compensate", &generated, &file, Some(InheritMode::SegmentCompensate));
 }
