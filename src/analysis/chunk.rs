@@ -189,7 +189,7 @@ impl Chunk<'_> {
             };
             let run = match fixed {
                 Some(above) => {
-                    let stretch = above.child(&mut CursorAt(&mut cursor, times[0]), DQuat::IDENTITY);
+                    let stretch = above.child(&mut CursorAt(&mut cursor, times[0]), DQuat::IDENTITY, &self.judge);
                     result.add_throughout(bone, times, &stretch.verdict(&self.judge));
                     Run::Fixed(stretch)
                 }
@@ -198,8 +198,8 @@ impl Chunk<'_> {
                     stretches.clear();
                     let mut start = DQuat::IDENTITY;
                     for (sample, &time) in times.iter().enumerate() {
-                        let stretch = above.at(sample).child(&mut CursorAt(&mut cursor, time), start);
-                        start = stretch.frame;
+                        let stretch = above.at(sample).child(&mut CursorAt(&mut cursor, time), start, &self.judge);
+                        start = stretch.frame();
                         result.add(bone, sample, time, &stretch.verdict(&self.judge));
                         stretches.push(stretch);
                     }
@@ -275,11 +275,11 @@ impl Chunk<'_> {
         for (sample, &time) in self.times.iter().enumerate() {
             self.subject.evaluate(&mut pose, plan.hierarchy, layers, time);
             for &bone in &plan.judged {
-                let start = stretches[bone].frame;
+                let start = stretches[bone].frame();
                 let stretch = match plan.parents[bone] {
                     _ if !plan.inherits[bone] => Stretch::of_matrix(&pose.model.model[bone], start),
-                    Some(parent) => stretches[parent].child(&mut &pose.local[bone], start),
-                    None => Stretch::NONE.child(&mut &pose.local[bone], start),
+                    Some(parent) => stretches[parent].child(&mut &pose.local[bone], start, &self.judge),
+                    None => Stretch::NONE.child(&mut &pose.local[bone], start, &self.judge),
                 };
                 stretches[bone] = stretch;
                 result.add(bone, sample, time, &stretch.verdict(&self.judge));
@@ -345,7 +345,9 @@ impl Plotter {
             curves.zip(bones).zip(&mut self.starts).zip(stretches)
         {
             let m = &model[bone];
-            let parts = decompose_with_stretch(m, stretch.frame, stretch.scale, stretch.sign)
+            let parts = stretch
+                .factors()
+                .and_then(|(frame, scale, sign)| decompose_with_stretch(m, frame, scale, sign))
                 .unwrap_or_else(|| decompose_near(m, *start));
             *start = parts.stretch;
             model_curve[sample] = Components::of_parts(&parts, m);

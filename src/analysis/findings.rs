@@ -104,13 +104,45 @@ pub(crate) struct Judge {
     stretch_half_cosine: f64,
     /// `sin²(min_shear_deg)`: a shear of angle `φ` has a largest column cosine of `sin φ`.
     shear_cosine_squared: f64,
+    /// The square of the largest spread `e/g` of `MᵀM` around `g·I` ([`Judge::certainly_uniform`]) that keeps the
+    /// scale factors' ratio below `1 + min_anisotropy/2`; 0 where the tolerances leave no room for that.
+    uniform_spread_squared: f64,
 }
+
+/// Anisotropy tolerances below this are too close to rounding for [`Judge::certainly_uniform`] to certify anything.
+const CERTIFIABLE_ANISOTROPY: f64 = 1e-10;
 
 impl Judge {
     pub fn new(tolerances: &Tolerances) -> Self {
         let stretch_half_cosine = (tolerances.min_stretch_deg.to_radians() * 0.5).cos();
         let shear_cosine_squared = tolerances.min_shear_deg.to_radians().sin().powi(2);
-        Judge { tolerances: *tolerances, stretch_half_cosine, shear_cosine_squared }
+        // Eigenvalues of MᵀM within g·(1 ± s) put the factors' ratio at most √((1+s)/(1−s)); half the tolerance is
+        // the target, the other half the margin for rounding (some 1e-15 here, in the SVD's factors).
+        let ratio_squared = (1.0 + 0.5 * tolerances.min_anisotropy).powi(2);
+        let spread = (ratio_squared - 1.0) / (ratio_squared + 1.0);
+        let certifiable = tolerances.min_anisotropy >= CERTIFIABLE_ANISOTROPY
+            && tolerances.degenerate_ratio * (1.0 + tolerances.min_anisotropy) < 1.0;
+        let uniform_spread_squared = if certifiable { spread * spread } else { 0.0 };
+        Judge { tolerances: *tolerances, stretch_half_cosine, shear_cosine_squared, uniform_spread_squared }
+    }
+
+    /// Whether a matrix with the Gram matrix `gram` (`MᵀM`) certainly has scale factors within half the anisotropy
+    /// tolerance of each other: every eigenvalue of `MᵀM` lies within `‖MᵀM − g·I‖_F` of `g`, its mean. Its
+    /// verdicts are then [`Judge::uniform_verdict`]'s, whatever its stretch frame.
+    #[inline]
+    pub fn certainly_uniform(&self, gram: &DMat3) -> bool {
+        let g = (gram.x_axis.x + gram.y_axis.y + gram.z_axis.z) / 3.0;
+        let spread = *gram - DMat3::from_diagonal(DVec3::splat(g));
+        let squared = spread.x_axis.length_squared() + spread.y_axis.length_squared() + spread.z_axis.length_squared();
+        // Strictly below: nothing passes when the tolerances leave no room (a spread of 0).
+        g > 0.0 && squared < self.uniform_spread_squared * g * g
+    }
+
+    /// The verdicts on a matrix [`Judge::certainly_uniform`] passed, of determinant sign `sign`: not anisotropic, so
+    /// neither stretched nor non-uniform (the stretch angle is 0), nor degenerate.
+    pub fn uniform_verdict(&self, sign: f64, shear_cosine_squared: f64) -> Verdict {
+        let findings = Findings { stretched: false, non_uniform: false, mirrored: sign < 0.0, degenerate: false };
+        Verdict { findings, stretch_half_cosine: 1.0, shear_cosine_squared }
     }
 
     /// The verdicts on a matrix whose stretch is `U·K·Uᵀ` (`U = R(stretch)`, `K = diag(scale)`), whose

@@ -29,7 +29,7 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-use super::channels::Channels;
+use super::channels::{Channels, evaluated_from_own_properties};
 use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
 use crate::model::{BoneTracks, Clip, Interpolation, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
@@ -92,16 +92,6 @@ struct Animated {
 fn is_flat(curve: &ufbx::AnimCurve) -> bool {
     let first = curve.keyframes.first().map(|k| k.value);
     curve.keyframes.iter().all(|k| Some(k.value) == first && k.left.dy == 0.0 && k.right.dy == 0.0)
-}
-
-/// Whether `ufbx_evaluate_transform` of `node` depends on time only through the node's own animated properties: none
-/// of its properties takes its value from a connection, and no scale helper (whose scale ufbx evaluates too) is
-/// involved.
-fn evaluated_from_own_curves(node: &ufbx::Node) -> bool {
-    let connected = node.element.props.props.iter().any(|p| p.flags.has_any(ufbx::PropFlags::CONNECTED));
-    let parent_helpers =
-        node.parent.as_ref().is_some_and(|p| p.scale_helper.is_some() || p.inherit_scale_node.is_some());
-    !connected && !parent_helpers && node.scale_helper.is_none() && !node.is_scale_helper
 }
 
 struct StackReader<'a> {
@@ -208,7 +198,7 @@ impl StackReader<'_> {
         }
         times.retain(|t| t.is_finite());
         for &id in &nodes {
-            moving[id] |= self.scene.nodes.get(id).is_none_or(|node| !evaluated_from_own_curves(node));
+            moving[id] |= self.scene.nodes.get(id).is_none_or(|node| !evaluated_from_own_properties(node));
         }
         Ok(Animated { nodes, moving, times, channels })
     }

@@ -48,16 +48,11 @@ impl<'a> Channels<'a> {
         };
         let props = &node.element.props;
         let adjusted = node.has_adjust_transform || node.adjust_mirror_axis != ufbx::MirrorAxis::None;
-        let helped = node.scale_helper.is_some()
-            || node.is_scale_helper
-            || node.parent.as_ref().is_some_and(|p| p.scale_helper.is_some() || p.inherit_scale_node.is_some());
-        let connected = props.props.iter().any(|p| p.flags.has_any(ufbx::PropFlags::CONNECTED));
         let animated = |name| ufbx::find_anim_prop(layer, &node.element, name).is_some();
         let other = |name| animated(name) || ufbx::find_prop(props, name).is_some_and(|p| !is_zero(vector(p)));
         if node.is_root
             || adjusted
-            || helped
-            || connected
+            || !evaluated_from_own_properties(node)
             || animated("RotationOrder")
             || OTHER_VECTORS.into_iter().any(other)
         {
@@ -102,6 +97,16 @@ impl<'a> Channels<'a> {
             scale,
         }
     }
+}
+
+/// Whether `ufbx_evaluate_transform` of `node` depends on time only through the node's own animated properties: none
+/// of its properties takes its value from a connection, and no scale helper (whose scale ufbx evaluates too) is
+/// involved.
+pub(super) fn evaluated_from_own_properties(node: &ufbx::Node) -> bool {
+    let connected = node.element.props.props.iter().any(|p| p.flags.has_any(ufbx::PropFlags::CONNECTED));
+    let parent_helpers =
+        node.parent.as_ref().is_some_and(|p| p.scale_helper.is_some() || p.inherit_scale_node.is_some());
+    !connected && !parent_helpers && node.scale_helper.is_none() && !node.is_scale_helper
 }
 
 /// A property's value as a vector (ufbx's `value_vec3`, the first three components of `value_vec4`).
