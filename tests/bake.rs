@@ -352,21 +352,22 @@ fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
     }
 }
 
+/// `rig` baked exactly as it declares itself, with the default keys, and the bake read back.
+fn baked_as_declared(rig: &Rig) -> (Request<'_>, bake::Baked, Rig) {
+    let modes = rig.skeleton.declared_modes();
+    let clips = bake::every_clip(rig, None);
+    let request = Request { rig, modes, clips, strategy: Strategy::Exact, tolerance: bake::DEFAULT_TOLERANCE };
+    let baked = bake::bake(&request);
+    let back = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+    (request, baked, back)
+}
+
 #[test]
 fn normals_morph_targets_and_their_weights_travel_with_the_meshes() {
     // Maya's in-between blend shapes, animated: the baked file's morph targets and weights give the source's
     // vertices within the tolerance on a dense grid; its normals are the source's.
-    let path = asset("fbx-ufbx-corpus/maya_blend_inbetween_7500_ascii.fbx");
-    let rig = import::load(&path).unwrap();
-    let request = Request {
-        rig: &rig,
-        modes: rig.skeleton.declared_modes(),
-        clips: bake::every_clip(&rig, None),
-        strategy: Strategy::Exact,
-        tolerance: bake::DEFAULT_TOLERANCE,
-    };
-    let baked = bake::bake(&request);
-    let back = import::load_bytes(Path::new("morph.glb"), &baked.glb).unwrap();
+    let rig = import::load(&asset("fbx-ufbx-corpus/maya_blend_inbetween_7500_ascii.fbx")).unwrap();
+    let (request, baked, back) = baked_as_declared(&rig);
     let (source, result) = (&rig.meshes[0], &back.meshes[0]);
     assert_eq!(result.morph_targets.len(), source.morph_targets.len());
     assert!(!source.normals.is_empty());
@@ -383,18 +384,9 @@ fn normals_morph_targets_and_their_weights_travel_with_the_meshes() {
 
 #[test]
 fn a_dual_quaternion_skin_is_baked_linear_and_the_report_says_what_it_costs() {
-    let path = asset("fbx-ufbx-corpus/maya_dual_quaternion_7500_ascii.fbx");
-    let rig = import::load(&path).unwrap();
-    let request = Request {
-        rig: &rig,
-        modes: rig.skeleton.declared_modes(),
-        clips: bake::every_clip(&rig, None),
-        strategy: Strategy::Exact,
-        tolerance: bake::DEFAULT_TOLERANCE,
-    };
-    let baked = bake::bake(&request);
+    let rig = import::load(&asset("fbx-ufbx-corpus/maya_dual_quaternion_7500_ascii.fbx")).unwrap();
+    let (request, baked, back) = baked_as_declared(&rig);
     assert!(baked.notes.iter().any(|n| n.contains("dual quaternions")), "{:?}", baked.notes);
-    let back = import::load_bytes(Path::new("dq.glb"), &baked.glb).unwrap();
     let report = bake::report(&request, &baked, &back);
     let animation = &report.animations[0];
     let bones = animation.bones.iter().map(|b| b.probe.max).fold(0.0, f64::max);
