@@ -204,3 +204,20 @@ fn a_layered_bake_is_one_new_clip() {
     let baked = json(&bonescope(&["inspect", &out, "--format", "json"]));
     assert!((baked["animation"]["duration"].as_f64().unwrap() - 1.0).abs() < 1e-6, "the synced cycle lasts 1 s");
 }
+
+#[test]
+fn a_blender_fbx_export_pairs_with_its_gltf_take_by_take() {
+    // Blender names FBX takes `Armature|take`: they pair with the glTF's `take`, and the comparison shows where the
+    // two exports of one rig part (the FBX's armature turned a quarter for its axes).
+    let (gltf, fbx) = (path(&asset("blender/stretchy_full.glb")), path(&asset("blender/stretchy_full.fbx")));
+    let report = json(&bonescope(&["diff", &gltf, &fbx, "--format", "json"]));
+    let animations = report["animations"].as_array().unwrap();
+    let pairs: Vec<(&str, &str)> =
+        animations.iter().map(|a| (a["a"].as_str().unwrap(), a["b"].as_str().unwrap())).collect();
+    assert_eq!(pairs, [("squash_stretch", "Stretchy|squash_stretch"), ("wave", "Stretchy|wave")]);
+    let root = &animations[0]["bones"][0];
+    assert_eq!(
+        (root["name"].as_str(), root["orientation_deg"]["max"].as_f64().map(f64::round)),
+        (Some("Stretchy"), Some(90.0))
+    );
+}

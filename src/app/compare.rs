@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use super::job::{Job, Progress};
 use crate::analysis::{Assessment, Components, Tolerances};
-use crate::diff::{Pairs, Side, compare, comparison_times, match_bones, match_meshes, model_curves};
+use crate::diff::{Pairs, Side, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
 use crate::eval::{LayerStack, Layers, Pose, SkinningMethod};
 use crate::import::{self, ImportError};
 use crate::model::{Clip, InheritMode, Rig};
@@ -60,10 +60,13 @@ impl Compared {
         self.bones.iter().filter(|b| b.is_none()).count()
     }
 
-    /// The clip here that stands for the document's: the one with its label, else the first.
+    /// The clip here that stands for the document's: the one `bonescope diff` pairs it with, else the first.
     pub fn clip_for(&self, clip: Option<&Clip>) -> Option<&Clip> {
-        let label = clip.map(Clip::label);
-        self.rig.clips.iter().find(|c| Some(c.label()) == label).or(self.rig.clips.first())
+        let partner = clip.and_then(|clip| {
+            let (pairs, _, _) = match_clips(std::slice::from_ref(clip), &self.rig.clips);
+            pairs.first().map(|&(_, j)| &self.rig.clips[j])
+        });
+        partner.or(self.rig.clips.first())
     }
 
     /// This file evaluated as it declares, for the document's clip.

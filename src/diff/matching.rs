@@ -113,22 +113,26 @@ pub fn match_meshes(a: &[Mesh], b: &[Mesh]) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// Clips paired by label (their name, or `animation N` for the N-th unnamed one, which is what a bake names it):
+/// Clips paired by label (their name, or `animation N` for the N-th unnamed one, which is what a bake names it),
+/// exactly, then as [`loose_name`] compares names (Blender's FBX names a take `Armature|walk`):
 /// `(clip in A, clip in B)`, and the clips of each side left without a partner.
 pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, Vec<usize>) {
     let mut taken = vec![false; b.len()];
-    let mut pairs = Vec::new();
-    let mut only_a = Vec::new();
-    for (i, clip) in a.iter().enumerate() {
-        let label = clip.label();
-        match (0..b.len()).find(|&j| !taken[j] && b[j].label() == label) {
-            Some(j) => {
-                taken[j] = true;
-                pairs.push((i, j));
+    let mut partner: Vec<Option<usize>> = vec![None; a.len()];
+    for key in [Clip::label, |c: &Clip| loose_name(&c.label())] {
+        for (i, clip) in a.iter().enumerate() {
+            if partner[i].is_some() {
+                continue;
             }
-            None => only_a.push(i),
+            let label = key(clip);
+            if let Some(j) = (0..b.len()).find(|&j| !taken[j] && key(&b[j]) == label) {
+                taken[j] = true;
+                partner[i] = Some(j);
+            }
         }
     }
+    let pairs = partner.iter().enumerate().filter_map(|(i, j)| j.map(|j| (i, j))).collect();
+    let only_a = (0..a.len()).filter(|&i| partner[i].is_none()).collect();
     let only_b = (0..b.len()).filter(|&j| !taken[j]).collect();
     (pairs, only_a, only_b)
 }
@@ -161,6 +165,18 @@ mod tests {
         // A bone merely named like a helper, without the matching child, is a bone.
         let lone = skeleton(&[("arm.stretch", None), ("hand", Some(0))]);
         assert_eq!(helpers(&lone), [false, false]);
+    }
+
+    #[test]
+    fn clips_pair_by_label_then_loosely() {
+        let clip = |index: usize, name: Option<&str>| Clip::new(index, name.map(str::to_owned), vec![], vec![]);
+        let a = [clip(0, Some("walk")), clip(1, Some("run")), clip(2, None)];
+        let b =
+            [clip(0, Some("Armature|run")), clip(1, Some("walk")), clip(2, Some("animation 2")), clip(3, Some("jog"))];
+        let (pairs, only_a, only_b) = match_clips(&a, &b);
+        assert_eq!(pairs, [(0, 1), (1, 0), (2, 2)]);
+        assert!(only_a.is_empty());
+        assert_eq!(only_b, [3]);
     }
 
     #[test]
