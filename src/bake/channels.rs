@@ -13,7 +13,8 @@ use rayon::prelude::*;
 use super::document::{Animation, Channel, Document, Interpolation, Node, Property};
 use super::keys::{Metrics, reduce, weights_error};
 use super::layout::{Layout, unit};
-use super::nodes::{NodeSample, Sampled};
+use super::nodes::{NodeSample, Sampled, Series};
+use super::times::BakeTimes;
 use crate::diff::Side;
 use crate::eval::MorphPose;
 
@@ -21,16 +22,14 @@ use crate::eval::MorphPose;
 pub struct ClipSamples<'a> {
     pub name: &'a str,
     pub side: &'a Side<'a>,
-    /// Sorted.
-    pub times: &'a [f64],
+    /// The times every bone was sampled at, and the stepped keys among them.
+    pub base: &'a BakeTimes,
     pub sampled: &'a Sampled,
-    /// Per sample: whether a stepped key is at it.
-    pub steps: &'a [bool],
 }
 
 /// The channels of `clip` for the nodes of `layout` in `document`.
 pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &Document) -> Animation {
-    let per_bone: Vec<Vec<Channel>> = (0..clip.sampled.bones)
+    let per_bone: Vec<Vec<Channel>> = (0..clip.sampled.series.len())
         .into_par_iter()
         .map(|bone| bone_channels(layout, clip, metrics, document, bone))
         .collect();
@@ -40,7 +39,7 @@ pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, documen
         && let Some(node) = document.nodes.first()
     {
         // glTF wants at least one channel; one that holds the first node still says how long the clip is.
-        let end = clip.times.last().copied().unwrap_or(0.0) as f32;
+        let end = clip.sampled.times.last().copied().unwrap_or(0.0) as f32;
         let times = if end > 0.0 { vec![0.0, end] } else { vec![0.0] };
         let values = times.iter().flat_map(|_| node.rotation).collect();
         let interpolation = Interpolation::Linear;
@@ -58,17 +57,18 @@ fn bone_channels(
     bone: usize,
 ) -> Vec<Channel> {
     let helper = layout.helper_node[bone].is_some();
-    let values = NodeValues::of(clip, bone, helper);
-    let (keys, interpolation) = match values.steps(clip.steps) {
+    let series = &clip.sampled.series[bone];
+    let values = NodeValues::of(series, helper);
+    let (keys, interpolation) = match values.steps(&clip.base.step_flags(&series.times)) {
         Some(keys) => (keys, Interpolation::Step),
         None => {
             let metric = metrics.bone(&clip.sampled.stats.parent_gain, bone);
-            let error = |i, j, k| metric.error(clip.sampled, clip.times, bone, helper, (i, j, k));
-            (reduce(clip.times.len(), metrics.budget, error), Interpolation::Linear)
+            let error = |i, j, k| metric.error(series, helper, (i, j, k));
+            (reduce(series.times.len(), metrics.budget, error), Interpolation::Linear)
         }
     };
-    let keys = distinct_f32_times(&keys, clip.times);
-    let key_times: Vec<f32> = keys.iter().map(|&k| clip.times[k] as f32).collect();
+    let keys = distinct_f32_times(&keys, &series.times);
+    let key_times: Vec<f32> = keys.iter().map(|&k| series.times[k] as f32).collect();
     let (outer, own) = (layout.helper_node[bone].unwrap_or(layout.bone_node[bone]), layout.bone_node[bone]);
     let mut wanted = vec![
         (outer, Property::Translation, &values.translation, 3),
@@ -98,9 +98,8 @@ struct NodeValues {
 }
 
 impl NodeValues {
-    fn of(clip: &ClipSamples, bone: usize, helper: bool) -> Self {
-        let samples: Vec<NodeSample> =
-            (0..clip.times.len()).map(|s| clip.sampled.at(s, bone).as_baked(helper)).collect();
+    fn of(series: &Series, helper: bool) -> Self {
+        let samples: Vec<NodeSample> = series.nodes.iter().map(|n| n.as_baked(helper)).collect();
         NodeValues {
             translation: samples.iter().flat_map(|s| s.translation.as_vec3().to_array()).collect(),
             rotation: continuous(samples.iter().map(|s| s.rotation)),
@@ -137,7 +136,7 @@ impl NodeValues {
 /// The morph weights of every mesh group whose bone the clip animates them on.
 fn weight_channels(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &Document) -> Vec<Channel> {
     let Some(source) = clip.side.clip else { return Vec::new() };
-    let (times, rig) = (clip.times, clip.side.rig);
+    let (times, rig) = (&clip.base.times, clip.side.rig);
     let mut channels = Vec::new();
     let mut morph = MorphPose::default();
     for (group, (node, meshes)) in document.meshes.iter().zip(&layout.groups) {
@@ -197,7 +196,9 @@ fn default_values(node: &Node, property: Property) -> Vec<f32> {
 }
 
 /// A channel of `values` at `times`, or `None` when every key repeats `default`; a channel whose keys all repeat
-/// its first keeps only its first and last key.
+/// its first keeps only its first and last key. Keys "repeat" a value when they differ from it by less than single
+/// precision resolves in the channel ([`resolution`]): the re-solve against baked parents leaves noise far below
+/// it in channels that never move, and keeping it would write every sample of them.
 fn channel(
     node: usize,
     property: Property,
@@ -210,17 +211,30 @@ fn channel(
         return None;
     }
     let width = values.len() / times.len();
-    let first = &values[..width];
-    if values.chunks_exact(width).all(|key| key == default) {
+    let resolution = resolution(&values, width);
+    let all_near = |value: &[f32]| values.chunks_exact(width).all(|key| near(key, value, resolution));
+    if all_near(default) {
         return None;
     }
-    if values.chunks_exact(width).all(|key| key == first) && times.len() > 2 {
-        let last = times.len() - 1;
-        let values = [first, &values[last * width..]].concat();
-        let times = vec![times[0], times[last]];
+    let first = &values[..width];
+    if all_near(first) && times.len() > 2 {
+        let values = first.repeat(2);
+        let times = vec![times[0], times[times.len() - 1]];
         return Some(Channel { node, property, interpolation, times, values });
     }
     Some(Channel { node, property, interpolation, times: times.to_vec(), values })
+}
+
+/// The smallest difference single precision resolves between keys of `width` numbers: its epsilon relative to
+/// the longest key (as a vector).
+fn resolution(values: &[f32], width: usize) -> f32 {
+    let longest = values.chunks_exact(width).map(|key| key.iter().map(|v| v * v).sum::<f32>()).fold(0.0, f32::max);
+    f32::EPSILON * longest.sqrt()
+}
+
+/// Whether keys `a` and `b` differ by no more than `resolution` in any number (equal ones always are).
+fn near(a: &[f32], b: &[f32], resolution: f32) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x == y || (x - y).abs() <= resolution)
 }
 
 /// `keys` without the samples whose time rounds to the same `f32` as an earlier one's (glTF's times are `f32` and
@@ -265,6 +279,14 @@ mod tests {
         assert_eq!(channel(0, Property::Translation, linear, &times, vec![0.0; 9], &default), None);
         let held = channel(0, Property::Translation, linear, &times, [1.0, 2.0, 3.0].repeat(3), &default).unwrap();
         assert_eq!((held.times, held.values), (vec![0.0, 1.0], [1.0, 2.0, 3.0].repeat(2)));
+        let noisy = [0.1, 0.2, 0.3, 0.1 + 2e-14, 0.2, 0.3, 0.1, 0.2 - 3e-9, 0.3];
+        let held = channel(0, Property::Translation, linear, &times, noisy.to_vec(), &default).unwrap();
+        assert_eq!(held.values, [0.1, 0.2, 0.3].repeat(2), "noise below single precision's resolution is held");
+        let moving = [0.1, 0.2, 0.3, 0.1, 0.2 + 1e-7, 0.3, 0.1, 0.2, 0.3];
+        let kept = channel(0, Property::Translation, linear, &times, moving.to_vec(), &default).unwrap();
+        assert_eq!(kept.times.len(), 3, "a motion single precision resolves is kept");
+        let near_default = [2e-14, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -1e-15, 1.0];
+        assert_eq!(channel(0, Property::Translation, linear, &times, near_default.to_vec(), &[0.0, 0.0, 1.0]), None);
         assert_eq!(distinct_f32_times(&[0, 1, 2], &[0.5, 0.5 + 1e-12, 1.0]), [0, 2], "one f32 time");
     }
 }

@@ -7,7 +7,7 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use super::nodes::{NodeSample, Sampled};
+use super::nodes::{NodeSample, Series};
 use crate::diff::{PROBE_FRACTION, Side};
 use crate::eval::{Pose, skin_meshes};
 use crate::math::slerp;
@@ -139,18 +139,12 @@ pub struct BoneMetric {
 }
 
 impl BoneMetric {
-    /// The model-space distance bound for sample `k` interpolated between `i` and `j` of `bone`, its nodes as
-    /// baked with or without a `helper`.
-    pub fn error(
-        &self,
-        sampled: &Sampled,
-        times: &[f64],
-        bone: usize,
-        helper: bool,
-        (i, j, k): (usize, usize, usize),
-    ) -> f64 {
+    /// The model-space distance bound for sample `k` of a bone's `series` interpolated between its samples `i` and
+    /// `j`, its nodes as baked with or without a `helper`.
+    pub fn error(&self, series: &Series, helper: bool, (i, j, k): (usize, usize, usize)) -> f64 {
+        let times = &series.times;
         let t = (times[k] - times[i]) / (times[j] - times[i]);
-        let node = |s: usize| sampled.at(s, bone).as_baked(helper);
+        let node = |s: usize| series.nodes[s].as_baked(helper);
         self.distance(&interpolate(&node(i), &node(j), t), &node(k))
     }
 

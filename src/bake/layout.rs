@@ -75,7 +75,7 @@ impl Layout {
         let mut document =
             Document { generator: format!("bonescope {}", env!("CARGO_PKG_VERSION")), ..Document::default() };
         for (bone, b) in rig.skeleton.bones().iter().enumerate() {
-            let node = &rest.at(0, bone).as_baked(self.helper_node[bone].is_some());
+            let node = &rest.series[bone].nodes[0].as_baked(self.helper_node[bone].is_some());
             let parent = b.parent.map(|p| self.bone_node[p]);
             match self.helper_node[bone] {
                 Some(helper) => {

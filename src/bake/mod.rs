@@ -38,6 +38,7 @@ use channels::ClipSamples;
 use keys::Metrics;
 use layout::Layout;
 use nodes::{NodeSample, Sampled};
+use rayon::prelude::*;
 use refine::refine;
 
 use crate::diff::{Side, rig_size};
@@ -127,19 +128,19 @@ pub fn bake(request: &Request) -> Baked {
     let size = if size > 0.0 { size } else { rig_size(&rest_side, &[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
     let metrics = Metrics::new(&rest_side, size, tolerance);
-    let sampled: Vec<(Vec<f64>, Sampled)> =
+    let sampled: Vec<Sampled> =
         sides.iter().zip(&base).map(|(side, base)| sample_densely(side, strategy, base, &metrics)).collect();
     let rest = nodes::rest(&rest_side, strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
-        .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|(_, s)| s.stats.stretched[bone]))
+        .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|s| s.stats.stretched[bone]))
         .collect();
     let layout = Layout::new(rig, &helpers);
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
-    for (((clip, side), base), (times, sampled)) in request.clips.iter().zip(&sides).zip(&base).zip(&sampled) {
-        let steps = base.step_flags(times);
-        let samples = ClipSamples { name: &clip.name, side, times, sampled, steps: &steps };
+    for (((clip, side), base), sampled) in request.clips.iter().zip(&sides).zip(&base).zip(&sampled) {
+        let samples = ClipSamples { name: &clip.name, side, base, sampled };
+        let times = &sampled.times;
         if clip.clip.is_none() && clip.layers.is_none() {
             // The rest pose is what the nodes hold without an animation.
             animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys: 0 });
@@ -150,23 +151,23 @@ pub fn bake(request: &Request) -> Baked {
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
         document.animations.push(animation);
     }
-    notes.extend(source_notes(rig, sampled.iter().map(|(_, s)| s.stats.singular).sum()));
+    notes.extend(source_notes(rig, sampled.iter().map(|s| s.stats.singular).sum()));
     Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }
 }
 
 /// Every bone's nodes at the base times, and wherever between them the source needs more ([`refine`]; not with a
 /// zero tolerance, which no halving could reach).
-fn sample_densely(side: &Side, strategy: Strategy, base: &BakeTimes, metrics: &Metrics) -> (Vec<f64>, Sampled) {
+fn sample_densely(side: &Side, strategy: Strategy, base: &BakeTimes, metrics: &Metrics) -> Sampled {
     let mut sampled = nodes::sample(side, &base.times, strategy);
-    nodes::follow_frames(&mut sampled);
+    sampled.series.par_iter_mut().for_each(nodes::follow_frames);
     if metrics.budget == 0.0 {
-        return (base.times.clone(), sampled);
+        return sampled;
     }
     let gains = sampled.stats.parent_gain.clone();
     let misses = |bone: usize, interpolated: &NodeSample, exact: &NodeSample| {
         metrics.bone(&gains, bone).distance(interpolated, exact) > metrics.budget
     };
-    refine(side, strategy, base.times.clone(), &base.step_flags(&base.times), sampled, &misses)
+    refine(side, strategy, &base.step_flags(&base.times), sampled, &misses)
 }
 
 /// What the source has that glTF says differently.
@@ -208,13 +209,42 @@ pub fn every_clip<'a>(rig: &'a Rig, only: Option<&'a Clip>) -> Vec<ClipToBake<'a
 }
 
 /// Writes `bytes` to `path` atomically: into a temporary file beside it, then renamed over it, so the path holds
-/// either its old content or all of the new one, never a half-written file.
+/// either its old content or all of the new one, never a half-written file. The file gets the permissions a new
+/// file would (a temporary file's are the owner's only).
 pub fn save(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
     let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let mut file = tempfile::NamedTempFile::new_in(folder)?;
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // Narrowed by the umask, as `File::create` is.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut file = builder.tempfile_in(folder)?;
     file.write_all(bytes)?;
     file.as_file().sync_all()?;
     file.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn save_replaces_the_file_whole_with_a_new_file_s_permissions() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.glb");
+        std::fs::write(&path, b"old content, longer than the new").unwrap();
+        super::save(&path, b"new").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left beside it");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let created = dir.path().join("created");
+            std::fs::write(&created, b"").unwrap();
+            let mode = |path| std::fs::metadata(path).unwrap().permissions().mode();
+            assert_eq!(mode(&path), mode(&created), "the mode a created file gets under this umask");
+        }
+    }
 }

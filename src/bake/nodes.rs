@@ -11,8 +11,9 @@
 //!   solved against its parent as baked and the errors do not add up down the chain.
 //!
 //! Where a parent's matrix is singular (a bone scaled to zero) `L` is taken from the source's own local transform.
-//! Samples are stored time-major (`samples × bones`), computed in parallel over chunks of time; [`follow_frames`]
-//! then makes each helper bone's `U` continuous over time.
+//! Each bone's samples are a [`Series`] of its own, since refinement samples only the bones that need it between
+//! the times all share; they are computed in parallel over chunks of time, and [`follow_frames`] then makes each
+//! bone's nodes (its `U` above all) continuous over time.
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use rayon::prelude::*;
@@ -91,64 +92,80 @@ impl NodeSample {
     }
 }
 
-/// Every bone's nodes at every time of one evaluation.
+/// One bone's nodes at the times it is sampled at, in time order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Series {
+    pub times: Vec<f64>,
+    pub nodes: Vec<NodeSample>,
+}
+
+impl Series {
+    /// `self` with `extra` (time, nodes) merged in, by time.
+    pub fn merged(self, mut extra: Vec<(f64, NodeSample)>) -> Series {
+        if extra.is_empty() {
+            return self;
+        }
+        extra.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut merged = Series {
+            times: Vec::with_capacity(self.times.len() + extra.len()),
+            nodes: Vec::with_capacity(self.times.len() + extra.len()),
+        };
+        let mut extra = extra.into_iter().peekable();
+        for (time, node) in self.times.into_iter().zip(self.nodes) {
+            while let Some((t, n)) = extra.next_if(|(t, _)| *t < time) {
+                merged.times.push(t);
+                merged.nodes.push(n);
+            }
+            merged.times.push(time);
+            merged.nodes.push(node);
+        }
+        for (t, n) in extra {
+            merged.times.push(t);
+            merged.nodes.push(n);
+        }
+        merged
+    }
+}
+
+/// Every bone's nodes over one evaluation, each bone sampled at its own times.
 #[derive(Clone, Debug)]
 pub struct Sampled {
-    pub bones: usize,
-    /// `samples × bones`, time-major.
-    pub samples: Vec<NodeSample>,
+    /// One per bone.
+    pub series: Vec<Series>,
+    /// Every time some bone is sampled at, sorted.
+    pub times: Vec<f64>,
     pub stats: Stats,
 }
 
-impl Sampled {
-    pub fn times(&self) -> usize {
-        self.samples.len() / self.bones.max(1)
-    }
+/// How many times are sampled between two appends to the bones' series: what is held twice at once.
+const BATCH: usize = 4096;
 
-    pub fn at(&self, sample: usize, bone: usize) -> &NodeSample {
-        &self.samples[sample * self.bones + bone]
-    }
-
-    /// The samples of one time, one per bone.
-    pub fn row(&self, sample: usize) -> &[NodeSample] {
-        &self.samples[sample * self.bones..(sample + 1) * self.bones]
-    }
-
-    /// `self`'s rows followed by `other`'s, with what both learnt about the bones.
-    pub fn append(mut self, other: Sampled) -> Sampled {
-        self.samples.extend(other.samples);
-        Sampled { stats: self.stats.merge(other.stats), ..self }
-    }
-
-    /// The rows in the order of `times` (one per row), and the times sorted.
-    pub fn sorted_by(self, times: &[f64]) -> (Vec<f64>, Sampled) {
-        let mut order: Vec<usize> = (0..times.len()).collect();
-        order.sort_by(|&a, &b| times[a].total_cmp(&times[b]));
-        let samples = order.iter().flat_map(|&row| self.row(row).iter().copied()).collect();
-        let sorted = order.iter().map(|&row| times[row]).collect();
-        (sorted, Sampled { samples, ..self })
-    }
-}
-
-/// Samples `side` at `times` for `strategy`.
+/// Samples `side` at `times` (sorted) for `strategy`, every bone at every time.
 pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
     let bones = side.rig.skeleton.len();
-    let parents: Vec<Option<usize>> = side.rig.skeleton.bones().iter().map(|b| b.parent).collect();
-    let mut samples = vec![NodeSample::IDENTITY; times.len() * bones];
-    let chunk = 64;
-    let stats = samples
-        .par_chunks_mut(chunk * bones.max(1))
-        .zip(times.par_chunks(chunk))
-        .map(|(out, times)| {
-            let mut worker = Worker::new(side.layers.clone(), bones);
-            for (row, &time) in out.chunks_mut(bones.max(1)).zip(times) {
-                side.evaluate(&mut worker.pose, &mut worker.layers, time);
-                worker.solve(&parents, strategy, row);
+    let empty = Series { times: times.to_vec(), nodes: Vec::with_capacity(times.len()) };
+    let mut series = vec![empty; bones];
+    let mut stats = Stats::new(bones);
+    for batch in times.chunks(BATCH) {
+        let rows: Vec<(Vec<NodeSample>, Stats)> = batch
+            .par_chunks(64)
+            .map(|times| {
+                let mut worker = Worker::new(side, strategy);
+                let mut rows = Vec::with_capacity(times.len() * bones);
+                for &time in times {
+                    rows.extend_from_slice(worker.solve_at(time));
+                }
+                (rows, worker.stats)
+            })
+            .collect();
+        for (rows, found) in rows {
+            stats = stats.merge(found);
+            for row in rows.chunks_exact(bones.max(1)) {
+                series.iter_mut().zip(row).for_each(|(series, node)| series.nodes.push(*node));
             }
-            worker.stats
-        })
-        .reduce(|| Stats::new(bones), Stats::merge);
-    Sampled { bones, samples, stats }
+        }
+    }
+    Sampled { series, times: times.to_vec(), stats }
 }
 
 /// What sampling learns about the bones.
@@ -164,11 +181,11 @@ pub struct Stats {
 }
 
 impl Stats {
-    fn new(bones: usize) -> Self {
+    pub fn new(bones: usize) -> Self {
         Stats { stretched: vec![false; bones], parent_gain: vec![0.0; bones], singular: 0 }
     }
 
-    fn merge(mut self, other: Stats) -> Self {
+    pub fn merge(mut self, other: Stats) -> Self {
         for (s, o) in self.stretched.iter_mut().zip(other.stretched) {
             *s |= o;
         }
@@ -180,59 +197,77 @@ impl Stats {
     }
 }
 
-/// One thread's pose, layers, baked model matrices and findings.
-struct Worker {
+/// One thread's evaluation of a side: its pose, layers, baked model matrices and findings.
+pub struct Worker<'a> {
+    side: &'a Side<'a>,
+    strategy: Strategy,
+    parents: Vec<Option<usize>>,
     pose: Pose,
     layers: Option<LayerStack>,
     /// `W'`: the model matrices the baked nodes give.
     baked: Vec<DMat4>,
     /// The previous time's stretch of each bone, where the search for this time's starts.
     previous: Vec<DQuat>,
-    stats: Stats,
+    /// Every bone's nodes at the time last solved.
+    row: Vec<NodeSample>,
+    pub stats: Stats,
 }
 
-impl Worker {
-    fn new(layers: Option<LayerStack>, bones: usize) -> Self {
+impl<'a> Worker<'a> {
+    pub fn new(side: &'a Side<'a>, strategy: Strategy) -> Self {
+        let parents: Vec<Option<usize>> = side.rig.skeleton.bones().iter().map(|b| b.parent).collect();
+        let bones = parents.len();
         Worker {
+            side,
+            strategy,
+            parents,
             pose: Pose::default(),
-            layers,
+            layers: side.layers.clone(),
             baked: vec![DMat4::IDENTITY; bones],
             previous: vec![DQuat::IDENTITY; bones],
+            row: vec![NodeSample::IDENTITY; bones],
             stats: Stats::new(bones),
         }
     }
 
-    /// Fills `row` with every bone's nodes for the pose just evaluated.
-    fn solve(&mut self, parents: &[Option<usize>], strategy: Strategy, row: &mut [NodeSample]) {
-        for (bone, &parent) in parents.iter().enumerate() {
-            let source = self.pose.model.model[bone];
-            let local = match parent {
-                None => source,
-                Some(p) => match affine_inverse(&self.baked[p]) {
-                    Some(inverse) => inverse * source,
-                    None => {
-                        self.stats.singular += 1;
-                        self.pose.local[bone].matrix()
-                    }
-                },
-            };
-            let parts = decompose_near(&local, self.previous[bone]);
-            self.previous[bone] = parts.stretch;
-            let gain = parent.map_or(1.0, |p| frobenius(&self.baked[p]));
-            self.stats.parent_gain[bone] = self.stats.parent_gain[bone].max(gain);
-            let sample = match strategy {
-                Strategy::Exact => {
-                    self.stats.stretched[bone] |= stretch_matters(&parts);
-                    self.baked[bone] = source;
-                    NodeSample::exact(&parts)
+    /// Every bone's nodes at `time`.
+    pub fn solve_at(&mut self, time: f64) -> &[NodeSample] {
+        self.side.evaluate(&mut self.pose, &mut self.layers, time);
+        for bone in 0..self.parents.len() {
+            self.row[bone] = self.solve(bone);
+        }
+        &self.row
+    }
+
+    /// The nodes of `bone` for the pose just evaluated, its parent's already solved.
+    fn solve(&mut self, bone: usize) -> NodeSample {
+        let parent = self.parents[bone];
+        let source = self.pose.model.model[bone];
+        let local = match parent {
+            None => source,
+            Some(p) => match affine_inverse(&self.baked[p]) {
+                Some(inverse) => inverse * source,
+                None => {
+                    self.stats.singular += 1;
+                    self.pose.local[bone].matrix()
                 }
-                Strategy::Trs => {
-                    let sample = NodeSample::trs(&parts);
-                    self.baked[bone] = parent.map_or(DMat4::IDENTITY, |p| self.baked[p]) * sample.matrix();
-                    sample
-                }
-            };
-            row[bone] = sample;
+            },
+        };
+        let parts = decompose_near(&local, self.previous[bone]);
+        self.previous[bone] = parts.stretch;
+        let gain = parent.map_or(1.0, |p| frobenius(&self.baked[p]));
+        self.stats.parent_gain[bone] = self.stats.parent_gain[bone].max(gain);
+        match self.strategy {
+            Strategy::Exact => {
+                self.stats.stretched[bone] |= stretch_matters(&parts);
+                self.baked[bone] = source;
+                NodeSample::exact(&parts)
+            }
+            Strategy::Trs => {
+                let sample = NodeSample::trs(&parts);
+                self.baked[bone] = parent.map_or(DMat4::IDENTITY, |p| self.baked[p]) * sample.matrix();
+                sample
+            }
         }
     }
 }
@@ -273,23 +308,17 @@ fn frobenius(m: &DMat4) -> f64 {
     (linear.x_axis.length_squared() + linear.y_axis.length_squared() + linear.z_axis.length_squared()).sqrt()
 }
 
-/// Makes every bone's nodes continuous over time ([`align`] each sample to the one before); a bone scaled to
-/// nothing from the start takes its rotations from the first sample where it is not.
-pub fn follow_frames(sampled: &mut Sampled) {
-    let bones = sampled.bones;
-    for s in 1..sampled.times() {
-        let (before, after) = sampled.samples.split_at_mut(s * bones);
-        let previous = &before[(s - 1) * bones..];
-        for (current, previous) in after[..bones].iter_mut().zip(previous) {
-            align(current, previous);
-        }
+/// Makes a bone's nodes continuous over time ([`align`] each sample to the one before); a bone scaled to nothing
+/// from the start takes its rotations from the first sample where it is not.
+pub fn follow_frames(series: &mut Series) {
+    let nodes = &mut series.nodes;
+    for s in 1..nodes.len() {
+        let previous = nodes[s - 1];
+        align(&mut nodes[s], &previous);
     }
-    for s in (0..sampled.times().saturating_sub(1)).rev() {
-        let (before, after) = sampled.samples.split_at_mut((s + 1) * bones);
-        for (current, next) in before[s * bones..].iter_mut().zip(&after[..bones]) {
-            if current.scale == DVec3::ZERO {
-                (current.rotation, current.stretch) = (next.rotation, next.stretch);
-            }
+    for s in (0..nodes.len().saturating_sub(1)).rev() {
+        if nodes[s].scale == DVec3::ZERO {
+            (nodes[s].rotation, nodes[s].stretch) = (nodes[s + 1].rotation, nodes[s + 1].stretch);
         }
     }
 }
@@ -334,17 +363,26 @@ mod tests {
         let mut sampled = sample(&side, &times, Strategy::Exact);
         let helper = sampled.stats.stretched.clone();
         assert!(helper.contains(&true), "the demo's compensated forearm is stretched in its local matrix");
-        follow_frames(&mut sampled);
+        sampled.series.iter_mut().for_each(follow_frames);
         let mut pose = Pose::default();
         for (s, &time) in times.iter().enumerate() {
             side.evaluate(&mut pose, &mut None, time);
             let mut baked: Vec<DMat4> = Vec::new();
             for (bone, b) in rig.skeleton.bones().iter().enumerate() {
-                let local = sampled.at(s, bone).as_baked(helper[bone]).matrix();
+                let local = sampled.series[bone].nodes[s].as_baked(helper[bone]).matrix();
                 baked.push(b.parent.map_or(local, |p| baked[p] * local));
                 assert!(baked[bone].abs_diff_eq(pose.model.model[bone], 1e-12), "{} at {time}", b.name);
             }
         }
+    }
+
+    #[test]
+    fn extra_samples_merge_in_time_order() {
+        let node = |x: f64| NodeSample { translation: DVec3::X * x, ..NodeSample::IDENTITY };
+        let series = Series { times: vec![1.0, 2.0], nodes: vec![node(1.0), node(2.0)] };
+        let merged = series.merged(vec![(2.5, node(2.5)), (0.5, node(0.5)), (1.5, node(1.5))]);
+        assert_eq!(merged.times, [0.5, 1.0, 1.5, 2.0, 2.5]);
+        assert!(merged.times.iter().zip(&merged.nodes).all(|(t, n)| n.translation.x == *t));
     }
 
     #[test]
@@ -362,11 +400,10 @@ mod tests {
             })
             .collect();
         let matrices: Vec<DMat4> = samples.iter().map(NodeSample::matrix).collect();
-        let stats = Stats { stretched: vec![true], parent_gain: vec![1.0], singular: 0 };
-        let mut sampled = Sampled { bones: 1, samples: std::mem::take(&mut samples), stats };
-        follow_frames(&mut sampled);
+        let mut series = Series { times: (0..6).map(f64::from).collect(), nodes: std::mem::take(&mut samples) };
+        follow_frames(&mut series);
         for (s, m) in matrices.iter().enumerate() {
-            let node = sampled.at(s, 0);
+            let node = &series.nodes[s];
             assert!(node.matrix().abs_diff_eq(*m, 1e-12), "sample {s} keeps its matrix");
             assert!(node.stretch.abs_diff_eq(frame, 1e-12), "sample {s}: {:?}", node.stretch);
             assert_eq!(node.scale, k);

@@ -1,83 +1,137 @@
-//! Sampling as densely as the source needs: wherever linear interpolation between two neighbouring samples misses
-//! the source at their midpoint by more than the tolerance, the midpoint's neighbours are sampled in turn.
+//! Sampling as densely as the source needs: wherever linear interpolation between two neighbouring samples of a
+//! bone misses the source at their midpoint by more than the tolerance, the bone is sampled at the midpoints of
+//! both halves in turn.
 //!
 //! Frames and key times are not always enough. A parent whose scale doubles within a frame, under a child that
 //! compensates it, needs the child's local scale to follow `1/s(t)`, a curve no straight line between two frames
 //! follows (4 % off at the middle, in Maya's mixed-inheritance test file). So every interval's midpoint is sampled
-//! and compared with the interpolation of its ends; an interval that misses is split, down to [`MAX_DEPTH`] halvings.
-//! Every midpoint sampled stays a sample, so the keys chosen later are checked against it too.
+//! and compared with the interpolation of its ends; where a bone misses, its halves are, down to [`MAX_DEPTH`]
+//! halvings. Only the bones that miss are sampled deeper (a pose is evaluated whole, but only their nodes are kept),
+//! so a few compensating bones do not multiply the samples of the whole rig. Every midpoint sampled stays a sample
+//! of the bones it was taken for, so the keys chosen later are checked against it too.
 
 use rayon::prelude::*;
 
 use super::Strategy;
 use super::keys::{interpolate, too_far};
-use super::nodes::{NodeSample, Sampled, align, follow_frames, sample};
+use super::nodes::{NodeSample, Sampled, Series, Stats, Worker, align, follow_frames};
 use super::times::in_single_precision;
 use crate::diff::Side;
 
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
 
-/// `sampled` (at `times`, sorted) with midpoints added wherever `misses(bone, interpolated, exact)` says the
-/// interpolation of an interval's ends misses its midpoint; the times and samples sorted, frames followed. The
-/// interval that ends at a stepped key (`steps`, per time) holds the key's jump, which no halving brings closer: it
-/// is left as it is.
-pub fn refine(
-    side: &Side,
-    strategy: Strategy,
+/// A test of a bone's interpolated nodes against its exact ones: `misses(bone, interpolated, exact)`.
+pub trait Misses: Fn(usize, &NodeSample, &NodeSample) -> bool + Sync {}
+impl<F: Fn(usize, &NodeSample, &NodeSample) -> bool + Sync> Misses for F {}
+
+/// `sampled` (every bone at the same sorted times, frames followed) with midpoints added to each bone wherever
+/// `misses` says the interpolation of an interval's ends misses its midpoint; frames followed again. The interval
+/// that ends at a stepped key (`steps`, per time) holds the key's jump, which no halving brings closer: it is left as
+/// it is.
+pub fn refine(side: &Side, strategy: Strategy, steps: &[bool], sampled: Sampled, misses: &impl Misses) -> Sampled {
+    let bones = sampled.series.len();
+    let halving = Halving { sampled: &sampled, misses };
+    let (stats, found) = (1..sampled.times.len())
+        .into_par_iter()
+        .filter(|&i| !steps[i])
+        .fold(
+            || (Worker::new(side, strategy), Found::new(bones)),
+            |(mut worker, mut found), i| {
+                halving.base_interval(&mut worker, i, &mut found);
+                (worker, found)
+            },
+        )
+        .map(|(worker, found)| (worker.stats, found))
+        .reduce(|| (Stats::new(bones), Found::new(bones)), |(a, one), (b, other)| (a.merge(b), one.merge(other)));
+    found.merged_into(sampled, stats)
+}
+
+/// The midpoints taken: per bone, (time, nodes) of those taken for it; and every time taken.
+struct Found {
+    per_bone: Vec<Vec<(f64, NodeSample)>>,
     times: Vec<f64>,
-    steps: &[bool],
-    sampled: Sampled,
-    misses: &(impl Fn(usize, &NodeSample, &NodeSample) -> bool + Sync),
-) -> (Vec<f64>, Sampled) {
-    // Bones whose stretch rotation never matters at the first samples are judged without it (it turns at random
-    // where the factors are nearly equal, and it will be dropped).
-    let helper = sampled.stats.stretched.clone();
-    let mut pool_times = times;
-    let mut pool = sampled;
-    let mut intervals: Vec<(usize, usize)> = (1..pool_times.len()).filter(|&i| !steps[i]).map(|i| (i - 1, i)).collect();
-    for _ in 0..MAX_DEPTH {
-        // Midpoints are taken in single precision, where their keys will be; an interval with no such time strictly
-        // inside it is as fine as glTF can store.
-        let middle = |&(a, b): &(usize, usize)| in_single_precision(0.5 * (pool_times[a] + pool_times[b]));
-        intervals.retain(|interval| {
-            (pool_times[interval.0] < middle(interval)) && (middle(interval) < pool_times[interval.1])
-        });
-        if intervals.is_empty() {
-            break;
+}
+
+impl Found {
+    fn new(bones: usize) -> Self {
+        Found { per_bone: vec![Vec::new(); bones], times: Vec::new() }
+    }
+
+    fn merge(mut self, other: Found) -> Self {
+        for (mine, theirs) in self.per_bone.iter_mut().zip(other.per_bone) {
+            mine.extend(theirs);
         }
-        let middles: Vec<f64> = intervals.iter().map(middle).collect();
-        let mut new = sample(side, &middles, strategy);
-        let failed: Vec<bool> = new
-            .samples
-            .par_chunks_mut(pool.bones.max(1))
-            .zip(&intervals)
-            .zip(&middles)
-            .map(|((middle, &(a, b)), &time)| {
-                // The middle in single precision is not quite half way.
-                let fraction = (time - pool_times[a]) / (pool_times[b] - pool_times[a]);
-                let (left, right) = (pool.row(a), pool.row(b));
-                let mut missed = false;
-                for (bone, exact) in middle.iter_mut().enumerate() {
-                    align(exact, &left[bone]);
-                    let [a, b, middle] = [&left[bone], &right[bone], &*exact].map(|n| n.as_baked(helper[bone]));
-                    missed |= too_far(&a, &b) || misses(bone, &interpolate(&a, &b, fraction), &middle);
-                }
-                missed
+        self.times.extend(other.times);
+        self
+    }
+
+    /// `sampled` with the midpoints merged into their bones' series (frames followed again), every time any bone
+    /// has, and what the midpoints taught about the bones (`stats`).
+    fn merged_into(self, sampled: Sampled, stats: Stats) -> Sampled {
+        let mut times = sampled.times;
+        times.extend(self.times);
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        let series: Vec<Series> = sampled
+            .series
+            .into_par_iter()
+            .zip(self.per_bone)
+            .map(|(series, extra)| {
+                let mut merged = series.merged(extra);
+                follow_frames(&mut merged);
+                merged
             })
             .collect();
-        let first_new = pool_times.len();
-        pool_times.extend_from_slice(&middles);
-        pool = pool.append(new);
-        intervals = intervals
-            .iter()
-            .zip(failed)
-            .enumerate()
-            .filter(|(_, (_, failed))| *failed)
-            .flat_map(|(q, (&(a, b), _))| [(a, first_new + q), (first_new + q, b)])
-            .collect();
+        Sampled { series, times, stats: sampled.stats.merge(stats) }
     }
-    let (times, mut sorted) = pool.sorted_by(&pool_times);
-    follow_frames(&mut sorted);
-    (times, sorted)
+}
+
+/// The ends of an interval for one bone that is still being halved: (bone, nodes at the start, nodes at the end).
+type Ends = (usize, NodeSample, NodeSample);
+
+struct Halving<'a, M> {
+    sampled: &'a Sampled,
+    misses: &'a M,
+}
+
+impl<M: Misses> Halving<'_, M> {
+    /// Halves the interval of base samples `i − 1` to `i` for every bone.
+    fn base_interval(&self, worker: &mut Worker, i: usize, found: &mut Found) {
+        let ends: Vec<Ends> =
+            self.sampled.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[i - 1], s.nodes[i])).collect();
+        let times = &self.sampled.times;
+        self.halve(worker, (times[i - 1], times[i]), ends, 0, found);
+    }
+
+    /// Samples the bones of `ends` at the middle of `span` (in single precision, where their keys will be; a span
+    /// with no such time strictly inside it is as fine as glTF can store), and halves both halves for those that
+    /// miss it, `depth` halvings deep.
+    fn halve(&self, worker: &mut Worker, span: (f64, f64), ends: Vec<Ends>, depth: usize, found: &mut Found) {
+        let time = in_single_precision(0.5 * (span.0 + span.1));
+        if ends.is_empty() || depth == MAX_DEPTH || !(span.0 < time && time < span.1) {
+            return;
+        }
+        // The middle in single precision is not quite half way.
+        let fraction = (time - span.0) / (span.1 - span.0);
+        let helper = &self.sampled.stats.stretched;
+        let row = worker.solve_at(time);
+        found.times.push(time);
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        for (bone, a, b) in ends {
+            let mut exact = row[bone];
+            align(&mut exact, &a);
+            found.per_bone[bone].push((time, exact));
+            // Bones whose stretch rotation never matters at the base samples are judged without it (it turns at
+            // random where the factors are nearly equal, and it will be dropped).
+            let [a_baked, b_baked, middle] = [&a, &b, &exact].map(|n| n.as_baked(helper[bone]));
+            let interpolated = interpolate(&a_baked, &b_baked, fraction);
+            if too_far(&a_baked, &b_baked) || (self.misses)(bone, &interpolated, &middle) {
+                left.push((bone, a, exact));
+                right.push((bone, exact, b));
+            }
+        }
+        self.halve(worker, (span.0, time), left, depth + 1, found);
+        self.halve(worker, (time, span.1), right, depth + 1, found);
+    }
 }
