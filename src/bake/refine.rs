@@ -135,3 +135,32 @@ impl<M: Misses> Halving<'_, M> {
         self.halve(worker, (time, span.1), right, depth + 1, found);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::model::InheritMode;
+
+    #[test]
+    fn only_the_bones_that_miss_are_halved_further() {
+        let rig = demo_rig();
+        let modes = vec![InheritMode::Full; rig.skeleton.len()];
+        let side = Side::new(&rig, rig.clips.first(), &modes);
+        let times: Vec<f64> = (0..=4).map(|k| f64::from(k) * 0.25).collect();
+        let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
+        let missing = 2;
+        let refined = refine(&side, Strategy::Exact, &[false; 5], base.clone(), &|bone, _: &_, _: &_| bone == missing);
+        let intervals = times.len() - 1;
+        for (bone, series) in refined.series.iter().enumerate() {
+            // Every interval's midpoint for every bone; for the one that misses, every level of halving.
+            let expected = times.len() + intervals * if bone == missing { (1 << MAX_DEPTH) - 1 } else { 1 };
+            assert_eq!(series.times.len(), expected, "bone {bone}");
+            assert!(series.times.windows(2).all(|w| w[0] < w[1]), "bone {bone}: sorted and distinct");
+            assert_eq!(series.times.len(), series.nodes.len());
+        }
+        assert_eq!(refined.times, refined.series[missing].times, "every time some bone has");
+        let stepped = refine(&side, Strategy::Exact, &[false, true, true, true, true], base, &|_, _: &_, _: &_| false);
+        assert_eq!(stepped.series[0].times.len(), times.len(), "intervals that end at stepped keys are left");
+    }
+}
