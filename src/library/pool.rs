@@ -33,27 +33,34 @@ pub fn in_order<T: Send>(
     let (sender, results) = mpsc::channel();
     let (work, next) = (&work, &next);
     // The scope's own closure runs here, on the caller's thread (which `done` may need), and waits for the workers.
+    // One worker per thread of the pool, as a broadcast: a broadcast job runs only on its own thread, so no thread
+    // waiting inside one file's parallel work can take up another worker and hold that file back behind it.
     pool.in_place_scope(|scope| {
-        for _ in 0..jobs {
-            let sender = sender.clone();
-            scope.spawn(move |_| {
-                while !stop.load(Ordering::Relaxed) {
-                    let index = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(path) = paths.get(index) else { break };
-                    if sender.send((index, work(path))).is_err() {
-                        break;
-                    }
+        scope.spawn_broadcast(move |_, _| {
+            while !stop.load(Ordering::Relaxed) {
+                let index = next.fetch_add(1, Ordering::Relaxed);
+                let Some(path) = paths.get(index) else { break };
+                if sender.send(Some((index, work(path)))).is_err() {
+                    return;
                 }
-            });
-        }
-        drop(sender);
+            }
+            // This worker is done (the channel itself closes only when the scope ends).
+            let _ = sender.send(None);
+        });
+        let mut working = pool.current_num_threads();
         let mut waiting = BTreeMap::new();
         let mut count = 0;
-        for (index, result) in results {
-            waiting.insert(index, result);
-            while let Some(result) = waiting.remove(&count) {
-                done(&paths[count], result);
-                count += 1;
+        while working > 0 {
+            match results.recv() {
+                Ok(Some((index, result))) => {
+                    waiting.insert(index, result);
+                    while let Some(result) = waiting.remove(&count) {
+                        done(&paths[count], result);
+                        count += 1;
+                    }
+                }
+                Ok(None) => working -= 1,
+                Err(_) => break,
             }
         }
         count
