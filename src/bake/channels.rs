@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::document::{Animation, Channel, Document, Interpolation, Node, Property};
 use super::keys::{Metrics, reduce, weights_error};
 use super::layout::{Layout, unit};
-use super::nodes::{NodeSample, Sampled, Series};
+use super::nodes::{NodeSample, Sampled};
 use super::times::BakeTimes;
 use crate::diff::Side;
 use crate::eval::MorphPose;
@@ -58,12 +58,13 @@ fn bone_channels(
 ) -> Vec<Channel> {
     let helper = layout.helper_node[bone].is_some();
     let series = &clip.sampled.series[bone];
-    let values = NodeValues::of(series, helper);
+    let baked: Vec<NodeSample> = series.nodes.iter().map(|n| n.as_baked(helper)).collect();
+    let values = NodeValues::of(&baked, helper);
     let (keys, interpolation) = match values.steps(&clip.base.step_flags(&series.times)) {
         Some(keys) => (keys, Interpolation::Step),
         None => {
             let metric = metrics.bone(&clip.sampled.stats.parent_gain, bone);
-            let error = |i, j, k| metric.error(series, helper, (i, j, k));
+            let error = |i, j, k| metric.error(&series.times, &baked, (i, j, k));
             (reduce(series.times.len(), metrics.budget, error), Interpolation::Linear)
         }
     };
@@ -98,8 +99,8 @@ struct NodeValues {
 }
 
 impl NodeValues {
-    fn of(series: &Series, helper: bool) -> Self {
-        let samples: Vec<NodeSample> = series.nodes.iter().map(|n| n.as_baked(helper)).collect();
+    /// From a bone's samples as baked (with a `helper` or without).
+    fn of(samples: &[NodeSample], helper: bool) -> Self {
         NodeValues {
             translation: samples.iter().flat_map(|s| s.translation.as_vec3().to_array()).collect(),
             rotation: continuous(samples.iter().map(|s| s.rotation)),

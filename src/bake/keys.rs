@@ -7,7 +7,7 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
-use super::nodes::{NodeSample, Series};
+use super::nodes::NodeSample;
 use crate::diff::{PROBE_FRACTION, Side};
 use crate::eval::{Pose, skin_meshes};
 use crate::math::slerp;
@@ -139,13 +139,11 @@ pub struct BoneMetric {
 }
 
 impl BoneMetric {
-    /// The model-space distance bound for sample `k` of a bone's `series` interpolated between its samples `i` and
-    /// `j`, its nodes as baked with or without a `helper`.
-    pub fn error(&self, series: &Series, helper: bool, (i, j, k): (usize, usize, usize)) -> f64 {
-        let times = &series.times;
+    /// The model-space distance bound for sample `k` of a bone's `nodes` (as baked, at `times`) interpolated
+    /// between its samples `i` and `j`.
+    pub fn error(&self, times: &[f64], nodes: &[NodeSample], (i, j, k): (usize, usize, usize)) -> f64 {
         let t = (times[k] - times[i]) / (times[j] - times[i]);
-        let node = |s: usize| series.nodes[s].as_baked(helper);
-        self.distance(&interpolate(&node(i), &node(j), t), &node(k))
+        self.distance(&interpolate(&nodes[i], &nodes[j], t), &nodes[k])
     }
 
     /// The model-space distance bound between the nodes `interpolated` and `exact`.
