@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::sample_times;
 use crate::eval::{Hierarchy, ModelPose, sample_clip};
-use crate::math::decompose_all;
+use crate::math::{angle_between, decompose_all};
 use crate::model::{Clip, Skeleton, Transform};
 
 /// Differences at most this big (model units, degrees) are floating-point rounding, not a difference.
@@ -55,12 +55,6 @@ pub struct ClipComparison {
     pub samples: usize,
     /// One per bone, in bone order.
     pub bones: Vec<BoneDifference>,
-}
-
-/// The angle between two rotations, in radians (accurate for tiny angles too).
-fn angle_between(a: glam::DQuat, b: glam::DQuat) -> f64 {
-    let d = a.conjugate() * b;
-    2.0 * d.xyz().length().atan2(d.w.abs())
 }
 
 /// Compares `clip` (or the rest pose) under `a`'s and `b`'s modes at every key time plus `rate` samples per second.

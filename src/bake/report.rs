@@ -61,7 +61,7 @@ pub struct BakeReport {
 impl BakeReport {
     /// The largest error of any animation.
     pub fn worst(&self) -> Extreme {
-        self.animations.iter().map(|a| a.worst).fold(Extreme::default(), |w, a| if a.max > w.max { a } else { w })
+        self.animations.iter().map(|a| a.worst).fold(Extreme::default(), Extreme::merge)
     }
 }
 

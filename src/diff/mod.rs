@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 use crate::analysis::Components;
 use crate::eval::{LayerStack, Pose};
-use crate::math::{AffineParts, decompose_all};
+use crate::math::{AffineParts, angle_between, decompose_all};
 
 /// How far along each axis the probe points lie, as a fraction of the rig's size.
 pub const PROBE_FRACTION: f64 = 0.1;
@@ -57,7 +57,7 @@ impl Extreme {
     }
 
     /// Combines an earlier stretch of time with a later one (ties keep the earlier time).
-    fn merge(mut self, later: Extreme) -> Self {
+    pub fn merge(mut self, later: Extreme) -> Self {
         self.add(later.max, later.time);
         self
     }
@@ -331,12 +331,6 @@ fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
         let point = DVec3::AXES[axis] * (probe_length / length);
         largest.max(difference.transform_point3(point).length())
     })
-}
-
-/// The angle between two rotations, in radians (accurate for tiny angles too).
-fn angle_between(a: DQuat, b: DQuat) -> f64 {
-    let d = a.conjugate() * b;
-    2.0 * d.xyz().length().atan2(d.w.abs())
 }
 
 /// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other

@@ -51,13 +51,6 @@ pub struct FileDiff {
     pub clips_only_b: Vec<String>,
 }
 
-impl FileDiff {
-    /// The largest distance of any animation.
-    pub fn worst(&self) -> Extreme {
-        self.animations.iter().map(|a| a.worst).fold(Extreme::default(), |w, a| if a.max > w.max { a } else { w })
-    }
-}
-
 /// Compares `a` with `b` at their key times and `rate` times a second; `map` pairs bones by name explicitly.
 pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f64) -> Result<FileDiff, String> {
     let (pairs, only_a, only_b) = pair_clips(a, b)?;

@@ -131,6 +131,13 @@ pub fn angle_of_half_cosine(half_cosine: f64) -> f64 {
     (2.0 * half_cosine.min(1.0).acos()).to_degrees()
 }
 
+/// The angle between two rotations, in radians, in `[0, π]` (accurate for tiny angles too, where an inverse cosine
+/// of their dot product loses half the digits).
+pub fn angle_between(a: DQuat, b: DQuat) -> f64 {
+    let d = a.conjugate() * b;
+    2.0 * d.xyz().length().atan2(d.w.abs())
+}
+
 /// The angle of a unit quaternion's rotation, in radians, in `[0, π]`.
 pub fn quat_angle(q: DQuat) -> f64 {
     2.0 * q.w.abs().min(1.0).acos()
