@@ -23,6 +23,8 @@ pub struct Compared {
     pub bones: Vec<Option<usize>>,
     /// Per mesh of the document: its partner here (same name and vertex count).
     pub meshes: Vec<Option<usize>>,
+    /// Per clip of the document: the clip here that stands for it, as `bonescope diff` pairs them (else the first).
+    clips: Vec<Option<usize>>,
 }
 
 impl Compared {
@@ -42,7 +44,12 @@ impl Compared {
         for (a, b) in match_meshes(&document.meshes, &rig.meshes) {
             meshes[a] = Some(b);
         }
-        Compared { path, rig, bones, meshes }
+        let first = (!rig.clips.is_empty()).then_some(0);
+        let mut clips = vec![first; document.clips.len()];
+        for (a, b) in match_clips(&document.clips, &rig.clips).0 {
+            clips[a] = Some(b);
+        }
+        Compared { path, rig, bones, meshes, clips }
     }
 
     /// The same file paired with another document rig (the document was reloaded).
@@ -60,17 +67,18 @@ impl Compared {
         self.bones.iter().filter(|b| b.is_none()).count()
     }
 
-    /// The clip here that stands for the document's: the one `bonescope diff` pairs it with, else the first.
-    pub fn clip_for(&self, clip: Option<&Clip>) -> Option<&Clip> {
-        let partner = clip.and_then(|clip| {
-            let (pairs, _, _) = match_clips(std::slice::from_ref(clip), &self.rig.clips);
-            pairs.first().map(|&(_, j)| &self.rig.clips[j])
-        });
-        partner.or(self.rig.clips.first())
+    /// The clip here that stands for the document's clip `clip` (an index; `None`: the rest pose, for which this
+    /// file plays its first clip).
+    pub fn clip_for(&self, clip: Option<usize>) -> Option<&Clip> {
+        let partner = match clip {
+            Some(clip) => self.clips.get(clip).copied().flatten(),
+            None => (!self.rig.clips.is_empty()).then_some(0),
+        };
+        partner.map(|c| &self.rig.clips[c])
     }
 
-    /// This file evaluated as it declares, for the document's clip.
-    pub fn side(&self, clip: Option<&Clip>) -> Side<'_> {
+    /// This file evaluated as it declares, for the document's clip `clip` (an index).
+    pub fn side(&self, clip: Option<usize>) -> Side<'_> {
         Side::new(&self.rig, self.clip_for(clip), &self.rig.skeleton.declared_modes())
     }
 
@@ -78,7 +86,7 @@ impl Compared {
     /// document puts it, under its pose), the paired meshes skinned (the others not drawn).
     pub fn ghost(
         &self,
-        clip: Option<&Clip>,
+        clip: Option<usize>,
         primary: &Layer,
         time: f64,
         skinning: SkinningMethod,
@@ -160,8 +168,9 @@ pub fn differences(
         let clip = key.clip.and_then(|c| rig.clips.get(c));
         let own = Side::new(&rig, clip, &key.modes);
         let own = if key.layers.is_empty() { own } else { own.with_layers(layers) };
-        let other = compared.side(clip);
-        let pairs = Pairs::of(&own, &other, &[]).ok()?;
+        let other = compared.side(key.clip);
+        // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
+        let pairs = Pairs { meshes: Vec::new(), ..Pairs::of(&own, &other, &[]).ok()? };
         let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.rate));
         let mut bones = vec![None; rig.skeleton.len()];
         for difference in &comparison.bones {
@@ -174,15 +183,13 @@ pub fn differences(
 /// The compared curves `key` asks for, as work for a [`Job`].
 pub fn curves(
     key: CurvesKey,
-    rig: Arc<Rig>,
     compared: Arc<Compared>,
 ) -> impl FnOnce(&Progress) -> Option<ComparedCurves> + Send + 'static {
     move |_| {
-        let clip = key.compare.clip.and_then(|c| rig.clips.get(c));
         let paired: Vec<(usize, usize)> =
             key.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
         let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
-        let curves = model_curves(&compared.side(clip), &partners, &key.times);
+        let curves = model_curves(&compared.side(key.compare.clip), &partners, &key.times);
         Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
     }
 }
@@ -207,8 +214,20 @@ mod tests {
             SkinningMethod::AsFile,
             &Tolerances::default(),
         );
-        let ghost = compared.ghost(rig.clips.first(), &primary, 0.5, SkinningMethod::AsFile, &Tolerances::default());
+        let ghost = compared.ghost(Some(0), &primary, 0.5, SkinningMethod::AsFile, &Tolerances::default());
         assert_eq!(ghost.model, primary.model);
         assert_eq!(ghost.meshes, primary.meshes);
+    }
+
+    #[test]
+    fn clips_pair_by_label_whatever_their_order() {
+        let rig = import::demo_rig();
+        let mut other = rig.clone();
+        other.clips.reverse();
+        let compared = Compared::pair(PathBuf::from("other.glb"), other, &rig);
+        for (c, clip) in rig.clips.iter().enumerate() {
+            assert_eq!(compared.clip_for(Some(c)).map(Clip::label), Some(clip.label()));
+        }
+        assert_eq!(compared.clip_for(None).map(Clip::label), compared.rig.clips.first().map(Clip::label));
     }
 }

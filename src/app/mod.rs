@@ -55,7 +55,7 @@ impl Frame {
         let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
         let ghost = match (doc.ghost, &doc.compared) {
             (Some(Ghost::Compared), Some(compared)) => {
-                Some(compared.ghost(doc.clip(), &primary, time, skinning, tolerances))
+                Some(compared.ghost(doc.clip, &primary, time, skinning, tolerances))
             }
             _ => doc.ghost_evaluation().map(|(modes, layered)| {
                 let ghost = doc.evaluate(&modes, time, layered);
@@ -398,7 +398,7 @@ impl BonescopeApp {
             self.compare_jobs.differences.update(key, work, move || waker.request_repaint());
         }
         if let Some(key) = self.compared_curves_key() {
-            let work = compare::curves(key.clone(), rig.clone(), compared);
+            let work = compare::curves(key.clone(), compared);
             let waker = ctx.clone();
             self.compare_jobs.curves.update(key, work, move || waker.request_repaint());
         }
