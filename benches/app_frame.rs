@@ -9,9 +9,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use bonescope::analysis::{CurveRequest, Judged, ScanOptions, Subject, analyze};
+use bonescope::analysis::{CurveRequest, Judged, ScanOptions, analyze};
 use bonescope::app::{BonescopeApp, Document, Settings};
-use bonescope::eval::Hierarchy;
+use bonescope::eval::{Evaluation, Hierarchy};
 use bonescope::import::stress_rig;
 use criterion::{Criterion, criterion_group, criterion_main};
 
@@ -118,7 +118,8 @@ fn analyze_clip(
     options: &ScanOptions,
 ) -> Option<bonescope::analysis::ClipAnalysis> {
     let never = std::sync::atomic::AtomicBool::new(false);
-    analyze(Subject::clip(&rig.skeleton, rig.clips.first()), hierarchy, request, options, &|_, _| {}, &never)
+    let evaluation = Evaluation::new(rig, rig.clips.first(), hierarchy.modes());
+    analyze(&evaluation, request, options, &|_, _| {}, &never)
 }
 
 criterion_group!(benches, app_frame, clip_analysis, selection_curves);

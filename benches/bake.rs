@@ -18,27 +18,22 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use bonescope::bake::{self, Request, Strategy};
-use bonescope::diff::{Pairs, Side, compare, comparison_times};
+use bonescope::diff::{Pairs, compare, comparison_times};
+use bonescope::eval::Evaluation;
 use bonescope::import;
 use bonescope::model::{InheritMode, Rig};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn request(rig: &Rig, mode: Option<InheritMode>) -> Request<'_> {
     let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
-    Request {
-        rig,
-        modes,
-        clips: bake::every_clip(rig, None),
-        strategy: Strategy::Exact,
-        tolerance: bake::DEFAULT_TOLERANCE,
-    }
+    Request::every_clip(&Evaluation::new(rig, None, &modes), None, Strategy::Exact, bake::DEFAULT_TOLERANCE)
 }
 
 /// The source's first clip against the bake's, as `bonescope diff` compares them.
 fn diff(source: &Request, baked: &Rig) {
-    let a = source.side(0);
-    let b = Side::new(baked, baked.clips.first(), &baked.skeleton.declared_modes());
-    let pairs = Pairs::of(&a, &b, &[]).unwrap();
+    let a = source.clips[0].source.clone();
+    let b = Evaluation::declared(baked, baked.clips.first());
+    let pairs = Pairs::by_name(&a, &b);
     compare(&a, &b, &pairs, &comparison_times(&a, &b, 60.0));
 }
 

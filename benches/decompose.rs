@@ -19,8 +19,7 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use bonescope::analysis::sample_times;
-use bonescope::eval::{Hierarchy, Pose};
+use bonescope::eval::Evaluation;
 use bonescope::import::stress_rig;
 use bonescope::math::{AffineParts, decompose, decompose_all, decompose_near};
 use bonescope::model::Rig;
@@ -278,13 +277,11 @@ fn print_fastest_passes(name: &str, set: &[DMat4]) {
 
 /// Every model matrix of the rig's first clip at every 30 Hz sample time (with the key times).
 fn clip_set(rig: &Rig) -> Vec<DMat4> {
-    let (skeleton, clip) = (&rig.skeleton, rig.clips.first());
-    let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes());
-    let mut pose = Pose::default();
+    let evaluation = Evaluation::declared(rig, rig.clips.first());
+    let mut evaluator = evaluation.evaluator();
     let mut set = Vec::new();
-    for time in sample_times(clip, 30.0) {
-        pose.evaluate(skeleton, clip, &hierarchy, time);
-        set.extend_from_slice(&pose.model.model);
+    for time in evaluation.times(30.0) {
+        set.extend_from_slice(&evaluator.evaluate(time).model.model);
     }
     set
 }

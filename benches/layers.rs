@@ -16,10 +16,9 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use bonescope::analysis::Layered;
 use bonescope::analysis::storage::{StorageOptions, storage_report};
 use bonescope::eval::layers::{Additive, AdditiveOrder, AdditiveReference, Blend, RotationBlend};
-use bonescope::eval::{Hierarchy, LayerStack, Layers, Pose, sample_clip};
+use bonescope::eval::{Evaluation, Hierarchy, LayerStack, Layers, Pose, sample_clip};
 use bonescope::import::stress_rig;
 use bonescope::model::{InheritMode, Rig};
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -114,13 +113,12 @@ fn layered_evaluation(c: &mut Criterion) {
 
 fn storage(c: &mut Criterion) {
     let rig = stress_rig(100, 10_000, 1);
-    let layers = LayerStack::default();
     let options = StorageOptions { rate: 0.0, ..StorageOptions::default() };
     let mut group = c.benchmark_group("storage");
     group.sample_size(10);
     for (name, mode) in [("full", InheritMode::Full), ("compensate", InheritMode::SegmentCompensate)] {
-        let hierarchy = Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]);
-        let report = storage_report(Layered { rig: &rig, layers: &layers }, rig.clips.first(), &hierarchy, &options);
+        let evaluation = Evaluation::new(&rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]);
+        let report = storage_report(&evaluation, &options);
         assert_eq!(report.frames, 10_001);
         println!(
             "storage {name}: {} marked bones, bytes {} / {}",
@@ -129,7 +127,7 @@ fn storage(c: &mut Criterion) {
             report.bytes_with_stretch
         );
         group.bench_function(format!("100_bones_10000_frames_{name}"), |b| {
-            b.iter(|| storage_report(Layered { rig: &rig, layers: &layers }, rig.clips.first(), &hierarchy, &options))
+            b.iter(|| storage_report(&evaluation, &options))
         });
     }
     group.finish();

@@ -1,6 +1,6 @@
 //! Whole-clip `scan` throughput in bone-samples per second, beside a bare local→model pass over the same clip.
 //!
-//! Both visit the same sample times (`sample_times(Some(&clip), 60.0)`, what `scan` uses by default). The bare pass
+//! Both visit the same sample times (`Evaluation::times(60.0)`, what `scan` uses by default). The bare pass
 //! is `Pose::evaluate` in a loop, single-threaded; `scan` runs once inside a 1-thread rayon pool (the like-for-like
 //! comparison) and once on the default pool. Sub-benchmarks split the cost into the pool hand-over, sampling,
 //! hierarchy, and the per-matrix assessment (decomposition plus verdicts).
@@ -15,10 +15,10 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
-use bonescope::analysis::{Assessment, ScanOptions, Subject, Tolerances, sample_times, scan};
-use bonescope::eval::{Hierarchy, Pose, sample_clip};
+use bonescope::analysis::{Assessment, ScanOptions, Tolerances, scan};
+use bonescope::eval::{Evaluation, Hierarchy, Pose, sample_clip};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 
@@ -157,9 +157,19 @@ fn generated_clip(rng: &mut Rng, skeleton: &Skeleton, scaled: &[usize]) -> Clip 
 
 struct Case {
     name: String,
-    skeleton: Skeleton,
-    clip: Clip,
+    /// The skeleton and its one clip.
+    rig: Rig,
     hierarchy: Hierarchy,
+}
+
+impl Case {
+    fn new(name: String, skeleton: Skeleton, clip: Clip, hierarchy: Hierarchy) -> Self {
+        Case { name, rig: Rig { skeleton, clips: vec![clip], ..Rig::default() }, hierarchy }
+    }
+
+    fn evaluation(&self) -> Evaluation<'_> {
+        Evaluation::new(&self.rig, self.rig.clips.first(), self.hierarchy.modes())
+    }
 }
 
 fn generated_case(squash: Squash) -> Case {
@@ -173,14 +183,14 @@ fn generated_case(squash: Squash) -> Case {
         Squash::Spine => "generated_100_spine_squash".into(),
         Squash::None => "generated_100_no_scale".into(),
     };
-    Case { name, skeleton, clip, hierarchy }
+    Case::new(name, skeleton, clip, hierarchy)
 }
 
 /// `generated_100` with every bone in Maya's segment scale compensate: no stretch passes down the hierarchy, every
 /// bone is judged from its decomposed model matrix.
 fn compensating_case() -> Case {
     let case = generated_case(Squash::Limbs);
-    let hierarchy = Hierarchy::new(&case.skeleton, &vec![InheritMode::SegmentCompensate; case.skeleton.len()]);
+    let hierarchy = Hierarchy::new(&case.rig.skeleton, &vec![InheritMode::SegmentCompensate; case.rig.skeleton.len()]);
     Case { name: "generated_100_compensate".into(), hierarchy, ..case }
 }
 
@@ -199,15 +209,15 @@ fn blender_case() -> Option<Case> {
     };
     let clip = rig.find_clip("squash_stretch").or(rig.clips.first())?.clone();
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
-    Some(Case { name: "stretchy_full".into(), skeleton: rig.skeleton, clip, hierarchy })
+    Some(Case::new("stretchy_full".into(), rig.skeleton, clip, hierarchy))
 }
 
 /// Model matrices of every bone at every time, concatenated.
 fn all_model_matrices(case: &Case, times: &[f64]) -> Vec<DMat4> {
     let mut pose = Pose::default();
-    let mut out = Vec::with_capacity(times.len() * case.skeleton.len());
+    let mut out = Vec::with_capacity(times.len() * case.rig.skeleton.len());
     for &t in times {
-        sample_clip(&case.skeleton, &case.clip, t, &mut pose.local);
+        sample_clip(&case.rig.skeleton, &case.rig.clips[0], t, &mut pose.local);
         case.hierarchy.evaluate(&pose.local, &mut pose.model);
         out.extend_from_slice(&pose.model.model);
     }
@@ -232,8 +242,7 @@ fn percent(part: usize, whole: usize) -> f64 {
 
 /// One line on the workload: how many bone-samples are sheared for real and how many can take the shortcut.
 fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
-    let summary =
-        scan(Subject::clip(&case.skeleton, Some(&case.clip)), &case.hierarchy, &ScanOptions::default(), &|_, _| {});
+    let summary = scan(&case.evaluation(), &ScanOptions::default(), &|_, _| {});
     let stretched_bones = summary.bones.iter().filter(|b| b.stretched()).count();
     let stretched_samples: usize = summary.bones.iter().map(|b| b.flagged_samples).sum();
     let n = models.len();
@@ -241,8 +250,8 @@ fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
         "{}: {} bones, clip {:.3} s, {} sample times, {n} bone-samples; {stretched_bones} bones / {:.1}% of bone-samples \
          flagged stretched; {:.1}% of bone-samples take the decompose shortcut",
         case.name,
-        case.skeleton.len(),
-        case.clip.duration(),
+        case.rig.skeleton.len(),
+        case.rig.clips[0].duration(),
         times.len(),
         percent(stretched_samples, n),
         percent(models.iter().filter(|m| shortcut_eligible(m)).count(), n),
@@ -251,21 +260,22 @@ fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
 
 /// `parts`: also the sub-benchmarks that split the cost.
 fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
-    let times = sample_times(Some(&case.clip), RATE);
+    let evaluation = case.evaluation();
+    let times = evaluation.times(RATE);
     let models = all_model_matrices(case, &times);
     describe(case, &times, &models);
     let locals: Vec<Vec<Transform>> = times
         .iter()
         .map(|&t| {
             let mut local = Vec::new();
-            sample_clip(&case.skeleton, &case.clip, t, &mut local);
+            sample_clip(&case.rig.skeleton, &case.rig.clips[0], t, &mut local);
             local
         })
         .collect();
     let options = ScanOptions::default();
     let tolerances = Tolerances::default();
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a 1-thread pool");
-    let (skeleton, clip, hierarchy) = (&case.skeleton, Some(&case.clip), &case.hierarchy);
+    let (skeleton, clip, hierarchy) = (&case.rig.skeleton, case.rig.clips.first(), &case.hierarchy);
 
     let mut group = c.benchmark_group(format!("scan/{}", case.name));
     group.throughput(Throughput::Elements(models.len() as u64));
@@ -279,25 +289,21 @@ fn bench_case(c: &mut Criterion, case: &Case, parts: bool) {
         })
     });
     group.bench_function("scan_1_thread", |b| {
-        b.iter(|| {
-            one_thread.install(|| black_box(scan(Subject::clip(skeleton, clip), hierarchy, &options, &|_, _| {})))
-        })
+        b.iter(|| one_thread.install(|| black_box(scan(&evaluation, &options, &|_, _| {}))))
     });
-    group.bench_function("scan_parallel", |b| {
-        b.iter(|| black_box(scan(Subject::clip(skeleton, clip), hierarchy, &options, &|_, _| {})))
-    });
+    group.bench_function("scan_parallel", |b| b.iter(|| black_box(scan(&evaluation, &options, &|_, _| {}))));
     if !parts {
         return group.finish();
     }
     // Where the time goes.
     // What `scan_1_thread` pays per call before any work: handing a closure to the 1-thread pool and back.
     group.bench_function("part_pool_install", |b| b.iter(|| one_thread.install(|| black_box(0))));
-    group.bench_function("part_sample_times", |b| b.iter(|| black_box(sample_times(black_box(clip), RATE))));
+    group.bench_function("part_sample_times", |b| b.iter(|| black_box(black_box(&evaluation).times(RATE))));
     group.bench_function("part_sample_clip", |b| {
         let mut local = Vec::new();
         b.iter(|| {
             for &t in &times {
-                sample_clip(skeleton, &case.clip, black_box(t), &mut local);
+                sample_clip(skeleton, &case.rig.clips[0], black_box(t), &mut local);
                 black_box(&local);
             }
         })

@@ -9,8 +9,8 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use bonescope::analysis::{CurveRequest, GhostRequest, ScanOptions, Subject, analyze};
-use bonescope::eval::Hierarchy;
+use bonescope::analysis::{CurveRequest, ScanOptions, analyze};
+use bonescope::eval::{Evaluation, Hierarchy};
 use bonescope::import::stress_rig;
 use bonescope::model::InheritMode;
 
@@ -25,16 +25,16 @@ fn main() {
     let plotted: Vec<usize> = (0..setting("PLOT", 8)).map(|i| 6 + 10 * i).collect();
     let ghost_mode = std::env::var("GHOST").ok().map(|id| id.parse::<InheritMode>().expect("a mode id"));
     let ghost_hierarchy = ghost_mode.map(|mode| Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]));
-    let ghost = ghost_hierarchy.as_ref().map(|hierarchy| GhostRequest { hierarchy, unlayered: false });
+    let evaluation = Evaluation::new(&rig, rig.clips.first(), hierarchy.modes());
+    let ghost = ghost_hierarchy.as_ref().map(|ghost| evaluation.with_modes(ghost.modes()));
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let never = AtomicBool::new(false);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(setting("THREADS", 1)).build().expect("a thread pool");
     for _ in 0..3 {
         let started = Instant::now();
         let analysis = pool.install(|| {
-            let subject = Subject::clip(&rig.skeleton, rig.clips.first());
-            let request = CurveRequest { bones: &plotted, ghost, ..Default::default() };
-            analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).expect("never cancelled")
+            let request = CurveRequest { bones: &plotted, ghost: ghost.as_ref(), ..Default::default() };
+            analyze(&evaluation, request, &options, &|_, _| {}, &never).expect("never cancelled")
         });
         let seconds = started.elapsed().as_secs_f64();
         let bone_samples = analysis.times.len() * rig.skeleton.len();

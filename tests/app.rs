@@ -157,7 +157,7 @@ fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
     // The target's model rotation: the chain of local rotations from the root (seed 003's joints).
     let rotation_at = |harness: &Harness<'static, BonescopeApp>, time: f64| {
         let doc = &harness.state().doc;
-        let local = doc.evaluate(&doc.modes, time, true).local;
+        let local = doc.evaluation().pose_at(time).local;
         let skeleton = &doc.rig.skeleton;
         let mut rotation = local[forearm].rotation;
         let mut at = skeleton.parent(forearm);
@@ -557,13 +557,8 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
 /// The file at `source` baked with every bone under `mode` by `strategy`, written to `out`.
 fn bake(source: &std::path::Path, mode: InheritMode, strategy: bonescope::bake::Strategy, out: &std::path::Path) {
     let rig = bonescope::import::load(source).unwrap();
-    let request = bonescope::bake::Request {
-        rig: &rig,
-        modes: vec![mode; rig.skeleton.len()],
-        clips: bonescope::bake::every_clip(&rig, None),
-        strategy,
-        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
-    };
+    let source = bonescope::eval::Evaluation::new(&rig, None, &vec![mode; rig.skeleton.len()]);
+    let request = bonescope::bake::Request::every_clip(&source, None, strategy, bonescope::bake::DEFAULT_TOLERANCE);
     bonescope::bake::save(out, &bonescope::bake::bake(&request).glb).unwrap();
 }
 
@@ -585,7 +580,8 @@ fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged
     harness.state_mut().doc.modes = vec![InheritMode::UnscaledParent; bones];
     harness.state_mut().compare(&baked);
     settle(&mut harness);
-    assert_eq!(harness.state().doc.ghost, Some(bonescope::app::Ghost::Compared));
+    let doc = &harness.state().doc;
+    assert!(matches!(&doc.ghost, Some(bonescope::app::Ghost::Compared(c)) if c.path == baked), "{:?}", doc.ghost);
     harness.get_by_label_contains("comparing with");
     // The TRS bake drops the stretch of `Mid` (it needed a helper): `Mid` and what hangs below it differ, the root
     // does not.

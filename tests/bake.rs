@@ -15,7 +15,8 @@ use std::process::{Command, Output};
 use std::sync::LazyLock;
 
 use bonescope::bake::{self, Request, Strategy};
-use bonescope::diff::{Pairs, Side, compare, comparison_times};
+use bonescope::diff::{Pairs, compare, comparison_times};
+use bonescope::eval::Evaluation;
 use bonescope::import;
 use bonescope::model::{InheritMode, Rig};
 use common::{asset, obj_positions, size};
@@ -93,7 +94,7 @@ struct Baked {
 fn request(source: &'static str, mode: Option<InheritMode>, strategy: Strategy, tolerance: f64) -> Request<'static> {
     let rig = &RIGS[source];
     let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
-    Request { rig, modes, clips: bake::every_clip(rig, None), strategy, tolerance }
+    Request::every_clip(&Evaluation::new(rig, None, &modes), None, strategy, tolerance)
 }
 
 fn bake_all(strategy: Strategy, tolerance: f64) -> Vec<Baked> {
@@ -115,25 +116,25 @@ static TRS: LazyLock<Vec<Baked>> = LazyLock::new(|| bake_all(Strategy::Trs, 0.0)
 
 /// The largest distance (bone probes and vertices) over every clip between the source and its bake, at the times
 /// `times` gives for each clip's pair of sides; with the rig size.
-fn worst(b: &Baked, strategy: Strategy, times: impl Fn(usize, &Side, &Side) -> Vec<f64>) -> (f64, f64) {
+fn worst(b: &Baked, strategy: Strategy, times: impl Fn(usize, &Evaluation, &Evaluation) -> Vec<f64>) -> (f64, f64) {
     let request = request(b.source, b.mode, strategy, 0.0);
     let mut worst: f64 = 0.0;
     for k in 0..request.clips.len() {
-        let source = request.side(k);
-        let baked = Side::new(&b.rig, b.rig.clips.get(k), &b.rig.skeleton.declared_modes());
-        let pairs = Pairs::of(&source, &baked, &[]).unwrap();
+        let source = request.clips[k].source.clone();
+        let baked = Evaluation::declared(&b.rig, b.rig.clips.get(k));
+        let pairs = Pairs::by_name(&source, &baked);
         let added: Vec<&str> = pairs.bones.only_b.iter().map(|&i| b.rig.skeleton.bone(i).name.as_str()).collect();
         let common_root = b.baked.notes.iter().any(|n| n.contains("a new root"));
         assert!(pairs.bones.only_a.is_empty(), "{}: every source bone is in the bake", b.source);
         assert!(added.is_empty() || (common_root && added.len() == 1), "{}: only in the bake: {added:?}", b.source);
-        assert_eq!(pairs.meshes.len(), request.rig.meshes.len(), "{}: every mesh pairs up", b.source);
+        assert_eq!(pairs.meshes.len(), request.rig().meshes.len(), "{}: every mesh pairs up", b.source);
         worst = worst.max(compare(&source, &baked, &pairs, &times(k, &source, &baked)).worst_distance().max);
     }
     (worst, b.baked.rig_size)
 }
 
 /// A dense grid: four times the clip's frame rate, at least 240 a second.
-fn dense(source: &Side) -> f64 {
+fn dense(source: &Evaluation) -> f64 {
     (4.0 * source.clip.map_or(30.0, |c| c.frame_rate())).max(240.0)
 }
 
@@ -354,9 +355,7 @@ fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
 
 /// `rig` baked exactly as it declares itself, with the default keys, and the bake read back.
 fn baked_as_declared(rig: &Rig) -> (Request<'_>, bake::Baked, Rig) {
-    let modes = rig.skeleton.declared_modes();
-    let clips = bake::every_clip(rig, None);
-    let request = Request { rig, modes, clips, strategy: Strategy::Exact, tolerance: bake::DEFAULT_TOLERANCE };
+    let request = Request::every_clip(&Evaluation::declared(rig, None), None, Strategy::Exact, bake::DEFAULT_TOLERANCE);
     let baked = bake::bake(&request);
     let back = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
     (request, baked, back)
@@ -374,9 +373,9 @@ fn normals_morph_targets_and_their_weights_travel_with_the_meshes() {
     for (a, b) in source.normals.iter().zip(&result.normals) {
         assert!(a.abs_diff_eq(*b, 1e-6), "{a} against {b}");
     }
-    let a = request.side(0);
-    let b = Side::new(&back, back.clips.first(), &back.skeleton.declared_modes());
-    let pairs = Pairs::of(&a, &b, &[]).unwrap();
+    let a = request.clips[0].source.clone();
+    let b = Evaluation::declared(&back, back.clips.first());
+    let pairs = Pairs::by_name(&a, &b);
     let comparison = compare(&a, &b, &pairs, &comparison_times(&a, &b, dense(&a)));
     let vertices = comparison.meshes[0].distance.max;
     assert!(vertices <= bake::DEFAULT_TOLERANCE * baked.rig_size, "{vertices:.2e} of {:.3}", baked.rig_size);

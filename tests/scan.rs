@@ -3,13 +3,18 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use bonescope::analysis::{
-    Assessment, Components, CurveRequest, GhostRequest, Judged, ScanOptions, Subject, analyze, sample_times, scan,
-};
-use bonescope::eval::{Hierarchy, Pose};
+use bonescope::analysis::{Assessment, Components, CurveRequest, Judged, ScanOptions, analyze, scan};
+use bonescope::eval::{Evaluation, Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Skeleton, Track, Transform};
+use bonescope::model::{
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, MAX_FRAMES, Rig, Skeleton, Track, Transform, sample_times,
+};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
+
+/// A rig of `skeleton` with one clip.
+fn rig_of((skeleton, clip): (Skeleton, Clip)) -> Rig {
+    Rig { skeleton, clips: vec![clip], ..Rig::default() }
+}
 
 /// A parent whose X scale grows linearly from 1 at t = 0 to 2 at t = 1, and a child turned 45° about Z.
 fn growing_parent() -> (Skeleton, Clip) {
@@ -26,15 +31,15 @@ fn growing_parent() -> (Skeleton, Clip) {
 
 #[test]
 fn sample_times_are_keys_plus_the_rate_grid() {
-    let (_, clip) = growing_parent();
-    let times = sample_times(Some(&clip), 4.0);
+    let rig = rig_of(growing_parent());
+    let times = Evaluation::declared(&rig, rig.clips.first()).times(4.0);
     assert_eq!(times, vec![0.0, 0.25, 0.5, 0.75, 1.0]);
-    assert_eq!(sample_times(None, 60.0), vec![0.0]);
+    assert_eq!(Evaluation::declared(&rig, None).times(60.0), vec![0.0]);
 }
 
 #[test]
 fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end() {
-    let (skeleton, clip) = growing_parent();
+    let rig = rig_of(growing_parent());
     let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
     let calls = AtomicUsize::new(0);
     let last = AtomicUsize::new(0);
@@ -43,8 +48,7 @@ fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end(
         calls.fetch_add(1, Ordering::Relaxed);
         last.fetch_max(done, Ordering::Relaxed);
     };
-    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
-    let result = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &options, &progress);
+    let result = scan(&Evaluation::declared(&rig, rig.clips.first()), &options, &progress);
     assert_eq!(result.samples, 11);
     assert!(calls.load(Ordering::Relaxed) >= 1);
     assert_eq!(last.load(Ordering::Relaxed), 11, "progress reaches the total");
@@ -62,28 +66,20 @@ fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end(
 
 #[test]
 fn segment_compensation_removes_the_stretch() {
-    let (skeleton, clip) = growing_parent();
-    let hierarchy = Hierarchy::new(&skeleton, &[InheritMode::Full, InheritMode::SegmentCompensate]);
-    let result = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &ScanOptions::default(), &|_, _| {});
+    let rig = rig_of(growing_parent());
+    let evaluation = Evaluation::new(&rig, rig.clips.first(), &[InheritMode::Full, InheritMode::SegmentCompensate]);
+    let result = scan(&evaluation, &ScanOptions::default(), &|_, _| {});
     assert!(result.bones.iter().all(|b| !b.stretched()));
 }
 
 #[test]
 fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
-    let (skeleton, clip) = growing_parent();
-    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
+    let rig = rig_of(growing_parent());
     let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
-    let never = std::sync::atomic::AtomicBool::new(false);
-    let request = bonescope::analysis::CurveRequest { bones: &[1], ghost: None, ..Default::default() };
-    let analysis = bonescope::analysis::analyze(
-        Subject::clip(&skeleton, Some(&clip)),
-        &hierarchy,
-        request,
-        &options,
-        &|_, _| {},
-        &never,
-    )
-    .unwrap();
+    let never = AtomicBool::new(false);
+    let request = CurveRequest { bones: &[1], ghost: None, ..Default::default() };
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let analysis = analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap();
     assert_eq!(analysis.stretched_spans(Some(1)), vec![(0.1, 1.0)]);
     assert_eq!(analysis.stretched_spans(None), vec![(0.1, 1.0)]);
     assert!(analysis.stretched_spans(Some(0)).is_empty());
@@ -95,7 +91,7 @@ fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
 fn brute_force(skeleton: &Skeleton, clip: &Clip, hierarchy: &Hierarchy, options: &ScanOptions) -> Vec<BruteSummary> {
     let mut pose = Pose::default();
     let mut summaries = vec![BruteSummary::default(); skeleton.len()];
-    for time in sample_times(Some(clip), options.rate) {
+    for time in sample_times(clip.key_times(), 0.0, clip.duration(), options.rate, MAX_FRAMES).times {
         pose.evaluate(skeleton, Some(clip), hierarchy, time);
         for (summary, model) in summaries.iter_mut().zip(&pose.model.model) {
             let a = Assessment::of(model, &options.tolerances);
@@ -131,12 +127,13 @@ struct BruteSummary {
 /// The scan judges bones from stretches passed down the hierarchy (model matrices only where a bone does not
 /// inherit fully); it must agree with decomposing every model matrix: counts and first times exactly, angles to
 /// 1e-9 degrees, the reported worst-shear time one where the shear is that worst, and every sample's flag.
-fn assert_scan_matches_brute_force(label: &str, skeleton: &Skeleton, clip: &Clip, modes: &[InheritMode]) {
+fn assert_scan_matches_brute_force(label: &str, rig: &Rig, clip: usize, modes: &[InheritMode]) {
+    let (skeleton, clip) = (&rig.skeleton, &rig.clips[clip]);
     let hierarchy = Hierarchy::new(skeleton, modes);
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let never = AtomicBool::new(false);
-    let subject = Subject::clip(skeleton, Some(clip));
-    let analysis = analyze(subject, &hierarchy, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
+    let evaluation = Evaluation::new(rig, Some(clip), modes);
+    let analysis = analyze(&evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
     let expected = brute_force(skeleton, clip, &hierarchy, &options);
     for (got, want) in analysis.scan.bones.iter().zip(&expected) {
         let bone = format!("{label}: bone {} ({})", got.index, skeleton.bone(got.index).name);
@@ -190,8 +187,8 @@ fn fixed_and_moving() -> (Skeleton, Clip) {
 
 #[test]
 fn the_scan_agrees_with_decomposing_every_model_matrix() {
-    let (skeleton, clip) = fixed_and_moving();
-    assert_scan_matches_brute_force("fixed and moving", &skeleton, &clip, &[InheritMode::Full; 5]);
+    let fixed = rig_of(fixed_and_moving());
+    assert_scan_matches_brute_force("fixed and moving", &fixed, 0, &[InheritMode::Full; 5]);
     // The long clip spreads over several chunks of several words of flags each.
     let (stress, long) = (stress_rig(40, 240, 4), stress_rig(12, 2400, 4));
     let demo = demo_rig();
@@ -211,11 +208,11 @@ fn the_scan_agrees_with_decomposing_every_model_matrix() {
         let skeleton = &rig.skeleton;
         for mode in InheritMode::ALL {
             let label = format!("{label}, all {}", mode.id());
-            assert_scan_matches_brute_force(&label, skeleton, &rig.clips[clip], &vec![mode; skeleton.len()]);
+            assert_scan_matches_brute_force(&label, rig, clip, &vec![mode; skeleton.len()]);
         }
         // Mixed: fully inheriting bones below bones judged from their model matrices.
         let mixed: Vec<InheritMode> = (0..skeleton.len()).map(|b| InheritMode::ALL[b % 3]).collect();
-        assert_scan_matches_brute_force(&format!("{label}, mixed"), skeleton, &rig.clips[clip], &mixed);
+        assert_scan_matches_brute_force(&format!("{label}, mixed"), rig, clip, &mixed);
     }
 }
 
@@ -252,12 +249,12 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let plotted = [7, 16, 25];
     let never = AtomicBool::new(false);
+    let evaluation = Evaluation::declared(&rig, Some(clip));
     for mode in InheritMode::ALL {
         let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]);
-        let ghost = GhostRequest { hierarchy: &ghost_hierarchy, unlayered: false };
-        let request = CurveRequest { bones: &plotted, ghost: Some(ghost), ..Default::default() };
-        let subject = Subject::clip(skeleton, Some(clip));
-        let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
+        let ghost = evaluation.with_modes(ghost_hierarchy.modes());
+        let request = CurveRequest { bones: &plotted, ghost: Some(&ghost), ..Default::default() };
+        let analysis = analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap();
         let (mut pose, mut ghost_pose) = (Pose::default(), Pose::default());
         for (sample, &time) in analysis.times.iter().enumerate() {
             pose.evaluate(skeleton, Some(clip), &hierarchy, time);
@@ -279,26 +276,24 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
 #[test]
 fn empty_rigs_single_keys_rest_poses_and_missing_bones_scan() {
     let options = ScanOptions::default();
-    let none = Skeleton::new(vec![]).unwrap();
-    let empty = Clip::new(0, None, vec![], vec![]);
-    let scanned = scan(Subject::clip(&none, Some(&empty)), &Hierarchy::new(&none, &[]), &options, &|_, _| {});
+    let none = rig_of((Skeleton::new(vec![]).unwrap(), Clip::new(0, None, vec![], vec![])));
+    let scanned = scan(&Evaluation::declared(&none, none.clips.first()), &options, &|_, _| {});
     assert_eq!((scanned.samples, scanned.bones.len()), (1, 0));
     let (skeleton, _) = growing_parent();
-    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
     let mut one_key = BoneTracks::new(0);
     let squashed = vec![Vec3::new(2.0, 1.0, 1.0)];
     one_key.scale = Some(Track::new(Arc::from([0.5].as_slice()), squashed, Interpolation::Step).unwrap());
-    let clip = Clip::new(0, None, vec![one_key], vec![]);
-    let scanned = scan(Subject::clip(&skeleton, Some(&clip)), &hierarchy, &options, &|_, _| {});
+    let rig = rig_of((skeleton, Clip::new(0, None, vec![one_key], vec![])));
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let scanned = scan(&evaluation, &options, &|_, _| {});
     // The child under a constant (2, 1, 1) scale, turned 45°: sheared at every sample, judged once.
     assert_eq!(scanned.bones[1].flagged_samples, scanned.samples);
-    let rest = scan(Subject::clip(&skeleton, None), &hierarchy, &options, &|_, _| {});
+    let rest = scan(&evaluation.at_rest(), &options, &|_, _| {});
     assert_eq!((rest.samples, rest.bones[1].flagged_samples), (1, 0));
     // Curves asked for a bone the skeleton does not have (a selection kept across a reload) are left out.
     let request = CurveRequest { bones: &[1, 7], ghost: None, ..Default::default() };
     let never = AtomicBool::new(false);
-    let subject = Subject::clip(&skeleton, Some(&clip));
-    let analysis = analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap();
+    let analysis = analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap();
     assert_eq!(analysis.curves_of(1).map(|c| c.model.len()), Some(analysis.times.len()));
     assert!(analysis.curves_of(7).is_none());
 }
@@ -313,11 +308,10 @@ fn curves_of_the_chains_alone_equal_those_of_the_whole_analysis() {
     let plotted = [7, 16, 25];
     let never = AtomicBool::new(false);
     for modes in [skeleton.declared_modes(), vec![InheritMode::SegmentCompensate; skeleton.len()]] {
-        let hierarchy = Hierarchy::new(skeleton, &modes);
-        let subject = Subject::clip(skeleton, Some(clip));
+        let evaluation = Evaluation::new(&rig, Some(clip), &modes);
         let analysis = |judged| {
             let request = CurveRequest { bones: &plotted, ghost: None, judged };
-            analyze(subject, &hierarchy, request, &options, &|_, _| {}, &never).unwrap()
+            analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap()
         };
         let (whole, chains) = (analysis(Judged::Every), analysis(Judged::CurveChains));
         assert_eq!(chains.times, whole.times);

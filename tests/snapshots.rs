@@ -180,13 +180,9 @@ fn demo_compared_with_its_trs_bake() {
     let folder = tempfile::tempdir().unwrap();
     let rig = bonescope::import::demo_rig();
     let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-    let request = bonescope::bake::Request {
-        rig: &rig,
-        modes: modes.clone(),
-        clips: bonescope::bake::every_clip(&rig, None),
-        strategy: bonescope::bake::Strategy::Trs,
-        tolerance: bonescope::bake::DEFAULT_TOLERANCE,
-    };
+    let source = bonescope::eval::Evaluation::new(&rig, None, &modes);
+    let (trs, tolerance) = (bonescope::bake::Strategy::Trs, bonescope::bake::DEFAULT_TOLERANCE);
+    let request = bonescope::bake::Request::every_clip(&source, None, trs, tolerance);
     let baked = folder.path().join("demo_trs.glb");
     bonescope::bake::save(&baked, &bonescope::bake::bake(&request).glb).unwrap();
     let mut doc = Document::demo();

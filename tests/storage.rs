@@ -2,9 +2,9 @@
 
 use std::sync::Arc;
 
+use bonescope::analysis::ScanOptions;
 use bonescope::analysis::storage::{StorageOptions, StorageReport, storage_report};
-use bonescope::analysis::{Layered, ScanOptions};
-use bonescope::eval::{Hierarchy, LayerStack};
+use bonescope::eval::Evaluation;
 use bonescope::import::demo_rig;
 use bonescope::math::decompose;
 use bonescope::model::{
@@ -55,10 +55,8 @@ fn compensating_child() -> Rig {
 }
 
 fn report(rig: &Rig, modes: &[InheritMode], rate: f64) -> StorageReport {
-    let hierarchy = Hierarchy::new(&rig.skeleton, modes);
-    let layers = LayerStack::default();
     let options = StorageOptions { rate, ..StorageOptions::default() };
-    storage_report(Layered { rig, layers: &layers }, rig.clips.first(), &hierarchy, &options)
+    storage_report(&Evaluation::new(rig, rig.clips.first(), modes), &options)
 }
 
 #[test]

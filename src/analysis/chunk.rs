@@ -11,13 +11,13 @@ use glam::{DMat4, DQuat};
 
 use super::clip_analysis::{BoneSummary, Components};
 use super::findings::{Judge, Verdict};
+use super::request::{CurveRequest, Judged, ScanOptions};
 use super::stretch::{CursorAt, Stretch};
-use super::subject::{CurveRequest, GhostRequest, Judged, ScanOptions, Subject};
-use crate::eval::{BoneCursor, Hierarchy, LayerStack, Pose};
+use crate::eval::{BoneCursor, Evaluation, Evaluator, Hierarchy, Pose};
 use crate::math::{decompose_near, decompose_with_stretch};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 
-/// What the workers need to know about the subject, found once per analysis.
+/// What the workers need to know about the evaluation, found once per analysis.
 pub(super) struct Plan<'a> {
     hierarchy: &'a Hierarchy,
     /// The clip, when it is judged bone by bone: no layers, every bone inheriting fully (or a root).
@@ -38,14 +38,14 @@ pub(super) struct Plan<'a> {
 }
 
 impl<'a> Plan<'a> {
-    pub fn new(subject: Subject<'a>, hierarchy: &'a Hierarchy, plotted: &[usize], judged: Judged) -> Self {
-        let skeleton = subject.skeleton;
+    pub fn new(evaluation: &'a Evaluation, plotted: &[usize], judged: Judged) -> Self {
+        let (skeleton, hierarchy) = (evaluation.skeleton(), &evaluation.hierarchy);
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
         // A root's mode changes nothing (it has no parent to inherit from): FBX files declare cameras and other
         // top-level nodes componentwise, and that must not take the whole rig off the bone-by-bone path.
         let inherits: Vec<bool> =
             parents.iter().zip(hierarchy.modes()).map(|(p, &m)| p.is_none() || m == InheritMode::Full).collect();
-        let by_bone = subject.clip.filter(|_| subject.layered.is_none() && inherits.iter().all(|&full| full));
+        let by_bone = evaluation.clip.filter(|_| evaluation.layers().is_none() && inherits.iter().all(|&full| full));
         let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
             (0..skeleton.len()).map(|b| by_bone.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
         };
@@ -112,25 +112,24 @@ pub(super) struct CurveSlices<'a> {
 
 /// Analyses the samples at `times`, writing the plotted bones' components into `curves`.
 pub(super) fn analyze_chunk(
-    subject: Subject,
+    evaluation: &Evaluation,
     plan: &Plan,
     request: CurveRequest,
     options: &ScanOptions,
     times: &[f64],
     mut curves: CurveSlices,
 ) -> ChunkResult {
-    let chunk = Chunk { subject, plan, request, judge: Judge::new(&options.tolerances), times };
-    let mut result = ChunkResult::new(subject.skeleton.len(), times.len());
-    let mut layers = subject.worker_layers();
+    let chunk = Chunk { evaluation, plan, request, judge: Judge::new(&options.tolerances), times };
+    let mut result = ChunkResult::new(evaluation.skeleton().len(), times.len());
     match plan.by_bone {
         Some(clip) => {
             let plotted = chunk.judge_by_bone(clip, &mut result);
             chunk.plot_by_bone(clip, &plotted, &mut curves);
         }
-        None => chunk.judge_by_pose(&mut layers, &mut result, &mut curves),
+        None => chunk.judge_by_pose(&mut evaluation.evaluator(), &mut result, &mut curves),
     }
     if let Some(ghost) = request.ghost {
-        chunk.plot_ghost(ghost, &mut layers, &mut curves.ghost_model);
+        chunk.plot_ghost(ghost, &mut curves.ghost_model);
     }
     result
 }
@@ -159,9 +158,9 @@ impl Run {
     }
 }
 
-/// One chunk's work: the subject and what to compute at `times`.
+/// One chunk's work: the evaluation and what to compute at `times`.
 struct Chunk<'a> {
-    subject: Subject<'a>,
+    evaluation: &'a Evaluation<'a>,
     plan: &'a Plan<'a>,
     request: CurveRequest<'a>,
     judge: Judge,
@@ -172,7 +171,7 @@ impl Chunk<'_> {
     /// Judges every bone of a fully inheriting rig, one bone over all the times before the next. Returns the
     /// plotted bones' stretches.
     fn judge_by_bone(&self, clip: &Clip, result: &mut ChunkResult) -> Vec<Run> {
-        let (skeleton, plan, times) = (self.subject.skeleton, self.plan, self.times);
+        let (skeleton, plan, times) = (self.evaluation.skeleton(), self.plan, self.times);
         let mut runs: Vec<Run> = (0..skeleton.len()).map(|_| Run::Done).collect();
         let mut pending_children = plan.children.clone();
         let mut spare: Vec<Vec<Stretch>> = Vec::new();
@@ -227,7 +226,7 @@ impl Chunk<'_> {
         if bones.is_empty() {
             return;
         }
-        let mut chains = Chains::new(self.subject.skeleton, clip, &plan.modelled);
+        let mut chains = Chains::new(self.evaluation.skeleton(), clip, &plan.modelled);
         let mut plot = Plotter::new(bones.len());
         for (sample, &time) in self.times.iter().enumerate() {
             let pose = chains.evaluate(time, plan.hierarchy);
@@ -236,26 +235,19 @@ impl Chunk<'_> {
         }
     }
 
-    /// The ghost curves: the plotted bones under the ghost's modes. Without layers only the plotted bones and their
-    /// ancestors are sampled and evaluated; through layers, whole poses.
-    fn plot_ghost(&self, ghost: GhostRequest, layers: &mut Option<LayerStack>, curves: &mut [&mut [Components]]) {
-        let (subject, bones) = (self.subject, self.request.bones);
-        let by_bone = subject.clip.filter(|_| ghost.unlayered || subject.layered.is_none());
-        let mut chains = by_bone.map(|clip| Chains::new(subject.skeleton, clip, &self.plan.modelled));
-        let mut whole = Pose::default();
+    /// The ghost curves: the plotted bones as `ghost` (the same rig and clip) evaluates them. Without layers only
+    /// the plotted bones and their ancestors are sampled and evaluated; through layers, whole poses.
+    fn plot_ghost(&self, ghost: &Evaluation, curves: &mut [&mut [Components]]) {
+        let bones = self.request.bones;
+        let by_bone = ghost.clip.filter(|_| ghost.layers().is_none());
+        let mut chains = by_bone.map(|clip| Chains::new(ghost.skeleton(), clip, &self.plan.modelled));
+        let mut whole = ghost.evaluator();
         // Where each ghost curve's decomposition starts: its stretch frame at the previous sample.
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
         for (sample, &time) in self.times.iter().enumerate() {
             let pose = match &mut chains {
-                Some(chains) => chains.evaluate(time, ghost.hierarchy),
-                None if ghost.unlayered => {
-                    whole.evaluate(subject.skeleton, subject.clip, ghost.hierarchy, time);
-                    &whole
-                }
-                None => {
-                    subject.evaluate(&mut whole, ghost.hierarchy, layers, time);
-                    &whole
-                }
+                Some(chains) => chains.evaluate(time, &ghost.hierarchy),
+                None => whole.evaluate(time),
             };
             for ((curve, &bone), start) in curves.iter_mut().zip(bones).zip(&mut starts) {
                 let components = Components::of_matrix(&pose.model.model[bone], *start);
@@ -267,13 +259,13 @@ impl Chunk<'_> {
 
     /// Judges every bone from whole poses, one sample after another (layers, or bones that do not inherit
     /// fully), keeping the plotted bones' curves on the way.
-    fn judge_by_pose(&self, layers: &mut Option<LayerStack>, result: &mut ChunkResult, curves: &mut CurveSlices) {
+    fn judge_by_pose(&self, evaluator: &mut Evaluator, result: &mut ChunkResult, curves: &mut CurveSlices) {
         let (plan, plotted) = (self.plan, self.request.bones);
-        let bones = self.subject.skeleton.len();
-        let (mut pose, mut stretches) = (Pose::default(), vec![Stretch::NONE; bones]);
+        let bones = self.evaluation.skeleton().len();
+        let mut stretches = vec![Stretch::NONE; bones];
         let mut plot = Plotter::new(plotted.len());
         for (sample, &time) in self.times.iter().enumerate() {
-            self.subject.evaluate(&mut pose, plan.hierarchy, layers, time);
+            let pose = evaluator.evaluate(time);
             for &bone in &plan.judged {
                 let start = stretches[bone].frame();
                 let stretch = match plan.parents[bone] {

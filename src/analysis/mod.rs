@@ -4,19 +4,15 @@
 mod bind;
 mod chunk;
 mod clip_analysis;
-mod compare;
 mod findings;
 pub mod report;
+mod request;
 mod scan;
 pub mod storage;
 mod stretch;
-mod subject;
 
 pub use bind::{BindMismatch, BindTolerance, bind_mismatches};
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
-pub use compare::{BoneDifference, ClipComparison, compare};
 pub use findings::{Assessment, Findings, Tolerances};
+pub use request::{CurveRequest, Judged, ScanOptions};
 pub use scan::{analyze, scan};
-pub use subject::{
-    CurveRequest, GhostRequest, Judged, Layered, ScanOptions, Subject, layered_sample_times, sample_times,
-};

@@ -202,56 +202,6 @@ impl<T> FileReport<T> {
 
 pub type FileScan = FileReport<AnimationScan>;
 
-/// One bone of `scan --compare-inherit`: its mode on each side and how far apart the two evaluations get.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct BoneComparisonReport {
-    pub name: String,
-    pub mode_a: InheritMode,
-    pub mode_b: InheritMode,
-    #[serde(flatten)]
-    pub difference: super::BoneDifference,
-}
-
-/// One clip of one file compared under two sets of modes.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct AnimationComparison {
-    /// `null` for a file without animations, whose rest pose is compared instead.
-    pub animation: Option<AnimationInfo>,
-    /// What each side is: `declared` or a mode id.
-    pub a: String,
-    pub b: String,
-    pub rate: f64,
-    pub samples: usize,
-    /// Every bone, in bone order.
-    pub bones: Vec<BoneComparisonReport>,
-}
-
-impl AnimationComparison {
-    /// `sides`: the label and the per-bone modes of each side.
-    pub fn new(
-        skeleton: &Skeleton,
-        clip: Option<&Clip>,
-        sides: [(String, &[InheritMode]); 2],
-        rate: f64,
-        comparison: super::ClipComparison,
-    ) -> Self {
-        let [(a, modes_a), (b, modes_b)] = sides;
-        let bones = comparison
-            .bones
-            .into_iter()
-            .map(|difference| BoneComparisonReport {
-                name: skeleton.bone(difference.index).name.clone(),
-                mode_a: modes_a[difference.index],
-                mode_b: modes_b[difference.index],
-                difference,
-            })
-            .collect();
-        AnimationComparison { animation: clip.map(AnimationInfo::of), a, b, rate, samples: comparison.samples, bones }
-    }
-}
-
-pub type FileComparison = FileReport<AnimationComparison>;
-
 /// `bonescope inspect --format json`: the report, the layers every sample was evaluated through (the default: none)
 /// and the skin joints whose bind matrix is not their rest model matrix.
 #[derive(Clone, Debug, PartialEq, Serialize)]

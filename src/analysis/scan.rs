@@ -7,41 +7,35 @@ use rayon::prelude::*;
 
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
-use super::subject::{CurveRequest, ScanOptions, Subject};
-use crate::eval::Hierarchy;
+use super::request::{CurveRequest, ScanOptions};
+use crate::eval::Evaluation;
 
 /// Words of 64 sample flags per parallel work item, at most: long enough to amortise a worker's buffers, and
 /// short enough for every thread to get several.
 const MAX_CHUNK_WORDS: usize = 16;
 
-/// Scans `subject` under `hierarchy`'s modes. `progress(done, total)` is called from worker threads as samples
+/// Scans `evaluation` over its whole clip. `progress(done, total)` is called from worker threads as samples
 /// complete.
-pub fn scan(
-    subject: Subject,
-    hierarchy: &Hierarchy,
-    options: &ScanOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> ClipScan {
+pub fn scan(evaluation: &Evaluation, options: &ScanOptions, progress: &(dyn Fn(usize, usize) + Sync)) -> ClipScan {
     let never = AtomicBool::new(false);
-    analyze(subject, hierarchy, CurveRequest::default(), options, progress, &never)
+    analyze(evaluation, CurveRequest::default(), options, progress, &never)
         .expect("an analysis that is never cancelled completes")
         .scan
 }
 
 /// The whole-clip analysis behind [`scan`] and the app's plots. Returns `None` when `cancel` was set.
 pub fn analyze(
-    subject: Subject,
-    hierarchy: &Hierarchy,
+    evaluation: &Evaluation,
     request: CurveRequest,
     options: &ScanOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
     cancel: &AtomicBool,
 ) -> Option<ClipAnalysis> {
-    let skeleton = subject.skeleton;
-    let times = subject.times(options.rate);
+    let skeleton = evaluation.skeleton();
+    let times = evaluation.times(options.rate);
     let in_range: Vec<usize> = request.bones.iter().copied().filter(|&b| b < skeleton.len()).collect();
     let request = CurveRequest { bones: &in_range, ..request };
-    let plan = Plan::new(subject, hierarchy, request.bones, request.judged);
+    let plan = Plan::new(evaluation, request.bones, request.judged);
     let done = AtomicUsize::new(0);
     let words = times.len().div_ceil(64);
     let chunk_len = 64 * (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
@@ -54,7 +48,7 @@ pub fn analyze(
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let result = analyze_chunk(subject, &plan, request, options, chunk, slices);
+            let result = analyze_chunk(evaluation, &plan, request, options, chunk, slices);
             progress(done.fetch_add(chunk.len(), Ordering::Relaxed) + chunk.len(), times.len());
             Some(result)
         })

@@ -24,11 +24,10 @@ use glam::{DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::subject::{Layered, layered_sample_times};
 use super::{Assessment, Tolerances};
 use crate::eval::skinning::skin_positions;
-use crate::eval::{Hierarchy, LayerStack, Pose};
-use crate::model::{Clip, InheritMode, Rig, Transform};
+use crate::eval::{Evaluation, Evaluator};
+use crate::model::{InheritMode, Rig, Transform};
 
 /// `f32` components of one key: translation 3 + rotation 4 + scale 3.
 pub const TRS_KEY_BYTES: u64 = 40;
@@ -97,17 +96,12 @@ pub struct StorageReport {
 /// Frames per parallel work item.
 const CHUNK: usize = 64;
 
-/// Measures the seed's storage on `clip` (the main clip of `layered.layers`), evaluated under `hierarchy`.
-pub fn storage_report(
-    layered: Layered,
-    clip: Option<&Clip>,
-    hierarchy: &Hierarchy,
-    options: &StorageOptions,
-) -> StorageReport {
-    let rig = layered.rig;
+/// Measures the seed's storage on `evaluation` over its whole clip.
+pub fn storage_report(evaluation: &Evaluation, options: &StorageOptions) -> StorageReport {
+    let rig = evaluation.rig;
     let bones = rig.skeleton.len();
-    let times = layered_sample_times(rig, clip, layered.layers, options.rate);
-    let runtime = || Runtime::new(layered, clip, hierarchy, options);
+    let times = evaluation.times(options.rate);
+    let runtime = || Runtime::new(evaluation, options);
     let stretched_frames = times
         .par_chunks(CHUNK)
         .map(|chunk| runtime().count_stretched(chunk))
@@ -139,32 +133,21 @@ pub fn storage_report(
 }
 
 /// One worker: the evaluated pose and the two rebuilt ones, with their buffers.
-struct Runtime<'a> {
+struct Runtime<'e, 'a> {
     rig: &'a Rig,
-    clip: Option<&'a Clip>,
-    hierarchy: &'a Hierarchy,
-    options: &'a StorageOptions,
-    layers: LayerStack,
-    pose: Pose,
+    evaluator: Evaluator<'e, 'a>,
+    options: &'e StorageOptions,
     seed: Vec<DMat4>,
     trs: Vec<DMat4>,
     vertices: [Vec<DVec3>; 3],
 }
 
-impl<'a> Runtime<'a> {
-    fn new(
-        layered: Layered<'a>,
-        clip: Option<&'a Clip>,
-        hierarchy: &'a Hierarchy,
-        options: &'a StorageOptions,
-    ) -> Self {
+impl<'e, 'a> Runtime<'e, 'a> {
+    fn new(evaluation: &'e Evaluation<'a>, options: &'e StorageOptions) -> Self {
         Runtime {
-            rig: layered.rig,
-            clip,
-            hierarchy,
+            rig: evaluation.rig,
+            evaluator: evaluation.evaluator(),
             options,
-            layers: layered.layers.clone(),
-            pose: Pose::default(),
             seed: Vec::new(),
             trs: Vec::new(),
             vertices: Default::default(),
@@ -172,15 +155,16 @@ impl<'a> Runtime<'a> {
     }
 
     fn evaluate(&mut self, time: f64) {
-        self.pose.evaluate_layered(self.rig, self.clip, self.hierarchy, &mut self.layers, time);
+        self.evaluator.evaluate(time);
     }
 
     /// The local transform stored for `bone` at the evaluated pose, and whether it is stretched.
     fn stored(&self, bone: usize) -> (Transform, bool) {
-        let local = &self.pose.local[bone];
+        let pose = &self.evaluator.pose;
+        let local = &pose.local[bone];
         let parent = self.rig.skeleton.parent(bone);
-        let model = &self.pose.model.model;
-        if local.is_trs() && (parent.is_none() || self.hierarchy.modes()[bone] == InheritMode::Full) {
+        let model = &pose.model.model;
+        if local.is_trs() && (parent.is_none() || self.evaluator.evaluation().modes()[bone] == InheritMode::Full) {
             return (*local, false);
         }
         let exported = parent.map_or(model[bone], |p| model[p].inverse() * model[bone]);
@@ -208,7 +192,7 @@ impl<'a> Runtime<'a> {
         for &time in times {
             self.evaluate(time);
             self.rebuild(marks);
-            for ((evaluated, seed), trs) in self.pose.model.model.iter().zip(&self.seed).zip(&self.trs) {
+            for ((evaluated, seed), trs) in self.evaluator.pose.model.model.iter().zip(&self.seed).zip(&self.trs) {
                 for probe in probes {
                     let at = evaluated.transform_point3(probe);
                     errors.seed.bone_axes.add(seed.transform_point3(probe).distance(at));
@@ -237,10 +221,11 @@ impl<'a> Runtime<'a> {
 
     fn measure_vertices(&mut self, errors: &mut Errors) {
         let [evaluated, seed, trs] = &mut self.vertices;
+        let pose = &self.evaluator.pose;
         for mesh in &self.rig.meshes {
-            skin_positions(mesh, &self.rig.skins, &self.pose.model.model, &self.pose.morph, evaluated);
-            skin_positions(mesh, &self.rig.skins, &self.seed, &self.pose.morph, seed);
-            skin_positions(mesh, &self.rig.skins, &self.trs, &self.pose.morph, trs);
+            skin_positions(mesh, &self.rig.skins, &pose.model.model, &pose.morph, evaluated);
+            skin_positions(mesh, &self.rig.skins, &self.seed, &pose.morph, seed);
+            skin_positions(mesh, &self.rig.skins, &self.trs, &pose.morph, trs);
             for ((at, s), t) in evaluated.iter().zip(seed.iter()).zip(trs.iter()) {
                 errors.seed.vertices.add(s.distance(*at));
                 errors.trs.vertices.add(t.distance(*at));

@@ -6,10 +6,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use super::Document;
 use super::job::{Job, Progress};
 use crate::analysis::{Assessment, Components, Tolerances};
-use crate::diff::{Pairs, Side, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
-use crate::eval::{LayerStack, Layers, Pose, SkinningMethod};
+use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
+use crate::eval::{Evaluation, Layers, SkinningMethod};
 use crate::import::{self, ImportError};
 use crate::model::{Clip, InheritMode, Rig};
 use crate::view::Layer;
@@ -36,8 +37,7 @@ impl Compared {
     /// `rig` (read from `path`) paired with the document's rig.
     pub fn pair(path: PathBuf, rig: Rig, document: &Rig) -> Self {
         let mut bones = vec![None; document.skeleton.len()];
-        // Explicit pairs are `bonescope diff --map`'s; the app pairs by name alone, so this cannot fail.
-        for (a, b) in match_bones(&document.skeleton, &rig.skeleton, &[]).map(|m| m.pairs).unwrap_or_default() {
+        for (a, b) in match_bones(&document.skeleton, &rig.skeleton).pairs {
             bones[a] = Some(b);
         }
         let mut meshes = vec![None; document.meshes.len()];
@@ -78,8 +78,8 @@ impl Compared {
     }
 
     /// This file evaluated as it declares, for the document's clip `clip` (an index).
-    pub fn side(&self, clip: Option<usize>) -> Side<'_> {
-        Side::new(&self.rig, self.clip_for(clip), &self.rig.skeleton.declared_modes())
+    pub fn evaluation(&self, clip: Option<usize>) -> Evaluation<'_> {
+        Evaluation::declared(&self.rig, self.clip_for(clip))
     }
 
     /// The ghost at `time`: this file's pose on the document's bones (a bone without a partner stays where the
@@ -92,10 +92,8 @@ impl Compared {
         skinning: SkinningMethod,
         tolerances: &Tolerances,
     ) -> Layer {
-        let mut side = self.side(clip);
-        side.skinning = skinning;
-        let mut pose = Pose::default();
-        side.evaluate(&mut pose, &mut None, time);
+        let evaluation = self.evaluation(clip).with_skinning(skinning);
+        let pose = evaluation.pose_at(time);
         let model: Vec<_> =
             self.bones.iter().zip(&primary.model).map(|(b, own)| b.map_or(*own, |b| pose.model.model[b])).collect();
         let assessments = Assessment::all(&model, tolerances);
@@ -105,7 +103,7 @@ impl Compared {
             .map(|m| {
                 let mut positions = Vec::new();
                 if let Some(m) = m {
-                    side.skin(&pose, *m, &mut positions);
+                    evaluation.skin(&pose, *m, &mut positions);
                 }
                 positions
             })
@@ -157,22 +155,20 @@ pub struct CompareJobs {
     pub curves: Job<CurvesKey, ComparedCurves>,
 }
 
-/// The differences `key` asks for, as work for a [`Job`]: the document (`rig`, through `layers`) against `compared`.
+/// The differences `key` asks for, as work for a [`Job`]: the document (the one `key` was made from) against
+/// `compared`.
 pub fn differences(
     key: CompareKey,
-    rig: Arc<Rig>,
-    layers: LayerStack,
+    doc: Document,
     compared: Arc<Compared>,
 ) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
     move |_| {
-        let clip = key.clip.and_then(|c| rig.clips.get(c));
-        let own = Side::new(&rig, clip, &key.modes);
-        let own = if key.layers.is_empty() { own } else { own.with_layers(layers) };
-        let other = compared.side(key.clip);
+        let own = doc.evaluation();
+        let other = compared.evaluation(key.clip);
         // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
-        let pairs = Pairs { meshes: Vec::new(), ..Pairs::of(&own, &other, &[]).ok()? };
+        let pairs = Pairs { meshes: Vec::new(), ..Pairs::by_name(&own, &other) };
         let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.rate));
-        let mut bones = vec![None; rig.skeleton.len()];
+        let mut bones = vec![None; doc.rig.skeleton.len()];
         for difference in &comparison.bones {
             bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
         }
@@ -189,7 +185,7 @@ pub fn curves(
         let paired: Vec<(usize, usize)> =
             key.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
         let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
-        let curves = model_curves(&compared.side(key.compare.clip), &partners, &key.times);
+        let curves = model_curves(&compared.evaluation(key.compare.clip), &partners, &key.times);
         Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
     }
 }
@@ -204,9 +200,7 @@ mod tests {
         let compared = Compared::pair(PathBuf::from("demo.glb"), rig.clone(), &rig);
         assert_eq!(compared.unpaired(), 0);
         assert!(compared.meshes.iter().all(Option::is_some));
-        let doc = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
-        let mut pose = Pose::default();
-        doc.evaluate(&mut pose, &mut None, 0.5);
+        let pose = Evaluation::declared(&rig, rig.clips.first()).pose_at(0.5);
         let primary = Layer::from_model(
             &rig,
             pose.model.model.clone(),

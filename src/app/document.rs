@@ -6,77 +6,48 @@ use std::sync::Arc;
 
 use super::compare::Compared;
 use crate::eval::layers::LayerError;
-use crate::eval::{Hierarchy, LayerStack, Layers, Pose};
+use crate::eval::{Evaluation, LayerStack, Layers};
 use crate::import::{self, ImportError};
-use crate::model::{Bone, Clip, DEFAULT_FRAME_RATE, InheritMode, Rig, Skeleton};
+use crate::model::{Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Rig, Skeleton};
 
 /// A second pose drawn translucent over the first and plotted dashed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug)]
 pub enum Ghost {
-    /// Every bone under this mode (with the same layers).
-    Mode(InheritMode),
-    /// Every bone under the mode its file declares (with the same layers).
-    Declared,
+    /// The document's clip through the same layers under other modes.
+    Modes(ModeChoice),
     /// The clip as authored: the document's modes without the layers.
     Unlayered,
-    /// The file compared with the document (File → Compare with…).
-    Compared,
+    /// The file compared with the document (File → Compare with…): its pose on the paired bones.
+    Compared(Arc<Compared>),
+}
+
+impl PartialEq for Ghost {
+    fn eq(&self, other: &Ghost) -> bool {
+        match (self, other) {
+            (Ghost::Modes(a), Ghost::Modes(b)) => a == b,
+            (Ghost::Unlayered, Ghost::Unlayered) => true,
+            (Ghost::Compared(a), Ghost::Compared(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 impl Ghost {
-    pub fn label(self) -> &'static str {
+    pub fn label(&self) -> &'static str {
         match self {
-            Ghost::Mode(mode) => mode.id(),
-            Ghost::Declared => "declared",
+            Ghost::Modes(choice) => choice.label(),
             Ghost::Unlayered => "without layers",
-            Ghost::Compared => "compared file",
+            Ghost::Compared(_) => "compared file",
         }
     }
 
-    /// For a ghost of the document's own rig, its modes (given the document's `modes` and the skeleton's declared
-    /// ones) and whether it goes through the layers; `None` for the compared file, another rig.
-    pub fn evaluation(self, modes: &[InheritMode], skeleton: &Skeleton) -> Option<(Vec<InheritMode>, bool)> {
+    /// The ghost's evaluation of the document's rig, given the document's own; `None` for the compared file,
+    /// another rig, whose pose is paired bone by bone ([`Compared::ghost`]).
+    pub fn evaluation<'a>(&self, document: &Evaluation<'a>) -> Option<Evaluation<'a>> {
         match self {
-            Ghost::Mode(mode) => Some((vec![mode; modes.len()], true)),
-            Ghost::Declared => Some((skeleton.declared_modes(), true)),
-            Ghost::Unlayered => Some((modes.to_vec(), false)),
-            Ghost::Compared => None,
-        }
-    }
-}
-
-/// What a mode edit sets: one of the modes, or each bone's own as its file declares it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ModeChoice {
-    Declared,
-    Mode(InheritMode),
-}
-
-impl ModeChoice {
-    /// "declared" first, then every mode.
-    pub fn all() -> impl Iterator<Item = ModeChoice> {
-        std::iter::once(ModeChoice::Declared).chain(InheritMode::ALL.into_iter().map(ModeChoice::Mode))
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            ModeChoice::Declared => "declared",
-            ModeChoice::Mode(mode) => mode.id(),
-        }
-    }
-
-    pub fn description(self) -> &'static str {
-        match self {
-            ModeChoice::Declared => "each bone as its file declares it",
-            ModeChoice::Mode(mode) => mode.description(),
-        }
-    }
-
-    /// The mode this choice gives `bone`.
-    fn mode_of(self, bone: &Bone) -> InheritMode {
-        match self {
-            ModeChoice::Declared => bone.inherit,
-            ModeChoice::Mode(mode) => mode,
+            Ghost::Modes(choice) => Some(document.with_modes(&document.skeleton().modes(*choice))),
+            Ghost::Unlayered => Some(document.without_layers()),
+            Ghost::Compared(_) => None,
         }
     }
 }
@@ -89,6 +60,7 @@ pub struct Document {
     pub rig: Arc<Rig>,
     /// One mode per bone, starting from what the file declares.
     pub modes: Vec<InheritMode>,
+    /// Never a compared file other than `compared`.
     pub ghost: Option<Ghost>,
     /// Index into `rig.clips`.
     pub clip: Option<usize>,
@@ -104,7 +76,7 @@ impl Document {
     pub fn demo() -> Self {
         let mut doc = Document::new(None, import::demo_rig());
         // The demo exists to show shear: put the ghost where the shear disappears.
-        doc.ghost = Some(Ghost::Mode(InheritMode::SegmentCompensate));
+        doc.ghost = Some(Ghost::Modes(ModeChoice::Mode(InheritMode::SegmentCompensate)));
         doc
     }
 
@@ -128,19 +100,23 @@ impl Document {
         }
     }
 
-    /// The same file re-read (after it changed on disk), keeping clip, modes and ghost where they still fit.
-    pub fn reloaded(&self, rig: Rig) -> Self {
+    /// The same file re-read (after it changed on disk), keeping clip, modes, ghost and layers where they still
+    /// fit. Layers naming clips or bones the new file lacks are dropped rather than kept half-valid: the error says
+    /// why, for the user.
+    pub fn reloaded(&self, rig: Rig) -> (Self, Option<LayerError>) {
         let mut doc = Document::new(self.path.clone(), rig);
         if doc.modes.len() == self.modes.len() {
             doc.modes.clone_from(&self.modes);
         }
-        doc.ghost = self.ghost;
         doc.frame_rate_override = self.frame_rate_override;
         doc.compared = self.compared.as_ref().map(|c| Arc::new(c.repaired(&doc.rig)));
+        doc.ghost = match &self.ghost {
+            Some(Ghost::Compared(_)) => doc.compared.clone().map(Ghost::Compared),
+            ghost => ghost.clone(),
+        };
         doc.clip = self.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.clip);
-        // Layers naming clips or bones the new file lacks are dropped rather than kept half-valid.
-        let _ = doc.set_layers(self.layers());
-        doc
+        let dropped = doc.set_layers(self.layers()).err();
+        (doc, dropped)
     }
 
     pub fn layers(&self) -> &Layers {
@@ -181,35 +157,30 @@ impl Document {
         self.layers.duration(&self.rig, self.clip())
     }
 
-    /// How a ghost of this rig is evaluated, when one is shown: its modes, and whether through the layers.
-    pub fn ghost_evaluation(&self) -> Option<(Vec<InheritMode>, bool)> {
-        self.ghost.and_then(|ghost| ghost.evaluation(&self.modes, &self.rig.skeleton))
+    /// What the document shows: its clip under its modes, through its layers.
+    pub fn evaluation(&self) -> Evaluation<'_> {
+        Evaluation::new(&self.rig, self.clip(), &self.modes).with_layers(self.layers.clone())
+    }
+
+    /// The ghost's evaluation of this rig, when the ghost is one (a compared file's is its own:
+    /// [`Compared::ghost`]).
+    pub fn ghost_evaluation(&self) -> Option<Evaluation<'_>> {
+        self.ghost.as_ref()?.evaluation(&self.evaluation())
     }
 
     /// Compares this document with `compared`, drawn as the ghost.
     pub fn compare_with(&mut self, compared: Compared) {
-        self.compared = Some(Arc::new(compared));
-        self.ghost = Some(Ghost::Compared);
+        let compared = Arc::new(compared);
+        self.compared = Some(compared.clone());
+        self.ghost = Some(Ghost::Compared(compared));
     }
 
     /// Stops comparing (a compared ghost goes too).
     pub fn stop_comparing(&mut self) {
         self.compared = None;
-        if self.ghost == Some(Ghost::Compared) {
+        if let Some(Ghost::Compared(_)) = self.ghost {
             self.ghost = None;
         }
-    }
-
-    /// The pose at `time` under `modes`, through the layers when `layered`.
-    pub fn evaluate(&self, modes: &[InheritMode], time: f64, layered: bool) -> Pose {
-        let hierarchy = Hierarchy::new(&self.rig.skeleton, modes);
-        let mut pose = Pose::default();
-        if layered && !self.layers().is_empty() {
-            pose.evaluate_layered(&self.rig, self.clip(), &hierarchy, &mut self.layers.clone(), time);
-        } else {
-            pose.evaluate(&self.rig.skeleton, self.clip(), &hierarchy, time);
-        }
-        pose
     }
 
     /// Sets the mode of one bone, of its subtree, or of all bones.
@@ -217,7 +188,7 @@ impl Document {
         let skeleton = &self.rig.skeleton;
         for (b, m) in self.modes.iter_mut().enumerate() {
             if scope.applies(skeleton, b, bone) {
-                *m = choice.mode_of(skeleton.bone(b));
+                *m = choice.mode_for(skeleton.bone(b).inherit);
             }
         }
     }
@@ -227,7 +198,8 @@ impl Document {
     pub fn current_choice(&self, bone: usize, scope: ModeScope) -> Option<ModeChoice> {
         let skeleton = &self.rig.skeleton;
         let in_scope = || (0..self.modes.len()).filter(move |&b| scope.applies(skeleton, b, bone));
-        let matches = |choice: ModeChoice| in_scope().all(|b| self.modes[b] == choice.mode_of(skeleton.bone(b)));
+        let matches =
+            |choice: ModeChoice| in_scope().all(|b| self.modes[b] == choice.mode_for(skeleton.bone(b).inherit));
         ModeChoice::all().find(|&choice| matches(choice))
     }
 
@@ -300,8 +272,11 @@ mod tests {
         assert_eq!(doc.modes, declared);
         assert_eq!(doc.current_choice(0, ModeScope::All), Some(ModeChoice::Declared));
         assert_eq!(doc.current_choice(2, ModeScope::Bone), Some(ModeChoice::Declared), "declared wins over its mode");
-        let (modes, layered) = Ghost::Declared.evaluation(&doc.modes, &doc.rig.skeleton).unwrap();
-        assert_eq!((modes, layered), (declared, true));
+        doc.set_layers(&Layers { bind_weight: 0.5, ..Layers::default() }).unwrap();
+        let ghost = Ghost::Modes(ModeChoice::Declared).evaluation(&doc.evaluation()).unwrap();
+        assert_eq!((ghost.modes(), ghost.layers().is_some()), (declared.as_slice(), true), "the same layers");
+        let unlayered = Ghost::Unlayered.evaluation(&doc.evaluation()).unwrap();
+        assert_eq!((unlayered.modes(), unlayered.layers().is_none()), (doc.modes.as_slice(), true));
     }
 
     #[test]
@@ -311,15 +286,21 @@ mod tests {
         doc.set_mode(2, ModeScope::Bone, ModeChoice::Mode(InheritMode::BlenderAligned));
         let blend = crate::eval::layers::Blend { clip: 0, weight: 0.3, sync: true, rotation: Default::default() };
         doc.set_layers(&Layers { blend: Some(blend), ..Layers::default() }).unwrap();
-        let again = doc.reloaded(import::demo_rig());
-        assert_eq!((again.clip, again.modes.clone(), again.ghost), (doc.clip, doc.modes.clone(), doc.ghost));
+        let (again, dropped) = doc.reloaded(import::demo_rig());
+        assert_eq!(dropped, None);
+        assert_eq!(
+            (again.clip, again.modes.clone(), again.ghost.clone()),
+            (doc.clip, doc.modes.clone(), doc.ghost.clone())
+        );
         assert_eq!(again.layers(), doc.layers());
         // A file that lost the blended clip keeps the document but drops the layers that no longer fit.
         let mut one_clip = import::demo_rig();
         one_clip.clips.truncate(1);
         doc.set_layers(&Layers { blend: Some(crate::eval::layers::Blend { clip: 1, ..blend }), ..Layers::default() })
             .unwrap();
-        assert!(doc.reloaded(one_clip).layers().is_empty());
+        let (again, dropped) = doc.reloaded(one_clip);
+        assert!(again.layers().is_empty());
+        assert!(dropped.unwrap().to_string().contains("no animation 1"), "the user is told why");
     }
 
     #[test]

@@ -5,12 +5,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
-use super::Ghost;
-use crate::analysis::{
-    ClipAnalysis, CurveRequest, GhostRequest, Judged, Layered, ScanOptions, Subject, Tolerances, analyze,
-};
-use crate::eval::{Hierarchy, LayerStack, Layers};
-use crate::model::{InheritMode, Rig};
+use super::{Document, Ghost};
+use crate::analysis::{ClipAnalysis, CurveRequest, Judged, ScanOptions, Tolerances, analyze};
+use crate::eval::Layers;
+use crate::model::InheritMode;
 
 /// How far a piece of work has come, and whether it should stop (a newer one replaced it).
 #[derive(Clone, Default)]
@@ -79,7 +77,8 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
         self.running = Some(Running { key, progress, result });
     }
 
-    fn collect(&mut self) {
+    /// Takes the running work's result if it has finished.
+    pub fn collect(&mut self) {
         let Some(running) = &self.running else { return };
         match running.result.try_recv() {
             Ok(Some(result)) => {
@@ -117,7 +116,8 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
     }
 }
 
-/// Everything a whole-clip analysis depends on.
+/// Everything a whole-clip analysis depends on: what the document's evaluation does, the ghost's, and what is
+/// asked of them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JobKey {
     /// Changes whenever a (re)loaded rig replaces the document's.
@@ -136,28 +136,15 @@ pub struct JobKey {
 /// The whole-clip analysis of the document.
 pub type AnalysisJob = Job<JobKey, ClipAnalysis>;
 
-/// The analysis `key` asks of `rig`, as work for a [`Job`].
-pub fn analysis(key: JobKey, rig: Arc<Rig>) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
+/// The analysis `key` asks of `doc` (the document `key` was made from), as work for a [`Job`].
+pub fn analysis(key: JobKey, doc: Document) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
     move |progress| {
-        let hierarchy = Hierarchy::new(&rig.skeleton, &key.modes);
-        // `(modes, unlayered)`; a compared file's ghost is another file's evaluation, not the analysis's.
-        let ghost_modes = key.ghost.and_then(|ghost| ghost.evaluation(&key.modes, &rig.skeleton));
-        let ghost_modes = ghost_modes.map(|(modes, layered)| (modes, !layered));
-        let ghost_hierarchy = ghost_modes.as_ref().map(|(modes, _)| Hierarchy::new(&rig.skeleton, modes));
-        let ghost = ghost_hierarchy
-            .as_ref()
-            .zip(ghost_modes.as_ref())
-            .map(|(hierarchy, (_, unlayered))| GhostRequest { hierarchy, unlayered: *unlayered });
-        let clip = key.clip.and_then(|c| rig.clips.get(c));
+        let evaluation = doc.evaluation();
+        // A compared file's ghost is another file's evaluation, not the analysis's.
+        let ghost = key.ghost.as_ref().and_then(|ghost| ghost.evaluation(&evaluation));
         let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
-        let request = CurveRequest { bones: &key.plotted, ghost, judged: key.judged };
+        let request = CurveRequest { bones: &key.plotted, ghost: ghost.as_ref(), judged: key.judged };
         let report = |done: usize, total: usize| progress.report(done, total);
-        // The document checked the layers against this rig; without layers the plain analysis is the same.
-        let stack = LayerStack::new(&rig, &key.layers).ok().filter(|_| !key.layers.is_empty());
-        let subject = match &stack {
-            Some(layers) => Subject::layered(Layered { rig: &rig, layers }, clip),
-            None => Subject::clip(&rig.skeleton, clip),
-        };
-        analyze(subject, &hierarchy, request, &options, &report, progress.cancelled())
+        analyze(&evaluation, request, &options, &report, progress.cancelled())
     }
 }

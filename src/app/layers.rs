@@ -5,15 +5,14 @@
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
 //! reported, not applied).
 
-use std::sync::mpsc::Receiver;
-
 use clap::ValueEnum;
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
+use super::job::{Job, Progress};
 use super::{Document, Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
-use crate::analysis::{BindMismatch, BindTolerance, Layered, bind_mismatches};
+use crate::analysis::{BindMismatch, BindTolerance, bind_mismatches};
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
 use crate::eval::{Hierarchy, Layers};
 use crate::model::{InheritMode, Rig, Skeleton, Transform};
@@ -22,36 +21,23 @@ use crate::view::Badge;
 /// The panel's own state: results computed on request, kept while they still describe the document.
 #[derive(Default)]
 pub struct LayersPanel {
-    storage: Option<Measurement>,
+    /// The storage report of one document state: measured off the UI thread (it walks the whole clip).
+    storage: Job<StorageKey, StorageReport>,
 }
 
-/// A storage report of one document state: measured off the UI thread (it walks the whole clip), then kept.
-struct Measurement {
-    of: (Layers, Option<usize>, Vec<InheritMode>),
-    result: Receiver<StorageReport>,
-    report: Option<StorageReport>,
-}
+/// What a storage report depends on: the document's layers, clip and modes.
+type StorageKey = (Layers, Option<usize>, Vec<InheritMode>);
 
-impl Measurement {
-    fn start(doc: &Document, ctx: egui::Context) -> Self {
-        let (rig, layers, clip, modes) = (doc.rig.clone(), doc.layer_stack().clone(), doc.clip, doc.modes.clone());
-        let (sender, result) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
-            let layered = Layered { rig: &rig, layers: &layers };
-            let clip = clip.and_then(|c| rig.clips.get(c));
-            let _ = sender.send(storage_report(layered, clip, &hierarchy, &StorageOptions::default()));
-            ctx.request_repaint();
-        });
-        Measurement { of: Self::key(doc), result, report: None }
-    }
-
-    fn key(doc: &Document) -> (Layers, Option<usize>, Vec<InheritMode>) {
-        (doc.layers().clone(), doc.clip, doc.modes.clone())
-    }
+fn storage_key(doc: &Document) -> StorageKey {
+    (doc.layers().clone(), doc.clip, doc.modes.clone())
 }
 
 impl LayersPanel {
+    /// Waits for a measurement under way (tests and headless renders want a settled state).
+    pub fn settle(&mut self) {
+        self.storage.wait();
+    }
+
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         ui.heading("Layers");
         let mut layers = shared.doc.layers().clone();
@@ -76,24 +62,21 @@ impl LayersPanel {
     fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
         CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
             let doc = &*shared.doc;
+            let key = storage_key(doc);
             if ui.button("Measure the clip").clicked() {
-                self.storage = Some(Measurement::start(doc, ui.ctx().clone()));
+                let doc = doc.clone();
+                let work = move |_: &Progress| Some(storage_report(&doc.evaluation(), &StorageOptions::default()));
+                let waker = ui.ctx().clone();
+                self.storage.update(key.clone(), work, move || waker.request_repaint());
             }
-            let current = self.storage.as_mut().filter(|m| m.of == Measurement::key(doc));
-            match current {
-                Some(m) => {
-                    if let Ok(report) = m.result.try_recv() {
-                        m.report = Some(report);
-                    }
-                    match &m.report {
-                        Some(report) => storage_table(ui, report),
-                        None => {
-                            ui.horizontal(|ui| {
-                                ui.spinner();
-                                ui.label("measuring the clip…");
-                            });
-                        }
-                    }
+            self.storage.collect();
+            match self.storage.for_key(&key) {
+                Some(report) => storage_table(ui, report),
+                None if self.storage.progress().is_some() => {
+                    ui.horizontal(|ui| {
+                        ui.spinner();
+                        ui.label("measuring the clip…");
+                    });
                 }
                 None => {
                     ui.label(RichText::new("Marks the bones stretched in any frame and prices their channel.").weak());

@@ -24,8 +24,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::mpsc::Receiver;
 
+pub use crate::model::ModeChoice;
 pub use compare::Compared;
-pub use document::{Document, Ghost, ModeChoice, ModeScope};
+pub use document::{Document, Ghost, ModeScope};
 pub use file_browser::NativeDialog;
 pub use plots::plot_id;
 pub use settings::{RotationFormat, Settings, TimeUnit};
@@ -51,14 +52,12 @@ pub struct Frame {
 impl Frame {
     fn evaluate(doc: &Document, time: f64, skinning: SkinningMethod, tolerances: &Tolerances) -> Frame {
         let rig = &doc.rig;
-        let pose = doc.evaluate(&doc.modes, time, true);
+        let pose = doc.evaluation().pose_at(time);
         let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
-        let ghost = match (doc.ghost, &doc.compared) {
-            (Some(Ghost::Compared), Some(compared)) => {
-                Some(compared.ghost(doc.clip, &primary, time, skinning, tolerances))
-            }
-            _ => doc.ghost_evaluation().map(|(modes, layered)| {
-                let ghost = doc.evaluate(&modes, time, layered);
+        let ghost = match &doc.ghost {
+            Some(Ghost::Compared(compared)) => Some(compared.ghost(doc.clip, &primary, time, skinning, tolerances)),
+            _ => doc.ghost_evaluation().map(|evaluation| {
+                let ghost = evaluation.pose_at(time);
                 Layer::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
             }),
         };
@@ -310,12 +309,18 @@ impl BonescopeApp {
                 let names =
                     |rig: &crate::model::Rig| rig.skeleton.bones().iter().map(|b| b.name.clone()).collect::<Vec<_>>();
                 let same_rig = names(&rig) == names(&self.doc.rig);
-                self.doc = self.doc.reloaded(rig);
+                let (doc, dropped) = self.doc.reloaded(rig);
+                self.doc = doc;
                 let bones = self.doc.rig.skeleton.len();
                 self.selection.retain(|&b| b < bones);
                 self.document_replaced(!same_rig);
                 self.notifications.resolved(&path.display().to_string());
-                self.notifications.info(format!("reloaded {}", path.display()));
+                match dropped {
+                    None => self.notifications.info(format!("reloaded {}", path.display())),
+                    Some(error) => {
+                        self.notifications.info(format!("reloaded {}; layers dropped: {error}", path.display()))
+                    }
+                }
             }
             Err(error) => self.notifications.error_about(&path.display().to_string(), format!("not reloaded: {error}")),
         }
@@ -356,7 +361,7 @@ impl BonescopeApp {
         let plotted = self.plotted();
         (!plotted.is_empty()).then(|| JobKey {
             plotted,
-            ghost: self.doc.ghost,
+            ghost: self.doc.ghost.clone(),
             judged: Judged::CurveChains,
             ..self.job_key()
         })
@@ -384,16 +389,16 @@ impl BonescopeApp {
 
     /// Starts the analyses the current state wants (each only when its key changed).
     fn request_analyses(&mut self, ctx: &egui::Context) {
-        let rig = &self.doc.rig;
+        let doc = &self.doc;
         let waker = ctx.clone();
-        self.job.update(self.job_key(), job::analysis(self.job_key(), rig.clone()), move || waker.request_repaint());
+        self.job.update(self.job_key(), job::analysis(self.job_key(), doc.clone()), move || waker.request_repaint());
         if let Some(key) = self.curves_key() {
             let waker = ctx.clone();
-            self.curves_job.update(key.clone(), job::analysis(key, rig.clone()), move || waker.request_repaint());
+            self.curves_job.update(key.clone(), job::analysis(key, doc.clone()), move || waker.request_repaint());
         }
         let Some(compared) = self.doc.compared.clone() else { return };
         if let Some(key) = self.compare_key() {
-            let work = compare::differences(key.clone(), rig.clone(), self.doc.layer_stack().clone(), compared.clone());
+            let work = compare::differences(key.clone(), self.doc.clone(), compared.clone());
             let waker = ctx.clone();
             self.compare_jobs.differences.update(key, work, move || waker.request_repaint());
         }
@@ -427,6 +432,7 @@ impl BonescopeApp {
         // The compared curves wait for the document's.
         self.request_analyses(ctx);
         self.compare_jobs.curves.wait();
+        self.layers.settle();
     }
 
     /// Each bone's largest difference from the compared file, if computed for the current state.

@@ -7,7 +7,6 @@ use egui::RichText;
 use super::{Ghost, ModeChoice, ModeScope, Shared};
 use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
-use crate::model::InheritMode;
 
 /// What the toolbar asks the app to do after the frame (things that replace the document).
 #[derive(Default)]
@@ -209,25 +208,25 @@ fn skinning_picker(ui: &mut egui::Ui, shared: &mut Shared) {
 
 fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Ghost");
-    let text = shared.doc.ghost.map_or("off", Ghost::label);
+    let text = shared.doc.ghost.as_ref().map_or("off", Ghost::label);
     egui::ComboBox::from_id_salt("ghost")
         .selected_text(text)
         .width(170.0)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
-            if let Some(compared) = &shared.doc.compared {
-                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Compared), Ghost::Compared.label())
-                    .on_hover_text(format!("{}, bones paired by name", compared.path.display()));
+            if let Some(compared) = shared.doc.compared.clone() {
+                let hint = format!("{}, bones paired by name", compared.path.display());
+                let ghost = Ghost::Compared(compared);
+                let label = ghost.label();
+                ui.selectable_value(&mut shared.doc.ghost, Some(ghost), label).on_hover_text(hint);
             }
             if !shared.doc.layers().is_empty() {
                 ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
                     .on_hover_text("the clip as authored, without the layers");
             }
-            ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Declared), Ghost::Declared.label())
-                .on_hover_text("each bone under the mode its file declares");
-            for mode in InheritMode::ALL {
-                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Mode(mode)), mode.id())
-                    .on_hover_text(mode.description());
+            for choice in ModeChoice::all() {
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Modes(choice)), choice.label())
+                    .on_hover_text(choice.description());
             }
         })
         .response

@@ -31,7 +31,8 @@ pub struct Viewport {
 impl Viewport {
     /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
     pub fn frame_all(&mut self, doc: &Document) {
-        let pose_at = |time| doc.evaluate(&doc.modes, time, true).model.model;
+        let evaluation = doc.evaluation();
+        let pose_at = |time| evaluation.pose_at(time).model.model;
         self.framing = motion_bounds(&doc.rig, doc.clip(), doc.duration(), MOTION_SAMPLES, pose_at);
     }
 
@@ -55,9 +56,9 @@ impl Viewport {
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
         scene.ghost = shared.frame.ghost.clone();
-        scene.ghost_label = match (shared.doc.ghost, &shared.doc.compared) {
-            (Some(Ghost::Compared), Some(compared)) => format!("ghost: {}", compared.title()),
-            (ghost, _) => ghost.map_or_else(String::new, |g| format!("ghost: {}", g.label())),
+        scene.ghost_label = match &shared.doc.ghost {
+            Some(Ghost::Compared(compared)) => format!("ghost: {}", compared.title()),
+            ghost => ghost.as_ref().map_or_else(String::new, |g| format!("ghost: {}", g.label())),
         };
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();

@@ -15,13 +15,12 @@ use super::keys::{Metrics, reduce, weights_error};
 use super::layout::{Layout, unit};
 use super::nodes::{NodeSample, Sampled};
 use super::times::BakeTimes;
-use crate::diff::Side;
-use crate::eval::MorphPose;
+use crate::eval::{Evaluation, MorphPose};
 
 /// One clip's samples, ready to become channels.
 pub struct ClipSamples<'a> {
     pub name: &'a str,
-    pub side: &'a Side<'a>,
+    pub source: &'a Evaluation<'a>,
     /// The times every bone was sampled at, and the stepped keys among them.
     pub base: &'a BakeTimes,
     pub sampled: &'a Sampled,
@@ -136,8 +135,8 @@ impl NodeValues {
 
 /// The morph weights of every mesh group whose bone the clip animates them on.
 fn weight_channels(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &Document) -> Vec<Channel> {
-    let Some(source) = clip.side.clip else { return Vec::new() };
-    let (times, rig) = (&clip.base.times, clip.side.rig);
+    let Some(source) = clip.source.clip else { return Vec::new() };
+    let (times, rig) = (&clip.base.times, clip.source.rig);
     let mut channels = Vec::new();
     let mut morph = MorphPose::default();
     for (group, (node, meshes)) in document.meshes.iter().zip(&layout.groups) {

@@ -8,8 +8,8 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::nodes::NodeSample;
-use crate::diff::{PROBE_FRACTION, Side};
-use crate::eval::{Pose, skin_meshes};
+use crate::diff::PROBE_FRACTION;
+use crate::eval::{Evaluation, Pose, skin_meshes};
 use crate::math::slerp;
 
 /// The indices of the samples to keep among `count` (the first and last always), such that
@@ -62,9 +62,8 @@ pub struct Metrics {
 
 impl Metrics {
     /// For the rig of `rest` (its rest pose under the bake's modes), `size` and `tolerance` in model units.
-    pub fn new(rest: &Side, size: f64, tolerance: f64) -> Self {
-        let mut pose = Pose::default();
-        rest.evaluate(&mut pose, &mut None, 0.0);
+    pub fn new(rest: &Evaluation, size: f64, tolerance: f64) -> Self {
+        let pose = rest.pose_at(0.0);
         let scales: Vec<f64> = pose.model.model.iter().map(uniform_scale).collect();
         let mut sorted: Vec<f64> = scales.iter().copied().filter(|s| *s > 0.0).collect();
         sorted.sort_by(f64::total_cmp);
@@ -87,7 +86,7 @@ impl Metrics {
 /// How far from each bone's origin, at rest, the points it moves lie: its descendants' origins, the vertices skinned
 /// to them or to it, and the probe points the report measures (`probe` out), with half as much again for the motion
 /// of the descendants' own animation.
-fn reaches(rest: &Side, pose: &Pose, probe: f64) -> Vec<f64> {
+fn reaches(rest: &Evaluation, pose: &Pose, probe: f64) -> Vec<f64> {
     let skeleton = &rest.rig.skeleton;
     let origins: Vec<DVec3> = pose.model.model.iter().map(|m| m.w_axis.truncate()).collect();
     let mut reach = vec![probe; skeleton.len()];

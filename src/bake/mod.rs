@@ -41,9 +41,8 @@ use nodes::{NodeSample, Sampled};
 use rayon::prelude::*;
 use refine::refine;
 
-use crate::diff::{Side, rig_size};
-use crate::eval::LayerStack;
-use crate::model::{Clip, InheritMode, Rig};
+use crate::eval::Evaluation;
+use crate::model::{Clip, Rig};
 
 /// How bones become glTF nodes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
@@ -59,37 +58,46 @@ pub enum Strategy {
 /// The default tolerance: keys reproduce the source within this fraction of the rig's size.
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
 
-/// One animation to bake.
+/// One animation to bake: its name in the baked file, and the evaluation it reproduces (a clip, or the rest pose,
+/// possibly through layers: a blend, an additive layer or a shake baked into a new clip).
 #[derive(Clone, Debug)]
 pub struct ClipToBake<'a> {
     pub name: String,
-    /// The clip (`None`: the rest pose).
-    pub clip: Option<&'a Clip>,
-    /// Layers the clip plays through (a blend, an additive layer or a shake baked into a new clip).
-    pub layers: Option<LayerStack>,
+    pub source: Evaluation<'a>,
 }
 
 /// What to bake.
 #[derive(Clone, Debug)]
 pub struct Request<'a> {
-    pub rig: &'a Rig,
-    /// One per bone: the inheritance the source is evaluated with.
-    pub modes: Vec<InheritMode>,
+    /// The rig at rest under the modes the source is evaluated with: what the nodes hold where no animation says
+    /// otherwise. Every clip's source is an evaluation of the same rig under the same modes.
+    pub rest: Evaluation<'a>,
     pub clips: Vec<ClipToBake<'a>>,
     pub strategy: Strategy,
     /// Between keys, the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     pub tolerance: f64,
 }
 
-impl Request<'_> {
-    /// The source evaluation of clip `index`.
-    pub fn side(&self, index: usize) -> Side<'_> {
-        let clip = &self.clips[index];
-        let side = Side::new(self.rig, clip.clip, &self.modes);
-        match &clip.layers {
-            Some(layers) => side.with_layers(layers.clone()),
-            None => side,
-        }
+impl<'a> Request<'a> {
+    /// Every clip of `source`'s rig (or the one `only` names) evaluated as `source` is, or its rest pose for a rig
+    /// without clips (which the baked nodes then hold, with no animation in the file).
+    pub fn every_clip(source: &Evaluation<'a>, only: Option<&'a Clip>, strategy: Strategy, tolerance: f64) -> Self {
+        let rest = source.at_rest();
+        let clips: Vec<&Clip> = match only {
+            Some(clip) => vec![clip],
+            None => source.rig.clips.iter().collect(),
+        };
+        let clips = if clips.is_empty() {
+            vec![ClipToBake { name: "rest pose".to_owned(), source: rest.clone() }]
+        } else {
+            let of = |clip: &'a Clip| rest.clone().with_clip(Some(clip));
+            clips.into_iter().map(|clip| ClipToBake { name: clip.label(), source: of(clip) }).collect()
+        };
+        Request { rest, clips, strategy, tolerance }
+    }
+
+    pub fn rig(&self) -> &'a Rig {
+        self.rest.rig
     }
 }
 
@@ -111,7 +119,7 @@ pub struct Baked {
     /// Per source bone: whether it got a helper node.
     pub helpers: Vec<bool>,
     pub animations: Vec<BakedAnimation>,
-    /// The rig's size ([`rig_size`]) and the tolerance in model units.
+    /// The rig's size ([`Evaluation::size`]) and the tolerance in model units.
     pub rig_size: f64,
     pub tolerance: f64,
     /// What a user should know about the result.
@@ -120,17 +128,16 @@ pub struct Baked {
 
 /// Bakes `request` into a glTF binary.
 pub fn bake(request: &Request) -> Baked {
-    let (rig, strategy) = (request.rig, request.strategy);
-    let sides: Vec<Side> = (0..request.clips.len()).map(|i| request.side(i)).collect();
-    let base: Vec<BakeTimes> = sides.iter().map(bake_times).collect();
-    let rest_side = Side::new(rig, None, &request.modes);
-    let size = sides.iter().zip(&base).map(|(side, base)| rig_size(side, &base.times)).fold(0.0, f64::max);
-    let size = if size > 0.0 { size } else { rig_size(&rest_side, &[0.0]) };
+    let (rig, strategy) = (request.rig(), request.strategy);
+    let sources: Vec<&Evaluation> = request.clips.iter().map(|c| &c.source).collect();
+    let base: Vec<BakeTimes> = sources.iter().map(|source| bake_times(source)).collect();
+    let size = sources.iter().zip(&base).map(|(source, base)| source.size(&base.times)).fold(0.0, f64::max);
+    let size = if size > 0.0 { size } else { request.rest.size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
-    let metrics = Metrics::new(&rest_side, size, tolerance);
+    let metrics = Metrics::new(&request.rest, size, tolerance);
     let sampled: Vec<Sampled> =
-        sides.iter().zip(&base).map(|(side, base)| sample_densely(side, strategy, base, &metrics)).collect();
-    let rest = nodes::rest(&rest_side, strategy);
+        sources.iter().zip(&base).map(|(source, base)| sample_densely(source, strategy, base, &metrics)).collect();
+    let rest = nodes::sample(&request.rest, &[0.0], strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
         .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|s| s.stats.stretched[bone]))
         .collect();
@@ -138,10 +145,10 @@ pub fn bake(request: &Request) -> Baked {
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
-    for (((clip, side), base), sampled) in request.clips.iter().zip(&sides).zip(&base).zip(&sampled) {
-        let samples = ClipSamples { name: &clip.name, side, base, sampled };
+    for ((clip, base), sampled) in request.clips.iter().zip(&base).zip(&sampled) {
+        let samples = ClipSamples { name: &clip.name, source: &clip.source, base, sampled };
         let times = &sampled.times;
-        if clip.clip.is_none() && clip.layers.is_none() {
+        if clip.source.clip.is_none() && clip.source.layers().is_none() {
             // The rest pose is what the nodes hold without an animation.
             animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys: 0 });
             continue;
@@ -157,8 +164,8 @@ pub fn bake(request: &Request) -> Baked {
 
 /// Every bone's nodes at the base times, and wherever between them the source needs more ([`refine`]; not with a
 /// zero tolerance, which no halving could reach).
-fn sample_densely(side: &Side, strategy: Strategy, base: &BakeTimes, metrics: &Metrics) -> Sampled {
-    let mut sampled = nodes::sample(side, &base.times, strategy);
+fn sample_densely(source: &Evaluation, strategy: Strategy, base: &BakeTimes, metrics: &Metrics) -> Sampled {
+    let mut sampled = nodes::sample(source, &base.times, strategy);
     sampled.series.par_iter_mut().for_each(nodes::follow_frames);
     if metrics.budget == 0.0 {
         return sampled;
@@ -167,7 +174,7 @@ fn sample_densely(side: &Side, strategy: Strategy, base: &BakeTimes, metrics: &M
     let misses = |bone: usize, interpolated: &NodeSample, exact: &NodeSample| {
         metrics.bone(&gains, bone).distance(interpolated, exact) > metrics.budget
     };
-    refine(side, strategy, &base.step_flags(&base.times), sampled, &misses)
+    refine(source, strategy, &base.step_flags(&base.times), sampled, &misses)
 }
 
 /// What the source has that glTF says differently.
@@ -193,19 +200,6 @@ fn source_notes(rig: &Rig, singular: usize) -> Vec<String> {
         ));
     }
     notes
-}
-
-/// The animations to bake for `rig`: every clip (or the one `only` names), or the rest pose for a file without any
-/// (which the baked nodes then hold, with no animation in the file).
-pub fn every_clip<'a>(rig: &'a Rig, only: Option<&'a Clip>) -> Vec<ClipToBake<'a>> {
-    let clips: Vec<&Clip> = match only {
-        Some(clip) => vec![clip],
-        None => rig.clips.iter().collect(),
-    };
-    if clips.is_empty() {
-        return vec![ClipToBake { name: "rest pose".to_owned(), clip: None, layers: None }];
-    }
-    clips.into_iter().map(|clip| ClipToBake { name: clip.label(), clip: Some(clip), layers: None }).collect()
 }
 
 /// Writes `bytes` to `path` atomically: into a temporary file beside it, then renamed over it, so the path holds

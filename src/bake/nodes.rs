@@ -19,8 +19,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 
 use super::Strategy;
-use crate::diff::Side;
-use crate::eval::{LayerStack, Pose};
+use crate::eval::{Evaluation, Evaluator};
 use crate::math::{AffineParts, decompose_near, stretch_nearest};
 use crate::model::affine;
 
@@ -140,9 +139,9 @@ pub struct Sampled {
 /// How many times are sampled between two appends to the bones' series: what is held twice at once.
 const BATCH: usize = 4096;
 
-/// Samples `side` at `times` (sorted) for `strategy`, every bone at every time.
-pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
-    let bones = side.rig.skeleton.len();
+/// Samples `source` at `times` (sorted) for `strategy`, every bone at every time.
+pub fn sample(source: &Evaluation, times: &[f64], strategy: Strategy) -> Sampled {
+    let bones = source.skeleton().len();
     let empty = Series { times: times.to_vec(), nodes: Vec::with_capacity(times.len()) };
     let mut series = vec![empty; bones];
     let mut stats = Stats::new(bones);
@@ -150,7 +149,7 @@ pub fn sample(side: &Side, times: &[f64], strategy: Strategy) -> Sampled {
         let rows: Vec<(Vec<NodeSample>, Stats)> = batch
             .par_chunks(64)
             .map(|times| {
-                let mut worker = Worker::new(side, strategy);
+                let mut worker = Worker::new(source, strategy);
                 let mut rows = Vec::with_capacity(times.len() * bones);
                 for &time in times {
                     rows.extend_from_slice(worker.solve_at(time));
@@ -197,13 +196,11 @@ impl Stats {
     }
 }
 
-/// One thread's evaluation of a side: its pose, layers, baked model matrices and findings.
-pub struct Worker<'a> {
-    side: &'a Side<'a>,
+/// One thread's evaluation of the source: its pose, baked model matrices and findings.
+pub struct Worker<'e, 'a> {
+    source: Evaluator<'e, 'a>,
     strategy: Strategy,
     parents: Vec<Option<usize>>,
-    pose: Pose,
-    layers: Option<LayerStack>,
     /// `W'`: the model matrices the baked nodes give.
     baked: Vec<DMat4>,
     /// The previous time's stretch of each bone, where the search for this time's starts.
@@ -213,16 +210,14 @@ pub struct Worker<'a> {
     pub stats: Stats,
 }
 
-impl<'a> Worker<'a> {
-    pub fn new(side: &'a Side<'a>, strategy: Strategy) -> Self {
-        let parents: Vec<Option<usize>> = side.rig.skeleton.bones().iter().map(|b| b.parent).collect();
+impl<'e, 'a> Worker<'e, 'a> {
+    pub fn new(source: &'e Evaluation<'a>, strategy: Strategy) -> Self {
+        let parents: Vec<Option<usize>> = source.skeleton().bones().iter().map(|b| b.parent).collect();
         let bones = parents.len();
         Worker {
-            side,
+            source: source.evaluator(),
             strategy,
             parents,
-            pose: Pose::default(),
-            layers: side.layers.clone(),
             baked: vec![DMat4::IDENTITY; bones],
             previous: vec![DQuat::IDENTITY; bones],
             row: vec![NodeSample::IDENTITY; bones],
@@ -232,7 +227,7 @@ impl<'a> Worker<'a> {
 
     /// Every bone's nodes at `time`.
     pub fn solve_at(&mut self, time: f64) -> &[NodeSample] {
-        self.side.evaluate(&mut self.pose, &mut self.layers, time);
+        self.source.evaluate(time);
         for bone in 0..self.parents.len() {
             self.row[bone] = self.solve(bone);
         }
@@ -242,14 +237,15 @@ impl<'a> Worker<'a> {
     /// The nodes of `bone` for the pose just evaluated, its parent's already solved.
     fn solve(&mut self, bone: usize) -> NodeSample {
         let parent = self.parents[bone];
-        let source = self.pose.model.model[bone];
+        let pose = &self.source.pose;
+        let source = pose.model.model[bone];
         let local = match parent {
             None => source,
             Some(p) => match affine_inverse(&self.baked[p]) {
                 Some(inverse) => inverse * source,
                 None => {
                     self.stats.singular += 1;
-                    self.pose.local[bone].matrix()
+                    pose.local[bone].matrix()
                 }
             },
         };
@@ -270,12 +266,6 @@ impl<'a> Worker<'a> {
             }
         }
     }
-}
-
-/// The nodes of the rest pose (no clip), one per bone: what the nodes hold where no animation says otherwise.
-pub fn rest(side: &Side, strategy: Strategy) -> Sampled {
-    let rest = Side { clip: None, layers: None, ..side.clone() };
-    sample(&rest, &[0.0], strategy)
 }
 
 /// Whether dropping `U` would change `U·K·Uᵀ` by more than rounding.
@@ -358,15 +348,14 @@ mod tests {
     fn exact_samples_give_back_every_model_matrix() {
         let rig = demo_rig();
         let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-        let side = Side::new(&rig, rig.clips.first(), &modes);
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
         let times: Vec<f64> = (0..=20).map(|k| f64::from(k) * side.duration() / 20.0).collect();
         let mut sampled = sample(&side, &times, Strategy::Exact);
         let helper = sampled.stats.stretched.clone();
         assert!(helper.contains(&true), "the demo's compensated forearm is stretched in its local matrix");
         sampled.series.iter_mut().for_each(follow_frames);
-        let mut pose = Pose::default();
         for (s, &time) in times.iter().enumerate() {
-            side.evaluate(&mut pose, &mut None, time);
+            let pose = side.pose_at(time);
             let mut baked: Vec<DMat4> = Vec::new();
             for (bone, b) in rig.skeleton.bones().iter().enumerate() {
                 let local = sampled.series[bone].nodes[s].as_baked(helper[bone]).matrix();

@@ -16,7 +16,7 @@ use super::Strategy;
 use super::keys::{interpolate, too_far};
 use super::nodes::{NodeSample, Sampled, Series, Stats, Worker, align, follow_frames};
 use super::times::in_single_precision;
-use crate::diff::Side;
+use crate::eval::Evaluation;
 
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
@@ -29,14 +29,20 @@ impl<F: Fn(usize, &NodeSample, &NodeSample) -> bool + Sync> Misses for F {}
 /// `misses` says the interpolation of an interval's ends misses its midpoint; frames followed again. The interval
 /// that ends at a stepped key (`steps`, per time) holds the key's jump, which no halving brings closer: it is left as
 /// it is.
-pub fn refine(side: &Side, strategy: Strategy, steps: &[bool], sampled: Sampled, misses: &impl Misses) -> Sampled {
+pub fn refine(
+    source: &Evaluation,
+    strategy: Strategy,
+    steps: &[bool],
+    sampled: Sampled,
+    misses: &impl Misses,
+) -> Sampled {
     let bones = sampled.series.len();
     let halving = Halving { sampled: &sampled, misses };
     let (stats, found) = (1..sampled.times.len())
         .into_par_iter()
         .filter(|&i| !steps[i])
         .fold(
-            || (Worker::new(side, strategy), Found::new(bones)),
+            || (Worker::new(source, strategy), Found::new(bones)),
             |(mut worker, mut found), i| {
                 halving.base_interval(&mut worker, i, &mut found);
                 (worker, found)
@@ -146,7 +152,7 @@ mod tests {
     fn only_the_bones_that_miss_are_halved_further() {
         let rig = demo_rig();
         let modes = vec![InheritMode::Full; rig.skeleton.len()];
-        let side = Side::new(&rig, rig.clips.first(), &modes);
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) * 0.25).collect();
         let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
         let missing = 2;

@@ -3,7 +3,8 @@
 //! that was written, not the intentions behind it.
 
 use super::{Baked, Request, Strategy};
-use crate::diff::{Extreme, MeshDifference, Pairs, Side, compare};
+use crate::diff::{Extreme, MeshDifference, Pairs, compare};
+use crate::eval::Evaluation;
 use crate::model::Rig;
 
 /// How one bone was baked.
@@ -67,16 +68,16 @@ impl BakeReport {
 
 /// Compares every animation of `request` with the same animation of `baked_rig` (the bake read back).
 pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
-    let skeleton = &request.rig.skeleton;
+    let skeleton = request.rest.skeleton();
     let animations = baked
         .animations
         .iter()
         .enumerate()
         .map(|(k, animation)| {
-            let source = request.side(k);
-            let result = Side::new(baked_rig, baked_rig.clips.get(k), &baked_rig.skeleton.declared_modes());
-            let pairs = Pairs::of(&source, &result, &[]).unwrap_or_default();
-            let comparison = compare(&source, &result, &pairs, &animation.times);
+            let source = &request.clips[k].source;
+            let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
+            let pairs = Pairs::by_name(source, &result);
+            let comparison = compare(source, &result, &pairs, &animation.times);
             let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {
                 (Strategy::Trs, _) => BoneNodes::Trs,
                 (Strategy::Exact, true) => BoneNodes::Helper,

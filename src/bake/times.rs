@@ -3,14 +3,11 @@
 //! tracks (a Hermite curve with equal tangents passes through the middle of its chord, so a midpoint alone would not
 //! show that it bends). [`super::refine`] adds what else lies between where the source needs it.
 
-use crate::diff::Side;
-use crate::model::{Clip, DEFAULT_FRAME_RATE, Interpolation, sample_times};
+use crate::eval::Evaluation;
+use crate::model::{Clip, DEFAULT_FRAME_RATE, Interpolation, MAX_FRAMES, sample_times};
 
 /// How long before a stepped key's jump the value before it is held (as the FBX importer and ufbx's baker do).
 pub const STEP_LEAD: f64 = 1e-3;
-
-/// The most frames baked at every one of; longer clips are thinned between sparse keys.
-const MAX_FRAMES: usize = 1 << 20;
 
 /// The times to bake a clip at first, and which of them are stepped keys.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,11 +26,11 @@ impl BakeTimes {
 }
 
 /// The times to bake `side` at first.
-pub fn bake_times(side: &Side) -> BakeTimes {
+pub fn bake_times(side: &Evaluation) -> BakeTimes {
     let rate = side.clip.map_or(DEFAULT_FRAME_RATE, Clip::frame_rate);
     let mut keys = side.key_times();
     let (mut steps, mut inside) = (Vec::new(), Vec::new());
-    if let (Some(clip), None) = (side.clip, &side.layers) {
+    if let (Some(clip), None) = (side.clip, side.layers()) {
         for (times, interpolation) in track_times(clip) {
             match interpolation {
                 Interpolation::Step => steps.extend_from_slice(&times[1..]),
@@ -55,9 +52,9 @@ pub fn bake_times(side: &Side) -> BakeTimes {
 
 /// Where sampling ends: the duration, or for a synced blend's cycle, which wraps to its start at its length, the
 /// last `f32` time before it (a player looping the baked clip wraps there too).
-fn end(side: &Side) -> f64 {
+fn end(side: &Evaluation) -> f64 {
     let duration = side.duration();
-    let wraps = side.layers.as_ref().is_some_and(|layers| layers.synced_cycle(side.rig, side.clip).is_some());
+    let wraps = side.layers().is_some_and(|layers| layers.synced_cycle(side.rig, side.clip).is_some());
     let just_before = f32::from_bits((duration as f32).to_bits().saturating_sub(1));
     if wraps && duration > 0.0 { f64::from(just_before) } else { duration }
 }
@@ -106,7 +103,7 @@ mod tests {
         let values = vec![Vec3::ZERO, Vec3::ZERO, Vec3::X, Vec3::ZERO, Vec3::Y, Vec3::X];
         tracks.translation = Some(Track::new(times, values, Interpolation::CubicSpline).unwrap());
         rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(1.0)];
-        let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
+        let side = Evaluation::declared(&rig, rig.clips.first());
         assert_eq!(bake_times(&side).times, [0.0, 0.25, 0.5, 0.75, 1.0]);
     }
 
@@ -117,7 +114,7 @@ mod tests {
         let mut tracks = BoneTracks::new(0);
         tracks.translation = Some(Track::new(times, vec![Vec3::ZERO, Vec3::X, Vec3::Y], Interpolation::Step).unwrap());
         rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(2.0)];
-        let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
+        let side = Evaluation::declared(&rig, rig.clips.first());
         // Frames 0, 0.5, 1; keys 0.25; leads 0.249, 0.999 (in single precision, where glTF keeps them).
         let expected = [0.0, 0.249, 0.25, 0.5, 0.999, 1.0];
         let got = bake_times(&side);

@@ -10,7 +10,7 @@ use super::layers::LayerArgs;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
-use crate::eval::LayerStack;
+use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 
 #[derive(Debug, Args)]
@@ -79,23 +79,23 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     if rig.skeleton.is_empty() {
         bail!("{}: no nodes to bake", source_name(args));
     }
-    let modes = args.eval.modes(&rig)?;
+    let source = Evaluation::new(&rig, None, &args.eval.modes(&rig)?);
     let layers = args.layers.layers(&rig)?;
-    let clips = if layers.is_empty() {
+    let (strategy, tolerance) = (args.strategy, args.tolerance);
+    let request = if layers.is_empty() {
         let only = match &args.eval.anim {
             Some(_) => args.eval.clip(&rig)?,
             None => None,
         };
-        bake::every_clip(&rig, only)
+        Request::every_clip(&source, only, strategy, tolerance)
     } else {
         // A layered result is one new clip, named after its main clip and what was layered on it.
         let clip = args.eval.clip(&rig)?;
-        let stack = LayerStack::new(&rig, &layers)?;
         let main = clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
         let name = format!("{main} + {}", layers.summary(&rig, clip));
-        vec![ClipToBake { name, clip, layers: Some(stack) }]
+        let layered = source.clone().with_clip(clip).with_layers(LayerStack::new(&rig, &layers)?);
+        Request { rest: source, clips: vec![ClipToBake { name, source: layered }], strategy, tolerance }
     };
-    let request = Request { rig: &rig, modes, clips, strategy: args.strategy, tolerance: args.tolerance };
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
     let report = bake::report(&request, &baked, &baked_rig);

@@ -7,11 +7,11 @@ use clap::Args;
 
 use super::Format;
 use super::bake::{Distance, parse_distance};
-use super::options::ModeSet;
+
 use super::table::{Table, mesh_differences};
 use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
 use crate::import;
-use crate::model::Rig;
+use crate::model::{ModeChoice, Rig};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -28,10 +28,10 @@ pub struct DiffArgs {
     pub anim_b: Option<String>,
     /// The first file's inheritance: `declared` (what its file says) or one mode for every bone.
     #[arg(long, value_name = "MODE", default_value = "declared")]
-    pub inherit_a: ModeSet,
+    pub inherit_a: ModeChoice,
     /// The second file's inheritance.
     #[arg(long, value_name = "MODE", default_value = "declared")]
-    pub inherit_b: ModeSet,
+    pub inherit_b: ModeChoice,
     /// Pair a bone of the first file with one of the second explicitly (repeatable); the rest pair by name, exactly,
     /// then ignoring case and namespace prefixes such as `mixamorig:` or `Armature|`.
     #[arg(long = "map", value_name = "A=B", value_parser = parse_pair)]
@@ -59,7 +59,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let (rig_a, rig_b) = (import::load(&args.a)?, import::load(&args.b)?);
     let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
     let b = side(&args.b, &rig_b, args.inherit_b, &args.anim_b);
-    let diff = diff_files(&a, &b, &args.map, args.rate).map_err(anyhow::Error::msg)?;
+    let diff = diff_files(&a, &b, &args.map, args.rate)?;
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
         Format::Table => print!("{}", render_table(&diff)),
@@ -68,12 +68,13 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
-fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeSet, anim: &Option<String>) -> FileSide<'a> {
+/// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`).
+pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Option<String>) -> FileSide<'a> {
     FileSide {
         file: path.display().to_string(),
         rig,
-        modes: modes.modes(rig),
-        inherit: modes.label(),
+        modes: rig.skeleton.modes(modes),
+        inherit: modes.label().to_owned(),
         anim: anim.clone(),
     }
 }
@@ -87,62 +88,70 @@ fn render_table(diff: &FileDiff) -> String {
         out.push_str(&format!("  animation only in B: {clip}\n"));
     }
     for animation in &diff.animations {
-        let percent = |v: f64| format!("{:.4} %", 100.0 * v / animation.rig_size);
-        out.push_str(&format!(
-            "\n`{}` against `{}`: {} samples, rig size {:.4}; worst distance {:.3e} ({}) at {:.4} s\n",
-            animation.a,
-            animation.b,
-            animation.samples,
-            animation.rig_size,
-            animation.worst.max,
-            percent(animation.worst.max),
-            animation.worst.time
-        ));
-        let mut bones = Table::new(&[
-            ("bone", false),
-            ("position", true),
-            ("at s", true),
-            ("probe", true),
-            ("at s", true),
-            ("orientation°", true),
-            ("at s", true),
-            ("scale ratio", true),
-            ("at s", true),
-            ("stretch°", true),
-            ("at s", true),
+        out.push('\n');
+        out.push_str(&render_animation(animation));
+    }
+    out
+}
+
+/// One pair of animations: the worst distance, every bone's differences, the meshes', what had no partner.
+pub(super) fn render_animation(animation: &AnimationDiff) -> String {
+    let mut out = String::new();
+    let percent = |v: f64| format!("{:.4} %", 100.0 * v / animation.rig_size);
+    out.push_str(&format!(
+        "`{}` against `{}`: {} samples, rig size {:.4}; worst distance {:.3e} ({}) at {:.4} s\n",
+        animation.a,
+        animation.b,
+        animation.samples,
+        animation.rig_size,
+        animation.worst.max,
+        percent(animation.worst.max),
+        animation.worst.time
+    ));
+    let mut bones = Table::new(&[
+        ("bone", false),
+        ("position", true),
+        ("at s", true),
+        ("probe", true),
+        ("at s", true),
+        ("orientation°", true),
+        ("at s", true),
+        ("scale ratio", true),
+        ("at s", true),
+        ("stretch°", true),
+        ("at s", true),
+    ]);
+    for bone in &animation.bones {
+        let name = match &bone.name_b {
+            Some(other) => format!("{} = {other}", bone.name),
+            None => bone.name.clone(),
+        };
+        bones.row(vec![
+            name,
+            format!("{:.3e}", bone.position.max),
+            format!("{:.4}", bone.position.time),
+            format!("{:.3e}", bone.probe.max),
+            format!("{:.4}", bone.probe.time),
+            format!("{:.4}", bone.orientation_deg.max),
+            format!("{:.4}", bone.orientation_deg.time),
+            format!("{:.6}", bone.scale_ratio.max),
+            format!("{:.4}", bone.scale_ratio.time),
+            format!("{:.4}", bone.stretch_deg.max),
+            format!("{:.4}", bone.stretch_deg.time),
         ]);
-        for bone in &animation.bones {
-            let name = match &bone.name_b {
-                Some(other) => format!("{} = {other}", bone.name),
-                None => bone.name.clone(),
-            };
-            bones.row(vec![
-                name,
-                format!("{:.3e}", bone.position.max),
-                format!("{:.4}", bone.position.time),
-                format!("{:.3e}", bone.probe.max),
-                format!("{:.4}", bone.probe.time),
-                format!("{:.4}", bone.orientation_deg.max),
-                format!("{:.4}", bone.orientation_deg.time),
-                format!("{:.6}", bone.scale_ratio.max),
-                format!("{:.4}", bone.scale_ratio.time),
-                format!("{:.4}", bone.stretch_deg.max),
-                format!("{:.4}", bone.stretch_deg.time),
-            ]);
-        }
-        out.push_str(&bones.to_string());
-        if !animation.meshes.is_empty() {
-            out.push_str(&mesh_differences(&animation.meshes, animation.rig_size).to_string());
-        }
-        if !animation.only_a.is_empty() {
-            out.push_str(&format!("  bones only in A: {}\n", animation.only_a.join(", ")));
-        }
-        if !animation.only_b.is_empty() {
-            out.push_str(&format!("  bones only in B: {}\n", animation.only_b.join(", ")));
-        }
-        if animation.helpers > 0 {
-            out.push_str(&format!("  {} bake helper nodes (`*.stretch`) left out\n", animation.helpers));
-        }
+    }
+    out.push_str(&bones.to_string());
+    if !animation.meshes.is_empty() {
+        out.push_str(&mesh_differences(&animation.meshes, animation.rig_size).to_string());
+    }
+    if !animation.only_a.is_empty() {
+        out.push_str(&format!("  bones only in A: {}\n", animation.only_a.join(", ")));
+    }
+    if !animation.only_b.is_empty() {
+        out.push_str(&format!("  bones only in B: {}\n", animation.only_b.join(", ")));
+    }
+    if animation.helpers > 0 {
+        out.push_str(&format!("  {} bake helper nodes (`*.stretch`) left out\n", animation.helpers));
     }
     out
 }

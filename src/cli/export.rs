@@ -8,9 +8,7 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use crate::eval::SkinningMethod;
-use crate::eval::skinning::skin_meshes_with;
-use crate::eval::{Hierarchy, Pose};
+use crate::eval::{Evaluation, SkinningMethod};
 use crate::export::{EvaluatedMesh, write_obj};
 use crate::import::{self, Options, Space};
 
@@ -50,12 +48,9 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     if rig.meshes.is_empty() {
         bail!("{}: no meshes to export", args.file.display());
     }
-    let clip = args.eval.clip(&rig)?;
-    let modes = args.eval.modes(&rig)?;
-    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
-    let mut pose = Pose::default();
-    pose.evaluate(&rig.skeleton, clip, &hierarchy, args.time);
-    let positions = skin_meshes_with(&rig, &pose.model.model, &pose.morph, args.skinning);
+    let evaluation = Evaluation::new(&rig, args.eval.clip(&rig)?, &args.eval.modes(&rig)?).with_skinning(args.skinning);
+    let positions = evaluation.skin_all(&evaluation.pose_at(args.time));
+    let clip = evaluation.clip;
     let meshes: Vec<EvaluatedMesh> = rig
         .meshes
         .iter()

@@ -9,7 +9,7 @@ use super::layers::LayerArgs;
 use super::table::{Table, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, InspectSubject, LayeredInspectReport, SampleReport};
-use crate::eval::{Hierarchy, LayerStack, Pose};
+use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 
 #[derive(Debug, Args)]
@@ -39,14 +39,13 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     }
     let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
     let layers = args.layers.layers(&rig)?;
-    let mut stack = LayerStack::new(&rig, &layers)?;
-    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
-    let mut pose = Pose::default();
+    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(LayerStack::new(&rig, &layers)?);
+    let mut evaluator = evaluation.evaluator();
     let samples = times
         .iter()
         .map(|&time| {
-            pose.evaluate_layered(&rig, clip, &hierarchy, &mut stack, time);
-            SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, &pose, &tolerances) }
+            let pose = evaluator.evaluate(time);
+            SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, pose, &tolerances) }
         })
         .collect();
     let summary = layers.summary(&rig, clip);
@@ -55,7 +54,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         rig: &rig,
         clip,
         inherit: args.eval.inherit_label(),
-        hierarchy: &hierarchy,
+        hierarchy: &evaluation.hierarchy,
         layers,
     };
     let report = LayeredInspectReport::new(subject, samples);

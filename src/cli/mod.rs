@@ -22,7 +22,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use layers::{LayerArgs, TargetArg};
-pub use options::{EvalArgs, Format, ModeSet, ToleranceArgs};
+pub use options::{EvalArgs, Format, ToleranceArgs};
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
 /// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.

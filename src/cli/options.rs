@@ -4,7 +4,7 @@ use anyhow::{Context, anyhow, bail};
 use clap::{Args, ValueEnum};
 
 use crate::analysis::Tolerances;
-use crate::model::{Clip, InheritMode, Rig};
+use crate::model::{Clip, InheritMode, ModeChoice, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -68,51 +68,22 @@ impl EvalArgs {
         Ok(modes)
     }
 
-    /// What the reports say under `inherit`: the global mode, or `declared`.
+    /// What the reports say the modes are: the global mode, or `declared`; `mixed` when single bones are given
+    /// their own (as the app says of a rig whose bones differ).
     pub fn inherit_label(&self) -> String {
-        self.inherit.map_or_else(|| "declared".to_owned(), |m| m.id().to_owned())
-    }
-}
-
-/// One side of `--compare-inherit`: the file's own modes, or one mode for every bone.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ModeSet {
-    Declared,
-    All(InheritMode),
-}
-
-impl ModeSet {
-    /// One mode per bone.
-    pub fn modes(self, rig: &Rig) -> Vec<InheritMode> {
-        match self {
-            ModeSet::Declared => rig.skeleton.declared_modes(),
-            ModeSet::All(mode) => vec![mode; rig.skeleton.len()],
-        }
-    }
-
-    pub fn label(self) -> String {
-        match self {
-            ModeSet::Declared => "declared".to_owned(),
-            ModeSet::All(mode) => mode.id().to_owned(),
+        match self.inherit {
+            _ if !self.inherit_bone.is_empty() => "mixed".to_owned(),
+            Some(mode) => mode.id().to_owned(),
+            None => "declared".to_owned(),
         }
     }
 }
 
-impl std::str::FromStr for ModeSet {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "declared" => Ok(ModeSet::Declared),
-            mode => mode.parse().map(ModeSet::All).map_err(|e| format!("{e}, or `declared`")),
-        }
-    }
-}
-
-/// `A,B`: two mode sets to compare.
-pub fn parse_comparison(s: &str) -> Result<[ModeSet; 2], String> {
+/// `A,B`: two mode choices to compare.
+pub fn parse_comparison(s: &str) -> Result<[ModeChoice; 2], String> {
     let (a, b) = s.split_once(',').ok_or_else(|| format!("expected two modes separated by a comma, got `{s}`"))?;
-    Ok([a.trim().parse()?, b.trim().parse()?])
+    let parse = |p: &str| p.trim().parse::<ModeChoice>().map_err(|e| e.to_string());
+    Ok([parse(a)?, parse(b)?])
 }
 
 /// The thresholds of the verdicts.

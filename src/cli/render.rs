@@ -88,7 +88,7 @@ pub enum Theme {
 }
 
 /// `--ghost`: off, or which ghost.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct GhostArg(Option<Ghost>);
 
 /// `--frames START:END:STEP`.
@@ -106,7 +106,7 @@ impl Frames {
 }
 
 /// Sequences longer than this are surely a typo.
-const MAX_FRAMES: i64 = 1_000_000;
+const MAX_RENDERED_FRAMES: i64 = 1_000_000;
 
 fn parse_frames(s: &str) -> Result<Frames, String> {
     let parts: Vec<&str> = s.split(':').collect();
@@ -116,8 +116,8 @@ fn parse_frames(s: &str) -> Result<Frames, String> {
     if frames.step < 1 || frames.end < frames.start {
         return Err(format!("expected START ≤ END and STEP ≥ 1, got `{s}`"));
     }
-    if (frames.end - frames.start) / frames.step >= MAX_FRAMES {
-        return Err(format!("more than {MAX_FRAMES} frames in `{s}`"));
+    if (frames.end - frames.start) / frames.step >= MAX_RENDERED_FRAMES {
+        return Err(format!("more than {MAX_RENDERED_FRAMES} frames in `{s}`"));
     }
     Ok(frames)
 }
@@ -132,11 +132,10 @@ fn parse_ghost(s: &str) -> Result<GhostArg, String> {
     match s {
         "none" => Ok(GhostArg(None)),
         "unlayered" => Ok(GhostArg(Some(Ghost::Unlayered))),
-        "declared" => Ok(GhostArg(Some(Ghost::Declared))),
-        mode => mode
+        choice => choice
             .parse()
-            .map(|m| GhostArg(Some(Ghost::Mode(m))))
-            .map_err(|e| format!("{e}, `declared`, `unlayered` or `none`")),
+            .map(|choice| GhostArg(Some(Ghost::Modes(choice))))
+            .map_err(|e| format!("{e}, `unlayered` or `none`")),
     }
 }
 
@@ -244,8 +243,8 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
     if let Some(path) = &args.compare {
         doc.compare_with(Compared::load(path, &doc.rig)?);
     }
-    if let Some(GhostArg(ghost)) = args.ghost {
-        doc.ghost = ghost;
+    if let Some(GhostArg(ghost)) = &args.ghost {
+        doc.ghost = ghost.clone();
     }
     let selection = args
         .select
@@ -330,8 +329,10 @@ mod tests {
         assert!(parse_camera("30,10,0").is_err());
         assert_eq!(parse_ghost("none"), Ok(GhostArg(None)));
         assert_eq!(parse_ghost("unlayered"), Ok(GhostArg(Some(Ghost::Unlayered))));
-        assert_eq!(parse_ghost("declared"), Ok(GhostArg(Some(Ghost::Declared))));
-        assert_eq!(parse_ghost("segment-compensate"), Ok(GhostArg(Some(Ghost::Mode(InheritMode::SegmentCompensate)))));
+        use crate::model::ModeChoice;
+        assert_eq!(parse_ghost("declared"), Ok(GhostArg(Some(Ghost::Modes(ModeChoice::Declared)))));
+        let compensate = ModeChoice::Mode(InheritMode::SegmentCompensate);
+        assert_eq!(parse_ghost("segment-compensate"), Ok(GhostArg(Some(Ghost::Modes(compensate)))));
         assert!(parse_ghost("sideways").is_err());
     }
 

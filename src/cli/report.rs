@@ -41,7 +41,7 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
     }
     let files = merge(files);
     match args.format {
-        ReportFormat::Table => print!("{}", render_files(&files, render_animation)),
+        ReportFormat::Table => print!("{}", render_files(&files, &render_animation)),
         ReportFormat::Json => println!("{}", serde_json::to_string_pretty(&files)?),
         ReportFormat::Junit => println!("{}", junit(&files)),
     }

@@ -11,16 +11,15 @@ use clap::{Args, ValueEnum};
 use super::layers::LayerArgs;
 use super::options::parse_comparison;
 use super::table::Table;
-use super::{EvalArgs, ModeSet, ToleranceArgs};
-use crate::analysis::report::{
-    AnimationComparison, AnimationInfo, AnimationScan, FileComparison, FileReport, FileScan,
-};
+use super::{EvalArgs, ToleranceArgs};
+use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
-use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
-use crate::eval::{Hierarchy, LayerStack};
+use crate::analysis::{ScanOptions, scan};
+use crate::diff::{AnimationDiff, diff_files};
+use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
-use crate::model::{Clip, Rig};
+use crate::model::{InheritMode, ModeChoice, Rig};
 
 #[derive(Debug, Args)]
 pub struct ScanArgs {
@@ -66,7 +65,7 @@ pub struct ScanArgs {
         value_parser = parse_comparison,
         conflicts_with_all = ["inherit", "inherit_bone", "fail_on_stretch"]
     )]
-    pub compare_inherit: Option<[ModeSet; 2]>,
+    pub compare_inherit: Option<[ModeChoice; 2]>,
     /// Instead of the stretched bones, report the seed's stretch-quaternion storage of each clip: the bones that
     /// need a stretch channel, bytes as plain TRS and with it, and the error of rebuilding the matrices with and
     /// without it (at points along each bone's axes and at skinned vertices).
@@ -130,7 +129,7 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         return run_storage(args, &options);
     }
     let report = |path: &Path| scan_file(path, args, &options);
-    let (files, _) = report_files(&inputs(args)?, args, report, render_animation, junit)?;
+    let (files, _) = report_files(&inputs(args)?, args, report, &render_animation, &junit)?;
     Ok(verdict(&files, args.fail_on_stretch))
 }
 
@@ -170,15 +169,6 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
     }
 }
 
-/// `--compare-inherit` as JUnit: it judges nothing, so each clip passes with its table as output.
-fn junit_comparison(files: &[FileComparison]) -> String {
-    junit_of(files, |file, clip| Case {
-        name: AnimationInfo::describe(clip.animation.as_ref()),
-        failures: Vec::new(),
-        output: Some(render_comparison(file, clip)),
-    })
-}
-
 /// `--storage` as JUnit: each clip passes with its storage report as output.
 fn junit_storage(files: &[FileStorage]) -> String {
     junit_of(files, |file, clip| Case {
@@ -189,7 +179,10 @@ fn junit_storage(files: &[FileStorage]) -> String {
 }
 
 /// How a kind of report is written as JUnit XML.
-type JunitOf<T> = fn(&[FileReport<T>]) -> String;
+type JunitOf<'a, T> = &'a dyn Fn(&[FileReport<T>]) -> String;
+
+/// How one clip of a kind of report is written as a table, given its file's name.
+type TableOf<'a, T> = &'a dyn Fn(&str, &T) -> String;
 
 /// Reports every file of `paths` as `report` makes it, in `format`: JSON lines as each file is done, the other
 /// formats at the end (tables per file by `animation`, JUnit by `junit` where the report has one); every file's
@@ -198,7 +191,7 @@ fn report_files<T: serde::Serialize + Send>(
     paths: &[PathBuf],
     args: &ScanArgs,
     report: impl Fn(&Path) -> FileReport<T> + Sync,
-    animation: fn(&str, &T) -> String,
+    animation: TableOf<T>,
     junit: JunitOf<T>,
 ) -> anyhow::Result<(Vec<FileReport<T>>, bool)> {
     let format = args.format;
@@ -297,9 +290,10 @@ fn loaded_code(all_loaded: bool) -> ExitCode {
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = path.display().to_string();
     let scanned = load_layered(path, args).map(|loaded| {
-        loaded.each_clip(|layered, clip, hierarchy| {
-            let result = scan(Subject::layered(layered, clip), hierarchy, options, &|_, _| {});
-            AnimationScan::new(&layered.rig.skeleton, clip, args.eval.inherit_label(), options.rate, result)
+        loaded.each_clip(|evaluation| {
+            let result = scan(evaluation, options, &|_, _| {});
+            let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);
+            AnimationScan::new(skeleton, clip, args.eval.inherit_label(), options.rate, result)
         })
     });
     FileReport::new(file, scanned)
@@ -308,7 +302,7 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
 /// A file loaded with its modes and layers resolved, and the clips `--anim` picks.
 struct Loaded {
     rig: Rig,
-    hierarchy: Hierarchy,
+    modes: Vec<InheritMode>,
     layers: LayerStack,
     /// Positions in `rig.clips`; `None` for the rest pose of a file without animations.
     clips: Vec<Option<usize>>,
@@ -316,7 +310,7 @@ struct Loaded {
 
 fn load_layered(path: &std::path::Path, args: &ScanArgs) -> anyhow::Result<Loaded> {
     let rig = import::load(path)?;
-    let hierarchy = Hierarchy::new(&rig.skeleton, &args.eval.modes(&rig)?);
+    let modes = args.eval.modes(&rig)?;
     let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
     let clips = match &args.eval.anim {
         Some(_) => {
@@ -326,13 +320,14 @@ fn load_layered(path: &std::path::Path, args: &ScanArgs) -> anyhow::Result<Loade
         None if rig.clips.is_empty() => vec![None],
         None => (0..rig.clips.len()).map(Some).collect(),
     };
-    Ok(Loaded { rig, hierarchy, layers, clips })
+    Ok(Loaded { rig, modes, layers, clips })
 }
 
 impl Loaded {
-    fn each_clip<T>(&self, mut f: impl FnMut(Layered, Option<&Clip>, &Hierarchy) -> T) -> Vec<T> {
-        let layered = Layered { rig: &self.rig, layers: &self.layers };
-        self.clips.iter().map(|c| f(layered, c.map(|i| &self.rig.clips[i]), &self.hierarchy)).collect()
+    /// `f` of each clip's evaluation.
+    fn each_clip<T>(&self, mut f: impl FnMut(&Evaluation) -> T) -> Vec<T> {
+        let rest = Evaluation::new(&self.rig, None, &self.modes).with_layers(self.layers.clone());
+        self.clips.iter().map(|c| f(&rest.clone().with_clip(c.map(|i| &self.rig.clips[i])))).collect()
     }
 }
 
@@ -345,16 +340,16 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     let measure = |path: &Path| {
         let file = path.display().to_string();
         let measured = load_layered(path, args).map(|loaded| {
-            loaded.each_clip(|layered, clip, hierarchy| AnimationStorage {
-                animation: clip.map(AnimationInfo::of),
+            loaded.each_clip(|evaluation| AnimationStorage {
+                animation: evaluation.clip.map(AnimationInfo::of),
                 inherit: args.eval.inherit_label(),
                 rate: storage.rate,
-                report: storage_report(layered, clip, hierarchy, &storage),
+                report: storage_report(evaluation, &storage),
             })
         });
         FileStorage::new(file, measured)
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, measure, render_storage, junit_storage)?;
+    let (_, loaded) = report_files(&inputs(args)?, args, measure, &render_storage, &junit_storage)?;
     Ok(loaded_code(loaded))
 }
 
@@ -390,70 +385,33 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
     }
 }
 
-fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {
-    let compare = |path: &Path| {
-        FileComparison::new(path.display().to_string(), compare_animations(path, &args.eval, sides, args.rate))
+/// `--compare-inherit`: each file's clips [`diff_files`]-compared with themselves under the two sides' modes.
+fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<ExitCode> {
+    let compare = |path: &Path| FileReport::new(path.display().to_string(), compare_animations(path, args, sides));
+    let [a, b] = sides.map(|side| side.label());
+    let render = |file: &str, diff: &AnimationDiff| {
+        format!("{file}  inherit: {a} against {b}\n{}\n", super::diff::render_animation(diff))
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, compare, render_comparison, junit_comparison)?;
+    // As JUnit: it judges nothing, so each clip passes with its table as output.
+    let junit = |files: &[FileReport<AnimationDiff>]| {
+        junit_of(files, |file, diff| Case {
+            name: diff.a.clone(),
+            failures: Vec::new(),
+            output: Some(render(file, diff)),
+        })
+    };
+    let (_, loaded) = report_files(&inputs(args)?, args, compare, &render, &junit)?;
     Ok(loaded_code(loaded))
 }
 
-fn compare_animations(
-    path: &std::path::Path,
-    eval: &EvalArgs,
-    sides: [ModeSet; 2],
-    rate: f64,
-) -> anyhow::Result<Vec<AnimationComparison>> {
+fn compare_animations(path: &Path, args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Vec<AnimationDiff>> {
     let rig = import::load(path)?;
-    let modes = sides.map(|side| side.modes(&rig));
-    let hierarchies = [Hierarchy::new(&rig.skeleton, &modes[0]), Hierarchy::new(&rig.skeleton, &modes[1])];
-    let clips = match eval.anim {
-        Some(_) => vec![eval.clip(&rig)?],
-        None if rig.clips.is_empty() => vec![None],
-        None => rig.clips.iter().map(Some).collect(),
-    };
-    Ok(clips
-        .into_iter()
-        .map(|clip| {
-            let result = compare(&rig.skeleton, clip, &hierarchies[0], &hierarchies[1], rate);
-            let labelled = [(sides[0].label(), modes[0].as_slice()), (sides[1].label(), modes[1].as_slice())];
-            AnimationComparison::new(&rig.skeleton, clip, labelled, rate, result)
-        })
-        .collect())
-}
-
-fn render_comparison(file: &str, comparison: &AnimationComparison) -> String {
-    let what = AnimationInfo::describe(comparison.animation.as_ref());
-    let mut out =
-        format!("{file}  {what}  {} samples, {} against {}\n", comparison.samples, comparison.a, comparison.b);
-    let mut table = Table::new(&[
-        ("bone", false),
-        ("A", false),
-        ("B", false),
-        ("max Δposition", true),
-        ("at s", true),
-        ("max Δorientation°", true),
-        ("at s", true),
-    ]);
-    for bone in &comparison.bones {
-        let d = &bone.difference;
-        table.row(vec![
-            bone.name.clone(),
-            bone.mode_a.id().to_owned(),
-            bone.mode_b.id().to_owned(),
-            format!("{:.6}", d.max_position_difference),
-            format!("{:.4}", d.position_time),
-            format!("{:.4}", d.max_orientation_difference_deg),
-            format!("{:.4}", d.orientation_time),
-        ]);
-    }
-    out.push_str(&table.to_string());
-    out.push('\n');
-    out
+    let [a, b] = sides.map(|modes| super::diff::side(path, &rig, modes, &args.eval.anim));
+    Ok(diff_files(&a, &b, &[], args.rate)?.animations)
 }
 
 /// The table form: per file its clips, or why it could not be loaded.
-pub(super) fn render_files<T>(files: &[FileReport<T>], animation: fn(&str, &T) -> String) -> String {
+pub(super) fn render_files<T>(files: &[FileReport<T>], animation: TableOf<T>) -> String {
     let mut out = String::new();
     for file in files {
         if let Some(error) = &file.error {

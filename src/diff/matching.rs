@@ -7,6 +7,7 @@
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
+use super::DiffError;
 use crate::model::{Clip, Mesh, Skeleton};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
@@ -43,32 +44,63 @@ pub fn loose_name(name: &str) -> String {
     name.rsplit([':', '|']).next().unwrap_or(name).to_lowercase()
 }
 
-/// Pairs the bones of `a` and `b` (see the module's documentation); `map` holds explicit `(name in A, name in B)`
-/// pairs, tried first. A pair in `map` that names no bone is an error naming it.
-pub fn match_bones(a: &Skeleton, b: &Skeleton, map: &[(String, String)]) -> Result<BoneMatching, String> {
-    let candidates = |s: &Skeleton| {
-        let helper = helpers(s);
-        (0..s.len()).filter(|&i| !helper[i]).collect::<Vec<_>>()
-    };
-    let (mut left_a, mut left_b) = (candidates(a), candidates(b));
-    let helpers = (a.len() - left_a.len()) + (b.len() - left_b.len());
-    let mut pairs = Vec::new();
+/// Pairs the bones of `a` and `b` by name (see the module's documentation).
+pub fn match_bones(a: &Skeleton, b: &Skeleton) -> BoneMatching {
+    Unmatched::new(a, b).by_name()
+}
+
+/// [`match_bones`] after the explicit `(name in A, name in B)` pairs of `map`; a pair that names no bone (or one
+/// already taken) is an error naming it.
+pub fn match_bones_mapped(a: &Skeleton, b: &Skeleton, map: &[(String, String)]) -> Result<BoneMatching, DiffError> {
+    let mut unmatched = Unmatched::new(a, b);
     for (name_a, name_b) in map {
-        let take = |left: &mut Vec<usize>, s: &Skeleton, name: &str, side: &str| {
-            let at = left.iter().position(|&i| s.bone(i).name == name);
-            at.map(|at| left.remove(at))
-                .ok_or_else(|| format!("--map {name_a}={name_b}: no unmatched bone `{name}` in {side}"))
-        };
-        let i = take(&mut left_a, a, name_a, "the first file")?;
-        let j = take(&mut left_b, b, name_b, "the second file")?;
-        pairs.push((i, j));
+        let no_bone =
+            |name: &str, file| DiffError::NoBone { map: format!("{name_a}={name_b}"), name: name.to_owned(), file };
+        let i = take(&mut unmatched.left_a, a, name_a).ok_or_else(|| no_bone(name_a, "first"))?;
+        let j = take(&mut unmatched.left_b, b, name_b).ok_or_else(|| no_bone(name_b, "second"))?;
+        unmatched.pairs.push((i, j));
     }
-    let exact = |s: &Skeleton, i: usize| s.bone(i).name.clone();
-    pair_by_key(a, b, &mut left_a, &mut left_b, &mut pairs, exact);
-    let loose = |s: &Skeleton, i: usize| loose_name(&s.bone(i).name);
-    pair_by_key(a, b, &mut left_a, &mut left_b, &mut pairs, loose);
-    pairs.sort_unstable();
-    Ok(BoneMatching { pairs, only_a: left_a, only_b: left_b, helpers })
+    Ok(unmatched.by_name())
+}
+
+/// The bone named `name` among those `left` (removed from them).
+fn take(left: &mut Vec<usize>, skeleton: &Skeleton, name: &str) -> Option<usize> {
+    let at = left.iter().position(|&i| skeleton.bone(i).name == name)?;
+    Some(left.remove(at))
+}
+
+/// Two skeletons' bones while they are being paired: the pairs so far and the bones left on each side.
+struct Unmatched<'s> {
+    a: &'s Skeleton,
+    b: &'s Skeleton,
+    left_a: Vec<usize>,
+    left_b: Vec<usize>,
+    pairs: Vec<(usize, usize)>,
+    helpers: usize,
+}
+
+impl<'s> Unmatched<'s> {
+    /// Every bone of both but the helper nodes.
+    fn new(a: &'s Skeleton, b: &'s Skeleton) -> Self {
+        let candidates = |s: &Skeleton| {
+            let helper = helpers(s);
+            (0..s.len()).filter(|&i| !helper[i]).collect::<Vec<_>>()
+        };
+        let (left_a, left_b) = (candidates(a), candidates(b));
+        let helpers = (a.len() - left_a.len()) + (b.len() - left_b.len());
+        Unmatched { a, b, left_a, left_b, pairs: Vec::new(), helpers }
+    }
+
+    /// The bones left paired by exact name, then by loose name.
+    fn by_name(mut self) -> BoneMatching {
+        let (a, b) = (self.a, self.b);
+        let exact = |s: &Skeleton, i: usize| s.bone(i).name.clone();
+        pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, exact);
+        let loose = |s: &Skeleton, i: usize| loose_name(&s.bone(i).name);
+        pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, loose);
+        self.pairs.sort_unstable();
+        BoneMatching { pairs: self.pairs, only_a: self.left_a, only_b: self.left_b, helpers: self.helpers }
+    }
 }
 
 /// Pairs the bones left on each side whose `key` agrees, the k-th of a key in A with the k-th in B, and removes
@@ -146,19 +178,20 @@ mod tests {
     fn exact_then_loose_then_mapped() {
         let a = skeleton(&[("Hips", None), ("mixamorig:Spine", Some(0)), ("Armature|Head", Some(1)), ("Tail", None)]);
         let b = skeleton(&[("hips", None), ("Hips", None), ("spine", Some(1)), ("HEAD", Some(2)), ("Cape", None)]);
-        let m = match_bones(&a, &b, &[]).unwrap();
+        let m = match_bones(&a, &b);
         assert_eq!(m.pairs, [(0, 1), (1, 2), (2, 3)], "exact `Hips` wins over the loose `hips`");
         assert_eq!((m.only_a, m.only_b), (vec![3], vec![0, 4]));
-        let mapped = match_bones(&a, &b, &[("Tail".into(), "Cape".into())]).unwrap();
+        let mapped = match_bones_mapped(&a, &b, &[("Tail".into(), "Cape".into())]).unwrap();
         assert!(mapped.pairs.contains(&(3, 4)));
-        assert!(match_bones(&a, &b, &[("Nope".into(), "Cape".into())]).unwrap_err().contains("`Nope`"));
+        let error = match_bones_mapped(&a, &b, &[("Nope".into(), "Cape".into())]).unwrap_err();
+        assert_eq!(error.to_string(), "--map Nope=Cape: no unmatched bone `Nope` in the first file");
     }
 
     #[test]
     fn repeated_names_pair_in_order_and_helpers_are_left_out() {
         let a = skeleton(&[("root", None), ("joint", Some(0)), ("joint", Some(1))]);
         let b = skeleton(&[("root", None), ("joint.stretch", Some(0)), ("joint", Some(1)), ("joint", Some(2))]);
-        let m = match_bones(&a, &b, &[]).unwrap();
+        let m = match_bones(&a, &b);
         assert_eq!(m.pairs, [(0, 0), (1, 2), (2, 3)]);
         assert_eq!(m.helpers, 1);
         assert!(m.only_a.is_empty() && m.only_b.is_empty());

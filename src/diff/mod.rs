@@ -16,18 +16,19 @@
 
 mod matching;
 mod report;
-mod side;
 
-pub use matching::{BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_clips, match_meshes};
+pub use matching::{
+    BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
+};
 pub use report::{AnimationDiff, FileDiff, FileSide, diff_files};
-pub use side::{Side, comparison_times, rig_size};
 
 use glam::{DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 
 use crate::analysis::Components;
-use crate::eval::{LayerStack, Pose};
+use crate::eval::{Evaluation, Evaluator};
 use crate::math::{AffineParts, angle_between, decompose_all};
+use crate::model::{MAX_FRAMES, sample_times};
 
 /// How far along each axis the probe points lie, as a fraction of the rig's size.
 pub const PROBE_FRACTION: f64 = 0.1;
@@ -142,11 +143,28 @@ pub struct Pairs {
 }
 
 impl Pairs {
-    /// Bones by name (with the explicit `map` first) and meshes by name and vertex count.
-    pub fn of(a: &Side, b: &Side, map: &[(String, String)]) -> Result<Self, String> {
-        let bones = match_bones(&a.rig.skeleton, &b.rig.skeleton, map)?;
+    /// Bones by name and meshes by name and vertex count.
+    pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
+        let bones = match_bones(a.skeleton(), b.skeleton());
+        Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) }
+    }
+
+    /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones.
+    pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
+        let bones = match_bones_mapped(a.skeleton(), b.skeleton(), map)?;
         Ok(Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) })
     }
+}
+
+/// Why two files cannot be compared as asked.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DiffError {
+    /// An explicit pair names a bone that is not there (or is already paired).
+    #[error("--map {map}: no unmatched bone `{name}` in the {file} file")]
+    NoBone { map: String, name: String, file: &'static str },
+    /// A clip asked for by name or index is not in the file.
+    #[error("{file}: no animation `{name}`")]
+    NoClip { file: String, name: String },
 }
 
 /// The result of comparing two evaluations.
@@ -154,7 +172,7 @@ impl Pairs {
 pub struct Comparison {
     /// How many times were compared.
     pub samples: usize,
-    /// The size of A's rig ([`rig_size`]), which relative figures are fractions of.
+    /// The size of A's rig ([`Evaluation::size`]), which relative figures are fractions of.
     pub rig_size: f64,
     /// One per pair of bones, in A's bone order.
     pub bones: Vec<BoneDifference>,
@@ -170,9 +188,17 @@ impl Comparison {
     }
 }
 
+/// The times two evaluations are compared at: every key time of either within the shorter duration, and `rate`
+/// times a second over it (sorted, near-duplicates counted once).
+pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
+    let end = a.duration().min(b.duration());
+    let keys = a.key_times().into_iter().chain(b.key_times());
+    sample_times(keys, 0.0, end, rate, MAX_FRAMES).times
+}
+
 /// Compares `a` and `b` at `times` (sorted).
-pub fn compare(a: &Side, b: &Side, pairs: &Pairs, times: &[f64]) -> Comparison {
-    let rig_size = rig_size(a, times);
+pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
+    let rig_size = a.size(times);
     let probe_length = rig_size * PROBE_FRACTION;
     let empty = || Differences::new(a, b, pairs);
     let totals = times
@@ -181,7 +207,7 @@ pub fn compare(a: &Side, b: &Side, pairs: &Pairs, times: &[f64]) -> Comparison {
             let mut worker = Worker::new(a, b);
             let mut differences = empty();
             for &time in chunk {
-                worker.evaluate(a, b, &pairs.meshes, time);
+                worker.evaluate(&pairs.meshes, time);
                 differences.add(&worker, probe_length, time);
             }
             differences
@@ -203,7 +229,7 @@ struct Differences {
 }
 
 impl Differences {
-    fn new(a: &Side, b: &Side, pairs: &Pairs) -> Self {
+    fn new(a: &Evaluation, b: &Evaluation, pairs: &Pairs) -> Self {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
         let bones =
             pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
@@ -230,7 +256,7 @@ impl Differences {
     }
 
     fn add(&mut self, worker: &Worker, probe_length: f64, time: f64) {
-        let (model_a, model_b) = (&worker.pose_a.model.model, &worker.pose_b.model.model);
+        let (model_a, model_b) = (&worker.a.pose.model.model, &worker.b.pose.model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             let (pa, pb) = (&worker.parts_a[difference.a], &worker.parts_b[difference.b]);
@@ -253,12 +279,10 @@ impl Differences {
     }
 }
 
-/// One thread's poses and buffers.
-struct Worker {
-    pose_a: Pose,
-    pose_b: Pose,
-    layers_a: Option<LayerStack>,
-    layers_b: Option<LayerStack>,
+/// One thread's evaluations and buffers.
+struct Worker<'e, 'a> {
+    a: Evaluator<'e, 'a>,
+    b: Evaluator<'e, 'a>,
     parts_a: Vec<AffineParts>,
     parts_b: Vec<AffineParts>,
     /// The paired meshes, skinned, in the order of the pairs.
@@ -266,13 +290,11 @@ struct Worker {
     skinned_b: Vec<Vec<DVec3>>,
 }
 
-impl Worker {
-    fn new(a: &Side, b: &Side) -> Self {
+impl<'e, 'a> Worker<'e, 'a> {
+    fn new(a: &'e Evaluation<'a>, b: &'e Evaluation<'a>) -> Self {
         Worker {
-            pose_a: Pose::default(),
-            pose_b: Pose::default(),
-            layers_a: a.layers.clone(),
-            layers_b: b.layers.clone(),
+            a: a.evaluator(),
+            b: b.evaluator(),
             parts_a: Vec::new(),
             parts_b: Vec::new(),
             skinned_a: Vec::new(),
@@ -281,31 +303,29 @@ impl Worker {
     }
 
     /// Evaluates both sides at `time`, skinning the paired `meshes`.
-    fn evaluate(&mut self, a: &Side, b: &Side, meshes: &[(usize, usize)], time: f64) {
-        a.evaluate(&mut self.pose_a, &mut self.layers_a, time);
-        b.evaluate(&mut self.pose_b, &mut self.layers_b, time);
-        self.parts_a = decompose_all(&self.pose_a.model.model);
-        self.parts_b = decompose_all(&self.pose_b.model.model);
+    fn evaluate(&mut self, meshes: &[(usize, usize)], time: f64) {
+        self.parts_a = decompose_all(&self.a.evaluate(time).model.model);
+        self.parts_b = decompose_all(&self.b.evaluate(time).model.model);
         self.skinned_a.resize_with(meshes.len(), Vec::new);
         self.skinned_b.resize_with(meshes.len(), Vec::new);
         for (k, &(i, j)) in meshes.iter().enumerate() {
-            a.skin(&self.pose_a, i, &mut self.skinned_a[k]);
-            b.skin(&self.pose_b, j, &mut self.skinned_b[k]);
+            self.a.evaluation().skin(&self.a.pose, i, &mut self.skinned_a[k]);
+            self.b.evaluation().skin(&self.b.pose, j, &mut self.skinned_b[k]);
         }
     }
 }
 
 /// The model-space components of `bones` of `side` at `times`, one curve per bone: a second file's curves beside the
 /// first's (the app plots a compared file dashed).
-pub fn model_curves(side: &Side, bones: &[usize], times: &[f64]) -> Vec<Vec<Components>> {
+pub fn model_curves(evaluation: &Evaluation, bones: &[usize], times: &[f64]) -> Vec<Vec<Components>> {
     let chunks: Vec<Vec<Vec<Components>>> = times
         .par_chunks(256)
         .map(|chunk| {
-            let (mut pose, mut layers) = (Pose::default(), side.layers.clone());
+            let mut evaluator = evaluation.evaluator();
             let mut starts = vec![DQuat::IDENTITY; bones.len()];
             let mut curves = vec![Vec::with_capacity(chunk.len()); bones.len()];
             for &time in chunk {
-                side.evaluate(&mut pose, &mut layers, time);
+                let pose = evaluator.evaluate(time);
                 for ((curve, start), &bone) in curves.iter_mut().zip(&mut starts).zip(bones) {
                     let components = Components::of_matrix(&pose.model.model[bone], *start);
                     *start = components.stretch.as_dquat();
@@ -370,13 +390,13 @@ const NEARLY_SAME_FRAME: f64 = 1e-6;
 mod tests {
     use super::*;
     use crate::import::demo_rig;
-    use crate::model::InheritMode;
+    use crate::model::{Bone, InheritMode, Rig, Skeleton, Transform};
 
     #[test]
     fn a_file_against_itself_differs_by_nothing() {
         let rig = demo_rig();
-        let side = Side::new(&rig, rig.clips.first(), &rig.skeleton.declared_modes());
-        let pairs = Pairs::of(&side, &side, &[]).unwrap();
+        let side = Evaluation::declared(&rig, rig.clips.first());
+        let pairs = Pairs::by_name(&side, &side);
         assert_eq!(pairs.bones.pairs.len(), rig.skeleton.len());
         let times = comparison_times(&side, &side, 30.0);
         let comparison = compare(&side, &side, &pairs, &times);
@@ -393,15 +413,51 @@ mod tests {
     fn two_modes_differ_where_the_shear_goes() {
         // The demo's forearm shears under full inheritance and not under segment scale compensate.
         let rig = demo_rig();
-        let full = Side::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
-        let compensated = Side::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]);
-        let pairs = Pairs::of(&full, &compensated, &[]).unwrap();
+        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
+        let compensated =
+            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]);
+        let pairs = Pairs::by_name(&full, &compensated);
         let comparison = compare(&full, &compensated, &pairs, &comparison_times(&full, &compensated, 30.0));
         let root = &comparison.bones[0];
         assert_eq!(root.probe.max, 0.0, "the root is the same in every mode");
         let forearm = comparison.bones.iter().find(|b| b.name == "forearm").unwrap();
         assert!(forearm.stretch_deg.max > 1.0 && forearm.scale_ratio.max > 1.01, "{forearm:?}");
         assert!(comparison.meshes[0].distance.max > 0.0 && comparison.meshes[0].mean > 0.0);
+    }
+
+    #[test]
+    fn positions_and_orientations_of_a_scaled_chain() {
+        // root scaled (2, 1, 1); mid 1 along X, turned 45° about Z, scaled (1, 2, 1); tip 1 along X, turned 30°.
+        // Unscaled-parent drops every ancestor's scale: tip at Rz(45°)·(1, 0, 0) + (1, 0, 0), turned 75°.
+        // Full: tip at diag(2,1,1)·[(1, 0, 0) + Rz(45°)·diag(1,2,1)·(1, 0, 0)] = (2 + 2c, c, 0) with c = cos 45°,
+        // and the linear part M = S0·Rz(45°)·S1·Rz(30°), whose closest rotation turns about Z by
+        // atan2(m10 − m01, m00 + m11) (the 2-D polar rotation; computed here without the decomposition code).
+        let rz = |deg: f64| Transform::from_trs(DVec3::X, DQuat::from_rotation_z(deg.to_radians()), DVec3::ONE);
+        let root = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
+        let mid = Transform { scale: DVec3::new(1.0, 2.0, 1.0), ..rz(45.0) };
+        let bone =
+            |name: &str, parent, rest| Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full };
+        let bones = vec![bone("root", None, root), bone("mid", Some(0), mid), bone("tip", Some(1), rz(30.0))];
+        let rig = Rig { skeleton: Skeleton::new(bones).unwrap(), ..Rig::default() };
+        let unscaled = Evaluation::new(&rig, None, &[InheritMode::UnscaledParent; 3]);
+        let full = Evaluation::new(&rig, None, &[InheritMode::Full; 3]);
+        let result =
+            compare(&unscaled, &full, &Pairs::by_name(&unscaled, &full), &comparison_times(&unscaled, &full, 60.0));
+        assert_eq!(result.samples, 1);
+        let c = std::f64::consts::FRAC_1_SQRT_2;
+        let tip = &result.bones[2];
+        let unscaled_tip = DVec3::new(1.0 + c, c, 0.0);
+        let full_tip = DVec3::new(2.0 + 2.0 * c, c, 0.0);
+        assert!((tip.position.max - (full_tip - unscaled_tip).length()).abs() < 1e-12, "{tip:?}");
+        let m = glam::DMat2::from_diagonal(glam::DVec2::new(2.0, 1.0))
+            * glam::DMat2::from_angle(45f64.to_radians())
+            * glam::DMat2::from_diagonal(glam::DVec2::new(1.0, 2.0))
+            * glam::DMat2::from_angle(30f64.to_radians());
+        let full_angle = (m.x_axis.y - m.y_axis.x).atan2(m.x_axis.x + m.y_axis.y).to_degrees();
+        assert!((tip.orientation_deg.max - (75.0 - full_angle).abs()).abs() < 1e-9, "{tip:?}");
+        assert!(tip.orientation_deg.max > 1.0, "the two scales around a rotation turn the tip");
+        let root = &result.bones[0];
+        assert_eq!((root.position.max, root.orientation_deg.max), (0.0, 0.0), "roots agree in every mode");
     }
 
     #[test]

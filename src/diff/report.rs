@@ -1,7 +1,8 @@
 //! Two files compared as a whole: their animations paired (by name, or as chosen), each pair compared, and what
 //! had no partner listed.
 
-use super::{BoneDifference, Extreme, MeshDifference, Pairs, Side, compare, comparison_times, match_clips};
+use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
+use crate::eval::Evaluation;
 use crate::model::{Clip, InheritMode, Rig};
 
 /// One side of a file comparison, before clips are chosen.
@@ -52,15 +53,15 @@ pub struct FileDiff {
 }
 
 /// Compares `a` with `b` at their key times and `rate` times a second; `map` pairs bones by name explicitly.
-pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f64) -> Result<FileDiff, String> {
+pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f64) -> Result<FileDiff, DiffError> {
     let (pairs, only_a, only_b) = pair_clips(a, b)?;
     let label = |rig: &Rig, clip: Option<usize>| clip.map_or_else(|| "rest pose".to_owned(), |c| rig.clips[c].label());
     let animations = pairs
         .iter()
         .map(|&(ca, cb)| {
-            let side_a = Side::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes);
-            let side_b = Side::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes);
-            let pairs = Pairs::of(&side_a, &side_b, map)?;
+            let side_a = Evaluation::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes);
+            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes);
+            let pairs = Pairs::mapped(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
             Ok(AnimationDiff {
@@ -76,7 +77,7 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
                 meshes: comparison.meshes,
             })
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect::<Result<Vec<_>, DiffError>>()?;
     Ok(FileDiff {
         a: a.file.clone(),
         b: b.file.clone(),
@@ -94,9 +95,10 @@ type ClipPairs = (Vec<(Option<usize>, Option<usize>)>, Vec<usize>, Vec<usize>);
 
 /// The clips to compare: the ones named (a name given for one side only is looked up on both), else every clip
 /// paired by name; two files without clips compare their rest poses.
-fn pair_clips(a: &FileSide, b: &FileSide) -> Result<ClipPairs, String> {
-    let find = |side: &FileSide, name: &str| -> Result<usize, String> {
-        let clip = side.rig.find_clip(name).ok_or_else(|| format!("{}: no animation `{name}`", side.file))?;
+fn pair_clips(a: &FileSide, b: &FileSide) -> Result<ClipPairs, DiffError> {
+    let find = |side: &FileSide, name: &str| -> Result<usize, DiffError> {
+        let no_clip = || DiffError::NoClip { file: side.file.clone(), name: name.to_owned() };
+        let clip = side.rig.find_clip(name).ok_or_else(no_clip)?;
         Ok(side.rig.clips.iter().position(|c| std::ptr::eq(c, clip)).unwrap_or(0))
     };
     match (&a.anim, &b.anim) {
@@ -107,7 +109,7 @@ fn pair_clips(a: &FileSide, b: &FileSide) -> Result<ClipPairs, String> {
         }
         (Some(x), Some(y)) => Ok((vec![(Some(find(a, x)?), Some(find(b, y)?))], vec![], vec![])),
         (Some(name), None) | (None, Some(name)) => {
-            let same = |side: &FileSide, other: &FileSide, index: usize| -> Result<usize, String> {
+            let same = |side: &FileSide, other: &FileSide, index: usize| -> Result<usize, DiffError> {
                 let clip: &Clip = &other.rig.clips[index];
                 find(side, clip.name.as_deref().unwrap_or(name))
             };

@@ -5,6 +5,7 @@
 mod bind;
 pub mod blender;
 mod cursor;
+mod evaluation;
 mod hierarchy;
 pub mod layers;
 mod morph;
@@ -15,6 +16,7 @@ pub mod skinning;
 pub(crate) use bind::invert;
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
 pub use cursor::BoneCursor;
+pub use evaluation::{Evaluation, Evaluator};
 pub use hierarchy::{Hierarchy, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use morph::MorphPose;

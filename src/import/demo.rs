@@ -220,14 +220,13 @@ mod tests {
     use glam::DMat4;
 
     use super::*;
-    use crate::analysis::{ScanOptions, Subject, scan};
-    use crate::eval::Hierarchy;
+    use crate::analysis::{ScanOptions, scan};
+    use crate::eval::Evaluation;
 
     fn stretched_bones(clip: usize, mode: InheritMode) -> Vec<String> {
         let rig = demo_rig();
-        let hierarchy = Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]);
-        let result =
-            scan(Subject::clip(&rig.skeleton, Some(&rig.clips[clip])), &hierarchy, &ScanOptions::default(), &|_, _| {});
+        let evaluation = Evaluation::new(&rig, Some(&rig.clips[clip]), &vec![mode; rig.skeleton.len()]);
+        let result = scan(&evaluation, &ScanOptions::default(), &|_, _| {});
         result.bones.iter().filter(|b| b.stretched()).map(|b| rig.skeleton.bone(b.index).name.clone()).collect()
     }
 

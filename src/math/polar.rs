@@ -132,8 +132,12 @@ pub fn angle_of_half_cosine(half_cosine: f64) -> f64 {
 }
 
 /// The angle between two rotations, in radians, in `[0, π]` (accurate for tiny angles too, where an inverse cosine
-/// of their dot product loses half the digits).
+/// of their dot product loses half the digits). Equal quaternions are exactly 0 apart (their product's rounding
+/// would say 1e-17).
 pub fn angle_between(a: DQuat, b: DQuat) -> f64 {
+    if a == b {
+        return 0.0;
+    }
     let d = a.conjugate() * b;
     2.0 * d.xyz().length().atan2(d.w.abs())
 }
@@ -352,6 +356,16 @@ mod tests {
     use rand_xorshift::XorShiftRng;
 
     use super::*;
+
+    #[test]
+    fn angles_between_rotations_are_exact_for_small_large_and_no_angles() {
+        let a = DQuat::from_rotation_y(0.3);
+        assert!((angle_between(a, DQuat::from_rotation_y(0.3 + 1e-9)) - 1e-9).abs() < 1e-15);
+        assert!((angle_between(a, -DQuat::from_rotation_y(1.3)) - 1.0).abs() < 1e-14);
+        let turned =
+            DQuat::from_xyzw(0.7018638453962487, 0.7018638453962488, -0.08594848762829187, 0.08594848762829192);
+        assert_eq!(angle_between(turned, turned), 0.0, "the product's rounding is no angle");
+    }
 
     /// A rotation drawn from deterministic noise.
     fn random_quat(rng: &mut XorShiftRng) -> DQuat {

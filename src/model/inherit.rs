@@ -108,9 +108,75 @@ impl FromStr for InheritMode {
     }
 }
 
+/// Modes for a set of bones: one mode for all, or each bone's own as its file declares it. What a mode edit sets,
+/// what a ghost shows, and each side of `diff` and `scan --compare-inherit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeChoice {
+    Declared,
+    Mode(InheritMode),
+}
+
+impl ModeChoice {
+    /// "declared" first, then every mode.
+    pub fn all() -> impl Iterator<Item = ModeChoice> {
+        std::iter::once(ModeChoice::Declared).chain(InheritMode::ALL.into_iter().map(ModeChoice::Mode))
+    }
+
+    /// `declared`, or the mode's id.
+    pub fn label(self) -> &'static str {
+        match self {
+            ModeChoice::Declared => "declared",
+            ModeChoice::Mode(mode) => mode.id(),
+        }
+    }
+
+    pub fn description(self) -> &'static str {
+        match self {
+            ModeChoice::Declared => "each bone as its file declares it",
+            ModeChoice::Mode(mode) => mode.description(),
+        }
+    }
+
+    /// The mode this choice gives a bone whose file declares `declared`.
+    pub fn mode_for(self, declared: InheritMode) -> InheritMode {
+        match self {
+            ModeChoice::Declared => declared,
+            ModeChoice::Mode(mode) => mode,
+        }
+    }
+}
+
+/// The error of parsing a choice that is neither `declared` nor a mode id.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}, or `declared`")]
+pub struct UnknownModeChoice(pub UnknownInheritMode);
+
+impl FromStr for ModeChoice {
+    type Err = UnknownModeChoice;
+
+    /// `declared` or a mode id.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "declared" => Ok(ModeChoice::Declared),
+            mode => mode.parse().map(ModeChoice::Mode).map_err(UnknownModeChoice),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn choices_round_trip_through_their_labels() {
+        for choice in ModeChoice::all() {
+            assert_eq!(choice.label().parse::<ModeChoice>(), Ok(choice));
+        }
+        assert_eq!(ModeChoice::all().count(), InheritMode::ALL.len() + 1);
+        let error = "sideways".parse::<ModeChoice>().unwrap_err();
+        assert!(error.to_string().starts_with("unknown inheritance mode `sideways`"), "{error}");
+        assert!(error.to_string().ends_with(", or `declared`"), "{error}");
+    }
 
     #[test]
     fn ids_round_trip() {

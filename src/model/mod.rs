@@ -10,12 +10,12 @@ mod transform;
 pub use clip::{
     BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
 };
-pub use inherit::{InheritMode, UnknownInheritMode};
+pub use inherit::{InheritMode, ModeChoice, UnknownInheritMode, UnknownModeChoice};
 #[cfg(test)]
 pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
-pub use timeline::{SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
+pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
 
 /// Everything bonescope knows about one file.

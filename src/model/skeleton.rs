@@ -1,6 +1,6 @@
 //! The bone hierarchy: flat arrays ordered parents-first, addressed by index.
 
-use super::{InheritMode, Transform};
+use super::{InheritMode, ModeChoice, Transform};
 
 /// One bone (every node of the source scene becomes one).
 #[derive(Clone, Debug, PartialEq)]
@@ -75,6 +75,11 @@ impl Skeleton {
     /// The modes the file declares, one per bone.
     pub fn declared_modes(&self) -> Vec<InheritMode> {
         self.bones.iter().map(|b| b.inherit).collect()
+    }
+
+    /// The mode `choice` gives each bone.
+    pub fn modes(&self, choice: ModeChoice) -> Vec<InheritMode> {
+        self.bones.iter().map(|b| choice.mode_for(b.inherit)).collect()
     }
 
     /// The rest pose, one local transform per bone.

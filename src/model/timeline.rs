@@ -11,6 +11,10 @@
 /// a 6,000-key clip at 60 Hz would be sampled twice as often as it has frames.
 const SAME_TIME: f64 = 1e-6;
 
+/// The most frames of a rate a whole-clip pass visits at every one of; past it, the grid is thinned between sparse
+/// keys as the module says.
+pub const MAX_FRAMES: usize = 1 << 20;
+
 /// How many times a long gap between two keys is sampled at when the grid is thinned.
 pub const SAMPLES_PER_SPARSE_GAP: usize = 64;
 

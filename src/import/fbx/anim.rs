@@ -32,14 +32,12 @@ use rayon::prelude::*;
 use super::channels::{Channels, evaluated_from_own_properties};
 use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
-use crate::model::{BoneTracks, Clip, Interpolation, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times};
+use crate::model::{
+    BoneTracks, Clip, Interpolation, MAX_FRAMES, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times,
+};
 
 /// Frames per second assumed when the file states none that makes sense.
 const DEFAULT_FPS: f64 = 30.0;
-
-/// The most frames a stack is sampled at every one of (9.7 hours at 30 fps); longer spans are thinned where keys are
-/// sparse.
-const MAX_FRAMES: usize = 1 << 20;
 
 /// How long before a stepped key's jump the value before it is sampled (as ufbx's baker does).
 const STEP: f64 = 1e-3;

@@ -1,0 +1,251 @@
+//! What is evaluated: a clip of a rig under one inheritance mode per bone, through layers, skinned one way, and the
+//! times a whole-clip pass visits it at. Every consumer builds one — the analysis, a ghost, a compared file, a bake
+//! and the file it wrote, `inspect`, `export` — and a comparison is two of them.
+
+use glam::DVec3;
+
+use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
+use super::{Hierarchy, LayerStack, Pose};
+use crate::model::{Clip, InheritMode, MAX_FRAMES, Rig, Skeleton, sample_times};
+
+/// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
+#[derive(Clone, Debug)]
+pub struct Evaluation<'a> {
+    pub rig: &'a Rig,
+    pub clip: Option<&'a Clip>,
+    /// The bones' modes, ready to combine local transforms into model matrices.
+    pub hierarchy: Hierarchy,
+    /// The layers the clip plays through; never a stack that leaves the clip as it is (that is `None`).
+    layers: Option<LayerStack>,
+    pub skinning: SkinningMethod,
+}
+
+impl<'a> Evaluation<'a> {
+    /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says.
+    pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Self {
+        let hierarchy = Hierarchy::new(&rig.skeleton, modes);
+        Evaluation { rig, clip, hierarchy, layers: None, skinning: SkinningMethod::AsFile }
+    }
+
+    /// `clip` of `rig` with the modes its file declares.
+    pub fn declared(rig: &'a Rig, clip: Option<&'a Clip>) -> Self {
+        Evaluation::new(rig, clip, &rig.skeleton.declared_modes())
+    }
+
+    /// The same through `layers` (built, and so checked, for this rig). Layers that change nothing are no layers:
+    /// the clip is then sampled directly.
+    pub fn with_layers(mut self, layers: LayerStack) -> Self {
+        self.layers = Some(layers).filter(|l| !l.is_empty());
+        self
+    }
+
+    /// The same modes (and layers) on another clip of the rig.
+    pub fn with_clip(mut self, clip: Option<&'a Clip>) -> Self {
+        self.clip = clip;
+        self
+    }
+
+    /// The same skinned with `method`.
+    pub fn with_skinning(mut self, method: SkinningMethod) -> Self {
+        self.skinning = method;
+        self
+    }
+
+    /// The same clip through the same layers under other modes (a ghost: "what if every bone were …").
+    pub fn with_modes(&self, modes: &[InheritMode]) -> Self {
+        Evaluation { hierarchy: Hierarchy::new(&self.rig.skeleton, modes), ..self.clone() }
+    }
+
+    /// The same clip as authored: without the layers.
+    pub fn without_layers(&self) -> Self {
+        Evaluation { layers: None, ..self.clone() }
+    }
+
+    /// The rig at rest under the same modes: no clip, no layers.
+    pub fn at_rest(&self) -> Self {
+        Evaluation { clip: None, layers: None, ..self.clone() }
+    }
+
+    pub fn skeleton(&self) -> &'a Skeleton {
+        &self.rig.skeleton
+    }
+
+    pub fn modes(&self) -> &[InheritMode] {
+        self.hierarchy.modes()
+    }
+
+    pub fn layers(&self) -> Option<&LayerStack> {
+        self.layers.as_ref()
+    }
+
+    /// How long the evaluation runs: the clip's duration, or the layered timeline's (a synced blend's cycle, a
+    /// crossfade into a longer clip).
+    pub fn duration(&self) -> f64 {
+        match &self.layers {
+            Some(layers) => layers.duration(self.rig, self.clip),
+            None => self.clip.map_or(0.0, Clip::duration),
+        }
+    }
+
+    /// The times at which the evaluation has keys: the clip's key times, or, where layers make a timeline of their
+    /// own, its two ends.
+    pub fn key_times(&self) -> Vec<f64> {
+        match &self.layers {
+            Some(_) => self.times(0.0),
+            None => self.clip.map_or_else(|| vec![0.0], Clip::key_times),
+        }
+    }
+
+    /// The times a whole-clip pass visits: every key time, plus `0, 1/rate, 2/rate, …` up to the duration, plus
+    /// the duration; sorted, without duplicates (thinned between sparse keys past [`MAX_FRAMES`] frames). Where the
+    /// layers change the timeline (a synced blend plays a cycle of another length, a crossfade runs on into the
+    /// incoming clip), the grid over the layered duration and its end. Just `[0]` for the rest pose.
+    pub fn times(&self, rate: f64) -> Vec<f64> {
+        let (rig, clip) = (self.rig, self.clip);
+        let main = clip.map_or(0.0, Clip::duration);
+        let retimed = self
+            .layers
+            .as_ref()
+            .is_some_and(|layers| layers.synced_cycle(rig, clip).is_some() || layers.duration(rig, clip) != main);
+        match clip {
+            _ if retimed => sample_times([], 0.0, self.duration(), rate, MAX_FRAMES).times,
+            Some(clip) => sample_times(clip.key_times(), 0.0, main, rate, MAX_FRAMES).times,
+            None => vec![0.0],
+        }
+    }
+
+    /// A worker's state for evaluating poses one time after another (its own pose buffers and copy of the layers).
+    pub fn evaluator(&self) -> Evaluator<'_, 'a> {
+        Evaluator { evaluation: self, layers: self.layers.clone(), pose: Pose::default() }
+    }
+
+    /// The pose at `time` (for a single time; a loop over times reuses one [`Evaluator`]).
+    pub fn pose_at(&self, time: f64) -> Pose {
+        let mut evaluator = self.evaluator();
+        evaluator.evaluate(time);
+        evaluator.pose
+    }
+
+    /// The positions of mesh `mesh` at `pose`, morphed and skinned (`out` is reused).
+    pub fn skin(&self, pose: &Pose, mesh: usize, out: &mut Vec<DVec3>) {
+        let (rig, model) = (self.rig, &pose.model.model);
+        skin_positions_with(&rig.meshes[mesh], &rig.skins, model, &pose.morph, self.skinning, out);
+    }
+
+    /// Every mesh at `pose`, morphed and skinned.
+    pub fn skin_all(&self, pose: &Pose) -> Vec<Vec<DVec3>> {
+        skin_meshes_with(self.rig, &pose.model.model, &pose.morph, self.skinning)
+    }
+
+    /// The size differences and tolerances are measured against: the largest bounding-box diagonal of the
+    /// character over `times` (the origins of the bones [`Rig::character_bones`] names at each time, with every
+    /// skinned mesh at the first time); 1 when that is zero (a single bone), so relative figures stay meaningful.
+    pub fn size(&self, times: &[f64]) -> f64 {
+        let character = self.rig.character_bones(self.clip);
+        let mut evaluator = self.evaluator();
+        let mut size: f64 = 0.0;
+        for (i, &time) in times.iter().enumerate() {
+            let pose = evaluator.evaluate(time);
+            let origins =
+                pose.model.model.iter().zip(&character).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
+            let vertices = if i == 0 { self.skin_all(pose).concat() } else { Vec::new() };
+            size = size.max(diagonal(origins.chain(vertices)));
+        }
+        if size > 0.0 && size.is_finite() { size } else { 1.0 }
+    }
+}
+
+/// One thread's state for evaluating an [`Evaluation`] at one time after another: the pose (reused across times,
+/// and across increasing times to skip key searches) and its own copy of the layers (they hold scratch buffers).
+#[derive(Clone, Debug)]
+pub struct Evaluator<'e, 'a> {
+    evaluation: &'e Evaluation<'a>,
+    layers: Option<LayerStack>,
+    pub pose: Pose,
+}
+
+impl<'e, 'a> Evaluator<'e, 'a> {
+    /// What this evaluator evaluates.
+    pub fn evaluation(&self) -> &'e Evaluation<'a> {
+        self.evaluation
+    }
+
+    /// Evaluates the pose at `time`.
+    pub fn evaluate(&mut self, time: f64) -> &Pose {
+        let e = self.evaluation;
+        match &mut self.layers {
+            Some(stack) => self.pose.evaluate_layered(e.rig, e.clip, &e.hierarchy, stack, time),
+            None => self.pose.evaluate(&e.rig.skeleton, e.clip, &e.hierarchy, time),
+        }
+        &self.pose
+    }
+}
+
+/// The diagonal of the bounding box of `points` (0 for none).
+fn diagonal(points: impl Iterator<Item = DVec3>) -> f64 {
+    let (lo, hi) = points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    if lo.cmple(hi).all() { (hi - lo).length() } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::Layers;
+    use crate::eval::layers::Crossfade;
+    use crate::import::demo_rig;
+
+    #[test]
+    fn the_demo_arm_is_about_its_length() {
+        let rig = demo_rig();
+        let evaluation = Evaluation::declared(&rig, rig.clips.first());
+        let times = evaluation.times(30.0);
+        assert_eq!(times.first(), Some(&0.0));
+        assert_eq!(times.last(), Some(&evaluation.duration()));
+        let size = evaluation.size(&times);
+        let rest = rig.skeleton.rest_model_matrices();
+        let span = rest.iter().map(|m| m.w_axis.truncate().length()).fold(0.0, f64::max);
+        assert!(size >= span && size < 4.0 * span, "{size} against the rest span {span}");
+        assert_eq!(diagonal(std::iter::empty()), 0.0);
+        assert_eq!(diagonal([DVec3::ZERO, DVec3::new(3.0, 4.0, 0.0)].into_iter()), 5.0);
+    }
+
+    #[test]
+    fn layers_that_change_nothing_are_no_layers() {
+        let rig = demo_rig();
+        let plain = Evaluation::declared(&rig, rig.clips.first());
+        let empty = plain.clone().with_layers(LayerStack::new(&rig, &Layers::default()).unwrap());
+        assert!(empty.layers().is_none());
+        assert_eq!(empty.times(30.0), plain.times(30.0));
+        assert_eq!(empty.key_times(), rig.clips[0].key_times());
+    }
+
+    #[test]
+    fn a_crossfade_into_a_longer_run_retimes_the_grid() {
+        // A crossfade at 1.5 s into the second clip (2 s long) runs on to 3.5 s; the grid covers that at the rate,
+        // both ends included, and a ghost without the layers keeps the clip's own times.
+        let rig = demo_rig();
+        let main = &rig.clips[0];
+        let crossfade = Crossfade { clip: 1, at: 1.5, duration: 0.5, curve: Default::default() };
+        let stack = LayerStack::new(&rig, &Layers { crossfade: Some(crossfade), ..Layers::default() }).unwrap();
+        let layered = Evaluation::declared(&rig, Some(main)).with_layers(stack);
+        let end = 1.5 + rig.clips[1].duration();
+        assert!(end > main.duration());
+        assert_eq!(layered.duration(), end);
+        let times = layered.times(10.0);
+        assert_eq!((times[0], *times.last().unwrap(), times.len()), (0.0, end, 36));
+        assert!(times.windows(2).all(|w| (w[1] - w[0] - 0.1).abs() < 1e-12), "{times:?}");
+        assert_eq!(layered.key_times(), [0.0, end]);
+        assert_eq!(layered.without_layers().times(10.0), Evaluation::declared(&rig, Some(main)).times(10.0));
+    }
+
+    #[test]
+    fn an_evaluator_matches_a_fresh_pose_at_every_time() {
+        let rig = demo_rig();
+        let evaluation = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
+        let mut evaluator = evaluation.evaluator();
+        for &time in &evaluation.times(12.0) {
+            let reused = evaluator.evaluate(time).model.model.clone();
+            assert_eq!(reused, evaluation.pose_at(time).model.model, "at {time}");
+        }
+    }
+}
