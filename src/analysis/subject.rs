@@ -54,7 +54,7 @@ pub struct GhostRequest<'a> {
 const MAX_FRAMES: usize = 1 << 20;
 
 /// The times a scan visits: every key time, plus `0, 1/rate, 2/rate, …` up to the duration, plus the duration;
-/// sorted, without duplicates (thinned between sparse keys for a clip of more than [`MAX_FRAMES`] frames). Just
+/// sorted, without duplicates (thinned between sparse keys for a clip of more than `MAX_FRAMES` (2²⁰) frames). Just
 /// `[0]` without a clip.
 pub fn sample_times(clip: Option<&Clip>, rate: f64) -> Vec<f64> {
     let Some(clip) = clip else { return vec![0.0] };
