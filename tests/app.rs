@@ -154,7 +154,7 @@ fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     let forearm = bone(&harness, "forearm");
-    // The target's model rotation: the chain of local rotations from the root (seed 003's joints).
+    // The target's model rotation: the chain of local rotations from the root (scale plays no part).
     let rotation_at = |harness: &Harness<'static, BonescopeApp>, time: f64| {
         let doc = &harness.state().doc;
         let local = doc.evaluation().pose_at(time).local;

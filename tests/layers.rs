@@ -1,5 +1,5 @@
-//! Runtime techniques layered on clips (`eval::layers`), against values computed by hand from the seeds' formulas,
-//! and the seed's walk–run sync on real motion capture.
+//! Runtime techniques layered on clips (`eval::layers`), against values computed by hand from their formulas, and
+//! the walk–run sync on real motion capture.
 
 use std::f64::consts::FRAC_PI_2;
 use std::path::PathBuf;
@@ -141,7 +141,7 @@ fn a_crossfade_runs_from_the_end_of_one_clip_into_the_start_of_another() {
 
 #[test]
 fn the_shake_grows_down_the_arm() {
-    // Demo arm, shake on the upper arm with the seed's defaults, at t = 0: factor 0.3, modifiers 1, 1.3, 1.6:
+    // Demo arm, shake on the upper arm with the default parameters, at t = 0: factor 0.3, modifiers 1, 1.3, 1.6:
     // translations (0, 0.3, 0), (0, 0.39, 0), (0, 0.48, 0) added; the shoulder above stays.
     let rig = demo_rig();
     let layers = Layers { shake: Some(Shake { bone: 1, params: ShakeParams::default() }), ..Layers::default() };
@@ -362,7 +362,7 @@ fn a_synced_walk_run_blend_plants_the_feet_at_the_same_phases() {
         let none = Layers::default();
         let walk_phase = stance_phase(&rig, walk, &none, t1, bone, STEPS);
         let run_phase = stance_phase(&rig, run, &none, t2, bone, STEPS);
-        // The animators matched the cycles (seed 001's requirement): each foot plants at nearly the same phase.
+        // The animators matched the cycles (what a synced blend needs): each foot plants at nearly the same phase.
         assert!(phase_distance(walk_phase, run_phase) < 0.1, "{foot}: walk {walk_phase:.3}, run {run_phase:.3}");
         for a in [0.25, 0.5, 0.75] {
             let blend = Blend { clip: run, weight: a, sync: true, rotation: RotationBlend::Slerp };

@@ -1,4 +1,4 @@
-//! The seed's stretch-quaternion storage report (`analysis::storage`) on rigs whose answer is known.
+//! The stretch-quaternion storage report (`analysis::storage`) on rigs whose answer is known.
 
 use std::sync::Arc;
 
@@ -69,7 +69,7 @@ fn a_compensating_child_needs_the_stretch_channel() {
     assert_eq!((r.marked[0].name.as_str(), r.marked[0].stretched_frames), ("child", 2));
     // 2 frames × 2 bones × 40 bytes; plus 2 frames × 1 marked bone × 16 bytes.
     assert_eq!((r.bytes_trs, r.bytes_with_stretch), (160, 192));
-    // The seed's recomposition is exact up to f32 rounding of the stored components.
+    // The stretch-quaternion recomposition is exact up to f32 rounding of the stored components.
     assert!(r.reconstruction.bone_axes.max < 1e-6, "{:?}", r.reconstruction);
     assert!(r.reconstruction.vertices.unwrap().max < 1e-6);
     // Dropping U: the runtime rebuilds diag(2,1,1)·T(1,0,0)·R·K instead of diag(2,1,1)·T(1,0,0)·A with

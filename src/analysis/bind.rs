@@ -1,4 +1,4 @@
-//! Does a skin's bind pose agree with the skeleton's rest pose? Keys are stored relative to one of them (seed 001);
+//! Does a skin's bind pose agree with the skeleton's rest pose? Keys are stored relative to one of them;
 //! when the two disagree, engines that start from the rest pose and engines that start from the bind pose show
 //! different things. The check names the joints and says by how much.
 //!

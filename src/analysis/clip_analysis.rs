@@ -14,7 +14,7 @@ pub struct BoneSummary {
     pub worst_shear_deg: f64,
     /// When the worst shear happens (the first such time).
     pub worst_shear_time: f64,
-    /// The largest angle of the stretch rotation among stretched samples (see [`Assessment::stretch_deg`]).
+    /// The largest angle of the stretch rotation among stretched samples (see [`super::Assessment::stretch_deg`]).
     pub worst_stretch_deg: f64,
     /// Samples where the bone is stretched.
     pub flagged_samples: usize,

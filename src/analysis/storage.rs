@@ -1,4 +1,4 @@
-//! The seed's stretch-quaternion storage (seed 000) measured on a clip: which bones need the stretch channel, what
+//! Stretch-quaternion storage (`docs/decomposition.md`) measured on a clip: which bones need the stretch channel, what
 //! it costs in bytes, and how far from the evaluated pose a runtime lands with it and without it.
 //!
 //! **What is stored.** At every frame each bone stores its local components as decomp_affine finds them in the
@@ -7,9 +7,10 @@
 //! bone is **marked** when that `L` is stretched at some frame (its stretch rotation `U` is not the identity, with
 //! the scan's tolerances). Components are rounded to `f32`, as stored.
 //!
-//! **What the runtime rebuilds.** `L' = T·R·U·K·Uᵀ` for marked bones (the seed's `InvStr·Scale·Str·Rot·Pos` in its
-//! row-vector order) and `T·R·K` for the others, chained as `W' = W'_parent · L'` (every child inherits its
-//! parent's scale, the seed's default). A TRS-only runtime drops `U` everywhere: `T·R·K` for every bone.
+//! **What the runtime rebuilds.** `L' = T·R·U·K·Uᵀ` for marked bones (in row-vector order: inverse stretch, scale,
+//! stretch, rotation, position) and `T·R·K` for the others, chained as `W' = W'_parent · L'` (every child inherits
+//! its parent's scale, as when no bone is flagged "don't inherit scale"). A TRS-only runtime drops `U` everywhere:
+//! `T·R·K` for every bone.
 //!
 //! **Byte model.** Every bone stores every frame in `f32`: translation 3 + rotation 4 + scale 3 components = 40
 //! bytes a key; a marked bone adds its stretch quaternion, 4 components = 16 bytes a key. No compression, no
@@ -87,7 +88,7 @@ pub struct StorageReport {
     /// With the stretch channel of the marked bones.
     pub bytes_with_stretch: u64,
     pub probe_distance: f64,
-    /// The seed's representation, rebuilt.
+    /// The stretch-quaternion format, rebuilt.
     pub reconstruction: RuntimeError,
     /// A runtime that drops the stretch.
     pub trs_only: RuntimeError,
@@ -96,7 +97,7 @@ pub struct StorageReport {
 /// Frames per parallel work item.
 const CHUNK: usize = 64;
 
-/// Measures the seed's storage on `evaluation` over its whole clip.
+/// Measures the stretch-quaternion storage of `evaluation` over its whole clip.
 pub fn storage_report(evaluation: &Evaluation, options: &StorageOptions) -> StorageReport {
     let rig = evaluation.rig;
     let bones = rig.skeleton.len();

@@ -58,7 +58,8 @@ impl LayersPanel {
         }
     }
 
-    /// The seed's runtime format for the current clip, measured when asked, off the UI thread.
+    /// The stretch-quaternion storage of the current clip (`docs/decomposition.md`), measured when asked, off the UI
+    /// thread.
     fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
         CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
             let doc = &*shared.doc;

@@ -649,7 +649,7 @@ impl BonescopeApp {
         }
     }
 
-    /// Play or pause (see [`timeline::toggle_play`]).
+    /// Play or pause; playing at the end of a clip that does not loop starts it again.
     pub fn toggle_play(&mut self) {
         timeline::toggle_play(&mut self.playing, &mut self.time, self.settings.looping, self.doc.duration());
     }

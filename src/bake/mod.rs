@@ -2,7 +2,7 @@
 //!
 //! A glTF node is translation·rotation·scale, and glTF composes nodes with full inheritance, so a bone whose model
 //! matrix `W` shears under its parent cannot be one node. It can be two. Shoemake's decomposition of the local matrix
-//! a bone needs, `L = W'_parent⁻¹·W = T·R·U·K·Uᵀ` (seed 000: `U` is the "stretch quaternion"), splits as
+//! a bone needs, `L = W'_parent⁻¹·W = T·R·U·K·Uᵀ` (`U` is the stretch rotation, `docs/decomposition.md`), splits as
 //!
 //! ```text
 //! L = (T · (R·U) · K) · (Uᵀ)

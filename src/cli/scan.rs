@@ -66,7 +66,7 @@ pub struct ScanArgs {
         conflicts_with_all = ["inherit", "inherit_bone", "fail_on_stretch"]
     )]
     pub compare_inherit: Option<[ModeChoice; 2]>,
-    /// Instead of the stretched bones, report the seed's stretch-quaternion storage of each clip: the bones that
+    /// Instead of the stretched bones, report each clip's stretch-quaternion storage: the bones that
     /// need a stretch channel, bytes as plain TRS and with it, and the error of rebuilding the matrices with and
     /// without it (at points along each bone's axes and at skinned vertices).
     #[arg(long, conflicts_with_all = ["compare_inherit", "fail_on_stretch"])]

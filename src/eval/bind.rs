@@ -1,4 +1,4 @@
-//! The bind pose (seed 001): where each joint was when the mesh was bound to the skeleton, read back from the
+//! The bind pose: where each joint was when the mesh was bound to the skeleton, read back from the
 //! skin's inverse bind matrices.
 //!
 //! An inverse bind matrix maps model space to the joint's space *in the skin's bind space*, which need not be the

@@ -2,7 +2,8 @@
 //!
 //! Besides its model matrix `W`, every bone gets the matrices its children may need: `U`, the model matrix
 //! without the bone's own scale (ufbx's `unscaled_node_to_world`), `G`, the rigid chain of translations and
-//! rotations only (the seed's first pass), and the scale vectors ufbx carries for componentwise inheritance.
+//! rotations only (the first pass of a two-pass "don't inherit scale"), and the scale vectors ufbx carries for
+//! componentwise inheritance.
 //! They are computed only where some bone needs them, so an all-`full` rig costs one matrix product per bone.
 
 use glam::{DMat4, DVec3};

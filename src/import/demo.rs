@@ -1,6 +1,7 @@
-//! The built-in demo rig: the seed's "picture 5". An arm whose upper bone squashes and stretches along its own
-//! axis while the forearm bends, so under full scale inheritance the forearm and hand shear; a skinned tube makes
-//! the shear visible on a surface. A second clip bends the arm without any stretch.
+//! The built-in demo rig: the shear that translation, rotation and scale cannot hold. An arm whose upper bone
+//! squashes and stretches along its own axis while the forearm bends, so under full scale inheritance the forearm
+//! and hand shear; a skinned tube makes the shear visible on a surface. A second clip bends the arm without any
+//! stretch.
 
 use std::f64::consts::PI;
 use std::sync::Arc;

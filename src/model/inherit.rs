@@ -1,6 +1,7 @@
 //! How a bone combines its parent's model matrix with its own local transform.
 //!
-//! The ids are the ones of `docs/inheritance-modes.md` and are what the command line and the JSON reports use.
+//! The ids are what the command line and the JSON reports use; `docs/inheritance-modes.md` gives the model matrix of
+//! every mode and which setting of which tool each one is.
 
 use std::fmt;
 use std::str::FromStr;
@@ -12,7 +13,8 @@ pub enum InheritMode {
     /// `W = W_p·L`: glTF, FBX RSrs, Blender Full, Unity, Godot, ozz. Shears under a rotated child.
     #[default]
     Full,
-    /// The seed's two-pass "don't inherit scale": `W = G_p·L` with `G` the rigid (T·R only) chain.
+    /// A runtime's two-pass "don't inherit scale" (bone matrices from translations and rotations first, the scale
+    /// added after): `W = G_p·L` with `G` the rigid (T·R only) chain.
     UnscaledParent,
     /// Maya segment scale compensate / FBX Rrs: `W = U_p·T(s_p⊙t)·R·S`.
     SegmentCompensate,

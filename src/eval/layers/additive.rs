@@ -1,4 +1,4 @@
-//! Additive layers (seed 001): a clip stored as its difference from a reference pose, added on top of another.
+//! Additive layers: a clip stored as its difference from a reference pose, added on top of another.
 //!
 //! Rotations do not commute, so the order matters: **local** order `q_base · q_add` turns the bone in its own
 //! frame (what engines do), **global** order `q_add · q_base` turns it in its parent's frame (3ds Max CAT). The

@@ -1,4 +1,4 @@
-//! A crossfade (seed 004): from some time on, the end of the playing clip blends into the start of another over a
+//! A crossfade: from some time on, the end of the playing clip blends into the start of another over a
 //! chosen duration, computed on the fly from both clips (no frames are stored).
 
 /// How the incoming clip's weight rises over the fade.

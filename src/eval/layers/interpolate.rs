@@ -1,5 +1,5 @@
-//! Reading a clip with another interpolation than the authored one (seeds 001, 004): the nearest key (the
-//! "jaggy" playback of seed 004), linear, or cubic; rotations by slerp, nlerp or per-component Euler XYZ angles.
+//! Reading a clip with another interpolation than the authored one: the nearest key (the "jaggy" playback of a
+//! runtime that shows the closest key), linear, or cubic; rotations by slerp, nlerp or per-component Euler XYZ angles.
 //!
 //! Cubic is Catmull-Rom through the keys: between keys `k` and `k + 1` a Hermite segment whose tangent at each key
 //! is the slope to its neighbours, `m_k = (p_{k+1} − p_{k−1}) / (t_{k+1} − t_{k−1})` (one-sided at the ends). With
@@ -9,7 +9,7 @@
 //!
 //! Euler XYZ angles are glam's `EulerRot::XYZ`; each key's angles are moved by whole turns to lie within half a
 //! turn of the previous key's, so the interpolation never spins the long way round one axis (it still does
-//! everything else Euler interpolation is known for: seed 001's video).
+//! everything else Euler interpolation is known for: paths off the great arc, uneven speed, gimbal lock).
 
 use std::f64::consts::TAU;
 

@@ -1,4 +1,4 @@
-//! Runtime techniques layered on a sampled clip, each as a game runtime does it (the seeds in `shared/seeds`):
+//! Runtime techniques layered on a sampled clip, each as a game runtime does it:
 //!
 //! ```text
 //! clip ─sample─▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ targets ─▶ pose
@@ -10,7 +10,7 @@
 //!
 //! [`Layers`] says what to do (serialisable; the default does nothing), [`LayerStack`] holds what it needs prepared
 //! once (bind pose, additive reference, shake modifiers) and the buffers for evaluating any number of times without
-//! allocating. Every step is also a pure function in its own module, tested against the seed's formulas.
+//! allocating. Every step is also a pure function in its own module, tested against the formulas its module states.
 //!
 //! Weights are clamped to `[0, 1]`, NaN counting as 0; clip and bone indices are checked when the stack is built;
 //! a non-finite time counts as 0. Nothing here panics on bad input.
@@ -42,7 +42,7 @@ use crate::model::{Clip, Rig, Skeleton, Transform};
 pub struct Blend {
     /// Index of the clip in the rig.
     pub clip: usize,
-    /// The seed's `a`: 0 is the main clip, 1 this one.
+    /// The blend factor `a`: 0 is the main clip, 1 this one.
     pub weight: f64,
     /// Play both at one normalised time over the blended cycle ([`SyncedCycle`]); else each at its own speed.
     pub sync: bool,
@@ -62,7 +62,7 @@ pub struct Additive {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Layers {
-    /// 1: the clip as sampled; 0: the bind pose (seed 001); between: mixed bone by bone.
+    /// 1: the clip as sampled; 0: the bind pose (`eval::bind`); between: mixed bone by bone.
     pub bind_weight: f64,
     /// How every clip a layer reads is sampled.
     pub interpolation: Resampling,

@@ -1,7 +1,7 @@
-//! Procedural shake (seed 004): a cosine wobble added to a bone and, growing level by level, to the bones below it
+//! Procedural shake: a cosine wobble added to a bone and, growing level by level, to the bones below it
 //! (the snowboarder's arms shaking on harsh snow).
 //!
-//! The seed's recipe, in its own names: `factor = cos(time·speed)·amplitude`; a bone modifier that starts at 1 on
+//! The recipe, with its parameters' names: `factor = cos(time·speed)·amplitude`; a bone modifier that starts at 1 on
 //! the chosen bone and grows by `attenuation` for every hierarchy level below it (while above 0.1, never below
 //! 0); `factor·modifier·(1 − fade)` scales a translation `(transx, transy, transz)` and a rotation of
 //! `(rotx, roty, rotz)` radians (Euler XYZ). Here the translation is added to the bone's local translation (in its
@@ -11,7 +11,8 @@ use glam::{DQuat, DVec3, EulerRot};
 
 use crate::model::{Skeleton, Transform};
 
-/// The seed's parameters (`m_fAnimProcedural*`), with its defaults.
+/// The shake's parameters, with the recipe's defaults: speed 40, amplitude 0.3, attenuation 0.3, translation
+/// (0, 1, 0), rotation (0, 0.1, 0) radians, fade 0.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct ShakeParams {
@@ -24,7 +25,7 @@ pub struct ShakeParams {
     pub translation: DVec3,
     /// `(rotx, roty, rotz)`, radians.
     pub rotation: DVec3,
-    /// 0: full shake; 1: none (the seed's runtime fade in/out).
+    /// 0: full shake; 1: none (what a runtime moves to fade the shake in and out).
     pub fade: f64,
 }
 
@@ -41,13 +42,13 @@ impl Default for ShakeParams {
     }
 }
 
-/// A parameter name that is not one of the seed's.
+/// A parameter name that is not one of [`ShakeParams::NAMES`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("no shake parameter `{0}` (known: {names})", names = ShakeParams::NAMES.join(", "))]
 pub struct UnknownShakeParam(pub String);
 
 impl ShakeParams {
-    /// The names [`ShakeParams::set`] knows, the seed's member names without `m_fAnimProcedural`.
+    /// The names [`ShakeParams::set`] knows, the recipe's own.
     pub const NAMES: [&str; 10] =
         ["speed", "amplitude", "attenuation", "transx", "transy", "transz", "rotx", "roty", "rotz", "fade"];
 
@@ -83,7 +84,7 @@ pub struct Shake {
     pub params: ShakeParams,
 }
 
-/// The seed's bone modifier of every bone: 1 on `bone`, then per level below it `m + attenuation` while `m > 0.1`,
+/// The bone modifier of every bone: 1 on `bone`, then per level below it `m + attenuation` while `m > 0.1`,
 /// never below 0; 0 outside `bone`'s subtree.
 pub fn bone_modifiers(skeleton: &Skeleton, bone: usize, attenuation: f64) -> Vec<f64> {
     let mut modifiers: Vec<Option<f64>> = Vec::with_capacity(skeleton.len());

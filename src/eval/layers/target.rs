@@ -1,7 +1,7 @@
-//! World-space targets (seed 003): a bone pinned to a model-space rotation, as a ragdoll's physics or a hand on a
+//! World-space targets: a bone pinned to a model-space rotation, as a ragdoll's physics or a hand on a
 //! ledge asks, by setting its local rotation to `inverse(parent model rotation) · target`.
 //!
-//! The parent's model rotation is that of the rigid chain of local rotations from the root (the seed's joint
+//! The parent's model rotation is that of the rigid chain of local rotations from the root (the joints' rotation
 //! quaternions; scale plays no part), with every target above it already applied. A weight tweens between the
 //! animated rotation (0) and the target (1) by slerp, so a bone can move in and out of the constraint.
 

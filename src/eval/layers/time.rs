@@ -1,9 +1,9 @@
-//! Time: 3ds Max's ticks, and the seed's sync of two cycles of different lengths (seed 001).
+//! Time: 3ds Max's ticks, and the sync of two cycles of different lengths (a walk blended with a run).
 
-/// 3ds Max's time unit: 1/4800 s, a multiple of the frame periods at 24, 25, 30, 50 and 60 fps (seed 004).
+/// 3ds Max's time unit: 1/4800 s, so that the frame periods at 24, 25, 30, 50 and 60 fps are whole numbers of ticks.
 pub const TICKS_PER_SECOND: f64 = 4800.0;
 
-/// Two cycles played at one normalised time, the seed's walk–run blend: with clip lengths `T1`, `T2` and blend
+/// Two cycles played at one normalised time, as a walk–run blend plays them: with clip lengths `T1`, `T2` and blend
 /// factor `a`, the blended cycle lasts `(T2 − T1)·a + T1` and the clips play at rates `T1/len` and `T2/len`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SyncedCycle {
@@ -31,8 +31,8 @@ impl SyncedCycle {
     }
 
     /// The time of each clip at blended time `time`: the same phase of both, i.e. `rate · time` within a cycle.
-    /// (The seed sets the second clip's normalised time to the first's rather than trusting two rates to stay in
-    /// step; so does this.)
+    /// (The second clip's normalised time is set to the first's rather than trusting two rates to stay in step,
+    /// which rounding would break over many cycles.)
     pub fn clip_times(&self, time: f64) -> [f64; 2] {
         let phase = self.phase(time);
         self.durations.map(|t| phase * t)
