@@ -605,3 +605,15 @@ fn comparisons_and_storage_reports_come_as_junit_too() {
         assert_eq!((count("testcase"), count("failure"), count("system-out")), (1, 0, 1), "{mode:?}");
     }
 }
+
+/// A build without the `gui` feature (`--no-default-features`) has every other command and says what it lacks.
+#[cfg(not(feature = "gui"))]
+#[test]
+fn without_the_gui_the_app_and_render_say_they_need_it() {
+    for args in [vec![], vec!["render", "--out", "x.png"]] {
+        let run = bonescope(&args);
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(stderr.contains("needs the `gui` feature") && stderr.lines().count() == 1, "{stderr}");
+    }
+}

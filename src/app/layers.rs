@@ -5,7 +5,6 @@
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
 //! reported, not applied).
 
-use clap::ValueEnum;
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
@@ -15,7 +14,7 @@ use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{BindMismatch, BindTolerance, bind_mismatches};
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
 use crate::eval::{Hierarchy, Layers};
-use crate::model::{InheritMode, Rig, Skeleton, Transform};
+use crate::model::{Choice, InheritMode, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
 /// The panel's own state: results computed on request, kept while they still describe the document.
@@ -323,16 +322,16 @@ fn clip_combo(ui: &mut Ui, label: &str, rig: &Rig, clip: &mut usize) {
     });
 }
 
-/// A combo box over the values of one of the library's option enums, named as the command line names them.
-fn value_combo<T: ValueEnum + PartialEq + Copy>(ui: &mut Ui, label: &str, value: &mut T) -> egui::Response {
-    let name = |v: &T| v.to_possible_value().map_or_else(String::new, |p| p.get_name().to_owned());
+/// A combo box over the values of one of the library's options, named as the command line names them and described
+/// on hover.
+fn value_combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T) -> egui::Response {
     ui.horizontal(|ui| {
         let label = ui.label(label);
         egui::ComboBox::from_id_salt(("layer-option", label.id))
-            .selected_text(name(value))
+            .selected_text(value.id())
             .show_ui(ui, |ui| {
-                for v in T::value_variants() {
-                    ui.selectable_value(value, *v, name(v));
+                for &v in T::ALL {
+                    ui.selectable_value(value, v, v.id()).on_hover_text(v.description());
                 }
             })
             .response

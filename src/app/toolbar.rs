@@ -7,6 +7,7 @@ use egui::RichText;
 use super::{Ghost, ModeChoice, ModeScope, Shared};
 use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
+use crate::model::Choice;
 
 /// What the toolbar asks the app to do after the frame (things that replace the document).
 #[derive(Default)]
@@ -197,7 +198,7 @@ fn skinning_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     egui::ComboBox::from_id_salt("skinning")
         .selected_text(skinning.label())
         .show_ui(ui, |ui| {
-            for method in SkinningMethod::ALL {
+            for &method in SkinningMethod::ALL {
                 ui.selectable_value(skinning, method, method.label());
             }
         })

@@ -42,10 +42,10 @@ use rayon::prelude::*;
 use refine::refine;
 
 use crate::eval::Evaluation;
-use crate::model::{Clip, Rig};
+use crate::model::{Choice, Clip, Rig};
 
 /// How bones become glTF nodes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Strategy {
     /// A helper node above every bone that needs its stretch rotation: exact.
@@ -53,6 +53,26 @@ pub enum Strategy {
     Exact,
     /// One TRS node per bone, re-solved against its baked parent: for runtimes that cannot shear.
     Trs,
+}
+
+impl Choice for Strategy {
+    const ALL: &'static [Strategy] = &[Strategy::Exact, Strategy::Trs];
+
+    fn id(self) -> &'static str {
+        match self {
+            Strategy::Exact => "exact",
+            Strategy::Trs => "trs",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            Strategy::Exact => "a helper node above every bone that needs its stretch rotation: exact",
+            Strategy::Trs => {
+                "one TRS node per bone, re-solved against its baked parent: for runtimes that cannot shear"
+            }
+        }
+    }
 }
 
 /// The default tolerance: keys reproduce the source within this fraction of the rig's size.

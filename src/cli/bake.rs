@@ -7,11 +7,13 @@ use anyhow::{Context, bail};
 use clap::Args;
 
 use super::layers::LayerArgs;
+use super::options::choice;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
+use crate::model::Choice;
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
@@ -24,7 +26,7 @@ pub struct BakeArgs {
     pub out: PathBuf,
     /// exact: a helper node `<bone>.stretch` above each bone that needs its stretch rotation; trs: one TRS node per
     /// bone, the closest to what it needs (for runtimes that cannot shear).
-    #[arg(long, value_enum, default_value_t)]
+    #[arg(long, value_parser = choice::<Strategy>(), default_value = Strategy::default().id())]
     pub strategy: Strategy,
     /// Between keys the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     #[arg(long, value_name = "FRACTION", default_value_t = bake::DEFAULT_TOLERANCE)]

@@ -8,9 +8,11 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
+use super::options::choice;
 use crate::eval::{Evaluation, SkinningMethod};
 use crate::export::{EvaluatedMesh, write_obj};
 use crate::import::{self, Options, Space};
+use crate::model::Choice;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum ExportFormat {
@@ -32,7 +34,7 @@ pub struct ExportArgs {
     pub format: ExportFormat,
     /// How meshes are skinned: as the file declares (FBX: linear, dual quaternion or a per-vertex blend), or one
     /// method everywhere.
-    #[arg(long, value_enum, default_value_t)]
+    #[arg(long, value_parser = choice::<SkinningMethod>(), default_value = SkinningMethod::default().id())]
     pub skinning: SkinningMethod,
     /// Where to write.
     #[arg(long, value_name = "PATH")]

@@ -5,12 +5,12 @@ use anyhow::{Context, anyhow, bail};
 use clap::Args;
 use glam::DQuat;
 
-use super::options::find_clip;
+use super::options::{choice, find_clip};
 use crate::eval::layers::{
     Additive, AdditiveOrder, AdditiveReference, Blend, Crossfade, FadeCurve, KeyInterpolation, Layers, Resampling,
     RotationBlend, RotationInterpolation, Shake, ShakeParams, Target,
 };
-use crate::model::Rig;
+use crate::model::{Choice, Rig};
 
 /// Runtime techniques layered on the animation, applied in this order: bind weight, interpolation, blend,
 /// additive, crossfade, shake, targets.
@@ -20,10 +20,10 @@ pub struct LayerArgs {
     #[arg(long, value_name = "W")]
     pub bind_weight: Option<f64>,
     /// Read every animation with this interpolation instead of the file's (cubic: Catmull-Rom through the keys).
-    #[arg(long, value_enum, value_name = "MODE", default_value_t)]
+    #[arg(long, value_parser = choice::<KeyInterpolation>(), value_name = "MODE", default_value = KeyInterpolation::default().id())]
     pub interp: KeyInterpolation,
     /// How rotation keys are interpolated (euler: per-component Euler XYZ angles).
-    #[arg(long, value_enum, value_name = "MODE", default_value_t)]
+    #[arg(long, value_parser = choice::<RotationInterpolation>(), value_name = "MODE", default_value = RotationInterpolation::default().id())]
     pub rot_interp: RotationInterpolation,
     /// Blend a second animation (name or index) with the main one.
     #[arg(long, value_name = "NAME|INDEX", requires = "weight")]
@@ -36,16 +36,16 @@ pub struct LayerArgs {
     #[arg(long, requires = "blend")]
     pub sync: bool,
     /// How the blend mixes rotations.
-    #[arg(long, value_enum, value_name = "MODE", requires = "blend")]
+    #[arg(long, value_parser = choice::<RotationBlend>(), value_name = "MODE", requires = "blend")]
     pub blend_rotation: Option<RotationBlend>,
     /// Add an additive animation (name or index): its difference from a reference pose.
     #[arg(long, value_name = "NAME|INDEX")]
     pub additive: Option<String>,
     /// The pose the additive animation is the difference from: its first frame or the rest pose.
-    #[arg(long, value_enum, value_name = "REF", requires = "additive")]
+    #[arg(long, value_parser = choice::<AdditiveReference>(), value_name = "REF", requires = "additive")]
     pub additive_ref: Option<AdditiveReference>,
     /// local: q_base·q_add (in the bone's frame); global: q_add·q_base (in the parent's frame).
-    #[arg(long, value_enum, value_name = "ORDER", requires = "additive")]
+    #[arg(long, value_parser = choice::<AdditiveOrder>(), value_name = "ORDER", requires = "additive")]
     pub additive_order: Option<AdditiveOrder>,
     /// How much of the additive animation to add (default 1).
     #[arg(long, value_name = "W", requires = "additive")]
@@ -60,7 +60,7 @@ pub struct LayerArgs {
     #[arg(long, value_name = "SECONDS", requires = "crossfade")]
     pub crossfade_duration: Option<f64>,
     /// How the incoming animation's weight rises.
-    #[arg(long, value_enum, value_name = "CURVE", requires = "crossfade")]
+    #[arg(long, value_parser = choice::<FadeCurve>(), value_name = "CURVE", requires = "crossfade")]
     pub crossfade_curve: Option<FadeCurve>,
     /// Shake this bone and, growing per level, the bones below it: factor = cos(time·speed)·amplitude.
     #[arg(long, value_name = "BONE")]

@@ -12,6 +12,7 @@ mod export;
 mod inspect;
 mod layers;
 mod options;
+#[cfg(feature = "gui")]
 mod render;
 mod report;
 mod scan;
@@ -52,8 +53,20 @@ pub enum Command {
     /// Compare two evaluations (two files, or one under two sets of modes) over time, bone by bone.
     Diff(diff::DiffArgs),
     /// Render the viewport (or the whole window) to PNG without a display, optionally checked against a reference.
+    #[cfg(feature = "gui")]
     Render(render::RenderArgs),
+    /// Render the viewport to PNG (needs the `gui` feature, which this build was made without).
+    #[cfg(not(feature = "gui"))]
+    Render {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+        args: Vec<std::ffi::OsString>,
+    },
 }
+
+/// What a build without the `gui` feature says of what needs it.
+#[cfg(not(feature = "gui"))]
+const NEEDS_GUI: &str = "needs the `gui` feature: install bonescope with its default features \
+    (cargo install --locked bonescope), not --no-default-features";
 
 /// Parses the process arguments and runs the command.
 pub fn main() -> ExitCode {
@@ -63,10 +76,16 @@ pub fn main() -> ExitCode {
         Some(Command::Scan(args)) => scan::run(&args),
         Some(Command::Report(args)) => report::run(&args),
         Some(Command::Export(args)) => export::run(&args),
+        #[cfg(feature = "gui")]
         Some(Command::Render(args)) => render::run(&args),
+        #[cfg(not(feature = "gui"))]
+        Some(Command::Render { .. }) => Err(anyhow::anyhow!("render {NEEDS_GUI}")),
         Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::Diff(args)) => diff::run(&args),
+        #[cfg(feature = "gui")]
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
+        #[cfg(not(feature = "gui"))]
+        None => Err(anyhow::anyhow!("the desktop app {NEEDS_GUI}; the commands are listed by --help")),
     };
     match result {
         Ok(code) => code,

@@ -1,10 +1,11 @@
 //! Options shared by several commands, defined once.
 
 use anyhow::{Context, anyhow, bail};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, ValueEnum};
 
 use crate::analysis::Tolerances;
-use crate::model::{Clip, InheritMode, ModeChoice, Rig};
+use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -13,6 +14,13 @@ pub enum Format {
     Table,
     /// One JSON document on standard output.
     Json,
+}
+
+/// The parser of one of the library's [`Choice`]s: its ids, each listed in `--help` with its description.
+pub fn choice<T: Choice>() -> impl TypedValueParser<Value = T> {
+    let values = T::ALL.iter().map(|v| PossibleValue::new(v.id()).help(v.description()));
+    // Clap lets through only the ids listed, each of which is a value's.
+    PossibleValuesParser::new(values).map(|id| T::from_id(&id).expect("an id of a listed value"))
 }
 
 /// Which clip, and which inheritance modes.
@@ -118,5 +126,43 @@ impl ToleranceArgs {
             min_shear_deg: self.min_shear_deg,
             ..Tolerances::default()
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::builder::TypedValueParser;
+
+    use super::*;
+    use crate::bake::Strategy;
+    use crate::eval::SkinningMethod;
+    use crate::eval::layers::{
+        AdditiveOrder, AdditiveReference, FadeCurve, KeyInterpolation, RotationBlend, RotationInterpolation,
+    };
+
+    /// Every value of `T` parses from its id on the command line, its id is what the JSON reports write, and its
+    /// help says something; anything else is refused.
+    fn parses_by_id<T: Choice + serde::Serialize + std::fmt::Debug>() {
+        let command = clap::Command::new("test");
+        let parser = choice::<T>();
+        for &value in T::ALL {
+            let parsed = parser.parse_ref(&command, None, std::ffi::OsStr::new(value.id())).unwrap();
+            assert_eq!(parsed, value);
+            assert_eq!(serde_json::to_string(&value).unwrap(), format!("\"{}\"", value.id()));
+            assert!(!value.description().is_empty(), "{value:?}");
+        }
+        assert!(parser.parse_ref(&command, None, std::ffi::OsStr::new("sideways")).is_err());
+    }
+
+    #[test]
+    fn every_choice_parses_by_the_id_its_reports_write() {
+        parses_by_id::<Strategy>();
+        parses_by_id::<SkinningMethod>();
+        parses_by_id::<KeyInterpolation>();
+        parses_by_id::<RotationInterpolation>();
+        parses_by_id::<RotationBlend>();
+        parses_by_id::<AdditiveReference>();
+        parses_by_id::<AdditiveOrder>();
+        parses_by_id::<FadeCurve>();
     }
 }

@@ -9,9 +9,11 @@ use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
 use super::layers::LayerArgs;
+use super::options::choice;
 use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Settings};
 use crate::eval::SkinningMethod;
 use crate::import;
+use crate::model::Choice;
 use crate::render::{Background, Difference, Renderer, compare};
 use crate::view::{SceneOptions, ViewKind};
 
@@ -55,7 +57,7 @@ pub struct RenderArgs {
     pub show: Option<SceneOptions>,
     /// How meshes are skinned: as the file declares (FBX: linear, dual quaternion or a per-vertex blend), or one
     /// method everywhere.
-    #[arg(long, value_enum, default_value_t)]
+    #[arg(long, value_parser = choice::<SkinningMethod>(), default_value = SkinningMethod::default().id())]
     pub skinning: SkinningMethod,
     /// The 3D camera: yaw and pitch in degrees, distance in model units (default: frames the whole animation).
     #[arg(long, value_name = "YAW,PITCH,DISTANCE", allow_hyphen_values = true, value_parser = parse_camera)]

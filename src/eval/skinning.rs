@@ -19,10 +19,10 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::MorphPose;
 use crate::math::decompose;
-use crate::model::{Mesh, Rig, Skin};
+use crate::model::{Choice, Mesh, Rig, Skin};
 
 /// Which skinning to use: the file's (per skin and vertex), or one of them everywhere (engines differ).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// What the file declares: linear, dual quaternion, or a per-vertex blend of both.
@@ -32,9 +32,27 @@ pub enum Method {
     DualQuaternion,
 }
 
-impl Method {
-    pub const ALL: [Method; 3] = [Method::AsFile, Method::Linear, Method::DualQuaternion];
+impl Choice for Method {
+    const ALL: &'static [Method] = &[Method::AsFile, Method::Linear, Method::DualQuaternion];
 
+    fn id(self) -> &'static str {
+        match self {
+            Method::AsFile => "as-file",
+            Method::Linear => "linear",
+            Method::DualQuaternion => "dual-quaternion",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            Method::AsFile => "what the file declares: linear, dual quaternion, or a per-vertex blend of both",
+            Method::Linear => "linear blend skinning everywhere",
+            Method::DualQuaternion => "dual quaternion skinning everywhere",
+        }
+    }
+}
+
+impl Method {
     pub fn label(self) -> &'static str {
         match self {
             Method::AsFile => "as the file says",

@@ -18,18 +18,3 @@ pub trait Choice: Copy + PartialEq + Send + Sync + 'static {
         Self::ALL.iter().copied().find(|v| v.id() == id)
     }
 }
-
-#[cfg(test)]
-pub(crate) mod tests {
-    use super::Choice;
-
-    /// Every value of `T` round-trips through its id, and its id is what serde writes.
-    pub fn ids_round_trip<T: Choice + serde::Serialize + std::fmt::Debug>() {
-        for &value in T::ALL {
-            assert_eq!(T::from_id(value.id()), Some(value));
-            assert_eq!(serde_json::to_string(&value).unwrap(), format!("\"{}\"", value.id()), "{value:?}");
-            assert!(!value.description().is_empty(), "{value:?}");
-        }
-        assert_eq!(T::from_id("no such value"), None);
-    }
-}

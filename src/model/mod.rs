@@ -1,5 +1,6 @@
 //! The loaded document: skeleton, clips, skins and meshes, independent of the file format they came from.
 
+mod choice;
 mod clip;
 mod inherit;
 mod skeleton;
@@ -7,6 +8,7 @@ mod skin;
 mod timeline;
 mod transform;
 
+pub use choice::Choice;
 pub use clip::{
     BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
 };

@@ -8,10 +8,10 @@
 use glam::{DQuat, DVec3};
 
 use crate::math::slerp;
-use crate::model::Transform;
+use crate::model::{Choice, Transform};
 
 /// The pose the additive clip is the difference from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AdditiveReference {
     /// The additive clip's own first frame (at t = 0).
@@ -21,8 +21,26 @@ pub enum AdditiveReference {
     Rest,
 }
 
+impl Choice for AdditiveReference {
+    const ALL: &'static [AdditiveReference] = &[AdditiveReference::First, AdditiveReference::Rest];
+
+    fn id(self) -> &'static str {
+        match self {
+            AdditiveReference::First => "first",
+            AdditiveReference::Rest => "rest",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            AdditiveReference::First => "the additive clip's own first frame (at t = 0)",
+            AdditiveReference::Rest => "the skeleton's rest pose",
+        }
+    }
+}
+
 /// The side of the base rotation the additive rotation goes on.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AdditiveOrder {
     /// `q_base · q_add`: in the bone's own frame.
@@ -30,6 +48,24 @@ pub enum AdditiveOrder {
     Local,
     /// `q_add · q_base`: in the parent's frame.
     Global,
+}
+
+impl Choice for AdditiveOrder {
+    const ALL: &'static [AdditiveOrder] = &[AdditiveOrder::Local, AdditiveOrder::Global];
+
+    fn id(self) -> &'static str {
+        match self {
+            AdditiveOrder::Local => "local",
+            AdditiveOrder::Global => "global",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            AdditiveOrder::Local => "q_base · q_add: in the bone's own frame",
+            AdditiveOrder::Global => "q_add · q_base: in the parent's frame",
+        }
+    }
 }
 
 /// What `sample` adds to `reference`: rotation `q_ref⁻¹·q` (local) or `q·q_ref⁻¹` (global), translation

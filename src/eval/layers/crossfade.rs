@@ -1,8 +1,10 @@
 //! A crossfade: from some time on, the end of the playing clip blends into the start of another over a
 //! chosen duration, computed on the fly from both clips (no frames are stored).
 
+use crate::model::Choice;
+
 /// How the incoming clip's weight rises over the fade.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FadeCurve {
     /// Constant speed: the weight is the fraction of the fade done.
@@ -10,6 +12,24 @@ pub enum FadeCurve {
     Linear,
     /// Smoothstep `3s² − 2s³`: starts and ends without a jump in speed.
     Smooth,
+}
+
+impl Choice for FadeCurve {
+    const ALL: &'static [FadeCurve] = &[FadeCurve::Linear, FadeCurve::Smooth];
+
+    fn id(self) -> &'static str {
+        match self {
+            FadeCurve::Linear => "linear",
+            FadeCurve::Smooth => "smooth",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            FadeCurve::Linear => "constant speed: the weight is the fraction of the fade done",
+            FadeCurve::Smooth => "smoothstep 3s² − 2s³: starts and ends without a jump in speed",
+        }
+    }
 }
 
 impl FadeCurve {

@@ -17,10 +17,10 @@ use glam::{DQuat, DVec3, EulerRot, Quat, Vec3};
 
 use super::super::sample::{Interpolate, Span, TrackSampler, hermite_basis, key_value, sample_track_near};
 use crate::math::{nlerp, slerp};
-use crate::model::{Interpolation, Track};
+use crate::model::{Choice, Interpolation, Track};
 
 /// Which values between keys.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum KeyInterpolation {
     /// As the file says.
@@ -33,8 +33,31 @@ pub enum KeyInterpolation {
     Cubic,
 }
 
+impl Choice for KeyInterpolation {
+    const ALL: &'static [KeyInterpolation] =
+        &[KeyInterpolation::Authored, KeyInterpolation::Nearest, KeyInterpolation::Linear, KeyInterpolation::Cubic];
+
+    fn id(self) -> &'static str {
+        match self {
+            KeyInterpolation::Authored => "authored",
+            KeyInterpolation::Nearest => "nearest",
+            KeyInterpolation::Linear => "linear",
+            KeyInterpolation::Cubic => "cubic",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            KeyInterpolation::Authored => "as the file says",
+            KeyInterpolation::Nearest => "the key closest in time (the later one at exactly half way)",
+            KeyInterpolation::Linear => "straight lines between keys",
+            KeyInterpolation::Cubic => "Catmull-Rom through the keys (a cubic-spline track keeps its own tangents)",
+        }
+    }
+}
+
 /// How rotation keys are interpolated wherever keys are mixed linearly (authored linear tracks included).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RotationInterpolation {
     /// What glTF specifies for linear rotation tracks.
@@ -43,6 +66,27 @@ pub enum RotationInterpolation {
     Nlerp,
     /// Per-component Euler XYZ angles.
     Euler,
+}
+
+impl Choice for RotationInterpolation {
+    const ALL: &'static [RotationInterpolation] =
+        &[RotationInterpolation::Slerp, RotationInterpolation::Nlerp, RotationInterpolation::Euler];
+
+    fn id(self) -> &'static str {
+        match self {
+            RotationInterpolation::Slerp => "slerp",
+            RotationInterpolation::Nlerp => "nlerp",
+            RotationInterpolation::Euler => "euler",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            RotationInterpolation::Slerp => "constant angular speed (what glTF specifies for linear rotation tracks)",
+            RotationInterpolation::Nlerp => "quaternion components mixed, then normalised",
+            RotationInterpolation::Euler => "per-component Euler XYZ angles",
+        }
+    }
 }
 
 /// An interpolation override for every track of a clip. The default reads every track as authored.

@@ -4,16 +4,34 @@
 use glam::DQuat;
 
 use crate::math::{nlerp, slerp};
-use crate::model::Transform;
+use crate::model::{Choice, Transform};
 
 /// How rotations are mixed: slerp (constant angular speed) or nlerp (cheaper, speeds up mid-way); both take the
 /// shortest path.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RotationBlend {
     #[default]
     Slerp,
     Nlerp,
+}
+
+impl Choice for RotationBlend {
+    const ALL: &'static [RotationBlend] = &[RotationBlend::Slerp, RotationBlend::Nlerp];
+
+    fn id(self) -> &'static str {
+        match self {
+            RotationBlend::Slerp => "slerp",
+            RotationBlend::Nlerp => "nlerp",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            RotationBlend::Slerp => "constant angular speed",
+            RotationBlend::Nlerp => "quaternion components mixed, then normalised",
+        }
+    }
 }
 
 impl RotationBlend {
