@@ -162,11 +162,21 @@ fn a_broken_file_is_one_line_naming_it_and_exit_2() {
 #[test]
 fn scan_exit_codes() {
     assert_eq!(bonescope(&["scan", &stretchy()]).status.code(), Some(0));
+    assert_eq!(bonescope(&["scan", &stretchy(), "--fail-above"]).status.code(), Some(1));
+    // The gate's angle: the worst shear of any stretched bone, read from the report, passes at itself and fails
+    // just below; the old spelling is the gate at 0°.
+    let report = json(&bonescope(&["scan", &stretchy(), "--format", "json"]));
+    let shears = report[0]["animations"].as_array().unwrap().iter().flat_map(|a| a["stretched"].as_array().unwrap());
+    let worst = shears.map(|b| b["worst_shear_deg"].as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(worst > 1.0, "{worst}");
+    let gate = |limit: f64| bonescope(&["scan", &stretchy(), "--fail-above", &limit.to_string()]).status.code();
+    assert_eq!((gate(worst), gate(0.999 * worst)), (Some(0), Some(1)));
     assert_eq!(bonescope(&["scan", &stretchy(), "--fail-on-stretch"]).status.code(), Some(1));
-    let compensated = bonescope(&["scan", &stretchy(), "--fail-on-stretch", "--inherit", "segment-compensate"]);
+    assert_eq!(bonescope(&["scan", &stretchy(), "--fail-above", "-1"]).status.code(), Some(2), "no negative angle");
+    let compensated = bonescope(&["scan", &stretchy(), "--fail-above", "--inherit", "segment-compensate"]);
     assert_eq!(compensated.status.code(), Some(0));
     let fox = asset("gltf-khronos/Fox.glb").display().to_string();
-    assert_eq!(bonescope(&["scan", &fox, "--fail-on-stretch"]).status.code(), Some(0));
+    assert_eq!(bonescope(&["scan", &fox, "--fail-above"]).status.code(), Some(0));
     // A missing file: exit 2, but the loadable file is still reported.
     let out = bonescope(&["scan", "no-such-file.glb", &stretchy(), "--format", "json"]);
     assert_eq!(out.status.code(), Some(2));
@@ -568,7 +578,7 @@ fn report_merges_the_shards_json_lines_into_the_whole_scan() {
     let whole = json(&bonescope(&["scan", &folder, "--include", "*.glb", "--format", "json"]));
     let merged = json(&bonescope(&["report", &shards[0], &shards[1], "--format", "json"]));
     assert_eq!(merged, whole, "the shards' reports, merged, are the whole scan's");
-    let gate = bonescope(&["report", &shards[0], &shards[1], "--fail-on-stretch"]);
+    let gate = bonescope(&["report", &shards[0], &shards[1], "--fail-above"]);
     assert_eq!(gate.status.code(), Some(1), "stretchy_full.glb has stretched bones");
     std::fs::write(dir.path().join("bad.jsonl"), "not json\n").unwrap();
     let bad = bonescope(&["report", &dir.path().join("bad.jsonl").display().to_string()]);
@@ -581,7 +591,7 @@ fn report_merges_the_shards_json_lines_into_the_whole_scan() {
 fn the_ci_examples_use_real_options() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/examples");
     for (file, options) in [
-        ("github-actions-scan.yml", &["--include", "--shard", "--format", "--progress", "--fail-on-stretch"][..]),
+        ("github-actions-scan.yml", &["--include", "--shard", "--format", "--progress", "--fail-above"][..]),
         ("kubernetes-indexed-job.yaml", &["--shard", "--format", "--progress"][..]),
     ] {
         let text = std::fs::read_to_string(root.join(file)).unwrap();

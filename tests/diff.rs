@@ -157,7 +157,7 @@ fn bake_gates_on_the_largest_error_and_writes_the_file_anyway() {
     let file = path(&asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx"));
     let bake = |limit: &str| {
         let args =
-            ["bake", &file, "--strategy", "trs", "--inherit", "unscaled-parent", "--out", &out, "--max-error", limit];
+            ["bake", &file, "--strategy", "trs", "--inherit", "unscaled-parent", "--out", &out, "--fail-above", limit];
         bonescope(&args)
     };
     let strict = bake("1e-9");

@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 
 use super::layers::LayerArgs;
-use super::options::choice;
+use super::options::{Distance, choice, parse_distance};
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
@@ -33,41 +33,12 @@ pub struct BakeArgs {
     pub tolerance: f64,
     /// Exit with status 1 when any probe point or vertex is farther than this from the source: a distance in model
     /// units (metres), or a percentage of the rig's size (`0.01%`).
-    #[arg(long, value_name = "D", value_parser = parse_distance)]
-    pub max_error: Option<Distance>,
+    #[arg(long, value_name = "D", value_parser = parse_distance, alias = "max-error")]
+    pub fail_above: Option<Distance>,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
     #[command(flatten)]
     pub layers: LayerArgs,
-}
-
-/// A distance in model units or relative to the rig's size.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Distance {
-    Units(f64),
-    Percent(f64),
-}
-
-impl Distance {
-    pub fn units(self, rig_size: f64) -> f64 {
-        match self {
-            Distance::Units(d) => d,
-            Distance::Percent(p) => p / 100.0 * rig_size,
-        }
-    }
-}
-
-pub fn parse_distance(s: &str) -> Result<Distance, String> {
-    let (number, percent) = match s.trim().strip_suffix('%') {
-        Some(number) => (number, true),
-        None => (s.trim(), false),
-    };
-    let value: f64 =
-        number.trim().parse().map_err(|_| format!("`{s}` is not a distance (a number, or a number and %)"))?;
-    if !(value.is_finite() && value >= 0.0) {
-        return Err(format!("the distance must be finite and ≥ 0, got `{s}`"));
-    }
-    Ok(if percent { Distance::Percent(value) } else { Distance::Units(value) })
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
@@ -107,7 +78,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
         Format::Table => print!("{}", render_table(args, &report, baked.glb.len())),
     }
     let worst = report.worst();
-    let over = args.max_error.is_some_and(|limit| worst.max > limit.units(report.rig_size));
+    let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));
     Ok(if over { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::Args;
 
 use super::Format;
-use super::bake::{Distance, parse_distance};
+use super::options::{Distance, parse_assignment, parse_distance, parse_rate};
 
 use super::table::{Table, mesh_differences};
 use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
@@ -34,10 +34,10 @@ pub struct DiffArgs {
     pub inherit_b: ModeChoice,
     /// Pair a bone of the first file with one of the second explicitly (repeatable); the rest pair by name, exactly,
     /// then ignoring case and namespace prefixes such as `mixamorig:` or `Armature|`.
-    #[arg(long = "map", value_name = "A=B", value_parser = parse_pair)]
+    #[arg(long = "map", value_name = "A=B", value_parser = parse_assignment)]
     pub map: Vec<(String, String)>,
     /// Samples per second over the shorter clip, on top of both files' key times.
-    #[arg(long, value_name = "HZ", default_value_t = 60.0)]
+    #[arg(long, value_name = "HZ", default_value_t = 60.0, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
@@ -47,15 +47,7 @@ pub struct DiffArgs {
     pub fail_above: Option<Distance>,
 }
 
-fn parse_pair(s: &str) -> Result<(String, String), String> {
-    let (a, b) = s.split_once('=').ok_or_else(|| format!("expected A=B, got `{s}`"))?;
-    Ok((a.to_owned(), b.to_owned()))
-}
-
 pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
-    if !(args.rate.is_finite() && args.rate >= 0.0) {
-        anyhow::bail!("--rate must be a finite number of samples per second ≥ 0, got {}", args.rate);
-    }
     let (rig_a, rig_b) = (import::load(&args.a)?, import::load(&args.b)?);
     let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
     let b = side(&args.b, &rig_b, args.inherit_b, &args.anim_b);

@@ -49,8 +49,59 @@ pub fn find_clip<'a>(rig: &'a Rig, name: &str) -> anyhow::Result<&'a Clip> {
 }
 
 fn parse_bone_mode(s: &str) -> Result<(String, InheritMode), String> {
-    let (name, mode) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=MODE, got `{s}`"))?;
-    Ok((name.to_owned(), mode.parse().map_err(|e| format!("{e}"))?))
+    let (name, mode) = parse_assignment(s)?;
+    Ok((name, mode.parse().map_err(|e| format!("{e}"))?))
+}
+
+/// `NAME=VALUE` (split at the last `=`: names from files may hold one, values do not).
+pub fn parse_assignment(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s.rsplit_once('=').ok_or_else(|| format!("expected NAME=VALUE, got `{s}`"))?;
+    Ok((name.to_owned(), value.to_owned()))
+}
+
+/// An angle in degrees: a finite number ≥ 0.
+pub fn parse_angle(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(angle) if angle.is_finite() && angle >= 0.0 => Ok(angle),
+        _ => Err(format!("expected a finite number of degrees ≥ 0, got `{s}`")),
+    }
+}
+
+/// Samples per second: a finite number ≥ 0 (0: the key times alone).
+pub fn parse_rate(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(rate) if rate.is_finite() && rate >= 0.0 => Ok(rate),
+        _ => Err(format!("expected a finite number of samples per second ≥ 0, got `{s}`")),
+    }
+}
+
+/// A distance in model units or relative to the rig's size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Distance {
+    Units(f64),
+    Percent(f64),
+}
+
+impl Distance {
+    pub fn units(self, rig_size: f64) -> f64 {
+        match self {
+            Distance::Units(d) => d,
+            Distance::Percent(p) => p / 100.0 * rig_size,
+        }
+    }
+}
+
+pub fn parse_distance(s: &str) -> Result<Distance, String> {
+    let (number, percent) = match s.trim().strip_suffix('%') {
+        Some(number) => (number, true),
+        None => (s.trim(), false),
+    };
+    let value: f64 =
+        number.trim().parse().map_err(|_| format!("`{s}` is not a distance (a number, or a number and %)"))?;
+    if !(value.is_finite() && value >= 0.0) {
+        return Err(format!("the distance must be finite and ≥ 0, got `{s}`"));
+    }
+    Ok(if percent { Distance::Percent(value) } else { Distance::Units(value) })
 }
 
 impl EvalArgs {

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 
+use super::options::parse_angle;
 use super::scan::{render_animation, render_files, verdict};
 use crate::library::{junit, merge, read_json_lines};
 
@@ -28,9 +29,10 @@ pub struct ReportArgs {
     pub files: Vec<PathBuf>,
     #[arg(long, value_enum, default_value_t)]
     pub format: ReportFormat,
-    /// Exit with status 1 when any bone is stretched.
-    #[arg(long)]
-    pub fail_on_stretch: bool,
+    /// Exit with status 1 when a bone is stretched and shears by more than DEGREES (without a value: any stretched
+    /// bone).
+    #[arg(long, value_name = "DEGREES", num_args = 0..=1, default_missing_value = "0", value_parser = parse_angle, alias = "fail-on-stretch")]
+    pub fail_above: Option<f64>,
 }
 
 pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
@@ -48,5 +50,5 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
     for error in files.iter().filter_map(|f| f.error.as_deref()) {
         eprintln!("error: {error}");
     }
-    Ok(verdict(&files, args.fail_on_stretch))
+    Ok(verdict(&files, args.fail_above))
 }

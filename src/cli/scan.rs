@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Args, ValueEnum};
 
 use super::layers::LayerArgs;
-use super::options::parse_comparison;
+use super::options::{parse_angle, parse_comparison, parse_rate};
 use super::table::Table;
 use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
@@ -49,13 +49,14 @@ pub struct ScanArgs {
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Samples per second, on top of every key time.
-    #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate)]
+    #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: ScanFormat,
-    /// Exit with status 1 when any bone is stretched.
-    #[arg(long)]
-    pub fail_on_stretch: bool,
+    /// Exit with status 1 when a bone is stretched and shears by more than DEGREES (without a value: any stretched
+    /// bone).
+    #[arg(long, value_name = "DEGREES", num_args = 0..=1, default_missing_value = "0", value_parser = parse_angle, alias = "fail-on-stretch")]
+    pub fail_above: Option<f64>,
     /// Instead of the stretched bones, compare two evaluations of every bone: the largest difference in position
     /// (model units) and orientation (degrees) and when each happens. Each side is `declared` (the file's modes)
     /// or a mode id, e.g. `declared,full` (the file as its DCC meant it, against a glTF/TRS engine).
@@ -63,13 +64,13 @@ pub struct ScanArgs {
         long,
         value_name = "A,B",
         value_parser = parse_comparison,
-        conflicts_with_all = ["inherit", "inherit_bone", "fail_on_stretch"]
+        conflicts_with_all = ["inherit", "inherit_bone", "fail_above"]
     )]
     pub compare_inherit: Option<[ModeChoice; 2]>,
     /// Instead of the stretched bones, report each clip's stretch-quaternion storage: the bones that
     /// need a stretch channel, bytes as plain TRS and with it, and the error of rebuilding the matrices with and
     /// without it (at points along each bone's axes and at skinned vertices).
-    #[arg(long, conflicts_with_all = ["compare_inherit", "fail_on_stretch"])]
+    #[arg(long, conflicts_with_all = ["compare_inherit", "fail_above"])]
     pub storage: bool,
     /// With --storage: how far along each bone's axes the error is measured, in the bone's local units.
     #[arg(
@@ -115,9 +116,6 @@ pub struct AnimationStorage {
 pub type FileStorage = FileReport<AnimationStorage>;
 
 pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
-    if !(args.rate >= 0.0 && args.rate.is_finite()) {
-        anyhow::bail!("--rate must be a finite number ≥ 0, got {}", args.rate);
-    }
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
     if let Some(sides) = args.compare_inherit {
         if args.layers != LayerArgs::default() {
@@ -130,16 +128,17 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     }
     let report = |path: &Path| scan_file(path, args, &options);
     let (files, _) = report_files(&inputs(args)?, args, report, &render_animation, &junit)?;
-    Ok(verdict(&files, args.fail_on_stretch))
+    Ok(verdict(&files, args.fail_above))
 }
 
-/// The exit code of a stretch scan: 2 when a file did not load, else 1 when `fail_on_stretch` and a bone is
-/// stretched, else 0.
-pub(super) fn verdict(files: &[FileScan], fail_on_stretch: bool) -> ExitCode {
-    let stretched = files.iter().flat_map(|f| &f.animations).any(|a| !a.stretched.is_empty());
+/// The exit code of a stretch scan: 2 when a file did not load, else 1 when a stretched bone shears by more than
+/// `fail_above` degrees, else 0.
+pub(super) fn verdict(files: &[FileScan], fail_above: Option<f64>) -> ExitCode {
+    let stretched = files.iter().flat_map(|f| &f.animations).flat_map(|a| &a.stretched);
+    let over = fail_above.is_some_and(|limit| stretched.map(|b| b.summary.worst_shear_deg).any(|shear| shear > limit));
     if files.iter().any(|f| f.error.is_some()) {
         ExitCode::from(2)
-    } else if stretched && fail_on_stretch {
+    } else if over {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
