@@ -8,11 +8,7 @@ use rayon::prelude::*;
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 use super::request::{CurveRequest, ScanOptions};
-use crate::eval::Evaluation;
-
-/// Words of 64 sample flags per parallel work item, at most: long enough to amortise a worker's buffers, and
-/// short enough for every thread to get several.
-const MAX_CHUNK_WORDS: usize = 16;
+use crate::eval::{Evaluation, run_length};
 
 /// Scans `evaluation` over its whole clip. `progress(done, total)` is called from worker threads as samples
 /// complete.
@@ -37,8 +33,8 @@ pub fn analyze(
     let request = CurveRequest { bones: &in_range, ..request };
     let plan = Plan::new(evaluation, request.bones, request.judged);
     let done = AtomicUsize::new(0);
-    let words = times.len().div_ceil(64);
-    let chunk_len = 64 * (words / (4 * rayon::current_num_threads())).clamp(1, MAX_CHUNK_WORDS);
+    // The runs of the one parallel driver (`over_runs`); each also fills its piece of every curve.
+    let chunk_len = run_length(times.len());
     let mut curves: Vec<(usize, Curves)> =
         request.bones.iter().map(|&b| (b, Curves::for_samples(times.len(), request.ghost.is_some()))).collect();
     let chunks: Vec<Option<ChunkResult>> = times

@@ -22,12 +22,11 @@
 //! are left out.
 
 use glam::{DMat4, DQuat, DVec3};
-use rayon::prelude::*;
 use serde::Serialize;
 
 use super::{Assessment, Tolerances};
 use crate::eval::skinning::skin_positions;
-use crate::eval::{Evaluation, Evaluator};
+use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::model::{InheritMode, Rig, Transform};
 
 /// `f32` components of one key: translation 3 + rotation 4 + scale 3.
@@ -94,24 +93,18 @@ pub struct StorageReport {
     pub trs_only: RuntimeError,
 }
 
-/// Frames per parallel work item.
-const CHUNK: usize = 64;
-
 /// Measures the stretch-quaternion storage of `evaluation` over its whole clip.
 pub fn storage_report(evaluation: &Evaluation, options: &StorageOptions) -> StorageReport {
     let rig = evaluation.rig;
     let bones = rig.skeleton.len();
     let times = evaluation.times(options.rate);
     let runtime = || Runtime::new(evaluation, options);
-    let stretched_frames = times
-        .par_chunks(CHUNK)
-        .map(|chunk| runtime().count_stretched(chunk))
-        .reduce(|| vec![0; bones], |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect());
+    let counts = over_runs(&times, |run| runtime().count_stretched(run));
+    let stretched_frames =
+        counts.into_iter().fold(vec![0; bones], |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect());
     let marks: Vec<bool> = stretched_frames.iter().map(|&n| n > 0).collect();
-    let errors = times
-        .par_chunks(CHUNK)
-        .map(|chunk| runtime().measure(chunk, &marks))
-        .reduce(Errors::default, |a, b| a.merge(&b));
+    let errors = over_runs(&times, |run| runtime().measure(run, &marks));
+    let errors = errors.iter().fold(Errors::default(), |a, b| a.merge(b));
     let marked: Vec<MarkedBone> = stretched_frames
         .iter()
         .enumerate()

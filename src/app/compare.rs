@@ -13,7 +13,7 @@ use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, ma
 use crate::eval::{Evaluation, Layers, SkinningMethod};
 use crate::import::{self, ImportError};
 use crate::model::{Clip, InheritMode, Rig};
-use crate::view::Layer;
+use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
 #[derive(Debug)]
@@ -87,11 +87,11 @@ impl Compared {
     pub fn ghost(
         &self,
         clip: Option<usize>,
-        primary: &Layer,
+        primary: &DrawnPose,
         time: f64,
         skinning: SkinningMethod,
         tolerances: &Tolerances,
-    ) -> Layer {
+    ) -> DrawnPose {
         let evaluation = self.evaluation(clip).with_skinning(skinning);
         let pose = evaluation.pose_at(time);
         let model: Vec<_> =
@@ -108,7 +108,7 @@ impl Compared {
                 positions
             })
             .collect();
-        Layer {
+        DrawnPose {
             model,
             findings: assessments.iter().map(|a| a.findings).collect(),
             shear_deg: assessments.iter().map(|a| a.shear_deg).collect(),
@@ -201,7 +201,7 @@ mod tests {
         assert_eq!(compared.unpaired(), 0);
         assert!(compared.meshes.iter().all(Option::is_some));
         let pose = Evaluation::declared(&rig, rig.clips.first()).pose_at(0.5);
-        let primary = Layer::from_model(
+        let primary = DrawnPose::from_model(
             &rig,
             pose.model.model.clone(),
             &pose.morph,

@@ -33,7 +33,7 @@ pub use settings::{RotationFormat, Settings, TimeUnit};
 
 use crate::analysis::{ClipAnalysis, Judged, Tolerances};
 use crate::eval::{Pose, SkinningMethod};
-use crate::view::Layer;
+use crate::view::DrawnPose;
 use compare::{CompareJobs, CompareKey, ComparedCurves, CurvesKey, Differences};
 use file_browser::{DialogOutcome, FileBrowser};
 use job::{AnalysisJob, JobKey};
@@ -43,25 +43,25 @@ use notifications::Notifications;
 pub const MAX_PLOTTED: usize = 8;
 
 /// The pose at the current time under the document's modes and layers, and the ghost pose.
-pub struct Frame {
+pub struct CurrentPose {
     pub pose: Pose,
-    pub primary: Layer,
-    pub ghost: Option<Layer>,
+    pub primary: DrawnPose,
+    pub ghost: Option<DrawnPose>,
 }
 
-impl Frame {
-    fn evaluate(doc: &Document, time: f64, skinning: SkinningMethod, tolerances: &Tolerances) -> Frame {
+impl CurrentPose {
+    fn evaluate(doc: &Document, time: f64, skinning: SkinningMethod, tolerances: &Tolerances) -> CurrentPose {
         let rig = &doc.rig;
         let pose = doc.evaluation().pose_at(time);
-        let primary = Layer::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
+        let primary = DrawnPose::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
         let ghost = match &doc.ghost {
             Some(Ghost::Compared(compared)) => Some(compared.ghost(doc.clip, &primary, time, skinning, tolerances)),
             _ => doc.ghost_evaluation().map(|evaluation| {
                 let ghost = evaluation.pose_at(time);
-                Layer::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
+                DrawnPose::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
             }),
         };
-        Frame { pose, primary, ghost }
+        CurrentPose { pose, primary, ghost }
     }
 }
 
@@ -73,7 +73,7 @@ pub struct Shared<'a> {
     pub playing: &'a mut bool,
     /// Selected bones; the last one is the inspected one.
     pub selection: &'a mut Vec<usize>,
-    pub frame: &'a Frame,
+    pub frame: &'a CurrentPose,
     /// The rig-wide analysis: every bone's summary and stretched samples.
     pub analysis: Option<&'a Arc<ClipAnalysis>>,
     /// The plotted bones' curves (a separate, quick analysis of their chains).
@@ -462,7 +462,8 @@ impl BonescopeApp {
         self.poll_background(&ctx);
         self.handle_input(&ctx);
         self.advance_playback(&ctx);
-        let frame = Frame::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.settings.tolerances);
+        let frame =
+            CurrentPose::evaluate(&self.doc, self.time, self.settings.scene.skinning, &self.settings.tolerances);
         let latest = self.job.latest().map(|(_, a)| a.clone());
         let curves = self.curves_job.latest().map(|(_, a)| a.clone());
         let comparing = self.doc.compared.is_some();
@@ -489,7 +490,7 @@ impl BonescopeApp {
             if self.chrome == Chrome::ViewportOnly {
                 egui::CentralPanel::default()
                     .frame(egui::Frame::NONE)
-                    .show(ui, |ui| self.viewport.canvas(ui, &mut shared, viewport::Background::Left));
+                    .show(ui, |ui| self.viewport.canvas(ui, &mut shared, viewport::CanvasFill::Left));
             } else {
                 egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
                 egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));

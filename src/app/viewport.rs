@@ -8,14 +8,14 @@ use glam::DVec2;
 
 use super::{Document, Ghost, Shared};
 use crate::eval::bind_model_matrices;
-use crate::view::{Bounds, Camera, Layer, Palette, Scene, ViewKind, motion_bounds, paint};
+use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
 
 /// Whether the canvas paints its background.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Background {
+pub enum CanvasFill {
     Painted,
     /// Left out: headless renders put it behind the picture after reading it back, because a window-sized fill
     /// costs the software rasteriser as much as everything else it draws together.
@@ -46,11 +46,11 @@ impl Viewport {
     /// The view toggles above the canvas.
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         toolbar(ui, shared);
-        self.canvas(ui, shared, Background::Painted);
+        self.canvas(ui, shared, CanvasFill::Painted);
     }
 
     /// The picture alone, filling the space left: what headless renders of the viewport show.
-    pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared, background: Background) {
+    pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared, background: CanvasFill) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
         let rig = shared.doc.rig.clone();
@@ -63,7 +63,7 @@ impl Viewport {
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {
-            scene.bind_pose = Some(Layer { model: bind_model_matrices(&rig), ..Layer::default() });
+            scene.bind_pose = Some(DrawnPose { model: bind_model_matrices(&rig), ..DrawnPose::default() });
         }
         let picture = paint::picture_rect(rect, &scene);
         self.frame_now(&mut shared.settings.camera, aspect(picture));
@@ -83,7 +83,7 @@ impl Viewport {
         }
         let camera = &shared.settings.camera;
         let mut palette = Palette::new(ui.visuals().dark_mode);
-        if background == Background::Left {
+        if background == CanvasFill::Left {
             palette.background = egui::Color32::TRANSPARENT;
         }
         paint::paint(ui.painter(), rect, camera, &scene, &palette);

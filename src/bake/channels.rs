@@ -10,7 +10,7 @@
 use glam::DQuat;
 use rayon::prelude::*;
 
-use super::document::{Animation, Channel, Document, Interpolation, Node, Property};
+use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property};
 use super::keys::{Metrics, reduce, weights_error};
 use super::layout::{Layout, unit};
 use super::nodes::{NodeSample, Sampled};
@@ -27,7 +27,7 @@ pub struct ClipSamples<'a> {
 }
 
 /// The channels of `clip` for the nodes of `layout` in `document`.
-pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &Document) -> Animation {
+pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Animation {
     let per_bone: Vec<Vec<Channel>> = (0..clip.sampled.series.len())
         .into_par_iter()
         .map(|bone| bone_channels(layout, clip, metrics, document, bone))
@@ -52,7 +52,7 @@ fn bone_channels(
     layout: &Layout,
     clip: &ClipSamples,
     metrics: &Metrics,
-    document: &Document,
+    document: &GltfDocument,
     bone: usize,
 ) -> Vec<Channel> {
     let helper = layout.helper_node[bone].is_some();
@@ -134,7 +134,7 @@ impl NodeValues {
 }
 
 /// The morph weights of every mesh group whose bone the clip animates them on.
-fn weight_channels(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &Document) -> Vec<Channel> {
+fn weight_channels(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
     let Some(source) = clip.source.clip else { return Vec::new() };
     let (times, rig) = (&clip.base.times, clip.source.rig);
     let mut channels = Vec::new();

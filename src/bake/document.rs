@@ -15,9 +15,9 @@ pub struct Node {
     /// A unit quaternion `[x, y, z, w]`.
     pub rotation: [f32; 4],
     pub scale: [f32; 3],
-    /// Index into [`Document::meshes`].
+    /// Index into [`GltfDocument::meshes`].
     pub mesh: Option<usize>,
-    /// Index into [`Document::skins`].
+    /// Index into [`GltfDocument::skins`].
     pub skin: Option<usize>,
 }
 
@@ -88,7 +88,7 @@ pub struct Animation {
 
 /// The whole baked scene.
 #[derive(Clone, Debug, Default)]
-pub struct Document<'a> {
+pub struct GltfDocument<'a> {
     pub nodes: Vec<Node>,
     pub meshes: Vec<MeshGroup<'a>>,
     pub skins: Vec<SkinOut>,

@@ -1,4 +1,4 @@
-//! A [`Document`] encoded as a glTF 2.0 binary (GLB) through the `gltf` crate's JSON types and GLB writer.
+//! A [`GltfDocument`] encoded as a glTF 2.0 binary (GLB) through the `gltf` crate's JSON types and GLB writer.
 //!
 //! One buffer (the GLB's BIN chunk) holds every accessor, each in its own 4-byte-aligned buffer view. Accessors get
 //! `min`/`max` where the specification requires them (positions, morph displacements, animation inputs), computed
@@ -12,11 +12,11 @@ use gltf::json::{self, Index, validation::Checked::Valid, validation::USize64};
 use json::accessor::{ComponentType, GenericComponentType, Type};
 use serde_json::Value;
 
-use super::document::{Animation, Document, Interpolation, MeshGroup, Node, Property, SkinOut};
+use super::document::{Animation, GltfDocument, Interpolation, MeshGroup, Node, Property, SkinOut};
 use crate::model::Mesh;
 
 /// The GLB bytes of `document`.
-pub fn encode(document: &Document) -> Vec<u8> {
+pub fn encode(document: &GltfDocument) -> Vec<u8> {
     let mut writer = Writer::default();
     writer.root.asset = json::Asset { generator: Some(document.generator.clone()), ..json::Asset::default() };
     let meshes: Vec<_> = document.meshes.iter().map(|m| writer.mesh(m, &document.skins)).collect();

@@ -4,7 +4,7 @@
 
 use glam::DQuat;
 
-use super::document::{Document, MeshGroup, Node};
+use super::document::{GltfDocument, MeshGroup, Node};
 use super::nodes::{NodeSample, Sampled};
 use super::skins::skins;
 use crate::diff::HELPER_SUFFIX;
@@ -71,9 +71,9 @@ impl Layout {
 
     /// The nodes, meshes and skins, with each node's default TRS from the rest pose; what a user should know of
     /// them goes to `notes`.
-    pub fn document<'a>(&self, rig: &'a Rig, rest: &Sampled, notes: &mut Vec<String>) -> Document<'a> {
+    pub fn document<'a>(&self, rig: &'a Rig, rest: &Sampled, notes: &mut Vec<String>) -> GltfDocument<'a> {
         let mut document =
-            Document { generator: format!("bonescope {}", env!("CARGO_PKG_VERSION")), ..Document::default() };
+            GltfDocument { generator: format!("bonescope {}", env!("CARGO_PKG_VERSION")), ..GltfDocument::default() };
         for (bone, b) in rig.skeleton.bones().iter().enumerate() {
             let node = &rest.series[bone].nodes[0].as_baked(self.helper_node[bone].is_some());
             let parent = b.parent.map(|p| self.bone_node[p]);

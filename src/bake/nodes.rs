@@ -16,10 +16,9 @@
 //! bone's nodes (its `U` above all) continuous over time.
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
-use rayon::prelude::*;
 
 use super::Strategy;
-use crate::eval::{Evaluation, Evaluator};
+use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::math::{AffineParts, decompose_near, stretch_nearest};
 use crate::model::affine;
 
@@ -146,17 +145,14 @@ pub fn sample(source: &Evaluation, times: &[f64], strategy: Strategy) -> Sampled
     let mut series = vec![empty; bones];
     let mut stats = Stats::new(bones);
     for batch in times.chunks(BATCH) {
-        let rows: Vec<(Vec<NodeSample>, Stats)> = batch
-            .par_chunks(64)
-            .map(|times| {
-                let mut worker = Worker::new(source, strategy);
-                let mut rows = Vec::with_capacity(times.len() * bones);
-                for &time in times {
-                    rows.extend_from_slice(worker.solve_at(time));
-                }
-                (rows, worker.stats)
-            })
-            .collect();
+        let rows = over_runs(batch, |run| {
+            let mut solver = NodeSolver::new(source, strategy);
+            let mut rows = Vec::with_capacity(run.len() * bones);
+            for &time in run {
+                rows.extend_from_slice(solver.solve_at(time));
+            }
+            (rows, solver.stats)
+        });
         for (rows, found) in rows {
             stats = stats.merge(found);
             for row in rows.chunks_exact(bones.max(1)) {
@@ -197,7 +193,7 @@ impl Stats {
 }
 
 /// One thread's evaluation of the source: its pose, baked model matrices and findings.
-pub struct Worker<'e, 'a> {
+pub struct NodeSolver<'e, 'a> {
     source: Evaluator<'e, 'a>,
     strategy: Strategy,
     parents: Vec<Option<usize>>,
@@ -210,11 +206,11 @@ pub struct Worker<'e, 'a> {
     pub stats: Stats,
 }
 
-impl<'e, 'a> Worker<'e, 'a> {
+impl<'e, 'a> NodeSolver<'e, 'a> {
     pub fn new(source: &'e Evaluation<'a>, strategy: Strategy) -> Self {
         let parents: Vec<Option<usize>> = source.skeleton().bones().iter().map(|b| b.parent).collect();
         let bones = parents.len();
-        Worker {
+        NodeSolver {
             source: source.evaluator(),
             strategy,
             parents,

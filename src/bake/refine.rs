@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::Strategy;
 use super::keys::{interpolate, too_far};
-use super::nodes::{NodeSample, Sampled, Series, Stats, Worker, align, follow_frames};
+use super::nodes::{NodeSample, NodeSolver, Sampled, Series, Stats, align, follow_frames};
 use super::times::in_single_precision;
 use crate::eval::Evaluation;
 
@@ -42,7 +42,7 @@ pub fn refine(
         .into_par_iter()
         .filter(|&i| !steps[i])
         .fold(
-            || (Worker::new(source, strategy), Found::new(bones)),
+            || (NodeSolver::new(source, strategy), Found::new(bones)),
             |(mut worker, mut found), i| {
                 halving.base_interval(&mut worker, i, &mut found);
                 (worker, found)
@@ -103,7 +103,7 @@ struct Halving<'a, M> {
 
 impl<M: Misses> Halving<'_, M> {
     /// Halves the interval of base samples `i − 1` to `i` for every bone.
-    fn base_interval(&self, worker: &mut Worker, i: usize, found: &mut Found) {
+    fn base_interval(&self, worker: &mut NodeSolver, i: usize, found: &mut Found) {
         let ends: Vec<Ends> =
             self.sampled.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[i - 1], s.nodes[i])).collect();
         let times = &self.sampled.times;
@@ -113,7 +113,7 @@ impl<M: Misses> Halving<'_, M> {
     /// Samples the bones of `ends` at the middle of `span` (in single precision, where their keys will be; a span
     /// with no such time strictly inside it is as fine as glTF can store), and halves both halves for those that
     /// miss it, `depth` halvings deep.
-    fn halve(&self, worker: &mut Worker, span: (f64, f64), ends: Vec<Ends>, depth: usize, found: &mut Found) {
+    fn halve(&self, worker: &mut NodeSolver, span: (f64, f64), ends: Vec<Ends>, depth: usize, found: &mut Found) {
         let time = in_single_precision(0.5 * (span.0 + span.1));
         if ends.is_empty() || depth == MAX_DEPTH || !(span.0 < time && time < span.1) {
             return;

@@ -2,12 +2,12 @@
 //! vertices no cluster weights), and every skin's joints under one root node (the validator's `SKIN_NO_COMMON_ROOT`);
 //! where the joints lie under several roots, one new root node takes them all in.
 
-use super::document::{Document, Node, SkinOut};
+use super::document::{GltfDocument, Node, SkinOut};
 use crate::model::Rig;
 
 /// The skins of `rig` over the nodes `bone_node` gives each bone; adds a common root node to `document` where a skin
 /// needs one, saying so in `notes`.
-pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut Document, notes: &mut Vec<String>) {
+pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut GltfDocument, notes: &mut Vec<String>) {
     let mut skins = Vec::with_capacity(rig.skins.len());
     for (s, skin) in rig.skins.iter().enumerate() {
         let used = used_joints(rig, s, skin.joints.len());
@@ -99,9 +99,9 @@ mod tests {
         Rig { skeleton, skins: vec![skin], meshes: vec![mesh], ..Rig::default() }
     }
 
-    fn document(rig: &Rig) -> Document<'static> {
+    fn document(rig: &Rig) -> GltfDocument<'static> {
         let nodes = rig.skeleton.bones().iter().map(|b| Node { name: b.name.clone(), ..Node::identity(b.parent) });
-        Document { nodes: nodes.collect(), ..Document::default() }
+        GltfDocument { nodes: nodes.collect(), ..GltfDocument::default() }
     }
 
     #[test]

@@ -23,10 +23,9 @@ pub use matching::{
 pub use report::{AnimationDiff, FileDiff, FileSide, diff_files};
 
 use glam::{DMat4, DQuat, DVec3};
-use rayon::prelude::*;
 
 use crate::analysis::Components;
-use crate::eval::{Evaluation, Evaluator};
+use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::math::{AffineParts, angle_between, decompose_all};
 use crate::model::{MAX_FRAMES, sample_times};
 
@@ -200,19 +199,16 @@ pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
 pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
     let rig_size = a.size(times);
     let probe_length = rig_size * PROBE_FRACTION;
-    let empty = || Differences::new(a, b, pairs);
-    let totals = times
-        .par_chunks(32)
-        .map(|chunk| {
-            let mut worker = Worker::new(a, b);
-            let mut differences = empty();
-            for &time in chunk {
-                worker.evaluate(&pairs.meshes, time);
-                differences.add(&worker, probe_length, time);
-            }
-            differences
-        })
-        .reduce(empty, Differences::merge);
+    let runs = over_runs(times, |run| {
+        let mut worker = PairEvaluator::new(a, b);
+        let mut differences = Differences::new(a, b, pairs);
+        for &time in run {
+            worker.evaluate(&pairs.meshes, time);
+            differences.add(&worker, probe_length, time);
+        }
+        differences
+    });
+    let totals = runs.into_iter().reduce(Differences::merge).unwrap_or_else(|| Differences::new(a, b, pairs));
     let count = times.len().max(1) as f64;
     let meshes = totals
         .meshes
@@ -255,7 +251,7 @@ impl Differences {
         Differences { bones, meshes }
     }
 
-    fn add(&mut self, worker: &Worker, probe_length: f64, time: f64) {
+    fn add(&mut self, worker: &PairEvaluator, probe_length: f64, time: f64) {
         let (model_a, model_b) = (&worker.a.pose.model.model, &worker.b.pose.model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
@@ -280,7 +276,7 @@ impl Differences {
 }
 
 /// One thread's evaluations and buffers.
-struct Worker<'e, 'a> {
+struct PairEvaluator<'e, 'a> {
     a: Evaluator<'e, 'a>,
     b: Evaluator<'e, 'a>,
     parts_a: Vec<AffineParts>,
@@ -290,9 +286,9 @@ struct Worker<'e, 'a> {
     skinned_b: Vec<Vec<DVec3>>,
 }
 
-impl<'e, 'a> Worker<'e, 'a> {
+impl<'e, 'a> PairEvaluator<'e, 'a> {
     fn new(a: &'e Evaluation<'a>, b: &'e Evaluation<'a>) -> Self {
-        Worker {
+        PairEvaluator {
             a: a.evaluator(),
             b: b.evaluator(),
             parts_a: Vec::new(),
@@ -318,23 +314,20 @@ impl<'e, 'a> Worker<'e, 'a> {
 /// The model-space components of `bones` of `side` at `times`, one curve per bone: a second file's curves beside the
 /// first's (the app plots a compared file dashed).
 pub fn model_curves(evaluation: &Evaluation, bones: &[usize], times: &[f64]) -> Vec<Vec<Components>> {
-    let chunks: Vec<Vec<Vec<Components>>> = times
-        .par_chunks(256)
-        .map(|chunk| {
-            let mut evaluator = evaluation.evaluator();
-            let mut starts = vec![DQuat::IDENTITY; bones.len()];
-            let mut curves = vec![Vec::with_capacity(chunk.len()); bones.len()];
-            for &time in chunk {
-                let pose = evaluator.evaluate(time);
-                for ((curve, start), &bone) in curves.iter_mut().zip(&mut starts).zip(bones) {
-                    let components = Components::of_matrix(&pose.model.model[bone], *start);
-                    *start = components.stretch.as_dquat();
-                    curve.push(components);
-                }
+    let chunks: Vec<Vec<Vec<Components>>> = over_runs(times, |run| {
+        let mut evaluator = evaluation.evaluator();
+        let mut starts = vec![DQuat::IDENTITY; bones.len()];
+        let mut curves = vec![Vec::with_capacity(run.len()); bones.len()];
+        for &time in run {
+            let pose = evaluator.evaluate(time);
+            for ((curve, start), &bone) in curves.iter_mut().zip(&mut starts).zip(bones) {
+                let components = Components::of_matrix(&pose.model.model[bone], *start);
+                *start = components.stretch.as_dquat();
+                curve.push(components);
             }
-            curves
-        })
-        .collect();
+        }
+        curves
+    });
     (0..bones.len()).map(|b| chunks.iter().flat_map(|chunk| chunk[b].iter().copied()).collect()).collect()
 }
 

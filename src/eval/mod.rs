@@ -10,6 +10,7 @@ mod hierarchy;
 pub mod layers;
 mod morph;
 mod pose;
+mod runs;
 mod sample;
 pub mod skinning;
 
@@ -21,5 +22,6 @@ pub use hierarchy::{Hierarchy, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use morph::MorphPose;
 pub use pose::Pose;
+pub use runs::{over_runs, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use skinning::{Method as SkinningMethod, skin_meshes};

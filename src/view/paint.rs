@@ -9,7 +9,7 @@ use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke};
 use glam::{DVec2, DVec3};
 
 use super::camera::{Camera, Projection};
-use super::scene::{Layer, Scene};
+use super::scene::{DrawnPose, Scene};
 use super::style::{Badge, Palette};
 
 /// Height of one caption line, in points.
@@ -73,8 +73,8 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         paint_wireframe(&painter, &projection, scene, palette);
     }
     if options.boxes {
-        let layer = &scene.primary;
-        paint_boxes(&painter, &projection, layer, scene.gizmo_unit, |bone| box_color(layer, bone, palette));
+        let drawn = &scene.primary;
+        paint_boxes(&painter, &projection, drawn, scene.gizmo_unit, |bone| box_color(drawn, bone, palette));
     }
     if options.axes {
         paint_axes(&painter, &projection, &scene.primary, scene.gizmo_unit, |c| c);
@@ -202,12 +202,12 @@ fn mesh_triangles(
     out: &mut Vec<Triangle>,
     projection: &Projection,
     scene: &Scene,
-    layer: &Layer,
+    drawn: &DrawnPose,
     color: Color32,
     camera: &Camera,
 ) {
     let eye = camera.eye();
-    for (mesh, positions) in scene.rig.meshes.iter().zip(&layer.meshes) {
+    for (mesh, positions) in scene.rig.meshes.iter().zip(&drawn.meshes) {
         for tri in mesh.indices.chunks_exact(3) {
             let corner = |i: u32| positions.get(i as usize).copied();
             if let (Some(a), Some(b), Some(c)) = (corner(tri[0]), corner(tri[1]), corner(tri[2])) {
@@ -218,8 +218,8 @@ fn mesh_triangles(
 }
 
 /// The colour of a bone: selection first, then its most serious finding.
-fn bone_color(scene: &Scene, layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
-    if scene.selected.contains(&bone) { palette.selected } else { layer.finding_color(bone).unwrap_or(palette.bone) }
+fn bone_color(scene: &Scene, drawn: &DrawnPose, bone: usize, palette: &Palette) -> Color32 {
+    if scene.selected.contains(&bone) { palette.selected } else { drawn.finding_color(bone).unwrap_or(palette.bone) }
 }
 
 /// Octahedral bones from head to tail: a waist at a fifth of the length, a tenth as wide as long, oriented by the
@@ -228,28 +228,28 @@ fn bone_triangles(
     out: &mut Vec<Triangle>,
     projection: &Projection,
     scene: &Scene,
-    layer: &Layer,
+    drawn: &DrawnPose,
     palette: &Palette,
     camera: &Camera,
     tint: Option<Color32>,
 ) {
     let eye = camera.eye();
-    for bone in 0..layer.model.len() {
-        let head = layer.head(bone);
-        let Some(tail) = scene.tail(layer, bone) else { continue };
+    for bone in 0..drawn.model.len() {
+        let head = drawn.head(bone);
+        let Some(tail) = scene.tail(drawn, bone) else { continue };
         let along = tail - head;
         let length = along.length();
         if length < 1e-9 {
             continue;
         }
         let axis = along / length;
-        let reference = layer.model[bone].x_axis.truncate();
+        let reference = drawn.model[bone].x_axis.truncate();
         let reference = if reference.cross(axis).length() > 1e-6 { reference } else { axis.any_orthonormal_vector() };
         let u = (reference - axis * reference.dot(axis)).normalize() * length * 0.1;
         let v = axis.cross(u.normalize()) * length * 0.1;
         let waist = head + along * 0.2;
         let ring = [waist + u, waist + v, waist - u, waist - v];
-        let color = tint.unwrap_or_else(|| bone_color(scene, layer, bone, palette));
+        let color = tint.unwrap_or_else(|| bone_color(scene, drawn, bone, palette));
         for i in 0..4 {
             let (a, b) = (ring[i], ring[(i + 1) % 4]);
             push_triangle(out, projection, [head, b, a], color, eye);
@@ -275,8 +275,8 @@ fn paint_wireframe(painter: &Painter, projection: &Projection, scene: &Scene, pa
 }
 
 /// A bone's box colour: its most important finding's, else the bone colour, faded.
-fn box_color(layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
-    layer.finding_color(bone).unwrap_or(palette.bone.gamma_multiply(0.6))
+fn box_color(drawn: &DrawnPose, bone: usize, palette: &Palette) -> Color32 {
+    drawn.finding_color(bone).unwrap_or(palette.bone.gamma_multiply(0.6))
 }
 
 /// Each bone's matrix applied to a cube of side `unit` (in the bone's own units, see [`Scene::gizmo_unit`])
@@ -284,12 +284,12 @@ fn box_color(layer: &Layer, bone: usize, palette: &Palette) -> Color32 {
 fn paint_boxes(
     painter: &Painter,
     projection: &Projection,
-    layer: &Layer,
+    drawn: &DrawnPose,
     unit: f64,
     color_of: impl Fn(usize) -> Color32,
 ) {
     let h = unit * 0.5;
-    for (bone, model) in layer.model.iter().enumerate() {
+    for (bone, model) in drawn.model.iter().enumerate() {
         let corner = |i: usize| {
             let pick = |bit: usize| if i & bit == 0 { -h } else { h };
             model.transform_point3(DVec3::new(pick(1), pick(2), pick(4)))
@@ -303,9 +303,15 @@ fn paint_boxes(
 
 /// Axis triads from the model matrix columns times `unit` (see [`Scene::gizmo_unit`]): their lengths show scale,
 /// their angles show shear.
-fn paint_axes(painter: &Painter, projection: &Projection, layer: &Layer, unit: f64, tint: impl Fn(Color32) -> Color32) {
+fn paint_axes(
+    painter: &Painter,
+    projection: &Projection,
+    drawn: &DrawnPose,
+    unit: f64,
+    tint: impl Fn(Color32) -> Color32,
+) {
     let palette_axes = Palette::new(true).axes;
-    for model in &layer.model {
+    for model in &drawn.model {
         let origin = model.w_axis.truncate();
         for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
             line(painter, projection, origin, origin + axis.truncate() * unit, Stroke::new(2.0, tint(color)));
@@ -314,13 +320,13 @@ fn paint_axes(painter: &Painter, projection: &Projection, layer: &Layer, unit: f
 }
 
 fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
-    let layer = &scene.primary;
-    for bone in 0..layer.model.len() {
-        let Some(p) = screen(projection, layer.head(bone)) else { continue };
+    let drawn = &scene.primary;
+    for bone in 0..drawn.model.len() {
+        let Some(p) = screen(projection, drawn.head(bone)) else { continue };
         let selected = scene.selected.contains(&bone);
-        let color = bone_color(scene, layer, bone, palette);
+        let color = bone_color(scene, drawn, bone, palette);
         painter.circle_filled(p, if selected { 5.0 } else { 3.5 }, color);
-        if let Some(badge) = Badge::primary(&layer.findings[bone]) {
+        if let Some(badge) = Badge::primary(&drawn.findings[bone]) {
             badge.paint_icon(painter, p + egui::vec2(9.0, -9.0), 4.5);
         }
         if scene.options.names || selected {
@@ -360,12 +366,12 @@ fn paint_caption(painter: &Painter, rect: Rect, caption: &[String], palette: &Pa
 mod tests {
     use super::*;
     use crate::import::demo_rig;
-    use crate::view::{Layer, SceneOptions};
+    use crate::view::{DrawnPose, SceneOptions};
 
     #[test]
     fn the_caption_has_its_own_strip_below_the_model() {
         let rig = demo_rig();
-        let mut scene = Scene::new(&rig, Layer::default(), SceneOptions::default());
+        let mut scene = Scene::new(&rig, DrawnPose::default(), SceneOptions::default());
         let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
         assert_eq!(picture_rect(rect, &scene), rect, "no caption, the whole canvas");
         scene.caption = vec!["demo rig · stretch".into(), "0.500 s".into(), "mode: full".into()];

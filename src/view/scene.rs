@@ -102,7 +102,7 @@ impl SceneOptions {
 
 /// One evaluated pose: model matrices, findings and skinned meshes.
 #[derive(Clone, Debug, Default)]
-pub struct Layer {
+pub struct DrawnPose {
     pub model: Vec<DMat4>,
     pub findings: Vec<Findings>,
     /// Per bone, its shear angle in degrees (how severe a stretched bone is).
@@ -111,7 +111,7 @@ pub struct Layer {
     pub meshes: Vec<Vec<DVec3>>,
 }
 
-impl Layer {
+impl DrawnPose {
     /// The findings of `model` and the meshes morphed by `morph` and skinned by `skinning` at it.
     pub fn from_model(
         rig: &Rig,
@@ -119,12 +119,12 @@ impl Layer {
         morph: &MorphPose,
         skinning: SkinningMethod,
         tolerances: &Tolerances,
-    ) -> Layer {
+    ) -> DrawnPose {
         let assessments = Assessment::all(&model, tolerances);
         let findings = assessments.iter().map(|a| a.findings).collect();
         let shear_deg = assessments.iter().map(|a| a.shear_deg).collect();
         let meshes = skin_meshes_with(rig, &model, morph, skinning);
-        Layer { model, findings, shear_deg, meshes }
+        DrawnPose { model, findings, shear_deg, meshes }
     }
 
     /// The colour of the bone's most important finding, stretched bones by their shear; `None` without one.
@@ -142,16 +142,16 @@ impl Layer {
 #[derive(Clone, Debug)]
 pub struct Scene<'a> {
     pub rig: &'a Rig,
-    pub primary: Layer,
+    pub primary: DrawnPose,
     /// The same pose under a second inheritance mode, drawn translucent over the first.
-    pub ghost: Option<Layer>,
+    pub ghost: Option<DrawnPose>,
     /// What the ghost is, for the legend.
     pub ghost_label: String,
     /// Lines naming what is shown (file, clip, time, modes, layers), drawn in the corner opposite the legend.
     pub caption: Vec<String>,
     /// The bind pose (from the skins' inverse bind matrices in model space, the rest pose elsewhere), drawn as a
     /// translucent skeleton where the character is.
-    pub bind_pose: Option<Layer>,
+    pub bind_pose: Option<DrawnPose>,
     pub selected: Vec<usize>,
     pub options: SceneOptions,
     /// How long axis triads and boxes are drawn, in model units, for a bone of the rig's typical scale.
@@ -165,7 +165,7 @@ pub struct Scene<'a> {
 }
 
 impl<'a> Scene<'a> {
-    pub fn new(rig: &'a Rig, primary: Layer, options: SceneOptions) -> Self {
+    pub fn new(rig: &'a Rig, primary: DrawnPose, options: SceneOptions) -> Self {
         let gizmo_size = gizmo_size(rig);
         let gizmo_unit = gizmo_size / typical_scale(rig);
         let mut first_child = vec![None; rig.skeleton.len()];
@@ -190,13 +190,13 @@ impl<'a> Scene<'a> {
     }
 
     /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on.
-    pub fn tail(&self, layer: &Layer, bone: usize) -> Option<DVec3> {
+    pub fn tail(&self, drawn: &DrawnPose, bone: usize) -> Option<DVec3> {
         if let Some(child) = self.first_child[bone] {
-            return Some(layer.head(child));
+            return Some(drawn.head(child));
         }
         let parent = self.rig.skeleton.parent(bone)?;
-        let along = layer.head(bone) - layer.head(parent);
-        (along.length() > 1e-9).then(|| layer.head(bone) + along * 0.35)
+        let along = drawn.head(bone) - drawn.head(parent);
+        (along.length() > 1e-9).then(|| drawn.head(bone) + along * 0.35)
     }
 
     /// Everything the scene may draw, for framing the camera.

@@ -1,0 +1,39 @@
+//! The one way whole-clip work runs in parallel: the sorted times cut into runs of consecutive times, each run
+//! worked through by one thread with state of its own (a pose, buffers, a copy of the layers), the runs' results
+//! handed back in time order so that merging them gives what one pass in order would.
+
+use rayon::prelude::*;
+
+/// Runs per thread, at least: enough for the threads to even out uneven runs.
+const RUNS_PER_THREAD: usize = 4;
+
+/// The most times in a run: past it a longer run saves nothing on setting a worker up.
+const MAX_RUN: usize = 1024;
+
+/// How many consecutive times of `count` one run takes: a multiple of 64 (an analysis keeps one flag per time in
+/// 64-bit words, which runs must not share), and short enough for every thread to get several runs.
+pub fn run_length(count: usize) -> usize {
+    64 * (count.div_ceil(64) / (RUNS_PER_THREAD * rayon::current_num_threads())).clamp(1, MAX_RUN / 64)
+}
+
+/// `work` of each run of consecutive `times` (of [`run_length`]), in parallel; the results in time order.
+pub fn over_runs<R: Send>(times: &[f64], work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
+    times.par_chunks(run_length(times.len())).map(work).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_cover_the_times_in_order_in_whole_words() {
+        for count in [0, 1, 63, 64, 65, 1000, 100_000, 3_000_000] {
+            let times: Vec<f64> = (0..count).map(|k| k as f64).collect();
+            let runs = over_runs(&times, |run| run.to_vec());
+            assert_eq!(runs.concat(), times, "{count} times");
+            let length = run_length(count);
+            assert!(length.is_multiple_of(64) && (64..=MAX_RUN).contains(&length), "{length}");
+            assert!(runs.iter().rev().skip(1).all(|run| run.len() == length), "only the last run is short");
+        }
+    }
+}
