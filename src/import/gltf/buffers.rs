@@ -10,26 +10,14 @@
 
 use std::borrow::Cow;
 use std::cell::OnceCell;
-use std::fmt;
 use std::io::Read;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use base64::Engine as _;
-use base64::engine::DecodePaddingMode;
-use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
-use serde::Deserialize;
-use serde::de::{self, Deserializer, Visitor};
-
 use super::schema::{self, Uint};
 use super::source::Region;
+use super::uri::Uri;
 use super::{Failure, Result};
-
-/// Base64 as glTF writers produce it; some leave out the `=` padding.
-const BASE64: GeneralPurpose = GeneralPurpose::new(
-    &base64::alphabet::STANDARD,
-    GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
-);
 
 /// The document's buffers, loaded when first asked for.
 pub(super) struct Buffers<'a> {
@@ -44,40 +32,6 @@ pub(super) struct Buffers<'a> {
 enum Data<'a> {
     Memory(Cow<'a, [u8]>),
     Blob(Region<'a>),
-}
-
-/// A buffer's `uri` as the JSON is read: a `data:` URI is decoded on the spot, straight from the JSON text (a `.gltf`
-/// file's base64 buffer is most of its text, which is then never copied as a string), any other URI kept to be
-/// followed when the buffer is needed.
-#[derive(Debug)]
-pub(super) enum Uri {
-    /// The bytes of a `data:` URI, or why they cannot be had (said only if the buffer is needed).
-    Data(std::result::Result<Vec<u8>, String>),
-    /// A file, by its URI reference.
-    Reference(String),
-}
-
-impl<'de> Deserialize<'de> for Uri {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> std::result::Result<Self, D::Error> {
-        struct UriVisitor;
-
-        impl Visitor<'_> for UriVisitor {
-            type Value = Uri;
-
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a URI")
-            }
-
-            fn visit_str<E: de::Error>(self, uri: &str) -> std::result::Result<Uri, E> {
-                Ok(match strip_prefix_ignore_case(uri, "data:") {
-                    Some(data) => Uri::Data(decode_data_uri(data)),
-                    None => Uri::Reference(uri.to_owned()),
-                })
-            }
-        }
-
-        deserializer.deserialize_str(UriVisitor)
-    }
 }
 
 impl<'a> Buffers<'a> {
@@ -147,17 +101,6 @@ fn read_file(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec
     Ok(data)
 }
 
-/// The payload of `data:[<media type>];base64,<payload>` (glTF buffers are always base64).
-fn decode_data_uri(after_scheme: &str) -> std::result::Result<Vec<u8>, String> {
-    let Some((header, payload)) = after_scheme.split_once(',') else {
-        return Err("malformed data URI (no comma)".into());
-    };
-    if !header.to_ascii_lowercase().ends_with(";base64") {
-        return Err(format!("data URI `data:{header},…` is not base64"));
-    }
-    BASE64.decode(payload).map_err(|e| format!("bad base64 in data URI: {e}"))
-}
-
 /// A URI reference as a relative path inside the glTF file's folder.
 pub(super) fn relative_path(uri: &str) -> std::result::Result<PathBuf, String> {
     if let Some(scheme) = scheme(uri) {
@@ -206,15 +149,9 @@ fn percent_decode(s: &str) -> Option<String> {
     String::from_utf8(bytes).ok()
 }
 
-fn strip_prefix_ignore_case<'a>(s: &'a str, prefix: &str) -> Option<&'a str> {
-    let head = s.get(..prefix.len())?;
-    head.eq_ignore_ascii_case(prefix).then(|| &s[prefix.len()..])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use base64::engine::general_purpose;
 
     #[test]
     fn relative_paths_are_percent_decoded() {
@@ -232,15 +169,5 @@ mod tests {
             assert!(err.contains("scheme"), "{uri}: {err}");
         }
         assert!(relative_path("bad%zz").is_err() && relative_path("bad%4").is_err() && relative_path("%ff").is_err());
-    }
-
-    #[test]
-    fn data_uris_decode_with_or_without_padding() {
-        assert_eq!(decode_data_uri("application/octet-stream;base64,AQID"), Ok(vec![1, 2, 3]));
-        assert_eq!(decode_data_uri("application/gltf-buffer;base64,AQI"), Ok(vec![1, 2]));
-        assert!(decode_data_uri("text/plain,hello").is_err());
-        assert!(decode_data_uri("application/octet-stream;base64,@@@@").is_err());
-        let encoded = general_purpose::STANDARD.encode([9u8; 10]);
-        assert_eq!(decode_data_uri(&format!(";base64,{encoded}")), Ok(vec![9; 10]));
     }
 }

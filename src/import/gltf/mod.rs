@@ -16,6 +16,7 @@ mod mesh;
 mod scene;
 mod schema;
 mod source;
+mod uri;
 
 use std::fs::File;
 use std::path::Path;

@@ -12,7 +12,7 @@ use std::fmt;
 use serde::Deserialize;
 use serde::de::{self, Deserializer, Visitor};
 
-use super::buffers::Uri;
+use super::uri::Uri;
 use super::{Failure, Result};
 
 /// A non-negative JSON integer: an index, a count, a byte offset. Written `1` or `1.0`.
