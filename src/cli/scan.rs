@@ -19,6 +19,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{Layered, ScanOptions, Subject, compare, scan};
 use crate::eval::{Hierarchy, LayerStack};
 use crate::import;
+use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
 use crate::model::{Clip, Rig};
 
@@ -153,7 +154,7 @@ fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
     let filter = Filter::new(&args.include, &args.exclude).map_err(anyhow::Error::msg)?;
     let inputs = collect(&args.files, &filter, &mut std::io::stdin().lock());
     for problem in &inputs.problems {
-        eprintln!("warning: {}: {}", problem.path.display(), problem.message);
+        eprintln!("warning: {}", printable(&format!("{}: {}", problem.path.display(), problem.message)));
     }
     Ok(match args.shard {
         Some((part, parts)) => inputs.shard(part, parts),
@@ -212,7 +213,7 @@ fn report_files<T: serde::Serialize + Send>(
     let done = |path: &Path, file: FileReport<T>| {
         progress.file_done(path);
         if let Some(error) = &file.error {
-            progress.println(&format!("error: {error}"));
+            progress.println(&format!("error: {}", printable(error)));
         }
         if format == ScanFormat::Jsonl && written.is_ok() {
             written = serde_json::to_string(&file).map_err(anyhow::Error::from).and_then(|line| {
@@ -266,10 +267,12 @@ impl Progress {
         self.done += 1;
         match &self.bar {
             Some(bar) => {
-                bar.set_message(path.display().to_string());
+                bar.set_message(shown(path));
                 bar.inc(1);
             }
-            None if self.lines => eprintln!("[{}/{}] {}", self.done, self.total, path.display()),
+            None if self.lines => {
+                eprintln!("[{}/{}] {}", self.done, self.total, shown(path));
+            }
             None => {}
         }
     }
@@ -289,13 +292,18 @@ impl Progress {
     }
 }
 
+/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
+pub(super) fn shown(path: &Path) -> String {
+    printable(&path.display().to_string()).into_owned()
+}
+
 /// 0 when every file loaded, 2 when one did not.
 fn loaded_code(all_loaded: bool) -> ExitCode {
     if all_loaded { ExitCode::SUCCESS } else { ExitCode::from(2) }
 }
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
-    let file = path.display().to_string();
+    let file = shown(path);
     let scanned = load_layered(path, args).map(|loaded| {
         loaded.each_clip(|layered, clip, hierarchy| {
             let result = scan(Subject::layered(layered, clip), hierarchy, options, &|_, _| {});
@@ -343,7 +351,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     let storage =
         StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
     let measure = |path: &Path| {
-        let file = path.display().to_string();
+        let file = shown(path);
         let measured = load_layered(path, args).map(|loaded| {
             loaded.each_clip(|layered, clip, hierarchy| AnimationStorage {
                 animation: clip.map(AnimationInfo::of),
@@ -391,9 +399,8 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 }
 
 fn run_comparison(args: &ScanArgs, sides: [ModeSet; 2]) -> anyhow::Result<ExitCode> {
-    let compare = |path: &Path| {
-        FileComparison::new(path.display().to_string(), compare_animations(path, &args.eval, sides, args.rate))
-    };
+    let compare =
+        |path: &Path| FileComparison::new(shown(path), compare_animations(path, &args.eval, sides, args.rate));
     let (_, loaded) = report_files(&inputs(args)?, args, compare, render_comparison, junit_comparison)?;
     Ok(loaded_code(loaded))
 }
