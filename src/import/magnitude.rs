@@ -9,7 +9,7 @@
 //! the time of its largest key. The limit leaves room for what evaluation does with a matrix: products of three
 //! entries (determinants), squares of sums (decomposition), and vertices in single precision under it.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::failure::{Failure, Result};
 use crate::model::{Clip, Rig, Track};
@@ -41,7 +41,7 @@ impl Largest {
 pub(super) fn check(rig: &Rig) -> Result<()> {
     let bones = rig.skeleton.bones();
     let mut scale: Vec<Largest> = bones.iter().map(|b| Largest::at_rest(b.rest.scale.abs().max_element())).collect();
-    let mut translation: Vec<Largest> = bones.iter().map(|b| Largest::at_rest(b.rest.translation.length())).collect();
+    let mut translation: Vec<Largest> = bones.iter().map(|b| Largest::at_rest(length(b.rest.translation))).collect();
     for clip in &rig.clips {
         widen(clip, &mut scale, &mut translation);
     }
@@ -73,27 +73,33 @@ pub(super) fn check(rig: &Rig) -> Result<()> {
 fn widen(clip: &Clip, scale: &mut [Largest], translation: &mut [Largest]) {
     for tracks in clip.tracks() {
         if let Some(track) = &tracks.scale {
-            largest_of(track, |v| v.abs().max_element(), &mut scale[tracks.bone]);
+            largest_of(track, |v| f64::from(v.abs().max_element()), &mut scale[tracks.bone]);
         }
         if let Some(track) = &tracks.translation {
-            largest_of(track, Vec3::length, &mut translation[tracks.bone]);
+            largest_of(track, |t: Vec3| length(t.as_dvec3()), &mut translation[tracks.bone]);
         }
     }
 }
 
 /// Widens `largest` by every stored value of `track` (tangents included), measured by `size`.
-fn largest_of<T: Copy>(track: &Track<T>, size: impl Fn(T) -> f32, largest: &mut Largest) {
+fn largest_of<T: Copy>(track: &Track<T>, size: impl Fn(T) -> f64, largest: &mut Largest) {
     let per_key = track.interpolation().values_per_key();
     for (i, &value) in track.values().iter().enumerate() {
-        largest.keep(f64::from(size(value)), track.times()[i / per_key]);
+        largest.keep(size(value), track.times()[i / per_key]);
     }
+}
+
+/// The length of `v`, scaled so that squaring cannot overflow where the length itself is finite (offsets of 1e308).
+fn length(v: DVec3) -> f64 {
+    let largest = v.abs().max_element();
+    if largest == 0.0 { 0.0 } else { largest * (v / largest).length() }
 }
 
 #[cfg(test)]
 mod tests {
     use std::sync::Arc;
 
-    use glam::{DQuat, DVec3};
+    use glam::DQuat;
 
     use super::*;
     use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, Skeleton, Transform};
@@ -127,6 +133,13 @@ mod tests {
         // Offsets of 1e308 pass the limit at the first bone, without any scale.
         let failure = check(&chain(4, 1.0, 1e308)).unwrap_err();
         assert_eq!(failure.place.as_deref(), Some("bone `b0`"));
+    }
+
+    #[test]
+    fn lengths_do_not_overflow_before_they_must() {
+        assert_eq!(length(DVec3::new(3.0, 4.0, 0.0)), 5.0);
+        assert_eq!(length(DVec3::new(1e308, 1e308, 0.0)), 1e308 * 2f64.sqrt());
+        assert_eq!(length(DVec3::ZERO), 0.0);
     }
 
     #[test]
