@@ -362,3 +362,20 @@ fn option_values_that_would_overflow_are_refused() {
     assert!(run.output.status.success());
     check_json(&run).unwrap();
 }
+
+#[test]
+fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("shared.glb");
+    // 200 channels sharing one sampler of 10,000 keys: 200 · 10,000 · 12 bytes of translations decoded, 80,000
+    // bytes of key times and 201 bones of 4 KiB: 24,903,296 bytes, 23.75 MiB.
+    std::fs::write(&file, corpus::shared_sampler(200, 10_000)).unwrap();
+    let f = file.to_str().unwrap();
+    let run = bonescope(&["inspect", f, "--max-memory", "16M"]);
+    check_run(&run).unwrap();
+    check_refusal(&run, &file, "animations[0]: needs ~24 MiB for 200 channels of 2000000 keys in all").unwrap();
+    assert!(String::from_utf8_lossy(&run.output.stderr).contains("the limit is 16 MiB (--max-memory)"));
+    let run = bonescope(&["scan", f, "--max-memory", "32MiB"]);
+    check_run(&run).unwrap();
+    assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));
+}

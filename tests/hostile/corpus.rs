@@ -126,7 +126,7 @@ fn memory() -> Vec<Case> {
 }
 
 /// `channels` nodes whose translation channels all share one sampler of `keys` keys.
-fn shared_sampler(channels: usize, keys: usize) -> Vec<u8> {
+pub fn shared_sampler(channels: usize, keys: usize) -> Vec<u8> {
     let mut g = Gltf::new();
     let times: Vec<f32> = (0..keys).map(|k| k as f32 / 30.0).collect();
     let values: Vec<f32> = (0..keys * 3).map(|i| (i % 7) as f32).collect();
