@@ -115,4 +115,13 @@ mod tests {
         assert!((found[0].angle_deg - 10.0).abs() < 1e-9);
         assert!(found[0].scale_change < 1e-12);
     }
+
+    #[test]
+    fn scale_changes_are_relative_to_the_rest_and_finite_at_zero() {
+        assert_eq!(scale_change(1.5, 1.0), 0.5);
+        assert_eq!(scale_change(-2.0, -4.0), 0.5, "mirrored factors compare by size");
+        assert_eq!(scale_change(2.0, 0.0), 1.0, "a zero rest factor: all of the bind's");
+        assert_eq!(scale_change(0.0, 0.0), 0.0);
+        assert_eq!(scale_change(1.0, 1e-320), 1.0, "a ratio past f64 counts as all of it");
+    }
 }

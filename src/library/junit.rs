@@ -186,3 +186,36 @@ fn stretch_case(clip: &AnimationScan) -> Case {
         .collect();
     Case { name, failures, output: None }
 }
+
+#[cfg(test)]
+mod tests {
+    use quick_xml::events::Event;
+
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_so_the_report_parses() {
+        let file = FileScan {
+            file: "evil\u{1b}]0;title\u{7}.glb".to_owned(),
+            error: Some("nodes[0]: bad \u{0}name\nwith a break".to_owned()),
+            animations: Vec::new(),
+        };
+        let xml = junit(&[file]);
+        let mut reader = quick_xml::Reader::from_str(&xml);
+        let mut texts = Vec::new();
+        loop {
+            match reader.read_event().expect("the report is XML 1.0") {
+                Event::Eof => break,
+                Event::Text(text) if !text.decode().unwrap().trim().is_empty() => {
+                    texts.push(text.decode().unwrap().into_owned());
+                }
+                Event::Start(element) | Event::Empty(element) if element.name().as_ref() == b"testsuite" => {
+                    let name = element.try_get_attribute("name").unwrap().unwrap().unescape_value().unwrap();
+                    assert_eq!(name, "evil\\x1b]0;title\\x07.glb");
+                }
+                _ => {}
+            }
+        }
+        assert_eq!(texts, ["nodes[0]: bad \\x00name\nwith a break"], "line breaks are XML; NUL is not");
+    }
+}
