@@ -12,7 +12,9 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use bonescope::app::{BonescopeApp, Document, Settings};
 use corpus::{Case, Expect};
+use egui_kittest::kittest::Queryable;
 use serde_json::Value;
 
 /// The address space each run may take (`RLIMIT_AS`), in KiB as `ulimit -v` counts.
@@ -378,4 +380,34 @@ fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
     let run = bonescope(&["scan", f, "--max-memory", "32MiB"]);
     check_run(&run).unwrap();
     assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));
+}
+
+#[test]
+fn the_app_keeps_its_document_through_every_refused_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.glb");
+    std::fs::write(&good, corpus::good_gltf()).unwrap();
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    harness.state_mut().open(&good);
+    harness.run();
+    assert_eq!(harness.state().doc.path.as_deref(), Some(good.as_path()));
+    let refused = corpus::all().into_iter().filter(|c| !c.huge && matches!(c.expect, Expect::Refused(_)));
+    for case in refused {
+        let file = case.write(dir.path());
+        harness.state_mut().open(&file);
+        harness.run();
+        assert_eq!(harness.state().doc.path.as_deref(), Some(good.as_path()), "{}: the document stays", case.name);
+    }
+    harness.get_by_label_contains("fifo_file/a.gltf: not a regular file");
+    // A notification names a file whose name would retitle a terminal, escaped (in an app of its own: at most four
+    // notifications are shown).
+    let mut harness = egui_kittest::Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    let evil = corpus::all().into_iter().find(|c| c.name == "file_name").unwrap().write(dir.path());
+    harness.state_mut().open(&evil);
+    harness.run();
+    harness.get_by_label_contains("\\x1b]0;pwned\\x07\\x1b[2J.bvh: line 2");
 }
