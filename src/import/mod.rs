@@ -227,4 +227,16 @@ mod tests {
         assert_eq!(detect(b""), None);
         assert_eq!(detect(b"   "), None);
     }
+
+    #[test]
+    fn names_from_a_file_are_printable_and_readable_in_length() {
+        let long = "y".repeat(1000);
+        let json = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}],
+                "nodes": [{{"name": "a\u001b[2J\nb", "children": [1]}}, {{"name": "{long}"}}]}}"#
+        );
+        let rig = load_bytes(Path::new("names.gltf"), json.as_bytes()).unwrap();
+        assert_eq!(rig.skeleton.bone(0).name, "a\\x1b[2J\\x0ab");
+        assert_eq!(rig.skeleton.bone(1).name, format!("{}…", "y".repeat(text::NAME_CHARS)));
+    }
 }
