@@ -210,7 +210,8 @@ mod tests {
                     texts.push(text.decode().unwrap().into_owned());
                 }
                 Event::Start(element) | Event::Empty(element) if element.name().as_ref() == b"testsuite" => {
-                    let name = element.try_get_attribute("name").unwrap().unwrap().unescape_value().unwrap();
+                    let name = element.try_get_attribute("name").unwrap().unwrap();
+                    let name = name.normalized_value(quick_xml::XmlVersion::Explicit1_0).unwrap();
                     assert_eq!(name, "evil\\x1b]0;title\\x07.glb");
                 }
                 _ => {}
