@@ -366,6 +366,20 @@ fn option_values_that_would_overflow_are_refused() {
 }
 
 #[test]
+fn a_bvh_of_too_many_joints_is_refused_before_they_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("wide.bvh");
+    // 10,000 joints and the root, 4 KiB each: 40 MiB.
+    std::fs::write(&file, corpus::wide_bvh(10_000)).unwrap();
+    let f = file.to_str().unwrap();
+    let run = bonescope(&["inspect", f, "--max-memory", "32M"]);
+    check_run(&run).unwrap();
+    check_refusal(&run, &file, "needs ~39 MiB for 10001 joints; the limit is 32 MiB").unwrap();
+    let run = bonescope(&["inspect", f, "--max-memory", "64M"]);
+    assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));
+}
+
+#[test]
 fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("shared.glb");

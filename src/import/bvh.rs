@@ -155,6 +155,7 @@ fn number(word: &str, line: usize, what: &str) -> Result<f64> {
 
 fn read(bytes: &[u8]) -> Result<Rig> {
     let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    check_declared_joints(text)?;
     let mut lines = Lines { text, number: 0 };
     let joints = read_hierarchy(&mut lines)?;
     let (frames, frame_time, header_line) = read_motion_header(&mut lines)?;
@@ -371,6 +372,22 @@ fn read_motion_header(lines: &mut Lines) -> Result<(u64, f64, usize)> {
         return Err(on_line(line, format!("Frame Time must be above 0, found {frame_time}")));
     }
     Ok((frames, frame_time, line))
+}
+
+/// Refuses a file that declares more joints than the memory budget holds bones, before any is read: a count of the
+/// lines that start with `ROOT`, `JOINT` or `End` up to `MOTION` (a quick pass, where reading the hierarchy of a
+/// million joints takes a second).
+fn check_declared_joints(text: &[u8]) -> Result<()> {
+    let starts = |line: &[u8], word: &[u8]| line.get(..word.len()).is_some_and(|w| w.eq_ignore_ascii_case(word));
+    let mut joints = 0u64;
+    for (_, line) in (Lines { text, number: 0 }) {
+        let line = line.trim_ascii_start();
+        if starts(line, b"MOTION") {
+            break;
+        }
+        joints += u64::from(starts(line, b"ROOT") || starts(line, b"JOINT") || starts(line, b"END"));
+    }
+    budget::check(joints.saturating_mul(budget::BONE_BYTES), None, || format!("{joints} joints"))
 }
 
 /// Refuses a file whose joints and frames (as many as the rest of the file, `rest` bytes, can hold) would exceed

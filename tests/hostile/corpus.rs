@@ -171,7 +171,7 @@ fn shared_inverse_binds(skins: usize, matrices: usize) -> Vec<u8> {
 }
 
 /// A BVH whose root has `joints` children, one frame.
-fn wide_bvh(joints: usize) -> Vec<u8> {
+pub fn wide_bvh(joints: usize) -> Vec<u8> {
     let mut text = String::from("HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n");
     for j in 0..joints {
         writeln!(text, "JOINT j{j}\n{{\nOFFSET 0 1 0\nCHANNELS 0\n}}").unwrap();
