@@ -39,7 +39,7 @@ pub struct BindMismatch {
     pub distance: f64,
     /// Between the two rotations (polar decomposition), in degrees.
     pub angle_deg: f64,
-    /// The largest relative change of a scale factor.
+    /// The largest relative change of a scale factor (1 for a factor that is zero at rest and not in the bind).
     pub scale_change: f64,
 }
 
@@ -73,13 +73,22 @@ pub fn bind_mismatches(rig: &Rig, hierarchy: &Hierarchy, tolerance: &BindToleran
 
 fn compare(bone: usize, name: String, bind: &DMat4, rest: &DMat4) -> BindMismatch {
     let (b, r) = (decompose(bind), decompose(rest));
-    let ratio = b.scale / r.scale;
     BindMismatch {
         bone,
         name,
         distance: b.translation.distance(r.translation),
         angle_deg: b.rotation.angle_between(r.rotation).to_degrees(),
-        scale_change: (ratio - 1.0).abs().max_element(),
+        scale_change: (0..3).map(|axis| scale_change(b.scale[axis], r.scale[axis])).fold(0.0, f64::max),
+    }
+}
+
+/// How much a scale factor changes from `rest` to `bind`, relative to `rest`; a zero (degenerate) rest factor has no
+/// such ratio, and counts as all of the bind's (1), or none when both are zero, never NaN or infinity.
+fn scale_change(bind: f64, rest: f64) -> f64 {
+    match (bind - rest).abs() / rest.abs() {
+        change if change.is_finite() => change,
+        _ if bind == rest => 0.0,
+        _ => 1.0,
     }
 }
 
@@ -105,5 +114,14 @@ mod tests {
         assert!((found[0].distance - 0.03).abs() < 1e-12);
         assert!((found[0].angle_deg - 10.0).abs() < 1e-9);
         assert!(found[0].scale_change < 1e-12);
+    }
+
+    #[test]
+    fn scale_changes_are_relative_to_the_rest_and_finite_at_zero() {
+        assert_eq!(scale_change(1.5, 1.0), 0.5);
+        assert_eq!(scale_change(-2.0, -4.0), 0.5, "mirrored factors compare by size");
+        assert_eq!(scale_change(2.0, 0.0), 1.0, "a zero rest factor: all of the bind's");
+        assert_eq!(scale_change(0.0, 0.0), 0.0);
+        assert_eq!(scale_change(1.0, 1e-320), 1.0, "a ratio past f64 counts as all of it");
     }
 }

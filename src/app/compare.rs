@@ -59,7 +59,9 @@ impl Compared {
 
     /// The file's name, for labels.
     pub fn title(&self) -> String {
-        self.path.file_name().map_or_else(|| self.path.display().to_string(), |n| n.to_string_lossy().into_owned())
+        let name =
+            self.path.file_name().map_or_else(|| self.path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        crate::import::text::printable(&name).into_owned()
     }
 
     /// How many of the document's bones have no partner here.

@@ -137,7 +137,11 @@ impl Document {
     pub fn title(&self) -> String {
         self.path.as_ref().map_or_else(
             || "demo rig".to_owned(),
-            |p| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            |p| {
+                let name = p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
+                // The window title: a file's name may hold control characters.
+                crate::import::text::printable(&name).into_owned()
+            },
         )
     }
 

@@ -53,6 +53,8 @@ impl Notifications {
     }
 
     fn push(&mut self, text: String, error: bool, topic: Option<String>) {
+        // A path or a name in a message may hold control characters: shown escaped, on one line.
+        let text = crate::import::text::printable(&text).into_owned();
         if let Some(same) = self.items.iter_mut().find(|n| n.text == text && n.error == error) {
             same.count += 1;
             same.shown_at = None;

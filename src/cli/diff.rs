@@ -63,7 +63,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
 /// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`).
 pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Option<String>) -> FileSide<'a> {
     FileSide {
-        file: path.display().to_string(),
+        file: super::scan::shown(path),
         rig,
         modes: rig.skeleton.modes(modes),
         inherit: modes.label().to_owned(),

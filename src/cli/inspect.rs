@@ -1,5 +1,6 @@
 //! `bonescope inspect`: every bone's matrices, decomposition and findings at chosen times.
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -50,7 +51,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         .collect();
     let summary = layers.summary(&rig, clip);
     let subject = InspectSubject {
-        file: args.file.display().to_string(),
+        file: super::scan::shown(&args.file),
         rig: &rig,
         clip,
         inherit: args.eval.inherit_label(),
@@ -59,7 +60,13 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     };
     let report = LayeredInspectReport::new(subject, samples);
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        Format::Json => {
+            // Written as it is serialised: a rig of a million bones prints gigabytes, never held in memory at once.
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            serde_json::to_writer_pretty(&mut out, &report)?;
+            writeln!(out)?;
+            out.flush()?;
+        }
         Format::Table => print!("{}", render_table(&report, &summary)),
     }
     Ok(ExitCode::SUCCESS)

@@ -88,11 +88,15 @@ pub struct TargetArg {
     pub weight: f64,
 }
 
+/// The largest shake parameter: a factor (speed × amplitude, times a per-level modifier growing by the attenuation)
+/// of a million per parameter is far beyond any shake, and keeps every shaken bone's matrix finite.
+const MAX_SHAKE_PARAM: f64 = 1e6;
+
 fn parse_shake_param(s: &str) -> Result<(String, f64), String> {
     let (name, value) = s.split_once('=').ok_or_else(|| format!("expected NAME=VALUE, got `{s}`"))?;
     let value: f64 = value.trim().parse().map_err(|_| format!("`{value}` is not a number"))?;
-    if !value.is_finite() {
-        return Err(format!("{name} must be finite, got {value}"));
+    if !value.is_finite() || value.abs() > MAX_SHAKE_PARAM {
+        return Err(format!("{name} must be a number from -{MAX_SHAKE_PARAM:e} to {MAX_SHAKE_PARAM:e}, got {value:e}"));
     }
     Ok((name.trim().to_owned(), value))
 }

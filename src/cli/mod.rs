@@ -34,6 +34,10 @@ pub use options::{EvalArgs, Format, ToleranceArgs};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// The most memory one file may make bonescope use, e.g. 8GiB or 512M (default: half the machine's memory,
+    /// at most a quarter of the process's address-space limit); a file estimated to need more is refused.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = crate::import::budget::parse_size)]
+    pub max_memory: Option<u64>,
     /// The animation file to open in the app (glTF .gltf/.glb, FBX, BVH).
     pub file: Option<std::path::PathBuf>,
 }
@@ -71,6 +75,7 @@ const NEEDS_GUI: &str = "needs the `gui` feature: install bonescope with its def
 /// Parses the process arguments and runs the command.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    crate::import::budget::set_limit(cli.max_memory);
     let result = match cli.command {
         Some(Command::Inspect(args)) => inspect::run(&args),
         Some(Command::Scan(args)) => scan::run(&args),
@@ -90,7 +95,9 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            // One line, whatever a file put into the message (its names are escaped on import; paths and
+            // options are escaped here).
+            eprintln!("error: {}", crate::import::text::printable(&format!("{error:#}")));
             ExitCode::from(2)
         }
     }

@@ -48,7 +48,7 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
         ReportFormat::Junit => println!("{}", junit(&files)),
     }
     for error in files.iter().filter_map(|f| f.error.as_deref()) {
-        eprintln!("error: {error}");
+        eprintln!("error: {}", crate::import::text::printable(error));
     }
     Ok(verdict(&files, args.fail_above))
 }

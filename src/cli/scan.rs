@@ -18,6 +18,7 @@ use crate::analysis::{ScanOptions, scan};
 use crate::diff::{AnimationDiff, diff_files};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
+use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
 use crate::model::{InheritMode, ModeChoice, Rig};
 
@@ -151,7 +152,7 @@ fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
     let filter = Filter::new(&args.include, &args.exclude).map_err(anyhow::Error::msg)?;
     let inputs = collect(&args.files, &filter, &mut std::io::stdin().lock());
     for problem in &inputs.problems {
-        eprintln!("warning: {}: {}", problem.path.display(), problem.message);
+        eprintln!("warning: {}", printable(&format!("{}: {}", problem.path.display(), problem.message)));
     }
     Ok(match args.shard {
         Some((part, parts)) => inputs.shard(part, parts),
@@ -204,7 +205,7 @@ fn report_files<T: serde::Serialize + Send>(
     let done = |path: &Path, file: FileReport<T>| {
         progress.file_done(path);
         if let Some(error) = &file.error {
-            progress.println(&format!("error: {error}"));
+            progress.println(&format!("error: {}", printable(error)));
         }
         if format == ScanFormat::Jsonl && written.is_ok() {
             written = serde_json::to_string(&file).map_err(anyhow::Error::from).and_then(|line| {
@@ -258,10 +259,12 @@ impl Progress {
         self.done += 1;
         match &self.bar {
             Some(bar) => {
-                bar.set_message(path.display().to_string());
+                bar.set_message(shown(path));
                 bar.inc(1);
             }
-            None if self.lines => eprintln!("[{}/{}] {}", self.done, self.total, path.display()),
+            None if self.lines => {
+                eprintln!("[{}/{}] {}", self.done, self.total, shown(path));
+            }
             None => {}
         }
     }
@@ -281,13 +284,18 @@ impl Progress {
     }
 }
 
+/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
+pub(super) fn shown(path: &Path) -> String {
+    printable(&path.display().to_string()).into_owned()
+}
+
 /// 0 when every file loaded, 2 when one did not.
 fn loaded_code(all_loaded: bool) -> ExitCode {
     if all_loaded { ExitCode::SUCCESS } else { ExitCode::from(2) }
 }
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
-    let file = path.display().to_string();
+    let file = shown(path);
     let scanned = load_layered(path, args).map(|loaded| {
         loaded.each_clip(|evaluation| {
             let result = scan(evaluation, options, &|_, _| {});
@@ -337,7 +345,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
     let storage =
         StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
     let measure = |path: &Path| {
-        let file = path.display().to_string();
+        let file = shown(path);
         let measured = load_layered(path, args).map(|loaded| {
             loaded.each_clip(|evaluation| AnimationStorage {
                 animation: evaluation.clip.map(AnimationInfo::of),
@@ -386,7 +394,7 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 
 /// `--compare-inherit`: each file's clips [`diff_files`]-compared with themselves under the two sides' modes.
 fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<ExitCode> {
-    let compare = |path: &Path| FileReport::new(path.display().to_string(), compare_animations(path, args, sides));
+    let compare = |path: &Path| FileReport::new(shown(path), compare_animations(path, args, sides));
     let [a, b] = sides.map(|side| side.label());
     let render = |file: &str, diff: &AnimationDiff| {
         format!("{file}  inherit: {a} against {b}\n{}\n", super::diff::render_animation(diff))

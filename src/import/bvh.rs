@@ -21,8 +21,8 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 
-use super::ImportError;
 use super::failure::{Failure, Result};
+use super::{ImportError, budget, text};
 use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
 
 /// Reads a BVH file whose bytes are in memory.
@@ -140,9 +140,10 @@ impl<'a> Iterator for Lines<'a> {
     }
 }
 
-/// The whitespace-separated words of a line (invalid UTF-8 is replaced, so names always print).
+/// The whitespace-separated words of a line, printable (invalid UTF-8 and control characters escaped: names and
+/// keywords are echoed in notes and errors).
 fn words(line: &[u8]) -> Vec<String> {
-    String::from_utf8_lossy(line).split_ascii_whitespace().map(str::to_owned).collect()
+    line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).map(text::printable_bytes).collect()
 }
 
 fn number(word: &str, line: usize, what: &str) -> Result<f64> {
@@ -154,15 +155,25 @@ fn number(word: &str, line: usize, what: &str) -> Result<f64> {
 
 fn read(bytes: &[u8]) -> Result<Rig> {
     let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    check_declared_joints(text)?;
     let mut lines = Lines { text, number: 0 };
     let joints = read_hierarchy(&mut lines)?;
     let (frames, frame_time, header_line) = read_motion_header(&mut lines)?;
+    check_budget(&joints, frames, lines.text.len())?;
     let skeleton = skeleton(&joints)?;
     let mut notes = vec![
         "units and axes: as written (BVH states neither; often centimetres, Y-up), no conversion".to_owned(),
         "position channels replace the OFFSET components they name; end sites are bones named <parent>_end".to_owned(),
     ];
-    let clips = match read_frames(&mut lines, &joints, frames, header_line)? {
+    let (values, rows) = read_frames(&mut lines, &joints, frames, header_line)?;
+    if rows > frames {
+        notes.push(format!(
+            "the MOTION section has {rows} rows, {} more than its `Frames: {frames}`: all {rows} are read",
+            rows - frames
+        ));
+    }
+    let frames = rows;
+    let clips = match values {
         None => {
             notes.push("the MOTION section has 0 frames: no animation".to_owned());
             Vec::new()
@@ -363,8 +374,45 @@ fn read_motion_header(lines: &mut Lines) -> Result<(u64, f64, usize)> {
     Ok((frames, frame_time, line))
 }
 
-/// Every frame's numbers, `frames × channels` of them; `None` when the header says 0 frames.
-fn read_frames(lines: &mut Lines, joints: &[Joint], frames: u64, header_line: usize) -> Result<Option<Vec<f64>>> {
+/// Refuses a file that declares more joints than the memory budget holds bones, before any is read: a count of the
+/// lines that start with `ROOT`, `JOINT` or `End` up to `MOTION` (a quick pass, where reading the hierarchy of a
+/// million joints takes a second).
+fn check_declared_joints(text: &[u8]) -> Result<()> {
+    let starts = |line: &[u8], word: &[u8]| line.get(..word.len()).is_some_and(|w| w.eq_ignore_ascii_case(word));
+    let mut joints = 0u64;
+    for (_, line) in (Lines { text, number: 0 }) {
+        let line = line.trim_ascii_start();
+        if starts(line, b"MOTION") {
+            break;
+        }
+        joints += u64::from(starts(line, b"ROOT") || starts(line, b"JOINT") || starts(line, b"END"));
+    }
+    budget::check(joints.saturating_mul(budget::BONE_BYTES), None, || format!("{joints} joints"))
+}
+
+/// Refuses a file whose joints and frames (as many as the rest of the file, `rest` bytes, can hold) would exceed
+/// the memory budget: a joint is a bone, and each frame a translation and a rotation key per joint with channels.
+fn check_budget(joints: &[Joint], frames: u64, rest: usize) -> Result<()> {
+    const KEY_BYTES: u64 = 8 + 12 + 16;
+    let per_frame = joints.iter().map(|j| j.channels.len() as u64).sum::<u64>();
+    // A number takes at least two bytes (a digit and a separator); every frame holds at least its line break.
+    let frames = frames.min(rest as u64 / (2 * per_frame).max(1));
+    let animated = joints.iter().filter(|j| !j.channels.is_empty()).count() as u64;
+    let per_frame_bytes = animated.saturating_mul(KEY_BYTES).saturating_add(per_frame.saturating_mul(8));
+    let bytes =
+        (joints.len() as u64).saturating_mul(budget::BONE_BYTES).saturating_add(frames.saturating_mul(per_frame_bytes));
+    budget::check(bytes, None, || format!("{} joints and {frames} frames", joints.len()))
+}
+
+/// Every frame's numbers, `rows × channels` of them (`None` when there are none), and the number of rows: those the
+/// header declares, or more when the file holds more (a common off-by-one that other readers accept; fewer is an
+/// error).
+fn read_frames(
+    lines: &mut Lines,
+    joints: &[Joint],
+    frames: u64,
+    header_line: usize,
+) -> Result<(Option<Vec<f64>>, u64)> {
     let per_frame: usize = joints.iter().map(|j| j.channels.len()).sum();
     // Each number takes at least two bytes (a digit and a separator): never reserve more than the file can hold.
     let room = lines.text.len() / 2 + 1;
@@ -381,10 +429,6 @@ fn read_frames(lines: &mut Lines, joints: &[Joint], frames: u64, header_line: us
         }
         read += 1;
         let frame = read - 1;
-        if read > frames {
-            let message = format!("frame {frame} is beyond the {frames} frames the header declares");
-            return Err(on_line(line, message));
-        }
         let before = values.len();
         for word in text.split_ascii_whitespace() {
             if values.len() - before == per_frame {
@@ -406,7 +450,7 @@ fn read_frames(lines: &mut Lines, joints: &[Joint], frames: u64, header_line: us
         let message = format!("the file ends after {read} frames, but the header declares {frames}");
         return Err(on_line(last_line, message));
     }
-    Ok((frames > 0).then_some(values))
+    Ok(((read > 0).then_some(values), read))
 }
 
 /// The distinct rotation orders of the joints (`ZXY` for `Zrotation Xrotation Yrotation`), in order of appearance.

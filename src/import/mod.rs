@@ -4,19 +4,23 @@
 //! problem into an [`ImportError`] naming the file and the place in it; none may panic or allocate much more than
 //! the file's size suggests, whatever the bytes (the fuzz targets in `fuzz/` and `examples/fuzz_import.rs` check).
 
+pub mod budget;
 mod bvh;
 mod demo;
 mod failure;
 mod fbx;
 mod gltf;
+mod magnitude;
+pub mod text;
 
 pub use demo::{demo_rig, stress_rig};
 
+use std::borrow::Cow;
 use std::fmt;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use crate::model::Rig;
+use crate::model::{Bone, Rig, Skeleton};
 
 pub use fbx::{memory_limit as fbx_memory_limit, ufbx_load_opts as fbx_load_opts};
 
@@ -31,7 +35,7 @@ pub struct ImportError {
 
 impl fmt::Display for ImportError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: ", self.path.display())?;
+        write!(f, "{}: ", text::printable(&self.path.to_string_lossy()))?;
         if let Some(place) = &self.place {
             write!(f, "{place}: ")?;
         }
@@ -39,10 +43,53 @@ impl fmt::Display for ImportError {
     }
 }
 
+/// The most characters of an error's place and of its message: they may quote the file (a path of FBX records a
+/// hundred thousand deep, a name thousands of characters long), and an error is one readable line.
+const PLACE_CHARS: usize = 300;
+const MESSAGE_CHARS: usize = 1000;
+
 impl ImportError {
+    /// The error, its place and message made printable and cut to a readable length ([`text`]).
     pub fn new(path: &Path, place: Option<String>, message: impl Into<String>) -> Self {
-        ImportError { path: path.to_owned(), place, message: message.into() }
+        let place = place.map(|p| text::printable_cut(&p, PLACE_CHARS));
+        ImportError { path: path.to_owned(), place, message: text::printable_cut(&message.into(), MESSAGE_CHARS) }
     }
+}
+
+/// What every loaded rig goes through: refused when its numbers can overflow ([`magnitude`]), its names and notes
+/// made printable.
+fn finish(path: &Path, rig: Rig) -> Result<Rig, ImportError> {
+    magnitude::check(&rig).map_err(|f| f.with_path(path))?;
+    Ok(printable_rig(rig))
+}
+
+/// The rig with every name and note from the file printable, and names cut to a readable length ([`text::name`]).
+fn printable_rig(mut rig: Rig) -> Rig {
+    let unprintable = |name: &str| name.chars().any(char::is_control) || name.chars().nth(text::NAME_CHARS).is_some();
+    let tidy = |name: &mut String| {
+        if unprintable(name) {
+            *name = text::name(name);
+        }
+    };
+    if rig.skeleton.bones().iter().any(|b| unprintable(&b.name)) {
+        let bones = rig.skeleton.bones().iter().map(|b| Bone { name: text::name(&b.name), ..b.clone() }).collect();
+        // The same bones in the same order: a skeleton already.
+        if let Ok(skeleton) = Skeleton::new(bones) {
+            rig.skeleton = skeleton;
+        }
+    }
+    rig.clips.iter_mut().filter_map(|c| c.name.as_mut()).for_each(tidy);
+    rig.skins.iter_mut().filter_map(|s| s.name.as_mut()).for_each(tidy);
+    for mesh in &mut rig.meshes {
+        tidy(&mut mesh.name);
+        mesh.morph_targets.iter_mut().for_each(|t| tidy(&mut t.name));
+    }
+    for note in &mut rig.notes {
+        if let Cow::Owned(printable) = text::printable(note) {
+            *note = printable;
+        }
+    }
+    rig
 }
 
 /// The formats bonescope reads.
@@ -116,13 +163,17 @@ pub fn load(path: &Path) -> Result<Rig, ImportError> {
 /// is not copied into memory whole before it is parsed; BVH is read whole first.
 pub fn load_with(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     let cannot_read = |e: std::io::Error| ImportError::new(path, None, format!("cannot read the file: {e}"));
+    // A pipe would block the open, a device never end: only regular files are opened.
+    if !std::fs::metadata(path).map_err(cannot_read)?.is_file() {
+        return Err(ImportError::new(path, None, "not a regular file (a folder, a pipe or a device): not read"));
+    }
     let mut file = std::fs::File::open(path).map_err(cannot_read)?;
     // As much as `detect` looks at; a recognised glTF or FBX file is read no further here.
     let mut bytes = Vec::new();
     (&mut file).take(FBX_ASCII_LOOKAHEAD as u64).read_to_end(&mut bytes).map_err(cannot_read)?;
     match detect(&bytes) {
-        Some(Format::Gltf) => return gltf::load_file(path, &file),
-        Some(Format::Fbx) => return fbx::load_file(path, file, &bytes, options),
+        Some(Format::Gltf) => return gltf::load_file(path, &file).and_then(|rig| finish(path, rig)),
+        Some(Format::Fbx) => return fbx::load_file(path, file, &bytes, options).and_then(|rig| finish(path, rig)),
         _ => {}
     }
     let size = file.metadata().map_or(0, |m| usize::try_from(m.len()).unwrap_or(0));
@@ -150,11 +201,12 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &Options) -> Result<R
 
 /// Parses `bytes` as `format`, whatever they look like (the fuzz targets use it to reach each parser directly).
 pub fn load_bytes_as(format: Format, path: &Path, bytes: &[u8], options: &Options) -> Result<Rig, ImportError> {
-    match format {
+    let rig = match format {
         Format::Gltf => gltf::load(path, bytes),
         Format::Fbx => fbx::load(path, bytes, options),
         Format::Bvh => bvh::load(path, bytes),
-    }
+    };
+    rig.and_then(|rig| finish(path, rig))
 }
 
 #[cfg(test)]
@@ -174,5 +226,17 @@ mod tests {
         assert_eq!(detect(b"Kaydara FBX Binary"), None, "a truncated magic is not FBX");
         assert_eq!(detect(b""), None);
         assert_eq!(detect(b"   "), None);
+    }
+
+    #[test]
+    fn names_from_a_file_are_printable_and_readable_in_length() {
+        let long = "y".repeat(1000);
+        let json = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}],
+                "nodes": [{{"name": "a\u001b[2J\nb", "children": [1]}}, {{"name": "{long}"}}]}}"#
+        );
+        let rig = load_bytes(Path::new("names.gltf"), json.as_bytes()).unwrap();
+        assert_eq!(rig.skeleton.bone(0).name, "a\\x1b[2J\\x0ab");
+        assert_eq!(rig.skeleton.bone(1).name, format!("{}…", "y".repeat(text::NAME_CHARS)));
     }
 }

@@ -2,8 +2,10 @@
 //!
 //! - A file is scanned as named, whatever its content (a file that is not an animation then fails to load, which
 //!   the report says).
-//! - A folder is walked recursively (symbolic links followed, loops detected by walkdir) and the files in it whose
-//!   content bonescope recognises ([`crate::import::detect`] on their first 64 KiB, never their name) are scanned;
+//! - A folder is walked recursively (symbolic links followed, loops detected by walkdir) and the files in it with an
+//!   animation's extension (`.gltf`, `.glb`, `.fbx`, `.bvh`, any case) or whose content bonescope recognises
+//!   ([`crate::import::detect`] on their first 64 KiB) are scanned: a broken export is an error in the report, never
+//!   passed over, and only a file foreign by both name and content is left out;
 //!   `--include`/`--exclude` globs narrow that down by path relative to the folder (a pattern without a `/`
 //!   matches the file name, as `*.fbx`).
 //! - A pattern with glob characters that names nothing as written (`'exports/**/*.fbx'`, quoted so the shell left it)
@@ -163,9 +165,13 @@ impl Inputs {
                     };
                     self.problem(&path, message);
                 }
-                Ok(entry) if entry.file_type().is_file() => {
+                Ok(entry) if !entry.file_type().is_dir() => {
                     let relative = entry.path().strip_prefix(folder).unwrap_or(entry.path());
-                    if filter.admits(relative) && recognised(entry.path()) {
+                    // Pipes and devices are never opened here: with an animation's name they fail to load, naming
+                    // themselves; without one they are not animations.
+                    let animation = has_animation_extension(entry.path())
+                        || (entry.file_type().is_file() && recognised(entry.path()));
+                    if filter.admits(relative) && animation {
                         let key = key_of(relative);
                         self.files.push(Found { path: entry.into_path(), key });
                     }
@@ -184,6 +190,15 @@ fn key_of(path: &Path) -> String {
 /// Whether `path` has glob characters.
 fn is_glob(path: &Path) -> bool {
     path.to_string_lossy().contains(['*', '?', '['])
+}
+
+/// The extensions of the formats bonescope reads.
+const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh"];
+
+/// Whether `path` is named as an animation file.
+fn has_animation_extension(path: &Path) -> bool {
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    extension.is_some_and(|e| ANIMATION_EXTENSIONS.contains(&e.as_str()))
 }
 
 /// Whether a file's first bytes are a format bonescope reads. JSON counts as glTF only with an `"asset"` key in
@@ -261,6 +276,22 @@ mod tests {
         ];
         assert_eq!(names(&inputs, dir.path()), expected, "not the JSON report");
         assert!(inputs.problems.is_empty(), "{:?}", inputs.problems);
+    }
+
+    #[test]
+    fn files_named_as_animations_are_scanned_whatever_their_content() {
+        let dir = library();
+        let root = dir.path();
+        std::fs::write(root.join("mocap/bad_magic.glb"), b"glTX\x02\0\0\0").unwrap();
+        std::fs::write(root.join("mocap/empty.GLTF"), b"").unwrap();
+        std::fs::write(root.join("mocap/stl.gltf"), b"solid cube\n").unwrap();
+        std::fs::write(root.join("mocap/readme.md"), b"solid cube\n").unwrap();
+        let inputs = collect(&[root.to_owned()], &Filter::default(), &mut std::io::empty());
+        let names = names(&inputs, root);
+        for name in ["mocap/bad_magic.glb", "mocap/empty.GLTF", "mocap/stl.gltf"] {
+            assert!(names.contains(&name.to_owned()), "{name} in {names:?}");
+        }
+        assert!(!names.iter().any(|n| n.ends_with("readme.md") || n.ends_with("notes.txt")), "{names:?}");
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! could not be loaded as an error. Scans that judge nothing (`--compare-inherit`, `--storage`) give passing cases
 //! with their table as the case's output.
 
+use std::borrow::Cow;
 use std::io;
 
 use quick_xml::Writer;
@@ -27,9 +28,9 @@ pub fn junit_of<T>(files: &[FileReport<T>], case: impl Fn(&str, &T) -> Case) -> 
     let suites: Vec<Suite> = files
         .iter()
         .map(|file| Suite {
-            name: &file.file,
-            error: file.error.as_deref(),
-            cases: file.animations.iter().map(|clip| case(&file.file, clip)).collect(),
+            name: xml_text(&file.file),
+            error: file.error.as_deref().map(xml_text),
+            cases: file.animations.iter().map(|clip| xml_case(case(&file.file, clip))).collect(),
         })
         .collect();
     let mut writer = Writer::new_with_indent(Vec::new(), b' ', 2);
@@ -37,10 +38,33 @@ pub fn junit_of<T>(files: &[FileReport<T>], case: impl Fn(&str, &T) -> Case) -> 
     String::from_utf8(writer.into_inner()).expect("quick-xml writes UTF-8")
 }
 
+/// Text XML 1.0 can hold: the control characters it forbids (all but tab, line feed and carriage return, which
+/// tables in `system-out` use) escaped as `\x1b`. Reports read back by `report` may come from anywhere.
+fn xml_text(text: &str) -> Cow<'_, str> {
+    let forbidden = |c: char| c.is_control() && !matches!(c, '\t' | '\n' | '\r');
+    if !text.chars().any(forbidden) {
+        return Cow::Borrowed(text);
+    }
+    let escape = |c: char| {
+        if forbidden(c) { crate::import::text::printable(&c.to_string()).into_owned() } else { c.to_string() }
+    };
+    Cow::Owned(text.chars().map(escape).collect())
+}
+
+/// A case whose texts XML can hold ([`xml_text`]).
+fn xml_case(case: Case) -> Case {
+    let own = |text: &str| xml_text(text).into_owned();
+    Case {
+        name: own(&case.name),
+        failures: case.failures.iter().map(|(message, details)| (own(message), own(details))).collect(),
+        output: case.output.as_deref().map(own),
+    }
+}
+
 /// One file: its clips' cases, or the error that kept it from loading.
 struct Suite<'a> {
-    name: &'a str,
-    error: Option<&'a str>,
+    name: Cow<'a, str>,
+    error: Option<Cow<'a, str>>,
     cases: Vec<Case>,
 }
 
@@ -97,11 +121,13 @@ fn write_suite(writer: &mut Writer<Vec<u8>>, suite: &Suite) -> io::Result<()> {
     let attributes = Counts::of(suite).attributes();
     let element = writer
         .create_element("testsuite")
-        .with_attribute(("name", suite.name))
+        .with_attribute(("name", suite.name.as_ref()))
         .with_attributes(attributes.iter().map(|(k, v)| (*k, v.as_str())));
-    element.write_inner_content(|writer| match suite.error {
+    element.write_inner_content(|writer| match suite.error.as_deref() {
         Some(error) => {
-            let case = writer.create_element("testcase").with_attributes([("classname", suite.name), ("name", "load")]);
+            let case = writer
+                .create_element("testcase")
+                .with_attributes([("classname", suite.name.as_ref()), ("name", "load")]);
             case.write_inner_content(|writer| {
                 let problem = writer.create_element("error").with_attributes([("message", error), ("type", "load")]);
                 problem.write_text_content(BytesText::new(error))?;
@@ -109,7 +135,7 @@ fn write_suite(writer: &mut Writer<Vec<u8>>, suite: &Suite) -> io::Result<()> {
             })?;
             Ok(())
         }
-        None => suite.cases.iter().try_for_each(|case| write_case(writer, suite.name, case)),
+        None => suite.cases.iter().try_for_each(|case| write_case(writer, &suite.name, case)),
     })?;
     Ok(())
 }
@@ -159,4 +185,38 @@ fn stretch_case(clip: &AnimationScan) -> Case {
         })
         .collect();
     Case { name, failures, output: None }
+}
+
+#[cfg(test)]
+mod tests {
+    use quick_xml::events::Event;
+
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_so_the_report_parses() {
+        let file = FileScan {
+            file: "evil\u{1b}]0;title\u{7}.glb".to_owned(),
+            error: Some("nodes[0]: bad \u{0}name\nwith a break".to_owned()),
+            animations: Vec::new(),
+        };
+        let xml = junit(&[file]);
+        let mut reader = quick_xml::Reader::from_str(&xml);
+        let mut texts = Vec::new();
+        loop {
+            match reader.read_event().expect("the report is XML 1.0") {
+                Event::Eof => break,
+                Event::Text(text) if !text.decode().unwrap().trim().is_empty() => {
+                    texts.push(text.decode().unwrap().into_owned());
+                }
+                Event::Start(element) | Event::Empty(element) if element.name().as_ref() == b"testsuite" => {
+                    let name = element.try_get_attribute("name").unwrap().unwrap();
+                    let name = name.normalized_value(quick_xml::XmlVersion::Explicit1_0).unwrap();
+                    assert_eq!(name, "evil\\x1b]0;title\\x07.glb");
+                }
+                _ => {}
+            }
+        }
+        assert_eq!(texts, ["nodes[0]: bad \\x00name\nwith a break"], "line breaks are XML; NUL is not");
+    }
 }

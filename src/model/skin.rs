@@ -85,10 +85,16 @@ impl Mesh {
         changed
     }
 
-    /// Removes the vertices whose position is not finite (NaN or infinite: a broken export), with their skinning and
-    /// every triangle that uses one, so the rest can be skinned and drawn; how many were removed.
+    /// Removes the vertices whose position, skin weights or morph displacements are not finite (NaN or infinite: a
+    /// broken export), with their skinning and every triangle that uses one, so the rest can be skinned and drawn;
+    /// how many were removed.
     pub fn remove_non_finite_vertices(&mut self) -> usize {
-        let keep: Vec<bool> = self.positions.iter().map(|p| p.is_finite()).collect();
+        let finite = |v: usize| {
+            self.positions[v].is_finite()
+                && self.weights.get(v).is_none_or(|w| w.iter().all(|x| x.is_finite()))
+                && self.morph_targets.iter().all(|t| t.offsets.get(v).is_none_or(|o| o.is_finite()))
+        };
+        let keep: Vec<bool> = (0..self.positions.len()).map(finite).collect();
         let removed = keep.iter().filter(|&&k| !k).count();
         if removed == 0 {
             return 0;

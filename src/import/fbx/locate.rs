@@ -7,7 +7,7 @@
 
 /// Where the structure of `bytes` first breaks, if it visibly does.
 pub(super) fn locate(bytes: &[u8]) -> Option<String> {
-    if bytes.starts_with(b"Kaydara FBX Binary  \0") { binary(bytes) } else { ascii(bytes) }
+    if bytes.starts_with(super::BINARY_MAGIC) { binary(bytes) } else { ascii(bytes) }
 }
 
 /// Little-endian integer of `width` bytes at `pos`, if the file holds it.
@@ -23,12 +23,22 @@ struct Open {
     claimed_end: u64,
 }
 
-/// The names of the open records, outermost first, then `name`, for messages.
+/// The names of the open records, outermost first, then `name`, for messages; a path deeper than a reader can
+/// take in keeps its outermost and innermost names and counts the ones between.
 fn path(stack: &[Open], name: &str) -> String {
+    const OUTER: usize = 3;
+    const INNER: usize = 3;
     let mut parts: Vec<&str> = stack.iter().map(|o| o.name.as_str()).collect();
     parts.push(name);
-    parts.join(" > ")
+    if parts.len() <= OUTER + INNER {
+        return parts.join(" > ");
+    }
+    let (outer, inner) = (parts[..OUTER].join(" > "), parts[parts.len() - INNER..].join(" > "));
+    format!("{outer} > ({} more) > {inner}", parts.len() - OUTER - INNER)
 }
+
+/// How deep ufbx reads nested records or blocks.
+const MAX_DEPTH: usize = 32;
 
 fn binary(bytes: &[u8]) -> Option<String> {
     const HEADER: usize = 27;
@@ -85,31 +95,39 @@ fn binary(bytes: &[u8]) -> Option<String> {
         let name_start = pos + record_header as u64;
         let name = bytes
             .get(name_start as usize..(name_start + name_len) as usize)
-            .map(|n| String::from_utf8_lossy(n).into_owned())
+            .map(crate::import::text::printable_bytes)
             .unwrap_or_else(|| "(name cut off)".to_owned());
-        let here = path(&stack, &name);
+        // Only a message needs the path: built per record, it made a deep file's walk quadratic.
+        let here = || path(&stack, &name);
         let properties = name_start + name_len;
         if let Some(parent) = stack.last()
             && end > parent.claimed_end
         {
             let parent_end = parent.claimed_end;
-            return Some(format!("byte {pos}: node `{here}` ends at byte {end}, after its parent (byte {parent_end})"));
+            return Some(format!(
+                "byte {pos}: node `{}` ends at byte {end}, after its parent (byte {parent_end})",
+                here()
+            ));
         }
         if end < properties {
-            return Some(format!("byte {pos}: node `{here}` claims to end at byte {end}, inside its own header"));
+            return Some(format!("byte {pos}: node `{}` claims to end at byte {end}, inside its own header", here()));
         }
         // A record that claims more than the file holds is walked up to the file's end: the innermost one is the place.
         let reachable = end.min(len);
         let Some(children) = properties.checked_add(list_len).filter(|&c| c <= reachable) else {
             if end > len {
-                return Some(format!("byte {len}: the file ends inside the properties of node `{here}`"));
+                return Some(format!("byte {len}: the file ends inside the properties of node `{}`", here()));
             }
             return Some(format!(
-                "byte {pos}: node `{here}` has {list_len} bytes of properties, more than fit before its end (byte {end})"
+                "byte {pos}: node `{}` has {list_len} bytes of properties, more than fit before its end (byte {end})",
+                here()
             ));
         };
         if let Some(problem) = check_properties(bytes, properties, children, count) {
-            return Some(format!("node `{here}`: {problem}"));
+            return Some(format!("node `{}`: {problem}", here()));
+        }
+        if stack.len() == MAX_DEPTH {
+            return Some(format!("byte {pos}: node `{}` is nested deeper than FBX readers go ({MAX_DEPTH})", here()));
         }
         pos = children;
         stack.push(Open { end: reachable, name, claimed_end: end });
@@ -157,7 +175,9 @@ fn array(bytes: &[u8], at: usize, element: u64) -> Option<u64> {
     Some(12 + data)
 }
 
-fn ascii(bytes: &[u8]) -> Option<String> {
+/// Where the blocks of an ASCII file first fail to balance: a `}` without its `{`, or the end inside a block or a
+/// string.
+pub(super) fn ascii(bytes: &[u8]) -> Option<String> {
     let mut line = 1usize;
     // Open blocks: the key before the `{` and the line it is on.
     let mut stack: Vec<(String, usize)> = Vec::new();
@@ -190,6 +210,9 @@ fn ascii(bytes: &[u8]) -> Option<String> {
                 }
             }
             b':' => key = std::mem::take(&mut word),
+            b'{' if stack.len() == MAX_DEPTH => {
+                return Some(format!("line {line}: blocks nested deeper than FBX readers go ({MAX_DEPTH})"));
+            }
             b'{' => stack.push((std::mem::take(&mut key), line)),
             b'}' => {
                 if stack.pop().is_none() {

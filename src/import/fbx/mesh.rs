@@ -13,6 +13,7 @@ use glam::Vec3;
 
 use super::scene::SceneBones;
 use super::{Failure, Result, matrix, memory_limit, node_name};
+use crate::import::budget::size;
 use crate::model::{Mesh, MorphTarget, NodeBind, Skin};
 
 pub(super) fn read(
@@ -26,20 +27,31 @@ pub(super) fn read(
     let mut tally = Tally::default();
     let follows_node = skins_follow_their_node(scene);
     // An instanced mesh is copied per node: a small file could otherwise ask for any amount of memory.
-    let mut budget = memory_limit(file_size);
+    let limit = memory_limit(file_size);
+    let mut needed = 0usize;
     for (bone, bone_data) in bones.skeleton.bones().iter().enumerate() {
         let Some(node) = scene.nodes.get(bone_data.node) else { continue };
         let Some(mesh) = node.mesh.as_ref() else { continue };
         let place = format!("mesh `{}` on node `{}`", mesh.element.name, node_name(node));
-        // Positions, joints and weights per vertex; three indices per triangle.
-        let bytes =
-            mesh.vertices.len().saturating_mul(12 + 8 + 16).saturating_add(mesh.num_triangles.saturating_mul(12));
-        budget = budget.checked_sub(bytes).ok_or_else(|| {
-            Failure::at(
-                &place,
-                "the meshes, copied for every node that shows them, need more memory than the file's size can justify",
-            )
-        })?;
+        // Positions, normals, joints and weights per vertex, and positions and normals skinned; three indices per
+        // triangle.
+        let bytes = mesh
+            .vertices
+            .len()
+            .saturating_mul(12 + 12 + 8 + 16 + 24)
+            .saturating_add(mesh.num_triangles.saturating_mul(12));
+        needed = needed.saturating_add(bytes);
+        if needed > limit {
+            let message = format!(
+                "needs ~{} for the meshes, each copied for every node that shows it ({} nodes show this one of {} \
+                 vertices); the limit is {} (for a file of this size, or --max-memory)",
+                size(needed as u64),
+                mesh.element.instances.len(),
+                mesh.vertices.len(),
+                size(limit as u64)
+            );
+            return Err(Failure::at(&place, message));
+        }
         let mut read = Mesh { name: mesh_name(mesh, node), bone, ..Mesh::default() };
         read.indices = triangles(mesh, &place, &mut tally)?;
         // Unskinned positions (and their displacements) are placed in the node's space.

@@ -33,6 +33,7 @@ use crate::model::Rig;
 
 /// Reads an FBX file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
+    check_braces(bytes).map_err(|f| f.with_path(path))?;
     let scene = ufbx::load_memory(bytes, ufbx_load_opts(options, bytes.len()))
         .map_err(|e| Failure::ufbx(&e, locate::locate(bytes)));
     scene.and_then(|scene| read(&scene, bytes.len(), options)).map_err(|f| f.with_path(path))
@@ -41,10 +42,33 @@ pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result
 /// Reads the FBX file at `path`, open as `file` after its first bytes `head`: ufbx reads the rest through a buffer of
 /// its own, so the file is never held in memory whole. (A file ufbx refuses is read whole to locate the break.)
 pub fn load_file(path: &Path, file: File, head: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
+    if !head.starts_with(BINARY_MAGIC) {
+        let bytes =
+            std::fs::read(path).map_err(|e| ImportError::new(path, None, format!("cannot read the file: {e}")))?;
+        check_braces(&bytes).map_err(|f| f.with_path(path))?;
+    }
     let size = file.metadata().map_or(head.len(), |m| usize::try_from(m.len()).unwrap_or(usize::MAX));
     let scene = ufbx::load_stream_prefix(ufbx::Stream::File(file), head, ufbx_load_opts(options, size))
         .map_err(|e| Failure::ufbx(&e, std::fs::read(path).ok().and_then(|bytes| locate::locate(&bytes))));
     scene.and_then(|scene| read(&scene, size, options)).map_err(|f| f.with_path(path))
+}
+
+/// How a binary FBX file starts.
+const BINARY_MAGIC: &[u8] = b"Kaydara FBX Binary  \0";
+
+/// Refuses an ASCII file whose blocks do not nest: ufbx reads one with a `{` or `}` missing or extra as a different
+/// hierarchy than its author's, without a word.
+fn check_braces(bytes: &[u8]) -> Result<()> {
+    if bytes.starts_with(BINARY_MAGIC) {
+        return Ok(());
+    }
+    match locate::ascii(bytes) {
+        None => Ok(()),
+        Some(place) => Err(Failure::at(
+            place,
+            "the file's blocks do not nest as they should: refused rather than read as another hierarchy",
+        )),
+    }
 }
 
 impl Failure {
@@ -86,9 +110,11 @@ fn reading(error: &ufbx::Error) -> Option<String> {
 }
 
 /// The memory ufbx may use for one file of `file_size` bytes: generous for real files (a compressed binary FBX
-/// expands several times, and ufbx keeps both the parse tree and the scene), bounded for hostile ones.
+/// expands several times, and ufbx keeps both the parse tree and the scene), bounded for hostile ones, and never
+/// beyond the memory budget ([`budget`](crate::import::budget)).
 pub fn memory_limit(file_size: usize) -> usize {
-    (256usize << 20).saturating_add(file_size.saturating_mul(64))
+    let by_size = (256usize << 20).saturating_add(file_size.saturating_mul(64));
+    by_size.min(usize::try_from(crate::import::budget::limit()).unwrap_or(usize::MAX))
 }
 
 /// The ufbx load options bonescope uses, so that tests can load a file exactly the way the importer does.

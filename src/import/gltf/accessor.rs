@@ -17,7 +17,7 @@ use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
 
 /// The most bytes of elements an accessor may hold without a buffer view behind them.
-const MAX_ZEROS: usize = 64 << 20;
+pub(super) const MAX_ZEROS: usize = 64 << 20;
 
 /// glTF's component types (`componentType`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,7 +62,7 @@ const FLOAT: &[Component] = &[(DataType::F32, false)];
 /// Rotation and morph-weight outputs: float, or signed or unsigned normalized bytes and shorts.
 const FLOAT_OR_NORMALIZED: &[Component] =
     &[(DataType::F32, false), (DataType::I8, true), (DataType::U8, true), (DataType::I16, true), (DataType::U16, true)];
-/// `WEIGHTS_0`: float, or unsigned normalized bytes and shorts.
+/// `WEIGHTS_n`: float, or unsigned normalized bytes and shorts.
 const FLOAT_OR_UNORM: &[Component] = &[(DataType::F32, false), (DataType::U8, true), (DataType::U16, true)];
 /// `POSITION` and morph-target displacements with `KHR_mesh_quantization`: float, or bytes and shorts, signed or
 /// not, normalized or not.
@@ -92,8 +92,8 @@ const TIMES: Use = Use { what: "keyframe times", kind: "SCALAR", components: FLO
 const ROTATIONS: Use = Use { what: "rotation output", kind: "VEC4", components: FLOAT_OR_NORMALIZED };
 const MORPH_WEIGHTS: Use = Use { what: "morph-weight output", kind: "SCALAR", components: FLOAT_OR_NORMALIZED };
 const MATRICES: Use = Use { what: "inverse bind matrices", kind: "MAT4", components: FLOAT };
-const JOINTS: Use = Use { what: "JOINTS_0", kind: "VEC4", components: JOINT_INDEX };
-const WEIGHTS: Use = Use { what: "WEIGHTS_0", kind: "VEC4", components: FLOAT_OR_UNORM };
+const JOINTS: Use = Use { what: "JOINTS_0/JOINTS_1", kind: "VEC4", components: JOINT_INDEX };
+const WEIGHTS: Use = Use { what: "WEIGHTS_0/WEIGHTS_1", kind: "VEC4", components: FLOAT_OR_UNORM };
 const INDICES: Use = Use { what: "indices", kind: "SCALAR", components: VERTEX_INDEX };
 
 /// The accessors of a document and the buffers behind them.
@@ -139,13 +139,13 @@ impl<'a> Accessors<'a> {
         self.read(index, user, &MATRICES, |m: [f32; 16]| DMat4::from_cols_array(&m.map(f64::from)))
     }
 
-    /// `JOINTS_0`: four unsigned byte or short joint indices per vertex.
+    /// `JOINTS_n`: four unsigned byte or short joint indices per vertex.
     pub fn joints(&self, index: Uint, user: &str) -> Result<Vec<[u16; 4]>> {
         // Both allowed types fit in u16.
         self.read(index, user, &JOINTS, |j: [u32; 4]| j.map(|i| i as u16))
     }
 
-    /// `WEIGHTS_0`: four weights per vertex, float or unsigned normalized.
+    /// `WEIGHTS_n`: four weights per vertex, float or unsigned normalized.
     pub fn weights(&self, index: Uint, user: &str) -> Result<Vec<[f32; 4]>> {
         self.read(index, user, &WEIGHTS, |w: [f32; 4]| w)
     }

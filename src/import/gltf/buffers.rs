@@ -4,7 +4,8 @@
 //! A buffer nothing reads is never opened, so a file whose unused buffer points at a missing file or an `http:` URI
 //! still loads; a buffer that is read and cannot be had fails naming who needed it. A URI may name a file in the
 //! glTF file's folder or below it, percent-encoded or not; absolute paths, `..` and every scheme but `data:` are
-//! refused, so a downloaded file cannot make bonescope read elsewhere on disk or reach the network. No buffer is
+//! refused, and the path must still lie inside the folder once symbolic links are resolved and name a regular file,
+//! so a downloaded file cannot make bonescope read elsewhere on disk, block on a pipe or reach the network. No buffer is
 //! read beyond its declared `byteLength` (a GLB chunk may carry padding), an external file included, so memory
 //! stays bounded by what the files actually hold.
 
@@ -90,10 +91,23 @@ impl<'a> Buffers<'a> {
     }
 }
 
-/// At most `length` bytes of the file a buffer URI reference names.
+/// At most `length` bytes of the file a buffer URI reference names: the path is resolved first (symbolic links
+/// followed) and must lead to a regular file inside the glTF file's folder, so a link cannot make bonescope read
+/// elsewhere, a pipe block it or a device (`/dev/zero`) feed it without end.
 fn read_file(uri: &str, folder: &Path, length: usize) -> std::result::Result<Vec<u8>, String> {
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
     let path = folder.join(relative_path(uri)?);
-    let file = std::fs::File::open(&path).map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
+    let resolve =
+        |path: &Path| path.canonicalize().map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()));
+    let (resolved, root) = (resolve(&path)?, resolve(folder)?);
+    if !resolved.starts_with(&root) {
+        return Err(format!("`{uri}` leads outside the glTF file's folder (through a symbolic link): not read"));
+    }
+    let regular = std::fs::metadata(&resolved).is_ok_and(|m| m.is_file());
+    if !regular {
+        return Err(format!("`{uri}` is not a regular file (a folder, a pipe or a device): not read"));
+    }
+    let file = std::fs::File::open(&resolved).map_err(|e| format!("cannot open `{uri}` ({}): {e}", path.display()))?;
     let mut data = Vec::new();
     file.take(length as u64)
         .read_to_end(&mut data)

@@ -21,8 +21,10 @@ const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// Extensions bonescope evaluates.
 const EVALUATED: &[&str] = &["KHR_mesh_quantization", "KHR_animation_pointer"];
-/// Prefixes of extensions that only touch materials, textures, images or lights, which bonescope does not draw.
-const NOT_DRAWN: &[&str] = &["KHR_materials_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "EXT_lights_"];
+/// Prefixes of extensions that only touch materials (`KHR_techniques_webgl`: shaders), textures, images or lights,
+/// which bonescope does not draw.
+const NOT_DRAWN: &[&str] =
+    &["KHR_materials_", "KHR_techniques_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "EXT_lights_"];
 
 /// The parsed document with the GLB `BIN` chunk, if any.
 pub(super) struct Parsed<'a> {

@@ -1,5 +1,8 @@
 //! Skins (joints and inverse bind matrices) and the triangle meshes of the scene's nodes.
 
+use std::collections::HashMap;
+use std::rc::Rc;
+
 use glam::{DMat4, DVec4};
 
 use super::accessor::Accessors;
@@ -11,8 +14,10 @@ use crate::model::{Mesh, MorphTarget, Skin};
 /// How far the last row of an inverse bind matrix, stored in single precision, may be from `0, 0, 0, 1`.
 const AFFINE_TOLERANCE: f64 = 1e-6;
 
-/// glTF's `mode` for triangle lists (the default).
+/// glTF's `mode`s of triangles: lists (the default), strips and fans.
 const TRIANGLES: usize = 4;
+const TRIANGLE_STRIP: usize = 5;
+const TRIANGLE_FAN: usize = 6;
 
 /// Every skin of the document, in file order (so `Rig::skins[i]` is `skins[i]`); every joint must be a bone.
 pub(super) fn read_skins(
@@ -21,14 +26,28 @@ pub(super) fn read_skins(
     bone_of_node: &[Option<usize>],
     notes: &mut Vec<String>,
 ) -> Result<Vec<Skin>> {
-    root.skins.iter().enumerate().map(|(i, skin)| read_skin(i, skin, root, accessors, bone_of_node, notes)).collect()
+    // Skins may share one accessor of matrices: it is decoded once, each skin taking its joints' share.
+    let mut decoded: HashMap<schema::Uint, Rc<Vec<DMat4>>> = HashMap::new();
+    let mut matrices = |accessor: schema::Uint, place: &str| -> Result<Rc<Vec<DMat4>>> {
+        if let Some(matrices) = decoded.get(&accessor) {
+            return Ok(matrices.clone());
+        }
+        let matrices = Rc::new(accessors.matrices(accessor, place)?);
+        decoded.insert(accessor, matrices.clone());
+        Ok(matrices)
+    };
+    let mut skins = Vec::with_capacity(root.skins.len());
+    for (i, skin) in root.skins.iter().enumerate() {
+        skins.push(read_skin(i, skin, root, &mut matrices, bone_of_node, notes)?);
+    }
+    Ok(skins)
 }
 
 fn read_skin(
     index: usize,
     skin: &schema::Skin,
     root: &Root,
-    accessors: &Accessors,
+    matrices: &mut impl FnMut(schema::Uint, &str) -> Result<Rc<Vec<DMat4>>>,
     bone_of_node: &[Option<usize>],
     notes: &mut Vec<String>,
 ) -> Result<Skin> {
@@ -46,13 +65,13 @@ fn read_skin(
     let inverse_bind = match skin.inverse_bind_matrices {
         None => vec![DMat4::IDENTITY; joints.len()],
         Some(accessor) => {
-            let mut matrices = accessors.matrices(accessor, &format!("{place}.inverseBindMatrices"))?;
+            let all = matrices(accessor, &format!("{place}.inverseBindMatrices"))?;
             // The spec allows more matrices than joints; the extra ones belong to no joint.
-            if matrices.len() < joints.len() {
-                let message = format!("{} inverse bind matrices for {} joints", matrices.len(), joints.len());
+            let Some(matrices) = all.get(..joints.len()) else {
+                let message = format!("{} inverse bind matrices for {} joints", all.len(), joints.len());
                 return Err(Failure::at(place, message));
-            }
-            matrices.truncate(joints.len());
+            };
+            let matrices = matrices.to_vec();
             if let Some(k) = matrices.iter().position(|m| !m.is_finite()) {
                 return Err(Failure::at(place, format!("inverse bind matrix {k} is not finite")));
             }
@@ -82,7 +101,7 @@ pub(super) fn read_meshes(
     notes: &mut Vec<String>,
 ) -> Result<Vec<Mesh>> {
     let mut meshes = Vec::new();
-    let (mut other_modes, mut unweighted, mut unnormalized) = (0, 0, 0);
+    let mut tally = Tally::default();
     // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
     let mut unread_normals = Vec::new();
     let mut unsupplied = Vec::new();
@@ -98,8 +117,9 @@ pub(super) fn read_meshes(
             None => None,
         };
         for (p, primitive) in mesh.primitives.iter().enumerate() {
-            if primitive.mode.map_or(TRIANGLES, |m| m.0) != TRIANGLES {
-                other_modes += 1;
+            let mode = primitive.mode.map_or(TRIANGLES, |m| m.0);
+            if !matches!(mode, TRIANGLES | TRIANGLE_STRIP | TRIANGLE_FAN) {
+                tally.other_modes += 1;
                 continue;
             }
             let place = format!("meshes[{}].primitives[{p}]", mesh_index.0);
@@ -119,32 +139,25 @@ pub(super) fn read_meshes(
                 Vec::new()
             });
             if let Some(skin) = skin {
-                if read_skinning(&mut read, primitive, accessors, &skins[skin], &place)? {
+                if read_skinning(&mut read, primitive, accessors, &skins[skin], &place, &mut tally)? {
                     read.skin = Some(skin);
-                    unnormalized += read.normalize_weights();
                 } else {
-                    unweighted += 1;
+                    tally.unweighted += 1;
                 }
             }
-            read.indices = triangle_indices(primitive, accessors, read.positions.len(), &place)?;
+            read.indices = triangle_indices(primitive, accessors, read.positions.len(), mode, &place, &mut tally)?;
             read.morph_targets = morph_targets(primitive, accessors, read.positions.len(), &place)?;
+            tally.non_finite += read.remove_non_finite_vertices();
+            tally.unnormalized += read.normalize_weights();
             let weights = node.weights.as_ref().unwrap_or(&mesh.weights);
             read.morph_weights =
                 (0..read.morph_targets.len()).map(|k| weights.get(k).map_or(0.0, |&w| w as f32)).collect();
             meshes.push(read);
         }
     }
-    if other_modes > 0 {
-        notes.push(format!("{other_modes} mesh primitives that are not triangle lists were skipped"));
-    }
-    if unweighted > 0 {
-        notes.push(format!("{unweighted} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned"));
-    }
+    tally.notes(notes);
     if !unread_normals.is_empty() {
         notes.push(format!("normals left out: {}", unread_normals.join("; ")));
-    }
-    if unnormalized > 0 {
-        notes.push(format!("{unnormalized} vertices' skin weights did not sum to 1; normalised, as glTF requires"));
     }
     if !unsupplied.is_empty() {
         notes.push(format!(
@@ -155,9 +168,62 @@ pub(super) fn read_meshes(
     Ok(meshes)
 }
 
+/// What the meshes of a document add up to, for the notes.
+#[derive(Default)]
+struct Tally {
+    /// Primitives of points or lines.
+    other_modes: usize,
+    unweighted: usize,
+    unnormalized: usize,
+    /// Vertices left out for a position, weight or displacement that is not finite.
+    non_finite: usize,
+    /// Vertices with more than four influences (two sets), of which the four strongest are kept.
+    beyond_four: usize,
+    /// Primitives whose indices end in an incomplete triangle.
+    incomplete: Vec<String>,
+}
+
+impl Tally {
+    fn notes(&self, notes: &mut Vec<String>) {
+        if self.other_modes > 0 {
+            notes.push(format!("{} mesh primitives of points or lines were skipped", self.other_modes));
+        }
+        if self.unweighted > 0 {
+            notes.push(format!(
+                "{} primitives of skinned nodes have no JOINTS_0/WEIGHTS_0, read unskinned",
+                self.unweighted
+            ));
+        }
+        if self.unnormalized > 0 {
+            let count = self.unnormalized;
+            notes.push(format!("{count} vertices' skin weights did not sum to 1; normalised, as glTF requires"));
+        }
+        if self.non_finite > 0 {
+            let count = self.non_finite;
+            notes.push(format!(
+                "{count} vertices whose position, weights or morph displacements are not finite left out"
+            ));
+        }
+        if self.beyond_four > 0 {
+            notes.push(format!(
+                "{} vertices have more than 4 influences (JOINTS_1/WEIGHTS_1): the 4 strongest are kept, renormalised",
+                self.beyond_four
+            ));
+        }
+        if !self.incomplete.is_empty() {
+            let places = self.incomplete.join(", ");
+            notes
+                .push(format!("indices that do not make whole triangles: the incomplete last one left out ({places})"));
+        }
+    }
+}
+
+/// The attributes of a primitive's geometry.
+const GEOMETRY: [&str; 5] = ["POSITION", "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "WEIGHTS_1"];
+
 /// A buffer without a source in the file that the primitive's geometry needs, if any.
 fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Option<schema::Uint> {
-    let attributes = ["POSITION", "JOINTS_0", "WEIGHTS_0"].into_iter().filter_map(|a| primitive.attributes.get(a));
+    let attributes = GEOMETRY.into_iter().filter_map(|a| primitive.attributes.get(a));
     attributes.copied().chain(primitive.indices).find_map(|accessor| accessors.unsupplied_buffer(accessor))
 }
 
@@ -207,25 +273,27 @@ fn morph_targets(
     primitive.targets.iter().enumerate().map(target).collect()
 }
 
-/// Reads `JOINTS_0` and `WEIGHTS_0` into `mesh`; `false` when the primitive lacks either.
+/// Reads `JOINTS_0` and `WEIGHTS_0` into `mesh` (with `JOINTS_1` and `WEIGHTS_1`, the four strongest of the eight
+/// influences); `false` when the primitive lacks the first set.
 fn read_skinning(
     mesh: &mut Mesh,
     primitive: &schema::Primitive,
     accessors: &Accessors,
     skin: &Skin,
     place: &str,
+    tally: &mut Tally,
 ) -> Result<bool> {
-    let (Some(&joints), Some(&weights)) = (primitive.attributes.get("JOINTS_0"), primitive.attributes.get("WEIGHTS_0"))
-    else {
+    let Some((joints, weights)) = influence_set(primitive, accessors, 0, mesh.positions.len(), place)? else {
         return Ok(false);
     };
-    mesh.joints = accessors.joints(joints, &format!("{place}.attributes.JOINTS_0"))?;
-    mesh.weights = accessors.weights(weights, &format!("{place}.attributes.WEIGHTS_0"))?;
-    let vertices = mesh.positions.len();
-    if mesh.joints.len() != vertices || mesh.weights.len() != vertices {
-        let message =
-            format!("{vertices} positions but {} JOINTS_0 and {} WEIGHTS_0", mesh.joints.len(), mesh.weights.len());
-        return Err(Failure::at(place, message));
+    (mesh.joints, mesh.weights) = (joints, weights);
+    if let Some((joints, weights)) = influence_set(primitive, accessors, 1, mesh.positions.len(), place)? {
+        for (v, (second_joints, second_weights)) in joints.into_iter().zip(weights).enumerate() {
+            let (joints, weights, dropped) =
+                strongest([mesh.joints[v], second_joints], [mesh.weights[v], second_weights]);
+            (mesh.joints[v], mesh.weights[v]) = (joints, weights);
+            tally.beyond_four += usize::from(dropped);
+        }
     }
     let limit = skin.joints.len();
     if let Some(v) = mesh.joints.iter().position(|j| j.iter().any(|&i| usize::from(i) >= limit)) {
@@ -235,25 +303,109 @@ fn read_skinning(
     Ok(true)
 }
 
-/// The triangle list: the `indices` accessor, or `0..n` without one.
+/// Influences per vertex: `JOINTS_set` and `WEIGHTS_set`, one of each per vertex; `None` without them.
+type Influences = (Vec<[u16; 4]>, Vec<[f32; 4]>);
+
+/// The influence set `set` of a primitive of `vertices` vertices, if it has one.
+fn influence_set(
+    primitive: &schema::Primitive,
+    accessors: &Accessors,
+    set: usize,
+    vertices: usize,
+    place: &str,
+) -> Result<Option<Influences>> {
+    let (joints_name, weights_name) = (format!("JOINTS_{set}"), format!("WEIGHTS_{set}"));
+    let (Some(&joints), Some(&weights)) =
+        (primitive.attributes.get(&joints_name), primitive.attributes.get(&weights_name))
+    else {
+        return Ok(None);
+    };
+    let joints = accessors.joints(joints, &format!("{place}.attributes.{joints_name}"))?;
+    let weights = accessors.weights(weights, &format!("{place}.attributes.{weights_name}"))?;
+    if joints.len() != vertices || weights.len() != vertices {
+        let message =
+            format!("{vertices} positions but {} {joints_name} and {} {weights_name}", joints.len(), weights.len());
+        return Err(Failure::at(place, message));
+    }
+    Ok(Some((joints, weights)))
+}
+
+/// The four strongest of a vertex's eight influences (the model holds four, as FBX's reader keeps them), and whether
+/// one with weight was left out; the weights are renormalised with the others afterwards.
+fn strongest(joints: [[u16; 4]; 2], weights: [[f32; 4]; 2]) -> ([u16; 4], [f32; 4], bool) {
+    let mut all: Vec<(f32, u16)> =
+        weights.as_flattened().iter().copied().zip(joints.as_flattened().iter().copied()).collect();
+    // Strongest first; a weight that is not a number sorts last, and its vertex is left out later.
+    all.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let dropped = all[4..].iter().any(|&(w, _)| w != 0.0);
+    (std::array::from_fn(|k| all[k].1), std::array::from_fn(|k| all[k].0), dropped)
+}
+
+/// The triangle list of a primitive drawn as `mode` (list, strip or fan): the `indices` accessor, or `0..n` without
+/// one; an incomplete last triangle of a list is left out (and noted).
 fn triangle_indices(
     primitive: &schema::Primitive,
     accessors: &Accessors,
     vertices: usize,
+    mode: usize,
     place: &str,
+    tally: &mut Tally,
 ) -> Result<Vec<u32>> {
-    let indices = match primitive.indices {
+    let mut indices = match primitive.indices {
         Some(accessor) => accessors.indices(accessor, &format!("{place}.indices"))?,
         None => {
             let n = u32::try_from(vertices).map_err(|_| Failure::at(place, "too many vertices"))?;
             (0..n).collect()
         }
     };
-    if !indices.len().is_multiple_of(3) {
-        return Err(Failure::at(place, format!("{} indices do not make whole triangles", indices.len())));
-    }
     if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertices) {
         return Err(Failure::at(place, format!("index {bad} is out of range ({vertices} vertices)")));
     }
-    Ok(indices)
+    Ok(match mode {
+        TRIANGLE_STRIP => strip_triangles(&indices),
+        TRIANGLE_FAN => fan_triangles(&indices),
+        _ => {
+            if !indices.len().is_multiple_of(3) {
+                tally.incomplete.push(place.to_owned());
+                indices.truncate(indices.len() - indices.len() % 3);
+            }
+            indices
+        }
+    })
+}
+
+/// A triangle strip as a list: triangle `i` is `v[i], v[i+(1+i%2)], v[i+(2−i%2)]` (the glTF specification's: every
+/// other one turned back, so all keep the first one's winding).
+fn strip_triangles(strip: &[u32]) -> Vec<u32> {
+    (0..strip.len().saturating_sub(2)).flat_map(|i| [strip[i], strip[i + 1 + i % 2], strip[i + 2 - i % 2]]).collect()
+}
+
+/// A triangle fan as a list: triangle `i` is `v[i+1], v[i+2], v[0]` (the glTF specification's order).
+fn fan_triangles(fan: &[u32]) -> Vec<u32> {
+    (1..fan.len().saturating_sub(1)).flat_map(|i| [fan[i], fan[i + 1], fan[0]]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_become_lists_in_the_specification_order() {
+        assert_eq!(strip_triangles(&[0, 1, 2, 3, 4]), [0, 1, 2, 1, 3, 2, 2, 3, 4]);
+        assert_eq!(fan_triangles(&[0, 1, 2, 3]), [1, 2, 0, 2, 3, 0]);
+        assert!(
+            strip_triangles(&[0, 1]).is_empty() && fan_triangles(&[0, 1]).is_empty() && fan_triangles(&[]).is_empty()
+        );
+    }
+
+    #[test]
+    fn the_four_strongest_of_eight_influences_are_kept() {
+        let (joints, weights, dropped) =
+            strongest([[0, 1, 2, 3], [4, 5, 6, 7]], [[0.1, 0.3, 0.0, 0.05], [0.2, 0.0, 0.25, 0.1]]);
+        assert_eq!(joints, [1, 6, 4, 0]);
+        assert_eq!(weights, [0.3, 0.25, 0.2, 0.1]);
+        assert!(dropped, "0.1 of joint 7 and 0.05 of joint 3 are left out");
+        let (_, _, dropped) = strongest([[0, 1, 0, 0], [2, 0, 0, 0]], [[0.5, 0.25, 0.0, 0.0], [0.25, 0.0, 0.0, 0.0]]);
+        assert!(!dropped);
+    }
 }

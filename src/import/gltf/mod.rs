@@ -12,6 +12,7 @@ mod accessor;
 mod animation;
 mod buffers;
 mod document;
+mod estimate;
 mod mesh;
 mod scene;
 mod schema;
@@ -44,6 +45,7 @@ fn read(path: &Path, source: Source<'_>) -> Result<Rig> {
     let mut notes = vec!["units: metres, Y-up (glTF)".to_owned()];
     notes.extend(parsed.notes);
     let root = &parsed.root;
+    estimate::check(root)?;
     let folder = path.parent().unwrap_or(Path::new(""));
     let buffers = buffers::Buffers::new(&root.buffers, parsed.blob, folder);
     let accessors = accessor::Accessors::new(root, &buffers);

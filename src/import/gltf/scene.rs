@@ -122,8 +122,28 @@ fn scene_roots(root: &Root, parents: &[Option<usize>], notes: &mut Vec<String>) 
     Ok(roots)
 }
 
+/// Checks that every number of the node's transform is a finite single-precision number, as glTF stores them: a
+/// value beyond (`1e39`) is a broken file, not a bigger rig.
+fn check_single_precision(node: &schema::Node, index: usize) -> Result<()> {
+    let fields: [(&str, Option<&[f64]>); 4] = [
+        ("matrix", node.matrix.as_ref().map(|m| &m[..])),
+        ("translation", node.translation.as_ref().map(|t| &t[..])),
+        ("rotation", node.rotation.as_ref().map(|r| &r[..])),
+        ("scale", node.scale.as_ref().map(|s| &s[..])),
+    ];
+    for (field, values) in fields {
+        let values = values.unwrap_or_default();
+        if let Some(k) = values.iter().position(|v| !v.is_finite() || v.abs() > f64::from(f32::MAX)) {
+            let message = format!("{} is not a finite single-precision number", values[k]);
+            return Err(Failure::at(format!("nodes[{index}].{field}[{k}]"), message));
+        }
+    }
+    Ok(())
+}
+
 /// The node's local transform: its `matrix` decomposed, or its TRS with the spec's defaults.
 fn rest_transform(node: &schema::Node, index: usize) -> Result<Transform> {
+    check_single_precision(node, index)?;
     let place = || format!("nodes[{index}]");
     let rest = match &node.matrix {
         Some(matrix) => {
