@@ -441,8 +441,8 @@ fn scan_evaluates_through_the_layers() {
 }
 
 #[test]
-fn scan_storage_reports_marked_bones_bytes_and_errors() {
-    let args = ["scan", &stretchy(), "--anim", "squash_stretch", "--storage", "--inherit", "segment-compensate"];
+fn storage_reports_marked_bones_bytes_and_errors() {
+    let args = ["storage", &stretchy(), "--anim", "squash_stretch", "--inherit", "segment-compensate"];
     let out = json(&bonescope(&[&args[..], &["--format", "json"]].concat()));
     let report = &out[0]["animations"][0];
     assert_eq!(
@@ -474,7 +474,7 @@ fn scan_storage_reports_marked_bones_bytes_and_errors() {
         table.contains("marked (stretch channel): forearm (") && table.contains("TRS only (stretch dropped)"),
         "{table}"
     );
-    let err = stderr_of(&["scan", &stretchy(), "--storage", "--probe-distance", "0"]);
+    let err = stderr_of(&["storage", &stretchy(), "--probe-distance", "0"]);
     assert!(err.contains("--probe-distance"), "{err}");
 }
 
@@ -607,12 +607,12 @@ fn the_ci_examples_use_real_options() {
 #[test]
 fn comparisons_and_storage_reports_come_as_junit_too() {
     let maya = asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx").display().to_string();
-    for mode in [&["--compare-inherit", "declared,full"][..], &["--storage"][..]] {
-        let output = bonescope(&[&["scan", maya.as_str(), "--format", "junit"][..], mode].concat());
-        assert!(output.status.success(), "{mode:?}: {}", String::from_utf8_lossy(&output.stderr));
+    for command in [&["scan", "--compare-inherit", "declared,full"][..], &["storage"][..]] {
+        let output = bonescope(&[command, &[maya.as_str(), "--format", "junit"][..]].concat());
+        assert!(output.status.success(), "{command:?}: {}", String::from_utf8_lossy(&output.stderr));
         let elements = xml_elements(&String::from_utf8(output.stdout).unwrap());
         let count = |name: &str| elements.iter().filter(|(n, _)| n == name).count();
-        assert_eq!((count("testcase"), count("failure"), count("system-out")), (1, 0, 1), "{mode:?}");
+        assert_eq!((count("testcase"), count("failure"), count("system-out")), (1, 0, 1), "{command:?}");
     }
 }
 

@@ -180,7 +180,7 @@ impl AnimationScan {
     }
 }
 
-/// One file of `bonescope scan` (plain, `--compare-inherit` or `--storage`): a report per clip, or why the file
+/// One file of `bonescope scan` (plain or `--compare-inherit`) or `bonescope storage`: a report per clip, or why the file
 /// could not be loaded.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct FileReport<T> {

@@ -1,10 +1,11 @@
 //! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
-//! inheritance modes), `export` writes the evaluated meshes of one time, `render` draws the viewport to PNG, `bake`
-//! writes any inheritance as plain glTF, `diff` compares two evaluations.
+//! inheritance modes), `storage` measures the stretch-quaternion storage of whole clips, `export` writes the
+//! evaluated meshes of one time, `render` draws the viewport to PNG, `bake` writes any inheritance as plain glTF,
+//! `diff` compares two evaluations.
 //!
-//! Exit codes: 0 success; 1 `scan --fail-on-stretch` found a stretched bone, `render --reference` found a
-//! picture over its threshold, `bake --max-error` or `diff --fail-above` a difference over its limit; 2 bad usage
-//! or a file that cannot be loaded (after reporting every file that could).
+//! Exit codes: 0 success; 1 `scan --fail-above` found a stretched bone, `render --reference` found a picture over
+//! its threshold, `bake --fail-above` or `diff --fail-above` a difference over its limit; 2 bad usage or a file that
+//! cannot be loaded (after reporting every file that could).
 
 mod bake;
 mod diff;
@@ -48,6 +49,9 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
     /// Scan whole clips of one or more files and report the stretched bones.
     Scan(scan::ScanArgs),
+    /// Measure each clip's stretch-quaternion storage: the bones that need a stretch channel, its bytes, and the
+    /// error of rebuilding the matrices with it and without it.
+    Storage(scan::StorageArgs),
     /// Merge the JSON lines of several scans (a library's shards) into one report and exit code.
     Report(report::ReportArgs),
     /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
@@ -79,6 +83,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Inspect(args)) => inspect::run(&args),
         Some(Command::Scan(args)) => scan::run(&args),
+        Some(Command::Storage(args)) => scan::run_storage(&args),
         Some(Command::Report(args)) => report::run(&args),
         Some(Command::Export(args)) => export::run(&args),
         #[cfg(feature = "gui")]

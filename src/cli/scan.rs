@@ -22,8 +22,10 @@ use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
 use crate::model::{InheritMode, ModeChoice, Rig};
 
+/// The files a report over a library covers, how many at once, and how it is written: what `scan` and `storage`
+/// share.
 #[derive(Debug, Args)]
-pub struct ScanArgs {
+pub struct LibraryArgs {
     /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content), folders (walked: every file in them
     /// that is an animation), globs (`'exports/**/*.fbx'`), or `-` for a list of paths on standard input.
     #[arg(required = true)]
@@ -47,13 +49,19 @@ pub struct ScanArgs {
     /// always shown).
     #[arg(long)]
     pub progress: bool,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: ScanFormat,
+}
+
+#[derive(Debug, Args)]
+pub struct ScanArgs {
+    #[command(flatten)]
+    pub library: LibraryArgs,
     #[command(flatten)]
     pub eval: EvalArgs,
     /// Samples per second, on top of every key time.
     #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate, value_parser = parse_rate)]
     pub rate: f64,
-    #[arg(long, value_enum, default_value_t)]
-    pub format: ScanFormat,
     /// Exit with status 1 when a bone is stretched and shears by more than DEGREES (without a value: any stretched
     /// bone).
     #[arg(long, value_name = "DEGREES", num_args = 0..=1, default_missing_value = "0", value_parser = parse_angle, alias = "fail-on-stretch")]
@@ -68,18 +76,25 @@ pub struct ScanArgs {
         conflicts_with_all = ["inherit", "inherit_bone", "fail_above"]
     )]
     pub compare_inherit: Option<[ModeChoice; 2]>,
-    /// Instead of the stretched bones, report each clip's stretch-quaternion storage: the bones that
-    /// need a stretch channel, bytes as plain TRS and with it, and the error of rebuilding the matrices with and
-    /// without it (at points along each bone's axes and at skinned vertices).
-    #[arg(long, conflicts_with_all = ["compare_inherit", "fail_above"])]
-    pub storage: bool,
-    /// With --storage: how far along each bone's axes the error is measured, in the bone's local units.
-    #[arg(
-        long,
-        value_name = "DISTANCE",
-        default_value_t = StorageOptions::default().probe_distance,
-        requires = "storage"
-    )]
+    #[command(flatten)]
+    pub tolerances: ToleranceArgs,
+    #[command(flatten)]
+    pub layers: LayerArgs,
+}
+
+/// `bonescope storage`: each clip's stretch-quaternion storage: the bones that need a stretch channel, bytes as plain
+/// TRS and with it, and the error of rebuilding the matrices with and without it.
+#[derive(Debug, Args)]
+pub struct StorageArgs {
+    #[command(flatten)]
+    pub library: LibraryArgs,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Frames per second, on top of every key time.
+    #[arg(long, value_name = "HZ", default_value_t = StorageOptions::default().rate, value_parser = parse_rate)]
+    pub rate: f64,
+    /// How far along each bone's axes the error is measured, in the bone's local units.
+    #[arg(long, value_name = "DISTANCE", default_value_t = StorageOptions::default().probe_distance)]
     pub probe_distance: f64,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
@@ -103,7 +118,7 @@ pub enum ScanFormat {
     Junit,
 }
 
-/// One clip of one file, as `scan --storage` reports it.
+/// One clip of one file, as `bonescope storage` reports it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AnimationStorage {
     /// `null` for a file without animations, whose rest pose is measured instead.
@@ -124,11 +139,8 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
         }
         return run_comparison(args, sides);
     }
-    if args.storage {
-        return run_storage(args, &options);
-    }
     let report = |path: &Path| scan_file(path, args, &options);
-    let (files, _) = report_files(&inputs(args)?, args, report, &render_animation, &junit)?;
+    let (files, _) = report_files(&inputs(&args.library)?, &args.library, report, &render_animation, &junit)?;
     Ok(verdict(&files, args.fail_above))
 }
 
@@ -148,7 +160,7 @@ pub(super) fn verdict(files: &[FileScan], fail_above: Option<f64>) -> ExitCode {
 
 /// The files the arguments name ([`crate::library::collect`]); what could not be read on the way is reported on
 /// standard error, and the scan goes on.
-fn inputs(args: &ScanArgs) -> anyhow::Result<Vec<PathBuf>> {
+fn inputs(args: &LibraryArgs) -> anyhow::Result<Vec<PathBuf>> {
     let filter = Filter::new(&args.include, &args.exclude).map_err(anyhow::Error::msg)?;
     let inputs = collect(&args.files, &filter, &mut std::io::stdin().lock());
     for problem in &inputs.problems {
@@ -169,7 +181,7 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
     }
 }
 
-/// `--storage` as JUnit: each clip passes with its storage report as output.
+/// `storage` as JUnit: each clip passes with its storage report as output.
 fn junit_storage(files: &[FileStorage]) -> String {
     junit_of(files, |file, clip| Case {
         name: AnimationInfo::describe(clip.animation.as_ref()),
@@ -189,7 +201,7 @@ type TableOf<'a, T> = &'a dyn Fn(&str, &T) -> String;
 /// error also on standard error as it happens. The reports, and whether all files loaded.
 fn report_files<T: serde::Serialize + Send>(
     paths: &[PathBuf],
-    args: &ScanArgs,
+    args: &LibraryArgs,
     report: impl Fn(&Path) -> FileReport<T> + Sync,
     animation: TableOf<T>,
     junit: JunitOf<T>,
@@ -296,7 +308,7 @@ fn loaded_code(all_loaded: bool) -> ExitCode {
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = shown(path);
-    let scanned = load_layered(path, args).map(|loaded| {
+    let scanned = load_layered(path, &args.eval, &args.layers).map(|loaded| {
         loaded.each_clip(|evaluation| {
             let result = scan(evaluation, options, &|_, _| {});
             let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);
@@ -315,13 +327,13 @@ struct Loaded {
     clips: Vec<Option<usize>>,
 }
 
-fn load_layered(path: &std::path::Path, args: &ScanArgs) -> anyhow::Result<Loaded> {
+fn load_layered(path: &std::path::Path, eval: &EvalArgs, layers: &LayerArgs) -> anyhow::Result<Loaded> {
     let rig = import::load(path)?;
-    let modes = args.eval.modes(&rig)?;
-    let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
-    let clips = match &args.eval.anim {
+    let modes = eval.modes(&rig)?;
+    let layers = LayerStack::new(&rig, &layers.layers(&rig)?)?;
+    let clips = match &eval.anim {
         Some(_) => {
-            let clip = args.eval.clip(&rig)?;
+            let clip = eval.clip(&rig)?;
             vec![clip.and_then(|c| rig.clips.iter().position(|other| std::ptr::eq(other, c)))]
         }
         None if rig.clips.is_empty() => vec![None],
@@ -338,15 +350,16 @@ impl Loaded {
     }
 }
 
-fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCode> {
+/// `bonescope storage`.
+pub fn run_storage(args: &StorageArgs) -> anyhow::Result<ExitCode> {
     if !(args.probe_distance > 0.0 && args.probe_distance.is_finite()) {
         anyhow::bail!("--probe-distance must be a positive number, got {}", args.probe_distance);
     }
-    let storage =
-        StorageOptions { rate: options.rate, tolerances: options.tolerances, probe_distance: args.probe_distance };
+    let (rate, tolerances) = (args.rate, args.tolerances.tolerances()?);
+    let storage = StorageOptions { rate, tolerances, probe_distance: args.probe_distance };
     let measure = |path: &Path| {
         let file = shown(path);
-        let measured = load_layered(path, args).map(|loaded| {
+        let measured = load_layered(path, &args.eval, &args.layers).map(|loaded| {
             loaded.each_clip(|evaluation| AnimationStorage {
                 animation: evaluation.clip.map(AnimationInfo::of),
                 inherit: args.eval.inherit_label(),
@@ -356,7 +369,7 @@ fn run_storage(args: &ScanArgs, options: &ScanOptions) -> anyhow::Result<ExitCod
         });
         FileStorage::new(file, measured)
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, measure, &render_storage, &junit_storage)?;
+    let (_, loaded) = report_files(&inputs(&args.library)?, &args.library, measure, &render_storage, &junit_storage)?;
     Ok(loaded_code(loaded))
 }
 
@@ -407,7 +420,7 @@ fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Exi
             output: Some(render(file, diff)),
         })
     };
-    let (_, loaded) = report_files(&inputs(args)?, args, compare, &render, &junit)?;
+    let (_, loaded) = report_files(&inputs(&args.library)?, &args.library, compare, &render, &junit)?;
     Ok(loaded_code(loaded))
 }
 

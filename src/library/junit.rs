@@ -1,6 +1,6 @@
 //! A scan as JUnit XML, the report CI systems show (GitLab, Jenkins, Azure DevOps, GitHub test reporters): one test
 //! suite per file, one test case per clip, a failure per stretched bone (its worst shear and when), and a file that
-//! could not be loaded as an error. Scans that judge nothing (`--compare-inherit`, `--storage`) give passing cases
+//! could not be loaded as an error. Reports that judge nothing (`scan --compare-inherit`, `storage`) give passing cases
 //! with their table as the case's output.
 
 use std::borrow::Cow;
