@@ -16,6 +16,9 @@
 //! fastest of many interleaved passes on the sheared sets, are measured once in the setup and printed to stderr (see
 //! `BENCHMARKS.md`).
 
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -338,7 +341,7 @@ fn benches(c: &mut Criterion) {
     bench_set(c, "decompose/sheared_extreme", &extreme);
     bench_sequence(c, &animated_set());
     bench_set(c, "decompose/clip_stress_rig", &clip_set(&stress_rig(50, 200, 5)));
-    let stretchy = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let stretchy = shared_assets::asset("blender/stretchy_full.glb");
     match bonescope::import::load(&stretchy) {
         Ok(rig) => bench_set(c, "decompose/clip_stretchy_full", &clip_set(&rig)),
         Err(e) => eprintln!("skipping decompose/clip_stretchy_full: {e}"),

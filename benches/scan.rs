@@ -9,9 +9,11 @@
 //! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
 //! `stretchy_full.glb` from the shared assets when it is there and loads.
 
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
 use std::f64::consts::TAU;
 use std::hint::black_box;
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -195,7 +197,7 @@ fn compensating_case() -> Case {
 }
 
 fn blender_case() -> Option<Case> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let path = shared_assets::asset("blender/stretchy_full.glb");
     if !path.exists() {
         eprintln!("skipping the Blender rig: {} is missing", path.display());
         return None;
