@@ -6,6 +6,9 @@
 //! (`../shared/assets/bvh`, 120 Hz) repeated 40 times, 175 s, judged down the selected bone's chain only (what the
 //! app computes on a click, beside the rig-wide summary it keeps): target under 50 ms.
 
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -78,7 +81,7 @@ fn clip_analysis(c: &mut Criterion) {
 
 /// The CMU walk with its motion repeated `times` times (the frame count and lines of the file's MOTION part).
 fn repeated_cmu_walk(times: usize) -> bonescope::model::Rig {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/cmu_12_01_walk.bvh");
+    let path = shared_assets::asset("bvh/cmu_12_01_walk.bvh");
     let text = std::fs::read_to_string(&path).expect("../shared/assets/bvh/cmu_12_01_walk.bvh");
     let (header, motion) = text.split_once("MOTION").unwrap();
     let mut lines = motion.lines().filter(|l| !l.trim().is_empty());

@@ -13,6 +13,8 @@
 #[allow(dead_code)]
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -56,8 +58,7 @@ fn benches(c: &mut Criterion, name: &str, rig: &Rig, file: &Path, mode: Option<I
 }
 
 fn baking(c: &mut Criterion) {
-    let locomotions =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
+    let locomotions = shared_assets::asset("fbx-proanimationbank/locomotions.fbx");
     let rig = import::load(&locomotions).expect("the shared assets are beside the repository");
     benches(c, "locomotions.fbx", &rig, &locomotions, None);
     let folder = tempfile::tempdir().unwrap();

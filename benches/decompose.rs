@@ -16,6 +16,10 @@
 //! fastest of many interleaved passes on the sheared sets, are measured once in the setup and printed to stderr (see
 //! `BENCHMARKS.md`).
 
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
+use std::f64::consts::TAU;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -26,78 +30,60 @@ use bonescope::model::Rig;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use nalgebra::Matrix3;
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 
 const BATCH: usize = 1024;
 const SEED: u64 = 0x5EED_B0E5_C0DE_2026;
 
-/// xorshift64*: small, fast, deterministic; plenty for test inputs.
-struct Rng(u64);
+/// Uniform on the rotation group (Shoemake's subgroup algorithm).
+fn random_rotation(rng: &mut XorShiftRng) -> DQuat {
+    let (u1, u2, u3) = (rng.random::<f64>(), rng.random_range(0.0..TAU), rng.random_range(0.0..TAU));
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    DQuat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()).normalize()
+}
 
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// Uniform on the rotation group (Shoemake's subgroup algorithm).
-    fn rotation(&mut self) -> DQuat {
-        let (u1, u2, u3) = (self.unit(), self.unit() * std::f64::consts::TAU, self.unit() * std::f64::consts::TAU);
-        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-        DQuat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()).normalize()
-    }
-
-    fn vec3(&mut self, lo: f64, hi: f64) -> DVec3 {
-        DVec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
-    }
+/// Each component uniform in [lo, hi).
+fn random_vec3(rng: &mut XorShiftRng, lo: f64, hi: f64) -> DVec3 {
+    DVec3::new(rng.random_range(lo..hi), rng.random_range(lo..hi), rng.random_range(lo..hi))
 }
 
 /// `T·R·U·K·Uᵀ`.
-fn sheared_matrix(rng: &mut Rng, k: DVec3) -> DMat4 {
-    let (r, u) = (DMat3::from_quat(rng.rotation()), DMat3::from_quat(rng.rotation()));
+fn sheared_matrix(rng: &mut XorShiftRng, k: DVec3) -> DMat4 {
+    let (r, u) = (DMat3::from_quat(random_rotation(rng)), DMat3::from_quat(random_rotation(rng)));
     let m = r * u * DMat3::from_diagonal(k) * u.transpose();
-    let t = rng.vec3(-1.0, 1.0);
+    let t = random_vec3(rng, -1.0, 1.0);
     DMat4::from_cols(m.x_axis.extend(0.0), m.y_axis.extend(0.0), m.z_axis.extend(0.0), t.extend(1.0))
 }
 
-fn shear_free_set(rng: &mut Rng) -> Vec<DMat4> {
+fn shear_free_set(rng: &mut XorShiftRng) -> Vec<DMat4> {
     (0..BATCH)
         .map(|_| {
-            let s = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
-            DMat4::from_scale_rotation_translation(s, rng.rotation(), rng.vec3(-1.0, 1.0))
+            let s = random_vec3(rng, 0.25, 4.0);
+            DMat4::from_scale_rotation_translation(s, random_rotation(rng), random_vec3(rng, -1.0, 1.0))
         })
         .collect()
 }
 
-fn sheared_set(rng: &mut Rng) -> Vec<DMat4> {
+fn sheared_set(rng: &mut XorShiftRng) -> Vec<DMat4> {
     (0..BATCH)
         .map(|_| {
-            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            let k = random_vec3(rng, 0.25, 4.0);
             sheared_matrix(rng, k)
         })
         .collect()
 }
 
 /// Factors `c·[1, ratio^-a, ratio^-1]` in a random order (the order is irrelevant under a random `U`).
-fn factors_with_ratio(rng: &mut Rng, ratio: f64) -> DVec3 {
-    let c = 10f64.powf(rng.range(-2.0, 2.0));
-    c * DVec3::new(1.0, ratio.powf(-rng.unit()), 1.0 / ratio)
+fn factors_with_ratio(rng: &mut XorShiftRng, ratio: f64) -> DVec3 {
+    let c = 10f64.powf(rng.random_range(-2.0..2.0));
+    c * DVec3::new(1.0, ratio.powf(-rng.random::<f64>()), 1.0 / ratio)
 }
 
-fn extreme_set(rng: &mut Rng) -> Vec<DMat4> {
+fn extreme_set(rng: &mut XorShiftRng) -> Vec<DMat4> {
     (0..BATCH)
         .map(|_| {
-            let ratio = 10f64.powf(rng.range(0.0, 6.0));
+            let ratio = 10f64.powf(rng.random_range(0.0..6.0));
             let k = factors_with_ratio(rng, ratio);
             sheared_matrix(rng, k)
         })
@@ -179,7 +165,7 @@ fn accuracy_row(label: &str, set: &[(DMat4, f64)]) {
 }
 
 fn print_accuracy() {
-    let mut rng = Rng(SEED ^ 0xACC);
+    let mut rng = XorShiftRng::seed_from_u64(SEED ^ 0xACC);
     eprintln!("accuracy over {BATCH} matrices per row (worst case; `bad` = recomposition error > 1e-12)");
     let header = format!("{:>9} {:>9} {:>9} {:>4}", "recompose", "orthog", "k_min", "bad");
     eprintln!("{:<22} | {header} | {header} | {header}", "set");
@@ -189,14 +175,17 @@ fn print_accuracy() {
     );
     let shear_free: Vec<(DMat4, f64)> = (0..BATCH)
         .map(|_| {
-            let s = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
-            (DMat4::from_scale_rotation_translation(s, rng.rotation(), rng.vec3(-1.0, 1.0)), s.min_element())
+            let s = random_vec3(&mut rng, 0.25, 4.0);
+            (
+                DMat4::from_scale_rotation_translation(s, random_rotation(&mut rng), random_vec3(&mut rng, -1.0, 1.0)),
+                s.min_element(),
+            )
         })
         .collect();
     accuracy_row("shear-free", &shear_free);
     let sheared: Vec<(DMat4, f64)> = (0..BATCH)
         .map(|_| {
-            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            let k = random_vec3(&mut rng, 0.25, 4.0);
             (sheared_matrix(&mut rng, k), k.min_element())
         })
         .collect();
@@ -213,7 +202,7 @@ fn print_accuracy() {
     }
     let mirrored: Vec<(DMat4, f64)> = (0..BATCH)
         .map(|_| {
-            let k = DVec3::new(rng.range(0.25, 4.0), rng.range(0.25, 4.0), rng.range(0.25, 4.0));
+            let k = random_vec3(&mut rng, 0.25, 4.0);
             (sheared_matrix(&mut rng, k) * DMat4::from_scale(DVec3::new(1.0, 1.0, -1.0)), k.min_element())
         })
         .collect();
@@ -324,7 +313,7 @@ fn bench_sequence(c: &mut Criterion, set: &[DMat4]) {
 
 fn benches(c: &mut Criterion) {
     print_accuracy();
-    let mut rng = Rng(SEED);
+    let mut rng = XorShiftRng::seed_from_u64(SEED);
     let shear_free = shear_free_set(&mut rng);
     let sheared = sheared_set(&mut rng);
     let extreme = extreme_set(&mut rng);
@@ -338,7 +327,7 @@ fn benches(c: &mut Criterion) {
     bench_set(c, "decompose/sheared_extreme", &extreme);
     bench_sequence(c, &animated_set());
     bench_set(c, "decompose/clip_stress_rig", &clip_set(&stress_rig(50, 200, 5)));
-    let stretchy = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let stretchy = shared_assets::asset("blender/stretchy_full.glb");
     match bonescope::import::load(&stretchy) {
         Ok(rig) => bench_set(c, "decompose/clip_stretchy_full", &clip_set(&rig)),
         Err(e) => eprintln!("skipping decompose/clip_stretchy_full: {e}"),

@@ -9,11 +9,14 @@
 
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use bonescope::import;
 use criterion::{Criterion, criterion_group, criterion_main};
+use shared_assets::asset;
 
 const FILES: &[&str] = &[
     "fbx-proanimationbank/skeleton.fbx",
@@ -21,10 +24,6 @@ const FILES: &[&str] = &[
     "gltf-khronos/cesium_man.gltf",
     "bvh/cmu_12_01_walk.bvh",
 ];
-
-fn asset(file: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(file)
-}
 
 /// The three ways of loading the file at `path`, as a group named `name`.
 fn load_file(c: &mut Criterion, name: &str, path: &Path) {

@@ -9,9 +9,11 @@
 //! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
 //! `stretchy_full.glb` from the shared assets when it is there and loads.
 
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
 use std::f64::consts::TAU;
 use std::hint::black_box;
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -21,6 +23,8 @@ use bonescope::math::decompose;
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DQuat, DVec3, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_xorshift::XorShiftRng;
 
 const BONES: usize = 100;
 const SPINE: usize = 10;
@@ -28,48 +32,25 @@ const KEYS_PER_SECOND: usize = 30;
 const SECONDS: usize = 10;
 const RATE: f64 = 60.0;
 
-/// xorshift64*: small, fast, deterministic.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.unit() * n as f64) as usize
-    }
-
-    fn axis(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
-            if (0.01..=1.0).contains(&v.length_squared()) {
-                return v.normalize();
-            }
+/// A unit axis, uniform on the sphere (a point of the unit ball, away from its centre, normalised).
+fn random_axis(rng: &mut XorShiftRng) -> DVec3 {
+    loop {
+        let v = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        if (0.01..=1.0).contains(&v.length_squared()) {
+            return v.normalize();
         }
     }
 }
 
 /// Parents-first bones: a spine of 10 from the root, then chains of 5–12 bones, each hanging off a random spine bone
 /// (60 %) or a random bone already placed (40 %), like limbs, fingers, tails and props on a character.
-fn generated_skeleton(rng: &mut Rng) -> Skeleton {
+fn generated_skeleton(rng: &mut XorShiftRng) -> Skeleton {
     let mut bones: Vec<Bone> = Vec::with_capacity(BONES);
-    let add = |bones: &mut Vec<Bone>, rng: &mut Rng, parent: Option<usize>| {
+    let add = |bones: &mut Vec<Bone>, rng: &mut XorShiftRng, parent: Option<usize>| {
         let index = bones.len();
         let rest = Transform::from_trs(
-            DVec3::new(rng.range(-0.05, 0.05), rng.range(0.1, 0.4), rng.range(-0.05, 0.05)),
-            DQuat::from_axis_angle(rng.axis(), rng.range(0.0, 0.5)),
+            DVec3::new(rng.random_range(-0.05..0.05), rng.random_range(0.1..0.4), rng.random_range(-0.05..0.05)),
+            DQuat::from_axis_angle(random_axis(rng), rng.random_range(0.0..0.5)),
             DVec3::ONE,
         );
         bones.push(Bone { name: format!("bone{index}"), node: index, parent, rest, inherit: InheritMode::Full });
@@ -80,8 +61,9 @@ fn generated_skeleton(rng: &mut Rng) -> Skeleton {
         parent = Some(add(&mut bones, rng, parent));
     }
     while bones.len() < BONES {
-        let length = 5 + rng.below(8);
-        let mut parent = if rng.unit() < 0.6 { rng.below(SPINE) } else { rng.below(bones.len()) };
+        let length = rng.random_range(5..=12);
+        let mut parent =
+            if rng.random_bool(0.6) { rng.random_range(0..SPINE) } else { rng.random_range(0..bones.len()) };
         for _ in 0..length.min(BONES - bones.len()) {
             parent = add(&mut bones, rng, Some(parent));
         }
@@ -101,10 +83,10 @@ enum Squash {
 }
 
 impl Squash {
-    fn scaled_bones(self, rng: &mut Rng) -> Vec<usize> {
+    fn scaled_bones(self, rng: &mut XorShiftRng) -> Vec<usize> {
         let mut bones = Vec::new();
         while bones.len() < BONES / 10 {
-            let bone = SPINE + rng.below(BONES - SPINE);
+            let bone = SPINE + rng.random_range(0..BONES - SPINE);
             if !bones.contains(&bone) {
                 bones.push(bone);
             }
@@ -122,7 +104,7 @@ impl Squash {
 
 /// Every bone: linear rotation (a swing of up to ±0.8 rad about a random axis) and translation tracks; the bones in
 /// `scaled` also a non-uniform scale track (squash and stretch along their own X/Y axes).
-fn generated_clip(rng: &mut Rng, skeleton: &Skeleton, scaled: &[usize]) -> Clip {
+fn generated_clip(rng: &mut XorShiftRng, skeleton: &Skeleton, scaled: &[usize]) -> Clip {
     let keys = KEYS_PER_SECOND * SECONDS + 1;
     let times: Arc<[f64]> = (0..keys).map(|i| i as f64 / KEYS_PER_SECOND as f64).collect();
     let tracks = skeleton
@@ -130,14 +112,15 @@ fn generated_clip(rng: &mut Rng, skeleton: &Skeleton, scaled: &[usize]) -> Clip 
         .iter()
         .enumerate()
         .map(|(index, bone)| {
-            let (axis, amplitude) = (rng.axis(), rng.range(0.2, 0.8));
-            let (frequency, phase) = (rng.range(0.2, 1.5), rng.range(0.0, TAU));
+            let (axis, amplitude) = (random_axis(rng), rng.random_range(0.2..0.8));
+            let (frequency, phase) = (rng.random_range(0.2..1.5), rng.random_range(0.0..TAU));
             let wave = |t: f64| (TAU * frequency * t + phase).sin();
             let rotation = times
                 .iter()
                 .map(|&t| (bone.rest.rotation * DQuat::from_axis_angle(axis, amplitude * wave(t))).as_quat())
                 .collect();
-            let offset = DVec3::new(rng.range(-0.05, 0.05), rng.range(-0.05, 0.05), rng.range(-0.05, 0.05));
+            let offset =
+                DVec3::new(rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05));
             let translation = times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
             let mut tracks = BoneTracks::new(index);
             tracks.rotation = Some(Track::new(times.clone(), rotation, Interpolation::Linear).unwrap());
@@ -173,7 +156,7 @@ impl Case {
 }
 
 fn generated_case(squash: Squash) -> Case {
-    let mut rng = Rng(0x5CA7_2026_1122_0001);
+    let mut rng = XorShiftRng::seed_from_u64(0x5CA7_2026_1122_0001);
     let skeleton = generated_skeleton(&mut rng);
     let scaled = squash.scaled_bones(&mut rng);
     let clip = generated_clip(&mut rng, &skeleton, &scaled);
@@ -195,7 +178,7 @@ fn compensating_case() -> Case {
 }
 
 fn blender_case() -> Option<Case> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let path = shared_assets::asset("blender/stretchy_full.glb");
     if !path.exists() {
         eprintln!("skipping the Blender rig: {} is missing", path.display());
         return None;

@@ -11,6 +11,11 @@
 //! 5 s is written to `fuzz/artifacts/`, and a watchdog thread writes out an input still running after 20 s (a
 //! hang); the run ends with executions, distinct error messages, findings and the peak resident memory.
 
+// Only the shared assets' folder is used here.
+#[allow(dead_code)]
+#[path = "../benches/support/shared_assets.rs"]
+mod shared_assets;
+
 use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -93,9 +98,8 @@ fn seeds(format: &str) -> Vec<(PathBuf, Vec<u8>)> {
         Format::Fbx => &["fbx"],
         Format::Bvh => &["bvh"],
     };
-    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
     let mut files = Vec::new();
-    for folder in std::fs::read_dir(&assets).expect("../shared/assets") {
+    for folder in std::fs::read_dir(shared_assets::root()).expect("../shared/assets") {
         let folder = folder.unwrap().path();
         if !folder.is_dir() {
             continue;

@@ -1,8 +1,11 @@
 //! The desktop app driven as a person would, through egui_kittest: select by label, change modes, step frames,
 //! and check what the panels show.
 
+mod common;
+
 use bonescope::app::{BonescopeApp, Document, Settings};
 use bonescope::model::InheritMode;
+use common::{asset, settle};
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -13,15 +16,6 @@ fn demo_app() -> Harness<'static, BonescopeApp> {
         .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
     settle(&mut harness);
     harness
-}
-
-/// Processes pending input, lets the background analysis it started finish, then lets the UI catch up. (A bare
-/// `run()` while the analysis runs would keep stepping until kittest gives up.)
-fn settle(harness: &mut Harness<'static, BonescopeApp>) {
-    harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
-    harness.run();
 }
 
 fn bone(harness: &Harness<'static, BonescopeApp>, name: &str) -> usize {
@@ -217,8 +211,7 @@ fn the_skinning_method_is_chosen_in_the_viewport_toolbar() {
 #[test]
 fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
     // Maya's long-keyframe test: 41 keys over ±166,666 s at 30 fps (10 million frames), sampled at its keys.
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets/fbx-ufbx-corpus/maya_long_keyframes_7700_ascii.fbx");
+    let path = asset("fbx-ufbx-corpus/maya_long_keyframes_7700_ascii.fbx");
     let rig = bonescope::import::load(&path).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
@@ -271,8 +264,7 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
 }
 
 fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path);
-    let doc = Document::load(&path).unwrap();
+    let doc = Document::load(&asset(path)).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
         .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
@@ -407,7 +399,7 @@ fn f_frames_a_selected_bone_with_room_around_it() {
 
 #[test]
 fn copy_as_json_is_what_inspect_prints_and_says_so() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let path = asset("blender/stretchy_full.glb");
     let mut harness = asset_app("blender/stretchy_full.glb");
     harness.state_mut().time = 0.5;
     harness.get_by_label("forearm").click();
@@ -449,9 +441,7 @@ fn a_broken_file_is_remembered_watched_and_opens_once_fixed() {
     let errors = harness.state().errors();
     assert_eq!((errors.len(), errors[0].1), (1, 2), "the same error twice is one message: {errors:?}");
     // Fixed on disk: the watcher opens it, and the error goes.
-    let good =
-        std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/bvh_test2.bvh"))
-            .unwrap();
+    let good = std::fs::read(asset("bvh/bvh_test2.bvh")).unwrap();
     std::fs::write(&file, good).unwrap();
     for _ in 0..100 {
         std::thread::sleep(std::time::Duration::from_millis(20));
@@ -467,7 +457,7 @@ fn a_broken_file_is_remembered_watched_and_opens_once_fixed() {
 #[test]
 fn a_message_under_the_pointer_holds_still() {
     let mut harness = demo_app();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh/bvh_test2.bvh");
+    let path = asset("bvh/bvh_test2.bvh");
     harness.state_mut().open(&path);
     harness.run();
     harness.get_by_label_contains("opened").hover();
@@ -511,7 +501,7 @@ fn file_open_without_a_desktop_dialog_uses_the_apps_own_browser() {
     harness.get_by_label_contains("no desktop file dialog here");
     harness.get_by_label("Open a file");
     // Type a folder: the browser enters it and lists its animation files; click one to open it.
-    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bvh");
+    let folder = asset("bvh");
     let field = harness.get_by_label("Path");
     field.click();
     harness.run();
@@ -564,8 +554,7 @@ fn bake(source: &std::path::Path, mode: InheritMode, strategy: bonescope::bake::
 
 /// Maya's mixed-inheritance file baked as the closest TRS under unscaled-parent, written to `folder`.
 fn maya_trs_bake(folder: &std::path::Path) -> std::path::PathBuf {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets/fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
+    let path = asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
     let out = folder.join("maya_trs.glb");
     bake(&path, InheritMode::UnscaledParent, bonescope::bake::Strategy::Trs, &out);
     out
@@ -610,7 +599,7 @@ fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged
 fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     let folder = tempfile::tempdir().unwrap();
     let copy = folder.path().join("copy.glb");
-    let source = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
+    let source = asset("blender/stretchy_full.glb");
     std::fs::copy(&source, &copy).unwrap();
     let mut harness = asset_app("blender/stretchy_full.glb");
     harness.state_mut().native_dialog = bonescope::app::NativeDialog::Unavailable;

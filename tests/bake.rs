@@ -11,7 +11,7 @@ mod common;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::sync::LazyLock;
 
 use bonescope::bake::{self, Request, Strategy};
@@ -19,7 +19,7 @@ use bonescope::diff::{Pairs, compare, comparison_times};
 use bonescope::eval::Evaluation;
 use bonescope::import;
 use bonescope::model::{InheritMode, Rig};
-use common::{asset, obj_positions, size};
+use common::{asset, bonescope, obj_positions, size};
 use rayon::prelude::*;
 use serde_json::Value;
 
@@ -248,10 +248,6 @@ fn every_baked_file_passes_the_khronos_validator() {
         .map(|r| format!("{}: {}", r["file"], r["messages"]))
         .collect();
     assert!(failing.is_empty(), "{} files with errors:\n{}", failing.len(), failing.join("\n"));
-}
-
-fn bonescope(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
 }
 
 /// The vertices `bonescope export` writes for `file` at `time`.

@@ -1,17 +1,13 @@
 //! The bind check on real files: skins bound under an axis conversion (glTF Z-up → Y-up), in centimetres under a
 //! 0.01 conversion (Maya), or beside a moved mesh node are fine and not flagged; a joint bound elsewhere is.
 
-use std::path::Path;
+mod common;
 
 use bonescope::analysis::{BindTolerance, bind_mismatches};
 use bonescope::eval::{Hierarchy, bind_model_matrices};
 use bonescope::model::Rig;
+use common::load_asset;
 use glam::{DMat4, DQuat, DVec3};
-
-fn load(path: &str) -> Rig {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path);
-    bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"))
-}
 
 fn flagged(rig: &Rig) -> Vec<String> {
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
@@ -27,7 +23,7 @@ fn skins_bound_at_rest_are_not_flagged_whatever_their_bind_space() {
         "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
         "fbx-proanimationbank/locomotions.fbx",
     ] {
-        assert_eq!(flagged(&load(file)), Vec::<String>::new(), "{file}");
+        assert_eq!(flagged(&load_asset(file)), Vec::<String>::new(), "{file}");
     }
 }
 
@@ -35,12 +31,12 @@ fn skins_bound_at_rest_are_not_flagged_whatever_their_bind_space() {
 fn a_stored_pose_that_is_not_the_bind_pose_is_flagged() {
     // Blender writes an FBX's node transforms at its current frame: there the forearm is turned 20° from where
     // the mesh was bound (the .glb of the same rig stores the bind pose as its rest, and is not flagged).
-    assert_eq!(flagged(&load("blender/stretchy_full.fbx")), ["forearm", "hand"]);
+    assert_eq!(flagged(&load_asset("blender/stretchy_full.fbx")), ["forearm", "hand"]);
 }
 
 #[test]
 fn a_joint_bound_elsewhere_is_flagged_alone() {
-    let mut rig = load("gltf-khronos/cesium_man.gltf");
+    let mut rig = load_asset("gltf-khronos/cesium_man.gltf");
     // Move one joint's bind 5 cm and 10° in the skin's bind space (a copy of the file's rig, changed here).
     let joint = 7;
     let moved =
@@ -53,7 +49,7 @@ fn a_joint_bound_elsewhere_is_flagged_alone() {
 #[test]
 fn the_bind_pose_is_drawn_where_the_character_is() {
     // Cesium Man's skin lives under a Z-up → Y-up node: its bind pose in model space is its rest pose, standing.
-    let rig = load("gltf-khronos/cesium_man.gltf");
+    let rig = load_asset("gltf-khronos/cesium_man.gltf");
     let bind = bind_model_matrices(&rig);
     let rest = rig.skeleton.rest_model_matrices();
     for &joint in &rig.skins[0].joints {

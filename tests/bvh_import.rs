@@ -1,18 +1,17 @@
 //! The BVH importer: every shared BVH file against its MANIFEST, a hand-written file whose model matrices are
 //! computed by hand below, and broken or hostile files that must fail naming the line.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
 use bonescope::model::Rig;
+use common::asset;
 use glam::{DMat3, DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
-
-fn asset(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path)
-}
 
 // ---------------------------------------------------------------------------------------------------------------
 // The shared files

@@ -1,26 +1,13 @@
 //! The `inspect` and `scan` commands as a user runs them: output shape, numbers that must hold, exit codes.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
+use common::{asset, bonescope, json};
 use glam::DMat4;
 use serde_json::Value;
 
-fn asset(path: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path)
-}
-
-fn bonescope(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
-}
-
 fn stretchy() -> String {
     asset("blender/stretchy_full.glb").display().to_string()
-}
-
-fn json(output: &Output) -> Value {
-    assert!(output.status.success(), "stderr: {}", String::from_utf8_lossy(&output.stderr));
-    serde_json::from_slice(&output.stdout).expect("valid JSON")
 }
 
 fn keys(v: &Value) -> Vec<&str> {

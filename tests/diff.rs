@@ -3,20 +3,9 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-use common::asset;
+use common::{asset, bonescope, json};
 use serde_json::Value;
-
-fn bonescope(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
-}
-
-fn json(output: &Output) -> Value {
-    assert!(output.status.success(), "stderr: {}", String::from_utf8_lossy(&output.stderr));
-    serde_json::from_slice(&output.stdout).expect("valid JSON")
-}
+use std::path::Path;
 
 fn path(p: &Path) -> String {
     p.display().to_string()

@@ -20,12 +20,12 @@ use bonescope::eval::skinning::skin_meshes;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, Options, Space};
 use bonescope::model::Rig;
-use common::{hausdorff, size};
+use common::{asset, hausdorff, size};
 use glam::DVec3;
 use rayon::prelude::*;
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-ufbx-corpus")
+    asset("fbx-ufbx-corpus")
 }
 
 /// Files of the corpus with extension `ext`, sorted.

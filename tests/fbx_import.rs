@@ -10,18 +10,10 @@ use bonescope::eval::skinning::skin_positions;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError, Options, Space};
 use bonescope::model::{InheritMode, Rig};
-use common::{hausdorff, obj_positions, size};
+use common::{asset, assets, hausdorff, load_asset, obj_positions, size};
 use glam::{DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
-
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
-}
-
-fn asset(path: &str) -> PathBuf {
-    assets().join(path)
-}
 
 /// Every `.fbx` under the shared assets, sorted.
 /// The FBX files of the shared asset folders, but for ufbx's whole test corpus (`fbx-ufbx-corpus`, hundreds of files
@@ -42,10 +34,6 @@ fn fbx_files() -> Vec<PathBuf> {
     files.sort();
     assert!(files.len() >= 19, "expected the shared FBX files, found {}", files.len());
     files
-}
-
-fn load(path: &str) -> Rig {
-    import::load(&asset(path)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The ufbx scene exactly as the importer loads it.
@@ -111,7 +99,7 @@ fn proanimationbank_files_have_the_manifest_takes() {
         assert!((0.7..1.3).contains(&height), "{file}: hips at {height} m");
     }
     // "skeleton.fbx: the skeleton with a skinned mesh".
-    let rig = load("fbx-proanimationbank/skeleton.fbx");
+    let rig = load_asset("fbx-proanimationbank/skeleton.fbx");
     assert_eq!(rig.meshes.len(), 1);
     let skin = &rig.skins[rig.meshes[0].skin.expect("skinned")];
     assert!(skin.joints.len() >= 50, "{} joints", skin.joints.len());
@@ -122,14 +110,14 @@ fn ufbx_data_files_show_what_their_readme_says() {
     let bone = |rig: &Rig, name: &str| rig.skeleton.find(name).unwrap_or_else(|| panic!("no bone {name}"));
     // Segment scale compensate (InheritType 2) under scaled parents, FBX 7.7 and 6.1.
     for file in ["maya_scale_no_inherit_7700_ascii.fbx", "maya_scale_no_inherit_6100_ascii.fbx"] {
-        let rig = load(&format!("fbx-ufbx-data/{file}"));
+        let rig = load_asset(&format!("fbx-ufbx-data/{file}"));
         let joint2 = bone(&rig, "joint2");
         assert_eq!(rig.skeleton.bone(joint2).inherit, InheritMode::SegmentCompensate, "{file}");
         let parent = rig.skeleton.parent(joint2).unwrap();
         assert!((rig.skeleton.bone(parent).rest.scale - DVec3::ONE).abs().max_element() > 0.5, "{file}: scaled parent");
     }
     // Animated parent scale over non-inheriting children.
-    let rig = load("fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx");
+    let rig = load_asset("fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx");
     let clip = &rig.clips[0];
     let child = (0..rig.skeleton.len())
         .find(|&b| {
@@ -144,11 +132,11 @@ fn ufbx_data_files_show_what_their_readme_says() {
         .is_some();
     assert!(child, "a segment-compensate bone under a parent whose scale is animated");
     // Static non-inheriting scale: compensating bones, nothing animated.
-    let rig = load("fbx-ufbx-data/maya_static_no_inherit_scale_7700_ascii.fbx");
+    let rig = load_asset("fbx-ufbx-data/maya_static_no_inherit_scale_7700_ascii.fbx");
     assert!(rig.skeleton.declared_modes().contains(&InheritMode::SegmentCompensate));
     assert!(rig.clips.iter().all(|c| c.tracks().is_empty()));
     // Curve interpolation modes: the clip is sampled at every frame (30 fps, 2 s).
-    let rig = load("fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx");
+    let rig = load_asset("fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx");
     assert_eq!(frames(rig.clips[0].duration(), 30.0), 61);
     assert!(rig.clips[0].key_times().len() >= 61);
     // Skinned meshes, from 3ds Max (FBX 7.5 and the old FBX 5 binary), Maya and Blender.
@@ -158,11 +146,11 @@ fn ufbx_data_files_show_what_their_readme_says() {
         "maya_advanced_skinned_pivot_7700_binary.fbx",
         "blender_293_half_skinned_7400_binary.fbx",
     ] {
-        let rig = load(&format!("fbx-ufbx-data/{file}"));
+        let rig = load_asset(&format!("fbx-ufbx-data/{file}"));
         assert!(rig.meshes.iter().any(|m| m.skin.is_some()), "{file}: a skinned mesh");
     }
     // "A mesh only partly bound to bones": two of its four vertices have no weights and follow the mesh's node.
-    let rig = load("fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx");
+    let rig = load_asset("fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx");
     let mesh = &rig.meshes[0];
     let skin = &rig.skins[mesh.skin.unwrap()];
     let own = skin.joints.iter().position(|&j| j == mesh.bone).expect("the mesh node is a joint");
@@ -176,7 +164,7 @@ fn blender_fbx_files_have_both_actions() {
     // blender/README.md: the squash-and-stretch rig (hips … head: 8 joints, a skinned tube, the armature), 30 fps,
     // frames 1–61, both actions as stacks. Blender's FBX takes start at 0, so 61 and 41 frames last 2 and 4/3 s.
     for (file, prefix) in [("stretchy_full.fbx", "Stretchy"), ("stretchy_noinherit.fbx", "StretchyNoInherit")] {
-        let rig = load(&format!("blender/{file}"));
+        let rig = load_asset(&format!("blender/{file}"));
         let names: Vec<String> = rig.clips.iter().map(|c| c.label()).collect();
         assert_eq!(names, [format!("{prefix}|squash_stretch"), format!("{prefix}|wave")], "{file}");
         let durations: Vec<usize> = rig.clips.iter().map(|c| frames(c.duration(), 30.0)).collect();
@@ -599,7 +587,7 @@ fn meshes_with_non_finite_vertices_load_without_them() {
     // ufbx's corpus: a cube with one NaN corner of 8 (counted in the file's text), and meshes of NaN and infinite
     // vertices; the skeleton and animation are fine.
     for file in ["synthetic_cube_nan_6100_ascii.fbx", "synthetic_inf_nan_7700_ascii.fbx"] {
-        let rig = load(&format!("fbx-ufbx-corpus/{file}"));
+        let rig = load_asset(&format!("fbx-ufbx-corpus/{file}"));
         let note = rig.notes.iter().find(|n| n.contains("not finite")).unwrap_or_else(|| panic!("{file}: no note"));
         if file.starts_with("synthetic_cube") {
             assert!(note.starts_with("1 vertices "), "{file}: {note}");

@@ -6,16 +6,19 @@
 //! take more than a second or crash. The counts per area are printed (`cargo test --test gltf_conformance --
 //! --nocapture`).
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+use common::asset;
 use rayon::prelude::*;
 use serde_json::Value;
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/gltf-validator-tests")
+    asset("gltf-validator-tests")
 }
 
 /// One test file and the validator's verdict on it.

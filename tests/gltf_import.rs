@@ -1,13 +1,16 @@
 //! The glTF importer against the shared sample assets, small hand-built documents that break one rule each, and
 //! mutated files that must fail cleanly instead of panicking.
 
+mod common;
+
 use std::collections::{BTreeSet, HashSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use base64::Engine as _;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
 use bonescope::model::{Clip, Interpolation, Rig};
+use common::{asset, assets, load_asset};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -15,10 +18,6 @@ use serde_json::{Value, json};
 
 // ---------------------------------------------------------------------------------------------------------------
 // Sample assets
-
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
-}
 
 /// What a folder's MANIFEST.md or README.md states about one file.
 struct Expected {
@@ -164,7 +163,7 @@ fn every_sample_asset_loads_as_its_manifest_says() {
     assert!(files.len() >= EXPECTED.len(), "found only {files:?}");
     for file in &files {
         let expected = EXPECTED.iter().find(|e| e.file == file).unwrap_or_else(|| panic!("{file} is not in EXPECTED"));
-        let rig = import::load(&assets().join(file)).unwrap_or_else(|e| panic!("{e}"));
+        let rig = load_asset(file);
         check_asset(&rig, expected);
     }
 }
@@ -230,7 +229,7 @@ fn animated(rig: &Rig) -> (HashSet<Interpolation>, BTreeSet<&'static str>) {
 
 #[test]
 fn blender_clips_have_the_stated_channels_and_first_key() {
-    let rig = import::load(&assets().join("blender/stretchy_full.glb")).unwrap();
+    let rig = import::load(&asset("blender/stretchy_full.glb")).unwrap();
     let channels = |name: &str| {
         let clip = rig.find_clip(name).unwrap();
         let count = |t: &bonescope::model::BoneTracks| {
@@ -248,7 +247,7 @@ fn blender_clips_have_the_stated_channels_and_first_key() {
 #[test]
 fn cubic_spline_values_keep_the_file_order() {
     // interpolation_test.gltf: "CubicSpline Translation" stores in-tangent, value, out-tangent per key.
-    let rig = import::load(&assets().join("gltf-khronos/interpolation_test.gltf")).unwrap();
+    let rig = import::load(&asset("gltf-khronos/interpolation_test.gltf")).unwrap();
     let clip = rig.find_clip("CubicSpline Translation").unwrap();
     let track = clip.tracks()[0].translation.as_ref().unwrap();
     assert_eq!(track.values().len(), 3 * track.times().len());

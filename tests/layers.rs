@@ -1,8 +1,9 @@
 //! Runtime techniques layered on clips (`eval::layers`), against values computed by hand from their formulas, and
 //! the walk–run sync on real motion capture.
 
+mod common;
+
 use std::f64::consts::FRAC_PI_2;
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use bonescope::eval::layers::{
@@ -13,6 +14,7 @@ use bonescope::eval::{Hierarchy, LayerStack, Layers, Pose, bind_pose};
 use bonescope::import::{self, demo_rig};
 use bonescope::math::decompose;
 use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use common::asset;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use proptest::prelude::*;
 
@@ -311,8 +313,7 @@ proptest! {
 }
 
 fn locomotions() -> Rig {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
-    import::load(&path).expect("the locomotion cycles load")
+    import::load(&asset("fbx-proanimationbank/locomotions.fbx")).expect("the locomotion cycles load")
 }
 
 /// When in its cycle a foot is planted: the circular mean of the phases at which `bone` is within a quarter of its

@@ -1,14 +1,13 @@
 //! `bonescope render` as a pipeline runs it: byte-identical pictures, modes that change them, reference checks with
 //! diff images, sequences, and errors that name the problem.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::{asset, bonescope};
 use tempfile::TempDir;
-
-fn bonescope(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
-}
 
 fn succeeds(output: &Output) -> String {
     assert!(output.status.success(), "stderr: {}", String::from_utf8_lossy(&output.stderr));
@@ -210,7 +209,7 @@ fn the_readme_pictures_are_what_their_commands_render() {
 #[test]
 fn a_synced_blend_sequence_repeats_with_the_blended_cycle() {
     let dir = TempDir::new().unwrap();
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/fbx-proanimationbank/locomotions.fbx");
+    let file = asset("fbx-proanimationbank/locomotions.fbx");
     let template = path(&dir, "blend_{frame}.png");
     // No legend: its caption states the time, which does differ.
     let args = ["--anim", "walk", "--blend", "run", "--weight", "0.5", "--sync", "--view", "side", "--show", "-legend"];

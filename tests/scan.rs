@@ -1,5 +1,7 @@
 //! Whole-clip scans: on clips whose answer is known by hand, and against decomposing every model matrix.
 
+mod common;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -198,8 +200,7 @@ fn the_scan_agrees_with_decomposing_every_model_matrix() {
         ("demo stretch", &demo, 0),
         ("demo plain", &demo, 1),
     ];
-    let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.glb");
-    let stretchy = bonescope::import::load(&shared);
+    let stretchy = bonescope::import::load(&common::asset("blender/stretchy_full.glb"));
     match &stretchy {
         Ok(rig) => subjects.push(("stretchy_full.glb", rig, 0)),
         Err(e) => eprintln!("skipping stretchy_full.glb: {e}"),

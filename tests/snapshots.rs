@@ -1,8 +1,11 @@
 //! Pictures of the main views with the demo rig, compared with the committed ones in `tests/snapshots/`
 //! (`UPDATE_SNAPSHOTS=1 cargo test --test snapshots` rewrites them; look at them before committing).
 
+mod common;
+
 use bonescope::app::{BonescopeApp, Document, Settings};
 use bonescope::view::ViewKind;
+use common::{asset, finish_analysis};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
@@ -17,16 +20,15 @@ fn window(settings: Settings, doc: Document, time: f64, bone: Option<&str>) -> H
     if let Some(bone) = bone {
         harness.get_by_label(bone).click();
     }
-    settle(&mut harness);
+    settle_for_snapshot(&mut harness);
     harness
 }
 
-/// Lets the background analysis finish, then runs a fixed number of frames, not `run()`: the analysis thread's
-/// wake-up may land in any step, and the plot needs a few frames to fit its bounds to the curves.
-fn settle(harness: &mut Harness<'static, BonescopeApp>) {
-    harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
+/// Lets the background analysis finish, then runs a fixed number of frames rather than `common::settle`'s `run()`:
+/// the analysis thread's wake-up may land in any step, and the plot needs a few frames to fit its bounds to the
+/// curves.
+fn settle_for_snapshot(harness: &mut Harness<'static, BonescopeApp>) {
+    finish_analysis(harness);
     harness.run_steps(8);
 }
 
@@ -66,7 +68,7 @@ fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
     harness.get_by_label("ghost").click();
     harness.step();
     harness.get_by_label("Only flagged").click();
-    settle(&mut harness);
+    settle_for_snapshot(&mut harness);
     harness.snapshot("demo_stretch_plots_with_ghost");
 }
 
@@ -76,7 +78,7 @@ fn long_clip_envelopes() {
     let rig = bonescope::import::stress_rig(20, 20_000, 5);
     let mut harness = window(Settings::default(), Document::new(None, rig), 300.0, None);
     harness.state_mut().selection = vec![6, 16];
-    settle(&mut harness);
+    settle_for_snapshot(&mut harness);
     harness.snapshot("long_clip_envelopes");
 }
 
@@ -124,7 +126,7 @@ fn fbx_blend_shapes_with_inbetweens() {
 
 /// A shared asset (`../shared/assets/FOLDER/NAME`) as a document.
 fn asset_document(path: &str) -> Document {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path);
+    let path = asset(path);
     let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
     Document::new(Some(path), rig)
 }
@@ -160,7 +162,7 @@ fn small_window_with_layers_and_inspector() {
         .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
     harness.state_mut().time = 0.5;
     harness.get_by_label("forearm").click();
-    settle(&mut harness);
+    settle_for_snapshot(&mut harness);
     harness.snapshot("small_window_with_layers_and_inspector");
 }
 
@@ -193,6 +195,6 @@ fn demo_compared_with_its_trs_bake() {
     settings.camera.view = ViewKind::Front;
     let mut harness = window(settings, doc, 0.5, Some("forearm"));
     harness.get_by_label("ghost").click();
-    settle(&mut harness);
+    settle_for_snapshot(&mut harness);
     harness.snapshot("demo_compared_with_its_trs_bake");
 }

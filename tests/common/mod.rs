@@ -1,15 +1,56 @@
-//! Helpers shared by the integration tests that compare evaluated geometry with the authoring tools' own. (Each
-//! test crate uses some of them.)
+//! Helpers shared by the integration tests: the shared assets, the `bonescope` command, the app under egui_kittest,
+//! and the geometry comparisons with the authoring tools' own. (Each test crate uses some of them.)
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
+use bonescope::model::Rig;
 use glam::DVec3;
 use rayon::prelude::*;
+use serde_json::Value;
 
-/// A file of the shared assets beside the repository.
+/// The shared assets' folder beside the repository.
+pub fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
+}
+
+/// A file of the shared assets (`FOLDER/NAME`).
 pub fn asset(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(path)
+    assets().join(path)
+}
+
+/// A file of the shared assets (`FOLDER/NAME`), loaded; panics with the import error.
+pub fn load_asset(path: &str) -> Rig {
+    bonescope::import::load(&asset(path)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The `bonescope` command run with `args`.
+pub fn bonescope(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
+}
+
+/// The JSON a successful command printed.
+pub fn json(output: &Output) -> Value {
+    assert!(output.status.success(), "stderr: {}", String::from_utf8_lossy(&output.stderr));
+    serde_json::from_slice(&output.stdout).expect("valid JSON")
+}
+
+/// Processes pending input and lets the background analysis it started finish; the UI has not caught up yet (see
+/// [`settle`]).
+#[cfg(feature = "gui")]
+pub fn finish_analysis(harness: &mut egui_kittest::Harness<'static, bonescope::app::BonescopeApp>) {
+    harness.step();
+    let ctx = harness.ctx.clone();
+    harness.state_mut().settle(&ctx);
+}
+
+/// [`finish_analysis`], then lets the UI catch up. (A bare `run()` while the analysis runs would keep stepping until
+/// kittest gives up.)
+#[cfg(feature = "gui")]
+pub fn settle(harness: &mut egui_kittest::Harness<'static, bonescope::app::BonescopeApp>) {
+    finish_analysis(harness);
+    harness.run();
 }
 
 /// The vertex positions (`v` lines) of a Wavefront OBJ file.
