@@ -49,13 +49,14 @@ impl<K, T> Default for Job<K, T> {
 }
 
 impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> {
-    /// Starts `work` on a thread when `key` differs from the finished or running one (a running one is cancelled);
-    /// collects a finished result. `on_done` is called from the worker when it finishes (to wake the UI). `work`
-    /// returns `None` when it was cancelled.
-    pub fn update(
+    /// Starts the work `work()` makes on a thread when `key` differs from the finished or running one (a running
+    /// one is cancelled); collects a finished result. The work is only made then: the UI asks every frame, and
+    /// making it copies what it works on. `on_done` is called from the worker when it finishes (to wake the UI).
+    /// The work returns `None` when it was cancelled.
+    pub fn update<W: FnOnce(&Progress) -> Option<T> + Send + 'static>(
         &mut self,
         key: K,
-        work: impl FnOnce(&Progress) -> Option<T> + Send + 'static,
+        work: impl FnOnce() -> W,
         on_done: impl Fn() + Send + 'static,
     ) {
         self.collect();
@@ -66,6 +67,7 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
         if let Some(old) = self.running.take() {
             old.progress.cancel.store(true, Ordering::Relaxed);
         }
+        let work = work();
         let (sender, result) = channel();
         let progress = Progress::default();
         let worker_progress = progress.clone();

@@ -65,7 +65,7 @@ impl LayersPanel {
             let key = storage_key(doc);
             if ui.button("Measure the clip").clicked() {
                 let doc = doc.clone();
-                let work = move |_: &Progress| Some(storage_report(&doc.evaluation(), &StorageOptions::default()));
+                let work = || move |_: &Progress| Some(storage_report(&doc.evaluation(), &StorageOptions::default()));
                 let waker = ui.ctx().clone();
                 self.storage.update(key.clone(), work, move || waker.request_repaint());
             }

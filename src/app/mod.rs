@@ -390,22 +390,25 @@ impl BonescopeApp {
     /// Starts the analyses the current state wants (each only when its key changed).
     fn request_analyses(&mut self, ctx: &egui::Context) {
         let doc = &self.doc;
+        let key = self.job_key();
         let waker = ctx.clone();
-        self.job.update(self.job_key(), job::analysis(self.job_key(), doc.clone()), move || waker.request_repaint());
+        let work = || job::analysis(key.clone(), doc.clone());
+        self.job.update(key.clone(), work, move || waker.request_repaint());
         if let Some(key) = self.curves_key() {
             let waker = ctx.clone();
-            self.curves_job.update(key.clone(), job::analysis(key, doc.clone()), move || waker.request_repaint());
+            let work = || job::analysis(key.clone(), doc.clone());
+            self.curves_job.update(key.clone(), work, move || waker.request_repaint());
         }
         let Some(compared) = self.doc.compared.clone() else { return };
         if let Some(key) = self.compare_key() {
-            let work = compare::differences(key.clone(), self.doc.clone(), compared.clone());
+            let work = || compare::differences(key.clone(), doc.clone(), compared.clone());
             let waker = ctx.clone();
-            self.compare_jobs.differences.update(key, work, move || waker.request_repaint());
+            self.compare_jobs.differences.update(key.clone(), work, move || waker.request_repaint());
         }
         if let Some(key) = self.compared_curves_key() {
-            let work = compare::curves(key.clone(), compared);
+            let work = || compare::curves(key.clone(), compared);
             let waker = ctx.clone();
-            self.compare_jobs.curves.update(key, work, move || waker.request_repaint());
+            self.compare_jobs.curves.update(key.clone(), work, move || waker.request_repaint());
         }
     }
 
