@@ -212,24 +212,20 @@ pub struct LayeredInspectReport {
     pub bind_mismatches: Vec<super::BindMismatch>,
 }
 
-/// What a report is of: the file (as named), the rig read from it, the clip, and how it is evaluated.
-pub struct InspectSubject<'a> {
-    pub file: String,
-    pub rig: &'a crate::model::Rig,
-    pub clip: Option<&'a crate::model::Clip>,
-    /// `declared`, or the mode given to every bone.
-    pub inherit: String,
-    pub hierarchy: &'a crate::eval::Hierarchy,
-    pub layers: crate::eval::Layers,
-}
-
 impl LayeredInspectReport {
-    /// The report `inspect` prints (and the app copies) for `subject` at the given samples.
-    pub fn new(subject: InspectSubject, samples: Vec<SampleReport>) -> Self {
-        let InspectSubject { file, rig, clip, inherit, hierarchy, layers } = subject;
-        let report =
-            InspectReport { file, notes: rig.notes.clone(), animation: clip.map(AnimationInfo::of), inherit, samples };
-        let bind_mismatches = super::bind_mismatches(rig, hierarchy, &super::BindTolerance::default());
+    /// The report `inspect` prints (and the app copies) of `file` (as named) evaluated as `evaluation` is, at the
+    /// given samples; `inherit` says what the modes are (`declared`, a mode's id, or `mixed`).
+    pub fn new(
+        file: String,
+        evaluation: &crate::eval::Evaluation,
+        inherit: String,
+        samples: Vec<SampleReport>,
+    ) -> Self {
+        let rig = evaluation.rig;
+        let animation = evaluation.clip.map(AnimationInfo::of);
+        let report = InspectReport { file, notes: rig.notes.clone(), animation, inherit, samples };
+        let layers = evaluation.layers().map(|stack| stack.layers().clone()).unwrap_or_default();
+        let bind_mismatches = super::bind_mismatches(rig, &evaluation.hierarchy, &super::BindTolerance::default());
         LayeredInspectReport { report, layers, bind_mismatches }
     }
 }

@@ -6,8 +6,7 @@ use glam::DMat4;
 
 use super::Shared;
 use super::{ModeChoice, ModeScope};
-use crate::analysis::report::{BoneReport, InspectSubject, LayeredInspectReport, SampleReport};
-use crate::eval::Hierarchy;
+use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
 use crate::view::Badge;
 
@@ -61,16 +60,9 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
 fn inspect_report(shared: &Shared, bones: Vec<BoneReport>) -> LayeredInspectReport {
     let doc = &*shared.doc;
     let inherit = doc.current_choice(0, ModeScope::All).map_or("mixed", ModeChoice::label).to_owned();
-    let hierarchy = Hierarchy::new(&doc.rig.skeleton, &doc.modes);
-    let subject = InspectSubject {
-        file: doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string()),
-        rig: &doc.rig,
-        clip: doc.clip(),
-        inherit,
-        hierarchy: &hierarchy,
-        layers: doc.layers().clone(),
-    };
-    LayeredInspectReport::new(subject, vec![SampleReport { time: *shared.time, bones }])
+    let file = doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string());
+    let samples = vec![SampleReport { time: *shared.time, bones }];
+    LayeredInspectReport::new(file, &doc.evaluation(), inherit, samples)
 }
 
 /// The morph-target weights in effect on the meshes the bone carries (animated by the clip, or the meshes' own).

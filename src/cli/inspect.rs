@@ -9,7 +9,7 @@ use clap::Args;
 use super::layers::LayerArgs;
 use super::table::{Table, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
-use crate::analysis::report::{AnimationInfo, BoneReport, InspectSubject, LayeredInspectReport, SampleReport};
+use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 
@@ -50,15 +50,8 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         })
         .collect();
     let summary = layers.summary(&rig, clip);
-    let subject = InspectSubject {
-        file: super::scan::shown(&args.file),
-        rig: &rig,
-        clip,
-        inherit: args.eval.inherit_label(),
-        hierarchy: &evaluation.hierarchy,
-        layers,
-    };
-    let report = LayeredInspectReport::new(subject, samples);
+    let report =
+        LayeredInspectReport::new(super::scan::shown(&args.file), &evaluation, args.eval.inherit_label(), samples);
     match args.format {
         Format::Json => {
             // Written as it is serialised: a rig of a million bones prints gigabytes, never held in memory at once.
