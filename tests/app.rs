@@ -96,7 +96,9 @@ fn a_file_that_fails_to_load_keeps_the_document_and_says_why() {
     harness.state_mut().open(&broken);
     harness.run();
     assert!(harness.state().doc.path.is_none(), "still the demo");
-    harness.get_by_label_contains("broken.glb");
+    // The file's name first, then what is wrong with it.
+    harness.get_by_label("broken.glb");
+    harness.get_by_label_contains("broken.glb:");
 }
 
 #[test]
@@ -417,7 +419,7 @@ fn copy_as_json_is_what_inspect_prints_and_says_so() {
         })
         .expect("copied");
     harness.run();
-    harness.get_by_label("copied to the clipboard");
+    harness.get_by_label("Copied");
     let cli = std::process::Command::new(env!("CARGO_BIN_EXE_bonescope"))
         .args(["inspect", &path.display().to_string(), "--time", "0.5", "--format", "json"])
         .output()
@@ -631,4 +633,208 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     let differences = harness.state().differences().expect("the reloaded file's differences");
     assert!(differences.bones.iter().any(|d| d.is_some_and(|d| d > 1e-3)), "{differences:?}");
     harness.get_by_label_contains("reloaded");
+}
+
+/// The app on a shared file in a laptop's window, 1280×800, with the Layers and the Inspector open and `bone`
+/// inspected at `time`.
+fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeApp> {
+    let doc = Document::load(&asset(path)).unwrap();
+    let index = doc.rig.skeleton.find(bone).unwrap();
+    let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    harness.state_mut().time = time;
+    harness.state_mut().selection = vec![index];
+    settle(&mut harness);
+    harness
+}
+
+/// Every label and button that starts inside a panel ends inside it: no number or name is cut at the panel's
+/// right edge (text that does not fit wraps, names shorten in the middle).
+fn assert_nothing_cut(harness: &Harness<'static, BonescopeApp>) {
+    use bonescope::app::Pane;
+    let window = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 800.0));
+    for pane in [Pane::Outliner, Pane::Inspector, Pane::Layers] {
+        let rect = harness.state().pane_rect(pane).unwrap_or_else(|| panic!("{pane:?} is shown"));
+        assert!(rect.width() >= 200.0, "{pane:?} is {} wide", rect.width());
+        let nodes = harness.query_all_by_role(Role::Label).chain(harness.query_all_by_role(Role::Button));
+        let mut checked = 0;
+        for node in nodes {
+            let r = node.rect();
+            let inside = rect.contains(egui::pos2(r.left() + 1.0, r.center().y)) && window.contains(r.center());
+            if inside {
+                checked += 1;
+                assert!(
+                    r.right() <= rect.right() + 1.0,
+                    "{pane:?}: {node:?} ends at {} past {}",
+                    r.right(),
+                    rect.right()
+                );
+            }
+        }
+        assert!(checked > 5, "{pane:?}: only {checked} labels");
+    }
+}
+
+#[test]
+fn at_a_laptops_size_every_number_and_name_is_whole() {
+    let harness = laptop_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", "Left_Tip", 0.5);
+    assert_nothing_cut(&harness);
+    // Both matrices whole, four columns each, within the Inspector.
+    let inspector = harness.state().pane_rect(bonescope::app::Pane::Inspector).unwrap();
+    let numbers = harness
+        .query_all_by_role(Role::Label)
+        .filter(|n| n.value().is_some_and(|l| l.trim().parse::<f64>().is_ok()))
+        .filter(|n| inspector.contains_rect(n.rect()))
+        .count();
+    assert!(numbers >= 2 * 16, "{numbers} numbers in the Inspector");
+    let harness = laptop_app("fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx", "Character1_RightHandMiddle3", 0.0);
+    assert_nothing_cut(&harness);
+}
+
+#[test]
+fn a_pause_or_an_idle_spell_never_counts_as_playing() {
+    // A mocked clock: the frame's input time is set by hand.
+    let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
+    let at = |harness: &mut Harness<'static, BonescopeApp>, t: f64| {
+        harness.input_mut().time = Some(t);
+        harness.step();
+    };
+    at(&mut harness, 100.0);
+    harness.state_mut().time = 0.0;
+    // Idle 3 s, then Play: the first frame adds nothing, the next ones their frame times.
+    at(&mut harness, 103.0);
+    harness.state_mut().toggle_play();
+    at(&mut harness, 103.0);
+    at(&mut harness, 103.05);
+    assert!((harness.state().time - 0.05).abs() < 1e-9, "{}", harness.state().time);
+    harness.state_mut().toggle_play();
+    at(&mut harness, 110.0);
+    harness.state_mut().toggle_play();
+    at(&mut harness, 110.0);
+    assert!((harness.state().time - 0.05).abs() < 1e-9, "the pause did not count: {}", harness.state().time);
+    harness.state_mut().playing = false;
+    // At the end of a clip without Loop, Play after an idle spell plays from the start.
+    let end = harness.state().doc.duration();
+    harness.state_mut().settings.looping = false;
+    harness.state_mut().time = end;
+    at(&mut harness, 200.0);
+    harness.state_mut().toggle_play();
+    at(&mut harness, 200.0);
+    at(&mut harness, 200.1);
+    assert!(harness.state().playing);
+    assert!((harness.state().time - 0.1).abs() < 1e-9, "{}", harness.state().time);
+}
+
+#[test]
+fn every_key_repeat_of_a_held_arrow_is_a_frame() {
+    let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
+    harness.state_mut().time = 0.0;
+    // A slow frame receives five repeats of →: five frames of the 120 Hz take.
+    for _ in 0..5 {
+        harness.input_mut().events.push(egui::Event::Key {
+            key: egui::Key::ArrowRight,
+            physical_key: None,
+            pressed: true,
+            repeat: true,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    harness.step();
+    let rate = harness.state().doc.frame_rate();
+    assert!((harness.state().time - 5.0 / rate).abs() < 1e-12, "{}", harness.state().time);
+}
+
+#[test]
+fn frames_are_frames_everywhere_once_chosen() {
+    let settings = Settings { time_unit: bonescope::app::TimeUnit::Frames, ..Settings::default() };
+    let doc = Document::load(&asset("bvh/cmu_12_01_walk.bvh")).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    settle(&mut harness);
+    let rate = harness.state().doc.frame_rate();
+    let frames = (harness.state().doc.duration() * rate).round();
+    harness.get_by_label(&format!("of {frames} frames"));
+    // A click anywhere on the time bar lands on a whole frame.
+    let bar = harness.get_by_label("time bar").rect();
+    let at = egui::pos2(bar.left() + 0.377 * bar.width(), bar.center().y);
+    harness.event(egui::Event::PointerMoved(at));
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    harness.run();
+    assert!(harness.state().time > 0.0, "the click moved the time");
+    let frame = harness.state().time * rate;
+    assert!((frame - frame.round()).abs() < 1e-9, "frame {frame}");
+}
+
+#[test]
+fn messages_stack_in_the_viewport_wrap_and_cover_no_control() {
+    use bonescope::app::Pane;
+    let mut harness = demo_app();
+    let dir = tempfile::tempdir().unwrap();
+    let long = format!("{}.glb", "a_very_long_file_name_from_a_studio_pipeline_".repeat(3));
+    for name in [long.as_str(), "second.glb"] {
+        let broken = dir.path().join(name);
+        std::fs::write(&broken, b"glTF\x02\x00\x00\x00").unwrap();
+        harness.state_mut().open(&broken);
+    }
+    harness.run();
+    let viewport = harness.state().pane_rect(Pane::Viewport).unwrap();
+    let messages = harness.state().notifications_rect().unwrap();
+    assert!(viewport.contains_rect(messages), "{messages:?} within {viewport:?}");
+    // Both whole: each error's text wraps within the stack, and each has its Dismiss.
+    assert_eq!(harness.query_all_by_label("Dismiss").count(), 2);
+    let texts: Vec<_> =
+        harness.query_all_by_role(Role::Label).filter(|n| n.value().is_some_and(|l| l.contains(".glb:"))).collect();
+    assert_eq!(texts.len(), 2, "both errors' texts");
+    for node in texts {
+        assert!(messages.contains_rect(node.rect().shrink(1.0)), "{:?} cut", node.value());
+    }
+    // The timeline's controls are outside it.
+    for label in ["Play", "current time", "time bar"] {
+        assert!(!messages.intersects(harness.get_by_label(label).rect()), "{label} covered");
+    }
+}
+
+#[test]
+fn nothing_moves_when_play_turns_to_pause_or_json_is_copied() {
+    use bonescope::app::Pane;
+    let mut harness = demo_app();
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    let before = (harness.get_by_label("Loop").rect(), harness.state().pane_rect(Pane::Layers));
+    let inspector = harness.state().pane_rect(Pane::Inspector);
+    harness.get_by_label("Play").click();
+    harness.step();
+    harness.step();
+    assert_eq!(harness.get_by_label("Loop").rect(), before.0, "the controls after Pause stay put");
+    harness.get_by_label("Pause").click();
+    harness.step();
+    harness.get_by_label("Copy as JSON").click();
+    harness.step();
+    harness.step();
+    harness.get_by_label("Copied");
+    assert_eq!(harness.state().pane_rect(Pane::Inspector), inspector);
+    assert_eq!(harness.state().pane_rect(Pane::Layers), before.1);
+}
+
+#[test]
+fn a_narrow_window_keeps_every_toolbar_control_with_a_long_take_name() {
+    let mut doc = Document::demo();
+    let rig = std::sync::Arc::make_mut(&mut doc.rig);
+    rig.clips[0].name = Some("Character1|Take 001|BaseLayer|walk_cycle_final_v12_approved_by_lead".to_owned());
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+    settle(&mut harness);
+    let layers = harness.get_by_label("Layers").rect();
+    assert!(layers.right() <= 1000.0 && layers.bottom() <= 700.0, "{layers:?}");
 }

@@ -150,20 +150,52 @@ fn cmu_walk_gizmos() {
     window(settings, asset_document("bvh/cmu_12_01_walk.bvh"), 1.0, None).snapshot("cmu_walk_gizmos");
 }
 
-/// A small laptop window, 1000×700, with the Layers panel and the Inspector open: the side panels keep their widths
-/// (at most a fifth of the window each), the viewport keeps the rest, its toolbar one row.
+/// A small laptop window, 1000×700, with the Layers panel and the Inspector open: the Inspector and the Layers
+/// share a column, the toolbar wraps rather than cut its controls.
 #[test]
 fn small_window_with_layers_and_inspector() {
     let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    laptop(egui::vec2(1000.0, 700.0), settings, Document::demo(), "forearm", 0.5)
+        .snapshot("small_window_with_layers_and_inspector");
+}
+
+/// A laptop's window, 1280×800, with the Layers and the Inspector open on a studio's file, one of its bones
+/// inspected: every matrix column, name and number whole.
+fn laptop(
+    size: egui::Vec2,
+    settings: Settings,
+    doc: Document,
+    bone: &str,
+    time: f64,
+) -> Harness<'static, BonescopeApp> {
+    let index = doc.rig.skeleton.find(bone).unwrap_or_else(|| panic!("{bone}"));
     let mut harness = Harness::builder()
-        .with_size(egui::vec2(1000.0, 700.0))
+        .with_size(size)
         .with_render_cursor(false)
         .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
-    harness.state_mut().time = 0.5;
-    harness.get_by_label("forearm").click();
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    harness.state_mut().time = time;
+    harness.state_mut().selection = vec![index];
     settle_for_snapshot(&mut harness);
-    harness.snapshot("small_window_with_layers_and_inspector");
+    harness
+}
+
+fn laptop_settings() -> Settings {
+    Settings { show_layers: true, show_inspector: true, ..Settings::default() }
+}
+
+#[test]
+fn laptop_maya_mixed_inherit_modes() {
+    let doc = asset_document("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
+    laptop(egui::vec2(1280.0, 800.0), laptop_settings(), doc, "Left_Tip", 0.5)
+        .snapshot("laptop_maya_mixed_inherit_modes");
+}
+
+#[test]
+fn laptop_maya_human_ik() {
+    let doc = asset_document("fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx");
+    laptop(egui::vec2(1280.0, 800.0), laptop_settings(), doc, "Character1_RightHandMiddle3", 0.0)
+        .snapshot("laptop_maya_human_ik");
 }
 
 /// Axis-angle curves: the angle in degrees and the unit axis in two plots sharing the time axis, the legend above

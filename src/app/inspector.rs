@@ -5,13 +5,13 @@ use egui::{Grid, RichText, Ui};
 use glam::DMat4;
 
 use super::Shared;
+use super::text::compact;
 use super::{ModeChoice, ModeScope};
 use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
 use crate::view::Badge;
 
 pub fn ui(ui: &mut Ui, shared: &mut Shared) {
-    ui.heading("Inspector");
     let Some(bone) = shared.inspected() else {
         ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
         return;
@@ -32,22 +32,8 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
     let explanation = badges.iter().map(|b| b.explanation()).collect::<Vec<_>>().join("; ");
     ui.label(RichText::new(text).color(color).strong()).on_hover_text(explanation);
     ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
-    ui.horizontal(|ui| {
-        let copied_at = ui.scope_id().with("copied-at");
-        let now = ui.input(|i| i.time);
-        let hint = "every bone now, as `bonescope inspect FILE --time T --format json` prints it";
-        if ui.button("Copy as JSON").on_hover_text(hint).clicked()
-            && let Ok(json) = serde_json::to_string_pretty(&inspect_report(shared, reports.clone()))
-        {
-            ui.ctx().copy_text(json);
-            ui.data_mut(|d| d.insert_temp(copied_at, now));
-        }
-        if ui.data(|d| d.get_temp::<f64>(copied_at)).is_some_and(|t| now - t < 3.0) {
-            ui.label(RichText::new("copied to the clipboard").weak());
-            ui.ctx().request_repaint_after(std::time::Duration::from_millis(500));
-        }
-    });
-    egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
+    copy_button(ui, shared, &reports);
+    egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;
@@ -55,6 +41,30 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
         section(ui, "Local", &local, &crate::math::decompose(&local), tolerance);
     });
 }
+
+/// Copies what `inspect --format json` prints; for a moment after, the button says it did (in its own width, so
+/// nothing beside or below it moves).
+fn copy_button(ui: &mut Ui, shared: &Shared, reports: &[BoneReport]) {
+    let copied_at = ui.scope_id().with("copied-at");
+    let now = ui.input(|i| i.time);
+    let copied = ui.data(|d| d.get_temp::<f64>(copied_at)).is_some_and(|t| now - t < COPIED_SECONDS);
+    let width = super::text::text_width(ui, "Copy as JSON", &egui::TextStyle::Button.resolve(ui.style()));
+    let button = egui::Button::new(if copied { "Copied" } else { "Copy as JSON" })
+        .min_size(egui::vec2(width + 2.0 * ui.spacing().button_padding.x, 0.0));
+    let hint = "every bone now, as `bonescope inspect FILE --time T --format json` prints it";
+    if ui.add(button).on_hover_text(hint).clicked()
+        && let Ok(json) = serde_json::to_string_pretty(&inspect_report(shared, reports.to_vec()))
+    {
+        ui.ctx().copy_text(json);
+        ui.data_mut(|d| d.insert_temp(copied_at, now));
+    }
+    if copied {
+        ui.ctx().request_repaint_after(std::time::Duration::from_millis(250));
+    }
+}
+
+/// How long the Copy button says "Copied".
+const COPIED_SECONDS: f64 = 2.0;
 
 /// What `inspect --format json` prints for the document at the current time: every bone, the layers, the bind check.
 fn inspect_report(shared: &Shared, bones: Vec<BoneReport>) -> LayeredInspectReport {
@@ -83,35 +93,45 @@ fn morph_weights(ui: &mut Ui, shared: &Shared, bone: usize) {
     }
 }
 
-/// A matrix and its parts. Where the scale factors are equal within `anisotropy` the stretch rotation `U` is
-/// undetermined (any frame diagonalises a uniform scale), so it is shown as the identity it is equivalent to.
+/// A matrix and its parts, in columns that fit a narrow panel (numbers in at most 7 characters, see
+/// [`compact`]). Where the scale factors are equal within `anisotropy` the stretch rotation `U` is undetermined (any
+/// frame diagonalises a uniform scale), so it is shown as the identity it is equivalent to.
 fn section(ui: &mut Ui, title: &str, matrix: &DMat4, parts: &AffineParts, anisotropy: f64) {
     ui.separator();
     ui.label(RichText::new(title).strong());
-    Grid::new(format!("{title}-matrix")).striped(true).show(ui, |ui| {
+    Grid::new(format!("{title}-matrix")).spacing([COLUMN_GAP, 2.0]).striped(true).show(ui, |ui| {
         for row in 0..4 {
-            for col in 0..4 {
-                ui.label(RichText::new(format!("{:>9.4}", matrix.col(col)[row])).monospace());
-            }
+            numbers(ui, &(0..4).map(|col| matrix.col(col)[row]).collect::<Vec<_>>());
             ui.end_row();
         }
     });
-    Grid::new(format!("{title}-parts")).show(ui, |ui| {
-        // Fixed-width numbers, so columns line up and nothing shifts as values change.
-        let v = |values: &[f64]| values.iter().map(|x| format!("{:>8.4}", x + 0.0)).collect::<Vec<_>>().join(" ");
-        let uniform = parts.anisotropy() <= anisotropy;
-        let stretch = if uniform { glam::DQuat::IDENTITY } else { parts.stretch };
-        let rows = [
-            ("translation", v(&parts.translation.to_array())),
-            ("rotation q", v(&parts.rotation.to_array())),
-            ("stretch U", format!("{}  ({:.3}°)", v(&stretch.to_array()), parts.stretch_angle_deg_within(anisotropy))),
-            ("scale k", v(&parts.scale.to_array())),
-            ("sign f", format!("{:>8}", parts.sign)),
+    let uniform = parts.anisotropy() <= anisotropy;
+    let stretch = if uniform { glam::DQuat::IDENTITY } else { parts.stretch };
+    Grid::new(format!("{title}-parts")).spacing([COLUMN_GAP, 2.0]).show(ui, |ui| {
+        let rows: [(&str, &str, Vec<f64>); 6] = [
+            ("translation", "T: x y z", parts.translation.to_array().to_vec()),
+            ("rotation", "R as a quaternion: x y z w", parts.rotation.to_array().to_vec()),
+            ("stretch U", "U as a quaternion: x y z w", stretch.to_array().to_vec()),
+            ("stretch °", "U's angle in degrees", vec![parts.stretch_angle_deg_within(anisotropy)]),
+            ("scale k", "K: the scale along U's axes", parts.scale.to_array().to_vec()),
+            ("sign f", "F: -1 mirrors", vec![parts.sign]),
         ];
-        for (name, value) in rows {
-            ui.label(name);
-            ui.label(RichText::new(value).monospace());
+        for (name, hint, values) in rows {
+            ui.label(name).on_hover_text(hint);
+            numbers(ui, &values);
             ui.end_row();
         }
     });
+}
+
+/// Points between the inspector's number columns.
+const COLUMN_GAP: f32 = 6.0;
+
+/// One grid cell per value, right-aligned in a fixed width (so columns line up and nothing shifts as values
+/// change), the exact value on hover.
+fn numbers(ui: &mut Ui, values: &[f64]) {
+    for &value in values {
+        let text = RichText::new(format!("{:>7}", compact(value + 0.0))).monospace();
+        ui.label(text).on_hover_text(format!("{value}"));
+    }
 }

@@ -38,9 +38,8 @@ impl LayersPanel {
     }
 
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        ui.heading("Layers");
         let mut layers = shared.doc.layers().clone();
-        egui::ScrollArea::both().auto_shrink([false, false]).show(ui, |ui| {
+        egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
             bind_section(ui, shared, &mut layers);
             interpolation_section(ui, shared, &mut layers);
             blend_section(ui, shared, &mut layers);

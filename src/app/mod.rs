@@ -10,11 +10,14 @@ mod file_browser;
 mod inspector;
 mod job;
 mod layers;
+mod layout;
 mod notifications;
 mod outliner;
 mod plots;
 mod reduce;
 mod settings;
+mod text;
+mod ticks;
 mod timeline;
 mod toolbar;
 mod viewport;
@@ -28,6 +31,7 @@ pub use crate::model::ModeChoice;
 pub use compare::Compared;
 pub use document::{Document, Ghost, ModeScope};
 pub use file_browser::NativeDialog;
+pub use layout::{Layout, Pane};
 pub use plots::plot_id;
 pub use settings::{RotationFormat, Settings, TimeUnit};
 
@@ -176,6 +180,9 @@ pub struct BonescopeApp {
     viewport: viewport::Viewport,
     layers: layers::LayersPanel,
     spans: SpanCache,
+    clock: timeline::PlayClock,
+    /// The window's size in the last frame.
+    window_size: egui::Vec2,
 }
 
 impl BonescopeApp {
@@ -206,6 +213,8 @@ impl BonescopeApp {
             viewport: viewport::Viewport::default(),
             layers: layers::LayersPanel::default(),
             spans: SpanCache::default(),
+            clock: timeline::PlayClock::default(),
+            window_size: egui::Vec2::ZERO,
         };
         app.document_replaced(true);
         app
@@ -236,7 +245,7 @@ impl BonescopeApp {
                 self.selection.clear();
                 self.time = 0.0;
                 self.document_replaced(true);
-                self.notifications.info(format!("opened {}", path.display()));
+                self.notifications.info_about(&topic, format!("opened {}", path.display()));
             }
             Err(error) => {
                 self.notifications.error_about(&topic, error.to_string());
@@ -259,7 +268,7 @@ impl BonescopeApp {
                 }
                 self.doc.compare_with(compared);
                 self.compared_replaced();
-                self.notifications.info(message);
+                self.notifications.info_about(&topic, message);
             }
             Err(error) => self.notifications.error_about(&topic, format!("not compared: {error}")),
         }
@@ -273,7 +282,7 @@ impl BonescopeApp {
                 self.doc.compared = Some(Arc::new(compared));
                 self.compared_replaced();
                 self.notifications.resolved(&path.display().to_string());
-                self.notifications.info(format!("reloaded {}", path.display()));
+                self.notifications.info_about(&path.display().to_string(), format!("reloaded {}", path.display()));
             }
             Err(error) => self.notifications.error_about(&path.display().to_string(), format!("not reloaded: {error}")),
         }
@@ -309,6 +318,7 @@ impl BonescopeApp {
                 let names =
                     |rig: &crate::model::Rig| rig.skeleton.bones().iter().map(|b| b.name.clone()).collect::<Vec<_>>();
                 let same_rig = names(&rig) == names(&self.doc.rig);
+                let topic = path.display().to_string();
                 let (doc, dropped) = self.doc.reloaded(rig);
                 self.doc = doc;
                 let bones = self.doc.rig.skeleton.len();
@@ -316,10 +326,10 @@ impl BonescopeApp {
                 self.document_replaced(!same_rig);
                 self.notifications.resolved(&path.display().to_string());
                 match dropped {
-                    None => self.notifications.info(format!("reloaded {}", path.display())),
-                    Some(error) => {
-                        self.notifications.info(format!("reloaded {}; layers dropped: {error}", path.display()))
-                    }
+                    None => self.notifications.info_about(&topic, format!("reloaded {}", path.display())),
+                    Some(error) => self
+                        .notifications
+                        .info_about(&topic, format!("reloaded {}; layers dropped: {error}", path.display())),
                 }
             }
             Err(error) => self.notifications.error_about(&path.display().to_string(), format!("not reloaded: {error}")),
@@ -453,6 +463,18 @@ impl BonescopeApp {
         self.curves_job.for_key(&self.curves_key()?).map(Arc::as_ref)
     }
 
+    /// Where `pane` was drawn in the last frame; `None` when hidden.
+    pub fn pane_rect(&self, pane: Pane) -> Option<egui::Rect> {
+        let tiles = &self.settings.layout.as_ref()?.tiles;
+        let tile = tiles.find_pane(&pane)?;
+        tiles.is_visible(tile).then(|| tiles.rect(tile)).flatten()
+    }
+
+    /// Where the messages were drawn in the last frame.
+    pub fn notifications_rect(&self) -> Option<egui::Rect> {
+        self.notifications.rect()
+    }
+
     /// The errors shown, with how many times each was said.
     pub fn errors(&self) -> Vec<(String, usize)> {
         self.notifications.errors()
@@ -462,6 +484,12 @@ impl BonescopeApp {
     pub fn ui(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         ctx.set_theme(if self.settings.dark { egui::Theme::Dark } else { egui::Theme::Light });
+        // After a resize the panels settle their sizes over a frame or two: draw those at once, not at the next
+        // input (the window would show a strip of nothing meanwhile).
+        let size = ctx.content_rect().size();
+        if std::mem::replace(&mut self.window_size, size) != size {
+            ctx.request_repaint();
+        }
         self.poll_background(&ctx);
         self.handle_input(&ctx);
         self.advance_playback(&ctx);
@@ -497,28 +525,26 @@ impl BonescopeApp {
             } else {
                 egui::Panel::top("menu").show(ui, |ui| toolbar::ui(ui, &mut shared, &mut actions));
                 egui::Panel::bottom("timeline").resizable(false).show(ui, |ui| timeline::ui(ui, &mut shared));
-                if shared.settings.show_plots {
-                    egui::Panel::bottom("plots")
-                        .resizable(true)
-                        .default_size(230.0)
-                        .min_size(160.0)
-                        .show(ui, |ui| self.plots.ui(ui, &mut shared));
-                }
-                let width = ui.available_width();
-                side_panel(egui::Panel::left("outliner"), 250.0, width)
-                    .show(ui, |ui| self.outliner.ui(ui, &mut shared));
-                if shared.settings.show_inspector {
-                    side_panel(egui::Panel::right("inspector"), 300.0, width)
-                        .show(ui, |ui| inspector::ui(ui, &mut shared));
-                }
-                if shared.settings.show_layers {
-                    side_panel(egui::Panel::right("layers"), 290.0, width)
-                        .show(ui, |ui| self.layers.ui(ui, &mut shared));
-                }
-                egui::CentralPanel::default().show(ui, |ui| self.viewport.ui(ui, &mut shared));
+                let width = ui.ctx().content_rect().width();
+                // The panels' background under the tiles (which paint none of their own).
+                let fill = egui::Frame::NONE.fill(ui.visuals().panel_fill);
+                egui::CentralPanel::default().frame(fill).show(ui, |ui| {
+                    // The arrangement lives in the settings (it persists); the panes borrow them through `shared`.
+                    let mut layout = layout::take_layout(shared.settings, width);
+                    let mut panes = layout::Panes {
+                        shared: &mut shared,
+                        outliner: &mut self.outliner,
+                        plots: &mut self.plots,
+                        viewport: &mut self.viewport,
+                        layers: &mut self.layers,
+                        style: ui.style().clone(),
+                    };
+                    layout.ui(&mut panes, ui);
+                    shared.settings.layout = Some(layout);
+                });
             }
         }
-        self.notifications.ui(&ctx);
+        self.notifications.ui(&ctx, self.viewport.rect().unwrap_or_else(|| ctx.content_rect()));
         if let Some((browser, purpose)) = &mut self.browser {
             let mut open = true;
             let chosen = browser.ui(&ctx, &mut open).map(|path| (path, *purpose));
@@ -640,7 +666,8 @@ impl BonescopeApp {
             self.toggle_play();
         }
         for (key, forward) in [(egui::Key::ArrowLeft, false), (egui::Key::ArrowRight, true)] {
-            if pressed(key) {
+            // A held key repeats faster than slow frames come: every repeat is a frame.
+            for _ in 0..ctx.input(|i| i.num_presses(key)) {
                 self.playing = false;
                 self.time = timeline::step_frame(self.time, self.doc.frame_rate(), forward, duration);
             }
@@ -659,13 +686,12 @@ impl BonescopeApp {
     }
 
     fn advance_playback(&mut self, ctx: &egui::Context) {
+        let now = ctx.input(|i| i.time);
+        let dt = self.clock.tick(now, self.playing) * self.settings.speed;
         if !self.playing {
             return;
         }
         let duration = self.doc.duration();
-        // The wall clock, not a smoothed frame time: when frames are slow the clip skips frames rather than playing
-        // in slow motion (a longer pause, a hidden window or a debugger, counts as one second).
-        let dt = f64::from(ctx.input(|i| i.unstable_dt).min(1.0)) * self.settings.speed;
         self.time += dt;
         if self.time > duration {
             if self.settings.looping && duration > 0.0 {
@@ -677,21 +703,6 @@ impl BonescopeApp {
         }
         ctx.request_repaint();
     }
-}
-
-/// The narrowest a side panel may be made, in points.
-const MIN_SIDE_PANEL: f32 = 160.0;
-
-/// The largest share of the window one side panel may take: with all three open (and their margins) the viewport
-/// keeps at least 40 %.
-const MAX_SIDE_SHARE: f32 = 0.19;
-
-/// A side panel of a stable width: `default` (within its range), resizable by the user between
-/// [`MIN_SIDE_PANEL`] and [`MAX_SIDE_SHARE`] of the window, remembered with egui's memory. Its contents scroll
-/// rather than widen it (see the panels' scroll areas), so selecting a bone never moves the viewport.
-fn side_panel(panel: egui::Panel, default: f32, window_width: f32) -> egui::Panel {
-    let max = (window_width * MAX_SIDE_SHARE).max(MIN_SIDE_PANEL);
-    panel.resizable(true).default_size(default.min(max)).size_range(MIN_SIDE_PANEL..=max)
 }
 
 /// Runs the native file dialog on its own thread so the UI keeps drawing.

@@ -1,13 +1,14 @@
 //! Short messages in the corner: errors stay until dismissed (or until what they were about is fixed), information
 //! fades after a few seconds.
 //!
-//! They are built not to get in the way: nothing fades or moves while the pointer is over them (so a click meant
-//! for Dismiss never lands on the timeline behind), a message repeated collapses into one with a count, and at
-//! most a few are shown, the rest counted.
+//! They are built not to get in the way: they stack in the viewport's lower right corner (never over a control),
+//! each as wide as the stack, its file's name first and its text wrapped (never cut); nothing fades or moves while
+//! the pointer is over them (so a click meant for Dismiss never lands on the viewport behind), a message repeated
+//! collapses into one with a count, and at most a few are shown, the rest counted.
 
 use std::time::Duration;
 
-use egui::{Align2, Color32, RichText};
+use egui::{Align2, Color32, Rect, RichText};
 
 const INFO_SECONDS: f64 = 4.0;
 
@@ -42,9 +43,19 @@ impl Notifications {
         self.push(text, false, None);
     }
 
+    /// Information about `topic` (a file): shown under the file's name.
+    pub fn info_about(&mut self, topic: &str, text: String) {
+        self.push(text, false, Some(topic.to_owned()));
+    }
+
     /// Drops the errors about `topic`: it loaded after all.
     pub fn resolved(&mut self, topic: &str) {
         self.items.retain(|n| !(n.error && n.topic.as_deref() == Some(topic)));
+    }
+
+    /// Where they were drawn last frame.
+    pub fn rect(&self) -> Option<egui::Rect> {
+        self.area
     }
 
     /// The errors kept, each with how many times it was said.
@@ -55,7 +66,7 @@ impl Notifications {
     fn push(&mut self, text: String, error: bool, topic: Option<String>) {
         // A path or a name in a message may hold control characters: shown escaped, on one line.
         let text = crate::import::text::printable(&text).into_owned();
-        if let Some(same) = self.items.iter_mut().find(|n| n.text == text && n.error == error) {
+        if let Some(same) = self.items.iter_mut().find(|n| n.text == text && n.error == error && n.topic == topic) {
             same.count += 1;
             same.shown_at = None;
             return;
@@ -63,7 +74,8 @@ impl Notifications {
         self.items.push(Notification { text, error, topic, count: 1, shown_at: None });
     }
 
-    pub fn ui(&mut self, ctx: &egui::Context) {
+    /// Shows the messages in the lower right corner of `within` (the viewport).
+    pub fn ui(&mut self, ctx: &egui::Context, within: Rect) {
         let now = ctx.input(|i| i.time);
         let hovered =
             self.area.is_some_and(|area| ctx.input(|i| i.pointer.hover_pos()).is_some_and(|p| area.contains(p)));
@@ -76,32 +88,22 @@ impl Notifications {
             self.area = None;
             return;
         }
+        let width = (within.width() - 2.0 * MARGIN).clamp(MIN_WIDTH, MAX_WIDTH);
         let mut dismissed = None;
         let hidden = self.items.len().saturating_sub(MAX_SHOWN);
         let response = egui::Area::new(egui::Id::unique("notifications"))
-            .anchor(Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -60.0))
+            .pivot(Align2::RIGHT_BOTTOM)
+            .fixed_pos(within.right_bottom() - egui::vec2(MARGIN, MARGIN))
             .show(ctx, |ui| {
+                ui.set_width(width);
                 if hidden > 0 {
                     ui.label(RichText::new(format!("{hidden} older messages")).weak());
                 }
                 for (i, n) in self.items.iter_mut().enumerate().skip(hidden) {
                     n.shown_at.get_or_insert(now);
-                    egui::Frame::popup(ui.style()).show(ui, |ui| {
-                        ui.set_max_width(520.0);
-                        ui.horizontal(|ui| {
-                            let (label, color) = if n.error {
-                                ("Error", Color32::from_rgb(235, 64, 100))
-                            } else {
-                                ("Info", ui.visuals().text_color())
-                            };
-                            ui.label(RichText::new(label).strong().color(color));
-                            let times = if n.count > 1 { format!(" (×{})", n.count) } else { String::new() };
-                            ui.label(format!("{}{times}", n.text));
-                            if ui.small_button("Dismiss").clicked() {
-                                dismissed = Some(i);
-                            }
-                        });
-                    });
+                    if n.ui(ui, width) {
+                        dismissed = Some(i);
+                    }
                 }
             });
         self.area = Some(response.response.rect);
@@ -111,6 +113,46 @@ impl Notifications {
         if self.items.iter().any(|n| !n.error) {
             ctx.request_repaint_after(Duration::from_millis(500));
         }
+    }
+}
+
+/// Points between the messages and the viewport's edges.
+const MARGIN: f32 = 10.0;
+/// The width of the stack: as wide as the viewport allows, up to a readable line.
+const MIN_WIDTH: f32 = 220.0;
+const MAX_WIDTH: f32 = 480.0;
+
+impl Notification {
+    /// One message `width` wide: its kind, its file's name and Dismiss on a line, the text wrapped below. Returns
+    /// whether it was dismissed.
+    fn ui(&self, ui: &mut egui::Ui, width: f32) -> bool {
+        let mut dismissed = false;
+        egui::Frame::popup(ui.style()).show(ui, |ui| {
+            ui.set_width(width - 2.0 * ui.style().spacing.window_margin.leftf());
+            ui.horizontal(|ui| {
+                let (kind, color) = if self.error {
+                    ("Error", Color32::from_rgb(235, 64, 100))
+                } else {
+                    ("Info", ui.visuals().text_color())
+                };
+                ui.label(RichText::new(kind).strong().color(color));
+                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                    dismissed = ui.small_button("Dismiss").clicked();
+                    if let Some(topic) = &self.topic {
+                        let name = std::path::Path::new(topic)
+                            .file_name()
+                            .map_or(topic.as_str(), |n| n.to_str().unwrap_or(topic));
+                        let name = crate::import::text::printable(name).into_owned();
+                        ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
+                            super::text::name_label(ui, &name, ui.available_width(), None).on_hover_text(topic);
+                        });
+                    }
+                });
+            });
+            let times = if self.count > 1 { format!(" (×{})", self.count) } else { String::new() };
+            ui.add(egui::Label::new(format!("{}{times}", self.text)).wrap());
+        });
+        dismissed
     }
 }
 

@@ -5,8 +5,9 @@ use std::collections::HashSet;
 
 use egui::{RichText, Sense, vec2};
 
-use super::{ModeChoice, ModeScope, Shared};
+use super::{ModeChoice, ModeScope, Shared, text};
 use crate::analysis::Findings;
+use crate::model::InheritMode;
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -20,15 +21,16 @@ pub struct Outliner {
 }
 
 const ROW_HEIGHT: f32 = 20.0;
-const INDENT: f32 = 12.0;
+const INDENT: f32 = 10.0;
 
 impl Outliner {
     pub fn ui(&mut self, ui: &mut egui::Ui, shared: &mut Shared) {
-        ui.heading("Skeleton");
-        ui.horizontal(|ui| {
+        // A narrow list puts "Only flagged" under the filter rather than past its edge (which would widen every
+        // row below).
+        ui.horizontal_wrapped(|ui| {
             let label = ui.label("Filter");
-            ui.add(egui::TextEdit::singleline(&mut self.filter).hint_text("bone name").desired_width(120.0))
-                .labelled_by(label.id);
+            let field = egui::TextEdit::singleline(&mut self.filter).hint_text("bone name").desired_width(120.0);
+            ui.add(field).labelled_by(label.id);
             ui.checkbox(&mut self.only_flagged, "Only flagged");
         });
         legend(ui);
@@ -38,7 +40,7 @@ impl Outliner {
             ui.label(RichText::new("no bone matches").weak());
         }
         let depths = shared.doc.rig.skeleton.depths();
-        let mut list = egui::ScrollArea::both().auto_shrink([false, false]);
+        let mut list = egui::ScrollArea::vertical().auto_shrink([false, false]);
         let inspected = shared.selection.last().copied();
         if inspected != self.shown {
             self.shown = inspected;
@@ -90,9 +92,11 @@ impl Outliner {
         let has_children = (bone + 1..skeleton.len()).any(|c| skeleton.parent(c) == Some(bone));
         let name = skeleton.bone(bone).name.clone();
         let findings = shared.frame.primary.findings[bone];
+        let row_width = ui.available_width();
         ui.horizontal(|ui| {
             ui.set_height(ROW_HEIGHT);
-            ui.add_space(depth as f32 * INDENT);
+            // Deep chains (a hand's fingers under a HumanIK rig) stop indenting before the names lose their room.
+            ui.add_space((depth as f32 * INDENT).min(MAX_INDENT_SHARE * row_width));
             if has_children {
                 let collapsed = self.collapsed.contains(&bone);
                 let toggle = ui.add(egui::Button::new(if collapsed { "+" } else { "−" }).small().frame(false));
@@ -104,8 +108,12 @@ impl Outliner {
                 ui.add_space(14.0);
             }
             badges(ui, &findings);
+            let font = egui::TextStyle::Button.resolve(ui.style());
+            let name_needs = text::text_width(ui, &name, &font) + 2.0 * ui.spacing().button_padding.x;
+            let notes = Notes::of(shared, bone).fitted(ui, ui.available_width() - name_needs);
+            let name_width = ui.available_width() - notes.width(ui);
             let selected = shared.selection.contains(&bone);
-            let label = ui.selectable_label(selected, &name);
+            let label = text::name_label(ui, &name, name_width, Some(selected));
             if label.clicked() {
                 let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
                 shared.select(bone, extend);
@@ -115,57 +123,133 @@ impl Outliner {
                 shared.select(bone, false);
             }
             label.context_menu(|ui| mode_menu(ui, shared, bone));
-            difference_badge(ui, shared, bone);
-            ui.label(RichText::new(shared.doc.modes[bone].id()).weak().small());
-            if let Some(summary) = shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched()) {
-                let worst = egui::Label::new(
-                    RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
-                        .small()
-                        .color(Badge::Stretched.color_for_shear(summary.worst_shear_deg)),
-                )
-                .sense(Sense::click());
-                let worst = ui.add(worst).on_hover_text(format!(
-                    "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s (click to go there)",
-                    summary.flagged_samples,
-                    shared.analysis.map_or(0, |a| a.scan.samples),
-                    summary.first_flagged_time.unwrap_or_default(),
-                    summary.worst_shear_deg,
-                    summary.worst_shear_time
-                ));
-                if worst.clicked() {
-                    shared.select(bone, false);
-                    *shared.playing = false;
-                    *shared.time = summary.worst_shear_time;
-                }
-            }
+            notes.ui(ui, shared, bone);
         });
+    }
+}
+
+/// Deep rows indent by at most this share of the list's width.
+const MAX_INDENT_SHARE: f32 = 0.15;
+
+/// What a row says after the name: the difference from a compared file, the mode, the worst shear. Measured before
+/// the name is laid out, so that the name gets the rest of the row (shortened in the middle when it must).
+struct Notes {
+    difference: Option<RichText>,
+    mode: Option<RichText>,
+    worst: Option<RichText>,
+}
+
+impl Notes {
+    fn of(shared: &Shared, bone: usize) -> Notes {
+        let worst = stretched_summary(shared, bone).map(|summary| {
+            RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
+                .small()
+                .color(Badge::Stretched.color_for_shear(summary.worst_shear_deg))
+        });
+        Notes {
+            difference: difference_text(shared, bone),
+            mode: Some(RichText::new(mode_abbreviation(shared.doc.modes[bone])).weak().small()),
+            worst,
+        }
+    }
+
+    fn texts(&self) -> impl Iterator<Item = &RichText> {
+        self.difference.iter().chain(&self.mode).chain(&self.worst)
+    }
+
+    /// The notes that leave the name whole in a row with `room` points beside the name: the name comes first, so
+    /// the mode goes first (the Inspector and the menu show it), then the difference; the worst shear stays (the
+    /// name shortens for it).
+    fn fitted(mut self, ui: &egui::Ui, room: f32) -> Notes {
+        if self.width(ui) > room {
+            self.mode = None;
+        }
+        if self.width(ui) > room {
+            self.difference = None;
+        }
+        self
+    }
+
+    fn width(&self, ui: &egui::Ui) -> f32 {
+        let font = egui::TextStyle::Small.resolve(ui.style());
+        let spacing = ui.spacing().item_spacing.x;
+        self.texts().map(|text| text::text_width(ui, text.text(), &font) + spacing).sum::<f32>() + spacing
+    }
+
+    fn ui(self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
+        if let Some(difference) = self.difference {
+            ui.label(difference).on_hover_text(difference_hint(shared, bone));
+        }
+        if let Some(mode) = self.mode {
+            ui.label(mode).on_hover_text(shared.doc.modes[bone].description());
+        }
+        if let (Some(worst), Some(summary)) = (self.worst, stretched_summary(shared, bone)) {
+            let worst = ui.add(egui::Label::new(worst).sense(Sense::click())).on_hover_text(format!(
+                "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s (click to go there)",
+                summary.flagged_samples,
+                shared.analysis.map_or(0, |a| a.scan.samples),
+                summary.first_flagged_time.unwrap_or_default(),
+                summary.worst_shear_deg,
+                summary.worst_shear_time
+            ));
+            if worst.clicked() {
+                let time = summary.worst_shear_time;
+                shared.select(bone, false);
+                *shared.playing = false;
+                *shared.time = time;
+            }
+        }
+    }
+}
+
+fn stretched_summary<'a>(shared: &Shared<'a>, bone: usize) -> Option<&'a crate::analysis::BoneSummary> {
+    shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched())
+}
+
+/// A mode in a few letters for the list (the full name and what it does on hover).
+fn mode_abbreviation(mode: InheritMode) -> &'static str {
+    match mode {
+        InheritMode::Full => "full",
+        InheritMode::UnscaledParent => "no-scale",
+        InheritMode::SegmentCompensate => "SSC",
+        InheritMode::Componentwise => "comp",
+        InheritMode::BlenderFixShear => "B fix",
+        InheritMode::BlenderAligned => "B align",
+        InheritMode::BlenderAverage => "B avg",
+        InheritMode::BlenderNone => "B none",
+        InheritMode::BlenderNoneLegacy => "B legacy",
     }
 }
 
 /// How far the compared file's partner of `bone` strays from it over the clip, when that is more than the threshold
 /// (a percentage of the rig's size); a bone without a partner says so.
-fn difference_badge(ui: &mut egui::Ui, shared: &Shared, bone: usize) {
-    let (Some(differences), Some(compared)) = (shared.differences, &shared.doc.compared) else { return };
-    let threshold = shared.settings.compare_threshold_percent;
+fn difference_text(shared: &Shared, bone: usize) -> Option<RichText> {
+    let differences = shared.differences?;
+    shared.doc.compared.as_ref()?;
     match differences.bones.get(bone).copied().flatten() {
-        Some(fraction) if 100.0 * fraction > threshold => {
+        Some(fraction) if 100.0 * fraction > shared.settings.compare_threshold_percent => {
             // The ghost's colour: the badge says where the ghost parts from the pose.
             let color = Palette::new(shared.settings.dark).ghost.to_opaque();
-            let text = RichText::new(format!("Δ {:.2}%", 100.0 * fraction)).small().color(color);
-            ui.label(text).on_hover_text(format!(
-                "{} strays from its partner in {} by up to {:.3e} over the clip ({:.4} % of the rig's size; badged \
-                 above {threshold} %, View → Thresholds)",
-                shared.doc.rig.skeleton.bone(bone).name,
-                compared.title(),
-                fraction * differences.rig_size,
-                100.0 * fraction,
-            ));
+            Some(RichText::new(format!("Δ {:.2}%", 100.0 * fraction)).small().color(color))
         }
-        Some(_) => {}
-        None => {
-            ui.label(RichText::new("unpaired").small().weak())
-                .on_hover_text(format!("no bone of this name in {}", compared.title()));
-        }
+        Some(_) => None,
+        None => Some(RichText::new("unpaired").small().weak()),
+    }
+}
+
+fn difference_hint(shared: &Shared, bone: usize) -> String {
+    let (Some(differences), Some(compared)) = (shared.differences, &shared.doc.compared) else { return String::new() };
+    let name = &shared.doc.rig.skeleton.bone(bone).name;
+    match differences.bones.get(bone).copied().flatten() {
+        Some(fraction) => format!(
+            "{name} strays from its partner in {} by up to {:.3e} over the clip ({:.4} % of the rig's size; badged \
+             above {} %, View → Thresholds)",
+            compared.title(),
+            fraction * differences.rig_size,
+            100.0 * fraction,
+            shared.settings.compare_threshold_percent,
+        ),
+        None => format!("no bone of this name in {}", compared.title()),
     }
 }
 
@@ -184,13 +268,23 @@ fn badges(ui: &mut egui::Ui, findings: &Findings) {
     }
 }
 
+/// The room an icon takes before its name in the legend.
+const ICON_WIDTH: f32 = 14.0;
+
 /// Colours and icons, explained once at the top of the list.
 fn legend(ui: &mut egui::Ui) {
     ui.horizontal_wrapped(|ui| {
+        let font = egui::TextStyle::Small.resolve(ui.style());
         for badge in Badge::ALL {
-            let (rect, _) = ui.allocate_exact_size(vec2(12.0, 14.0), Sense::hover());
-            badge.paint_icon(ui.painter(), rect.center(), 4.5);
-            ui.label(RichText::new(badge.label()).small()).on_hover_text(badge.explanation());
+            // Icon and name as one item of a known size, so that a row too short for it wraps before it.
+            let galley = ui.painter().layout_no_wrap(badge.label().to_owned(), font.clone(), ui.visuals().text_color());
+            let size = vec2(ICON_WIDTH + galley.size().x, galley.size().y.max(14.0));
+            let (rect, response) = ui.allocate_exact_size(size, Sense::hover());
+            badge.paint_icon(ui.painter(), egui::pos2(rect.left() + 6.0, rect.center().y), 4.5);
+            let text_at = egui::pos2(rect.left() + ICON_WIDTH, rect.center().y - galley.size().y / 2.0);
+            ui.painter().galley(text_at, galley, ui.visuals().text_color());
+            response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Label, true, badge.label()));
+            response.on_hover_text(badge.explanation());
         }
     });
 }

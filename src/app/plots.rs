@@ -14,6 +14,7 @@ use super::{Ghost, RotationFormat, Shared};
 use std::sync::Arc;
 
 use super::reduce::{Reduced, merge_spans, reduce};
+use super::ticks;
 use crate::analysis::{ClipAnalysis, Components};
 use crate::view::Badge;
 
@@ -298,8 +299,14 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
         .allow_zoom(false)
         .show_x(place.last)
         .allow_double_click_reset(true);
+    let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
+    plot = plot
+        .x_grid_spacer(move |input| ticks::time_marks(input, unit, rate))
+        .y_grid_spacer(ticks::value_marks)
+        .x_axis_formatter(move |mark, _| ticks::time_label(mark.value, mark.step_size, unit, rate))
+        .y_axis_formatter(|mark, _| ticks::value_label(mark.value, mark.step_size));
     if place.last {
-        plot = plot.x_axis_label("time (s)");
+        plot = plot.x_axis_label(format!("time ({})", unit.label()));
     }
     if place.reset {
         plot = plot.reset();
@@ -356,7 +363,7 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
         && let Some(at) = response.inner
     {
         *shared.playing = false;
-        *shared.time = at.x.clamp(0.0, shared.doc.duration());
+        *shared.time = unit.snap(at.x, rate).clamp(0.0, shared.doc.duration());
     }
 }
 

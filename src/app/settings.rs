@@ -28,12 +28,29 @@ impl TimeUnit {
         }
     }
 
-    /// `seconds` in this unit, as text.
+    /// The time `seconds` in this unit, as text: a frame number is whole on a frame, with a decimal between frames.
     pub fn format(self, seconds: f64, frame_rate: f64) -> String {
         match self {
             TimeUnit::Seconds => format!("{seconds:.3} s"),
-            TimeUnit::Frames => format!("frame {:.1}", seconds * frame_rate),
+            TimeUnit::Frames => format!("frame {}", frame_number(seconds * frame_rate)),
             TimeUnit::Ticks => format!("{:.0} ticks", seconds * TICKS_PER_SECOND),
+        }
+    }
+
+    /// A length of `seconds` (a clip's duration) in this unit, as text.
+    pub fn format_length(self, seconds: f64, frame_rate: f64) -> String {
+        match self {
+            TimeUnit::Frames => format!("{} frames", frame_number(seconds * frame_rate)),
+            _ => self.format(seconds, frame_rate),
+        }
+    }
+
+    /// The time a click at `seconds` means in this unit: the nearest whole frame when counting frames (a pointer
+    /// cannot aim between them on purpose), the time itself otherwise.
+    pub fn snap(self, seconds: f64, frame_rate: f64) -> f64 {
+        match self {
+            TimeUnit::Frames if frame_rate > 0.0 => (seconds * frame_rate).round() / frame_rate,
+            _ => seconds,
         }
     }
 
@@ -50,6 +67,11 @@ impl TimeUnit {
             TimeUnit::Ticks => value / TICKS_PER_SECOND,
         })
     }
+}
+
+/// A frame number: whole within a thousandth of a frame, else with one decimal.
+fn frame_number(frames: f64) -> String {
+    if (frames - frames.round()).abs() < 1e-3 { format!("{:.0}", frames + 0.0) } else { format!("{frames:.1}") }
 }
 
 /// Which plotted quantity, and how rotations are shown.
@@ -85,6 +107,8 @@ pub struct Settings {
     pub show_layers: bool,
     /// Bones farther than this percentage of the rig's size from their partner in a compared file are badged.
     pub compare_threshold_percent: f64,
+    /// How the panels are arranged; `None` until the first frame makes one for the window's width.
+    pub layout: Option<super::Layout>,
 }
 
 impl Default for Settings {
@@ -104,6 +128,7 @@ impl Default for Settings {
             show_inspector: true,
             show_layers: false,
             compare_threshold_percent: 0.01,
+            layout: None,
         }
     }
 }
@@ -129,7 +154,11 @@ mod tests {
     #[test]
     fn time_units() {
         assert_eq!(TimeUnit::Seconds.format(1.5, 30.0), "1.500 s");
-        assert_eq!(TimeUnit::Frames.format(1.5, 30.0), "frame 45.0");
+        assert_eq!(TimeUnit::Frames.format(1.5, 30.0), "frame 45");
+        assert_eq!(TimeUnit::Frames.format(1.51, 30.0), "frame 45.3");
+        assert_eq!(TimeUnit::Frames.format_length(20959.0 / 120.0, 120.0), "20959 frames");
+        assert_eq!(TimeUnit::Frames.snap(1.51, 30.0), 1.5);
+        assert_eq!(TimeUnit::Seconds.snap(1.51, 30.0), 1.51);
         assert_eq!(TimeUnit::Ticks.format(1.5, 30.0), "7200 ticks");
     }
 

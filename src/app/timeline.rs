@@ -26,6 +26,28 @@ pub fn step_frame(time: f64, rate: f64, forward: bool, duration: f64) -> f64 {
     (next / rate).clamp(0.0, duration.max(0.0))
 }
 
+/// The playback's clock: the seconds between frames while playing, measured from the frame that started playing, so
+/// that the time spent paused or idle before it never counts (egui's frame time after an idle spell is the spell).
+#[derive(Default)]
+pub struct PlayClock {
+    /// The input time of the last frame that played.
+    last: Option<f64>,
+}
+
+/// The most one frame advances the clip: a longer stall (a hidden window, a debugger) skips no more than this.
+const MAX_FRAME_SECONDS: f64 = 0.25;
+
+impl PlayClock {
+    /// The seconds to advance at input time `now`: 0 on the first frame of playing and while paused.
+    pub fn tick(&mut self, now: f64, playing: bool) -> f64 {
+        let previous = std::mem::replace(&mut self.last, playing.then_some(now));
+        match previous {
+            Some(previous) if playing => (now - previous).clamp(0.0, MAX_FRAME_SECONDS),
+            _ => 0.0,
+        }
+    }
+}
+
 /// Play or pause; playing at the end of a clip that does not loop starts it again.
 pub fn toggle_play(playing: &mut bool, time: &mut f64, looping: bool, duration: f64) {
     *playing = !*playing;
@@ -39,7 +61,10 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     let rate = shared.doc.frame_rate();
     frame_button(ui, shared, "Previous frame", "← key", false, rate, duration);
     let play_label = if *shared.playing { "Pause" } else { "Play" };
-    if ui.button(play_label).on_hover_text("Space; Home and End go to the ends").clicked() {
+    // As wide as its wider label, so that nothing after it moves when it changes.
+    let width = super::text::text_width(ui, "Pause", &egui::TextStyle::Button.resolve(ui.style()));
+    let play = egui::Button::new(play_label).min_size(vec2(width + 2.0 * ui.spacing().button_padding.x, 0.0));
+    if ui.add(play).on_hover_text("Space; Home and End go to the ends").clicked() {
         toggle_play(shared.playing, shared.time, shared.settings.looping, duration);
     }
     frame_button(ui, shared, "Next frame", "→ key", true, rate, duration);
@@ -48,7 +73,7 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     ui.separator();
     let unit = shared.settings.time_unit;
     time_field(ui, shared, unit, rate, duration);
-    ui.label(format!("of {}", unit.format(duration, rate)));
+    ui.label(format!("of {}", unit.format_length(duration, rate)));
     let label = ui.label("in");
     egui::ComboBox::from_id_salt("time-unit")
         .selected_text(unit.label())
@@ -114,12 +139,13 @@ fn time_bar(ui: &mut egui::Ui, shared: &mut Shared) {
         && let Some(p) = response.interact_pointer_pos()
     {
         *shared.playing = false;
-        *shared.time = (f64::from((p.x - rect.left()) / rect.width().max(1.0)) * duration).clamp(0.0, duration);
+        let time = f64::from((p.x - rect.left()) / rect.width().max(1.0)) * duration;
+        *shared.time = shared.settings.time_unit.snap(time, shared.doc.frame_rate()).clamp(0.0, duration);
     }
     let painter = ui.painter_at(rect);
     let visuals = ui.visuals();
     painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
-    seconds_grid(&painter, rect, duration, visuals.weak_text_color(), x_of);
+    ruler(&painter, rect, duration, (shared.settings.time_unit, shared.doc.frame_rate()), visuals.weak_text_color());
     if let Some(clip) = shared.doc.clip() {
         key_ticks(&painter, rect, clip, shared.selection, visuals.text_color(), x_of);
     }
@@ -128,26 +154,24 @@ fn time_bar(ui: &mut egui::Ui, shared: &mut Shared) {
     painter.line_segment([pos2(x, rect.top()), pos2(x, rect.bottom())], Stroke::new(2.0, visuals.selection.bg_fill));
 }
 
-fn seconds_grid(painter: &egui::Painter, rect: Rect, duration: f64, color: Color32, x_of: impl Fn(f64) -> f32) {
+/// The ruler: a labelled tick at 1-2-5 steps of the timeline's unit.
+fn ruler(painter: &egui::Painter, rect: Rect, duration: f64, (unit, rate): (TimeUnit, f64), color: Color32) {
     if duration <= 0.0 {
         return;
     }
-    let step = [0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 30.0, 60.0, 300.0, 600.0]
-        .into_iter()
-        .find(|s| duration / s <= 20.0)
-        .unwrap_or(duration / 10.0);
-    let mut t = 0.0;
-    while t <= duration + 1e-9 {
+    let step = super::ticks::time_step(unit, rate, f64::from(rect.width()) / duration);
+    let x_of = |t: f64| rect.left() + (t / duration) as f32 * rect.width();
+    for i in 0..=(duration / step + 1e-9).floor() as usize {
+        let t = i as f64 * step;
         let x = x_of(t);
         painter.line_segment([pos2(x, rect.bottom() - 8.0), pos2(x, rect.bottom())], Stroke::new(1.0, color));
         painter.text(
             pos2(x + 2.0, rect.bottom() - 9.0),
             egui::Align2::LEFT_BOTTOM,
-            format!("{t:.2}"),
+            super::ticks::time_label(t, step, unit, rate),
             egui::FontId::proportional(9.0),
             color,
         );
-        t += step;
     }
 }
 
@@ -227,6 +251,19 @@ mod tests {
         // Within the clip.
         assert_eq!(step_frame(0.0, 30.0, false, 10.0), 0.0);
         assert_eq!(step_frame(9.99, 30.0, true, 10.0), 10.0);
+    }
+
+    #[test]
+    fn the_clock_counts_only_the_time_spent_playing() {
+        let mut clock = PlayClock::default();
+        assert_eq!(clock.tick(0.0, false), 0.0);
+        // Idle for 3 s, then Play: the first frame adds nothing, the next its frame time.
+        assert_eq!(clock.tick(3.0, true), 0.0);
+        assert!((clock.tick(3.016, true) - 0.016).abs() < 1e-12);
+        // Paused for 10 s, then playing again: nothing of the pause.
+        assert_eq!(clock.tick(13.0, false), 0.0);
+        assert_eq!(clock.tick(13.5, true), 0.0);
+        assert_eq!(clock.tick(20.0, true), MAX_FRAME_SECONDS, "a stall skips at most a quarter second");
     }
 
     #[test]

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use egui::RichText;
 
-use super::{Ghost, ModeChoice, ModeScope, Shared};
+use super::{Ghost, ModeChoice, ModeScope, Shared, text};
 use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
 use crate::model::Choice;
@@ -29,7 +29,8 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         ui.separator();
         ui.label(RichText::new(shared.doc.title()).strong());
     });
-    ui.horizontal(|ui| {
+    // On a narrow window the pickers wrap onto a second row rather than run off the edge.
+    ui.horizontal_wrapped(|ui| {
         clip_picker(ui, shared, actions);
         ui.separator();
         mode_picker(ui, shared);
@@ -139,15 +140,24 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     if ui.button("Frame all").clicked() {
         actions.frame_all = true;
     }
+    if ui.button("Reset the panels").on_hover_text("the arrangement made for this window's width").clicked() {
+        shared.settings.layout = None;
+    }
 }
+
+/// The widest the animation's name is shown in the toolbar, in points.
+const CLIP_NAME_WIDTH: f32 = 160.0;
 
 fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     let label = ui.label("Animation");
     let clips = &shared.doc.rig.clips;
     let current = shared.doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
+    // A take's name can be a path long: shortened in the middle, whole on hover and in the list.
+    let font = egui::TextStyle::Button.resolve(ui.style());
+    let shown = text::shorten_middle(&current, |t| text::text_width(ui, t, &font) <= CLIP_NAME_WIDTH);
     let mut chosen = shared.doc.clip;
     egui::ComboBox::from_id_salt("animation")
-        .selected_text(current)
+        .selected_text(shown)
         .show_ui(ui, |ui| {
             for clip in clips {
                 ui.selectable_value(
@@ -159,7 +169,8 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
             ui.selectable_value(&mut chosen, None, "rest pose");
         })
         .response
-        .labelled_by(label.id);
+        .labelled_by(label.id)
+        .on_hover_text(current);
     if chosen != shared.doc.clip {
         shared.doc.clip = chosen;
         actions.clip_changed = true;

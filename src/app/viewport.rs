@@ -26,10 +26,17 @@ pub enum CanvasFill {
 pub struct Viewport {
     /// Bounds to frame once the canvas knows its shape (framing fits them to the aspect ratio).
     framing: Option<Bounds>,
+    /// Where the canvas was drawn last.
+    rect: Option<egui::Rect>,
 }
 
 impl Viewport {
     /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
+    /// Where the canvas was drawn in the last frame (messages go in its corner).
+    pub fn rect(&self) -> Option<egui::Rect> {
+        self.rect
+    }
+
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
@@ -52,6 +59,7 @@ impl Viewport {
     /// The picture alone, filling the space left: what headless renders of the viewport show.
     pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared, background: CanvasFill) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        self.rect = Some(rect);
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);

@@ -137,7 +137,9 @@ impl Palette {
                 selected: Color32::from_rgb(255, 230, 90),
                 mesh: Color32::from_rgba_unmultiplied(120, 150, 170, 110),
                 ghost: Color32::from_rgba_unmultiplied(120, 220, 255, 90),
-                bind_pose: Color32::from_rgba_unmultiplied(200, 200, 200, 70),
+                // Violet: apart from the bones' grey, the ghost's cyan and the selection's yellow, and bright enough to read
+                // on the dark background.
+                bind_pose: Color32::from_rgba_unmultiplied(190, 140, 255, 150),
                 text: Color32::from_rgb(225, 228, 235),
                 axes,
             }
@@ -150,10 +152,38 @@ impl Palette {
                 selected: Color32::from_rgb(205, 140, 0),
                 mesh: Color32::from_rgba_unmultiplied(120, 150, 175, 110),
                 ghost: Color32::from_rgba_unmultiplied(0, 130, 200, 90),
-                bind_pose: Color32::from_rgba_unmultiplied(60, 60, 60, 70),
+                bind_pose: Color32::from_rgba_unmultiplied(95, 40, 165, 190),
                 text: Color32::from_rgb(30, 32, 36),
                 axes,
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// WCAG's contrast ratio of `color` painted over `background` (alpha blended in sRGB, as egui blends).
+    fn contrast(color: Color32, background: Color32) -> f64 {
+        let [r, g, b, a] = color.to_srgba_unmultiplied().map(|c| f64::from(c) / 255.0);
+        let [br, bg, bb, _] = background.to_srgba_unmultiplied().map(|c| f64::from(c) / 255.0);
+        let over = [r * a + br * (1.0 - a), g * a + bg * (1.0 - a), b * a + bb * (1.0 - a)];
+        let luminance = |[r, g, b]: [f64; 3]| {
+            let linear = |c: f64| if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
+            0.2126 * linear(r) + 0.7152 * linear(g) + 0.0722 * linear(b)
+        };
+        let (l1, l2) = (luminance(over), luminance([br, bg, bb]));
+        (l1.max(l2) + 0.05) / (l1.min(l2) + 0.05)
+    }
+
+    #[test]
+    fn the_bind_pose_reads_on_either_theme() {
+        // 3:1 is WCAG's least contrast for graphics that must be made out.
+        for dark in [true, false] {
+            let palette = Palette::new(dark);
+            let ratio = contrast(palette.bind_pose, palette.background);
+            assert!(ratio >= 3.0, "dark {dark}: {ratio:.2}");
         }
     }
 }

@@ -1,0 +1,110 @@
+//! Text that fits: numbers in a few characters without losing their size, names shortened in the middle (where
+//! rigs' names differ: `Character1_LeftUpLeg` and `Character1_LeftLeg` share their start) with the full name on
+//! hover.
+
+use egui::{FontId, Response, RichText, Sense, TextStyle, Ui, WidgetText};
+
+/// Below this a value is shown as 0: floating-point noise of a matrix, not a measurement.
+const NOISE: f64 = 1e-9;
+
+/// `x` in at most 7 characters (8 for a negative exponent of two digits) with four or five significant digits: 4
+/// decimals below 10, one fewer per digit before the point, scientific notation from 100000 up and for values below
+/// 0.001 (so 3e-5 is not shown as 0.0000).
+pub fn compact(x: f64) -> String {
+    let size = x.abs();
+    if !x.is_finite() {
+        return "—".to_owned();
+    }
+    if size < NOISE {
+        return "0".to_owned();
+    }
+    if !(1e-3..1e5).contains(&size) {
+        return format!("{x:.1e}");
+    }
+    let digits_before = (size.log10().floor() as i32 + 1).max(1);
+    let decimals = (5 - digits_before).clamp(0, 4) as usize;
+    let text = format!("{x:.decimals$}");
+    // 9.99996 rounds to "10.0000": one decimal too many for the width.
+    if text.trim_start_matches('-').len() > 6 && decimals > 0 { format!("{x:.0$}", decimals - 1) } else { text }
+}
+
+/// `text` with characters taken from its middle and replaced by "…" until `fits` says it fits; the whole text when
+/// it does, "…" alone when nothing else fits.
+pub fn shorten_middle(text: &str, fits: impl Fn(&str) -> bool) -> String {
+    if fits(text) {
+        return text.to_owned();
+    }
+    let chars: Vec<char> = text.chars().collect();
+    // The most characters kept (half before the ellipsis, the rest after) that still fit.
+    let (mut low, mut high) = (0, chars.len());
+    while low < high {
+        let keep = (low + high).div_ceil(2);
+        if fits(&elide(&chars, keep)) {
+            low = keep;
+        } else {
+            high = keep - 1;
+        }
+    }
+    elide(&chars, low)
+}
+
+fn elide(chars: &[char], keep: usize) -> String {
+    let head = keep.div_ceil(2);
+    let tail = keep - head;
+    chars[..head].iter().chain(['…'].iter()).chain(&chars[chars.len() - tail..]).collect()
+}
+
+/// A label of `name` no wider than `width` points, shortened in the middle when it has to be, with the full name on
+/// hover; clickable and selectable like [`Ui::selectable_label`] when `selected` is given.
+pub fn name_label(ui: &mut Ui, name: &str, width: f32, selected: Option<bool>) -> Response {
+    let font = TextStyle::Button.resolve(ui.style());
+    let padding = if selected.is_some() { 2.0 * ui.spacing().button_padding.x } else { 0.0 };
+    let shown = shorten_middle(name, |text| text_width(ui, text, &font) + padding <= width);
+    let shortened = shown != name;
+    let response = match selected {
+        Some(selected) => ui.add(egui::Button::selectable(selected, WidgetText::from(RichText::new(&shown)))),
+        None => ui.add(egui::Label::new(&shown).sense(Sense::hover())),
+    };
+    if shortened { response.on_hover_text(name) } else { response }
+}
+
+pub fn text_width(ui: &Ui, text: &str, font: &FontId) -> f32 {
+    ui.fonts_mut(|fonts| fonts.layout_no_wrap(text.to_owned(), font.clone(), egui::Color32::WHITE).size().x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_keep_their_size_in_seven_characters() {
+        let cases = [
+            (0.0, "0"),
+            (1e-17, "0"),
+            (std::f64::consts::FRAC_1_SQRT_2, "0.7071"),
+            (-std::f64::consts::FRAC_1_SQRT_2, "-0.7071"),
+            (12.34567, "12.346"),
+            (-123.4567, "-123.46"),
+            (1234.567, "1234.6"),
+            (12345.67, "12346"),
+            (123456.7, "1.2e5"),
+            (3e-5, "3.0e-5"),
+            (-4.77e-9, "-4.8e-9"),
+            (9.99996, "10.000"),
+            (f64::NAN, "—"),
+        ];
+        for (x, shown) in cases {
+            assert_eq!(compact(x), shown, "{x}");
+            assert!(compact(x).chars().count() <= 7);
+        }
+    }
+
+    #[test]
+    fn names_lose_their_middle_to_fit() {
+        let fits = |limit: usize| move |text: &str| text.chars().count() <= limit;
+        assert_eq!(shorten_middle("forearm", fits(10)), "forearm");
+        assert_eq!(shorten_middle("Character1_LeftUpLeg", fits(12)), "Charac…UpLeg");
+        assert_eq!(shorten_middle("Character1_LeftUpLeg", fits(1)), "…");
+        assert_eq!(shorten_middle("Character1_LeftUpLeg", fits(0)), "…", "nothing fits: the ellipsis alone");
+    }
+}
