@@ -67,7 +67,8 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
         let main = clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
         let name = format!("{main} + {}", layers.summary(&rig, clip));
         let layered = source.clone().with_clip(clip).with_layers(LayerStack::new(&rig, &layers)?);
-        Request { rest: source, clips: vec![ClipToBake { name, source: layered }], strategy, tolerance }
+        let clips = vec![ClipToBake { name, source: layered }];
+        Request { rest: source, clips, strategy, tolerance, rotations: bake::EVERY_RUNTIME }
     };
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
