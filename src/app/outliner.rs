@@ -162,6 +162,10 @@ fn difference_badge(ui: &mut egui::Ui, shared: &Shared, bone: usize) {
             ));
         }
         Some(_) => {}
+        None if compared.conversion.get(bone).copied().unwrap_or(false) => {
+            ui.label(RichText::new("converts").small().weak())
+                .on_hover_text("only states the file's axes and unit: left out of the comparison, as `diff` leaves it");
+        }
         None => {
             ui.label(RichText::new("unpaired").small().weak())
                 .on_hover_text(format!("no bone of this name in {}", compared.title()));
