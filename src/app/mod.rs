@@ -379,7 +379,7 @@ impl BonescopeApp {
 
     /// What the comparison with the compared file depends on, when there is one.
     fn compare_key(&self) -> Option<CompareKey> {
-        self.doc.compared.as_ref()?;
+        let units = self.doc.compared.as_ref()?.units();
         let key = self.job_key();
         Some(CompareKey {
             generations: (self.generation, self.compared_generation),
@@ -387,6 +387,7 @@ impl BonescopeApp {
             modes: key.modes,
             layers: key.layers,
             rate: key.rate,
+            units,
         })
     }
 
