@@ -75,6 +75,16 @@ impl Compared {
         Compared { states_unit: self.states_unit, document_unit, ..repaired }
     }
 
+    /// The file read again after it changed on disk, paired with `document`, keeping the units the user gave.
+    pub fn reloaded(&self, document: &Rig) -> Result<Self, ImportError> {
+        let mut rig = import::load(&self.path)?;
+        if rig.unit.is_none() && !self.states_unit {
+            rig.unit = self.rig.unit;
+        }
+        let fresh = Compared::pair(self.path.clone(), rig, document);
+        Ok(Compared { document_unit: self.document_unit, ..fresh })
+    }
+
     /// The document's unit and the compared file's, as the comparison takes them.
     pub fn units(&self) -> [Option<Unit>; 2] {
         [self.document_unit, self.rig.unit]
@@ -283,6 +293,25 @@ mod tests {
         let ghost = compared.ghost(Some(0), &primary, 0.5, SkinningMethod::AsFile, &Tolerances::default());
         assert_eq!(ghost.model, primary.model);
         assert_eq!(ghost.meshes, primary.meshes);
+    }
+
+    #[test]
+    fn a_reload_keeps_the_unit_given_to_a_file_that_states_none() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("walk.bvh");
+        let bvh = "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  \
+                   OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.0333333\n0 0 0\n";
+        std::fs::write(&path, bvh).unwrap();
+        let document = import::demo_rig();
+        let loaded = Compared::load(&path, &document).unwrap();
+        assert_eq!(loaded.units()[1], None, "a BVH states no unit");
+        let centimetres: Unit = "cm".parse().unwrap();
+        let mut given = loaded.clone();
+        given.rig.unit = Some(centimetres);
+        std::fs::write(&path, bvh.replace("0 1 0", "0 2 0")).unwrap();
+        let reloaded = given.reloaded(&document).unwrap();
+        assert_eq!(reloaded.units(), given.units(), "the unit picked survives the file's change");
+        assert_ne!(reloaded.rig.skeleton.len(), 0);
     }
 
     #[test]

@@ -276,8 +276,9 @@ impl BonescopeApp {
 
     /// Re-reads the compared file after it changed on disk.
     fn reload_compared(&mut self) {
-        let Some(path) = self.doc.compared.as_ref().map(|c| c.path.clone()) else { return };
-        match Compared::load(&path, &self.doc.rig) {
+        let Some(compared) = self.doc.compared.clone() else { return };
+        let path = compared.path.clone();
+        match compared.reloaded(&self.doc.rig) {
             Ok(compared) => {
                 self.doc.compared = Some(Arc::new(compared));
                 self.compared_replaced();
