@@ -619,7 +619,8 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     harness.get_by_label("copy.glb").click();
     settle(&mut harness);
     assert_eq!(harness.state().doc.compared.as_ref().map(|c| c.path.clone()), Some(copy.clone()));
-    assert!(harness.state().differences().unwrap().bones.iter().all(|d| d.unwrap() == 0.0), "a file against its copy");
+    let differences = &harness.state().differences().unwrap().bones;
+    assert!(differences.iter().flatten().all(|&d| d == 0.0), "a file against its copy: {differences:?}");
     // The copy changes on disk (rewritten as the same clip under segment scale compensate): the comparison follows.
     bake(&source, InheritMode::SegmentCompensate, bonescope::bake::Strategy::Exact, &copy);
     for _ in 0..100 {
@@ -837,4 +838,44 @@ fn a_narrow_window_keeps_every_toolbar_control_with_a_long_take_name() {
     settle(&mut harness);
     let layers = harness.get_by_label("Layers").rect();
     assert!(layers.right() <= 1000.0 && layers.bottom() <= 700.0, "{layers:?}");
+}
+
+/// The height (largest minus smallest Y) of the document's bones that have a partner in the compared file, in the
+/// document's pose at `time` and in the ghost's (the compared file's pose, as drawn).
+fn figure_and_ghost_heights(app: &BonescopeApp, time: f64) -> (f64, f64) {
+    let doc = &app.doc;
+    let compared = doc.compared.as_ref().expect("a compared file");
+    let (own, other) = (doc.evaluation().pose_at(time), compared.evaluation(doc.clip).pose_at(time));
+    let height =
+        |ys: Vec<f64>| ys.iter().copied().fold(f64::MIN, f64::max) - ys.iter().copied().fold(f64::MAX, f64::min);
+    let paired: Vec<(usize, usize)> =
+        compared.bones.iter().enumerate().filter_map(|(a, b)| b.map(|b| (a, b))).collect();
+    let figure = height(paired.iter().map(|&(a, _)| own.model.model[a].w_axis.y).collect());
+    let ghost = height(paired.iter().map(|&(_, b)| other.model.model[b].w_axis.y).collect());
+    (figure, ghost)
+}
+
+#[test]
+fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
+    // ProAnimationBank's run is in metres once imported; the CMU walk states no unit. Taken as written its ghost
+    // stands about 17 times the runner's height; in CMU's own unit (1/0.45 inch, picked beside the ghost picker)
+    // the two subjects stand within a few percent of each other (1.37 m and 1.29 m from toe to head at 0 s).
+    let mut harness = asset_app("fbx-proanimationbank/run.fbx");
+    harness.state_mut().compare(&asset("bvh/cmu_12_01_walk.bvh"));
+    settle(&mut harness);
+    let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
+    assert!(ghost / figure > 10.0, "as written: {figure} against {ghost}");
+    let worst = |bones: &[Option<f64>]| bones.iter().flatten().copied().fold(0.0, f64::max);
+    let before = worst(&harness.state().differences().expect("differences").bones);
+    harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh").click();
+    harness.run();
+    harness.get_by_label("CMU mocap units (1/0.45 in)").click();
+    settle(&mut harness);
+    let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
+    assert!((ghost / figure - 1.0).abs() < 0.15, "in CMU units: {figure} against {ghost}");
+    assert_eq!(harness.state().doc.compared.as_ref().unwrap().units()[1].map(|u| u.in_metres()), Some(0.0254 / 0.45));
+    // The badges follow the unit: the bones now differ by what their motions do, not by a seventeenfold size.
+    let after = worst(&harness.state().differences().expect("differences in the unit picked").bones);
+    assert!(after < before / 2.0, "{before} then {after}");
+    harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh");
 }

@@ -251,11 +251,26 @@ fn compare_inherit_reports_every_bone_and_when() {
     let out = json(&bonescope(&["scan", &file, "--compare-inherit", "declared,full", "--format", "json"]));
     assert_eq!(keys(&out[0]), ["animations", "error", "file"]);
     let comparison = &out[0]["animations"][0];
-    let diff_keys = ["a", "b", "bones", "helpers", "meshes", "only_a", "only_b", "rig_size", "samples", "worst"];
+    let diff_keys = [
+        "a",
+        "b",
+        "bones",
+        "conversion_a",
+        "conversion_b",
+        "helpers",
+        "meshes",
+        "only_a",
+        "only_b",
+        "rig_size",
+        "samples",
+        "worst",
+    ];
     assert_eq!(keys(comparison), diff_keys);
     assert_eq!(comparison["a"], comparison["b"], "a clip against itself");
     let bones = comparison["bones"].as_array().unwrap();
-    assert_eq!(bones.len(), 7);
+    // The cube's node, static at identity, only carries the mesh: a conversion node, not compared.
+    assert_eq!(bones.len(), 6);
+    assert_eq!(comparison["conversion_a"], serde_json::json!(["pCube1"]));
     let rig = bonescope::import::load(std::path::Path::new(&file)).unwrap();
     let declared = rig.skeleton.declared_modes();
     let full = vec![bonescope::model::InheritMode::Full; rig.skeleton.len()];

@@ -35,13 +35,15 @@ fn a_file_against_itself_differs_by_nothing() {
     assert_eq!(out.status.code(), Some(0));
     let report = json(&out);
     let keys: Vec<&str> = report.as_object().unwrap().keys().map(String::as_str).collect();
-    assert_eq!(keys, ["a", "animations", "b", "clips_only_a", "clips_only_b", "inherit_a", "inherit_b", "rate"]);
+    let all =
+        ["a", "animations", "b", "clips_only_a", "clips_only_b", "inherit_a", "inherit_b", "rate", "unit_a", "unit_b"];
+    assert_eq!(keys, all);
     let animations = report["animations"].as_array().unwrap();
     assert_eq!(animations.len(), 2, "both clips, paired by name");
     for animation in animations {
         assert_eq!(animation["a"], animation["b"]);
         assert_eq!(animation["worst"]["max"], 0.0);
-        assert_eq!(animation["bones"].as_array().unwrap().len(), 10);
+        assert_eq!(animation["bones"].as_array().unwrap().len(), 8, "10 nodes, the armature and mesh nodes aside");
         assert_eq!(animation["meshes"][0]["vertices"], 648);
         let bone = &animation["bones"][4];
         let fields: Vec<&str> = bone.as_object().unwrap().keys().map(String::as_str).collect();
@@ -75,20 +77,25 @@ fn two_modes_of_one_file_differ_where_the_modes_do_and_fail_the_gate() {
 fn bones_pair_by_name_without_case_or_namespace_and_by_map() {
     let folder = tempfile::tempdir().unwrap();
     let original = path(&asset("gltf-khronos/rigged_simple.gltf"));
-    // `Bone` becomes `mixamorig:BONE`, `Armature` becomes `Rig|armature`, `Cylinder` becomes `Tube`.
+    // `Bone` becomes `mixamorig:BONE`, `Bone.001` becomes `Tip`, and the nodes that only turn the axes (`Z_UP`, a
+    // quarter about X; `Armature`, a quarter about Z) and carry the mesh (`Cylinder`) get other names too.
     let other = renamed(folder.path(), |name| match name {
         "Bone" => "mixamorig:BONE".to_owned(),
+        "Bone.001" => "Tip".to_owned(),
+        "Z_UP" => "Y_UP".to_owned(),
         "Armature" => "Rig|armature".to_owned(),
         "Cylinder" => "Tube".to_owned(),
         other => other.to_owned(),
     });
     let report = json(&bonescope(&["diff", &original, &other, "--format", "json"]));
     let animation = &report["animations"][0];
-    assert_eq!(names(&animation["only_a"]), ["Cylinder"]);
-    assert_eq!(names(&animation["only_b"]), ["Tube"]);
+    assert_eq!(names(&animation["only_a"]), ["Bone.001"]);
+    assert_eq!(names(&animation["only_b"]), ["Tip"]);
+    assert_eq!(names(&animation["conversion_a"]), ["Z_UP", "Armature", "Cylinder"]);
+    assert_eq!(names(&animation["conversion_b"]), ["Y_UP", "Rig|armature", "Tube"], "by role, whatever the names");
     let bone = animation["bones"].as_array().unwrap().iter().find(|b| b["name"] == "Bone").unwrap();
     assert_eq!(bone["name_b"], "mixamorig:BONE");
-    let mapped = json(&bonescope(&["diff", &original, &other, "--map", "Cylinder=Tube", "--format", "json"]));
+    let mapped = json(&bonescope(&["diff", &original, &other, "--map", "Bone.001=Tip", "--format", "json"]));
     let animation = &mapped["animations"][0];
     assert!(names(&animation["only_a"]).is_empty() && names(&animation["only_b"]).is_empty());
     assert_eq!(animation["worst"]["max"], 0.0, "renaming moves nothing");
@@ -195,18 +202,70 @@ fn a_layered_bake_is_one_new_clip() {
 }
 
 #[test]
-fn a_blender_fbx_export_pairs_with_its_gltf_take_by_take() {
-    // Blender names FBX takes `Armature|take`: they pair with the glTF's `take`, and the comparison shows where the
-    // two exports of one rig part (the FBX's armature turned a quarter for its axes).
+fn a_blender_fbx_export_pairs_with_its_gltf_take_by_take_conversion_nodes_aside() {
+    // Blender names FBX takes `Armature|take`: they pair with the glTF's `take`. The FBX's armature and mesh nodes
+    // are turned −90° about X to state its axes, the glTF's sit at identity: conversion nodes both, left out (they
+    // differed by a quarter turn, a probe √2·10 % of the rig away, above every bone's 3.7 %).
     let (gltf, fbx) = (path(&asset("blender/stretchy_full.glb")), path(&asset("blender/stretchy_full.fbx")));
     let report = json(&bonescope(&["diff", &gltf, &fbx, "--format", "json"]));
+    assert_eq!((report["unit_a"].as_f64(), report["unit_b"].as_f64()), (Some(1.0), Some(1.0)));
     let animations = report["animations"].as_array().unwrap();
     let pairs: Vec<(&str, &str)> =
         animations.iter().map(|a| (a["a"].as_str().unwrap(), a["b"].as_str().unwrap())).collect();
     assert_eq!(pairs, [("squash_stretch", "Stretchy|squash_stretch"), ("wave", "Stretchy|wave")]);
-    let root = &animations[0]["bones"][0];
-    assert_eq!(
-        (root["name"].as_str(), root["orientation_deg"]["max"].as_f64().map(f64::round)),
-        (Some("Stretchy"), Some(90.0))
+    for animation in animations {
+        let conversion = ["Stretchy", "Stretchy_skin"];
+        assert_eq!(
+            (names(&animation["conversion_a"]), names(&animation["conversion_b"])),
+            (conversion.into(), conversion.into())
+        );
+        let bones: Vec<&str> =
+            animation["bones"].as_array().unwrap().iter().map(|b| b["name"].as_str().unwrap()).collect();
+        assert_eq!(bones, ["hips", "spine", "chest", "upper_arm", "forearm", "hand", "neck", "head"]);
+        assert!(names(&animation["only_a"]).is_empty() && names(&animation["only_b"]).is_empty(), "{animation}");
+        // No quarter turn is left: what parts the exports is the arm's motion between keys, 16° at most.
+        for bone in animation["bones"].as_array().unwrap() {
+            assert!(bone["orientation_deg"]["max"].as_f64().unwrap() < 20.0, "{bone}");
+        }
+    }
+}
+
+#[test]
+fn a_bvh_is_compared_in_the_unit_it_is_given() {
+    // ProAnimationBank's run is in centimetres, converted to metres on import as a scale of 0.01 above the roots;
+    // every bone's frame carries it. The CMU walk states no unit: taken as it is, each bone's scale is 100× the
+    // run's; given centimetres, the two agree (to the FBX's single precision); given CMU's own 1/0.45 inch, they
+    // differ by the ratio of the units, 2.54 / 0.45.
+    let (run, walk) = (path(&asset("fbx-proanimationbank/run.fbx")), path(&asset("bvh/cmu_12_01_walk.bvh")));
+    let diff = |unit: &[&str]| {
+        let args = [&["diff", run.as_str(), walk.as_str(), "--anim-a", "0", "--anim-b", "0", "--format", "json"], unit]
+            .concat();
+        json(&bonescope(&args))
+    };
+    let scale_ratios = |report: &Value| -> Vec<f64> {
+        let bones = report["animations"][0]["bones"].as_array().unwrap();
+        bones.iter().map(|b| b["scale_ratio"]["max"].as_f64().unwrap()).collect()
+    };
+    let as_written = diff(&[]);
+    assert_eq!(as_written["unit_b"], Value::Null);
+    assert!(
+        scale_ratios(&as_written).iter().all(|r| (r / 100.0 - 1.0).abs() < 1e-5),
+        "{:?}",
+        scale_ratios(&as_written)
     );
+    let centimetres = diff(&["--unit-b", "cm"]);
+    assert_eq!((centimetres["unit_a"].as_f64(), centimetres["unit_b"].as_f64()), (Some(1.0), Some(0.01)));
+    let ratios = scale_ratios(&centimetres);
+    assert!(ratios.len() >= 20 && ratios.iter().all(|r| (r - 1.0).abs() < 1e-5), "{ratios:?}");
+    let cmu = diff(&["--unit-b", "cmu"]);
+    assert!(scale_ratios(&cmu).iter().all(|r| (r / (2.54 / 0.45) - 1.0).abs() < 1e-5), "{:?}", scale_ratios(&cmu));
+    // The table states the unit given and the scale B's lengths took.
+    let table = bonescope(&["diff", &run, &walk, "--anim-a", "0", "--anim-b", "0", "--unit-b", "cmu"]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(text.contains("unit: CMU mocap units (1/0.45 in) (given; the file states none)"), "{text}");
+    assert!(text.contains("B's lengths scaled by 0.0564444"), "{text}");
+    // A file that states its unit takes no other.
+    let refused = bonescope(&["diff", &run, &walk, "--unit-a", "cm"]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--unit-a: the file states its unit (metres)"));
 }

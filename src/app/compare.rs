@@ -1,27 +1,37 @@
 //! A second file compared with the document (File → Compare with…), as `bonescope diff` compares two files: its
 //! bones and meshes paired with the document's by name, its pose drawn as the ghost over the document's, its curves
 //! plotted dashed beside the document's, and each bone's largest difference over the clip, which the outliner badges
-//! above a threshold. The file is watched and reloaded like the document.
+//! above a threshold; conversion nodes, which only state a file's axes and unit, are left out as `diff` leaves them.
+//! The compared file is measured in the document's unit; where a file states none (BVH), the user gives it one
+//! ([`unit_pickers`]). The file is watched and reloaded like the document.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::Document;
 use super::job::{Job, Progress};
+use super::{Document, Ghost};
 use crate::analysis::{Assessment, Components, Tolerances};
 use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
 use crate::eval::{Evaluation, Layers, SkinningMethod};
 use crate::import::{self, ImportError};
-use crate::model::{Clip, InheritMode, Rig};
+use crate::model::{Clip, InheritMode, Rig, Unit};
 use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Compared {
     pub path: PathBuf,
+    /// The file's rig; its unit the file's own, or the one the user gave it where the file states none.
     pub rig: Rig,
+    /// Whether the file states its unit.
+    states_unit: bool,
+    /// The unit the file is measured in: the document's, or the one the user gave the document where its file
+    /// states none.
+    document_unit: Option<Unit>,
     /// Per bone of the document: its partner here.
     pub bones: Vec<Option<usize>>,
+    /// Per bone of the document: whether it is a conversion node, left out of the comparison.
+    pub conversion: Vec<bool>,
     /// Per mesh of the document: its partner here (same name and vertex count).
     pub meshes: Vec<Option<usize>>,
     /// Per clip of the document: the clip here that stands for it, as `bonescope diff` pairs them (else the first).
@@ -36,9 +46,14 @@ impl Compared {
 
     /// `rig` (read from `path`) paired with the document's rig.
     pub fn pair(path: PathBuf, rig: Rig, document: &Rig) -> Self {
+        let matching = match_bones(document, &rig);
         let mut bones = vec![None; document.skeleton.len()];
-        for (a, b) in match_bones(&document.skeleton, &rig.skeleton).pairs {
+        for &(a, b) in &matching.pairs {
             bones[a] = Some(b);
+        }
+        let mut conversion = vec![false; document.skeleton.len()];
+        for &a in &matching.conversion_a {
+            conversion[a] = true;
         }
         let mut meshes = vec![None; document.meshes.len()];
         for (a, b) in match_meshes(&document.meshes, &rig.meshes) {
@@ -49,12 +64,30 @@ impl Compared {
         for (a, b) in match_clips(&document.clips, &rig.clips).0 {
             clips[a] = Some(b);
         }
-        Compared { path, rig, bones, meshes, clips }
+        let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
+        Compared { path, rig, states_unit, document_unit, bones, conversion, meshes, clips }
     }
 
-    /// The same file paired with another document rig (the document was reloaded).
+    /// The same file paired with another document rig (the document was reloaded), keeping the units given.
     pub fn repaired(&self, document: &Rig) -> Self {
-        Compared::pair(self.path.clone(), self.rig.clone(), document)
+        let repaired = Compared::pair(self.path.clone(), self.rig.clone(), document);
+        let document_unit = document.unit.or(self.document_unit);
+        Compared { states_unit: self.states_unit, document_unit, ..repaired }
+    }
+
+    /// The file read again after it changed on disk, paired with `document`, keeping the units the user gave.
+    pub fn reloaded(&self, document: &Rig) -> Result<Self, ImportError> {
+        let mut rig = import::load(&self.path)?;
+        if rig.unit.is_none() && !self.states_unit {
+            rig.unit = self.rig.unit;
+        }
+        let fresh = Compared::pair(self.path.clone(), rig, document);
+        Ok(Compared { document_unit: self.document_unit, ..fresh })
+    }
+
+    /// The document's unit and the compared file's, as the comparison takes them.
+    pub fn units(&self) -> [Option<Unit>; 2] {
+        [self.document_unit, self.rig.unit]
     }
 
     /// The file's name, for labels.
@@ -64,9 +97,9 @@ impl Compared {
         crate::import::text::printable(&name).into_owned()
     }
 
-    /// How many of the document's bones have no partner here.
+    /// How many of the document's bones (conversion nodes aside) have no partner here.
     pub fn unpaired(&self) -> usize {
-        self.bones.iter().filter(|b| b.is_none()).count()
+        self.bones.iter().zip(&self.conversion).filter(|(b, c)| b.is_none() && !**c).count()
     }
 
     /// The clip here that stands for the document's clip `clip` (an index; `None`: the rest pose, for which this
@@ -79,9 +112,10 @@ impl Compared {
         partner.map(|c| &self.rig.clips[c])
     }
 
-    /// This file evaluated as it declares, for the document's clip `clip` (an index).
+    /// This file evaluated as it declares, for the document's clip `clip` (an index), measured in the document's
+    /// unit.
     pub fn evaluation(&self, clip: Option<usize>) -> Evaluation<'_> {
-        Evaluation::declared(&self.rig, self.clip_for(clip))
+        Evaluation::declared(&self.rig, self.clip_for(clip)).measured_in(self.document_unit)
     }
 
     /// The ghost at `time`: this file's pose on the document's bones (a bone without a partner stays where the
@@ -119,6 +153,50 @@ impl Compared {
     }
 }
 
+/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in: the
+/// ghost, the dashed curves and the differences follow it.
+pub fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
+    let Some(compared) = doc.compared.clone() else { return };
+    if !compared.states_unit
+        && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
+    {
+        let mut changed = (*compared).clone();
+        changed.rig.unit = Some(unit);
+        replace(doc, changed);
+    }
+    if doc.rig.unit.is_none()
+        && let Some(unit) = unit_picker(ui, &doc.title(), compared.document_unit, &compared.title())
+    {
+        replace(doc, Compared { document_unit: Some(unit), ..(*compared).clone() });
+    }
+}
+
+/// A picker of the unit `file` is in (`unit`, `None` while not given); the unit picked, if another.
+fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -> Option<Unit> {
+    let label = ui.label(format!("unit of {file}"));
+    let mut picked = unit;
+    egui::ComboBox::from_id_salt(("unit", file))
+        .selected_text(unit.map_or_else(|| "not stated".to_owned(), |u| u.to_string()))
+        .show_ui(ui, |ui| {
+            for named in Unit::named() {
+                ui.selectable_value(&mut picked, Some(named), named.to_string());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(format!("{file} states no unit: the one it is in, to compare it with {other} in one unit"));
+    picked.filter(|_| picked != unit)
+}
+
+/// The document compared with `compared` instead, the ghost too where it showed the earlier comparison.
+fn replace(doc: &mut Document, compared: Compared) {
+    let compared = Arc::new(compared);
+    if matches!(doc.ghost, Some(Ghost::Compared(_))) {
+        doc.ghost = Some(Ghost::Compared(compared.clone()));
+    }
+    doc.compared = Some(compared);
+}
+
 /// What the comparison over the clip depends on.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompareKey {
@@ -128,13 +206,15 @@ pub struct CompareKey {
     pub modes: Vec<InheritMode>,
     pub layers: Layers,
     pub rate: f64,
+    /// The units the two files are taken in ([`Compared::units`]).
+    pub units: [Option<Unit>; 2],
 }
 
 /// Each document bone's largest difference from the compared file over the clip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Differences {
     /// Per document bone: the largest distance of its origin and axis probes, as a fraction of the rig's size
-    /// (`None` without a partner).
+    /// (`None` without a partner, and for conversion nodes).
     pub bones: Vec<Option<f64>>,
     pub rig_size: f64,
 }
@@ -213,6 +293,25 @@ mod tests {
         let ghost = compared.ghost(Some(0), &primary, 0.5, SkinningMethod::AsFile, &Tolerances::default());
         assert_eq!(ghost.model, primary.model);
         assert_eq!(ghost.meshes, primary.meshes);
+    }
+
+    #[test]
+    fn a_reload_keeps_the_unit_given_to_a_file_that_states_none() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("walk.bvh");
+        let bvh = "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  \
+                   OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.0333333\n0 0 0\n";
+        std::fs::write(&path, bvh).unwrap();
+        let document = import::demo_rig();
+        let loaded = Compared::load(&path, &document).unwrap();
+        assert_eq!(loaded.units()[1], None, "a BVH states no unit");
+        let centimetres: Unit = "cm".parse().unwrap();
+        let mut given = loaded.clone();
+        given.rig.unit = Some(centimetres);
+        std::fs::write(&path, bvh.replace("0 1 0", "0 2 0")).unwrap();
+        let reloaded = given.reloaded(&document).unwrap();
+        assert_eq!(reloaded.units(), given.units(), "the unit picked survives the file's change");
+        assert_ne!(reloaded.rig.skeleton.len(), 0);
     }
 
     #[test]

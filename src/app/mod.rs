@@ -276,8 +276,9 @@ impl BonescopeApp {
 
     /// Re-reads the compared file after it changed on disk.
     fn reload_compared(&mut self) {
-        let Some(path) = self.doc.compared.as_ref().map(|c| c.path.clone()) else { return };
-        match Compared::load(&path, &self.doc.rig) {
+        let Some(compared) = self.doc.compared.clone() else { return };
+        let path = compared.path.clone();
+        match compared.reloaded(&self.doc.rig) {
             Ok(compared) => {
                 self.doc.compared = Some(Arc::new(compared));
                 self.compared_replaced();
@@ -379,7 +380,7 @@ impl BonescopeApp {
 
     /// What the comparison with the compared file depends on, when there is one.
     fn compare_key(&self) -> Option<CompareKey> {
-        self.doc.compared.as_ref()?;
+        let units = self.doc.compared.as_ref()?.units();
         let key = self.job_key();
         Some(CompareKey {
             generations: (self.generation, self.compared_generation),
@@ -387,6 +388,7 @@ impl BonescopeApp {
             modes: key.modes,
             layers: key.layers,
             rate: key.rate,
+            units,
         })
     }
 

@@ -233,6 +233,7 @@ fn difference_text(shared: &Shared, bone: usize) -> Option<RichText> {
             Some(RichText::new(format!("Δ {:.2}%", 100.0 * fraction)).small().color(color))
         }
         Some(_) => None,
+        None if converts(shared, bone) => Some(RichText::new("converts").small().weak()),
         None => Some(RichText::new("unpaired").small().weak()),
     }
 }
@@ -249,8 +250,16 @@ fn difference_hint(shared: &Shared, bone: usize) -> String {
             100.0 * fraction,
             shared.settings.compare_threshold_percent,
         ),
+        None if converts(shared, bone) => {
+            "only states the file's axes and unit: left out of the comparison, as `diff` leaves it".to_owned()
+        }
         None => format!("no bone of this name in {}", compared.title()),
     }
+}
+
+/// Whether `bone` is a conversion node of the document (its axes and unit), which comparisons leave out.
+fn converts(shared: &Shared, bone: usize) -> bool {
+    shared.doc.compared.as_ref().is_some_and(|compared| compared.conversion.get(bone).copied().unwrap_or(false))
 }
 
 /// The icons of a bone's findings, painted in a fixed-width slot so names line up.

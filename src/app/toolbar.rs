@@ -36,6 +36,7 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         mode_picker(ui, shared);
         ui.separator();
         ghost_picker(ui, shared);
+        super::compare::unit_pickers(ui, shared.doc);
         ui.separator();
         if !shared.doc.rig.skins.is_empty() {
             skinning_picker(ui, shared);

@@ -11,7 +11,7 @@ use super::options::{Distance, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences};
 use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
 use crate::import;
-use crate::model::{ModeChoice, Rig};
+use crate::model::{ModeChoice, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -36,28 +36,48 @@ pub struct DiffArgs {
     /// then ignoring case and namespace prefixes such as `mixamorig:` or `Armature|`.
     #[arg(long = "map", value_name = "A=B", value_parser = parse_assignment)]
     pub map: Vec<(String, String)>,
+    /// The first file's unit where the file states none (BVH): m, cm, mm, in, ft, cmu (the CMU mocap database's
+    /// 1/0.45 inch), or its length in metres. Lengths are compared in the first file's unit.
+    #[arg(long, value_name = "UNIT")]
+    pub unit_a: Option<Unit>,
+    /// The second file's unit where the file states none; the second file's lengths are brought into the first's.
+    #[arg(long, value_name = "UNIT")]
+    pub unit_b: Option<Unit>,
     /// Samples per second over the shorter clip, on top of both files' key times.
     #[arg(long, value_name = "HZ", default_value_t = 60.0, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
     /// Exit with status 1 when a bone's origin or axis probe, or a vertex, differs by more than this: a distance in
-    /// model units (metres), or a percentage of the first rig's size (`0.01%`).
+    /// the first file's unit, or a percentage of the first rig's size (`0.01%`).
     #[arg(long, value_name = "DIST", value_parser = parse_distance)]
     pub fail_above: Option<Distance>,
 }
 
 pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
-    let (rig_a, rig_b) = (import::load(&args.a)?, import::load(&args.b)?);
+    let rig_a = stated_unit(import::load(&args.a)?, args.unit_a, "--unit-a")?;
+    let rig_b = stated_unit(import::load(&args.b)?, args.unit_b, "--unit-b")?;
     let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
     let b = side(&args.b, &rig_b, args.inherit_b, &args.anim_b);
     let diff = diff_files(&a, &b, &args.map, args.rate)?;
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
-        Format::Table => print!("{}", render_table(&diff)),
+        Format::Table => print!("{}", render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()])),
     }
     let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `rig` in `unit` (given as `option`), which only a rig whose file states no unit may be given.
+fn stated_unit(mut rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result<Rig> {
+    match (rig.unit, unit) {
+        (Some(stated), Some(_)) => {
+            anyhow::bail!("{option}: the file states its unit ({stated}); give one only to a file that does not (BVH)")
+        }
+        (None, given) => rig.unit = given,
+        (Some(_), None) => {}
+    }
+    Ok(rig)
 }
 
 /// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`).
@@ -71,8 +91,20 @@ pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Opti
     }
 }
 
-fn render_table(diff: &FileDiff) -> String {
-    let mut out = format!("A: {}  inherit: {}\nB: {}  inherit: {}\n", diff.a, diff.inherit_a, diff.b, diff.inherit_b);
+/// The table of `diff`, saying which units were `given` (`--unit-a`, `--unit-b`).
+fn render_table(diff: &FileDiff, given: [bool; 2]) -> String {
+    let [unit_a, unit_b] = [(diff.unit_a, given[0]), (diff.unit_b, given[1])].map(|(unit, given)| match unit {
+        Some(unit) if given => format!("{unit} (given; the file states none)"),
+        Some(unit) => unit.to_string(),
+        None => "not stated (numbers taken as they are)".to_owned(),
+    });
+    let mut out = format!("A: {}  inherit: {}  unit: {unit_a}\n", diff.a, diff.inherit_a);
+    out.push_str(&format!("B: {}  inherit: {}  unit: {unit_b}\n", diff.b, diff.inherit_b));
+    if let (Some(a), Some(b)) = (diff.unit_a, diff.unit_b)
+        && a != b
+    {
+        out.push_str(&format!("  B's lengths scaled by {} into A's {a}\n", b.per(a)));
+    }
     for clip in &diff.clips_only_a {
         out.push_str(&format!("  animation only in A: {clip}\n"));
     }
@@ -144,6 +176,14 @@ pub(super) fn render_animation(animation: &AnimationDiff) -> String {
     }
     if animation.helpers > 0 {
         out.push_str(&format!("  {} bake helper nodes (`*.stretch`) left out\n", animation.helpers));
+    }
+    for (side, nodes) in [("A", &animation.conversion_a), ("B", &animation.conversion_b)] {
+        if !nodes.is_empty() {
+            out.push_str(&format!(
+                "  conversion nodes of {side} left out (they only state axes and unit): {}\n",
+                nodes.join(", ")
+            ));
+        }
     }
     out
 }

@@ -3,12 +3,14 @@
 //! Bones are matched by name in three passes, each over what the earlier ones left: the user's explicit pairs
 //! (`--map a=b`), exact names, then names compared without case and without a namespace prefix (`mixamorig:Hips`,
 //! `Armature|Hips` and `hips` are one name). Repeated names pair up in file order. The helper nodes a bake inserts
-//! (`<name>.stretch`, whose child is the bone `<name>`) are not bones of the rig and are left out of both sides.
+//! (`<name>.stretch`, whose child is the bone `<name>`) are not bones of the rig and are left out of both sides, and
+//! so are conversion nodes ([`Rig::conversion_nodes`]): whatever their names, they only state a file's axes and
+//! unit, which the bones below them already carry into model space.
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use super::DiffError;
-use crate::model::{Clip, Mesh, Skeleton};
+use crate::model::{Clip, Mesh, Rig, Skeleton};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
 pub const HELPER_SUFFIX: &str = ".stretch";
@@ -23,6 +25,9 @@ pub struct BoneMatching {
     pub only_b: Vec<usize>,
     /// How many helper nodes were left out, on both sides together.
     pub helpers: usize,
+    /// The conversion nodes of each side, left out, in bone order.
+    pub conversion_a: Vec<usize>,
+    pub conversion_b: Vec<usize>,
 }
 
 /// For each bone, whether it is a bake's helper node: named `<name>.stretch` with a child named `<name>`.
@@ -45,19 +50,19 @@ pub fn loose_name(name: &str) -> String {
 }
 
 /// Pairs the bones of `a` and `b` by name (see the module's documentation).
-pub fn match_bones(a: &Skeleton, b: &Skeleton) -> BoneMatching {
+pub fn match_bones(a: &Rig, b: &Rig) -> BoneMatching {
     Unmatched::new(a, b).by_name()
 }
 
 /// [`match_bones`] after the explicit `(name in A, name in B)` pairs of `map`; a pair that names no bone (or one
 /// already taken) is an error naming it.
-pub fn match_bones_mapped(a: &Skeleton, b: &Skeleton, map: &[(String, String)]) -> Result<BoneMatching, DiffError> {
+pub fn match_bones_mapped(a: &Rig, b: &Rig, map: &[(String, String)]) -> Result<BoneMatching, DiffError> {
     let mut unmatched = Unmatched::new(a, b);
     for (name_a, name_b) in map {
         let no_bone =
             |name: &str, file| DiffError::NoBone { map: format!("{name_a}={name_b}"), name: name.to_owned(), file };
-        let i = take(&mut unmatched.left_a, a, name_a).ok_or_else(|| no_bone(name_a, "first"))?;
-        let j = take(&mut unmatched.left_b, b, name_b).ok_or_else(|| no_bone(name_b, "second"))?;
+        let i = take(&mut unmatched.left_a, &a.skeleton, name_a).ok_or_else(|| no_bone(name_a, "first"))?;
+        let j = take(&mut unmatched.left_b, &b.skeleton, name_b).ok_or_else(|| no_bone(name_b, "second"))?;
         unmatched.pairs.push((i, j));
     }
     Ok(unmatched.by_name())
@@ -77,18 +82,27 @@ struct Unmatched<'s> {
     left_b: Vec<usize>,
     pairs: Vec<(usize, usize)>,
     helpers: usize,
+    conversion_a: Vec<usize>,
+    conversion_b: Vec<usize>,
 }
 
 impl<'s> Unmatched<'s> {
-    /// Every bone of both but the helper nodes.
-    fn new(a: &'s Skeleton, b: &'s Skeleton) -> Self {
-        let candidates = |s: &Skeleton| {
-            let helper = helpers(s);
-            (0..s.len()).filter(|&i| !helper[i]).collect::<Vec<_>>()
-        };
-        let (left_a, left_b) = (candidates(a), candidates(b));
-        let helpers = (a.len() - left_a.len()) + (b.len() - left_b.len());
-        Unmatched { a, b, left_a, left_b, pairs: Vec::new(), helpers }
+    /// Every bone of both but the helper and conversion nodes.
+    fn new(a: &'s Rig, b: &'s Rig) -> Self {
+        let (helpers_a, helpers_b) = (helpers(&a.skeleton), helpers(&b.skeleton));
+        let helpers = [&helpers_a, &helpers_b].iter().map(|h| h.iter().filter(|&&h| h).count()).sum();
+        let (conversion_a, left_a) = split(&a.conversion_nodes(), &helpers_a);
+        let (conversion_b, left_b) = split(&b.conversion_nodes(), &helpers_b);
+        Unmatched {
+            a: &a.skeleton,
+            b: &b.skeleton,
+            left_a,
+            left_b,
+            pairs: Vec::new(),
+            helpers,
+            conversion_a,
+            conversion_b,
+        }
     }
 
     /// The bones left paired by exact name, then by loose name.
@@ -99,8 +113,22 @@ impl<'s> Unmatched<'s> {
         let loose = |s: &Skeleton, i: usize| loose_name(&s.bone(i).name);
         pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, loose);
         self.pairs.sort_unstable();
-        BoneMatching { pairs: self.pairs, only_a: self.left_a, only_b: self.left_b, helpers: self.helpers }
+        BoneMatching {
+            pairs: self.pairs,
+            only_a: self.left_a,
+            only_b: self.left_b,
+            helpers: self.helpers,
+            conversion_a: self.conversion_a,
+            conversion_b: self.conversion_b,
+        }
     }
+}
+
+/// The bones that are `conversion` nodes, and those to pair (neither conversion nor `helper` nodes).
+fn split(conversion: &[bool], helper: &[bool]) -> (Vec<usize>, Vec<usize>) {
+    let bones = 0..conversion.len();
+    let (conversion, pair): (Vec<usize>, Vec<usize>) = bones.filter(|&i| !helper[i]).partition(|&i| conversion[i]);
+    (conversion, pair)
 }
 
 /// Pairs the bones left on each side whose `key` agrees, the k-th of a key in A with the k-th in B, and removes
@@ -171,13 +199,22 @@ pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, 
 
 #[cfg(test)]
 mod tests {
+    use glam::{DQuat, DVec3};
+
     use super::*;
-    use crate::model::named_skeleton as skeleton;
+    use crate::model::{Bone, Transform, named_skeleton};
+
+    /// A rig of bones named and parented, each a step along X from its parent (so that none is a conversion node).
+    fn rig(bones: &[(&str, Option<usize>)]) -> Rig {
+        let step = Transform::from_trs(DVec3::X, DQuat::IDENTITY, DVec3::ONE);
+        let moved = named_skeleton(bones).bones().iter().map(|b| Bone { rest: step, ..b.clone() }).collect();
+        Rig { skeleton: Skeleton::new(moved).unwrap(), ..Rig::default() }
+    }
 
     #[test]
     fn exact_then_loose_then_mapped() {
-        let a = skeleton(&[("Hips", None), ("mixamorig:Spine", Some(0)), ("Armature|Head", Some(1)), ("Tail", None)]);
-        let b = skeleton(&[("hips", None), ("Hips", None), ("spine", Some(1)), ("HEAD", Some(2)), ("Cape", None)]);
+        let a = rig(&[("Hips", None), ("mixamorig:Spine", Some(0)), ("Armature|Head", Some(1)), ("Tail", None)]);
+        let b = rig(&[("hips", None), ("Hips", None), ("spine", Some(1)), ("HEAD", Some(2)), ("Cape", None)]);
         let m = match_bones(&a, &b);
         assert_eq!(m.pairs, [(0, 1), (1, 2), (2, 3)], "exact `Hips` wins over the loose `hips`");
         assert_eq!((m.only_a, m.only_b), (vec![3], vec![0, 4]));
@@ -189,15 +226,33 @@ mod tests {
 
     #[test]
     fn repeated_names_pair_in_order_and_helpers_are_left_out() {
-        let a = skeleton(&[("root", None), ("joint", Some(0)), ("joint", Some(1))]);
-        let b = skeleton(&[("root", None), ("joint.stretch", Some(0)), ("joint", Some(1)), ("joint", Some(2))]);
+        let a = rig(&[("root", None), ("joint", Some(0)), ("joint", Some(1))]);
+        let b = rig(&[("root", None), ("joint.stretch", Some(0)), ("joint", Some(1)), ("joint", Some(2))]);
         let m = match_bones(&a, &b);
         assert_eq!(m.pairs, [(0, 0), (1, 2), (2, 3)]);
         assert_eq!(m.helpers, 1);
         assert!(m.only_a.is_empty() && m.only_b.is_empty());
         // A bone merely named like a helper, without the matching child, is a bone.
-        let lone = skeleton(&[("arm.stretch", None), ("hand", Some(0))]);
+        let lone = named_skeleton(&[("arm.stretch", None), ("hand", Some(0))]);
         assert_eq!(helpers(&lone), [false, false]);
+    }
+
+    #[test]
+    fn conversion_nodes_are_left_out_whatever_their_names() {
+        // A: an armature turned −90° about X above the hips (Blender's FBX); B: a `Scene` node at identity above
+        // them (a glTF exporter's). Neither is compared, and neither is a bone without a partner.
+        let mut a = rig(&[("Armature", None), ("hips", Some(0)), ("spine", Some(1))]);
+        let mut b = rig(&[("Scene", None), ("hips", Some(0)), ("spine", Some(1))]);
+        let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
+        for (rig, rest) in [(&mut a, turned), (&mut b, Transform::IDENTITY)] {
+            let bones = rig.skeleton.bones().iter().enumerate();
+            let bones = bones.map(|(i, bone)| if i == 0 { Bone { rest, ..bone.clone() } } else { bone.clone() });
+            rig.skeleton = Skeleton::new(bones.collect()).unwrap();
+        }
+        let m = match_bones(&a, &b);
+        assert_eq!(m.pairs, [(1, 1), (2, 2)]);
+        assert_eq!((m.conversion_a, m.conversion_b), (vec![0], vec![0]));
+        assert!(m.only_a.is_empty() && m.only_b.is_empty());
     }
 
     #[test]

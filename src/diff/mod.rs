@@ -1,8 +1,9 @@
 //! Two evaluations compared over time, bone by bone and vertex by vertex: two files (an export and its source, a
 //! bake and what it baked), or one file under two sets of modes.
 //!
-//! Bones are paired by name ([`match_bones`]); at every time both poses are evaluated and each pair's model matrices
-//! `W_a`, `W_b` are compared through their polar decompositions:
+//! Bones are paired by name ([`match_bones`]), conversion nodes left out; at every time both poses are evaluated, in
+//! one unit (B's lengths measured in A's: [`Evaluation::measured_in`]), and each pair's model matrices `W_a`, `W_b`
+//! are compared through their polar decompositions:
 //! - **position**: the distance between the two origins;
 //! - **probe**: the largest distance of a point of the bone's frame — its origin and one point on each of its axes,
 //!   [`PROBE_FRACTION`] of the rig's size from the origin in A — between where A and B put it (rotation, scale and
@@ -144,13 +145,13 @@ pub struct Pairs {
 impl Pairs {
     /// Bones by name and meshes by name and vertex count.
     pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
-        let bones = match_bones(a.skeleton(), b.skeleton());
+        let bones = match_bones(a.rig, b.rig);
         Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) }
     }
 
     /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones.
     pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
-        let bones = match_bones_mapped(a.skeleton(), b.skeleton(), map)?;
+        let bones = match_bones_mapped(a.rig, b.rig, map)?;
         Ok(Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) })
     }
 }
@@ -195,7 +196,8 @@ pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
     sample_times(keys, 0.0, end, rate, MAX_FRAMES).times
 }
 
-/// Compares `a` and `b` at `times` (sorted).
+/// Compares `a` and `b` at `times` (sorted), in the units each is measured in: to compare two files, measure `b` in
+/// `a`'s rig's unit first ([`Evaluation::measured_in`]), so that lengths are in A's unit.
 pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
     let rig_size = a.size(times);
     let probe_length = rig_size * PROBE_FRACTION;

@@ -3,7 +3,7 @@
 
 use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
 use crate::eval::Evaluation;
-use crate::model::{Clip, InheritMode, Rig};
+use crate::model::{Clip, InheritMode, Rig, Unit};
 
 /// One side of a file comparison, before clips are chosen.
 #[derive(Clone, Debug)]
@@ -36,6 +36,9 @@ pub struct AnimationDiff {
     pub only_b: Vec<String>,
     /// Helper nodes of a bake, left out.
     pub helpers: usize,
+    /// Conversion nodes, left out: nodes that only state the file's axes and unit.
+    pub conversion_a: Vec<String>,
+    pub conversion_b: Vec<String>,
 }
 
 /// The whole comparison.
@@ -45,6 +48,10 @@ pub struct FileDiff {
     pub b: String,
     pub inherit_a: String,
     pub inherit_b: String,
+    /// The rigs' units in metres (`null`: the file states none, and its numbers are taken as they are); lengths are
+    /// in A's unit, B's brought into it.
+    pub unit_a: Option<Unit>,
+    pub unit_b: Option<Unit>,
     pub rate: f64,
     pub animations: Vec<AnimationDiff>,
     /// Clips without a partner.
@@ -52,7 +59,8 @@ pub struct FileDiff {
     pub clips_only_b: Vec<String>,
 }
 
-/// Compares `a` with `b` at their key times and `rate` times a second; `map` pairs bones by name explicitly.
+/// Compares `a` with `b` at their key times and `rate` times a second, lengths in A's unit; `map` pairs bones by
+/// name explicitly.
 pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f64) -> Result<FileDiff, DiffError> {
     let (pairs, only_a, only_b) = pair_clips(a, b)?;
     let label = |rig: &Rig, clip: Option<usize>| clip.map_or_else(|| "rest pose".to_owned(), |c| rig.clips[c].label());
@@ -60,7 +68,7 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
         .iter()
         .map(|&(ca, cb)| {
             let side_a = Evaluation::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes);
-            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes);
+            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes).measured_in(a.rig.unit);
             let pairs = Pairs::mapped(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
@@ -73,6 +81,8 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
                 only_a: names(a.rig, &pairs.bones.only_a),
                 only_b: names(b.rig, &pairs.bones.only_b),
                 helpers: pairs.bones.helpers,
+                conversion_a: names(a.rig, &pairs.bones.conversion_a),
+                conversion_b: names(b.rig, &pairs.bones.conversion_b),
                 bones: comparison.bones,
                 meshes: comparison.meshes,
             })
@@ -83,6 +93,8 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
         b: b.file.clone(),
         inherit_a: a.inherit.clone(),
         inherit_b: b.inherit.clone(),
+        unit_a: a.rig.unit,
+        unit_b: b.rig.unit,
         rate,
         animations,
         clips_only_a: only_a.iter().map(|&c| label(a.rig, Some(c))).collect(),

@@ -1,13 +1,13 @@
 //! What is evaluated: a clip of a rig under one inheritance mode per bone, through layers, skinned one way, and the
-//! times a whole-clip pass visits it at. Every consumer builds one — the analysis, a ghost, a compared file, a bake
+//! times a whole-clip pass visits it at, its lengths in its rig's unit or another. Every consumer builds one — the analysis, a ghost, a compared file, a bake
 //! and the file it wrote, `inspect`, `export` — and a comparison is two of them.
 
-use glam::DVec3;
+use glam::{DMat4, DVec3, DVec4};
 
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose};
-use crate::model::{Clip, InheritMode, MAX_FRAMES, Rig, Skeleton, sample_times};
+use crate::model::{Clip, InheritMode, MAX_FRAMES, Rig, Skeleton, Unit, sample_times};
 
 /// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
 #[derive(Clone, Debug)]
@@ -19,13 +19,15 @@ pub struct Evaluation<'a> {
     /// The layers the clip plays through; never a stack that leaves the clip as it is (that is `None`).
     layers: Option<LayerStack>,
     pub skinning: SkinningMethod,
+    /// What the model matrices multiply lengths by: 1 in the rig's own unit ([`Evaluation::measured_in`]).
+    length_scale: f64,
 }
 
 impl<'a> Evaluation<'a> {
     /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says.
     pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Self {
         let hierarchy = Hierarchy::new(&rig.skeleton, modes);
-        Evaluation { rig, clip, hierarchy, layers: None, skinning: SkinningMethod::AsFile }
+        Evaluation { rig, clip, hierarchy, layers: None, skinning: SkinningMethod::AsFile, length_scale: 1.0 }
     }
 
     /// `clip` of `rig` with the modes its file declares.
@@ -49,6 +51,18 @@ impl<'a> Evaluation<'a> {
     /// The same skinned with `method`.
     pub fn with_skinning(mut self, method: SkinningMethod) -> Self {
         self.skinning = method;
+        self
+    }
+
+    /// The same with its lengths in `unit`: every model matrix (and so every skinned vertex) scaled about the origin
+    /// by the rig's unit per `unit`, as ufbx converts an FBX file's unit (a uniform scale above the roots, which
+    /// commutes with every rotation and so with every mode). Where the rig or `unit` is not known, the rig's numbers
+    /// are taken as they are.
+    pub fn measured_in(mut self, unit: Option<Unit>) -> Self {
+        self.length_scale = match (self.rig.unit, unit) {
+            (Some(own), Some(unit)) => own.per(unit),
+            _ => 1.0,
+        };
         self
     }
 
@@ -185,7 +199,20 @@ impl<'e, 'a> Evaluator<'e, 'a> {
             Some(stack) => self.pose.evaluate_layered(e.rig, e.clip, &e.hierarchy, stack, time),
             None => self.pose.evaluate(&e.rig.skeleton, e.clip, &e.hierarchy, time),
         }
+        if e.length_scale != 1.0 {
+            scale_lengths(&mut self.pose.model.model, e.length_scale);
+        }
         &self.pose
+    }
+}
+
+/// `S(scale)·W` for every matrix `W`: each column's vector part scaled, the translation's included.
+fn scale_lengths(model: &mut [DMat4], scale: f64) {
+    let columns = DVec4::new(scale, scale, scale, 1.0);
+    for m in model {
+        for axis in [&mut m.x_axis, &mut m.y_axis, &mut m.z_axis, &mut m.w_axis] {
+            *axis *= columns;
+        }
     }
 }
 
@@ -244,6 +271,29 @@ mod tests {
         assert!(times.windows(2).all(|w| (w[1] - w[0] - 0.1).abs() < 1e-12), "{times:?}");
         assert_eq!(layered.key_times(), [0.0, end]);
         assert_eq!(layered.without_layers().times(10.0), Evaluation::declared(&rig, Some(main)).times(10.0));
+    }
+
+    #[test]
+    fn measured_in_centimetres_every_length_is_a_hundred_times_longer() {
+        // The demo is in metres: in centimetres each origin, each axis and each vertex is 100× as long, to rounding.
+        let rig = demo_rig();
+        let metres = Evaluation::declared(&rig, rig.clips.first());
+        let centimetres = metres.clone().measured_in("cm".parse().ok());
+        let (a, b) = (metres.pose_at(0.7), centimetres.pose_at(0.7));
+        for (wa, wb) in a.model.model.iter().zip(&b.model.model) {
+            assert!(wb.abs_diff_eq(DMat4::from_scale(DVec3::splat(100.0)) * *wa, 1e-12), "{wa} → {wb}");
+        }
+        let (va, vb) = (metres.skin_all(&a), centimetres.skin_all(&b));
+        for (p, q) in va.concat().iter().zip(&vb.concat()) {
+            assert!((*q - 100.0 * *p).length() < 1e-12, "{p} → {q}");
+        }
+        let times = metres.times(10.0);
+        assert!((centimetres.size(&times) / metres.size(&times) - 100.0).abs() < 1e-9);
+        // A unit that is not known leaves the numbers as they are.
+        let unstated = Rig { unit: None, ..rig.clone() };
+        let as_is = Evaluation::declared(&unstated, rig.clips.first()).measured_in("cm".parse().ok());
+        assert_eq!(as_is.pose_at(0.7).model.model, a.model.model);
+        assert_eq!(metres.clone().measured_in(None).pose_at(0.7).model.model, a.model.model);
     }
 
     #[test]

@@ -188,7 +188,7 @@ fn read(bytes: &[u8]) -> Result<Rig> {
             vec![clip(&joints, &values, frames as usize, frame_time)?]
         }
     };
-    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), notes })
+    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), unit: None, notes })
 }
 
 /// `HIERARCHY` up to and including `MOTION`.

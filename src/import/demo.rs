@@ -8,7 +8,9 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3, Quat, Vec3};
 
-use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, Rig, Skeleton, Skin, Track, Transform};
+use crate::model::{
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, Rig, Skeleton, Skin, Track, Transform, Unit,
+};
 
 /// Bone indices of the demo rig.
 const SHOULDER: usize = 0;
@@ -34,6 +36,7 @@ pub fn demo_rig() -> Rig {
             "built-in demo: the upper arm squashes and stretches along its own axis while the forearm bends".into(),
             "units: metres, Y-up".into(),
         ],
+        unit: Some(Unit::METRE),
         skeleton,
     }
 }
@@ -212,6 +215,7 @@ pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
         skeleton: Skeleton::new(skeleton_bones).expect("parents come first"),
         clips: vec![Clip::new(0, Some("generated".into()), tracks, vec![])],
         notes: vec![format!("generated: {bones} bones, {frames} frames, a key every {step} frames")],
+        unit: Some(Unit::METRE),
         ..Rig::default()
     }
 }

@@ -115,7 +115,14 @@ mod tests {
                 inherit: InheritMode::Full,
             })
             .collect();
-        Rig { skeleton: Skeleton::new(bones).unwrap(), clips: vec![], skins: vec![], meshes: vec![], notes: vec![] }
+        Rig {
+            skeleton: Skeleton::new(bones).unwrap(),
+            clips: vec![],
+            skins: vec![],
+            meshes: vec![],
+            unit: None,
+            notes: vec![],
+        }
     }
 
     #[test]

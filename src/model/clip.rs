@@ -8,6 +8,8 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
+use super::Transform;
+
 /// How values between keys are computed (glTF's sampler interpolations).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -125,6 +127,11 @@ impl<T: KeyValue> Track<T> {
             .chunks(per_key)
             .all(|key| key.iter().enumerate().all(|(i, v)| if i == per_key / 2 { *v == first } else { v.is_zero() }))
     }
+
+    /// The one value a constant track holds ([`Track::is_constant`]).
+    pub fn held(&self) -> Option<T> {
+        self.is_constant().then(|| self.values[self.interpolation.values_per_key() / 2])
+    }
 }
 
 impl<T> Track<T> {
@@ -209,6 +216,21 @@ pub struct BoneTracks {
 impl BoneTracks {
     pub fn new(bone: usize) -> Self {
         BoneTracks { bone, translation: None, rotation: None, scale: None }
+    }
+
+    /// The transform the bone holds throughout when every track holds one value (`rest` where it has no track).
+    pub fn held(&self, rest: &Transform) -> Option<Transform> {
+        let mut held = *rest;
+        if let Some(track) = &self.translation {
+            held.translation = track.held()?.as_dvec3();
+        }
+        if let Some(track) = &self.rotation {
+            held.rotation = track.held()?.as_dquat().normalize();
+        }
+        if let Some(track) = &self.scale {
+            held.scale = track.held()?.as_dvec3();
+        }
+        Some(held)
     }
 
     /// The time arrays of the animated properties (each sorted; possibly the same array more than once).

@@ -7,6 +7,7 @@ mod skeleton;
 mod skin;
 mod timeline;
 mod transform;
+mod unit;
 
 pub use choice::Choice;
 pub use clip::{
@@ -19,6 +20,7 @@ pub use skeleton::{Bone, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
+pub use unit::{Unit, UnknownUnit};
 
 /// Everything bonescope knows about one file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,6 +29,9 @@ pub struct Rig {
     pub clips: Vec<Clip>,
     pub skins: Vec<Skin>,
     pub meshes: Vec<Mesh>,
+    /// What its lengths are in, `None` where the file does not say (BVH): every reader fills it, and comparisons
+    /// bring two rigs into one unit with it.
+    pub unit: Option<Unit>,
     /// Facts about the import a user should know (units, axes, what was listed but not evaluated).
     pub notes: Vec<String>,
 }
@@ -38,6 +43,33 @@ impl Rig {
             .iter()
             .find(|c| c.name.as_deref() == Some(name))
             .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
+    }
+
+    /// For each bone, whether it is a conversion node: one at the top of the hierarchy (a root, or below conversion
+    /// nodes only) that only changes axes or units ([`Transform::only_converts`]) at rest and in every clip (which
+    /// may key it, but only to hold one value) and that carries bones or a mesh. Exporters put such nodes above a character to state their axes and unit (Blender's
+    /// FBX armature turned −90° about X, a glTF exporter's "Armature" at identity); two files of one character hold
+    /// them or not, under any name, so comparisons recognise them by this role instead of pairing them by name.
+    pub fn conversion_nodes(&self) -> Vec<bool> {
+        let bones = self.skeleton.bones();
+        let mut carries = vec![false; bones.len()];
+        for parent in bones.iter().filter_map(|b| b.parent).chain(self.meshes.iter().map(|m| m.bone)) {
+            if let Some(c) = carries.get_mut(parent) {
+                *c = true;
+            }
+        }
+        let mut conversion = vec![false; bones.len()];
+        for (i, bone) in bones.iter().enumerate() {
+            let on_top = bone.parent.is_none_or(|p| conversion[p]);
+            conversion[i] = on_top && carries[i] && self.only_converts(i, &bone.rest);
+        }
+        conversion
+    }
+
+    /// Whether `bone` (at `rest`) only converts axes or units, at rest and throughout every clip.
+    fn only_converts(&self, bone: usize, rest: &Transform) -> bool {
+        let held = |clip: &Clip| clip.tracks_of(bone).map_or(Some(*rest), |tracks| tracks.held(rest));
+        rest.only_converts() && self.clips.iter().all(|clip| held(clip).is_some_and(|h| h.only_converts()))
     }
 
     /// For each bone, whether it belongs to the character: the bones `clip` animates and the skins' joints, so that a
@@ -56,5 +88,50 @@ impl Rig {
             character.fill(true);
         }
         character
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::{DQuat, DVec3, Quat, Vec3};
+
+    use super::*;
+
+    #[test]
+    fn conversion_nodes_are_static_tops_that_only_convert_and_carry_something() {
+        let bone =
+            |name: &str, parent, rest| Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full };
+        let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
+        let up = Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE);
+        let bones = vec![
+            bone("Armature", None, turned),               // converts, carries `Scene`
+            bone("Scene", Some(0), Transform::IDENTITY),  // below a conversion node, carries `hips`
+            bone("hips", Some(1), up),                    // moved: a bone
+            bone("marker", Some(2), Transform::IDENTITY), // identity, but below a bone
+            bone("skin", None, turned),                   // carries a mesh
+            bone("locator", None, Transform::IDENTITY),   // carries nothing
+            bone("mover", None, Transform::IDENTITY),     // animated
+            bone("passenger", Some(6), up),
+            bone("keyed", None, Transform::IDENTITY), // keyed, but to hold a quarter turn throughout
+            bone("rider", Some(8), up),
+        ];
+        let times: Arc<[f64]> = Arc::from([0.0, 1.0]);
+        let track = Track::new(times.clone(), vec![Vec3::ZERO, Vec3::X], Interpolation::Linear).unwrap();
+        let quarter = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+        let held = Track::new(times, vec![quarter, quarter], Interpolation::Linear).unwrap();
+        let tracks = vec![
+            BoneTracks { translation: Some(track), ..BoneTracks::new(6) },
+            BoneTracks { rotation: Some(held), ..BoneTracks::new(8) },
+        ];
+        let clip = Clip::new(0, None, tracks, vec![]);
+        let rig = Rig {
+            skeleton: Skeleton::new(bones).unwrap(),
+            clips: vec![clip],
+            meshes: vec![Mesh { bone: 4, ..Mesh::default() }],
+            ..Rig::default()
+        };
+        assert_eq!(rig.conversion_nodes(), [true, true, false, false, true, false, false, false, true, false]);
     }
 }

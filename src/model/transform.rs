@@ -2,6 +2,10 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
+/// How far from an axis, relative to its length, a converted axis may point: exporters write quarter turns in
+/// single precision (Blender's cos 90° is 4.4e-8).
+pub const CONVERTS: f64 = 1e-6;
+
 /// `L = T(translation)·R(rotation)·U·S(scale)·Uᵀ` with `U = R(stretch)`.
 ///
 /// `stretch` is the identity for everything a TRS format can say; it is only set when a rest matrix with shear
@@ -48,6 +52,22 @@ impl Transform {
         DMat4::from_rotation_translation(self.rotation, self.translation)
     }
 
+    /// Whether the transform only changes axis conventions and units: no translation, and a linear part that maps
+    /// each axis onto ± another, all scaled alike (quarter turns, mirrors, a uniform scale), to [`CONVERTS`].
+    pub fn only_converts(&self) -> bool {
+        let linear = DMat3::from_quat(self.rotation) * self.scale_matrix();
+        let scale = linear.x_axis.length();
+        let tolerance = CONVERTS * scale;
+        let mut taken = [false; 3];
+        let onto_axes = [linear.x_axis, linear.y_axis, linear.z_axis].into_iter().all(|column| {
+            let axis = column.abs().max_position();
+            let fresh = !std::mem::replace(&mut taken[axis], true);
+            let off_axis = (column - DVec3::AXES[axis] * column[axis]).length();
+            fresh && (column[axis].abs() - scale).abs() <= tolerance && off_axis <= tolerance
+        });
+        scale > 0.0 && scale.is_finite() && self.translation.length() <= tolerance && onto_axes
+    }
+
     /// The full local matrix `T·R·U·S·Uᵀ`.
     pub fn matrix(&self) -> DMat4 {
         if self.is_trs() {
@@ -74,6 +94,26 @@ mod tests {
         let mut stretched = t;
         stretched.stretch = DQuat::from_rotation_z(1e-300); // not bit-identical to IDENTITY: takes the other path
         assert!(t.matrix().abs_diff_eq(stretched.matrix(), 1e-12));
+    }
+
+    #[test]
+    fn conversions_turn_axes_onto_axes_and_scale_alike() {
+        let quarter = std::f64::consts::FRAC_PI_2;
+        let trs = |t: DVec3, r: DQuat, s: DVec3| Transform::from_trs(t, r, s);
+        // Blender's FBX armature: −90° about X, in single precision; a unit scale; a mirror; nothing at all.
+        let blender = trs(DVec3::ZERO, DQuat::from_rotation_x(f64::from(-quarter as f32)), DVec3::ONE);
+        assert!(blender.only_converts());
+        assert!(trs(DVec3::ZERO, DQuat::from_rotation_y(quarter), DVec3::splat(0.01)).only_converts());
+        assert!(trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(1.0, 1.0, -1.0)).only_converts());
+        assert!(Transform::IDENTITY.only_converts());
+        // Not conversions: a move, a turn between axes, a non-uniform scale, a collapse, a stretch off the axes.
+        assert!(!trs(DVec3::X * 1e-3, DQuat::IDENTITY, DVec3::ONE).only_converts());
+        assert!(!trs(DVec3::ZERO, DQuat::from_rotation_z(0.3), DVec3::ONE).only_converts());
+        assert!(!trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(1.0, 2.0, 1.0)).only_converts());
+        assert!(!trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::ZERO).only_converts());
+        let stretch = DQuat::from_rotation_z(0.5);
+        let sheared = Transform { stretch, ..trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0)) };
+        assert!(!sheared.only_converts());
     }
 
     #[test]

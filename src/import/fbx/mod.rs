@@ -29,7 +29,7 @@ use std::path::Path;
 
 use super::failure::{Failure, Result};
 use super::{ImportError, Options, Space};
-use crate::model::Rig;
+use crate::model::{Rig, Unit};
 
 /// Reads an FBX file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
@@ -148,27 +148,32 @@ fn read(scene: &ufbx::SceneRoot, file_size: usize, options: &Options) -> Result<
     let bones = scene::read(scene, &mut notes)?;
     let (skins, meshes) = mesh::read(scene, &bones, file_size, &mut notes)?;
     let clips = anim::read_clips(scene, &bones.bone_of_node, file_size, &mut notes)?;
-    Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, notes })
+    let unit = unit(scene, options.space);
+    Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, unit, notes })
 }
 
-/// What the file's units and axes are, and what became of them. (ufbx keeps the file's own settings in
-/// `scene.settings` even when it converts.)
+/// The unit the file states (ufbx keeps the file's own settings in `scene.settings` even when it converts).
+fn file_unit(scene: &ufbx::Scene) -> Option<Unit> {
+    Unit::metres(scene.settings.unit_meters)
+}
+
+/// The unit of the loaded rig: metres where ufbx converted the file's stated unit, else the file's.
+fn unit(scene: &ufbx::Scene, space: Space) -> Option<Unit> {
+    let stated = file_unit(scene);
+    match space {
+        Space::YUpMetres => stated.map(|_| Unit::METRE),
+        Space::File => stated,
+    }
+}
+
+/// What the file's units and axes are, and what became of them.
 fn space_note(scene: &ufbx::Scene, space: Space) -> String {
     let settings = &scene.settings;
     let up = match settings.axes.up {
         ufbx::CoordinateAxis::Unknown => "no up axis stated".to_owned(),
         axis => format!("{}-up", axis_name(axis)),
     };
-    let unit = settings.unit_meters;
-    let unit = if (unit - 0.01).abs() < 1e-12 {
-        "centimetres".to_owned()
-    } else if (unit - 1.0).abs() < 1e-12 {
-        "metres".to_owned()
-    } else if unit > 0.0 && unit.is_finite() {
-        format!("units of {unit} m")
-    } else {
-        "no unit stated".to_owned()
-    };
+    let unit = file_unit(scene).map_or_else(|| "no unit stated".to_owned(), |u| u.to_string());
     let stated = settings.axes.up != ufbx::CoordinateAxis::Unknown;
     match space {
         Space::YUpMetres if stated => format!(

@@ -23,7 +23,7 @@ use std::fs::File;
 use std::path::Path;
 
 use super::ImportError;
-use crate::model::Rig;
+use crate::model::{Rig, Unit};
 use source::Source;
 
 use super::failure::{Failure, Result};
@@ -53,5 +53,5 @@ fn read(path: &Path, source: Source<'_>) -> Result<Rig> {
     let skins = mesh::read_skins(root, &accessors, &scene.bone_of_node, &mut notes)?;
     let meshes = mesh::read_meshes(root, &accessors, &scene, &skins, &mut notes)?;
     let clips = animation::read_clips(root, &accessors, &scene.bone_of_node, &mut notes)?;
-    Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, notes })
+    Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, unit: Some(Unit::METRE), notes })
 }

@@ -1,0 +1,114 @@
+//! What a rig's lengths mean: the length of one model unit, in metres.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// The length of one unit of a rig's numbers, in metres (positive and finite). glTF states metres; FBX states its
+/// `UnitScaleFactor` (and is converted to metres on import); BVH states nothing, and then a person does.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(transparent)]
+pub struct Unit {
+    metres: f64,
+}
+
+/// The units people name, as `(id, plural name, metres)`.
+const NAMED: [(&str, &str, f64); 6] = [
+    ("m", "metres", 1.0),
+    ("cm", "centimetres", 0.01),
+    ("mm", "millimetres", 0.001),
+    ("in", "inches", 0.0254),
+    ("ft", "feet", 0.3048),
+    // The CMU motion capture database's skeletons (and the BVH conversions of them) measure in 1/0.45 inch.
+    ("cmu", "CMU mocap units (1/0.45 in)", 0.0254 / 0.45),
+];
+
+/// How close two lengths in metres must be for a unit to take a name (a file's single-precision factor included).
+const SAME_LENGTH: f64 = 1e-6;
+
+impl Unit {
+    pub const METRE: Unit = Unit { metres: 1.0 };
+
+    /// A unit `metres` long; `None` unless that is positive and finite.
+    pub fn metres(metres: f64) -> Option<Unit> {
+        (metres > 0.0 && metres.is_finite()).then_some(Unit { metres })
+    }
+
+    pub fn in_metres(self) -> f64 {
+        self.metres
+    }
+
+    /// How many `other`s one of this unit is: what a length in this unit is multiplied by to be in `other`.
+    pub fn per(self, other: Unit) -> f64 {
+        self.metres / other.metres
+    }
+
+    /// The units people name (`m`, `cm`, …), for pickers.
+    pub fn named() -> impl Iterator<Item = Unit> {
+        NAMED.into_iter().map(|(_, _, metres)| Unit { metres })
+    }
+
+    /// The name and id of this unit, when it has one.
+    fn name(self) -> Option<(&'static str, &'static str)> {
+        NAMED
+            .into_iter()
+            .find(|&(_, _, metres)| (self.metres / metres - 1.0).abs() < SAME_LENGTH)
+            .map(|(id, name, _)| (id, name))
+    }
+}
+
+impl fmt::Display for Unit {
+    /// `centimetres`, or `units of 0.5 m` for a unit without a name.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.name() {
+            Some((_, name)) => f.write_str(name),
+            None => write!(f, "units of {} m", self.metres),
+        }
+    }
+}
+
+/// A unit that is neither named nor a positive number of metres.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("`{0}` is not a unit: expected m, cm, mm, in, ft, cmu, or the unit's length in metres (0.01)")]
+pub struct UnknownUnit(pub String);
+
+impl FromStr for Unit {
+    type Err = UnknownUnit;
+
+    /// An id (`cm`) or a length in metres (`0.01`).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let text = s.trim();
+        let named = NAMED.into_iter().find(|(id, _, _)| id.eq_ignore_ascii_case(text)).map(|(_, _, m)| m);
+        named.or_else(|| text.parse().ok()).and_then(Unit::metres).ok_or_else(|| UnknownUnit(s.to_owned()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_parse_by_id_or_length_and_print_their_name() {
+        let cm: Unit = "cm".parse().unwrap();
+        assert_eq!(cm.in_metres(), 0.01);
+        assert_eq!(cm.to_string(), "centimetres");
+        assert_eq!(" IN ".parse::<Unit>().unwrap().to_string(), "inches");
+        assert_eq!("0.001".parse::<Unit>().unwrap().to_string(), "millimetres");
+        assert_eq!("0.5".parse::<Unit>().unwrap().to_string(), "units of 0.5 m");
+        // A factor stored in single precision is still its unit.
+        assert_eq!(Unit::metres(f64::from(0.01f32)).unwrap().to_string(), "centimetres");
+        for bad in ["", "0", "-1", "inf", "NaN", "furlong"] {
+            assert!(bad.parse::<Unit>().is_err(), "{bad}");
+        }
+        assert_eq!(Unit::metres(f64::NAN), None);
+    }
+
+    #[test]
+    fn a_length_converts_by_the_ratio_of_the_units() {
+        // 1 CMU unit is 1/0.45 in = 0.0254/0.45 m ≈ 5.644 cm.
+        let cmu: Unit = "cmu".parse().unwrap();
+        let cm: Unit = "cm".parse().unwrap();
+        assert!((cmu.per(cm) - 2.54 / 0.45).abs() < 1e-12);
+        assert_eq!(Unit::METRE.per(cm), 100.0);
+        assert_eq!(Unit::named().count(), NAMED.len());
+    }
+}
