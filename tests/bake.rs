@@ -404,3 +404,56 @@ fn a_dual_quaternion_skin_is_baked_linear_and_the_report_says_what_it_costs() {
     // The twisted mesh is where linear blending pinches what dual quaternions keep: the report shows it.
     assert!(animation.meshes[0].distance.max > 0.01 * baked.rig_size, "{:?}", animation.meshes[0]);
 }
+
+/// `bonescope bake SOURCE --for ENGINE --format json` with `more` options, into `out`: the report.
+fn bake_for(source: &str, engine: &str, out: &Path, more: &[&str]) -> Value {
+    let path = asset(source).display().to_string();
+    let args = [&["bake", &path, "--for", engine, "--out", &out.display().to_string(), "--format", "json"], more];
+    let output = bonescope(&args.concat());
+    assert!(output.status.success(), "{engine}: {}", String::from_utf8_lossy(&output.stderr));
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+#[test]
+fn each_engine_plays_its_bake_within_the_tolerance_as_it_interpolates() {
+    // Maya's mixed-inheritance file, where Blender played a slerp-only bake 3.9e-3 of the model off between frames:
+    // each engine's bake, played as that engine interpolates rotations, on a grid of quarter frames (24 fps), stays
+    // within the tolerance of the source, and its report says so.
+    let source = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
+    let folder = tempfile::tempdir().unwrap();
+    for (engine, played) in [("generic", "nlerp"), ("generic", "slerp"), ("blender", "nlerp"), ("unity", "nlerp")]
+        .into_iter()
+        .chain([("three", "slerp"), ("godot", "slerp")])
+    {
+        let out = folder.path().join(format!("{engine}.glb"));
+        let report = bake_for(source, engine, &out, &[]);
+        assert_eq!((report["engine"].as_str(), report["strategy"].as_str()), (Some(engine), Some("exact")));
+        let tolerance = report["tolerance"].as_f64().unwrap();
+        assert!(report["animations"][0]["worst"]["max"].as_f64().unwrap() <= tolerance, "{engine}: reported");
+        let (path, baked) = (asset(source).display().to_string(), out.display().to_string());
+        let measured = diff_worst(&[&path, &baked, "--interp", played, "--rate", "96"]);
+        assert!(measured <= tolerance, "{engine} played by {played}: {measured:e} > {tolerance:e}");
+    }
+}
+
+#[test]
+fn unreal_gets_one_trs_node_per_bone_and_its_report_is_what_diff_measures_under_nlerp() {
+    // Maya's file with every bone under an unscaled parent, which shears; every sample a key (tolerance 0), so
+    // diff at the clip's own rate visits exactly the sampled times.
+    let source = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
+    let folder = tempfile::tempdir().unwrap();
+    let out = folder.path().join("unreal.glb");
+    let inherit = InheritMode::UnscaledParent.id();
+    let report = bake_for(source, "unreal", &out, &["--tolerance", "0", "--inherit", inherit]);
+    assert_eq!(report["rotations"], serde_json::json!(["nlerp"]));
+    let bones = report["animations"][0]["bones"].as_array().unwrap();
+    assert!(bones.iter().all(|b| b["nodes"] == "trs"), "one TRS node per bone");
+    assert!(report["helpers"].as_array().unwrap().is_empty());
+    let reported = report["animations"][0]["worst"]["max"].as_f64().unwrap();
+    let rate = RIGS[source].clips[0].frame_rate().to_string();
+    let (path, baked) = (asset(source).display().to_string(), out.display().to_string());
+    let measured = diff_worst(&[&path, &baked, "--inherit-a", inherit, "--interp", "nlerp", "--rate", &rate]);
+    let size = report["rig_size"].as_f64().unwrap();
+    assert!((reported - measured).abs() <= EXACT * size, "{reported} vs {measured}");
+    assert!(reported > bake::DEFAULT_TOLERANCE * size, "the shear is beyond a TRS: {reported:e}");
+}

@@ -22,6 +22,7 @@
 
 mod channels;
 mod document;
+mod engine;
 mod glb;
 mod keys;
 mod layout;
@@ -31,6 +32,7 @@ pub mod report;
 mod skins;
 mod times;
 
+pub use engine::Engine;
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
 
@@ -102,13 +104,14 @@ pub struct Request<'a> {
     pub strategy: Strategy,
     /// Between keys, the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     pub tolerance: f64,
-    /// The rotation interpolations under which it does.
-    pub rotations: &'static [RotationInterpolation],
+    /// The runtime it is for: under the rotation interpolations it plays keys with ([`Engine::rotations`]), the
+    /// result stays within the tolerance.
+    pub engine: Engine,
 }
 
 impl<'a> Request<'a> {
     /// Every clip of `source`'s rig (or the one `only` names) evaluated as `source` is, or its rest pose for a rig
-    /// without clips (which the baked nodes then hold, with no animation in the file).
+    /// without clips (which the baked nodes then hold, with no animation in the file), for every runtime.
     pub fn every_clip(source: &Evaluation<'a>, only: Option<&'a Clip>, strategy: Strategy, tolerance: f64) -> Self {
         let rest = source.at_rest();
         let clips: Vec<&Clip> = match only {
@@ -121,7 +124,7 @@ impl<'a> Request<'a> {
             let of = |clip: &'a Clip| rest.clone().with_clip(Some(clip));
             clips.into_iter().map(|clip| ClipToBake { name: clip.label(), source: of(clip) }).collect()
         };
-        Request { rest, clips, strategy, tolerance, rotations: EVERY_RUNTIME }
+        Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
 
     pub fn rig(&self) -> &'a Rig {
@@ -162,7 +165,7 @@ pub fn bake(request: &Request) -> Baked {
     let size = sources.iter().zip(&base).map(|(source, base)| source.size(&base.times)).fold(0.0, f64::max);
     let size = if size > 0.0 { size } else { request.rest.size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
-    let metrics = Metrics::new(&request.rest, size, tolerance, request.rotations);
+    let metrics = Metrics::new(&request.rest, size, tolerance, request.engine.rotations());
     let sampled: Vec<Sampled> =
         sources.iter().zip(&base).map(|(source, base)| sample_densely(source, strategy, base, &metrics)).collect();
     let rest = nodes::sample(&request.rest, &[0.0], strategy);
