@@ -165,7 +165,7 @@ impl BoneMetric {
         self.rotations.iter().map(|&r| self.distance(&interpolate(a, b, t, r), exact)).fold(0.0, f64::max)
     }
 
-    /// How far apart (as [`BoneMetric::distance`] measures) the interpolations of `rotations` can put the nodes
+    /// How far apart (as `BoneMetric::distance` measures) the interpolations of `rotations` can put the nodes
     /// between `a` and `b`: nothing without nlerp among them, else as far as nlerp departs from slerp. Both agree at
     /// the keys and half way, where refinement samples, so this, not a sample, tells where nlerp leaves the source.
     ///
