@@ -20,44 +20,9 @@ use bonescope::eval::Evaluation;
 use bonescope::eval::layers::RotationInterpolation;
 use bonescope::import;
 use bonescope::model::{Choice, InheritMode, Rig};
-use common::{asset, bonescope, obj_positions, size};
+use common::{ANIMATED, asset, bonescope, obj_positions, size};
 use rayon::prelude::*;
 use serde_json::Value;
-
-/// Every shared asset with animation or skins (the corpus and the validator's suite have their own tests).
-const SOURCES: &[&str] = &[
-    "blender/stretchy_full.glb",
-    "blender/stretchy_noinherit.glb",
-    "blender/stretchy_full.fbx",
-    "blender/stretchy_noinherit.fbx",
-    "blender/stretchy_full.bvh",
-    "gltf-khronos/Fox.glb",
-    "gltf-khronos/SimpleSkin.gltf",
-    "gltf-khronos/box_animated.gltf",
-    "gltf-khronos/cesium_man.gltf",
-    "gltf-khronos/interpolation_test.gltf",
-    "gltf-khronos/rigged_simple.gltf",
-    "fbx-proanimationbank/locomotions.fbx",
-    "fbx-proanimationbank/skeleton.fbx",
-    "fbx-proanimationbank/walk.fbx",
-    "fbx-proanimationbank/crossarms.fbx",
-    "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_scale_no_inherit_6100_ascii.fbx",
-    "fbx-ufbx-data/maya_scale_no_inherit_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_scale_no_inherit_step_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_static_no_inherit_scale_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx",
-    "fbx-ufbx-data/maya_advanced_skinned_pivot_7700_binary.fbx",
-    "fbx-ufbx-data/max7_skin_5000_binary.fbx",
-    "fbx-ufbx-data/max_transformed_skin_7500_binary.fbx",
-    "fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx",
-    "bvh/cmu_12_01_walk.bvh",
-    "bvh/bvh_test2.bvh",
-    "bvh/standard_skeleton.bvh",
-    "bvh/rotation_first_root.bvh",
-    "bvh/full_precision_frame_time.bvh",
-];
 
 /// The demo rig stands beside the files.
 const DEMO: &str = "demo";
@@ -75,13 +40,13 @@ fn label(mode: Option<InheritMode>) -> &'static str {
 }
 
 static RIGS: LazyLock<HashMap<&'static str, Rig>> = LazyLock::new(|| {
-    let mut rigs: HashMap<&str, Rig> = SOURCES.par_iter().map(|&f| (f, import::load(&asset(f)).unwrap())).collect();
+    let mut rigs: HashMap<&str, Rig> = ANIMATED.par_iter().map(|&f| (f, import::load(&asset(f)).unwrap())).collect();
     rigs.insert(DEMO, import::demo_rig());
     rigs
 });
 
 fn sources() -> Vec<&'static str> {
-    SOURCES.iter().copied().chain([DEMO]).collect()
+    ANIMATED.iter().copied().chain([DEMO]).collect()
 }
 
 /// One bake of one source under one mode.

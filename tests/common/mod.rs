@@ -10,6 +10,42 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde_json::Value;
 
+/// Every shared asset with animation or skins, as the bake tests take them (the FBX corpus and the validator's suite
+/// have their own tests).
+pub const ANIMATED: &[&str] = &[
+    "blender/stretchy_full.glb",
+    "blender/stretchy_noinherit.glb",
+    "blender/stretchy_full.fbx",
+    "blender/stretchy_noinherit.fbx",
+    "blender/stretchy_full.bvh",
+    "gltf-khronos/Fox.glb",
+    "gltf-khronos/SimpleSkin.gltf",
+    "gltf-khronos/box_animated.gltf",
+    "gltf-khronos/cesium_man.gltf",
+    "gltf-khronos/interpolation_test.gltf",
+    "gltf-khronos/rigged_simple.gltf",
+    "fbx-proanimationbank/locomotions.fbx",
+    "fbx-proanimationbank/skeleton.fbx",
+    "fbx-proanimationbank/walk.fbx",
+    "fbx-proanimationbank/crossarms.fbx",
+    "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_6100_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_scale_no_inherit_step_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_static_no_inherit_scale_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx",
+    "fbx-ufbx-data/maya_advanced_skinned_pivot_7700_binary.fbx",
+    "fbx-ufbx-data/max7_skin_5000_binary.fbx",
+    "fbx-ufbx-data/max_transformed_skin_7500_binary.fbx",
+    "fbx-ufbx-data/blender_293_half_skinned_7400_binary.fbx",
+    "bvh/cmu_12_01_walk.bvh",
+    "bvh/bvh_test2.bvh",
+    "bvh/standard_skeleton.bvh",
+    "bvh/rotation_first_root.bvh",
+    "bvh/full_precision_frame_time.bvh",
+];
+
 /// The shared assets' folder beside the repository.
 pub fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")

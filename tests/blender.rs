@@ -1,0 +1,134 @@
+//! Blender's glTF importer as a judge of `bonescope bake`: every shared animation file (and the demo rig), baked for
+//! the engines whose keys must survive Blender's interpolation (`generic`, `blender`, `unity`: nlerp of the
+//! quaternion components), is imported by Blender 4.5's own importer (`tests/blender/play.py`) and played at each
+//! frame of the source and half way between frames. Every bone's origin and every skinned vertex must be within the
+//! bake's tolerance of bonescope's evaluation of the *source* (its first clip), plus 1e-6 of the rig's size for
+//! the single precision Blender plays in. Origins and skinned vertices do not depend on the importer's choice of
+//! bone orientation.
+//!
+//! Runs where `BONESCOPE_BLENDER_PYTHON` names a Python 3.11 with Blender's module (`pip install "bpy==4.5.*"`;
+//! `.ci/run` installs it pinned); elsewhere it says that it was skipped, and why.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use bonescope::bake::{self, Engine, Request};
+use bonescope::eval::Evaluation;
+use bonescope::import;
+use bonescope::model::{Choice, Rig};
+use common::{ANIMATED, asset, hausdorff};
+use glam::DVec3;
+use serde_json::Value;
+
+/// Bakes Blender plays beyond their tolerance today, by source file, with what is known. A known one that starts to
+/// play within its tolerance fails the test too, so the list only shrinks.
+const KNOWN: &[(&str, &str)] = &[
+    ("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", CLOSE_KEYS),
+    ("fbx-ufbx-data/maya_anim_no_inherit_scale_7700_ascii.fbx", CLOSE_KEYS),
+    ("fbx-proanimationbank/locomotions.fbx", CLOSE_KEYS),
+];
+
+/// Measured: bonescope's own reading of these bakes, played by nlerp, is within the tolerance at the same times
+/// (`diff --interp nlerp`); Blender is off only within the first frames, at whole frames too (2.6e-3 of the rig at
+/// frame 1 of Maya's file, 5.3e-4 at frame 1 of `locomotions.fbx`), and the bakes hold keys as close as 0.0038
+/// frames where refinement halved the compensating bones' intervals. Suspected, not yet shown: Blender's F-curves
+/// take keys closer than a hundredth of a frame for one.
+const CLOSE_KEYS: &str = "off near the first frames, where keys lie closer than a hundredth of Blender's frame";
+
+/// The Python with Blender's module, when there is one.
+fn blender_python() -> Option<PathBuf> {
+    let python = PathBuf::from(std::env::var_os("BONESCOPE_BLENDER_PYTHON")?);
+    let imports = Command::new(&python).args(["-c", "import bpy"]).output().ok()?;
+    imports.status.success().then_some(python)
+}
+
+/// Every frame of `source`'s clip and every half frame, in seconds.
+fn frames_and_halves(source: &Evaluation) -> Vec<f64> {
+    let rate = source.clip.map_or(30.0, |c| c.frame_rate());
+    let halves = (2.0 * source.duration() * rate).floor() as usize;
+    (0..=halves).map(|h| h as f64 / (2.0 * rate)).collect()
+}
+
+/// What Blender shows of `glb` at `times`: per time, the origins by name and every mesh vertex, in glTF's axes.
+fn played_by_blender(python: &Path, glb: &Path, times: &[f64], folder: &Path) -> Vec<(Value, Vec<DVec3>)> {
+    let (times_file, out) = (folder.join("times.json"), folder.join("played.json"));
+    std::fs::write(&times_file, serde_json::to_vec(times).unwrap()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/play.py");
+    let run = Command::new(python).arg(script).args([glb, &times_file, &out]).output().unwrap();
+    assert!(run.status.success(), "{}: {}", glb.display(), String::from_utf8_lossy(&run.stderr));
+    let played: Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let point = |v: &Value| DVec3::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap(), v[2].as_f64().unwrap());
+    let at_times = played["played"].as_array().unwrap().iter();
+    at_times.map(|p| (p["origins"].clone(), p["vertices"].as_array().unwrap().iter().map(point).collect())).collect()
+}
+
+/// The largest distance, over `times`, between `source`'s bone origins and vertices and Blender's (`played`).
+fn largest_distance(source: &Evaluation, times: &[f64], played: &[(Value, Vec<DVec3>)], name: &str) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (&time, (origins, vertices)) in times.iter().zip(played) {
+        let pose = source.pose_at(time);
+        let mut matched = 0;
+        for (bone, model) in source.skeleton().bones().iter().zip(&pose.model.model) {
+            // Blender cuts names to 63 bytes; a bone it renamed is judged by the vertices it moves.
+            let Some(origin) = origins.get(&bone.name).and_then(Value::as_array) else { continue };
+            let origin =
+                DVec3::new(origin[0].as_f64().unwrap(), origin[1].as_f64().unwrap(), origin[2].as_f64().unwrap());
+            worst = worst.max(origin.distance(model.w_axis.truncate()));
+            matched += 1;
+        }
+        assert!(matched > 0, "{name}: no bone of the source by name in Blender's scene");
+        // Blender merges vertices that glTF splits for their normals or texture coordinates: the two are compared
+        // as sets of points (the farther of each point's nearest on the other side).
+        let skinned = source.skin_all(&pose).into_iter().zip(&source.rig.meshes).filter(|(_, m)| m.skin.is_some());
+        let ours: Vec<DVec3> = skinned.flat_map(|(vertices, _)| vertices).collect();
+        assert_eq!(ours.is_empty(), vertices.is_empty(), "{name}: meshes on one side only");
+        if !ours.is_empty() {
+            worst = worst.max(hausdorff(&ours, vertices));
+        }
+    }
+    worst
+}
+
+#[test]
+fn blender_plays_every_bake_within_its_tolerance() {
+    let Some(python) = blender_python() else {
+        eprintln!(
+            "skipped: set BONESCOPE_BLENDER_PYTHON to a Python 3.11 with Blender's module (`pip install \"bpy==4.5.*\"` \
+             in a virtual environment; .ci/run does) to judge the bakes by Blender's glTF importer"
+        );
+        return;
+    };
+    let folder = tempfile::tempdir().unwrap();
+    let rigs: Vec<(&str, Rig)> = ANIMATED
+        .iter()
+        .map(|&f| (f, import::load(&asset(f)).unwrap()))
+        .chain([("demo", import::demo_rig())])
+        .filter(|(_, rig)| !rig.clips.is_empty())
+        .collect();
+    let mut failures = Vec::new();
+    for (file, rig) in &rigs {
+        let source = Evaluation::declared(rig, rig.clips.first());
+        let times = frames_and_halves(&source);
+        for engine in [Engine::Generic, Engine::Blender, Engine::Unity] {
+            let every = Request::every_clip(&source, rig.clips.first(), engine.strategy(), bake::DEFAULT_TOLERANCE);
+            let baked = bake::bake(&Request { engine, ..every });
+            let glb = folder.path().join("baked.glb");
+            bake::save(&glb, &baked.glb).unwrap();
+            let name = format!("{file} for {}", engine.id());
+            let played = played_by_blender(&python, &glb, &times, folder.path());
+            let worst = largest_distance(&source, &times, &played, &name);
+            let allowed = baked.tolerance + 1e-6 * baked.rig_size;
+            println!("{name}: {:.2e} of the rig size ({} times)", worst / baked.rig_size, times.len());
+            let known = KNOWN.iter().find(|(f, _)| f == file);
+            match (worst > allowed, known) {
+                (true, None) => failures.push(format!("{name}: {:.2e} of the rig size", worst / baked.rig_size)),
+                (false, Some(_)) => failures.push(format!("{name}: within the tolerance now, no longer known")),
+                (true, Some((_, why))) => println!("known: {name} ({why})"),
+                (false, None) => {}
+            }
+        }
+    }
+    assert!(failures.is_empty(), "Blender plays these bakes beyond their tolerance:\n{}", failures.join("\n"));
+}
