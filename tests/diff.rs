@@ -137,9 +137,10 @@ fn bake_reports_json_and_diff_pairs_its_helpers_away() {
     let out = path(&folder.path().join("demo.glb"));
     let report = json(&bonescope(&["bake", "--inherit", "segment-compensate", "--out", &out, "--format", "json"]));
     let keys: Vec<&str> = report.as_object().unwrap().keys().map(String::as_str).collect();
-    assert_eq!(keys, ["animations", "helpers", "notes", "rig_size", "strategy", "tolerance"]);
+    assert_eq!(keys, ["animations", "engine", "helpers", "notes", "rig_size", "rotations", "strategy", "tolerance"]);
     assert_eq!(names(&report["helpers"]), ["forearm"]);
-    assert_eq!(report["strategy"], "exact");
+    assert_eq!((&report["engine"], &report["strategy"]), (&Value::from("generic"), &Value::from("exact")));
+    assert_eq!(names(&report["rotations"]), ["slerp", "nlerp"], "the default bake is for every runtime");
     let animation = &report["animations"][0];
     let forearm = animation["bones"].as_array().unwrap().iter().find(|b| b["name"] == "forearm").unwrap();
     assert_eq!(forearm["nodes"], "helper");
