@@ -396,6 +396,22 @@ fn assert_fails(result: Result<Rig, ImportError>, place: &str, needle: &str) {
 }
 
 #[test]
+fn channels_sharing_a_sampler_share_its_decoded_values() {
+    // The translation sampler drives the root's translation and its scale too: one decode, two tracks.
+    let mut sample = sample();
+    let channels = sample.json["animations"][0]["channels"].as_array_mut().unwrap();
+    channels.push(json!({ "sampler": 0, "target": { "node": 0, "path": "translation" } }));
+    channels.push(json!({ "sampler": 0, "target": { "node": 0, "path": "scale" } }));
+    let rig = load_glb(&sample).unwrap();
+    let clip = rig.find_clip("move").unwrap();
+    let (root, child) = (clip.tracks_of(0).unwrap(), clip.tracks_of(1).unwrap());
+    let values = |track: &Option<bonescope::model::Track<Vec3>>| track.as_ref().unwrap().values().as_ptr();
+    assert!(std::ptr::eq(values(&child.translation), values(&root.translation)));
+    assert!(std::ptr::eq(values(&root.translation), values(&root.scale)));
+    assert_eq!(root.scale.as_ref().unwrap().values(), TRANSLATIONS.map(Vec3::from_array));
+}
+
+#[test]
 fn the_sample_loads_as_gltf_and_as_glb() {
     let sample = sample();
     for rig in [load_gltf(&sample).unwrap(), load_glb(&sample).unwrap()] {

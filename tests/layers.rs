@@ -286,7 +286,7 @@ proptest! {
 fn vector_track() -> impl Strategy<Value = Track<Vec3>> {
     prop::collection::vec((0.01..1.0f64, -100.0..100.0f32), 1..8).prop_map(|keys| {
         let times: Vec<f64> = keys.iter().scan(0.0, |t, (step, _)| Some(std::mem::replace(t, *t + step))).collect();
-        let values = keys.iter().map(|&(_, x)| Vec3::new(x, -x, 0.5 * x)).collect();
+        let values: Vec<_> = keys.iter().map(|&(_, x)| Vec3::new(x, -x, 0.5 * x)).collect();
         Track::new(Arc::from(times), values, Interpolation::Linear).unwrap()
     })
 }

@@ -34,7 +34,8 @@ impl Interpolation {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track<T> {
     times: Arc<[f64]>,
-    values: Vec<T>,
+    /// Shared, like the times, by the tracks of channels that read one sampler's output.
+    values: Arc<[T]>,
     interpolation: Interpolation,
 }
 
@@ -95,7 +96,12 @@ impl<T: KeyValue> Track<T> {
     /// splines, at least two keys); every value finite. Keys closer than [`KEY_TIME_RESOLUTION`] (equal times
     /// included, as exporters and zero-filled accessors write them) count once: the last of them holds from that
     /// time on, as a jump does.
-    pub fn new(times: Arc<[f64]>, values: Vec<T>, interpolation: Interpolation) -> Result<Self, TrackError> {
+    pub fn new(
+        times: Arc<[f64]>,
+        values: impl Into<Arc<[T]>>,
+        interpolation: Interpolation,
+    ) -> Result<Self, TrackError> {
+        let values = values.into();
         if times.is_empty() {
             return Err(TrackError::Empty);
         }
@@ -192,7 +198,7 @@ pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
 
 /// Sorted `times` and their keys (`per_key` values each) with each run of keys closer than
 /// [`KEY_TIME_RESOLUTION`] to the previous one reduced to its last key; the inputs themselves when there is none.
-fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Vec<T>, per_key: usize) -> (Arc<[f64]>, Vec<T>) {
+fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Arc<[T]>, per_key: usize) -> (Arc<[f64]>, Arc<[T]>) {
     let close = |w: &[f64]| w[1] - w[0] < KEY_TIME_RESOLUTION;
     if !times.windows(2).fold(false, |any, w| any | close(w)) {
         return (times, values);
