@@ -27,7 +27,7 @@ fn inspect_json_has_exactly_the_documented_shape() {
     assert_eq!(keys(&out), ["animation", "bind_mismatches", "file", "inherit", "layers", "notes", "samples"]);
     assert_eq!(out["layers"]["bind_weight"], 1.0, "no layers: {}", out["layers"]);
     assert_eq!(out["layers"]["blend"], Value::Null);
-    assert_eq!(keys(&out["animation"]), ["duration", "index", "name"]);
+    assert_eq!(keys(&out["animation"]), ["duration", "frame_rate", "index", "name"]);
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");
     assert_eq!(out["inherit"], "declared");
@@ -613,4 +613,18 @@ fn without_the_gui_the_app_and_render_say_they_need_it() {
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert!(stderr.contains("needs the `gui` feature") && stderr.lines().count() == 1, "{stderr}");
     }
+}
+
+#[test]
+fn gltf_frame_rates_are_read_from_sparse_key_times() {
+    // Blender's cubic-spline exports key every 10th to 30th frame of its 30 fps scene from frame 1, (1 + 10k)/30 s
+    // and so on: 0.33 to 1 s apart, yet at 30 fps (the most common spacing read 2 and 3 fps).
+    for anim in ["squash_stretch", "wave"] {
+        let out = json(&bonescope(&["inspect", &stretchy(), "--anim", anim, "--format", "json"]));
+        assert_eq!(out["animation"]["frame_rate"], 30.0, "{anim}");
+    }
+    let scan = json(&bonescope(&["scan", &stretchy(), "--format", "json"]));
+    let rates: Vec<&Value> =
+        scan[0]["animations"].as_array().unwrap().iter().map(|a| &a["animation"]["frame_rate"]).collect();
+    assert_eq!(rates, [30.0, 30.0]);
 }

@@ -42,11 +42,18 @@ pub struct AnimationInfo {
     pub index: usize,
     pub name: Option<String>,
     pub duration: f64,
+    /// Frames per second: the file's, or for glTF the rate its key times show ([`Clip::frame_rate`]).
+    pub frame_rate: f64,
 }
 
 impl AnimationInfo {
     pub fn of(clip: &Clip) -> Self {
-        AnimationInfo { index: clip.index, name: clip.name.clone(), duration: clip.duration() }
+        AnimationInfo {
+            index: clip.index,
+            name: clip.name.clone(),
+            duration: clip.duration(),
+            frame_rate: clip.frame_rate(),
+        }
     }
 
     /// `animation 0 `walk` (1.333 s)`, or the rest pose when there is no animation.
