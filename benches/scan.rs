@@ -115,18 +115,19 @@ fn generated_clip(rng: &mut XorShiftRng, skeleton: &Skeleton, scaled: &[usize]) 
             let (axis, amplitude) = (random_axis(rng), rng.random_range(0.2..0.8));
             let (frequency, phase) = (rng.random_range(0.2..1.5), rng.random_range(0.0..TAU));
             let wave = |t: f64| (TAU * frequency * t + phase).sin();
-            let rotation = times
+            let rotation: Vec<_> = times
                 .iter()
                 .map(|&t| (bone.rest.rotation * DQuat::from_axis_angle(axis, amplitude * wave(t))).as_quat())
                 .collect();
             let offset =
                 DVec3::new(rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05));
-            let translation = times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
+            let translation: Vec<_> =
+                times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
             let mut tracks = BoneTracks::new(index);
             tracks.rotation = Some(Track::new(times.clone(), rotation, Interpolation::Linear).unwrap());
             tracks.translation = Some(Track::new(times.clone(), translation, Interpolation::Linear).unwrap());
             if scaled.contains(&index) {
-                let scale = times
+                let scale: Vec<_> = times
                     .iter()
                     .map(|&t| Vec3::new(1.0 + 0.4 * wave(t) as f32, 1.0 - 0.25 * wave(t) as f32, 1.0))
                     .collect();

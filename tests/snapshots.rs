@@ -124,6 +124,15 @@ fn fbx_blend_shapes_with_inbetweens() {
     window(Settings::default(), doc, 2.5, Some("pCube1")).snapshot("fbx_blend_shapes_with_inbetweens");
 }
 
+/// Blender's FBX stores its current frame, the forearm turned 20° from where the mesh was bound: the Layers panel's
+/// bind check notes the stored pose, with no warning.
+#[test]
+fn fbx_stored_pose_noted_in_the_layers_panel() {
+    let settings = Settings { show_layers: true, ..Settings::default() };
+    let doc = asset_document("blender/stretchy_full.fbx");
+    window(settings, doc, 0.0, None).snapshot("fbx_stored_pose_noted_in_the_layers_panel");
+}
+
 /// A shared asset (`../shared/assets/FOLDER/NAME`) as a document.
 fn asset_document(path: &str) -> Document {
     let path = asset(path);

@@ -163,7 +163,7 @@ impl Reader<'_, '_> {
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
             .collect();
-        Ok(Clip::new(index, animation.name.clone(), tracks, morph).with_key_spacing_rate())
+        Ok(Clip::new(index, animation.name.clone(), tracks, morph).with_key_rate())
     }
 
     /// What `target` animates, checked to exist.
