@@ -15,7 +15,7 @@ pub use clip::{
 pub use inherit::{InheritMode, ModeChoice, UnknownInheritMode, UnknownModeChoice};
 #[cfg(test)]
 pub(crate) use skeleton::named as named_skeleton;
-pub use skeleton::{Bone, ParentOrderError, Skeleton};
+pub use skeleton::{Bone, NodeRole, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
@@ -38,23 +38,5 @@ impl Rig {
             .iter()
             .find(|c| c.name.as_deref() == Some(name))
             .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
-    }
-
-    /// For each bone, whether it belongs to the character: the bones `clip` animates and the skins' joints, so that a
-    /// file's cameras, lights and helpers far from it (FBX exports often carry six "Producer" cameras 150 m out)
-    /// stay out of its size and framing; every bone when that leaves none.
-    pub fn character_bones(&self, clip: Option<&Clip>) -> Vec<bool> {
-        let mut character = vec![false; self.skeleton.len()];
-        let animated = clip.into_iter().flat_map(|c| c.tracks().iter().map(|t| t.bone));
-        let joints = self.skins.iter().flat_map(|s| s.joints.iter().copied());
-        for bone in animated.chain(joints) {
-            if let Some(c) = character.get_mut(bone) {
-                *c = true;
-            }
-        }
-        if !character.contains(&true) {
-            character.fill(true);
-        }
-        character
     }
 }
