@@ -20,7 +20,7 @@ use std::time::Duration;
 use bonescope::analysis::{Assessment, ScanOptions, Tolerances, scan};
 use bonescope::eval::{Evaluation, Hierarchy, Pose, sample_clip};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, NodeRole, Rig, Skeleton, Track, Transform};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
@@ -53,7 +53,14 @@ fn generated_skeleton(rng: &mut XorShiftRng) -> Skeleton {
             DQuat::from_axis_angle(random_axis(rng), rng.random_range(0.0..0.5)),
             DVec3::ONE,
         );
-        bones.push(Bone { name: format!("bone{index}"), node: index, parent, rest, inherit: InheritMode::Full });
+        bones.push(Bone {
+            name: format!("bone{index}"),
+            node: index,
+            parent,
+            rest,
+            inherit: InheritMode::Full,
+            role: NodeRole::Joint,
+        });
         index
     };
     let mut parent = None;

@@ -671,8 +671,10 @@ fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeAp
     let doc = Document::load(&asset(path)).unwrap();
     let index = doc.rig.skeleton.find(bone).unwrap();
     let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    // Scrolling the outliner to a bone deep in a long list settles over a few more frames than the default allows.
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
+        .with_max_steps(12)
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
     harness.state_mut().time = time;
     harness.state_mut().selection = vec![index];

@@ -159,6 +159,16 @@ fn cmu_walk_gizmos() {
     window(settings, asset_document("bvh/cmu_12_01_walk.bvh"), 1.0, None).snapshot("cmu_walk_gizmos");
 }
 
+/// 3ds Max's walk: the biped in the tree, its six "Producer" cameras, three cameras with their targets, a sky light
+/// and the footsteps in their own group, opened (it starts collapsed).
+#[test]
+fn walk_outliner_with_cameras_and_helpers() {
+    let mut harness = window(Settings::default(), asset_document("fbx-proanimationbank/walk.fbx"), 0.0, None);
+    harness.get_by_label_contains("Cameras, lights and helpers").click();
+    settle_for_snapshot(&mut harness);
+    harness.snapshot("walk_outliner_with_cameras_and_helpers");
+}
+
 /// A small laptop window, 1000×700, with the Layers panel and the Inspector open: the Inspector and the Layers
 /// share a column, the toolbar wraps rather than cut its controls.
 #[test]

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3, Quat, Vec3};
 
 use crate::model::{
-    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, Rig, Skeleton, Skin, Track, Transform, Unit,
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, NodeRole, Rig, Skeleton, Skin, Track, Transform, Unit,
 };
 
 /// Bone indices of the demo rig.
@@ -48,6 +48,7 @@ fn skeleton() -> Skeleton {
         parent,
         rest: Transform::from_trs(translation, DQuat::IDENTITY, DVec3::ONE),
         inherit: InheritMode::Full,
+        role: NodeRole::Joint,
     };
     Skeleton::new(vec![
         bone("shoulder", None, DVec3::new(0.0, 1.5, 0.0)),
@@ -188,6 +189,7 @@ pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
             parent,
             rest: Transform::from_trs(offset, DQuat::IDENTITY, DVec3::ONE),
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         });
         let phase = b as f64 * 0.37;
         let mut t = BoneTracks::new(b);
