@@ -23,22 +23,8 @@ fn rig_of((skeleton, clip): (Skeleton, Clip)) -> Rig {
 fn growing_parent() -> (Skeleton, Clip) {
     let child_rest = Transform::from_trs(DVec3::X, DQuat::from_rotation_z(45f64.to_radians()), DVec3::ONE);
     let bones = vec![
-        Bone {
-            name: "parent".into(),
-            node: 0,
-            parent: None,
-            rest: Transform::IDENTITY,
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        },
-        Bone {
-            name: "child".into(),
-            node: 1,
-            parent: Some(0),
-            rest: child_rest,
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        },
+        Bone::joint("parent", None, Transform::IDENTITY),
+        Bone { node: 1, ..Bone::joint("child", Some(0), child_rest) },
     ];
     let mut tracks = BoneTracks::new(0);
     let times: Arc<[f64]> = Arc::from([0.0, 1.0].as_slice());
@@ -192,14 +178,7 @@ fn assert_scan_matches_brute_force(label: &str, rig: &Rig, clip: usize, modes: &
 /// Bones whose stretch never changes (judged once per chunk) beside ones that do: a constantly sheared bone under a
 /// rest scale of (1, 2, 1), a turning bone below it, and a bone with a constant non-uniform scale track.
 fn fixed_and_moving() -> (Skeleton, Clip) {
-    let bone = |name: &str, parent: Option<usize>, rest: Transform| Bone {
-        name: name.into(),
-        node: 0,
-        parent,
-        rest,
-        inherit: InheritMode::Full,
-        role: NodeRole::Joint,
-    };
+    let bone = |name: &str, parent: Option<usize>, rest: Transform| Bone::joint(name, parent, rest);
     let turned = DQuat::from_rotation_z(0.5);
     let bones = vec![
         bone("root", None, Transform::IDENTITY),

@@ -8,7 +8,7 @@ use bonescope::eval::Evaluation;
 use bonescope::import::demo_rig;
 use bonescope::math::decompose;
 use bonescope::model::{
-    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, NodeRole, Rig, Skeleton, Skin, Track, Transform,
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, Rig, Skeleton, Skin, Track, Transform,
 };
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec3};
 
@@ -21,21 +21,11 @@ fn compensating_child() -> Rig {
     let rest =
         |translation: DVec3, turn: f64| Transform::from_trs(translation, DQuat::from_rotation_z(turn), DVec3::ONE);
     let bones = vec![
+        Bone::joint("parent", None, Transform::IDENTITY),
         Bone {
-            name: "parent".into(),
-            node: 0,
-            parent: None,
-            rest: Transform::IDENTITY,
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        },
-        Bone {
-            name: "child".into(),
             node: 1,
-            parent: Some(0),
-            rest: rest(DVec3::X, std::f64::consts::FRAC_PI_4),
             inherit: InheritMode::SegmentCompensate,
-            role: NodeRole::Joint,
+            ..Bone::joint("child", Some(0), rest(DVec3::X, std::f64::consts::FRAC_PI_4))
         },
     ];
     let skeleton = Skeleton::new(bones).unwrap();

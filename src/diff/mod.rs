@@ -385,7 +385,7 @@ const NEARLY_SAME_FRAME: f64 = 1e-6;
 mod tests {
     use super::*;
     use crate::import::demo_rig;
-    use crate::model::{Bone, InheritMode, NodeRole, Rig, Skeleton, Transform};
+    use crate::model::{Bone, InheritMode, Rig, Skeleton, Transform};
 
     #[test]
     fn a_file_against_itself_differs_by_nothing() {
@@ -430,14 +430,7 @@ mod tests {
         let rz = |deg: f64| Transform::from_trs(DVec3::X, DQuat::from_rotation_z(deg.to_radians()), DVec3::ONE);
         let root = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
         let mid = Transform { scale: DVec3::new(1.0, 2.0, 1.0), ..rz(45.0) };
-        let bone = |name: &str, parent, rest| Bone {
-            name: name.into(),
-            node: 0,
-            parent,
-            rest,
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        };
+        let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
         let bones = vec![bone("root", None, root), bone("mid", Some(0), mid), bone("tip", Some(1), rz(30.0))];
         let rig = Rig { skeleton: Skeleton::new(bones).unwrap(), ..Rig::default() };
         let unscaled = Evaluation::new(&rig, None, &[InheritMode::UnscaledParent; 3]);

@@ -83,14 +83,7 @@ mod tests {
 
     #[test]
     fn conversion_nodes_are_static_tops_that_only_convert_and_carry_something() {
-        let bone = |name: &str, parent, rest| Bone {
-            name: name.into(),
-            node: 0,
-            parent,
-            rest,
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        };
+        let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
         let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
         let up = Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE);
         let bones = vec![

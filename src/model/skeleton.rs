@@ -18,6 +18,14 @@ pub struct Bone {
     pub role: NodeRole,
 }
 
+impl Bone {
+    /// A joint under `parent` that inherits fully, of node 0: what hand-built rigs start from (other fields by struct
+    /// update).
+    pub fn joint(name: impl Into<String>, parent: Option<usize>, rest: Transform) -> Bone {
+        Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full, role: NodeRole::Joint }
+    }
+}
+
 /// What a node of the source scene is. Files carry more than the character: DCC exports keep their cameras (3ds Max
 /// writes six "Producer" cameras 150 m out), lights, camera targets, IK effectors and meshes as nodes beside the
 /// joints. Those are listed apart, neither drawn as bones nor framed by default (see [`NodeRole::is_figure`]).
