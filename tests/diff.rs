@@ -3,9 +3,15 @@
 
 mod common;
 
-use common::{asset, bonescope, json};
-use serde_json::Value;
 use std::path::Path;
+use std::sync::Arc;
+
+use bonescope::diff::{FileSide, diff_files};
+use bonescope::eval::layers::RotationInterpolation;
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use common::{asset, bonescope, json};
+use glam::Quat;
+use serde_json::Value;
 
 fn path(p: &Path) -> String {
     p.display().to_string()
@@ -35,8 +41,20 @@ fn a_file_against_itself_differs_by_nothing() {
     assert_eq!(out.status.code(), Some(0));
     let report = json(&out);
     let keys: Vec<&str> = report.as_object().unwrap().keys().map(String::as_str).collect();
-    let all =
-        ["a", "animations", "b", "clips_only_a", "clips_only_b", "inherit_a", "inherit_b", "rate", "unit_a", "unit_b"];
+    let all = [
+        "a",
+        "animations",
+        "b",
+        "clips_only_a",
+        "clips_only_b",
+        "inherit_a",
+        "inherit_b",
+        "interp_a",
+        "interp_b",
+        "rate",
+        "unit_a",
+        "unit_b",
+    ];
     assert_eq!(keys, all);
     let animations = report["animations"].as_array().unwrap();
     assert_eq!(animations.len(), 2, "both clips, paired by name");
@@ -268,4 +286,36 @@ fn a_bvh_is_compared_in_the_unit_it_is_given() {
     let refused = bonescope(&["diff", &run, &walk, "--unit-a", "cm"]);
     assert_eq!(refused.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--unit-a: the file states its unit (metres)"));
+}
+
+#[test]
+fn nlerp_playback_departs_from_slerp_as_its_formula_says() {
+    // One bone turned from rest to 90° about Z over a second, two linear keys: compared with itself played by
+    // nlerp, it is as far off as nlerp is from slerp. On the quaternion arc of φ = 45° between the keys nlerp is at
+    // atan(t·sin φ / (1 − t + t·cos φ)) where slerp is at t·φ; the rotations part by twice that difference, largest
+    // (0.91882°) at t = ½ ± √3/6: on the 60 Hz grid at 13/60 s and 47/60 s alike, 0.918805°.
+    let bone = Bone { name: "b".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full };
+    let mut tracks = BoneTracks::new(0);
+    let keys = vec![Quat::IDENTITY, Quat::from_rotation_z(std::f32::consts::FRAC_PI_2)];
+    tracks.rotation = Some(Track::new(Arc::from([0.0, 1.0].as_slice()), keys, Interpolation::Linear).unwrap());
+    let clip = Clip::new(0, Some("turn".into()), vec![tracks], vec![]);
+    let rig = Rig { skeleton: Skeleton::new(vec![bone]).unwrap(), clips: vec![clip], ..Rig::default() };
+    let side = |interp| FileSide {
+        file: "turn".into(),
+        rig: &rig,
+        modes: vec![InheritMode::Full],
+        inherit: "declared".into(),
+        anim: None,
+        interp,
+    };
+    let orientation = |interp| {
+        let diff = diff_files(&side(RotationInterpolation::Slerp), &side(interp), &[], 60.0).unwrap();
+        assert_eq!(diff.interp_b, interp);
+        diff.animations[0].bones[0].orientation_deg
+    };
+    assert_eq!(orientation(RotationInterpolation::Slerp).max, 0.0, "as authored");
+    let nlerp = orientation(RotationInterpolation::Nlerp);
+    assert!((nlerp.max - 0.918805).abs() < 1e-4, "{nlerp:?}");
+    let at = |seconds: f64| (nlerp.time - seconds).abs() < 1e-9;
+    assert!(at(13.0 / 60.0) || at(47.0 / 60.0), "nlerp leads, then lags by as much: {nlerp:?}");
 }

@@ -343,3 +343,30 @@ fn every_fbx_loads_and_matches_the_authoring_tools_geometry() {
     assert!(regressions.is_empty(), "{} comparisons differ:\n{}", regressions.len(), regressions.join("\n"));
     assert!(fixed.is_empty(), "known differences that now match (remove them from the list):\n{}", fixed.join("\n"));
 }
+
+#[test]
+fn synthetic_bind_to_root_shows_the_stored_pose_not_frame_0() {
+    // ufbx's synthetic file connects its skin deformer and clusters to the root node as well as to the mesh (ufbx
+    // ignores those connections, with a warning: its own test checks only that). Each cluster's `Transform` is
+    // the mesh node relative to the cluster's bone (ufbx's `mesh_node_to_bone`), and the skin is dual quaternion.
+    // Its OBJ shows the pose the file stores, `joint2` turned 49.5459° (Maya's current frame when it saved, between
+    // frames 4 and 5 of the take, which turns the joint from 64.20274° at frame 1 to -108.0638° at frame 40):
+    // bonescope's stored pose matches it to rounding. Frame 0 of the take (the curve held at its first key) is
+    // another pose: the same skin, worked by hand with `joint2` at 64.20274°, is 0.08465 of the model away.
+    let fbx = corpus().join("synthetic_bind_to_root_7700_ascii.fbx");
+    let rig = import::load_with(&fbx, &Options { space: Space::File }).unwrap();
+    let reference = common::obj_positions(&corpus().join("synthetic_bind_to_root.obj"));
+    let joint2 = rig.skeleton.bones().iter().position(|b| b.name == "joint2").unwrap();
+    let error_at = |clip: Option<usize>| {
+        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+        let mut pose = Pose::default();
+        pose.evaluate(&rig.skeleton, clip.map(|c| &rig.clips[c]), &hierarchy, 0.0);
+        let turned = pose.local[joint2].rotation.to_axis_angle().1.to_degrees();
+        let vertices = skin_meshes(&rig, &pose.model.model, &pose.morph).concat();
+        (turned, hausdorff(&vertices, &reference) / size(&reference))
+    };
+    let (turned, stored) = error_at(None);
+    assert!((turned - 49.5459027633167).abs() < 1e-9 && stored < 1e-6, "stored pose: {turned}°, {stored:e}");
+    let (turned, frame_0) = error_at(Some(0));
+    assert!((turned - 64.20274).abs() < 1e-4 && (frame_0 - 0.08465).abs() < 1e-4, "frame 0: {turned}°, {frame_0}");
+}

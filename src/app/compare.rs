@@ -12,9 +12,10 @@ use super::job::{Job, Progress};
 use super::{Document, Ghost};
 use crate::analysis::{Assessment, Components, Tolerances};
 use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
+use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Layers, SkinningMethod};
 use crate::import::{self, ImportError};
-use crate::model::{Clip, InheritMode, Rig, Unit};
+use crate::model::{Choice, Clip, InheritMode, Rig, Unit};
 use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
@@ -36,6 +37,9 @@ pub struct Compared {
     pub meshes: Vec<Option<usize>>,
     /// Per clip of the document: the clip here that stands for it, as `bonescope diff` pairs them (else the first).
     clips: Vec<Option<usize>>,
+    /// How its linear rotation keys are played: as the file says (slerp), or as a component-wise runtime (Blender,
+    /// Unity, Unreal) plays them (`bonescope diff --interp`).
+    pub played: RotationInterpolation,
 }
 
 impl Compared {
@@ -65,24 +69,27 @@ impl Compared {
             clips[a] = Some(b);
         }
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
-        Compared { path, rig, states_unit, document_unit, bones, conversion, meshes, clips }
+        let played = RotationInterpolation::default();
+        Compared { path, rig, states_unit, document_unit, bones, conversion, meshes, clips, played }
     }
 
-    /// The same file paired with another document rig (the document was reloaded), keeping the units given.
+    /// The same file paired with another document rig (the document was reloaded), keeping the units given and
+    /// how it is played.
     pub fn repaired(&self, document: &Rig) -> Self {
         let repaired = Compared::pair(self.path.clone(), self.rig.clone(), document);
         let document_unit = document.unit.or(self.document_unit);
-        Compared { states_unit: self.states_unit, document_unit, ..repaired }
+        Compared { states_unit: self.states_unit, document_unit, played: self.played, ..repaired }
     }
 
-    /// The file read again after it changed on disk, paired with `document`, keeping the units the user gave.
+    /// The file read again after it changed on disk, paired with `document`, keeping the units the user gave and
+    /// how it is played.
     pub fn reloaded(&self, document: &Rig) -> Result<Self, ImportError> {
         let mut rig = import::load(&self.path)?;
         if rig.unit.is_none() && !self.states_unit {
             rig.unit = self.rig.unit;
         }
         let fresh = Compared::pair(self.path.clone(), rig, document);
-        Ok(Compared { document_unit: self.document_unit, ..fresh })
+        Ok(Compared { document_unit: self.document_unit, played: self.played, ..fresh })
     }
 
     /// The document's unit and the compared file's, as the comparison takes them.
@@ -113,9 +120,9 @@ impl Compared {
     }
 
     /// This file evaluated as it declares, for the document's clip `clip` (an index), measured in the document's
-    /// unit.
+    /// unit, its rotation keys played as chosen.
     pub fn evaluation(&self, clip: Option<usize>) -> Evaluation<'_> {
-        Evaluation::declared(&self.rig, self.clip_for(clip)).measured_in(self.document_unit)
+        Evaluation::declared(&self.rig, self.clip_for(clip)).measured_in(self.document_unit).played_with(self.played)
     }
 
     /// The ghost at `time`: this file's pose on the document's bones (a bone without a partner stays where the
@@ -171,6 +178,21 @@ pub fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     }
 }
 
+/// File → "Play compared rotations by" while comparing: how the compared file's rotation keys are played, to see
+/// a bake as Blender, Unity or Unreal (nlerp) will show it.
+pub fn rotation_menu(ui: &mut egui::Ui, doc: &mut Document) {
+    let Some(compared) = doc.compared.clone() else { return };
+    ui.menu_button("Play compared rotations by", |ui| {
+        for &played in RotationInterpolation::ALL {
+            let chosen =
+                ui.selectable_label(played == compared.played, played.id()).on_hover_text(played.description());
+            if chosen.clicked() && played != compared.played {
+                replace(doc, Compared { played, ..(*compared).clone() });
+            }
+        }
+    });
+}
+
 /// A picker of the unit `file` is in (`unit`, `None` while not given); the unit picked, if another.
 fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -> Option<Unit> {
     let label = ui.label(format!("unit of {file}"));
@@ -208,6 +230,8 @@ pub struct CompareKey {
     pub rate: f64,
     /// The units the two files are taken in ([`Compared::units`]).
     pub units: [Option<Unit>; 2],
+    /// How the compared file's rotation keys are played.
+    pub played: RotationInterpolation,
 }
 
 /// Each document bone's largest difference from the compared file over the clip.
@@ -275,6 +299,30 @@ pub fn curves(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::angle_between;
+    use crate::model::{Bone, BoneTracks, Interpolation, Skeleton, Track, Transform};
+
+    #[test]
+    fn a_compared_file_played_by_nlerp_is_where_nlerp_puts_it() {
+        // One bone turned a quarter turn about Z over a second by two linear keys, compared with itself played by
+        // nlerp: 13/60 s in, nlerp is at 2·atan(t·sin φ / (1 − t + t·cos φ)) with φ = 45°, slerp at t·90°,
+        // 0.918805° apart.
+        let bone =
+            Bone { name: "b".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full };
+        let mut tracks = BoneTracks::new(0);
+        let keys = vec![glam::Quat::IDENTITY, glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2)];
+        tracks.rotation = Some(Track::new(Arc::from([0.0, 1.0].as_slice()), keys, Interpolation::Linear).unwrap());
+        let clip = Clip::new(0, Some("turn".into()), vec![tracks], vec![]);
+        let rig = Rig { skeleton: Skeleton::new(vec![bone]).unwrap(), clips: vec![clip], ..Rig::default() };
+        let played =
+            Compared { played: RotationInterpolation::Nlerp, ..Compared::pair("turn".into(), rig.clone(), &rig) };
+        let time = 13.0 / 60.0;
+        let rotation = |e: Evaluation| e.pose_at(time).local[0].rotation;
+        let own = rotation(Evaluation::declared(&rig, rig.clips.first()));
+        let apart = angle_between(own, rotation(played.evaluation(Some(0)))).to_degrees();
+        assert!((apart - 0.918805).abs() < 1e-4, "{apart}°");
+        assert_eq!(rotation(played.repaired(&rig).evaluation(Some(0))), rotation(played.evaluation(Some(0))));
+    }
 
     #[test]
     fn a_file_compared_with_itself_pairs_everything_and_ghosts_its_pose() {

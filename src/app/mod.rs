@@ -380,7 +380,8 @@ impl BonescopeApp {
 
     /// What the comparison with the compared file depends on, when there is one.
     fn compare_key(&self) -> Option<CompareKey> {
-        let units = self.doc.compared.as_ref()?.units();
+        let compared = self.doc.compared.as_ref()?;
+        let (units, played) = (compared.units(), compared.played);
         let key = self.job_key();
         Some(CompareKey {
             generations: (self.generation, self.compared_generation),
@@ -389,6 +390,7 @@ impl BonescopeApp {
             layers: key.layers,
             rate: key.rate,
             units,
+            played,
         })
     }
 

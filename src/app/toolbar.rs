@@ -74,6 +74,7 @@ fn file_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     {
         actions.stop_comparing = true;
     }
+    super::compare::rotation_menu(ui, shared.doc);
     ui.separator();
     if ui.button("Quit").clicked() {
         ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);

@@ -22,6 +22,7 @@
 
 mod channels;
 mod document;
+mod engine;
 mod glb;
 mod keys;
 mod layout;
@@ -31,6 +32,7 @@ pub mod report;
 mod skins;
 mod times;
 
+pub use engine::Engine;
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
 
@@ -42,6 +44,7 @@ use rayon::prelude::*;
 use refine::refine;
 
 use crate::eval::Evaluation;
+use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Clip, Rig};
 
 /// How bones become glTF nodes.
@@ -78,6 +81,11 @@ impl Choice for Strategy {
 /// The default tolerance: keys reproduce the source within this fraction of the rig's size.
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
 
+/// How the runtimes that play glTF interpolate rotation keys: slerp, as glTF specifies, and nlerp, where a player
+/// makes one curve of each quaternion component and normalises their values (Blender's importer, Unity, Unreal's
+/// compressed tracks). Keys that survive both play within the tolerance everywhere.
+pub const EVERY_RUNTIME: &[RotationInterpolation] = &[RotationInterpolation::Slerp, RotationInterpolation::Nlerp];
+
 /// One animation to bake: its name in the baked file, and the evaluation it reproduces (a clip, or the rest pose,
 /// possibly through layers: a blend, an additive layer or a shake baked into a new clip).
 #[derive(Clone, Debug)]
@@ -96,11 +104,14 @@ pub struct Request<'a> {
     pub strategy: Strategy,
     /// Between keys, the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     pub tolerance: f64,
+    /// The runtime it is for: under the rotation interpolations it plays keys with ([`Engine::rotations`]), the
+    /// result stays within the tolerance.
+    pub engine: Engine,
 }
 
 impl<'a> Request<'a> {
     /// Every clip of `source`'s rig (or the one `only` names) evaluated as `source` is, or its rest pose for a rig
-    /// without clips (which the baked nodes then hold, with no animation in the file).
+    /// without clips (which the baked nodes then hold, with no animation in the file), for every runtime.
     pub fn every_clip(source: &Evaluation<'a>, only: Option<&'a Clip>, strategy: Strategy, tolerance: f64) -> Self {
         let rest = source.at_rest();
         let clips: Vec<&Clip> = match only {
@@ -113,7 +124,7 @@ impl<'a> Request<'a> {
             let of = |clip: &'a Clip| rest.clone().with_clip(Some(clip));
             clips.into_iter().map(|clip| ClipToBake { name: clip.label(), source: of(clip) }).collect()
         };
-        Request { rest, clips, strategy, tolerance }
+        Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
 
     pub fn rig(&self) -> &'a Rig {
@@ -154,7 +165,7 @@ pub fn bake(request: &Request) -> Baked {
     let size = sources.iter().zip(&base).map(|(source, base)| source.size(&base.times)).fold(0.0, f64::max);
     let size = if size > 0.0 { size } else { request.rest.size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
-    let metrics = Metrics::new(&request.rest, size, tolerance);
+    let metrics = Metrics::new(&request.rest, size, tolerance, request.engine.rotations());
     let sampled: Vec<Sampled> =
         sources.iter().zip(&base).map(|(source, base)| sample_densely(source, strategy, base, &metrics)).collect();
     let rest = nodes::sample(&request.rest, &[0.0], strategy);
@@ -191,8 +202,9 @@ fn sample_densely(source: &Evaluation, strategy: Strategy, base: &BakeTimes, met
         return sampled;
     }
     let gains = sampled.stats.parent_gain.clone();
-    let misses = |bone: usize, interpolated: &NodeSample, exact: &NodeSample| {
-        metrics.bone(&gains, bone).distance(interpolated, exact) > metrics.budget
+    let misses = |bone: usize, ends: [&NodeSample; 2], fraction: f64, exact: &NodeSample| {
+        let metric = metrics.bone(&gains, bone);
+        metric.between(ends, fraction, exact) > metrics.budget || metric.parting(ends) > metrics.budget
     };
     refine(source, strategy, &base.step_flags(&base.times), sampled, &misses)
 }

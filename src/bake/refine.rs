@@ -1,11 +1,13 @@
 //! Sampling as densely as the source needs: wherever linear interpolation between two neighbouring samples of a
-//! bone misses the source at their midpoint by more than the tolerance, the bone is sampled at the midpoints of
-//! both halves in turn.
+//! bone (under any of the rotation interpolations the keys must survive) misses the source at their midpoint by
+//! more than the tolerance, the bone is sampled at the midpoints of both halves in turn.
 //!
 //! Frames and key times are not always enough. A parent whose scale doubles within a frame, under a child that
 //! compensates it, needs the child's local scale to follow `1/s(t)`, a curve no straight line between two frames
 //! follows (4 % off at the middle, in Maya's mixed-inheritance test file). So every interval's midpoint is sampled
-//! and compared with the interpolation of its ends; where a bone misses, its halves are, down to [`MAX_DEPTH`]
+//! and compared with the interpolation of its ends (and, for keys a runtime may play by nlerp, its ends checked to
+//! be near enough in angle that nlerp cannot part from slerp by more than the tolerance: the two agree half way,
+//! so the midpoint cannot show it); where a bone misses, its halves are, down to [`MAX_DEPTH`]
 //! halvings. Only the bones that miss are sampled deeper (a pose is evaluated whole, but only their nodes are kept),
 //! so a few compensating bones do not multiply the samples of the whole rig. Every midpoint sampled stays a sample
 //! of the bones it was taken for, so the keys chosen later are checked against it too.
@@ -13,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::Strategy;
-use super::keys::{interpolate, too_far};
+use super::keys::too_far;
 use super::nodes::{NodeSample, NodeSolver, Sampled, Series, Stats, align, follow_frames};
 use super::times::in_single_precision;
 use crate::eval::Evaluation;
@@ -21,9 +23,10 @@ use crate::eval::Evaluation;
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
 
-/// A test of a bone's interpolated nodes against its exact ones: `misses(bone, interpolated, exact)`.
-pub trait Misses: Fn(usize, &NodeSample, &NodeSample) -> bool + Sync {}
-impl<F: Fn(usize, &NodeSample, &NodeSample) -> bool + Sync> Misses for F {}
+/// A test of a bone's nodes interpolated a fraction of the way between two samples against its exact ones:
+/// `misses(bone, [from, to], fraction, exact)`.
+pub trait Misses: Fn(usize, [&NodeSample; 2], f64, &NodeSample) -> bool + Sync {}
+impl<F: Fn(usize, [&NodeSample; 2], f64, &NodeSample) -> bool + Sync> Misses for F {}
 
 /// `sampled` (every bone at the same sorted times, frames followed) with midpoints added to each bone wherever
 /// `misses` says the interpolation of an interval's ends misses its midpoint; frames followed again. The interval
@@ -131,8 +134,7 @@ impl<M: Misses> Halving<'_, M> {
             // Bones whose stretch rotation never matters at the base samples are judged without it (it turns at
             // random where the factors are nearly equal, and it will be dropped).
             let [a_baked, b_baked, middle] = [&a, &b, &exact].map(|n| n.as_baked(helper[bone]));
-            let interpolated = interpolate(&a_baked, &b_baked, fraction);
-            if too_far(&a_baked, &b_baked) || (self.misses)(bone, &interpolated, &middle) {
+            if too_far(&a_baked, &b_baked) || (self.misses)(bone, [&a_baked, &b_baked], fraction, &middle) {
                 left.push((bone, a, exact));
                 right.push((bone, exact, b));
             }
@@ -156,7 +158,7 @@ mod tests {
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) * 0.25).collect();
         let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
         let missing = 2;
-        let refined = refine(&side, Strategy::Exact, &[false; 5], base.clone(), &|bone, _: &_, _: &_| bone == missing);
+        let refined = refine(&side, Strategy::Exact, &[false; 5], base.clone(), &|bone, _, _, _: &_| bone == missing);
         let intervals = times.len() - 1;
         for (bone, series) in refined.series.iter().enumerate() {
             // Every interval's midpoint for every bone; for the one that misses, every level of halving.
@@ -166,7 +168,7 @@ mod tests {
             assert_eq!(series.times.len(), series.nodes.len());
         }
         assert_eq!(refined.times, refined.series[missing].times, "every time some bone has");
-        let stepped = refine(&side, Strategy::Exact, &[false, true, true, true, true], base, &|_, _: &_, _: &_| false);
+        let stepped = refine(&side, Strategy::Exact, &[false, true, true, true, true], base, &|_, _, _, _: &_| false);
         assert_eq!(stepped.series[0].times.len(), times.len(), "intervals that end at stepped keys are left");
     }
 }

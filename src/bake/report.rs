@@ -1,11 +1,13 @@
 //! How close a bake came to its source: the source's evaluation against the baked file's, read back by bonescope's
-//! own glTF importer and compared at every sampled time ([`crate::diff::compare`]), so the report measures the file
-//! that was written, not the intentions behind it.
+//! own glTF importer, played with each rotation interpolation of the runtime it is for, and compared at every
+//! sampled time ([`crate::diff::compare`]; the worse of the interpolations per bone), so the report measures the
+//! file that was written, as that runtime plays it, not the intentions behind it.
 
-use super::{Baked, Request, Strategy};
-use crate::diff::{Extreme, MeshDifference, Pairs, compare};
+use super::{Baked, Engine, Request, Strategy};
+use crate::diff::{Comparison, Extreme, MeshDifference, Pairs, compare};
 use crate::eval::Evaluation;
-use crate::model::Rig;
+use crate::eval::layers::RotationInterpolation;
+use crate::model::{Choice, Rig};
 
 /// How one bone was baked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -49,6 +51,10 @@ pub struct AnimationReport {
 /// The whole report.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct BakeReport {
+    /// The runtime the bake is for, and the rotation interpolations it plays keys with, which the errors are the
+    /// worse of.
+    pub engine: Engine,
+    pub rotations: &'static [RotationInterpolation],
     pub strategy: Strategy,
     pub rig_size: f64,
     /// The key tolerance, model units.
@@ -64,6 +70,25 @@ impl BakeReport {
     pub fn worst(&self) -> Extreme {
         self.animations.iter().map(|a| a.worst).fold(Extreme::default(), Extreme::merge)
     }
+
+    /// What the runtime will show, in a line: the source within the tolerance (helper nodes), or the closest TRS
+    /// per bone, whose error the report lists.
+    pub fn what_it_shows(&self) -> String {
+        let played: Vec<&str> = self.rotations.iter().map(|r| r.id()).collect();
+        let played = played.join(" and ");
+        match self.strategy {
+            Strategy::Exact => format!(
+                "{} shows the source within {:.3e} (rotation keys checked under {played}; measured below)",
+                self.engine.id(),
+                self.tolerance
+            ),
+            Strategy::Trs => format!(
+                "{} shows each bone's closest TRS (rotations by {played}): exact only where no bone shears; the \
+                 error per bone is below",
+                self.engine.id()
+            ),
+        }
+    }
 }
 
 /// Compares every animation of `request` with the same animation of `baked_rig` (the bake read back).
@@ -77,7 +102,9 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
             let source = &request.clips[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
             let pairs = Pairs::by_name(source, &result);
-            let comparison = compare(source, &result, &pairs, &animation.times);
+            let comparison = played(request.engine, |rotation| {
+                compare(source, &result.clone().played_with(rotation), &pairs, &animation.times)
+            });
             let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {
                 (Strategy::Trs, _) => BoneNodes::Trs,
                 (Strategy::Exact, true) => BoneNodes::Helper,
@@ -106,6 +133,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
         .collect();
     let helpers = skeleton.bones().iter().zip(&baked.helpers).filter(|(_, h)| **h).map(|(b, _)| b.name.clone());
     BakeReport {
+        engine: request.engine,
+        rotations: request.engine.rotations(),
         strategy: request.strategy,
         rig_size: baked.rig_size,
         tolerance: baked.tolerance,
@@ -113,4 +142,11 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
         animations,
         notes: baked.notes.clone(),
     }
+}
+
+/// The worse of the comparisons `compare` makes under each rotation interpolation `engine` plays keys with.
+fn played(engine: Engine, compare: impl Fn(RotationInterpolation) -> Comparison) -> Comparison {
+    let rotations = engine.rotations().iter().map(|&rotation| compare(rotation));
+    // Every engine plays keys some way; glTF's way stands in for none.
+    rotations.reduce(Comparison::worse).unwrap_or_else(|| compare(RotationInterpolation::Slerp))
 }

@@ -10,7 +10,7 @@ use super::layers::LayerArgs;
 use super::options::{Distance, choice, parse_distance};
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
-use crate::bake::{self, BakeReport, ClipToBake, Request, Strategy};
+use crate::bake::{self, BakeReport, ClipToBake, Engine, Request, Strategy};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 use crate::model::Choice;
@@ -24,10 +24,14 @@ pub struct BakeArgs {
     /// Where to write the glTF binary (written whole or not at all).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
+    /// The runtime the file is for: its strategy (trs for Unreal, exact elsewhere) and the rotation interpolation
+    /// its keys must survive (slerp, nlerp, or both for `generic`).
+    #[arg(long = "for", value_name = "ENGINE", value_parser = choice::<Engine>(), default_value = Engine::default().id())]
+    pub engine: Engine,
     /// exact: a helper node `<bone>.stretch` above each bone that needs its stretch rotation; trs: one TRS node per
-    /// bone, the closest to what it needs (for runtimes that cannot shear).
-    #[arg(long, value_parser = choice::<Strategy>(), default_value = Strategy::default().id())]
-    pub strategy: Strategy,
+    /// bone, the closest to what it needs (for runtimes that cannot shear). Default: the --for engine's.
+    #[arg(long, value_parser = choice::<Strategy>())]
+    pub strategy: Option<Strategy>,
     /// Between keys the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     #[arg(long, value_name = "FRACTION", default_value_t = bake::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
@@ -54,20 +58,21 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     }
     let source = Evaluation::new(&rig, None, &args.eval.modes(&rig)?);
     let layers = args.layers.layers(&rig)?;
-    let (strategy, tolerance) = (args.strategy, args.tolerance);
+    let (strategy, tolerance) = (args.strategy.unwrap_or(args.engine.strategy()), args.tolerance);
     let request = if layers.is_empty() {
         let only = match &args.eval.anim {
             Some(_) => args.eval.clip(&rig)?,
             None => None,
         };
-        Request::every_clip(&source, only, strategy, tolerance)
+        Request { engine: args.engine, ..Request::every_clip(&source, only, strategy, tolerance) }
     } else {
         // A layered result is one new clip, named after its main clip and what was layered on it.
         let clip = args.eval.clip(&rig)?;
         let main = clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
         let name = format!("{main} + {}", layers.summary(&rig, clip));
         let layered = source.clone().with_clip(clip).with_layers(LayerStack::new(&rig, &layers)?);
-        Request { rest: source, clips: vec![ClipToBake { name, source: layered }], strategy, tolerance }
+        let clips = vec![ClipToBake { name, source: layered }];
+        Request { rest: source, clips, strategy, tolerance, engine: args.engine }
     };
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
@@ -91,15 +96,14 @@ fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
     let size = report.rig_size;
     let percent = |v: f64| format!("{:.6} %", 100.0 * v / size);
     let mut out = format!(
-        "{} → {} ({bytes} bytes)  strategy: {}  inherit: {}\n",
+        "{} → {} ({bytes} bytes)  for: {}  strategy: {}  inherit: {}\n",
         source_name(args),
         args.out.display(),
-        match report.strategy {
-            Strategy::Exact => "exact",
-            Strategy::Trs => "trs",
-        },
+        report.engine.id(),
+        report.strategy.id(),
         args.eval.inherit_label()
     );
+    out.push_str(&format!("  {}\n", report.what_it_shows()));
     out.push_str(&format!(
         "  rig size {size:.6}; keys within {:.3e} ({} of the rig size)\n",
         report.tolerance, args.tolerance

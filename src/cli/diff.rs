@@ -6,12 +6,13 @@ use std::process::ExitCode;
 use clap::Args;
 
 use super::Format;
-use super::options::{Distance, parse_assignment, parse_distance, parse_rate};
+use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
 
 use super::table::{Table, mesh_differences};
 use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
+use crate::eval::layers::RotationInterpolation;
 use crate::import;
-use crate::model::{ModeChoice, Rig, Unit};
+use crate::model::{Choice, ModeChoice, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -43,6 +44,10 @@ pub struct DiffArgs {
     /// The second file's unit where the file states none; the second file's lengths are brought into the first's.
     #[arg(long, value_name = "UNIT")]
     pub unit_b: Option<Unit>,
+    /// How the second file's linear rotation keys are played: `slerp` as glTF says, `nlerp` as a runtime that
+    /// keys each quaternion component as a curve of its own (Blender, Unity, Unreal) plays a bake.
+    #[arg(long, value_parser = choice::<RotationInterpolation>(), value_name = "MODE", default_value = RotationInterpolation::default().id())]
+    pub interp: RotationInterpolation,
     /// Samples per second over the shorter clip, on top of both files' key times.
     #[arg(long, value_name = "HZ", default_value_t = 60.0, value_parser = parse_rate)]
     pub rate: f64,
@@ -58,7 +63,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let rig_a = stated_unit(import::load(&args.a)?, args.unit_a, "--unit-a")?;
     let rig_b = stated_unit(import::load(&args.b)?, args.unit_b, "--unit-b")?;
     let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
-    let b = side(&args.b, &rig_b, args.inherit_b, &args.anim_b);
+    let b = FileSide { interp: args.interp, ..side(&args.b, &rig_b, args.inherit_b, &args.anim_b) };
     let diff = diff_files(&a, &b, &args.map, args.rate)?;
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
@@ -80,7 +85,7 @@ fn stated_unit(mut rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result
     Ok(rig)
 }
 
-/// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`).
+/// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`), as authored.
 pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Option<String>) -> FileSide<'a> {
     FileSide {
         file: super::scan::shown(path),
@@ -88,6 +93,7 @@ pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Opti
         modes: rig.skeleton.modes(modes),
         inherit: modes.label().to_owned(),
         anim: anim.clone(),
+        interp: RotationInterpolation::default(),
     }
 }
 
@@ -98,8 +104,13 @@ fn render_table(diff: &FileDiff, given: [bool; 2]) -> String {
         Some(unit) => unit.to_string(),
         None => "not stated (numbers taken as they are)".to_owned(),
     });
-    let mut out = format!("A: {}  inherit: {}  unit: {unit_a}\n", diff.a, diff.inherit_a);
-    out.push_str(&format!("B: {}  inherit: {}  unit: {unit_b}\n", diff.b, diff.inherit_b));
+    let played = |interp: RotationInterpolation| match interp {
+        RotationInterpolation::Slerp => String::new(),
+        other => format!("  rotations: {}", other.id()),
+    };
+    let (played_a, played_b) = (played(diff.interp_a), played(diff.interp_b));
+    let mut out = format!("A: {}  inherit: {}  unit: {unit_a}{played_a}\n", diff.a, diff.inherit_a);
+    out.push_str(&format!("B: {}  inherit: {}  unit: {unit_b}{played_b}\n", diff.b, diff.inherit_b));
     if let (Some(a), Some(b)) = (diff.unit_a, diff.unit_b)
         && a != b
     {

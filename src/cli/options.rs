@@ -185,7 +185,7 @@ mod tests {
     use clap::builder::TypedValueParser;
 
     use super::*;
-    use crate::bake::Strategy;
+    use crate::bake::{Engine, Strategy};
     use crate::eval::SkinningMethod;
     use crate::eval::layers::{
         AdditiveOrder, AdditiveReference, FadeCurve, KeyInterpolation, RotationBlend, RotationInterpolation,
@@ -208,6 +208,7 @@ mod tests {
     #[test]
     fn every_choice_parses_by_the_id_its_reports_write() {
         parses_by_id::<Strategy>();
+        parses_by_id::<Engine>();
         parses_by_id::<SkinningMethod>();
         parses_by_id::<KeyInterpolation>();
         parses_by_id::<RotationInterpolation>();

@@ -180,6 +180,19 @@ pub struct Comparison {
 }
 
 impl Comparison {
+    /// The worse of two comparisons of the same pairs at the same times (one side played two ways): per bone and
+    /// mesh the larger of each difference, and of the mean vertex distances.
+    pub fn worse(self, other: Comparison) -> Comparison {
+        let bones = self.bones.into_iter().zip(other.bones).map(|(x, y)| x.merge(y)).collect();
+        let meshes = self
+            .meshes
+            .into_iter()
+            .zip(other.meshes)
+            .map(|(x, y)| MeshDifference { distance: x.distance.merge(y.distance), mean: x.mean.max(y.mean), ..x })
+            .collect();
+        Comparison { bones, meshes, ..self }
+    }
+
     /// The largest probe distance of any bone and vertex distance of any mesh: how far anything moved.
     pub fn worst_distance(&self) -> Extreme {
         let bones = self.bones.iter().map(|b| b.probe);

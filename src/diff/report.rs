@@ -3,6 +3,7 @@
 
 use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
 use crate::eval::Evaluation;
+use crate::eval::layers::RotationInterpolation;
 use crate::model::{Clip, InheritMode, Rig, Unit};
 
 /// One side of a file comparison, before clips are chosen.
@@ -16,6 +17,8 @@ pub struct FileSide<'a> {
     pub inherit: String,
     /// The clip to compare (by name or index); every clip, paired by name, when neither side names one.
     pub anim: Option<String>,
+    /// How its linear rotation tracks are interpolated: as the file says (slerp), or as a runtime plays them.
+    pub interp: RotationInterpolation,
 }
 
 /// One pair of animations compared.
@@ -52,6 +55,9 @@ pub struct FileDiff {
     /// in A's unit, B's brought into it.
     pub unit_a: Option<Unit>,
     pub unit_b: Option<Unit>,
+    /// How each side's linear rotation tracks were interpolated.
+    pub interp_a: RotationInterpolation,
+    pub interp_b: RotationInterpolation,
     pub rate: f64,
     pub animations: Vec<AnimationDiff>,
     /// Clips without a partner.
@@ -67,8 +73,10 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
     let animations = pairs
         .iter()
         .map(|&(ca, cb)| {
-            let side_a = Evaluation::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes);
-            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes).measured_in(a.rig.unit);
+            let side_a = Evaluation::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes).played_with(a.interp);
+            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes)
+                .measured_in(a.rig.unit)
+                .played_with(b.interp);
             let pairs = Pairs::mapped(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
@@ -95,6 +103,8 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
         inherit_b: b.inherit.clone(),
         unit_a: a.rig.unit,
         unit_b: b.rig.unit,
+        interp_a: a.interp,
+        interp_b: b.interp,
         rate,
         animations,
         clips_only_a: only_a.iter().map(|&c| label(a.rig, Some(c))).collect(),

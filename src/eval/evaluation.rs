@@ -4,6 +4,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
+use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose};
 use crate::model::{Clip, InheritMode, MAX_FRAMES, Rig, Skeleton, Unit, sample_times};
@@ -68,6 +69,13 @@ impl<'a> Evaluation<'a> {
     /// The same clip through the same layers under other modes (a ghost: "what if every bone were …").
     pub fn with_modes(&self, modes: &[InheritMode]) -> Self {
         Evaluation { hierarchy: Hierarchy::new(&self.rig.skeleton, modes), ..self.clone() }
+    }
+
+    /// The same clip, without layers, its linear rotation tracks interpolated by `rotation`: as a runtime that
+    /// interpolates them so plays the file (slerp is as authored, glTF's).
+    pub fn played_with(self, rotation: RotationInterpolation) -> Self {
+        let resampling = Resampling { rotation, ..Resampling::default() };
+        self.with_layers(LayerStack::resampling(resampling))
     }
 
     /// The same clip as authored: without the layers.

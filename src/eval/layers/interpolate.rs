@@ -89,6 +89,20 @@ impl Choice for RotationInterpolation {
     }
 }
 
+impl RotationInterpolation {
+    /// The rotation a fraction `t` of the way from `a` to `b`.
+    pub fn mix(self, a: DQuat, b: DQuat, t: f64) -> DQuat {
+        match self {
+            RotationInterpolation::Slerp => slerp(a, b, t),
+            RotationInterpolation::Nlerp => nlerp(a, b, t),
+            RotationInterpolation::Euler => {
+                let from = euler(a);
+                from_euler(from.lerp(unwrap(euler(b), from), t))
+            }
+        }
+    }
+}
+
 /// An interpolation override for every track of a clip. The default reads every track as authored.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
@@ -194,14 +208,7 @@ impl Channel for Vec3 {
 
 impl Channel for Quat {
     fn mix(a: DQuat, b: DQuat, t: f64, rotation: RotationInterpolation) -> DQuat {
-        match rotation {
-            RotationInterpolation::Slerp => slerp(a, b, t),
-            RotationInterpolation::Nlerp => nlerp(a, b, t),
-            RotationInterpolation::Euler => {
-                let from = euler(a);
-                from_euler(from.lerp(unwrap(euler(b), from), t))
-            }
-        }
+        rotation.mix(a, b, t)
     }
 
     fn combine(keys: [DQuat; 4], weights: [f64; 4], rotation: RotationInterpolation) -> DQuat {

@@ -224,6 +224,11 @@ impl LayerStack {
         })
     }
 
+    /// A stack that only reads every clip with `interpolation`: it names no clip or bone, so nothing to check.
+    pub fn resampling(interpolation: Resampling) -> Self {
+        LayerStack { layers: Layers { interpolation, ..Layers::default() }, ..LayerStack::default() }
+    }
+
     pub fn layers(&self) -> &Layers {
         &self.layers
     }
