@@ -20,7 +20,7 @@ use std::time::Duration;
 use bonescope::analysis::{Assessment, ScanOptions, Tolerances, scan};
 use bonescope::eval::{Evaluation, Hierarchy, Pose, sample_clip};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, NodeRole, Rig, Skeleton, Track, Transform};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
@@ -53,7 +53,14 @@ fn generated_skeleton(rng: &mut XorShiftRng) -> Skeleton {
             DQuat::from_axis_angle(random_axis(rng), rng.random_range(0.0..0.5)),
             DVec3::ONE,
         );
-        bones.push(Bone { name: format!("bone{index}"), node: index, parent, rest, inherit: InheritMode::Full });
+        bones.push(Bone {
+            name: format!("bone{index}"),
+            node: index,
+            parent,
+            rest,
+            inherit: InheritMode::Full,
+            role: NodeRole::Joint,
+        });
         index
     };
     let mut parent = None;
@@ -115,18 +122,19 @@ fn generated_clip(rng: &mut XorShiftRng, skeleton: &Skeleton, scaled: &[usize]) 
             let (axis, amplitude) = (random_axis(rng), rng.random_range(0.2..0.8));
             let (frequency, phase) = (rng.random_range(0.2..1.5), rng.random_range(0.0..TAU));
             let wave = |t: f64| (TAU * frequency * t + phase).sin();
-            let rotation = times
+            let rotation: Vec<_> = times
                 .iter()
                 .map(|&t| (bone.rest.rotation * DQuat::from_axis_angle(axis, amplitude * wave(t))).as_quat())
                 .collect();
             let offset =
                 DVec3::new(rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05));
-            let translation = times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
+            let translation: Vec<_> =
+                times.iter().map(|&t| (bone.rest.translation + offset * wave(t)).as_vec3()).collect();
             let mut tracks = BoneTracks::new(index);
             tracks.rotation = Some(Track::new(times.clone(), rotation, Interpolation::Linear).unwrap());
             tracks.translation = Some(Track::new(times.clone(), translation, Interpolation::Linear).unwrap());
             if scaled.contains(&index) {
-                let scale = times
+                let scale: Vec<_> = times
                     .iter()
                     .map(|&t| Vec3::new(1.0 + 0.4 * wave(t) as f32, 1.0 - 0.25 * wave(t) as f32, 1.0))
                     .collect();

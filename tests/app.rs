@@ -178,6 +178,35 @@ fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
     }
 }
 
+/// The app on `doc` with the Layers panel open, settled.
+fn layers_app(doc: Document) -> Harness<'static, BonescopeApp> {
+    let settings = Settings { show_layers: true, ..Settings::default() };
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+    settle(&mut harness);
+    harness
+}
+
+#[test]
+fn the_bind_pose_section_warns_of_a_broken_skin_and_notes_a_stored_pose() {
+    // The demo with the forearm's bind alone moved 3 cm up: the hand, bound where it was, is left behind by it.
+    let mut rig = bonescope::import::demo_rig();
+    rig.skins[0].inverse_bind[1] = glam::DMat4::from_translation(glam::DVec3::new(1.0, 1.53, 0.0)).inverse();
+    let harness = layers_app(Document::new(None, rig));
+    harness.get_by_label_contains("1 joint's bind matrix disagrees with the joints around: the skin is broken there");
+    assert!(harness.query_by_label_contains("stored pose").is_none());
+    // Blender's FBX stores its current frame, the forearm turned 20° from its bind: a note, not a warning.
+    let harness = layers_app(Document::new(
+        Some(asset("blender/stretchy_full.fbx")),
+        common::load_asset("blender/stretchy_full.fbx"),
+    ));
+    harness
+        .get_by_label_contains("note: the stored pose is not the bind pose: 1 joint (forearm) is posed up to 20.00°");
+    assert!(harness.query_by_label_contains("disagree").is_none());
+    assert!(harness.query_by_label_contains("agree with the rest pose").is_none());
+}
+
 #[test]
 fn the_storage_report_is_measured_off_the_ui_thread_and_shown() {
     let mut harness = demo_app();
@@ -642,8 +671,10 @@ fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeAp
     let doc = Document::load(&asset(path)).unwrap();
     let index = doc.rig.skeleton.find(bone).unwrap();
     let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    // Scrolling the outliner to a bone deep in a long list settles over a few more frames than the default allows.
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
+        .with_max_steps(12)
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
     harness.state_mut().time = time;
     harness.state_mut().selection = vec![index];

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
-use bonescope::model::Rig;
+use bonescope::model::{NodeRole, Rig};
 use common::asset;
 use glam::{DMat3, DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
@@ -34,8 +34,12 @@ const MANIFEST: &[Row] = &[
 fn every_shared_bvh_matches_its_manifest() {
     for &(file, joints, end_sites, frames, frame_time, orders) in MANIFEST {
         let rig = import::load(&asset(file)).unwrap_or_else(|e| panic!("{e}"));
-        let ends = rig.skeleton.bones().iter().filter(|b| b.name.ends_with("_end")).count();
+        let roles: Vec<NodeRole> = rig.skeleton.bones().iter().map(|b| b.role).collect();
+        let ends = roles.iter().filter(|r| **r == NodeRole::EndSite).count();
         assert_eq!((rig.skeleton.len() - ends, ends), (joints, end_sites), "{file}: joints and end sites");
+        assert!(roles.iter().all(|r| r.is_figure()), "{file}: a BVH holds nothing but the figure");
+        let named_ends = rig.skeleton.bones().iter().filter(|b| b.name.ends_with("_end"));
+        assert!(named_ends.clone().all(|b| b.role == NodeRole::EndSite) && named_ends.count() == ends, "{file}");
         assert_eq!(rig.clips.len(), 1, "{file}");
         let clip = &rig.clips[0];
         let times = clip.key_times();

@@ -2,6 +2,9 @@
 
 mod common;
 
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
 use common::{asset, bonescope, json};
 use glam::DMat4;
 use serde_json::Value;
@@ -27,7 +30,7 @@ fn inspect_json_has_exactly_the_documented_shape() {
     assert_eq!(keys(&out), ["animation", "bind_mismatches", "file", "inherit", "layers", "notes", "samples"]);
     assert_eq!(out["layers"]["bind_weight"], 1.0, "no layers: {}", out["layers"]);
     assert_eq!(out["layers"]["blend"], Value::Null);
-    assert_eq!(keys(&out["animation"]), ["duration", "index", "name"]);
+    assert_eq!(keys(&out["animation"]), ["duration", "frame_rate", "index", "name"]);
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");
     assert_eq!(out["inherit"], "declared");
@@ -628,4 +631,83 @@ fn without_the_gui_the_app_and_render_say_they_need_it() {
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert!(stderr.contains("needs the `gui` feature") && stderr.lines().count() == 1, "{stderr}");
     }
+}
+
+#[test]
+fn gltf_frame_rates_are_read_from_sparse_key_times() {
+    // Blender's cubic-spline exports key every 10th to 30th frame of its 30 fps scene from frame 1, (1 + 10k)/30 s
+    // and so on: 0.33 to 1 s apart, yet at 30 fps (the most common spacing read 2 and 3 fps).
+    for anim in ["squash_stretch", "wave"] {
+        let out = json(&bonescope(&["inspect", &stretchy(), "--anim", anim, "--format", "json"]));
+        assert_eq!(out["animation"]["frame_rate"], 30.0, "{anim}");
+    }
+    let scan = json(&bonescope(&["scan", &stretchy(), "--format", "json"]));
+    let rates: Vec<&Value> =
+        scan[0]["animations"].as_array().unwrap().iter().map(|a| &a["animation"]["frame_rate"]).collect();
+    assert_eq!(rates, [30.0, 30.0]);
+}
+
+/// A copy of Cesium Man in `dir` with skin joint `joint`'s inverse bind matrix translated by `offset` (in the
+/// skin's bind space, metres), edited in the base64 buffer the file embeds; the path and the moved joint's node.
+fn cesium_man_with_a_moved_bind(dir: &Path, joint: usize, offset: [f32; 3]) -> (PathBuf, u64) {
+    let mut gltf: Value =
+        serde_json::from_slice(&std::fs::read(asset("gltf-khronos/cesium_man.gltf")).unwrap()).unwrap();
+    let skin = &gltf["skins"][0];
+    let node = skin["joints"][joint].as_u64().unwrap();
+    let accessor = &gltf["accessors"][skin["inverseBindMatrices"].as_u64().unwrap() as usize];
+    let view = &gltf["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+    let offset_of = |v: &Value| v["byteOffset"].as_u64().unwrap_or(0) as usize;
+    // Column-major 4×4 floats: the translation is floats 12 to 14 of the joint's matrix.
+    let translation = offset_of(view) + offset_of(accessor) + 64 * joint + 4 * 12;
+    let buffer = view["buffer"].as_u64().unwrap() as usize;
+    let uri = gltf["buffers"][buffer]["uri"].as_str().unwrap().to_owned();
+    let (prefix, data) = uri.split_once("base64,").unwrap();
+    let base64 = base64::engine::general_purpose::STANDARD;
+    let mut bytes = base64.decode(data).unwrap();
+    for (k, delta) in offset.iter().enumerate() {
+        let at = translation + 4 * k;
+        let moved = f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) + delta;
+        bytes[at..at + 4].copy_from_slice(&moved.to_le_bytes());
+    }
+    gltf["buffers"][buffer]["uri"] = Value::from(format!("{prefix}base64,{}", base64.encode(bytes)));
+    let path = dir.join("cesium_man_moved_bind.gltf");
+    std::fs::write(&path, serde_json::to_vec(&gltf).unwrap()).unwrap();
+    (path, node)
+}
+
+#[test]
+fn inspect_warns_of_broken_skins_and_notes_stored_poses() {
+    // Skins that render right, stored in another pose than their bind: a note, no bind mismatch.
+    let skins = [
+        ("blender/stretchy_full.fbx", "1 joint (forearm) is posed"),
+        ("fbx-ufbx-data/max_transformed_skin_7500_binary.fbx", "3 joints (Bone002, Bone003, Bone004) are posed"),
+        ("fbx-ufbx-corpus/maya_dual_quaternion_7500_ascii.fbx", "1 joint (joint2) is posed"),
+    ];
+    for (file, posed) in skins {
+        let path = asset(file).display().to_string();
+        let out = json(&bonescope(&["inspect", &path, "--format", "json"]));
+        assert_eq!(out["bind_mismatches"], Value::Array(vec![]), "{file}");
+        let notes: Vec<&str> = out["notes"].as_array().unwrap().iter().map(|n| n.as_str().unwrap()).collect();
+        assert!(
+            notes.iter().any(|n| n.starts_with("the stored pose is not the bind pose") && n.contains(posed)),
+            "{notes:?}"
+        );
+        let table = String::from_utf8(bonescope(&["inspect", &path]).stdout).unwrap();
+        assert!(table.contains(&format!("note: the stored pose is not the bind pose: {posed}")), "{table}");
+        assert!(!table.contains("warning"), "{table}");
+    }
+    // Cesium Man with one joint's bind moved 5 cm (node16, above node17 which stays bound where it was): broken.
+    let dir = tempfile::tempdir().unwrap();
+    let (moved, node) = cesium_man_with_a_moved_bind(dir.path(), 5, [0.0, 0.05, 0.0]);
+    let moved = moved.display().to_string();
+    let out = json(&bonescope(&["inspect", &moved, "--format", "json"]));
+    let name =
+        out["samples"][0]["bones"].as_array().unwrap().iter().find(|b| b["node"] == node).unwrap()["name"].clone();
+    let mismatches = out["bind_mismatches"].as_array().unwrap();
+    assert_eq!(mismatches.iter().map(|m| &m["name"]).collect::<Vec<_>>(), [&name]);
+    assert!((mismatches[0]["distance"].as_f64().unwrap() - 0.05).abs() < 1e-6, "{}", mismatches[0]);
+    assert!(mismatches[0]["angle_deg"].as_f64().unwrap() < 1e-3, "{}", mismatches[0]);
+    assert!(!out["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("bind pose")));
+    let table = String::from_utf8(bonescope(&["inspect", &moved]).stdout).unwrap();
+    assert!(table.contains(&format!("warning: `{}` is bound 0.05", name.as_str().unwrap())), "{table}");
 }

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use bonescope::eval::skinning::skin_positions;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError, Options, Space};
-use bonescope::model::{InheritMode, Rig};
+use bonescope::model::{InheritMode, NodeRole, Rig};
 use common::{asset, assets, hausdorff, load_asset, obj_positions, size};
 use glam::{DMat4, DVec3};
 use rand::{RngExt, SeedableRng};
@@ -598,4 +598,44 @@ fn meshes_with_non_finite_vertices_load_without_them() {
             assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()), "{file}: {}", mesh.name);
         }
     }
+}
+
+/// Each node's role from its FBX node attribute, judged against the types the ASCII twin of Maya's HumanIK file
+/// writes on its `Model:` lines: limb nodes are joints, and so is the `Null` they hang from (`Character1_Reference`);
+/// the control rig's `Null` and its IK and FK effectors are helpers. 3ds Max's walk keeps its cameras beside the
+/// biped, with their targets, a sky light and the biped's footsteps written as `Null` models.
+#[test]
+fn nodes_have_the_role_of_their_fbx_attribute() {
+    let ascii = std::fs::read_to_string(asset("fbx-ufbx-corpus/maya_human_ik_6100_ascii.fbx")).unwrap();
+    let rig = load_asset("fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx");
+    let mut checked = 0;
+    for line in ascii.lines().filter(|l| l.trim_start().starts_with("Model: \"Model::")) {
+        let fields: Vec<&str> = line.split('"').collect();
+        let (name, kind) = (fields[1].trim_start_matches("Model::"), fields[3]);
+        let expected = match (kind, name) {
+            ("LimbNode", _) | ("Null", "Character1_Reference") => NodeRole::Joint,
+            ("Null" | "IKEffector" | "FKEffector", _) => NodeRole::Helper,
+            _ => panic!("{name}: a `{kind}` this test does not expect"),
+        };
+        let bone = rig.skeleton.find(name).unwrap_or_else(|| panic!("no bone {name}"));
+        assert_eq!(rig.skeleton.bone(bone).role, expected, "{name} ({kind})");
+        checked += 1;
+    }
+    assert_eq!(checked, rig.skeleton.len(), "every node has its line");
+
+    let walk = load_asset("fbx-proanimationbank/walk.fbx");
+    let role = |name: &str| walk.skeleton.bone(walk.skeleton.find(name).unwrap()).role;
+    for name in ["Producer Perspective", "Producer Front", "Camera Switcher", "Camera01", "Camera03"] {
+        assert_eq!(role(name), NodeRole::Camera, "{name}");
+    }
+    for name in ["Sky01", "Camera01.Target", "Bip01 Footsteps"] {
+        assert_eq!(role(name), NodeRole::Helper, "{name}");
+    }
+    for name in ["Hips", "Pelvis", "LeftHandThumb1", "Bip01RToe0Nub"] {
+        assert_eq!(role(name), NodeRole::Joint, "{name}");
+    }
+    // Nodes 0 to 13 and 82, 83 are the cameras, their targets and the sky light, 15 the biped's footsteps (a `Null`
+    // below the hips); the rest is the biped.
+    let figure: Vec<bool> = walk.skeleton.figure();
+    assert!(figure.iter().enumerate().all(|(b, &f)| f == ((14..82).contains(&b) && b != 15)), "{figure:?}");
 }

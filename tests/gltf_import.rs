@@ -9,7 +9,7 @@ use std::path::Path;
 use base64::Engine as _;
 use bonescope::eval::{Hierarchy, Pose};
 use bonescope::import::{self, ImportError};
-use bonescope::model::{Clip, Interpolation, Rig};
+use bonescope::model::{Clip, Interpolation, NodeRole, Rig};
 use common::{asset, assets, load_asset};
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rand::{RngExt, SeedableRng};
@@ -393,6 +393,67 @@ fn assert_fails(result: Result<Rig, ImportError>, place: &str, needle: &str) {
     assert_eq!(error.place.as_deref(), Some(place), "{text}");
     assert!(error.message.contains(needle), "{text} (expected `{needle}`)");
     assert!(text.starts_with(&error.path.display().to_string()) && !text.contains('\n'), "{text}");
+}
+
+/// A node's role: Cesium Man's nodes (unnamed: node 0 the Z-up root, 21 the armature, 2 to 20 the skin's joints,
+/// 1 the skinned mesh); in a hand-written scene, a camera, a light, a node nothing refers to and one that an
+/// animation moves.
+#[test]
+fn nodes_have_the_role_of_what_refers_to_them() {
+    let cesium = load_asset("gltf-khronos/cesium_man.gltf");
+    let role = |rig: &Rig, name: &str| rig.skeleton.bones()[rig.skeleton.find(name).unwrap()].role;
+    for node in [0].into_iter().chain(2..=21) {
+        assert_eq!(role(&cesium, &format!("node{node}")), NodeRole::Joint, "node {node}");
+    }
+    assert_eq!(role(&cesium, "node1"), NodeRole::Mesh);
+
+    let times = [0.0f32, 1.0];
+    let translations = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0];
+    let bin: Vec<u8> = times.iter().chain(&translations).flat_map(|v| v.to_le_bytes()).collect();
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let document = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "scenes": [{"nodes": [0, 1, 2, 3]}],
+        "nodes": [
+            {"name": "cam", "camera": 0},
+            {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"name": "empty"},
+            {"name": "moved"}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+        "buffers": [{"byteLength": bin.len(), "uri": uri}],
+        "bufferViews": [{"buffer": 0, "byteLength": 8}, {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1.0]},
+            {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}
+        ],
+        "animations": [{"samplers": [{"input": 0, "output": 1}],
+                        "channels": [{"sampler": 0, "target": {"node": 3, "path": "translation"}}]}]
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let rig = load_file(dir.path(), "roles.gltf", document.to_string().as_bytes()).unwrap_or_else(|e| panic!("{e}"));
+    let expected = [("cam", NodeRole::Camera), ("lamp", NodeRole::Light), ("empty", NodeRole::Helper)];
+    for (name, expected) in expected.into_iter().chain([("moved", NodeRole::Joint)]) {
+        assert_eq!(role(&rig, name), expected, "{name}");
+    }
+}
+
+#[test]
+fn channels_sharing_a_sampler_share_its_decoded_values() {
+    // The translation sampler drives the root's translation and its scale too: one decode, two tracks.
+    let mut sample = sample();
+    let channels = sample.json["animations"][0]["channels"].as_array_mut().unwrap();
+    channels.push(json!({ "sampler": 0, "target": { "node": 0, "path": "translation" } }));
+    channels.push(json!({ "sampler": 0, "target": { "node": 0, "path": "scale" } }));
+    let rig = load_glb(&sample).unwrap();
+    let clip = rig.find_clip("move").unwrap();
+    let (root, child) = (clip.tracks_of(0).unwrap(), clip.tracks_of(1).unwrap());
+    let values = |track: &Option<bonescope::model::Track<Vec3>>| track.as_ref().unwrap().values().as_ptr();
+    assert!(std::ptr::eq(values(&child.translation), values(&root.translation)));
+    assert!(std::ptr::eq(values(&root.translation), values(&root.scale)));
+    assert_eq!(root.scale.as_ref().unwrap().values(), TRANSLATIONS.map(Vec3::from_array));
 }
 
 #[test]

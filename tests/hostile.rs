@@ -383,14 +383,15 @@ fn a_bvh_of_too_many_joints_is_refused_before_they_are_read() {
 fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("shared.glb");
-    // 200 channels sharing one sampler of 10,000 keys: 200 · 10,000 · 12 bytes of translations decoded, 80,000
-    // bytes of key times and 201 bones of 4 KiB: 24,903,296 bytes, 23.75 MiB.
-    std::fs::write(&file, corpus::shared_sampler(200, 10_000)).unwrap();
+    // 200 channels sharing one sampler of 100,000 keys: its translations decoded once (1,200,000 bytes), 800,000
+    // bytes of key times and 201 bones of 4 KiB (823,296 bytes): 2,823,296 bytes, 2.7 MiB, the animation the
+    // largest part.
+    std::fs::write(&file, corpus::shared_sampler(200, 100_000)).unwrap();
     let f = file.to_str().unwrap();
-    let run = bonescope(&["inspect", f, "--max-memory", "16M"]);
+    let run = bonescope(&["inspect", f, "--max-memory", "2M"]);
     check_run(&run).unwrap();
-    check_refusal(&run, &file, "animations[0]: needs ~24 MiB for 200 channels of 2000000 keys in all").unwrap();
-    assert!(String::from_utf8_lossy(&run.output.stderr).contains("the limit is 16 MiB (--max-memory)"));
+    check_refusal(&run, &file, "animations[0]: needs ~2.7 MiB for 200 channels of 20000000 keys in all").unwrap();
+    assert!(String::from_utf8_lossy(&run.output.stderr).contains("the limit is 2.0 MiB (--max-memory)"));
     let run = bonescope(&["scan", f, "--max-memory", "32MiB"]);
     check_run(&run).unwrap();
     assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));

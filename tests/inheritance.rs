@@ -2,7 +2,7 @@
 
 use bonescope::eval::{Hierarchy, ModelPose};
 use bonescope::math::shear_deg;
-use bonescope::model::{Bone, InheritMode, Skeleton, Transform};
+use bonescope::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use proptest::prelude::*;
 
@@ -18,6 +18,7 @@ fn chain(locals: &[Transform]) -> Skeleton {
             parent: i.checked_sub(1),
             rest: *rest,
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         })
         .collect();
     Skeleton::new(bones).unwrap()

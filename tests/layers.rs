@@ -13,15 +13,21 @@ use bonescope::eval::layers::{
 use bonescope::eval::{Hierarchy, LayerStack, Layers, Pose, bind_pose};
 use bonescope::import::{self, demo_rig};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, NodeRole, Rig, Skeleton, Track, Transform};
 use common::asset;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use proptest::prelude::*;
 
 /// One root bone and clips that move it along X linearly: `(duration, speed)` each, so x = speed · t.
 fn sliding_rig(clips: &[(f64, f64)]) -> Rig {
-    let bone =
-        Bone { name: "root".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full };
+    let bone = Bone {
+        name: "root".into(),
+        node: 0,
+        parent: None,
+        rest: Transform::IDENTITY,
+        inherit: InheritMode::Full,
+        role: NodeRole::Joint,
+    };
     let clips = clips
         .iter()
         .enumerate()
@@ -286,7 +292,7 @@ proptest! {
 fn vector_track() -> impl Strategy<Value = Track<Vec3>> {
     prop::collection::vec((0.01..1.0f64, -100.0..100.0f32), 1..8).prop_map(|keys| {
         let times: Vec<f64> = keys.iter().scan(0.0, |t, (step, _)| Some(std::mem::replace(t, *t + step))).collect();
-        let values = keys.iter().map(|&(_, x)| Vec3::new(x, -x, 0.5 * x)).collect();
+        let values: Vec<_> = keys.iter().map(|&(_, x)| Vec3::new(x, -x, 0.5 * x)).collect();
         Track::new(Arc::from(times), values, Interpolation::Linear).unwrap()
     })
 }

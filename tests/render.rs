@@ -222,3 +222,65 @@ fn a_synced_blend_sequence_repeats_with_the_blended_cycle() {
     assert!(frame("0015") == frame("0045"));
     assert!(frame("0000") != frame("0015"), "half a cycle later it is not");
 }
+
+/// The rows with a drawn pixel (one that is not the background, the colour of the top-left pixel), and the leftmost
+/// and rightmost columns drawn.
+fn drawn_rows_and_columns(image: &image::RgbaImage) -> (Vec<u32>, [u32; 2]) {
+    let background = *image.get_pixel(0, 0);
+    let drawn: Vec<(u32, u32)> =
+        image.enumerate_pixels().filter(|(_, _, p)| **p != background).map(|(x, y, _)| (x, y)).collect();
+    let mut rows: Vec<u32> = drawn.iter().map(|&(_, y)| y).collect();
+    rows.dedup();
+    let columns = drawn.iter().fold([u32::MAX, 0], |[l, r], &(x, _)| [l.min(x), r.max(x)]);
+    (rows, columns)
+}
+
+/// The opening view of studio files frames the figure, not the cameras and helpers beside it (walk.fbx's "Producer"
+/// cameras stand 150 m out) nor only part of it: with bones alone drawn, what is drawn is one figure (no gap of
+/// more than 5 % of the height between drawn rows: no camera drawn far from it; a hip joint may leave a few rows
+/// empty below the spine) between 30 % and 98 % of the picture's height, touching no edge.
+#[test]
+fn the_opening_view_frames_the_figure_whole() {
+    let dir = TempDir::new().unwrap();
+    let files = [
+        "fbx-proanimationbank/walk.fbx",
+        "fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx",
+        "fbx-proanimationbank/locomotions.fbx",
+        "gltf-khronos/cesium_man.gltf",
+        "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
+    ];
+    for file in files {
+        let out = path(&dir, "opening.png");
+        succeeds(&bonescope(&["render", arg(&asset(file)), "--show", "bones", "--out", arg(&out)]));
+        let image = image::open(&out).unwrap().to_rgba8();
+        let (width, height) = image.dimensions();
+        let (rows, [left, right]) = drawn_rows_and_columns(&image);
+        let (Some(&top), Some(&bottom)) = (rows.first(), rows.last()) else { panic!("{file}: nothing drawn") };
+        let gap = rows.windows(2).map(|pair| pair[1] - pair[0] - 1).max().unwrap_or(0);
+        assert!(f64::from(gap) < 0.05 * f64::from(height), "{file}: something is drawn {gap} rows apart from the rest");
+        let share = f64::from(bottom - top + 1) / f64::from(height);
+        assert!((0.30..=0.98).contains(&share), "{file}: the figure is {:.1} % of the height", share * 100.0);
+        assert!(left > 0 && top > 0 && right < width - 1 && bottom < height - 1, "{file}: cut at an edge");
+    }
+}
+
+/// Axis triads and boxes have a smallest size on screen: at the opening view of CMU's walk (the whole walk framed,
+/// the figure a quarter of the picture) and of ProAnimationBank's locomotions from the front, turning them on
+/// changes more than 0.4 % of the picture (before they had a minimum, 28 pixels and 0.13 %).
+#[test]
+fn gizmos_are_visible_at_the_opening_view() {
+    let dir = TempDir::new().unwrap();
+    for (file, view) in [("bvh/cmu_12_01_walk.bvh", "persp"), ("fbx-proanimationbank/locomotions.fbx", "front")] {
+        let file_path = asset(file);
+        let render = |show: &str| {
+            let out = path(&dir, &format!("{show}.png"));
+            let args = ["render", arg(&file_path), "--view", view, "--show", show, "--out", arg(&out)];
+            succeeds(&bonescope(&args));
+            image::open(out).unwrap().to_rgba8()
+        };
+        let (bones, gizmos) = (render("bones"), render("bones,axes,boxes"));
+        let changed = bones.pixels().zip(gizmos.pixels()).filter(|(a, b)| a != b).count();
+        let percent = 100.0 * changed as f64 / f64::from(bones.width() * bones.height());
+        assert!(percent > 0.4, "{file}: axes and boxes change {changed} pixels, {percent:.2} % of the picture");
+    }
+}

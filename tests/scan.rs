@@ -9,7 +9,8 @@ use bonescope::analysis::{Assessment, Components, CurveRequest, Judged, ScanOpti
 use bonescope::eval::{Evaluation, Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{
-    Bone, BoneTracks, Clip, InheritMode, Interpolation, MAX_FRAMES, Rig, Skeleton, Track, Transform, sample_times,
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, MAX_FRAMES, NodeRole, Rig, Skeleton, Track, Transform,
+    sample_times,
 };
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 
@@ -22,8 +23,8 @@ fn rig_of((skeleton, clip): (Skeleton, Clip)) -> Rig {
 fn growing_parent() -> (Skeleton, Clip) {
     let child_rest = Transform::from_trs(DVec3::X, DQuat::from_rotation_z(45f64.to_radians()), DVec3::ONE);
     let bones = vec![
-        Bone { name: "parent".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full },
-        Bone { name: "child".into(), node: 1, parent: Some(0), rest: child_rest, inherit: InheritMode::Full },
+        Bone::joint("parent", None, Transform::IDENTITY),
+        Bone { node: 1, ..Bone::joint("child", Some(0), child_rest) },
     ];
     let mut tracks = BoneTracks::new(0);
     let times: Arc<[f64]> = Arc::from([0.0, 1.0].as_slice());
@@ -86,6 +87,24 @@ fn stretched_spans_run_from_the_first_flagged_sample_to_the_end() {
     assert_eq!(analysis.stretched_spans(None), vec![(0.1, 1.0)]);
     assert!(analysis.stretched_spans(Some(0)).is_empty());
     assert_eq!(analysis.curves_of(1).unwrap().model.len(), 11);
+}
+
+/// A camera hung under the growing parent, beside a joint that stays still: the camera shears as the child did, and
+/// its summary says so, but the "any bone" spans the timeline marks are the figure's, which is never stretched.
+#[test]
+fn a_stretched_camera_is_reported_but_does_not_mark_the_figure_stretched() {
+    let (skeleton, clip) = growing_parent();
+    let mut bones = skeleton.bones().to_vec();
+    bones[1].role = NodeRole::Camera;
+    bones.push(Bone { name: "hand".into(), node: 2, parent: Some(0), role: NodeRole::Joint, ..bones[0].clone() });
+    let rig = rig_of((Skeleton::new(bones).unwrap(), clip));
+    let options = ScanOptions { rate: 10.0, ..ScanOptions::default() };
+    let never = AtomicBool::new(false);
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let analysis = analyze(&evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
+    assert_eq!(analysis.scan.bones[1].flagged_samples, 10, "the camera's matrix is sheared all the same");
+    assert_eq!(analysis.stretched_spans(Some(1)), vec![(0.1, 1.0)]);
+    assert!(analysis.stretched_spans(None).is_empty(), "no bone of the figure is stretched");
 }
 
 /// The per-bone summaries of a whole-clip scan, computed the plain way: every bone's model matrix evaluated and
@@ -159,13 +178,7 @@ fn assert_scan_matches_brute_force(label: &str, rig: &Rig, clip: usize, modes: &
 /// Bones whose stretch never changes (judged once per chunk) beside ones that do: a constantly sheared bone under a
 /// rest scale of (1, 2, 1), a turning bone below it, and a bone with a constant non-uniform scale track.
 fn fixed_and_moving() -> (Skeleton, Clip) {
-    let bone = |name: &str, parent: Option<usize>, rest: Transform| Bone {
-        name: name.into(),
-        node: 0,
-        parent,
-        rest,
-        inherit: InheritMode::Full,
-    };
+    let bone = |name: &str, parent: Option<usize>, rest: Transform| Bone::joint(name, parent, rest);
     let turned = DQuat::from_rotation_z(0.5);
     let bones = vec![
         bone("root", None, Transform::IDENTITY),

@@ -124,6 +124,15 @@ fn fbx_blend_shapes_with_inbetweens() {
     window(Settings::default(), doc, 2.5, Some("pCube1")).snapshot("fbx_blend_shapes_with_inbetweens");
 }
 
+/// Blender's FBX stores its current frame, the forearm turned 20° from where the mesh was bound: the Layers panel's
+/// bind check notes the stored pose, with no warning.
+#[test]
+fn fbx_stored_pose_noted_in_the_layers_panel() {
+    let settings = Settings { show_layers: true, ..Settings::default() };
+    let doc = asset_document("blender/stretchy_full.fbx");
+    window(settings, doc, 0.0, None).snapshot("fbx_stored_pose_noted_in_the_layers_panel");
+}
+
 /// A shared asset (`../shared/assets/FOLDER/NAME`) as a document.
 fn asset_document(path: &str) -> Document {
     let path = asset(path);
@@ -148,6 +157,16 @@ fn cmu_walk_gizmos() {
     let mut settings = Settings::default();
     settings.scene.boxes = true;
     window(settings, asset_document("bvh/cmu_12_01_walk.bvh"), 1.0, None).snapshot("cmu_walk_gizmos");
+}
+
+/// 3ds Max's walk: the biped in the tree, its six "Producer" cameras, three cameras with their targets, a sky light
+/// and the footsteps in their own group, opened (it starts collapsed).
+#[test]
+fn walk_outliner_with_cameras_and_helpers() {
+    let mut harness = window(Settings::default(), asset_document("fbx-proanimationbank/walk.fbx"), 0.0, None);
+    harness.get_by_label_contains("Cameras, lights and helpers").click();
+    settle_for_snapshot(&mut harness);
+    harness.snapshot("walk_outliner_with_cameras_and_helpers");
 }
 
 /// A small laptop window, 1000×700, with the Layers panel and the Inspector open: the Inspector and the Layers

@@ -21,13 +21,11 @@ fn compensating_child() -> Rig {
     let rest =
         |translation: DVec3, turn: f64| Transform::from_trs(translation, DQuat::from_rotation_z(turn), DVec3::ONE);
     let bones = vec![
-        Bone { name: "parent".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full },
+        Bone::joint("parent", None, Transform::IDENTITY),
         Bone {
-            name: "child".into(),
             node: 1,
-            parent: Some(0),
-            rest: rest(DVec3::X, std::f64::consts::FRAC_PI_4),
             inherit: InheritMode::SegmentCompensate,
+            ..Bone::joint("child", Some(0), rest(DVec3::X, std::f64::consts::FRAC_PI_4))
         },
     ];
     let skeleton = Skeleton::new(bones).unwrap();

@@ -185,7 +185,8 @@ pub struct ClipAnalysis {
     /// Bit `s` of bone `b`'s row: stretched at sample `s`. Rows of `words_per_bone` words.
     pub(super) stretched_bits: Vec<u64>,
     pub(super) words_per_bone: usize,
-    /// Bit `s`: some bone is stretched at sample `s`.
+    /// Bit `s`: some bone of the figure is stretched at sample `s` (a camera under a squashed parent is no
+    /// character's problem: [`crate::model::Skeleton::figure`]).
     pub(super) any_stretched_bits: Vec<u64>,
     /// `(bone, curves)` for the requested bones, in request order.
     pub curves: Vec<(usize, Curves)>,
@@ -198,12 +199,12 @@ impl ClipAnalysis {
         word >> (sample % 64) & 1 == 1
     }
 
-    /// Whether any bone is stretched at sample `sample`.
+    /// Whether any bone of the figure is stretched at sample `sample`.
     pub fn any_stretched_at(&self, sample: usize) -> bool {
         self.any_stretched_bits.get(sample / 64).is_some_and(|word| word >> (sample % 64) & 1 == 1)
     }
 
-    /// The time spans in which `bone` (or, for `None`, any bone) is stretched: from the first flagged sample to
+    /// The time spans in which `bone` (or, for `None`, any bone of the figure) is stretched: from the first flagged sample to
     /// the first sample after it that is not (or the last sample).
     pub fn stretched_spans(&self, bone: Option<usize>) -> Vec<(f64, f64)> {
         let flagged = |s: usize| bone.map_or_else(|| self.any_stretched_at(s), |b| self.stretched_at(b, s));

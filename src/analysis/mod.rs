@@ -11,7 +11,7 @@ mod scan;
 pub mod storage;
 mod stretch;
 
-pub use bind::{BindMismatch, BindTolerance, bind_mismatches};
+pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check_bind};
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};

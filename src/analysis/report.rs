@@ -42,11 +42,18 @@ pub struct AnimationInfo {
     pub index: usize,
     pub name: Option<String>,
     pub duration: f64,
+    /// Frames per second: the file's, or for glTF the rate its key times show ([`Clip::frame_rate`]).
+    pub frame_rate: f64,
 }
 
 impl AnimationInfo {
     pub fn of(clip: &Clip) -> Self {
-        AnimationInfo { index: clip.index, name: clip.name.clone(), duration: clip.duration() }
+        AnimationInfo {
+            index: clip.index,
+            name: clip.name.clone(),
+            duration: clip.duration(),
+            frame_rate: clip.frame_rate(),
+        }
     }
 
     /// `animation 0 `walk` (1.333 s)`, or the rest pose when there is no animation.
@@ -119,7 +126,8 @@ pub struct SampleReport {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InspectReport {
     pub file: String,
-    /// What the importer says about the file: units and axes, how animation was read, what was skipped.
+    /// What the importer says about the file (units and axes, how animation was read, what was skipped), and
+    /// which joints the stored pose holds away from the bind pose.
     pub notes: Vec<String>,
     pub animation: Option<AnimationInfo>,
     /// The mode given for every bone, or `declared` when each bone keeps the file's.
@@ -203,7 +211,8 @@ impl<T> FileReport<T> {
 pub type FileScan = FileReport<AnimationScan>;
 
 /// `bonescope inspect --format json`: the report, the layers every sample was evaluated through (the default: none)
-/// and the skin joints whose bind matrix is not their rest model matrix.
+/// and the skin joints whose bind matrices break the skin (joints only posed away from their bind are in the notes:
+/// [`super::BindCheck`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LayeredInspectReport {
     #[serde(flatten)]
@@ -223,9 +232,10 @@ impl LayeredInspectReport {
     ) -> Self {
         let rig = evaluation.rig;
         let animation = evaluation.clip.map(AnimationInfo::of);
-        let report = InspectReport { file, notes: rig.notes.clone(), animation, inherit, samples };
+        let bind = super::check_bind(evaluation, &super::BindTolerance::default());
+        let notes = rig.notes.iter().cloned().chain(bind.note()).collect();
+        let report = InspectReport { file, notes, animation, inherit, samples };
         let layers = evaluation.layers().map(|stack| stack.layers().clone()).unwrap_or_default();
-        let bind_mismatches = super::bind_mismatches(rig, &evaluation.hierarchy, &super::BindTolerance::default());
-        LayeredInspectReport { report, layers, bind_mismatches }
+        LayeredInspectReport { report, layers, bind_mismatches: bind.broken }
     }
 }

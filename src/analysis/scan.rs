@@ -50,7 +50,7 @@ pub fn analyze(
         })
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
-    Some(assemble(skeleton.len(), times, curves, chunks))
+    Some(assemble(&skeleton.figure(), times, curves, chunks))
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.
@@ -73,7 +73,9 @@ fn pieces(samples: &mut [Components], len: usize) -> impl Iterator<Item = Option
     samples.chunks_mut(len).map(Some).chain(std::iter::repeat_with(|| None))
 }
 
-fn assemble(bones: usize, times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks: Vec<ChunkResult>) -> ClipAnalysis {
+/// The chunks' results as one analysis; `figure` (one flag per bone) says which bones count for "any bone".
+fn assemble(figure: &[bool], times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks: Vec<ChunkResult>) -> ClipAnalysis {
+    let bones = figure.len();
     let words_per_bone = times.len().div_ceil(64);
     let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();
     let mut stretched_bits = vec![0u64; bones * words_per_bone];
@@ -84,8 +86,10 @@ fn assemble(bones: usize, times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks:
         for (bone, (summary, bits)) in chunk.summaries.iter().zip(chunk.bits.chunks(chunk.words)).enumerate() {
             summaries[bone].merge(summary);
             stretched_bits[bone * words_per_bone..][words.clone()].copy_from_slice(bits);
-            for (any, word) in any_stretched_bits[words.clone()].iter_mut().zip(bits) {
-                *any |= word;
+            if figure[bone] {
+                for (any, word) in any_stretched_bits[words.clone()].iter_mut().zip(bits) {
+                    *any |= word;
+                }
             }
         }
         first_word = words.end;

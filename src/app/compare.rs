@@ -307,8 +307,7 @@ mod tests {
         // One bone turned a quarter turn about Z over a second by two linear keys, compared with itself played by
         // nlerp: 13/60 s in, nlerp is at 2·atan(t·sin φ / (1 − t + t·cos φ)) with φ = 45°, slerp at t·90°,
         // 0.918805° apart.
-        let bone =
-            Bone { name: "b".into(), node: 0, parent: None, rest: Transform::IDENTITY, inherit: InheritMode::Full };
+        let bone = Bone::joint("b", None, Transform::IDENTITY);
         let mut tracks = BoneTracks::new(0);
         let keys = vec![glam::Quat::IDENTITY, glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2)];
         tracks.rotation = Some(Track::new(Arc::from([0.0, 1.0].as_slice()), keys, Interpolation::Linear).unwrap());

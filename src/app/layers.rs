@@ -5,15 +5,17 @@
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
 //! reported, not applied).
 
+use std::sync::Arc;
+
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
 use super::job::{Job, Progress};
 use super::{Document, Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
-use crate::analysis::{BindMismatch, BindTolerance, bind_mismatches};
+use crate::analysis::{BindCheck, BindTolerance, check_bind};
+use crate::eval::Layers;
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
-use crate::eval::{Hierarchy, Layers};
 use crate::model::{Choice, InheritMode, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
@@ -22,6 +24,23 @@ use crate::view::Badge;
 pub struct LayersPanel {
     /// The storage report of one document state: measured off the UI thread (it walks the whole clip).
     storage: Job<StorageKey, StorageReport>,
+    /// The bind check of the document's rig, clip and modes: off the UI thread (where joints are off their bind,
+    /// it walks the whole clip).
+    bind: Job<BindKey, BindCheck>,
+}
+
+/// What a bind check depends on: the rig (this one, not an equal one), its clip and the modes.
+#[derive(Clone)]
+struct BindKey {
+    rig: Arc<Rig>,
+    clip: Option<usize>,
+    modes: Vec<InheritMode>,
+}
+
+impl PartialEq for BindKey {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.rig, &other.rig) && self.clip == other.clip && self.modes == other.modes
+    }
 }
 
 /// What a storage report depends on: the document's layers, clip and modes.
@@ -35,12 +54,13 @@ impl LayersPanel {
     /// Waits for a measurement under way (tests and headless renders want a settled state).
     pub fn settle(&mut self) {
         self.storage.wait();
+        self.bind.wait();
     }
 
     pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         let mut layers = shared.doc.layers().clone();
         egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-            bind_section(ui, shared, &mut layers);
+            self.bind_section(ui, shared, &mut layers);
             interpolation_section(ui, shared, &mut layers);
             blend_section(ui, shared, &mut layers);
             additive_section(ui, shared, &mut layers);
@@ -54,6 +74,36 @@ impl LayersPanel {
         {
             ui.colored_label(Badge::Stretched.color(), error.to_string());
         }
+    }
+
+    /// The bind weight, and the bind check: joints whose bind matrices break the skin (a warning), and joints the
+    /// stored pose holds away from their bind (a note).
+    fn bind_section(&mut self, ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
+        CollapsingHeader::new("Bind pose").default_open(true).show(ui, |ui| {
+            weight_slider(ui, &mut layers.bind_weight, "clip weight").on_hover_text("0: the bind pose, 1: the clip");
+            ui.checkbox(&mut shared.settings.scene.bind_pose, "Show the bind pose");
+            let doc = &*shared.doc;
+            if doc.rig.skins.is_empty() {
+                ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
+                return;
+            }
+            let key = BindKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone() };
+            let work = || {
+                let doc = doc.clone();
+                move |_: &Progress| Some(check_bind(&doc.evaluation(), &BindTolerance::default()))
+            };
+            let waker = ui.ctx().clone();
+            self.bind.update(key.clone(), work, move || waker.request_repaint());
+            match self.bind.for_key(&key) {
+                Some(check) => bind_report(ui, check),
+                None => {
+                    ui.horizontal(|ui| {
+                        ui.spinner();
+                        ui.label("checking the bind matrices…");
+                    });
+                }
+            }
+        });
     }
 
     /// The stretch-quaternion storage of the current clip (`docs/decomposition.md`), measured when asked, off the UI
@@ -85,40 +135,31 @@ impl LayersPanel {
     }
 }
 
-fn bind_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
-    CollapsingHeader::new("Bind pose").default_open(true).show(ui, |ui| {
-        weight_slider(ui, &mut layers.bind_weight, "clip weight").on_hover_text("0: the bind pose, 1: the clip");
-        ui.checkbox(&mut shared.settings.scene.bind_pose, "Show the bind pose");
-        let rig = &shared.doc.rig;
-        if rig.skins.is_empty() {
-            ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
-            return;
-        }
-        let mismatches =
-            bind_mismatches(rig, &Hierarchy::new(&rig.skeleton, &shared.doc.modes), &BindTolerance::default());
-        bind_report(ui, &mismatches);
-    });
-}
-
-fn bind_report(ui: &mut Ui, mismatches: &[BindMismatch]) {
-    if mismatches.is_empty() {
+fn bind_report(ui: &mut Ui, check: &BindCheck) {
+    if check.broken.is_empty() && check.posed.is_empty() {
         ui.label("inverse bind matrices agree with the rest pose");
-        return;
     }
-    let text = format!("{} joints' bind pose differs from the rest pose", mismatches.len());
-    ui.colored_label(Badge::NonUniform.color(), text);
-    egui::Grid::new("bind-mismatches").striped(true).show(ui, |ui| {
-        ui.label("joint");
-        ui.label("distance");
-        ui.label("angle°");
-        ui.end_row();
-        for m in mismatches.iter().take(12) {
-            ui.label(&m.name);
-            ui.monospace(format!("{:.4}", m.distance));
-            ui.monospace(format!("{:.3}", m.angle_deg));
+    if !check.broken.is_empty() {
+        let count = check.broken.len();
+        let joints = if count == 1 { "joint's bind matrix disagrees" } else { "joints' bind matrices disagree" };
+        let text = format!("{count} {joints} with the joints around: the skin is broken there");
+        ui.colored_label(Badge::Stretched.color(), text);
+        egui::Grid::new("bind-mismatches").striped(true).show(ui, |ui| {
+            ui.label("joint");
+            ui.label("distance");
+            ui.label("angle°");
             ui.end_row();
-        }
-    });
+            for m in check.broken.iter().take(12) {
+                ui.label(&m.name);
+                ui.monospace(format!("{:.4}", m.gap.distance));
+                ui.monospace(format!("{:.3}", m.gap.angle_deg));
+                ui.end_row();
+            }
+        });
+    }
+    if let Some(note) = check.note() {
+        ui.label(RichText::new(format!("note: {note}")).weak());
+    }
 }
 
 fn interpolation_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {

@@ -1,5 +1,6 @@
 //! The bone hierarchy as a tree with finding badges, a name filter, "only flagged", and each bone's inheritance
-//! mode (right-click a bone to set it for the bone, its subtree or all bones).
+//! mode (right-click a bone to set it for the bone, its subtree or all bones). The nodes beside the figure (cameras,
+//! lights, meshes' nodes, helpers) are listed apart, in a group collapsed at first.
 
 use std::collections::HashSet;
 
@@ -7,7 +8,7 @@ use egui::{RichText, Sense, vec2};
 
 use super::{ModeChoice, ModeScope, Shared, text};
 use crate::analysis::Findings;
-use crate::model::InheritMode;
+use crate::model::{InheritMode, NodeRole};
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -34,6 +35,7 @@ impl Outliner {
             ui.checkbox(&mut self.only_flagged, "Only flagged");
         });
         legend(ui);
+        self.others(ui, shared);
         ui.separator();
         let rows = self.visible_rows(shared);
         if rows.is_empty() {
@@ -71,8 +73,10 @@ impl Outliner {
         now || ever
     }
 
+    /// The figure's bones the tree shows.
     fn visible_rows(&self, shared: &Shared) -> Vec<usize> {
         let skeleton = &shared.doc.rig.skeleton;
+        let figure = skeleton.figure();
         let filter = self.filter.to_lowercase();
         let mut hidden = vec![false; skeleton.len()];
         let mut rows = Vec::new();
@@ -80,11 +84,44 @@ impl Outliner {
             // Without a filter, collapsed bones hide their subtree.
             hidden[bone] = b.parent.is_some_and(|p| hidden[p] || self.collapsed.contains(&p));
             let matches = if filter.is_empty() { !hidden[bone] } else { b.name.to_lowercase().contains(&filter) };
-            if matches && (!self.only_flagged || Self::flagged(shared, bone)) {
+            if figure[bone] && matches && (!self.only_flagged || Self::flagged(shared, bone)) {
                 rows.push(bone);
             }
         }
         rows
+    }
+
+    /// The nodes that are not the figure's, by role, under a header collapsed at first: a file's cameras and
+    /// helpers can outnumber its joints, and are seldom what it is opened for. The filters apply to them too.
+    fn others(&mut self, ui: &mut egui::Ui, shared: &mut Shared) {
+        let skeleton = &shared.doc.rig.skeleton;
+        let figure = skeleton.figure();
+        let filter = self.filter.to_lowercase();
+        let others: Vec<(NodeRole, usize)> = (0..skeleton.len())
+            .filter(|&b| !figure[b] && skeleton.bone(b).name.to_lowercase().contains(&filter))
+            .filter(|&b| !self.only_flagged || Self::flagged(shared, b))
+            .map(|b| (skeleton.bone(b).role, b))
+            .collect();
+        if others.is_empty() {
+            return;
+        }
+        let header = egui::CollapsingHeader::new(format!("Cameras, lights and helpers ({})", others.len()))
+            .id_salt("outliner-others")
+            .default_open(false);
+        header.show(ui, |ui| {
+            let list = egui::ScrollArea::vertical().id_salt("outliner-others-list").max_height(ROW_HEIGHT * 8.0);
+            list.show(ui, |ui| {
+                for role in [NodeRole::Camera, NodeRole::Light, NodeRole::Mesh, NodeRole::Helper] {
+                    let bones: Vec<usize> = others.iter().filter(|(r, _)| *r == role).map(|(_, b)| *b).collect();
+                    if !bones.is_empty() {
+                        ui.label(RichText::new(format!("{}s", role.label())).weak().small());
+                    }
+                    for bone in bones {
+                        self.row(ui, shared, bone, 0);
+                    }
+                }
+            });
+        });
     }
 
     fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, depth: usize) {

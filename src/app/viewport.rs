@@ -7,7 +7,6 @@ use egui::{Sense, Ui};
 use glam::DVec2;
 
 use super::{Document, Ghost, Shared};
-use crate::eval::bind_model_matrices;
 use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
@@ -71,7 +70,7 @@ impl Viewport {
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
         if shared.settings.scene.bind_pose {
-            scene.bind_pose = Some(DrawnPose { model: bind_model_matrices(&rig), ..DrawnPose::default() });
+            scene.bind_pose = Some(DrawnPose::bind(&rig, &scene.primary));
         }
         let picture = paint::picture_rect(rect, &scene);
         self.frame_now(&mut shared.settings.camera, aspect(picture));
@@ -174,6 +173,8 @@ fn toggles(ui: &mut Ui, shared: &mut Shared) {
     ui.toggle_value(&mut o.mesh, "Mesh");
     ui.toggle_value(&mut o.wireframe, "Wireframe");
     ui.toggle_value(&mut o.bind_pose, "Bind pose");
+    ui.toggle_value(&mut o.helpers, "Helpers")
+        .on_hover_text("cameras, lights, meshes' nodes and other helpers as bones");
     ui.toggle_value(&mut o.names, "Names");
     ui.toggle_value(&mut o.grid, "Grid");
     ui.toggle_value(&mut o.legend, "Legend");

@@ -77,11 +77,12 @@ fn render_table(layered: &LayeredInspectReport, layers_summary: &str) -> String 
     }
     for m in &layered.bind_mismatches {
         out.push_str(&format!(
-            "  warning: `{}` is bound {:.6} units and {:.4}° away from its rest pose (scale {:+.4} %)\n",
+            "  warning: `{}` is bound {:.6} units and {:.4}° (scale {:+.4} %) off the joints around it: the skin is \
+             broken there\n",
             m.name,
-            m.distance,
-            m.angle_deg,
-            100.0 * m.scale_change
+            m.gap.distance,
+            m.gap.angle_deg,
+            100.0 * m.gap.scale_change
         ));
     }
     for sample in &report.samples {

@@ -52,7 +52,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME")]
     pub select: Vec<String>,
     /// What to draw: `bones,axes,boxes` exactly those, or `+boxes,-grid` to change the defaults. Items: bones,
-    /// axes, boxes, mesh, wireframe, bind-pose, names, grid, legend.
+    /// axes, boxes, mesh, wireframe, bind-pose, helpers (cameras, lights and other nodes beside the figure), names,
+    /// grid, legend.
     #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = SceneOptions::parse_list)]
     pub show: Option<SceneOptions>,
     /// How meshes are skinned: as the file declares (FBX: linear, dual quaternion or a per-vertex blend), or one

@@ -443,8 +443,7 @@ mod tests {
         let rz = |deg: f64| Transform::from_trs(DVec3::X, DQuat::from_rotation_z(deg.to_radians()), DVec3::ONE);
         let root = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
         let mid = Transform { scale: DVec3::new(1.0, 2.0, 1.0), ..rz(45.0) };
-        let bone =
-            |name: &str, parent, rest| Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full };
+        let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
         let bones = vec![bone("root", None, root), bone("mid", Some(0), mid), bone("tip", Some(1), rz(30.0))];
         let rig = Rig { skeleton: Skeleton::new(bones).unwrap(), ..Rig::default() };
         let unscaled = Evaluation::new(&rig, None, &[InheritMode::UnscaledParent; 3]);

@@ -20,25 +20,31 @@ pub fn skin_bind_spaces(rig: &Rig, rest_model: &[DMat4]) -> Vec<DMat4> {
     rig.skins
         .iter()
         .map(|skin| {
-            let spaces: Vec<[f64; 16]> = skin
+            let spaces = skin
                 .joints
                 .iter()
                 .zip(&skin.inverse_bind)
-                .filter_map(|(&joint, ibm)| Some((*rest_model.get(joint)? * *ibm).to_cols_array()))
-                .filter(|m| m.iter().all(|x| x.is_finite()))
-                .collect();
-            if spaces.is_empty() {
-                return DMat4::IDENTITY;
-            }
-            let mut median = [0.0; 16];
-            for (entry, out) in median.iter_mut().enumerate() {
-                let mut values: Vec<f64> = spaces.iter().map(|m| m[entry]).collect();
-                values.sort_by(f64::total_cmp);
-                *out = values[values.len() / 2];
-            }
-            DMat4::from_cols_array(&median)
+                .filter_map(|(&joint, ibm)| Some(*rest_model.get(joint)? * *ibm));
+            median(spaces).unwrap_or(DMat4::IDENTITY)
         })
         .collect()
+}
+
+/// The entry-wise median of the finite `matrices` (the upper one of an even count): their common value when most
+/// agree, whatever the others hold; `None` when there is none.
+pub(crate) fn median(matrices: impl Iterator<Item = DMat4>) -> Option<DMat4> {
+    let entries: Vec<[f64; 16]> =
+        matrices.map(|m| m.to_cols_array()).filter(|m| m.iter().all(|x| x.is_finite())).collect();
+    if entries.is_empty() {
+        return None;
+    }
+    let mut median = [0.0; 16];
+    for (entry, out) in median.iter_mut().enumerate() {
+        let mut values: Vec<f64> = entries.iter().map(|m| m[entry]).collect();
+        values.sort_by(f64::total_cmp);
+        *out = values[values.len() / 2];
+    }
+    Some(DMat4::from_cols_array(&median))
 }
 
 /// The rest pose's model matrices under the file's own modes.

@@ -160,10 +160,10 @@ impl<'a> Evaluation<'a> {
     }
 
     /// The size differences and tolerances are measured against: the largest bounding-box diagonal of the
-    /// character over `times` (the origins of the bones [`Rig::character_bones`] names at each time, with every
+    /// character over `times` (the origins of the figure's bones, [`Skeleton::figure`], at each time, with every
     /// skinned mesh at the first time); 1 when that is zero (a single bone), so relative figures stay meaningful.
     pub fn size(&self, times: &[f64]) -> f64 {
-        let character = self.rig.character_bones(self.clip);
+        let character = self.rig.skeleton.figure();
         let mut evaluator = self.evaluator();
         let mut size: f64 = 0.0;
         for (i, &time) in times.iter().enumerate() {

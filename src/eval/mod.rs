@@ -14,8 +14,8 @@ mod runs;
 mod sample;
 pub mod skinning;
 
-pub(crate) use bind::invert;
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
+pub(crate) use bind::{invert, median};
 pub use cursor::BoneCursor;
 pub use evaluation::{Evaluation, Evaluator};
 pub use hierarchy::{Hierarchy, ModelPose};

@@ -236,7 +236,8 @@ mod tests {
     use super::*;
 
     fn vec_track(times: &[f64], values: &[[f32; 3]], interpolation: Interpolation) -> Track<Vec3> {
-        Track::new(Arc::from(times), values.iter().map(|&v| Vec3::from(v)).collect(), interpolation).unwrap()
+        Track::new(Arc::from(times), values.iter().map(|&v| Vec3::from(v)).collect::<Arc<[_]>>(), interpolation)
+            .unwrap()
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //!   position channel names, which the channel replaces (Blender writes `offset + location` there);
 //! - rotation channels are Euler angles in degrees composed in the order the channels are listed, intrinsically:
 //!   `Zrotation Xrotation Yrotation` is `R = Rz·Rx·Ry`; position and rotation channels may be interleaved;
-//! - an `End Site` becomes a bone named `<parent>_end` with its offset as translation and no channels;
+//! - an `End Site` becomes a bone named `<parent>_end` with its offset as translation and no channels, in the role of
+//!   an end site (the tip of its parent's bone);
 //! - frame `k` is at `k · Frame Time` seconds (the frame time is kept at full precision), one LINEAR key per frame.
 //!
 //! Hostile files: counts are checked against what the file holds (a header claiming 2³² frames fails at the end of
@@ -23,7 +24,7 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 
 use super::failure::{Failure, Result};
 use super::{ImportError, budget, text};
-use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, NodeRole, Rig, Skeleton, Track, Transform};
 
 /// Reads a BVH file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8]) -> std::result::Result<Rig, ImportError> {
@@ -482,6 +483,7 @@ fn skeleton(joints: &[Joint]) -> Result<Skeleton> {
             parent: joint.parent,
             rest: Transform::from_trs(joint.offset.unwrap_or_default(), DQuat::IDENTITY, DVec3::ONE),
             inherit: InheritMode::Full,
+            role: if joint.end_site { NodeRole::EndSite } else { NodeRole::Joint },
         })
         .collect();
     // Cannot fail: a joint is declared after its parent.

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3, Quat, Vec3};
 
 use crate::model::{
-    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, Rig, Skeleton, Skin, Track, Transform, Unit,
+    Bone, BoneTracks, Clip, InheritMode, Interpolation, Mesh, NodeRole, Rig, Skeleton, Skin, Track, Transform, Unit,
 };
 
 /// Bone indices of the demo rig.
@@ -48,6 +48,7 @@ fn skeleton() -> Skeleton {
         parent,
         rest: Transform::from_trs(translation, DQuat::IDENTITY, DVec3::ONE),
         inherit: InheritMode::Full,
+        role: NodeRole::Joint,
     };
     Skeleton::new(vec![
         bone("shoulder", None, DVec3::new(0.0, 1.5, 0.0)),
@@ -71,7 +72,7 @@ fn bend(t: f64) -> Quat {
 }
 
 fn rotation_track(times: &Arc<[f64]>, rotation: impl Fn(f64) -> Quat) -> Track<Quat> {
-    Track::new(times.clone(), times.iter().map(|&t| rotation(t)).collect(), Interpolation::Linear)
+    Track::new(times.clone(), times.iter().map(|&t| rotation(t)).collect::<Arc<[_]>>(), Interpolation::Linear)
         .expect("demo keys are valid")
 }
 
@@ -85,7 +86,7 @@ fn stretch_clip() -> Clip {
     };
     let mut upper = BoneTracks::new(UPPER_ARM);
     upper.scale = Some(
-        Track::new(times.clone(), times.iter().map(|&t| scale(t)).collect(), Interpolation::Linear)
+        Track::new(times.clone(), times.iter().map(|&t| scale(t)).collect::<Arc<[_]>>(), Interpolation::Linear)
             .expect("demo keys are valid"),
     );
     let mut forearm = BoneTracks::new(FOREARM);
@@ -188,6 +189,7 @@ pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
             parent,
             rest: Transform::from_trs(offset, DQuat::IDENTITY, DVec3::ONE),
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         });
         let phase = b as f64 * 0.37;
         let mut t = BoneTracks::new(b);
@@ -196,7 +198,7 @@ pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
             Quat::from_rotation_z(angle as f32) * Quat::from_rotation_x((0.5 * angle) as f32)
         };
         t.rotation = Some(
-            Track::new(times.clone(), (0..key_count).map(rotation).collect(), Interpolation::Linear)
+            Track::new(times.clone(), (0..key_count).map(rotation).collect::<Arc<[_]>>(), Interpolation::Linear)
                 .expect("generated keys are valid"),
         );
         if b % 10 == 5 {
@@ -205,7 +207,7 @@ pub fn stress_rig(bones: usize, frames: usize, key_step: usize) -> Rig {
                 Vec3::new(s as f32, (1.0 / s) as f32, 1.0)
             };
             t.scale = Some(
-                Track::new(times.clone(), (0..key_count).map(scale).collect(), Interpolation::Linear)
+                Track::new(times.clone(), (0..key_count).map(scale).collect::<Arc<[_]>>(), Interpolation::Linear)
                     .expect("generated keys are valid"),
             );
         }

@@ -102,7 +102,7 @@ mod tests {
     use glam::DQuat;
 
     use super::*;
-    use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, Skeleton, Transform};
+    use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, NodeRole, Skeleton, Transform};
 
     /// A chain of bones, each scaled by `scale` and moved by `offset` at rest.
     fn chain(depth: usize, scale: f64, offset: f64) -> Rig {
@@ -113,6 +113,7 @@ mod tests {
                 parent: i.checked_sub(1),
                 rest: Transform::from_trs(DVec3::new(offset, 0.0, 0.0), DQuat::IDENTITY, DVec3::splat(scale)),
                 inherit: InheritMode::Full,
+                role: NodeRole::Joint,
             })
             .collect();
         Rig {

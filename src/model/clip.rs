@@ -34,7 +34,8 @@ impl Interpolation {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track<T> {
     times: Arc<[f64]>,
-    values: Vec<T>,
+    /// Shared, like the times, by the tracks of channels that read one sampler's output.
+    values: Arc<[T]>,
     interpolation: Interpolation,
 }
 
@@ -95,7 +96,12 @@ impl<T: KeyValue> Track<T> {
     /// splines, at least two keys); every value finite. Keys closer than [`KEY_TIME_RESOLUTION`] (equal times
     /// included, as exporters and zero-filled accessors write them) count once: the last of them holds from that
     /// time on, as a jump does.
-    pub fn new(times: Arc<[f64]>, values: Vec<T>, interpolation: Interpolation) -> Result<Self, TrackError> {
+    pub fn new(
+        times: Arc<[f64]>,
+        values: impl Into<Arc<[T]>>,
+        interpolation: Interpolation,
+    ) -> Result<Self, TrackError> {
+        let values = values.into();
         if times.is_empty() {
             return Err(TrackError::Empty);
         }
@@ -156,10 +162,44 @@ impl<T> Track<T> {
 /// Frames per second assumed for a clip whose keys show no rate.
 pub const DEFAULT_FRAME_RATE: f64 = 30.0;
 
-/// The rate of the most common spacing between consecutive key times of each array, rounded to 1/1000 fps (at least
-/// a quarter of the spacings, and at least two, must agree, so scattered keys give none): 24 for keys 1/24 s apart,
-/// even with some keys missing.
+/// The frame rate the key times show, for a format that states none: the slowest rate whose frames every key lands
+/// on ([`grid_rate`]), else the most common spacing between keys ([`spacing_rate`]).
 fn key_rate(arrays: Vec<&[f64]>) -> Option<f64> {
+    grid_rate(&arrays).or_else(|| spacing_rate(&arrays))
+}
+
+/// Frame rates animation is commonly authored at, tried first, slowest first: keys at whole seconds are at 24 fps,
+/// not 1, and keys every other frame of 60 fps at 30, not 15 (any rate whose frames hold every key is right about
+/// the keys; a standard one is also likely the scene's).
+const STANDARD_RATES: [f64; 9] = [24.0, 25.0, 30.0, 48.0, 50.0, 60.0, 100.0, 120.0, 240.0];
+
+/// The fastest rate tried for a grid; finer key times are read by their spacing.
+const MAX_GRID_RATE: u32 = 240;
+
+/// The slowest frame rate, standard ones first, then every whole rate up to [`MAX_GRID_RATE`] fps, on whose frames
+/// every key time lies (within single precision); `None` when no rate fits, or when every key sits at t = 0 (any
+/// rate would). An exporter that keys only some frames (Blender's cubic splines: every 15th) still shows its rate,
+/// where the spacing of the keys would show 2 fps.
+fn grid_rate(arrays: &[&[f64]]) -> Option<f64> {
+    let times = || arrays.iter().flat_map(|times| times.iter().copied());
+    if !times().any(|t| t > 0.0) {
+        return None;
+    }
+    let whole_rates = (1..=MAX_GRID_RATE).map(f64::from);
+    STANDARD_RATES.into_iter().chain(whole_rates).find(|&rate| times().all(|t| on_frame(t, rate)))
+}
+
+/// Whether `time` is a whole frame at `rate`, within the rounding of a single-precision time (half a unit in the
+/// last place, so `2⁻²⁴ · time` seconds; four times that allowed).
+fn on_frame(time: f64, rate: f64) -> bool {
+    let frame = time * rate;
+    (frame - frame.round()).abs() <= 2.0 * f64::from(f32::EPSILON) * frame.abs()
+}
+
+/// The rate of the most common spacing between consecutive key times of each array, rounded to 1/1000 fps (at least
+/// a quarter of the spacings, and at least two, must agree, so scattered keys give none): 29.97 for keys 1001/30000 s
+/// apart, even with some keys missing.
+fn spacing_rate(arrays: &[&[f64]]) -> Option<f64> {
     let mut counts: std::collections::BTreeMap<u64, usize> = std::collections::BTreeMap::new();
     let mut total = 0;
     for gap in arrays.iter().flat_map(|times| times.windows(2)).map(|w| w[1] - w[0]).filter(|&gap| gap > 1e-6) {
@@ -192,7 +232,7 @@ pub const KEY_TIME_RESOLUTION: f64 = 1.0 / 46_186_158_000.0;
 
 /// Sorted `times` and their keys (`per_key` values each) with each run of keys closer than
 /// [`KEY_TIME_RESOLUTION`] to the previous one reduced to its last key; the inputs themselves when there is none.
-fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Vec<T>, per_key: usize) -> (Arc<[f64]>, Vec<T>) {
+fn merge_close_keys<T: Copy>(times: Arc<[f64]>, values: Arc<[T]>, per_key: usize) -> (Arc<[f64]>, Arc<[T]>) {
     let close = |w: &[f64]| w[1] - w[0] < KEY_TIME_RESOLUTION;
     if !times.windows(2).fold(false, |any, w| any | close(w)) {
         return (times, values);
@@ -267,7 +307,7 @@ pub struct Clip {
     /// Sorted by bone, at most one entry per bone.
     morph: Vec<MorphWeights>,
     duration: f64,
-    /// Frames per second: the rate the file states (FBX, BVH), else the most common key spacing (see
+    /// Frames per second: the rate the file states (FBX, BVH), else the rate its key times show (see
     /// [`Clip::frame_rate`]).
     frame_rate: Option<f64>,
 }
@@ -283,10 +323,10 @@ impl Clip {
         Clip { index, name, tracks, morph, duration, frame_rate: None }
     }
 
-    /// The clip with the rate of its most common key spacing as its frame rate, for a format that states none
-    /// (glTF): a file exported at 24 fps has keys 1/24 s apart. Gaps are counted within each time array, so no
-    /// merge of the arrays is needed.
-    pub fn with_key_spacing_rate(mut self) -> Self {
+    /// The clip with the rate its key times show as its frame rate, for a format that states none (glTF): the
+    /// slowest (standard first) rate on whose frames every key lies, so a file exported at 24 fps reads as 24 fps
+    /// however few of its frames are keyed; else the rate of the most common spacing between keys.
+    pub fn with_key_rate(mut self) -> Self {
         self.frame_rate = key_rate(self.time_arrays());
         self
     }
@@ -299,8 +339,8 @@ impl Clip {
         self
     }
 
-    /// Frames per second of the clip: the file's own rate where it states one (FBX, BVH), else the rate of its
-    /// most common key spacing where the importer measured it ([`Clip::with_key_spacing_rate`]), else 30.
+    /// Frames per second of the clip: the file's own rate where it states one (FBX, BVH), else the rate its key
+    /// times show where the importer measured it ([`Clip::with_key_rate`]), else 30.
     pub fn frame_rate(&self) -> f64 {
         self.frame_rate.unwrap_or(DEFAULT_FRAME_RATE)
     }
@@ -360,22 +400,79 @@ impl Clip {
 mod tests {
     use super::*;
 
+    /// A clip whose one track has keys at `times` (rounded to single precision, as glTF stores them), its rate read
+    /// from them.
+    fn keyed_at(times: impl IntoIterator<Item = f64>) -> Clip {
+        let times: Vec<f64> = times.into_iter().map(|t| f64::from(t as f32)).collect();
+        let n = times.len();
+        let mut tracks = BoneTracks::new(0);
+        tracks.translation = Some(Track::new(times.into(), vec![Vec3::ZERO; n], Interpolation::Linear).unwrap());
+        Clip::new(0, None, vec![tracks], vec![]).with_key_rate()
+    }
+
     #[test]
-    fn the_frame_rate_is_the_files_or_the_key_spacing() {
-        let track = |times: Vec<f64>| {
-            let n = times.len();
-            let mut tracks = BoneTracks::new(0);
-            tracks.translation = Some(Track::new(times.into(), vec![Vec3::ZERO; n], Interpolation::Linear).unwrap());
-            Clip::new(0, None, vec![tracks], vec![]).with_key_spacing_rate()
-        };
-        // Keys 1/24 s apart with one missing: 24 fps (to 1/1000 fps).
+    fn the_frame_rate_is_the_files_or_the_key_times() {
+        // Keys 1/24 s apart with one missing: 24 fps.
         let mut times: Vec<f64> = (0..48).map(|k| f64::from(k) / 24.0).collect();
         times.remove(7);
-        assert_eq!(track(times.clone()).frame_rate(), 24.0);
-        // Scattered keys: no rate, 30 assumed; a stated rate wins over the spacing.
-        assert_eq!(track(vec![0.0, 0.3, 0.35, 1.1, 1.7]).frame_rate(), DEFAULT_FRAME_RATE);
-        assert_eq!(track(times).with_frame_rate(120.0).frame_rate(), 120.0);
-        assert_eq!(track(vec![0.0]).with_frame_rate(f64::NAN).frame_rate(), DEFAULT_FRAME_RATE);
+        assert_eq!(keyed_at(times.clone()).frame_rate(), 24.0);
+        // Blender's cubic splines key every 15th frame of 30 fps from frame 1: spaced 0.5 s, but at 30 fps.
+        assert_eq!(keyed_at((0..5).map(|k| f64::from(1 + 15 * k) / 30.0)).frame_rate(), 30.0);
+        // Every other frame of 60 fps lies on 30 fps's frames, the slower standard rate; every third (k/20 s) on
+        // none of 24's, 25's, 30's, 48's or 50's.
+        assert_eq!(keyed_at((0..30).map(|k| f64::from(2 * k) / 60.0)).frame_rate(), 30.0);
+        assert_eq!(keyed_at((0..30).map(|k| f64::from(3 * k) / 60.0)).frame_rate(), 60.0);
+        // Frames no standard rate holds: the slowest whole rate that does (7 fps), else the spacing (NTSC 29.97,
+        // rounded to 1/1000 fps, whose frames no whole rate up to 240 holds).
+        assert_eq!(keyed_at((0..20).map(|k| f64::from(k) / 7.0)).frame_rate(), 7.0);
+        assert_eq!(keyed_at((0..60).map(|k| f64::from(k) * 1001.0 / 30000.0)).frame_rate(), 29.97);
+        // Scattered keys: no rate, 30 assumed; keys only at 0 show none either; a stated rate wins over the keys.
+        assert_eq!(keyed_at([0.0, 0.314159, 0.35, 1.1, 1.7]).frame_rate(), DEFAULT_FRAME_RATE);
+        assert_eq!(keyed_at([0.0]).frame_rate(), DEFAULT_FRAME_RATE);
+        assert_eq!(keyed_at(times).with_frame_rate(120.0).frame_rate(), 120.0);
+        assert_eq!(keyed_at([0.0]).with_frame_rate(f64::NAN).frame_rate(), DEFAULT_FRAME_RATE);
+    }
+
+    #[test]
+    fn a_frame_is_whole_within_single_precision() {
+        // 1/30 s is 0.033333335 in f32: 1.00000004 frames, on the frame; a tenth of a millisecond off is not.
+        assert!(on_frame(f64::from(1.0f32 / 30.0), 30.0));
+        assert!(!on_frame(1.0 / 30.0 + 1e-4, 30.0));
+        // An hour in: f32 times are 1/4096 s apart, still within the tolerance of whole frames at 24 fps.
+        assert!(on_frame(f64::from((86_399.0f64 / 24.0) as f32), 24.0));
+        assert!(!on_frame(3600.0 + 0.5 / 24.0, 24.0));
+    }
+
+    /// The slowest standard rate whose frames hold the frames `frames` of `rate`: frame k at rate r is frame k·r'/r
+    /// at r', whole for every k exactly when r'·gcd(k) is a multiple of r. Exact integer arithmetic on frame
+    /// numbers, independent of the floating-point test on times.
+    fn slowest_standard_rate_holding(rate: u64, frames: &[u64]) -> Option<f64> {
+        let gcd = frames.iter().fold(0, |g, &k| num_gcd(g, k));
+        STANDARD_RATES.into_iter().find(|&other| (other as u64 * gcd).is_multiple_of(rate))
+    }
+
+    fn num_gcd(a: u64, b: u64) -> u64 {
+        if b == 0 { a } else { num_gcd(b, a % b) }
+    }
+
+    proptest::proptest! {
+        /// Any subset of a standard rate's frames (over a minute, as single-precision times) reads as the slowest
+        /// standard rate on whose frames they all lie: the rate itself when two keys are one frame apart, else a
+        /// rate its frames lie on too (24 for every other frame of 48), by the exact arithmetic above.
+        #[test]
+        fn a_subset_of_a_standard_rates_frames_reads_as_the_slowest_rate_holding_them(
+            rate in proptest::sample::select(STANDARD_RATES.to_vec()),
+            frames in proptest::collection::btree_set(0u64..4000, 2..40),
+        ) {
+            let frames: Vec<u64> = frames.into_iter().collect();
+            let clip = keyed_at(frames.iter().map(|&k| k as f64 / rate));
+            let expected = slowest_standard_rate_holding(rate as u64, &frames);
+            proptest::prop_assert!(expected.is_some(), "the rate itself holds them");
+            proptest::prop_assert_eq!(clip.frame_rate(), expected.unwrap_or_default());
+            if frames.windows(2).any(|w| w[1] - w[0] == 1) {
+                proptest::prop_assert_eq!(clip.frame_rate(), rate);
+            }
+        }
     }
 
     fn times(t: &[f64]) -> Arc<[f64]> {

@@ -16,7 +16,7 @@ pub use clip::{
 pub use inherit::{InheritMode, ModeChoice, UnknownInheritMode, UnknownModeChoice};
 #[cfg(test)]
 pub(crate) use skeleton::named as named_skeleton;
-pub use skeleton::{Bone, ParentOrderError, Skeleton};
+pub use skeleton::{Bone, NodeRole, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
@@ -71,24 +71,6 @@ impl Rig {
         let held = |clip: &Clip| clip.tracks_of(bone).map_or(Some(*rest), |tracks| tracks.held(rest));
         rest.only_converts() && self.clips.iter().all(|clip| held(clip).is_some_and(|h| h.only_converts()))
     }
-
-    /// For each bone, whether it belongs to the character: the bones `clip` animates and the skins' joints, so that a
-    /// file's cameras, lights and helpers far from it (FBX exports often carry six "Producer" cameras 150 m out)
-    /// stay out of its size and framing; every bone when that leaves none.
-    pub fn character_bones(&self, clip: Option<&Clip>) -> Vec<bool> {
-        let mut character = vec![false; self.skeleton.len()];
-        let animated = clip.into_iter().flat_map(|c| c.tracks().iter().map(|t| t.bone));
-        let joints = self.skins.iter().flat_map(|s| s.joints.iter().copied());
-        for bone in animated.chain(joints) {
-            if let Some(c) = character.get_mut(bone) {
-                *c = true;
-            }
-        }
-        if !character.contains(&true) {
-            character.fill(true);
-        }
-        character
-    }
 }
 
 #[cfg(test)]
@@ -101,8 +83,7 @@ mod tests {
 
     #[test]
     fn conversion_nodes_are_static_tops_that_only_convert_and_carry_something() {
-        let bone =
-            |name: &str, parent, rest| Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full };
+        let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
         let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
         let up = Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE);
         let bones = vec![

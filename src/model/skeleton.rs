@@ -14,6 +14,55 @@ pub struct Bone {
     pub rest: Transform,
     /// The mode the file declares (`full` where the format has no such notion).
     pub inherit: InheritMode,
+    /// What the node is: a joint of the figure or something the file carries beside it.
+    pub role: NodeRole,
+}
+
+impl Bone {
+    /// A joint under `parent` that inherits fully, of node 0: what hand-built rigs start from (other fields by struct
+    /// update).
+    pub fn joint(name: impl Into<String>, parent: Option<usize>, rest: Transform) -> Bone {
+        Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full, role: NodeRole::Joint }
+    }
+}
+
+/// What a node of the source scene is. Files carry more than the character: DCC exports keep their cameras (3ds Max
+/// writes six "Producer" cameras 150 m out), lights, camera targets, IK effectors and meshes as nodes beside the
+/// joints. Those are listed apart, neither drawn as bones nor framed by default (see [`NodeRole::is_figure`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum NodeRole {
+    /// A joint of the skeleton (an FBX limb node or skin cluster's bone, a glTF skin joint or animated node, a BVH
+    /// joint), or a node joints hang from (a null above the hips moves the whole figure).
+    #[default]
+    Joint,
+    /// The tip of a chain: a BVH `End Site`, where its parent's bone ends; no bone of its own starts there.
+    EndSite,
+    /// A node that shows a mesh and is no joint.
+    Mesh,
+    Camera,
+    Light,
+    /// Any other node: an FBX null or marker (a camera's target, an IK effector), a glTF node with no part in a
+    /// skin or the animation.
+    Helper,
+}
+
+impl NodeRole {
+    /// Whether the node belongs to the figure: the joints and their tips, which are drawn as bones and framed.
+    pub fn is_figure(self) -> bool {
+        matches!(self, NodeRole::Joint | NodeRole::EndSite)
+    }
+
+    /// The role in a word, for lists.
+    pub fn label(self) -> &'static str {
+        match self {
+            NodeRole::Joint => "joint",
+            NodeRole::EndSite => "end site",
+            NodeRole::Mesh => "mesh",
+            NodeRole::Camera => "camera",
+            NodeRole::Light => "light",
+            NodeRole::Helper => "helper",
+        }
+    }
 }
 
 /// Bones in parents-first order.
@@ -32,11 +81,21 @@ pub struct ParentOrderError {
 }
 
 impl Skeleton {
-    /// Builds a skeleton, checking that every parent comes before its children.
-    pub fn new(bones: Vec<Bone>) -> Result<Self, ParentOrderError> {
+    /// Builds a skeleton, checking that every parent comes before its children. A node that figure bones hang from
+    /// is a joint whatever the file made of it: its transform moves them.
+    pub fn new(mut bones: Vec<Bone>) -> Result<Self, ParentOrderError> {
         for (index, bone) in bones.iter().enumerate() {
             if let Some(parent) = bone.parent.filter(|&p| p >= index) {
                 return Err(ParentOrderError { bone: index, name: bone.name.clone(), parent });
+            }
+        }
+        // Children come after their parents: walking backwards reaches every descendant before its ancestors.
+        for index in (0..bones.len()).rev() {
+            if let Some(parent) = bones[index].parent
+                && bones[index].role.is_figure()
+                && !bones[parent].role.is_figure()
+            {
+                bones[parent].role = NodeRole::Joint;
             }
         }
         Ok(Skeleton { bones })
@@ -80,6 +139,13 @@ impl Skeleton {
     /// The mode `choice` gives each bone.
     pub fn modes(&self, choice: ModeChoice) -> Vec<InheritMode> {
         self.bones.iter().map(|b| choice.mode_for(b.inherit)).collect()
+    }
+
+    /// Per bone, whether it belongs to the figure ([`NodeRole::is_figure`]); every bone when none does (a file of
+    /// nulls or of rigid meshes has nothing else to show).
+    pub fn figure(&self) -> Vec<bool> {
+        let figure: Vec<bool> = self.bones.iter().map(|b| b.role.is_figure()).collect();
+        if figure.contains(&true) { figure } else { vec![true; figure.len()] }
     }
 
     /// The rest pose, one local transform per bone.
@@ -128,6 +194,7 @@ pub(crate) fn named(bones: &[(&str, Option<usize>)]) -> Skeleton {
         parent: *parent,
         rest: Transform::IDENTITY,
         inherit: InheritMode::Full,
+        role: NodeRole::Joint,
     };
     Skeleton::new(bones.iter().map(bone).collect()).expect("parents first")
 }
@@ -137,7 +204,14 @@ mod tests {
     use super::*;
 
     fn bone(name: &str, parent: Option<usize>) -> Bone {
-        Bone { name: name.into(), node: 0, parent, rest: Transform::IDENTITY, inherit: InheritMode::Full }
+        Bone {
+            name: name.into(),
+            node: 0,
+            parent,
+            rest: Transform::IDENTITY,
+            inherit: InheritMode::Full,
+            role: NodeRole::Joint,
+        }
     }
 
     #[test]
@@ -154,5 +228,29 @@ mod tests {
         assert_eq!(s.depths(), vec![0, 1, 2, 1]);
         assert!(s.is_in_subtree(2, 1) && s.is_in_subtree(2, 0) && !s.is_in_subtree(3, 1));
         assert_eq!(s.find("c"), Some(3));
+    }
+
+    #[test]
+    fn nodes_that_joints_hang_from_are_joints_and_the_rest_keep_their_role() {
+        // scene (null) → armature (null) → hips (joint) → tip (end site); scene → camera → target (null);
+        // scene → body (mesh).
+        let with_role = |name: &str, parent: Option<usize>, role: NodeRole| Bone { role, ..bone(name, parent) };
+        let s = Skeleton::new(vec![
+            with_role("scene", None, NodeRole::Helper),
+            with_role("armature", Some(0), NodeRole::Helper),
+            with_role("hips", Some(1), NodeRole::Joint),
+            with_role("tip", Some(2), NodeRole::EndSite),
+            with_role("camera", Some(0), NodeRole::Camera),
+            with_role("target", Some(4), NodeRole::Helper),
+            with_role("body", Some(0), NodeRole::Mesh),
+        ])
+        .unwrap();
+        let roles: Vec<NodeRole> = s.bones().iter().map(|b| b.role).collect();
+        use NodeRole::*;
+        assert_eq!(roles, [Joint, Joint, Joint, EndSite, Camera, Helper, Mesh]);
+        assert_eq!(s.figure(), [true, true, true, true, false, false, false]);
+        // Nothing of the figure: every node is shown rather than none.
+        let nulls = Skeleton::new(vec![with_role("a", None, Helper), with_role("b", Some(0), Mesh)]).unwrap();
+        assert_eq!(nulls.figure(), [true, true]);
     }
 }

@@ -53,7 +53,7 @@ impl Transform {
     }
 
     /// Whether the transform only changes axis conventions and units: no translation, and a linear part that maps
-    /// each axis onto ± another, all scaled alike (quarter turns, mirrors, a uniform scale), to [`CONVERTS`].
+    /// each axis onto ± another, all scaled alike (quarter turns, mirrors, a uniform scale), to within `CONVERTS` of its length.
     pub fn only_converts(&self) -> bool {
         let linear = DMat3::from_quat(self.rotation) * self.scale_matrix();
         let scale = linear.x_axis.length();

@@ -216,6 +216,8 @@ impl Camera {
 #[derive(Clone, Copy, Debug)]
 pub struct Projection {
     view_projection: DMat4,
+    /// The screen's right in model space.
+    right: DVec3,
     origin: DVec2,
     size: DVec2,
 }
@@ -224,7 +226,17 @@ impl Projection {
     /// `origin` is the rectangle's top-left corner, `size` its width and height, in points.
     pub fn new(camera: &Camera, origin: DVec2, size: DVec2) -> Self {
         let aspect = if size.y > 0.0 { size.x / size.y } else { 1.0 };
-        Projection { view_projection: camera.view_projection(aspect), origin, size }
+        let (direction, up) = camera.eye_direction();
+        let right = up.cross(direction).normalize_or_zero();
+        Projection { view_projection: camera.view_projection(aspect), right, origin, size }
+    }
+
+    /// How long a model-space length of 1 at `p`, across the line of sight, is on screen, in points; `None` behind
+    /// the eye. (Across the line of sight the perspective divide is the same at both ends, so this is exact.)
+    pub fn points_per_unit(&self, p: DVec3) -> Option<f64> {
+        let (a, _) = self.project(p)?;
+        let (b, _) = self.project(p + self.right)?;
+        Some(a.distance(b))
     }
 
     /// The screen position and depth (larger is farther) of `p`; `None` behind the eye.
@@ -288,6 +300,26 @@ mod tests {
             assert!(filled > tight, "{view:?}: the box fills only {filled} of the picture");
         }
         assert!(Bounds::of([DVec3::NAN]).is_none());
+    }
+
+    #[test]
+    fn a_unit_across_the_line_of_sight_measures_what_the_field_of_view_gives() {
+        // 100 points of height show 2·distance·tan(fov/2) at the target, in every view; in perspective a point
+        // twice as far looks half as long, in the 2D views the same.
+        let camera = Camera { yaw: 0.3, pitch: 0.2, ..Camera::default() };
+        let visible = 2.0 * camera.distance * (FOV_Y * 0.5).tan();
+        for view in ViewKind::ALL {
+            let camera = Camera { view, ..camera };
+            let p = projection(&camera);
+            let at_target = p.points_per_unit(camera.target).unwrap();
+            assert!((at_target - 100.0 / visible).abs() < 1e-9, "{view:?}: {at_target}");
+            let (back, _) = camera.eye_direction();
+            let farther = p.points_per_unit(camera.target - back * camera.distance).unwrap();
+            let expected = if view == ViewKind::Persp { at_target / 2.0 } else { at_target };
+            assert!((farther - expected).abs() < 1e-9, "{view:?}: {farther}");
+        }
+        let camera = Camera::default();
+        assert_eq!(projection(&camera).points_per_unit(camera.eye() + (camera.eye() - camera.target)), None);
     }
 
     #[test]

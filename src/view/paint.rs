@@ -58,10 +58,10 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         paint_sorted(&painter, ghost_triangles);
         let faded = |c: Color32| c.gamma_multiply(0.45);
         if options.boxes {
-            paint_boxes(&painter, &projection, ghost, scene.gizmo_unit, |bone| faded(box_color(ghost, bone, palette)));
+            paint_boxes(&painter, &projection, scene, ghost, |bone| faded(box_color(ghost, bone, palette)));
         }
         if options.axes {
-            paint_axes(&painter, &projection, ghost, scene.gizmo_unit, faded);
+            paint_axes(&painter, &projection, scene, ghost, faded);
         }
     }
     if options.bones {
@@ -74,10 +74,10 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
     }
     if options.boxes {
         let drawn = &scene.primary;
-        paint_boxes(&painter, &projection, drawn, scene.gizmo_unit, |bone| box_color(drawn, bone, palette));
+        paint_boxes(&painter, &projection, scene, drawn, |bone| box_color(drawn, bone, palette));
     }
     if options.axes {
-        paint_axes(&painter, &projection, &scene.primary, scene.gizmo_unit, |c| c);
+        paint_axes(&painter, &projection, scene, &scene.primary, |c| c);
     }
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
@@ -114,7 +114,7 @@ pub fn pick(scene: &Scene, camera: &Camera, rect: Rect, at: Pos2) -> Option<usiz
     let projection = projection(camera, picture_rect(rect, scene));
     let at = glam::Vec2::new(at.x, at.y);
     let mut best: Option<(f32, usize)> = None;
-    for bone in 0..scene.primary.model.len() {
+    for bone in (0..scene.primary.model.len()).filter(|&b| scene.shows(b)) {
         let Some(head) = screen(&projection, scene.primary.head(bone)) else { continue };
         let head = glam::Vec2::new(head.x, head.y);
         let tail =
@@ -234,7 +234,7 @@ fn bone_triangles(
     tint: Option<Color32>,
 ) {
     let eye = camera.eye();
-    for bone in 0..drawn.model.len() {
+    for bone in (0..drawn.model.len()).filter(|&b| scene.shows(b)) {
         let head = drawn.head(bone);
         let Some(tail) = scene.tail(drawn, bone) else { continue };
         let along = tail - head;
@@ -279,17 +279,29 @@ fn box_color(drawn: &DrawnPose, bone: usize, palette: &Palette) -> Color32 {
     drawn.finding_color(bone).unwrap_or(palette.bone.gamma_multiply(0.6))
 }
 
-/// Each bone's matrix applied to a cube of side `unit` (in the bone's own units, see [`Scene::gizmo_unit`])
-/// centred on the joint: shear slants it, non-uniform scale stretches it.
+/// The smallest length, in points, axis triads and boxes are drawn with (at the rig's typical scale): like a DCC's
+/// manipulators they stay readable however far the view is zoomed out.
+const MIN_GIZMO: f64 = 16.0;
+
+/// The gizmo unit ([`Scene::gizmo_unit`]) for a joint at `at`: enlarged where a gizmo of the rig's typical scale
+/// would be drawn shorter than [`MIN_GIZMO`], so a bone's own scale and shear still show in proportion.
+fn gizmo_unit(scene: &Scene, projection: &Projection, at: DVec3) -> f64 {
+    let drawn = projection.points_per_unit(at).map_or(0.0, |k| k * scene.gizmo_size);
+    let enlarge = if drawn > 0.0 && drawn.is_finite() { (MIN_GIZMO / drawn).max(1.0) } else { 1.0 };
+    scene.gizmo_unit * enlarge
+}
+
+/// Each shown bone's matrix applied to a cube of side [`gizmo_unit`] (in the bone's own units) centred on the
+/// joint: shear slants it, non-uniform scale stretches it.
 fn paint_boxes(
     painter: &Painter,
     projection: &Projection,
+    scene: &Scene,
     drawn: &DrawnPose,
-    unit: f64,
     color_of: impl Fn(usize) -> Color32,
 ) {
-    let h = unit * 0.5;
-    for (bone, model) in drawn.model.iter().enumerate() {
+    for (bone, model) in drawn.model.iter().enumerate().filter(|(b, _)| scene.shows(*b)) {
+        let h = gizmo_unit(scene, projection, model.w_axis.truncate()) * 0.5;
         let corner = |i: usize| {
             let pick = |bit: usize| if i & bit == 0 { -h } else { h };
             model.transform_point3(DVec3::new(pick(1), pick(2), pick(4)))
@@ -301,18 +313,19 @@ fn paint_boxes(
     }
 }
 
-/// Axis triads from the model matrix columns times `unit` (see [`Scene::gizmo_unit`]): their lengths show scale,
+/// Axis triads of the shown bones from their model matrix columns times [`gizmo_unit`]: their lengths show scale,
 /// their angles show shear.
 fn paint_axes(
     painter: &Painter,
     projection: &Projection,
+    scene: &Scene,
     drawn: &DrawnPose,
-    unit: f64,
     tint: impl Fn(Color32) -> Color32,
 ) {
     let palette_axes = Palette::new(true).axes;
-    for model in &drawn.model {
+    for (_, model) in drawn.model.iter().enumerate().filter(|(b, _)| scene.shows(*b)) {
         let origin = model.w_axis.truncate();
+        let unit = gizmo_unit(scene, projection, origin);
         for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
             line(painter, projection, origin, origin + axis.truncate() * unit, Stroke::new(2.0, tint(color)));
         }
@@ -321,7 +334,7 @@ fn paint_axes(
 
 fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palette: &Palette) {
     let drawn = &scene.primary;
-    for bone in 0..drawn.model.len() {
+    for bone in (0..drawn.model.len()).filter(|&b| scene.shows(b)) {
         let Some(p) = screen(projection, drawn.head(bone)) else { continue };
         let selected = scene.selected.contains(&bone);
         let color = bone_color(scene, drawn, bone, palette);
@@ -367,6 +380,25 @@ mod tests {
     use super::*;
     use crate::import::demo_rig;
     use crate::view::{DrawnPose, SceneOptions};
+
+    #[test]
+    fn gizmos_keep_their_size_up_close_and_a_smallest_size_far_away() {
+        // The demo rig's typical scale is 1: a triad of `unit` is `unit · points_per_unit` long on screen.
+        let rig = demo_rig();
+        let scene = Scene::new(&rig, DrawnPose::default(), SceneOptions::default());
+        let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
+        let at = DVec3::new(0.0, 1.5, 0.0);
+        for (distance, on_screen) in [(2.0, None), (500.0, Some(MIN_GIZMO))] {
+            let camera = Camera { distance, target: at, ..Camera::default() };
+            let projection = projection(&camera, rect);
+            let unit = gizmo_unit(&scene, &projection, at);
+            let length = unit * projection.points_per_unit(at).unwrap();
+            match on_screen {
+                None => assert_eq!(unit, scene.gizmo_unit, "close up, the rig's own size ({length} points)"),
+                Some(points) => assert!((length - points).abs() < 1e-9, "far away, {length} points"),
+            }
+        }
+    }
 
     #[test]
     fn the_caption_has_its_own_strip_below_the_model() {

@@ -7,8 +7,8 @@ use super::camera::Bounds;
 use super::style::Badge;
 use crate::analysis::{Assessment, Findings, Tolerances};
 use crate::eval::skinning::skin_meshes_with;
-use crate::eval::{MorphPose, SkinningMethod, skin_meshes};
-use crate::model::{Clip, Rig};
+use crate::eval::{MorphPose, SkinningMethod, bind_model_matrices, skin_meshes};
+use crate::model::{Clip, NodeRole, Rig};
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -24,6 +24,8 @@ pub struct SceneOptions {
     pub boxes: bool,
     pub names: bool,
     pub bind_pose: bool,
+    /// Cameras, lights, meshes' nodes and other helpers the file carries beside the figure, drawn as bones too.
+    pub helpers: bool,
     pub legend: bool,
     /// How meshes are skinned: as the file declares, or linear / dual quaternion everywhere (engines differ).
     pub skinning: SkinningMethod,
@@ -40,6 +42,7 @@ impl Default for SceneOptions {
             boxes: false,
             names: false,
             bind_pose: false,
+            helpers: false,
             legend: true,
             skinning: SkinningMethod::AsFile,
         }
@@ -48,8 +51,8 @@ impl Default for SceneOptions {
 
 impl SceneOptions {
     /// The names `--show` takes, in toolbar order.
-    pub const NAMES: [&'static str; 9] =
-        ["bones", "axes", "boxes", "mesh", "wireframe", "bind-pose", "names", "grid", "legend"];
+    pub const NAMES: [&'static str; 10] =
+        ["bones", "axes", "boxes", "mesh", "wireframe", "bind-pose", "helpers", "names", "grid", "legend"];
 
     /// The switch called `name`.
     fn switch(&mut self, name: &str) -> Option<&mut bool> {
@@ -60,6 +63,7 @@ impl SceneOptions {
             "mesh" => &mut self.mesh,
             "wireframe" => &mut self.wireframe,
             "bind-pose" => &mut self.bind_pose,
+            "helpers" => &mut self.helpers,
             "names" => &mut self.names,
             "grid" => &mut self.grid,
             "legend" => &mut self.legend,
@@ -94,6 +98,7 @@ impl SceneOptions {
             boxes: false,
             names: false,
             bind_pose: false,
+            helpers: false,
             legend: false,
             skinning: SkinningMethod::AsFile,
         }
@@ -133,6 +138,22 @@ impl DrawnPose {
         Some(badge.color_for_shear(self.shear_deg.get(bone).copied().unwrap_or(0.0)))
     }
 
+    /// The bind pose to draw beside `pose`: where the skins were bound, in model space. A rig without skins (motion
+    /// capture) has only its rest pose, which stands wherever the file's offsets put it (a BVH's at the origin,
+    /// hips on the floor and legs below it, while the take walks away): each root is moved to where `pose` has it,
+    /// so the rest skeleton stands over the character.
+    pub fn bind(rig: &Rig, pose: &DrawnPose) -> DrawnPose {
+        let mut model = bind_model_matrices(rig);
+        if rig.skins.is_empty() && model.len() == pose.model.len() {
+            let mut shift = vec![DVec3::ZERO; model.len()];
+            for (bone, b) in rig.skeleton.bones().iter().enumerate() {
+                shift[bone] = b.parent.map_or_else(|| pose.head(bone) - model[bone].w_axis.truncate(), |p| shift[p]);
+                model[bone].w_axis += shift[bone].extend(0.0);
+            }
+        }
+        DrawnPose { model, ..DrawnPose::default() }
+    }
+
     pub fn head(&self, bone: usize) -> DVec3 {
         self.model[bone].w_axis.truncate()
     }
@@ -160,7 +181,11 @@ pub struct Scene<'a> {
     /// so a centimetre rig under a 0.01 conversion gets triads of `gizmo_size`, while a bone scaled or sheared
     /// relative to the rest shows it in the lengths and angles of its axes.
     pub gizmo_unit: f64,
-    /// Each bone's first child, found once (the tail of every bone is asked for each frame).
+    /// Per bone, whether it belongs to the figure ([`Skeleton::figure`](crate::model::Skeleton::figure)), found
+    /// once.
+    figure: Vec<bool>,
+    /// Each bone's first child of the figure (a helper below a joint, a camera's target, say, does not end its
+    /// bone), found once: the tail of every bone is asked for each frame.
     first_child: Vec<Option<usize>>,
 }
 
@@ -168,9 +193,10 @@ impl<'a> Scene<'a> {
     pub fn new(rig: &'a Rig, primary: DrawnPose, options: SceneOptions) -> Self {
         let gizmo_size = gizmo_size(rig);
         let gizmo_unit = gizmo_size / typical_scale(rig);
+        let figure = rig.skeleton.figure();
         let mut first_child = vec![None; rig.skeleton.len()];
         for (bone, b) in rig.skeleton.bones().iter().enumerate().rev() {
-            if let Some(parent) = b.parent {
+            if let Some(parent) = b.parent.filter(|&p| figure[bone] || !figure[p]) {
                 first_child[parent] = Some(bone);
             }
         }
@@ -185,23 +211,34 @@ impl<'a> Scene<'a> {
             options,
             gizmo_size,
             gizmo_unit,
+            figure,
             first_child,
         }
     }
 
-    /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on.
+    /// Whether `bone` is drawn: a bone of the figure, a helper when they are shown, or anything selected (picked in
+    /// the outliner's list of helpers, a camera shows where it is).
+    pub fn shows(&self, bone: usize) -> bool {
+        self.figure.get(bone).copied().unwrap_or(false) || self.options.helpers || self.selected.contains(&bone)
+    }
+
+    /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on. An
+    /// end site has none: it is the tail of its parent's bone.
     pub fn tail(&self, drawn: &DrawnPose, bone: usize) -> Option<DVec3> {
         if let Some(child) = self.first_child[bone] {
             return Some(drawn.head(child));
+        }
+        if self.rig.skeleton.bone(bone).role == NodeRole::EndSite {
+            return None;
         }
         let parent = self.rig.skeleton.parent(bone)?;
         let along = drawn.head(bone) - drawn.head(parent);
         (along.length() > 1e-9).then(|| drawn.head(bone) + along * 0.35)
     }
 
-    /// Everything the scene may draw, for framing the camera.
+    /// What framing the camera on this pose should keep in view: the figure's joints and the meshes.
     pub fn bounds(&self) -> Option<Bounds> {
-        let heads = (0..self.primary.model.len()).map(|b| self.primary.head(b));
+        let heads = self.primary.model.iter().zip(&self.figure).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
         let vertices = self.primary.meshes.iter().flatten().copied();
         Bounds::of(heads.chain(vertices))
     }
@@ -239,7 +276,7 @@ pub fn typical_scale(rig: &Rig) -> f64 {
 
 /// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `duration` by `pose_at`
 /// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
-/// matter count ([`Rig::character_bones`]), and the skinned meshes; the bounds grow by the size of the axis triads and
+/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes; the bounds grow by the size of the axis triads and
 /// boxes drawn around the joints.
 pub fn motion_bounds(
     rig: &Rig,
@@ -248,7 +285,7 @@ pub fn motion_bounds(
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
 ) -> Option<Bounds> {
-    let framed = rig.character_bones(clip);
+    let framed = rig.skeleton.figure();
     let mut morph = MorphPose::default();
     let bounds = (0..samples.max(1))
         .filter_map(|i| {
@@ -287,8 +324,42 @@ mod tests {
     }
 
     #[test]
-    fn the_typical_scale_is_the_median_uniform_scale_of_the_rest_pose() {
+    fn a_rig_without_skins_has_its_rest_pose_drawn_where_the_pose_stands() {
         use crate::model::{Bone, InheritMode, Skeleton, Transform};
+        // Mocap: hips at the origin at rest, a knee 0.5 below. The take has the hips at (5, 1, 2), turned.
+        let bone = |name: &str, parent: Option<usize>, y: f64| Bone {
+            name: name.into(),
+            node: 0,
+            parent,
+            rest: Transform::from_trs(DVec3::new(0.0, y, 0.0), glam::DQuat::IDENTITY, DVec3::ONE),
+            inherit: InheritMode::Full,
+            role: NodeRole::Joint,
+        };
+        let rig = Rig {
+            skeleton: Skeleton::new(vec![bone("hips", None, 0.0), bone("knee", Some(0), -0.5)]).unwrap(),
+            ..Rig::default()
+        };
+        let hips = DMat4::from_rotation_translation(glam::DQuat::from_rotation_y(1.0), DVec3::new(5.0, 1.0, 2.0));
+        let pose = DrawnPose {
+            model: vec![hips, hips * DMat4::from_translation(DVec3::new(0.0, -0.5, 0.0))],
+            ..DrawnPose::default()
+        };
+        let bind = DrawnPose::bind(&rig, &pose);
+        // Moved, not turned: the rest pose's own orientation, its hips where the take's are.
+        assert!(bind.head(0).abs_diff_eq(DVec3::new(5.0, 1.0, 2.0), 1e-12), "{}", bind.head(0));
+        assert!(bind.head(1).abs_diff_eq(DVec3::new(5.0, 0.5, 2.0), 1e-12), "{}", bind.head(1));
+        // With skins the bind pose is where the mesh was bound, wherever the pose is.
+        let demo = crate::import::demo_rig();
+        let far = DrawnPose {
+            model: vec![DMat4::from_translation(DVec3::splat(9.0)); demo.skeleton.len()],
+            ..DrawnPose::default()
+        };
+        assert_eq!(DrawnPose::bind(&demo, &far).model, bind_model_matrices(&demo));
+    }
+
+    #[test]
+    fn the_typical_scale_is_the_median_uniform_scale_of_the_rest_pose() {
+        use crate::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
         // A centimetre rig under a 0.01 conversion at its top: every bone's model matrix scales by 0.01, one bone
         // is stretched (2, 1, 0.5: cube root of the determinant 1) relative to it.
         let bone = |name: &str, parent: Option<usize>, scale: glam::DVec3| Bone {
@@ -297,6 +368,7 @@ mod tests {
             parent,
             rest: Transform::from_trs(glam::DVec3::X, glam::DQuat::IDENTITY, scale),
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         };
         let skeleton = Skeleton::new(vec![
             bone("root", None, glam::DVec3::splat(0.01)),

@@ -601,7 +601,37 @@ fn leniency() -> Vec<Case> {
             Expect::Refused("KHR_draco_mesh_compression"),
         ),
         Case::new("gltf_nan_weight", 8, "a.glb", nan_weight(), Expect::Loads("not finite")),
+        Case::new("fbx_nan_vertex", 8, "a.fbx", fbx_nan_vertex(), Expect::Loads("not finite")),
+        Case::new("gltf_eight_influences", 8, "a.glb", eight_influences(), Expect::Loads("more than 4 influences")),
     ]
+}
+
+/// A triangle with a vertex at NaN, shown by one mesh node.
+fn fbx_nan_vertex() -> Vec<u8> {
+    let objects = "\tGeometry: 1, \"Geometry::g\", \"Mesh\" {\n\t\tVertices: *9 {\n\t\t\ta: 0,0,0,1,0,0,nan,1,0\n\t\t}\n\
+                   \t\tPolygonVertexIndex: *3 {\n\t\t\ta: 0,1,-3\n\t\t}\n\t}\n\
+                   \tModel: 100, \"Model::m\", \"Mesh\" {\n\t\tVersion: 232\n\t}\n";
+    ascii_fbx(objects, "\tC: \"OO\",100,0\n\tC: \"OO\",1,100\n").into_bytes()
+}
+
+/// A skinned triangle whose first vertex has eight influences (`JOINTS_1`/`WEIGHTS_1`), on eight joints.
+fn eight_influences() -> Vec<u8> {
+    let mut g = Gltf::new();
+    let position = g.triangle_positions();
+    let joints_0 = g.u16s(&[0, 1, 2, 3, 0, 0, 0, 0, 0, 0, 0, 0], "VEC4", 4);
+    let joints_1 = g.u16s(&[4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0], "VEC4", 4);
+    let weights_0 = g.floats(&[0.125, 0.125, 0.125, 0.125, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0], "VEC4", 4);
+    let weights_1 = g.floats(&[0.125, 0.125, 0.125, 0.125, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0], "VEC4", 4);
+    g.mesh(json!({"attributes": {
+        "POSITION": position, "JOINTS_0": joints_0, "WEIGHTS_0": weights_0, "JOINTS_1": joints_1, "WEIGHTS_1": weights_1,
+    }}));
+    g.node(json!({"children": [1, 2, 3, 4, 5, 6, 7, 8, 9]}));
+    for _ in 0..8 {
+        g.node(json!({}));
+    }
+    g.node(json!({"mesh": 0, "skin": 0}));
+    g.json["skins"] = json!([{"joints": [1, 2, 3, 4, 5, 6, 7, 8]}]);
+    g.glb()
 }
 
 /// A skinned triangle one of whose vertices has a NaN weight.

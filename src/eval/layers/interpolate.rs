@@ -254,7 +254,8 @@ mod tests {
     use crate::eval::sample_track;
 
     fn x_track(times: &[f64], xs: &[f32], interpolation: Interpolation) -> Track<Vec3> {
-        Track::new(Arc::from(times), xs.iter().map(|&x| Vec3::new(x, 0.0, 0.0)).collect(), interpolation).unwrap()
+        Track::new(Arc::from(times), xs.iter().map(|&x| Vec3::new(x, 0.0, 0.0)).collect::<Arc<[_]>>(), interpolation)
+            .unwrap()
     }
 
     fn keys(keys: KeyInterpolation) -> Resampling {
@@ -306,7 +307,8 @@ mod tests {
 
     fn rotation_track(rotations: &[DQuat]) -> Track<Quat> {
         let times: Vec<f64> = (0..rotations.len()).map(|i| i as f64).collect();
-        Track::new(Arc::from(times), rotations.iter().map(|q| q.as_quat()).collect(), Interpolation::Linear).unwrap()
+        Track::new(Arc::from(times), rotations.iter().map(|q| q.as_quat()).collect::<Arc<[_]>>(), Interpolation::Linear)
+            .unwrap()
     }
 
     #[test]

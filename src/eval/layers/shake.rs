@@ -114,7 +114,7 @@ pub fn shake_pose(pose: &mut [Transform], modifiers: &[f64], params: &ShakeParam
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Bone, InheritMode};
+    use crate::model::{Bone, InheritMode, NodeRole};
 
     fn chain() -> Skeleton {
         let bone = |parent| Bone {
@@ -123,6 +123,7 @@ mod tests {
             parent,
             rest: Transform::IDENTITY,
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         };
         Skeleton::new(vec![bone(None), bone(Some(0)), bone(Some(1)), bone(Some(2)), bone(Some(0))]).unwrap()
     }

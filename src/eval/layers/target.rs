@@ -53,7 +53,7 @@ mod tests {
     use glam::DVec3;
 
     use super::*;
-    use crate::model::{Bone, InheritMode};
+    use crate::model::{Bone, InheritMode, NodeRole};
 
     fn arm() -> Skeleton {
         let bone = |parent, rotation| Bone {
@@ -62,6 +62,7 @@ mod tests {
             parent,
             rest: Transform::from_trs(DVec3::X, rotation, DVec3::ONE),
             inherit: InheritMode::Full,
+            role: NodeRole::Joint,
         };
         Skeleton::new(vec![
             bone(None, DQuat::from_rotation_z(FRAC_PI_2)),

@@ -3,11 +3,15 @@
 //! Every node below ufbx's synthetic root becomes a bone, depth first, children in file order. The root itself
 //! becomes a bone only when it carries a transform (it does not with the options bonescope loads with, but a bone
 //! list must not silently drop one). The walk uses an explicit stack.
+//!
+//! Each node's role comes from its FBX node attribute ([`role`]): limb nodes and the nodes skin clusters bind to are
+//! joints, cameras and lights are what they say, and a null, a marker (HumanIK's effectors) or anything else is a
+//! helper, unless joints hang from it ([`Skeleton::new`]).
 
 use glam::{DQuat, DVec3};
 
 use super::{Failure, Result, node_name};
-use crate::model::{Bone, InheritMode, Skeleton, Transform};
+use crate::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
 
 /// The skeleton and the node ↔ bone mapping.
 pub(super) struct SceneBones {
@@ -28,6 +32,13 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
         stack.push((root, None));
     }
     let mut counts = [0usize; 3];
+    // Skin clusters may bind to any node (a null, a mesh): what a mesh is bound to is a joint.
+    let mut bound = vec![false; node_count];
+    for node in scene.skin_clusters.iter().filter_map(|c| c.bone_node.as_ref()) {
+        if let Some(b) = bound.get_mut(node.element.typed_id as usize) {
+            *b = true;
+        }
+    }
     while let Some((node, parent)) = stack.pop() {
         let id = node.element.typed_id as usize;
         let Some(slot) = bone_of_node.get_mut(id) else {
@@ -44,7 +55,8 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
             InheritMode::Componentwise => 2,
             _ => 0,
         }] += 1;
-        bones.push(Bone { name: node_name(node), node: id, parent, rest: transform(node)?, inherit });
+        let role = if bound[id] { NodeRole::Joint } else { role(node) };
+        bones.push(Bone { name: node_name(node), node: id, parent, rest: transform(node)?, inherit, role });
         stack.extend(node.children.iter().rev().map(|c| (c.as_ref(), Some(bone))));
     }
     notes.push(format!(
@@ -58,6 +70,19 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
     }
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
     Ok(SceneBones { skeleton, bone_of_node })
+}
+
+/// What the node's attribute makes it (a node without one is a transform, a helper).
+fn role(node: &ufbx::Node) -> NodeRole {
+    match node.attrib_type {
+        ufbx::ElementType::Bone => NodeRole::Joint,
+        ufbx::ElementType::Mesh => NodeRole::Mesh,
+        ufbx::ElementType::Camera | ufbx::ElementType::StereoCamera | ufbx::ElementType::CameraSwitcher => {
+            NodeRole::Camera
+        }
+        ufbx::ElementType::Light => NodeRole::Light,
+        _ => NodeRole::Helper,
+    }
 }
 
 /// ufbx's reading of the file's InheritType, as a bonescope mode.

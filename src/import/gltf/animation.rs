@@ -10,6 +10,8 @@ use std::collections::hash_map::{Entry, HashMap};
 use std::collections::{BTreeMap, HashSet};
 use std::sync::Arc;
 
+use glam::{Quat, Vec3};
+
 use super::accessor::Accessors;
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
@@ -29,7 +31,15 @@ pub(super) fn read_clips(
     bone_of_node: &[Option<usize>],
     notes: &mut Vec<String>,
 ) -> Result<Vec<Clip>> {
-    let mut reader = Reader { root, accessors, bone_of_node, times: HashMap::new(), tally: Tally::default() };
+    let mut reader = Reader {
+        root,
+        accessors,
+        bone_of_node,
+        times: HashMap::new(),
+        vec3s: HashMap::new(),
+        rotations: HashMap::new(),
+        tally: Tally::default(),
+    };
     let clips = root.animations.iter().enumerate().map(|(i, a)| reader.clip(i, a)).collect::<Result<Vec<_>>>()?;
     let tally = reader.tally;
     if tally.outside_scene > 0 {
@@ -87,6 +97,10 @@ struct Reader<'a, 'd> {
     bone_of_node: &'a [Option<usize>],
     /// Key times by input accessor index.
     times: HashMap<Uint, Arc<[f64]>>,
+    /// Decoded outputs by accessor index: channels sharing a sampler share its values (2,000 channels of one
+    /// 100,000-key sampler are one decode, not 2,000).
+    vec3s: HashMap<Uint, Arc<[Vec3]>>,
+    rotations: HashMap<Uint, Arc<[Quat]>>,
     tally: Tally,
 }
 
@@ -128,15 +142,18 @@ impl Reader<'_, '_> {
             let bone_tracks = tracks.entry(bone).or_insert_with(|| BoneTracks::new(bone));
             match property {
                 Property::Translation => {
-                    let values = self.accessors.vec3s(output, &place, "translation output")?;
+                    let values = decoded(&mut self.vec3s, output, || {
+                        self.accessors.vec3s(output, &place, "translation output")
+                    })?;
                     bone_tracks.translation = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Scale => {
-                    let values = self.accessors.vec3s(output, &place, "scale output")?;
+                    let values =
+                        decoded(&mut self.vec3s, output, || self.accessors.vec3s(output, &place, "scale output"))?;
                     bone_tracks.scale = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Rotation => {
-                    let values = self.accessors.rotations(output, &place)?;
+                    let values = decoded(&mut self.rotations, output, || self.accessors.rotations(output, &place))?;
                     bone_tracks.rotation = Some(track(times, values, interpolation, &place)?);
                 }
                 Property::Weights => morph.push(self.morph_weights(bone, sampler, channel.sampler, index)?),
@@ -146,7 +163,7 @@ impl Reader<'_, '_> {
             .into_values()
             .filter(|t| t.translation.is_some() || t.rotation.is_some() || t.scale.is_some())
             .collect();
-        Ok(Clip::new(index, animation.name.clone(), tracks, morph).with_key_spacing_rate())
+        Ok(Clip::new(index, animation.name.clone(), tracks, morph).with_key_rate())
     }
 
     /// What `target` animates, checked to exist.
@@ -226,10 +243,22 @@ impl Reader<'_, '_> {
     }
 }
 
+/// The values of `accessor`, decoded by `decode` on first use.
+fn decoded<T>(
+    cache: &mut HashMap<Uint, Arc<[T]>>,
+    accessor: Uint,
+    decode: impl FnOnce() -> Result<Vec<T>>,
+) -> Result<Arc<[T]>> {
+    match cache.entry(accessor) {
+        Entry::Occupied(entry) => Ok(entry.get().clone()),
+        Entry::Vacant(entry) => Ok(entry.insert(decode()?.into()).clone()),
+    }
+}
+
 /// A checked track; what [`Track::new`] finds wrong is placed at the sampler.
 fn track<T: KeyValue>(
     times: Arc<[f64]>,
-    values: Vec<T>,
+    values: Arc<[T]>,
     interpolation: Interpolation,
     place: &str,
 ) -> Result<Track<T>> {

@@ -57,14 +57,15 @@ fn bones(root: &Root) -> Part {
     Part { bytes: nodes.saturating_mul(budget::BONE_BYTES), place: None, what: format!("{nodes} nodes as bones") }
 }
 
-/// Every channel's keys, each decoded into its own track; key times once per input.
+/// Every channel's keys; key times once per input and values once per output accessor (channels that share a
+/// sampler share its decoded values).
 fn clips(root: &Root) -> Part {
     let mut total = 0u64;
     let mut largest = (0u64, 0usize, 0u64);
     for (index, animation) in root.animations.iter().enumerate() {
         let mut bytes = 0u64;
         let mut keys = 0u64;
-        let mut inputs = HashSet::new();
+        let (mut inputs, mut outputs_read) = (HashSet::new(), HashSet::new());
         for channel in &animation.channels {
             let Some(sampler) = animation.samplers.get(channel.sampler.0) else { continue };
             let per_key = match channel.target.path.as_str() {
@@ -74,7 +75,10 @@ fn clips(root: &Root) -> Part {
             };
             let outputs = count(root, sampler.output);
             keys = keys.saturating_add(outputs);
-            bytes = bytes.saturating_add(outputs.saturating_mul(per_key));
+            // Morph weights are split into a track per target: they are not shared.
+            if per_key == WEIGHT_KEY || outputs_read.insert((sampler.output, per_key)) {
+                bytes = bytes.saturating_add(outputs.saturating_mul(per_key));
+            }
             if inputs.insert(sampler.input) {
                 bytes = bytes.saturating_add(count(root, sampler.input).saturating_mul(TIME_BYTES));
             }
@@ -89,7 +93,7 @@ fn clips(root: &Root) -> Part {
     Part {
         bytes: total,
         place: Some(format!("animations[{index}]")),
-        what: format!("{channels} channels of {keys} keys in all, each decoded into a track of its own"),
+        what: format!("{channels} channels of {keys} keys in all"),
     }
 }
 

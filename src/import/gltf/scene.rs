@@ -3,12 +3,15 @@
 //! Every node of the scene becomes a bone, in depth-first order. The hierarchy is checked first (no node with two
 //! parents, no cycle), and the walk uses an explicit stack, so a hostile file can neither loop nor overflow the
 //! call stack.
+//!
+//! A node's role: a camera or a light when it has one; a joint when a skin lists it or the animation moves it; a
+//! mesh when it shows one; otherwise a helper, unless joints hang from it ([`Skeleton::new`]).
 
 use glam::{DMat4, DQuat, DVec3, DVec4};
 
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
-use crate::model::{Bone, InheritMode, Skeleton, Transform};
+use crate::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
 
 /// The skeleton and the node ↔ bone mapping.
 pub(super) struct SceneBones {
@@ -21,6 +24,7 @@ pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
     let parents = parents(root)?;
     check_acyclic(&parents)?;
     let roots = scene_roots(root, &parents, notes)?;
+    let moved = joints_and_animated(root);
     let mut bone_of_node = vec![None; root.nodes.len()];
     let mut bones = Vec::new();
     // Depth-first: (node, parent bone), children pushed in reverse so they come out in file order.
@@ -35,6 +39,7 @@ pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
             parent,
             rest: rest_transform(node, index)?,
             inherit: InheritMode::Full,
+            role: role(node, moved[index]),
         });
         stack.extend(node.children.iter().rev().map(|c| (c.0, Some(bone))));
     }
@@ -45,6 +50,37 @@ pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
     // Cannot fail: depth-first order puts every parent before its children.
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
     Ok(SceneBones { skeleton, bone_of_node })
+}
+
+/// Per node, whether a skin lists it as a joint or an animation channel moves it (its translation, rotation or
+/// scale; animated morph weights move no node). References out of range are left to the skins' and animations'
+/// own readers, which name them.
+fn joints_and_animated(root: &Root) -> Vec<bool> {
+    let mut moved = vec![false; root.nodes.len()];
+    let joints = root.skins.iter().flat_map(|s| &s.joints).map(|j| j.0);
+    let channels = root.animations.iter().flat_map(|a| &a.channels).map(|c| &c.target);
+    let animated = channels.filter(|t| t.path != "weights").filter_map(|t| t.node).map(|n| n.0);
+    for node in joints.chain(animated) {
+        if let Some(m) = moved.get_mut(node) {
+            *m = true;
+        }
+    }
+    moved
+}
+
+/// What a node is (a node can hold a camera and be animated: it is a camera).
+fn role(node: &schema::Node, moved: bool) -> NodeRole {
+    if node.camera.is_some() {
+        NodeRole::Camera
+    } else if node.extensions.lights_punctual.is_some() {
+        NodeRole::Light
+    } else if moved {
+        NodeRole::Joint
+    } else if node.mesh.is_some() {
+        NodeRole::Mesh
+    } else {
+        NodeRole::Helper
+    }
 }
 
 /// Each node's parent; a child that does not exist, or a node listed as a child twice, is an error.

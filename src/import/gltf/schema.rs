@@ -106,6 +106,17 @@ pub(super) struct Node {
     pub scale: Option<[f64; 3]>,
     /// Morph-target weights of this node's mesh, overriding the mesh's own.
     pub weights: Option<Vec<f64>>,
+    /// Only whether the node has a camera counts (it is not framed as part of the figure), not what it is.
+    pub camera: Option<de::IgnoredAny>,
+    pub extensions: NodeExtensions,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(default)]
+pub(super) struct NodeExtensions {
+    /// A light of `KHR_lights_punctual` on the node; as for cameras, only its presence counts.
+    #[serde(rename = "KHR_lights_punctual")]
+    pub lights_punctual: Option<de::IgnoredAny>,
 }
 
 #[derive(Debug, Deserialize, Default)]
