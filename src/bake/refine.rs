@@ -23,6 +23,11 @@ use crate::eval::Evaluation;
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
 
+/// The closest two keys of one bone are put by halving, in seconds: a hundredth of a frame at 24 fps. Blender's
+/// importer keys each glTF time on an F-curve, and an F-curve takes two keys within 0.01 frame of each other for one
+/// (the second replaces the first), so finer keys would be played with the wrong value at the frame itself.
+const MIN_KEY_SPACING: f64 = 0.01 / 24.0;
+
 /// A test of a bone's nodes interpolated a fraction of the way between two samples against its exact ones:
 /// `misses(bone, [from, to], fraction, exact)`.
 pub trait Misses: Fn(usize, [&NodeSample; 2], f64, &NodeSample) -> bool + Sync {}
@@ -118,7 +123,8 @@ impl<M: Misses> Halving<'_, M> {
     /// miss it, `depth` halvings deep.
     fn halve(&self, worker: &mut NodeSolver, span: (f64, f64), ends: Vec<Ends>, depth: usize, found: &mut Found) {
         let time = in_single_precision(0.5 * (span.0 + span.1));
-        if ends.is_empty() || depth == MAX_DEPTH || !(span.0 < time && time < span.1) {
+        let room = (time - span.0).min(span.1 - time);
+        if ends.is_empty() || depth == MAX_DEPTH || !(span.0 < time && time < span.1) || room < MIN_KEY_SPACING {
             return;
         }
         // The middle in single precision is not quite half way.
