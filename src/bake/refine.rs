@@ -177,4 +177,20 @@ mod tests {
         let stepped = refine(&side, Strategy::Exact, &[false, true, true, true, true], base, &|_, _, _, _: &_| false);
         assert_eq!(stepped.series[0].times.len(), times.len(), "intervals that end at stepped keys are left");
     }
+
+    #[test]
+    fn halving_stops_a_hundredth_of_a_frame_apart() {
+        // Frames of 24 fps, a bone that always misses: halved while the halves stay 1/2400 s wide, 1/24 → 1/1536 s
+        // (the next halves, 1/3072 s, would be closer than that), so 63 midpoints an interval.
+        let rig = demo_rig();
+        let modes = vec![InheritMode::Full; rig.skeleton.len()];
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
+        let times: Vec<f64> = (0..=4).map(|k| f64::from(k) / 24.0).collect();
+        let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
+        let refined = refine(&side, Strategy::Exact, &[false; 5], base, &|bone, _, _, _: &_| bone == 2);
+        let series = &refined.series[2].times;
+        assert_eq!(series.len(), times.len() + 4 * 63);
+        let closest = series.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
+        assert!((MIN_KEY_SPACING..2.0 * MIN_KEY_SPACING).contains(&closest), "{closest}");
+    }
 }
