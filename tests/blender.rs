@@ -24,15 +24,11 @@ use serde_json::Value;
 
 /// Bakes Blender plays beyond their tolerance today, by source file, with what is known. A known one that starts to
 /// play within its tolerance fails the test too, so the list only shrinks.
-const KNOWN: &[(&str, &str)] = &[("fbx-proanimationbank/locomotions.fbx", CLOSE_KEYS)];
-
-/// Shown: Blender's F-curves take two keys within a hundredth of a frame for one (the second replaces the first), so
-/// a bake whose keys lie closer is played with the wrong value at the frame itself. The bake's refinement no longer
-/// puts keys closer than that at 24 fps, which brought Maya's mixed-inheritance file from 2.6e-3 of the rig at frame 1
-/// to within the tolerance. `locomotions.fbx` (5.4e-4 at frame 1) keeps keys 1.2e-4 s apart that are its own key
-/// times, not the refinement's.
-const CLOSE_KEYS: &str =
-    "off near the first frames, where the source's own keys lie closer than a hundredth of Blender's frame";
+///
+/// None today. Blender's F-curves take two keys within a hundredth of a frame for one (the second replaces the
+/// first), which put Maya's mixed-inheritance file 2.6e-3 of the rig off at frame 1 and `locomotions.fbx` 5.4e-4, until
+/// the bake stopped writing keys closer than that (`bake::times::MIN_KEY_SPACING`).
+const KNOWN: &[(&str, &str)] = &[];
 
 /// The Python with Blender's module, when there is one.
 fn blender_python() -> Option<PathBuf> {

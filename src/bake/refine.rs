@@ -17,16 +17,11 @@ use rayon::prelude::*;
 use super::Strategy;
 use super::keys::too_far;
 use super::nodes::{NodeSample, NodeSolver, Sampled, Series, Stats, align, follow_frames};
-use super::times::in_single_precision;
+use super::times::{MIN_KEY_SPACING, in_single_precision};
 use crate::eval::Evaluation;
 
 /// The most times an interval between two base samples is halved.
 const MAX_DEPTH: usize = 8;
-
-/// The closest two keys of one bone are put by halving, in seconds: a hundredth of a frame at 24 fps. Blender's
-/// importer keys each glTF time on an F-curve, and an F-curve takes two keys within 0.01 frame of each other for one
-/// (the second replaces the first), so finer keys would be played with the wrong value at the frame itself.
-const MIN_KEY_SPACING: f64 = 0.01 / 24.0;
 
 /// A test of a bone's nodes interpolated a fraction of the way between two samples against its exact ones:
 /// `misses(bone, [from, to], fraction, exact)`.

@@ -9,6 +9,11 @@ use crate::model::{Clip, DEFAULT_FRAME_RATE, Interpolation, MAX_FRAMES, sample_t
 /// How long before a stepped key's jump the value before it is held (as the FBX importer and ufbx's baker do).
 pub const STEP_LEAD: f64 = 1e-3;
 
+/// The closest two baked times lie, in seconds: a hundredth of a frame at 24 fps. Blender's importer keys each glTF
+/// time on an F-curve, and an F-curve takes two keys within 0.01 frame of each other for one (the second replaces
+/// the first), so closer keys would be played with the wrong value at the frame itself.
+pub const MIN_KEY_SPACING: f64 = 0.01 / 24.0;
+
 /// The times to bake a clip at first, and which of them are stepped keys.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakeTimes {
@@ -46,8 +51,30 @@ pub fn bake_times(side: &Evaluation) -> BakeTimes {
     times.dedup();
     steps.sort_by(f64::total_cmp);
     steps.dedup();
+    let times = spaced(times, &steps);
     steps.retain(|s| times.binary_search_by(|t| t.total_cmp(s)).is_ok());
     BakeTimes { times, steps }
+}
+
+/// `times` (sorted) thinned to [`MIN_KEY_SPACING`]: of two closer times (a frame and a key of the source a fraction of
+/// a millisecond off it) the earlier stays, unless the later is the clip's end or a stepped key (a jump, kept where it
+/// is); two such times both stay, and so does the start.
+fn spaced(times: Vec<f64>, steps: &[f64]) -> Vec<f64> {
+    let last = times.last().copied();
+    let kept = |t: f64| Some(t) == last || steps.binary_search_by(|s| s.total_cmp(&t)).is_ok();
+    let mut spaced: Vec<f64> = Vec::with_capacity(times.len());
+    for t in times {
+        let start = spaced.len() == 1;
+        match spaced.last_mut() {
+            Some(previous) if t - *previous < MIN_KEY_SPACING => match (kept(t), start || kept(*previous)) {
+                (true, false) => *previous = t,
+                (true, true) => spaced.push(t),
+                (false, _) => {}
+            },
+            _ => spaced.push(t),
+        }
+    }
+    spaced
 }
 
 /// Where sampling ends: the duration, or for a synced blend's cycle, which wraps to its start at its length, the
@@ -121,5 +148,15 @@ mod tests {
         assert_eq!(got.times.len(), expected.len(), "{got:?}");
         assert!(got.times.iter().zip(expected).all(|(&g, e)| g == in_single_precision(e)), "{got:?}");
         assert_eq!(got.step_flags(&got.times), [false, false, true, false, false, true]);
+    }
+
+    #[test]
+    fn times_closer_than_a_hundredth_of_a_frame_are_thinned() {
+        let close = 0.5 * MIN_KEY_SPACING;
+        // A key just after a frame goes; a stepped key just after one stays in its place; the start and end stay.
+        let times = vec![0.0, close, 0.5, 0.5 + close, 1.0 - close, 1.0];
+        assert_eq!(spaced(times.clone(), &[]), [0.0, 0.5, 1.0]);
+        assert_eq!(spaced(times, &[0.5 + close]), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(vec![0.0, 0.25, 0.5], &[]), [0.0, 0.25, 0.5], "frames apart stay");
     }
 }
