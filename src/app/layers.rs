@@ -23,31 +23,32 @@ use crate::view::Badge;
 #[derive(Default)]
 pub struct LayersPanel {
     /// The storage report of one document state: measured off the UI thread (it walks the whole clip).
-    storage: Job<StorageKey, StorageReport>,
-    /// The bind check of the document's rig, clip and modes: off the UI thread (where joints are off their bind,
-    /// it walks the whole clip).
-    bind: Job<BindKey, BindCheck>,
+    storage: Job<DocumentKey, StorageReport>,
+    /// The bind check of the document: off the UI thread (where joints are off their bind, it walks the whole clip).
+    bind: Job<DocumentKey, BindCheck>,
 }
 
-/// What a bind check depends on: the rig (this one, not an equal one), its clip and the modes.
+/// What the panel's measurements depend on: the document's rig (this one, not an equal one: another file opened
+/// with the same bones is measured anew), its clip, modes and layers.
 #[derive(Clone)]
-struct BindKey {
+struct DocumentKey {
     rig: Arc<Rig>,
     clip: Option<usize>,
     modes: Vec<InheritMode>,
+    layers: Layers,
 }
 
-impl PartialEq for BindKey {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.rig, &other.rig) && self.clip == other.clip && self.modes == other.modes
+impl DocumentKey {
+    fn of(doc: &Document) -> Self {
+        DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
     }
 }
 
-/// What a storage report depends on: the document's layers, clip and modes.
-type StorageKey = (Layers, Option<usize>, Vec<InheritMode>);
-
-fn storage_key(doc: &Document) -> StorageKey {
-    (doc.layers().clone(), doc.clip, doc.modes.clone())
+impl PartialEq for DocumentKey {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.rig, &other.rig)
+            && (self.clip, &self.modes, &self.layers) == (other.clip, &other.modes, &other.layers)
+    }
 }
 
 impl LayersPanel {
@@ -87,7 +88,7 @@ impl LayersPanel {
                 ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
                 return;
             }
-            let key = BindKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone() };
+            let key = DocumentKey::of(doc);
             let work = || {
                 let doc = doc.clone();
                 move |_: &Progress| Some(check_bind(&doc.evaluation(), &BindTolerance::default()))
@@ -111,7 +112,7 @@ impl LayersPanel {
     fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
         CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
             let doc = &*shared.doc;
-            let key = storage_key(doc);
+            let key = DocumentKey::of(doc);
             if ui.button("Measure the clip").clicked() {
                 let doc = doc.clone();
                 let work = || move |_: &Progress| Some(storage_report(&doc.evaluation(), &StorageOptions::default()));
