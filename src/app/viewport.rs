@@ -152,13 +152,10 @@ fn aspect(rect: egui::Rect) -> f64 {
     f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0))
 }
 
-/// One row of view and display toggles; in a narrow window it scrolls sideways (wheel or drag) instead of wrapping
-/// onto a second row that would push the picture down.
+/// The view and display toggles: a narrow viewport wraps them onto a second row rather than hide the last ones
+/// past its edge (the row's height changes only when the viewport's width does, never as the user works).
 fn toolbar(ui: &mut Ui, shared: &mut Shared) {
-    let row = egui::ScrollArea::horizontal()
-        .id_salt("viewport-toolbar")
-        .scroll_bar_visibility(egui::scroll_area::ScrollBarVisibility::AlwaysHidden);
-    row.show(ui, |ui| ui.horizontal(|ui| toggles(ui, shared)));
+    ui.horizontal_wrapped(|ui| toggles(ui, shared));
 }
 
 fn toggles(ui: &mut Ui, shared: &mut Shared) {
