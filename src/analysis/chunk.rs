@@ -13,7 +13,7 @@ use super::clip_analysis::{BoneSummary, Components};
 use super::findings::{Judge, Verdict};
 use super::request::{CurveRequest, Judged, ScanOptions};
 use super::stretch::{CursorAt, Stretch};
-use crate::eval::{BoneCursor, Evaluation, Evaluator, Hierarchy, Pose};
+use crate::eval::{BoneCursor, Chains, Evaluation, Evaluator, Hierarchy};
 use crate::math::{decompose_near, decompose_with_stretch};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 
@@ -279,33 +279,6 @@ impl Chunk<'_> {
             let judged = plotted.iter().map(|&bone| stretches[bone]);
             plot.put(sample, plotted, &pose.local, &pose.model.model, judged, curves);
         }
-    }
-}
-
-/// Some bones (plotted ones and all their ancestors) read from a clip one bone at a time and evaluated under a
-/// hierarchy, sample by sample: the rest of a big rig is never sampled.
-struct Chains<'a> {
-    /// The bones, parents first.
-    bones: &'a [usize],
-    cursors: Vec<BoneCursor<'a>>,
-    /// Only the bones' entries are meaningful.
-    pose: Pose,
-}
-
-impl<'a> Chains<'a> {
-    fn new(skeleton: &Skeleton, clip: &'a Clip, bones: &'a [usize]) -> Self {
-        let cursors = bones.iter().map(|&b| BoneCursor::new(skeleton, clip, b)).collect();
-        let mut pose = Pose::default();
-        pose.local = vec![Transform::IDENTITY; skeleton.len()];
-        Chains { bones, cursors, pose }
-    }
-
-    fn evaluate(&mut self, time: f64, hierarchy: &Hierarchy) -> &Pose {
-        for (&bone, cursor) in self.bones.iter().zip(&mut self.cursors) {
-            self.pose.local[bone] = cursor.local(time);
-        }
-        hierarchy.evaluate_bones(&self.pose.local, self.bones, &mut self.pose.model);
-        &self.pose
     }
 }
 

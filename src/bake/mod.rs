@@ -48,7 +48,7 @@ use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Clip, Rig};
 
 /// How bones become glTF nodes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Strategy {
     /// A helper node above every bone that needs its stretch rotation: exact.

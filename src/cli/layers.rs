@@ -13,7 +13,7 @@ use crate::eval::layers::{
 use crate::model::{Choice, Rig};
 
 /// Runtime techniques layered on the animation, applied in this order: bind weight, interpolation, blend,
-/// additive, crossfade, shake, targets.
+/// additive, crossfade, shake, uniform scale, targets.
 #[derive(Clone, Debug, Default, PartialEq, Args)]
 pub struct LayerArgs {
     /// Mix with the bind pose from the skin's inverse bind matrices: 1 is the animation, 0 the bind pose.
@@ -75,6 +75,10 @@ pub struct LayerArgs {
         allow_negative_numbers = true
     )]
     pub shake_param: Vec<(String, f64)>,
+    /// Replace this bone's local scale by its uniform part, the geometric mean of its factors' magnitudes, each
+    /// sign kept (repeatable): what `explain` proposes for an ancestor whose squash shears the bones below it.
+    #[arg(long, value_name = "BONE")]
+    pub uniform_scale: Vec<String>,
     /// Pin a bone to a model-space rotation (quaternion x,y,z,w), with an optional weight (repeatable).
     #[arg(long, value_name = "BONE=x,y,z,w[@WEIGHT]", value_parser = parse_target, allow_negative_numbers = true)]
     pub target: Vec<TargetArg>,
@@ -158,6 +162,9 @@ impl LayerArgs {
                 params.set(param, *value).context("--shake-param")?;
             }
             layers.shake = Some(Shake { bone: bone_index(rig, "--shake", name)?, params });
+        }
+        for name in &self.uniform_scale {
+            layers.uniform_scale.push(bone_index(rig, "--uniform-scale", name)?);
         }
         for target in &self.target {
             layers.targets.push(Target {

@@ -4,6 +4,7 @@
 
 mod bind;
 pub mod blender;
+mod chains;
 mod cursor;
 mod evaluation;
 mod hierarchy;
@@ -16,6 +17,7 @@ pub mod skinning;
 
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
 pub(crate) use bind::{invert, median};
+pub use chains::Chains;
 pub use cursor::BoneCursor;
 pub use evaluation::{Evaluation, Evaluator};
 pub use hierarchy::{Hierarchy, ModelPose};

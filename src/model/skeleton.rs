@@ -172,6 +172,13 @@ impl Skeleton {
         depths
     }
 
+    /// `bone` and its ancestors, the root first and `bone` last.
+    pub fn chain(&self, bone: usize) -> Vec<usize> {
+        let mut chain: Vec<usize> = std::iter::successors(Some(bone), |&b| self.bones[b].parent).collect();
+        chain.reverse();
+        chain
+    }
+
     /// Whether `bone` is `ancestor` or lies below it.
     pub fn is_in_subtree(&self, bone: usize, ancestor: usize) -> bool {
         let mut current = Some(bone);

@@ -1,11 +1,11 @@
 //! Runtime techniques layered on a sampled clip, each as a game runtime does it:
 //!
 //! ```text
-//! clip ─sample─▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ targets ─▶ pose
-//!   (interpolation       (mix with     (second   (difference  (into a third  (cosine   (model-space
-//!    override, for        bind pose)    clip,     from a ref,  clip, weight   wobble)   rotations)
-//!    every clip read)                   synced)   local or     over time)
-//!                                                 global)
+//! clip ─sample─▶ pose ─▶ bind weight ─▶ blend ─▶ additive ─▶ crossfade ─▶ shake ─▶ uniform ─▶ targets ─▶ pose
+//!   (interpolation       (mix with     (second   (difference  (into a third  (cosine   (chosen    (model-space
+//!    override, for        bind pose)    clip,     from a ref,  clip, weight   wobble)   bones'     rotations)
+//!    every clip read)                   synced)   local or     over time)               scale made
+//!                                                 global)                               uniform)
 //! ```
 //!
 //! [`Layers`] says what to do (serialisable; the default does nothing), [`LayerStack`] holds what it needs prepared
@@ -22,6 +22,7 @@ mod mix;
 mod shake;
 mod target;
 mod time;
+mod uniform;
 
 pub use additive::{AdditiveOrder, AdditiveReference, add, add_poses, difference};
 pub use crossfade::{Crossfade, FadeCurve};
@@ -30,6 +31,7 @@ pub use mix::{RotationBlend, mix, mix_poses, unit_weight};
 pub use shake::{Shake, ShakeParams, UnknownShakeParam, bone_modifiers, shake_pose};
 pub use target::{Target, pin_pose};
 pub use time::{SyncedCycle, TICKS_PER_SECOND};
+pub use uniform::{uniform_part, uniform_pose, uniform_scale};
 
 use glam::DQuat;
 
@@ -70,6 +72,9 @@ pub struct Layers {
     pub additive: Option<Additive>,
     pub crossfade: Option<Crossfade>,
     pub shake: Option<Shake>,
+    /// Bones whose local scale is replaced by its uniform part ([`uniform_part`]): an ancestor's squash taken out
+    /// to see the shear it causes go.
+    pub uniform_scale: Vec<usize>,
     pub targets: Vec<Target>,
 }
 
@@ -82,6 +87,7 @@ impl Default for Layers {
             additive: None,
             crossfade: None,
             shake: None,
+            uniform_scale: Vec::new(),
             targets: Vec::new(),
         }
     }
@@ -122,6 +128,9 @@ impl Layers {
         }
         if let Some(s) = &layers.shake {
             parts.push(format!("shake `{}`", bone(s.bone)));
+        }
+        for &b in &layers.uniform_scale {
+            parts.push(format!("uniform scale `{}`", bone(b)));
         }
         for t in &layers.targets {
             parts.push(format!("target `{}` weight {}", bone(t.bone), t.weight));
@@ -188,6 +197,9 @@ impl LayerStack {
         }
         for target in &layers.targets {
             check_bone("target", target.bone)?;
+        }
+        for &bone in &layers.uniform_scale {
+            check_bone("uniform scale", bone)?;
         }
         let reference = match &layers.additive {
             None => Vec::new(),
@@ -289,6 +301,7 @@ impl LayerStack {
         if let Some(shake) = &layers.shake {
             shake_pose(local, &self.modifiers, &shake.params, time);
         }
+        uniform_pose(local, &layers.uniform_scale);
         pin_pose(skeleton, local, &layers.targets, &mut self.chain);
     }
 }

@@ -1,0 +1,304 @@
+//! Whose scale shears a bone: every bone of its chain asked how much shear is left without its squash.
+
+use glam::{DMat3, DMat4, DQuat, DVec3};
+
+use crate::analysis::{Assessment, Tolerances};
+use crate::eval::layers::uniform_scale;
+use crate::eval::{Chains, Evaluation, Evaluator, Hierarchy, ModelPose, over_runs};
+use crate::math::{AffineParts, shear_deg};
+use crate::model::{Skeleton, Transform};
+
+/// One bone of the explained bone's chain (the explained bone included) at one time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Link {
+    pub bone: usize,
+    pub name: String,
+    /// Its local scale factors, signed.
+    pub scale: DVec3,
+    /// How unequal they are: `max|k|/min|k| − 1` (0: uniform, nothing to take out).
+    pub anisotropy: f64,
+    /// The smallest angle, in degrees, between this bone's scale axes and the axes of the next bone down the chain
+    /// (up to swapping axes and merging factors within the anisotropy tolerance): a squash shears the bones below
+    /// it only when they turn its axes off themselves. `None` for the explained bone.
+    pub turn_deg: Option<f64>,
+    /// The explained bone's shear, in degrees, with this bone's local scale made uniform and all else as evaluated.
+    pub shear_left_deg: f64,
+    /// The shear minus what is left: how much of it this bone's squash causes (negative where it counters another).
+    pub contribution_deg: f64,
+}
+
+/// Why one bone shears at one time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Attribution {
+    pub bone: usize,
+    pub time: f64,
+    /// Its shear (the largest deviation from 90° between two of its model axes), in degrees.
+    pub shear_deg: f64,
+    /// Whether the analysis flags it: sheared beyond the tolerances.
+    pub stretched: bool,
+    /// The root first, the explained bone last.
+    pub chain: Vec<Link>,
+    /// The fewest bones of the chain whose scales, all made uniform, leave the bone unflagged (empty when it is
+    /// not flagged). Contributions need not add up, since scales compound and cancel; this set is what suffices.
+    pub sufficient: Vec<usize>,
+}
+
+impl Attribution {
+    /// The bone whose squash causes the most shear, if any causes some.
+    pub fn main_cause(&self) -> Option<&Link> {
+        self.chain
+            .iter()
+            .filter(|l| l.contribution_deg > 0.0)
+            .max_by(|a, b| a.contribution_deg.total_cmp(&b.contribution_deg))
+    }
+}
+
+/// A stretch of time in which one bone's squash is the main cause of the shear.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CauseSpan {
+    pub bone: usize,
+    pub name: String,
+    /// From its first sample to the first sample after it with another main cause, or none (the last sample).
+    pub from: f64,
+    pub to: f64,
+}
+
+/// Why one bone shears over a clip.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Causes {
+    pub samples: usize,
+    /// Samples at which the bone is flagged.
+    pub stretched_samples: usize,
+    /// The attribution at the worst flagged sample (the worst shear where none is flagged), or at the time asked.
+    pub at: Attribution,
+    /// The main cause's time spans, in time order.
+    pub spans: Vec<CauseSpan>,
+}
+
+/// Why `bone` shears at `time` in `evaluation`.
+pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &Tolerances) -> Attribution {
+    let skeleton = evaluation.skeleton();
+    let chain = skeleton.chain(bone);
+    let mut local = evaluation.pose_at(time).local;
+    let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
+    let assessment = Assessment::of(&probe.matrix(&mut local, &[]), tolerances);
+    let shear = assessment.shear_deg;
+    let links: Vec<Link> = chain
+        .iter()
+        .enumerate()
+        .map(|(i, &b)| {
+            let shear_left = Assessment::of(&probe.matrix(&mut local, &[b]), tolerances).shear_deg;
+            let next = chain.get(i + 1).map(|&c| local[c].rotation);
+            link(skeleton, b, &local[b], next, shear, shear_left, tolerances)
+        })
+        .collect();
+    let stretched = assessment.findings.stretched;
+    let sufficient = if stretched { sufficient(&mut probe, &mut local, &links, tolerances) } else { Vec::new() };
+    Attribution { bone, time, shear_deg: shear, stretched, chain: links, sufficient }
+}
+
+/// Why `bone` shears over `times` (sorted) of `evaluation`, with the detail at `at` (the worst time for `None`).
+pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f64>, tolerances: &Tolerances) -> Causes {
+    let skeleton = evaluation.skeleton();
+    let chain = skeleton.chain(bone);
+    let samples: Vec<Sample> = over_runs(times, |run| {
+        let mut source = ChainSource::new(evaluation, &chain);
+        let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
+        let mut local = vec![Transform::IDENTITY; skeleton.len()];
+        let mut start = DQuat::IDENTITY;
+        run.iter()
+            .map(|&time| {
+                source.local_at(time, &chain, &mut local);
+                probe.sample(&mut local, &mut start, tolerances)
+            })
+            .collect::<Vec<_>>()
+    })
+    .concat();
+    // The first flagged sample with the largest shear (the largest shear where none is flagged).
+    let key = |s: &Sample| (s.stretched, s.shear_deg);
+    let worst = (0..samples.len()).reduce(|w, s| if key(&samples[s]) > key(&samples[w]) { s } else { w });
+    let worst = worst.map_or(0.0, |s| times[s]);
+    let time = at.unwrap_or(worst);
+    Causes {
+        samples: samples.len(),
+        stretched_samples: samples.iter().filter(|s| s.stretched).count(),
+        at: attribute(evaluation, bone, time, tolerances),
+        spans: spans(skeleton, &samples, times),
+    }
+}
+
+/// One sample of the explained bone over a clip.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    shear_deg: f64,
+    stretched: bool,
+    /// The chain bone whose uniform scale removes the most shear, when the bone is flagged.
+    main_cause: Option<usize>,
+}
+
+/// The runs of samples with one main cause.
+fn spans(skeleton: &Skeleton, samples: &[Sample], times: &[f64]) -> Vec<CauseSpan> {
+    let mut spans: Vec<CauseSpan> = Vec::new();
+    let mut open = false;
+    for (sample, &time) in samples.iter().zip(times) {
+        if open && spans.last().is_some_and(|span| Some(span.bone) != sample.main_cause) {
+            spans.last_mut().expect("an open span").to = time;
+            open = false;
+        }
+        match sample.main_cause {
+            Some(bone) if !open => {
+                spans.push(CauseSpan { bone, name: skeleton.bone(bone).name.clone(), from: time, to: time });
+                open = true;
+            }
+            Some(_) => spans.last_mut().expect("an open span").to = time,
+            None => {}
+        }
+    }
+    spans
+}
+
+/// Where the chain's local transforms come from at each time: the clip read bone by bone (no layers), or whole
+/// poses through the layers.
+enum ChainSource<'e, 'a> {
+    Bones(Box<Chains<'e>>, &'e Hierarchy),
+    Poses(Box<Evaluator<'e, 'a>>),
+}
+
+impl<'e, 'a> ChainSource<'e, 'a> {
+    fn new(evaluation: &'e Evaluation<'a>, chain: &'e [usize]) -> Self {
+        match evaluation.clip.filter(|_| evaluation.layers().is_none()) {
+            Some(clip) => {
+                ChainSource::Bones(Box::new(Chains::new(evaluation.skeleton(), clip, chain)), &evaluation.hierarchy)
+            }
+            None => ChainSource::Poses(Box::new(evaluation.evaluator())),
+        }
+    }
+
+    /// Writes the chain's local transforms at `time` into `local`.
+    fn local_at(&mut self, time: f64, chain: &[usize], local: &mut [Transform]) {
+        let pose = match self {
+            ChainSource::Bones(chains, hierarchy) => chains.evaluate(time, hierarchy),
+            ChainSource::Poses(evaluator) => evaluator.evaluate(time),
+        };
+        for &bone in chain {
+            local[bone] = pose.local[bone];
+        }
+    }
+}
+
+/// The explained bone's model matrix with some scales of its chain made uniform.
+struct Probe<'a> {
+    hierarchy: &'a Hierarchy,
+    chain: &'a [usize],
+    bone: usize,
+    model: ModelPose,
+}
+
+impl<'a> Probe<'a> {
+    fn new(hierarchy: &'a Hierarchy, chain: &'a [usize], bone: usize) -> Self {
+        Probe { hierarchy, chain, bone, model: ModelPose::default() }
+    }
+
+    /// The bone's model matrix with the scales of `uniform` made uniform in `local` (which is left as it was).
+    fn matrix(&mut self, local: &mut [Transform], uniform: &[usize]) -> DMat4 {
+        let saved: Vec<Transform> = uniform.iter().map(|&b| local[b]).collect();
+        uniform.iter().for_each(|&b| uniform_scale(&mut local[b]));
+        self.hierarchy.evaluate_bones(local, self.chain, &mut self.model);
+        uniform.iter().zip(saved).for_each(|(&b, t)| local[b] = t);
+        self.model.model[self.bone]
+    }
+
+    /// The bone's shear and verdict at one time, and the main cause where it is flagged: the chain bone, among those
+    /// scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix, without a
+    /// decomposition). `start` is where the verdict's decomposition starts, updated for the next sample.
+    fn sample(&mut self, local: &mut [Transform], start: &mut DQuat, tolerances: &Tolerances) -> Sample {
+        let m = self.matrix(local, &[]);
+        let assessment = Assessment::near(&m, tolerances, *start);
+        *start = assessment.parts.stretch;
+        let shear = column_shear(&m);
+        let mut main_cause = None;
+        if assessment.findings.stretched {
+            let mut largest = 0.0;
+            for &bone in self.chain {
+                if anisotropy(local[bone].scale) > tolerances.min_anisotropy {
+                    let contribution = shear - column_shear(&self.matrix(local, &[bone]));
+                    if contribution > largest {
+                        (largest, main_cause) = (contribution, Some(bone));
+                    }
+                }
+            }
+        }
+        Sample { shear_deg: assessment.shear_deg, stretched: assessment.findings.stretched, main_cause }
+    }
+}
+
+/// The shear of `m`'s columns in degrees.
+fn column_shear(m: &DMat4) -> f64 {
+    shear_deg(&DMat3::from_mat4(*m))
+}
+
+/// `max|k|/min|k| − 1` (0 for a zero scale: nothing to compare).
+fn anisotropy(scale: DVec3) -> f64 {
+    let k = scale.abs();
+    let (min, max) = (k.min_element(), k.max_element());
+    if min > 0.0 { max / min - 1.0 } else { 0.0 }
+}
+
+/// The link of bone `bone`, whose local transform is `local` and whose child on the chain turns by `next`.
+fn link(
+    skeleton: &Skeleton,
+    bone: usize,
+    local: &Transform,
+    next: Option<DQuat>,
+    shear: f64,
+    shear_left: f64,
+    tolerances: &Tolerances,
+) -> Link {
+    // The scale's axes seen from the child: columns of `Rᵀ·U`; their angle to the child's own axes is that of a
+    // stretch rotation, up to the symmetries of the factors.
+    let turn = next.map(|rotation| {
+        let seen = AffineParts {
+            stretch: rotation.conjugate() * local.stretch,
+            scale: local.scale.abs(),
+            ..AffineParts::IDENTITY
+        };
+        seen.stretch_angle_deg_within(tolerances.min_anisotropy)
+    });
+    Link {
+        bone,
+        name: skeleton.bone(bone).name.clone(),
+        scale: local.scale,
+        anisotropy: anisotropy(local.scale),
+        turn_deg: turn,
+        shear_left_deg: shear_left,
+        contribution_deg: shear - shear_left,
+    }
+}
+
+/// The most subsets searched for the fewest bones that suffice; past it, bones are added greedily.
+const EXHAUSTIVE_CANDIDATES: usize = 12;
+
+/// The fewest bones of `links` (among those scaled unequally) whose uniform scales together leave the bone
+/// unflagged: every subset by size, or greedily by contribution for a long chain of squashes.
+fn sufficient(probe: &mut Probe, local: &mut [Transform], links: &[Link], tolerances: &Tolerances) -> Vec<usize> {
+    let mut candidates: Vec<&Link> = links.iter().filter(|l| l.anisotropy > tolerances.min_anisotropy).collect();
+    candidates.sort_by(|a, b| b.contribution_deg.total_cmp(&a.contribution_deg));
+    let mut clears = |bones: &[usize]| !Assessment::of(&probe.matrix(local, bones), tolerances).findings.stretched;
+    let found = if candidates.len() <= EXHAUSTIVE_CANDIDATES {
+        let mut masks: Vec<u32> = (1..1u32 << candidates.len()).collect();
+        masks.sort_by_key(|m| m.count_ones());
+        masks.into_iter().map(|mask| pick(&candidates, mask)).find(|bones| clears(bones))
+    } else {
+        (1..=candidates.len())
+            .map(|n| candidates[..n].iter().map(|l| l.bone).collect::<Vec<_>>())
+            .find(|bones| clears(bones))
+    };
+    let mut bones = found.unwrap_or_default();
+    bones.sort_unstable();
+    bones
+}
+
+/// The bones of the candidates whose bits are set in `mask`.
+fn pick(candidates: &[&Link], mask: u32) -> Vec<usize> {
+    candidates.iter().enumerate().filter(|(i, _)| mask >> i & 1 == 1).map(|(_, l)| l.bone).collect()
+}

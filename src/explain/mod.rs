@@ -1,0 +1,225 @@
+//! Why a bone shears, and the cheapest fix.
+//!
+//! A bone's model matrix shears when an unequal scale on its chain meets a rotation below it that turns the scale's
+//! axes: under full inheritance `W = L_root···L_parent·L_bone`, and the columns of `S·R` stay orthogonal only where
+//! `R` keeps `S`'s axes on axes. **Attribution** ([`attribute`], [`causes`]) asks every bone of the chain, the bone
+//! itself included, how much shear is left when only its local scale is replaced by its uniform part
+//! (`eval::layers::uniform_part`), all else as evaluated; the difference is its contribution. Scales compound and
+//! cancel, so contributions need not add up: the fewest bones whose uniform scales together remove the shear are
+//! named as well. Over a clip every flagged sample has a main cause (the largest contribution), and the runs of
+//! samples with one main cause are its time spans.
+//!
+//! **Fixes** ([`Change`]) are other evaluations of the same clip: one bone of the chain under another inheritance
+//! mode, one squashing bone's scale made uniform (a layer), or the clip baked (exact or TRS). Each is analysed as
+//! `scan` analyses a clip and compared with the evaluation explained as `diff` compares two: the shear left on the
+//! bone and what it does to the others, and the visible cost, how far the skin (or, without a mesh, the bones'
+//! probe points) moves at worst. A fix that removes the shear comes before one that does not; among those, the one
+//! that moves the character least.
+
+mod attribution;
+mod fixes;
+
+pub use attribution::{Attribution, CauseSpan, Causes, Link, attribute, causes};
+pub use fixes::{Change, Cost, Fix, Measured};
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+
+use crate::analysis::{ClipScan, ScanOptions, scan};
+use crate::eval::Evaluation;
+use fixes::{Outcome, candidates, rank};
+
+/// One bone explained over a clip.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Explanation {
+    pub bone: usize,
+    pub name: String,
+    pub causes: Causes,
+    /// Ranked: the best first. Empty when the bone is never flagged.
+    pub fixes: Vec<Fix>,
+    /// Changes that could not be measured, and why.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+impl Explanation {
+    /// The best fix, if the bone needs one.
+    pub fn best_fix(&self) -> Option<&Fix> {
+        self.fixes.first()
+    }
+}
+
+/// The bones `scan` flags, the worst shear first.
+pub fn flagged(scan: &ClipScan) -> Vec<usize> {
+    let mut bones: Vec<_> = scan.bones.iter().filter(|b| b.stretched()).collect();
+    bones.sort_by(|a, b| b.worst_shear_deg.total_cmp(&a.worst_shear_deg).then(a.index.cmp(&b.index)));
+    bones.into_iter().map(|b| b.index).collect()
+}
+
+/// Explains each of `bones` over `evaluation`'s clip (every flagged bone, the worst first, for `None`), with the
+/// detail at time `at` (each bone's worst time for `None`). Fixes shared by several bones are measured once.
+pub fn explain(
+    evaluation: &Evaluation,
+    bones: Option<&[usize]>,
+    at: Option<f64>,
+    options: &ScanOptions,
+) -> Vec<Explanation> {
+    let before = scan(evaluation, options, &|_, _| {});
+    let bones = bones.map_or_else(|| flagged(&before), <[usize]>::to_vec);
+    let times = evaluation.times(options.rate);
+    let tolerances = &options.tolerances;
+    let causes: Vec<Causes> = bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at, tolerances)).collect();
+    let changes: Vec<Vec<Change>> = bones
+        .iter()
+        .zip(&causes)
+        .map(|(&bone, causes)| match causes.stretched_samples {
+            0 => Vec::new(),
+            _ => candidates(evaluation, bone, &scaled(causes, tolerances.min_anisotropy)),
+        })
+        .collect();
+    let mut distinct: Vec<Change> = changes.iter().flatten().copied().collect();
+    distinct.sort_by_key(|c| format!("{c:?}"));
+    distinct.dedup();
+    let outcomes: HashMap<Change, Result<Outcome, String>> =
+        distinct.into_par_iter().map(|change| (change, Outcome::of(evaluation, change, options))).collect();
+    let skeleton = evaluation.skeleton();
+    bones
+        .iter()
+        .zip(causes)
+        .zip(changes)
+        .map(|((&bone, causes), changes)| {
+            let mut fixes = Vec::new();
+            let mut notes = Vec::new();
+            for change in changes {
+                match &outcomes[&change] {
+                    Ok(outcome) => fixes.push(Fix::new(skeleton, bone, change, outcome, &before)),
+                    Err(why) => notes.push(format!("{}: {why}", change.describe(skeleton))),
+                }
+            }
+            rank(&mut fixes);
+            Explanation { bone, name: skeleton.bone(bone).name.clone(), causes, fixes, notes }
+        })
+        .collect()
+}
+
+/// The bones of the chain that squash where the bone is flagged: every main cause, and every unequally scaled
+/// bone at the detailed time.
+fn scaled(causes: &Causes, min_anisotropy: f64) -> Vec<usize> {
+    let at = causes.at.chain.iter().filter(|l| l.anisotropy > min_anisotropy).map(|l| l.bone);
+    let mut bones: Vec<usize> = causes.spans.iter().map(|s| s.bone).chain(at).collect();
+    bones.sort_unstable();
+    bones.dedup();
+    bones
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::{DQuat, DVec3, Quat, Vec3};
+
+    use super::*;
+    use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+
+    fn rig(bones: Vec<Bone>, clips: Vec<Clip>) -> Rig {
+        Rig { skeleton: Skeleton::new(bones).unwrap(), clips, ..Rig::default() }
+    }
+
+    fn turned(axis: DVec3, degrees: f64) -> Transform {
+        Transform::from_trs(DVec3::X, DQuat::from_axis_angle(axis, degrees.to_radians()), DVec3::ONE)
+    }
+
+    #[test]
+    fn a_squashed_parent_over_a_turned_child_is_all_of_its_shear() {
+        // Parent scaled (2, 1, 1), child turned 45° about Z: the child's X and Y axes are diag(2,1,1)·(c, s, 0)
+        // and diag(2,1,1)·(−s, c, 0) with c = s = 1/√2, i.e. (√2, 1/√2, 0) and (−√2, 1/√2, 0): cos = (−2 + 1/2)/(5/2)
+        // = −3/5, a shear of asin(3/5) = 36.87°. Without the parent's squash there is none.
+        let parent = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
+        let rig = rig(
+            vec![Bone::joint("parent", None, parent), Bone::joint("child", Some(0), turned(DVec3::Z, 45.0))],
+            vec![],
+        );
+        let evaluation = Evaluation::declared(&rig, None);
+        let explained = explain(&evaluation, None, None, &ScanOptions::default());
+        assert_eq!(explained.len(), 1, "only the child is flagged");
+        let child = &explained[0];
+        let at = &child.causes.at;
+        let expected = 0.6f64.asin().to_degrees();
+        assert!((at.shear_deg - expected).abs() < 1e-9, "{} against {expected}", at.shear_deg);
+        let parent = &at.chain[0];
+        assert!(parent.shear_left_deg.abs() < 1e-9 && (parent.contribution_deg - expected).abs() < 1e-9, "{parent:?}");
+        assert!(
+            (parent.anisotropy - 1.0).abs() < 1e-12 && (parent.turn_deg.unwrap() - 45.0).abs() < 1e-9,
+            "{parent:?}"
+        );
+        assert!(at.chain[1].contribution_deg.abs() < 1e-9, "the child's own scale is uniform");
+        assert_eq!((at.sufficient.as_slice(), at.main_cause().map(|l| l.bone)), (&[0][..], Some(0)));
+        let compensate = Change::Mode { bone: 1, mode: InheritMode::SegmentCompensate };
+        let fix = child.fixes.iter().find(|f| f.change == compensate).unwrap();
+        assert!(fix.removes && fix.shear_left_deg < 1e-9, "{fix:?}");
+        assert!(child.fixes[0].removes, "a fix that removes the shear ranks first: {:?}", child.fixes[0]);
+        let exact = child.fixes.iter().find(|f| f.change == Change::Bake { strategy: crate::bake::Strategy::Exact });
+        let exact = exact.unwrap();
+        assert!(
+            !exact.removes && (exact.shear_left_deg - expected).abs() < 1e-4,
+            "an exact bake keeps the shear: {exact:?}"
+        );
+        assert!(exact.cost.fraction < 1e-6 && exact.cost.measured == Measured::Bones, "{exact:?}");
+    }
+
+    /// A track of `values` at `times`, linear.
+    fn track<T: crate::model::KeyValue>(times: &[f64], values: &[T]) -> Track<T> {
+        Track::new(Arc::from(times), values.to_vec(), Interpolation::Linear).unwrap()
+    }
+
+    #[test]
+    fn each_squash_is_the_main_cause_while_it_lasts() {
+        // root → a → m → b; a squashes along X until 1 s and is uniform from 1.5 s; m squashes along Y from 2 s on,
+        // uniform until 1.5 s. m turns a's axes 30° about Z, b turns m's 30° about X: b shears under either squash.
+        let bones = vec![
+            Bone::joint("root", None, Transform::IDENTITY),
+            Bone::joint("a", Some(0), Transform::from_trs(DVec3::X, DQuat::IDENTITY, DVec3::ONE)),
+            Bone::joint("m", Some(1), turned(DVec3::Z, 30.0)),
+            Bone::joint("b", Some(2), turned(DVec3::X, 30.0)),
+        ];
+        let squash = |x: f32, y: f32| Vec3::new(x, y, 1.0);
+        let mut a = BoneTracks::new(1);
+        a.scale = Some(track(&[0.0, 1.0, 1.5, 3.0], &[squash(1.5, 1.0), squash(1.5, 1.0), Vec3::ONE, Vec3::ONE]));
+        let mut m = BoneTracks::new(2);
+        m.scale = Some(track(&[0.0, 1.5, 2.0, 3.0], &[Vec3::ONE, Vec3::ONE, squash(1.0, 1.5), squash(1.0, 1.5)]));
+        m.rotation = Some(track(&[0.0], &[Quat::from_rotation_z(30f32.to_radians())]));
+        let rig = rig(bones, vec![Clip::new(0, None, vec![a, m], vec![])]);
+        let evaluation = Evaluation::declared(&rig, rig.clips.first());
+        let times = evaluation.times(10.0);
+        let causes = causes(&evaluation, 3, &times, None, &Default::default());
+        let spans: Vec<(&str, f64, f64)> = causes.spans.iter().map(|s| (s.name.as_str(), s.from, s.to)).collect();
+        assert_eq!(spans.len(), 2, "{spans:?}");
+        assert_eq!((spans[0].0, spans[0].1), ("a", 0.0));
+        assert!((1.4..=1.6).contains(&spans[0].2), "a is the cause until both are uniform at 1.5 s: {spans:?}");
+        assert_eq!((spans[1].0, spans[1].2), ("m", 3.0));
+        assert!(spans[1].1 > 1.5 && spans[1].1 < 1.7, "{spans:?}");
+        assert!(causes.at.time >= 2.0, "the worst shear is under m's full squash: {:?}", causes.at);
+    }
+
+    #[test]
+    fn a_bone_scaled_along_its_own_axes_has_nothing_to_explain() {
+        // Scaled (2, 1, 1) with its child along the same axes: non-uniform, but no shear anywhere.
+        let scaled = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
+        let rig = rig(
+            vec![Bone::joint("scaled", None, scaled), Bone::joint("child", Some(0), turned(DVec3::Z, 90.0))],
+            vec![],
+        );
+        let evaluation = Evaluation::declared(&rig, None);
+        assert!(explain(&evaluation, None, None, &ScanOptions::default()).is_empty(), "nothing is flagged");
+        for explained in explain(&evaluation, Some(&[0, 1]), None, &ScanOptions::default()) {
+            assert_eq!(explained.causes.stretched_samples, 0, "{explained:?}");
+            assert!(
+                explained.fixes.is_empty()
+                    && explained.causes.spans.is_empty()
+                    && explained.causes.at.sufficient.is_empty()
+            );
+            assert!(explained.causes.at.shear_deg < 1e-9);
+        }
+    }
+}
