@@ -157,6 +157,25 @@ pub struct AnimationScan {
     pub non_uniform: Vec<String>,
     pub mirrored: Vec<String>,
     pub degenerate: Vec<String>,
+    /// With `scan --explain`: each stretched bone's main cause and best fix (`crate::explain`), worst first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub explained: Vec<ExplainedBone>,
+}
+
+/// A stretched bone's explanation in brief: whose squash shears it most, and the cheapest fix.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct ExplainedBone {
+    pub name: String,
+    /// The bone of its chain whose uniform scale would remove the most shear where it shears most.
+    pub main_cause: Option<String>,
+    /// The best fix, what it leaves, and how far it moves the skin (or, without a mesh, the bones' probe points):
+    /// in the rig's units and as a fraction of its size.
+    pub best_fix: Option<String>,
+    pub fix_removes: Option<bool>,
+    pub fix_cost: Option<f64>,
+    pub fix_cost_fraction: Option<f64>,
+    /// All of it in a line for people.
+    pub line: String,
 }
 
 impl AnimationScan {
@@ -184,6 +203,7 @@ impl AnimationScan {
             non_uniform,
             mirrored,
             degenerate,
+            explained: Vec::new(),
         }
     }
 }

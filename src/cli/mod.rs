@@ -1,7 +1,7 @@
 //! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
 //! inheritance modes), `storage` measures the stretch-quaternion storage of whole clips, `export` writes the
 //! evaluated meshes of one time, `render` draws the viewport to PNG, `bake` writes any inheritance as plain glTF,
-//! `diff` compares two evaluations.
+//! `diff` compares two evaluations, `explain` says whose scale shears a bone and which fix costs least.
 //!
 //! Exit codes: 0 success; 1 `scan --fail-above` found a stretched bone, `render --reference` found a picture over
 //! its threshold, `bake --fail-above` or `diff --fail-above` a difference over its limit; 2 bad usage or a file that
@@ -9,6 +9,7 @@
 
 mod bake;
 mod diff;
+mod explain;
 mod export;
 mod inspect;
 mod layers;
@@ -56,6 +57,9 @@ pub enum Command {
     Report(report::ReportArgs),
     /// Write every mesh as evaluated at one time (skinned), in the file's own units and axes.
     Export(export::ExportArgs),
+    /// Explain why bones shear: whose scale causes it (each bone of the chain with its scale made uniform), when,
+    /// and the fixes (another mode on one bone, one scale made uniform, a bake) ranked by how far they move the skin.
+    Explain(explain::ExplainArgs),
     /// Bake any scale inheritance into a plain glTF binary that every engine plays exactly (or as the closest TRS).
     Bake(bake::BakeArgs),
     /// Compare two evaluations (two files, or one under two sets of modes) over time, bone by bone.
@@ -90,6 +94,7 @@ pub fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         #[cfg(not(feature = "gui"))]
         Some(Command::Render { .. }) => Err(anyhow::anyhow!("render {NEEDS_GUI}")),
+        Some(Command::Explain(args)) => explain::run(&args),
         Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::Diff(args)) => diff::run(&args),
         #[cfg(feature = "gui")]

@@ -199,15 +199,6 @@ impl Comparison {
         let meshes = self.meshes.iter().map(|m| m.distance);
         bones.chain(meshes).fold(Extreme::default(), Extreme::merge)
     }
-
-    /// How far what a viewer sees moved: the largest vertex distance of any skinned mesh, or, where no meshes were
-    /// compared, the largest probe distance of any bone (its origin and axes).
-    pub fn visible_distance(&self) -> Extreme {
-        match self.meshes.is_empty() {
-            true => self.bones.iter().map(|b| b.probe).fold(Extreme::default(), Extreme::merge),
-            false => self.meshes.iter().map(|m| m.distance).fold(Extreme::default(), Extreme::merge),
-        }
-    }
 }
 
 /// The times two evaluations are compared at: every key time of either within the shorter duration, and `rate`

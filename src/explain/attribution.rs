@@ -17,9 +17,10 @@ pub struct Link {
     pub scale: DVec3,
     /// How unequal they are: `max|k|/min|k| − 1` (0: uniform, nothing to take out).
     pub anisotropy: f64,
-    /// The smallest angle, in degrees, between this bone's scale axes and the axes of the next bone down the chain
-    /// (up to swapping axes and merging factors within the anisotropy tolerance): a squash shears the bones below
-    /// it only when they turn its axes off themselves. `None` for the explained bone.
+    /// The smallest angle, in degrees, between this bone's scale axes and the explained bone's axes, as the local
+    /// rotations of the chain below it turn them (up to swapping axes and merging factors within the anisotropy
+    /// tolerance): a squash shears a bone below it only when the rotations between turn its axes off themselves.
+    /// `None` for the explained bone.
     pub turn_deg: Option<f64>,
     /// The explained bone's shear, in degrees, with this bone's local scale made uniform and all else as evaluated.
     pub shear_left_deg: f64,
@@ -83,13 +84,18 @@ pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &T
     let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
     let assessment = Assessment::of(&probe.matrix(&mut local, &[]), tolerances);
     let shear = assessment.shear_deg;
+    // The turn from each bone of the chain down to the explained bone: the local rotations below it, in order.
+    let mut below = vec![DQuat::IDENTITY; chain.len()];
+    for i in (0..chain.len().saturating_sub(1)).rev() {
+        below[i] = local[chain[i + 1]].rotation * below[i + 1];
+    }
     let links: Vec<Link> = chain
         .iter()
-        .enumerate()
-        .map(|(i, &b)| {
+        .zip(&below)
+        .map(|(&b, &turn)| {
             let shear_left = Assessment::of(&probe.matrix(&mut local, &[b]), tolerances).shear_deg;
-            let next = chain.get(i + 1).map(|&c| local[c].rotation);
-            link(skeleton, b, &local[b], next, shear, shear_left, tolerances)
+            let turn = (b != bone).then_some(turn);
+            link(skeleton, b, &local[b], turn, shear, shear_left, tolerances)
         })
         .collect();
     let stretched = assessment.findings.stretched;
@@ -244,19 +250,20 @@ fn anisotropy(scale: DVec3) -> f64 {
     if min > 0.0 { max / min - 1.0 } else { 0.0 }
 }
 
-/// The link of bone `bone`, whose local transform is `local` and whose child on the chain turns by `next`.
+/// The link of bone `bone`, whose local transform is `local` and whose chain down to the explained bone turns by
+/// `below`.
 fn link(
     skeleton: &Skeleton,
     bone: usize,
     local: &Transform,
-    next: Option<DQuat>,
+    below: Option<DQuat>,
     shear: f64,
     shear_left: f64,
     tolerances: &Tolerances,
 ) -> Link {
-    // The scale's axes seen from the child: columns of `Rᵀ·U`; their angle to the child's own axes is that of a
+    // The scale's axes seen from the explained bone: columns of `Rᵀ·U`; their angle to the child's own axes is that of a
     // stretch rotation, up to the symmetries of the factors.
-    let turn = next.map(|rotation| {
+    let turn = below.map(|rotation| {
         let seen = AffineParts {
             stretch: rotation.conjugate() * local.stretch,
             scale: local.scale.abs(),

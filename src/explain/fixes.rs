@@ -8,7 +8,7 @@ use crate::bake::{self, ClipToBake, Engine, Request, Strategy};
 use crate::diff::{Comparison, Extreme, Pairs, compare, comparison_times};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
-use crate::model::{Choice, Clip, InheritMode, Rig, Skeleton};
+use crate::model::{Choice, Clip, InheritMode, Rig, Skeleton, Unit};
 
 /// A change to how the clip is evaluated that may take a bone's shear away.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -78,20 +78,21 @@ impl Change {
     }
 }
 
-/// What a viewer's eye measures a change by.
+/// Where a change's cost was largest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Measured {
-    /// The skinned vertices.
+    /// At a skinned vertex (or a vertex of a mesh hanging from a bone).
     Skin,
-    /// The bones' origins and probe points on their axes (a rig without a mesh).
+    /// At a bone no mesh shows (its origin or a probe point on its axes): a rig without a mesh, or a part of the
+    /// figure its meshes do not cover.
     Bones,
 }
 
 /// How far a change moves what the viewer sees, at worst over the clip.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Cost {
-    /// In the rig's units, and the first time it happens ([`Comparison::visible_distance`]).
+    /// In the rig's units, and the first time it happens.
     pub distance: Extreme,
     /// As a fraction of the rig's size.
     pub fraction: f64,
@@ -99,9 +100,16 @@ pub struct Cost {
 }
 
 impl Cost {
-    fn of(comparison: &Comparison) -> Self {
-        let distance = comparison.visible_distance();
-        let measured = if comparison.meshes.is_empty() { Measured::Bones } else { Measured::Skin };
+    /// The cost `comparison` (of the rig `rig` against a change of it) shows: the largest distance of any mesh's
+    /// vertices, and of the probe points of every bone of the figure that no mesh shows
+    /// ([`Rig::shown_by_meshes`]); a skin that stays put does not hide a neck that moves.
+    pub fn of(comparison: &Comparison, rig: &Rig) -> Self {
+        let (shown, figure) = (rig.shown_by_meshes(), rig.skeleton.figure());
+        let skin = comparison.meshes.iter().map(|m| m.distance).fold(Extreme::default(), Extreme::merge);
+        let unseen = comparison.bones.iter().filter(|b| figure[b.a] && !shown[b.a]).map(|b| b.probe);
+        let bones = unseen.fold(Extreme::default(), Extreme::merge);
+        let (distance, measured) = if bones.max > skin.max { (bones, Measured::Bones) } else { (skin, Measured::Skin) };
+        let measured = if comparison.meshes.is_empty() { Measured::Bones } else { measured };
         Cost { distance, fraction: distance.max / comparison.rig_size, measured }
     }
 }
@@ -144,7 +152,7 @@ impl Outcome {
             .collect();
         let pairs = Pairs::by_name(source, fixed);
         let comparison = compare(source, fixed, &pairs, &comparison_times(source, fixed, options.rate));
-        Outcome { shear, cost: Cost::of(&comparison) }
+        Outcome { shear, cost: Cost::of(&comparison, source.rig) }
     }
 }
 
@@ -185,6 +193,19 @@ impl Fix {
             cleared: others(true),
             cost: outcome.cost,
         }
+    }
+}
+
+impl Fix {
+    /// "forearm → segment-compensate, moves the skin 0.4 mm" (and the shear it leaves, where it leaves some),
+    /// lengths in `unit` (the rig's).
+    pub fn summary(&self, unit: Option<Unit>) -> String {
+        let moved = match self.cost.measured {
+            Measured::Skin => "moves the skin",
+            Measured::Bones => "moves the bones",
+        };
+        let left = if self.removes { String::new() } else { format!(", leaves {:.2}°", self.shear_left_deg) };
+        format!("{}, {moved} {}{left}", self.label, Unit::readable(unit, self.cost.distance.max))
     }
 }
 

@@ -26,8 +26,10 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use crate::analysis::{ClipScan, ScanOptions, scan};
+use crate::analysis::report::ExplainedBone;
+use crate::analysis::{ClipScan, ScanOptions};
 use crate::eval::Evaluation;
+use crate::model::Unit;
 use fixes::{Outcome, candidates, rank};
 
 /// One bone explained over a clip.
@@ -48,6 +50,46 @@ impl Explanation {
     pub fn best_fix(&self) -> Option<&Fix> {
         self.fixes.first()
     }
+
+    /// The explanation in brief, as `scan --explain` records it.
+    pub fn brief(&self, unit: Option<Unit>) -> ExplainedBone {
+        let fix = self.best_fix();
+        ExplainedBone {
+            name: self.name.clone(),
+            main_cause: self.causes.at.main_cause().map(|l| l.name.clone()),
+            best_fix: fix.map(|f| f.label.clone()),
+            fix_removes: fix.map(|f| f.removes),
+            fix_cost: fix.map(|f| f.cost.distance.max),
+            fix_cost_fraction: fix.map(|f| f.cost.fraction),
+            line: self.headline(unit),
+        }
+    }
+
+    /// One line for a report: the main cause where the bone shears most, and the best fix, lengths in `unit` (the
+    /// rig's). "forearm: upper_arm's scale (1.3, 0.8, 1) under a 35° turn; fix: forearm → segment-compensate,
+    /// moves the skin 0.4 mm".
+    pub fn headline(&self, unit: Option<Unit>) -> String {
+        let name = &self.name;
+        if self.causes.stretched_samples == 0 {
+            return format!("{name}: not sheared beyond the tolerances");
+        }
+        let cause = match self.causes.at.main_cause() {
+            Some(link) if link.bone == self.bone => "its own stretch".to_owned(),
+            Some(link) => format!(
+                "{}'s scale ({:.3}, {:.3}, {:.3}) under a {:.0}° turn",
+                link.name,
+                link.scale.x,
+                link.scale.y,
+                link.scale.z,
+                link.turn_deg.unwrap_or(0.0)
+            ),
+            None => "no single bone's scale".to_owned(),
+        };
+        match self.best_fix() {
+            Some(fix) => format!("{name}: {cause}; fix: {}", fix.summary(unit)),
+            None => format!("{name}: {cause}"),
+        }
+    }
 }
 
 /// The bones `scan` flags, the worst shear first.
@@ -58,15 +100,16 @@ pub fn flagged(scan: &ClipScan) -> Vec<usize> {
 }
 
 /// Explains each of `bones` over `evaluation`'s clip (every flagged bone, the worst first, for `None`), with the
-/// detail at time `at` (each bone's worst time for `None`). Fixes shared by several bones are measured once.
+/// detail at time `at` (each bone's worst time for `None`). `before` is the clip's scan with `options` (what the
+/// fixes change). Fixes shared by several bones are measured once.
 pub fn explain(
     evaluation: &Evaluation,
+    before: &ClipScan,
     bones: Option<&[usize]>,
     at: Option<f64>,
     options: &ScanOptions,
 ) -> Vec<Explanation> {
-    let before = scan(evaluation, options, &|_, _| {});
-    let bones = bones.map_or_else(|| flagged(&before), <[usize]>::to_vec);
+    let bones = bones.map_or_else(|| flagged(before), <[usize]>::to_vec);
     let times = evaluation.times(options.rate);
     let tolerances = &options.tolerances;
     let causes: Vec<Causes> = bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at, tolerances)).collect();
@@ -93,7 +136,7 @@ pub fn explain(
             let mut notes = Vec::new();
             for change in changes {
                 match &outcomes[&change] {
-                    Ok(outcome) => fixes.push(Fix::new(skeleton, bone, change, outcome, &before)),
+                    Ok(outcome) => fixes.push(Fix::new(skeleton, bone, change, outcome, before)),
                     Err(why) => notes.push(format!("{}: {why}", change.describe(skeleton))),
                 }
             }
@@ -126,6 +169,13 @@ mod tests {
         Rig { skeleton: Skeleton::new(bones).unwrap(), clips, ..Rig::default() }
     }
 
+    /// `bones` (the flagged ones for `None`) of `evaluation` explained with the default options.
+    fn explained(evaluation: &Evaluation, bones: Option<&[usize]>) -> Vec<Explanation> {
+        let options = ScanOptions::default();
+        let before = crate::analysis::scan(evaluation, &options, &|_, _| {});
+        explain(evaluation, &before, bones, None, &options)
+    }
+
     fn turned(axis: DVec3, degrees: f64) -> Transform {
         Transform::from_trs(DVec3::X, DQuat::from_axis_angle(axis, degrees.to_radians()), DVec3::ONE)
     }
@@ -141,7 +191,7 @@ mod tests {
             vec![],
         );
         let evaluation = Evaluation::declared(&rig, None);
-        let explained = explain(&evaluation, None, None, &ScanOptions::default());
+        let explained = explained(&evaluation, None);
         assert_eq!(explained.len(), 1, "only the child is flagged");
         let child = &explained[0];
         let at = &child.causes.at;
@@ -211,8 +261,8 @@ mod tests {
             vec![],
         );
         let evaluation = Evaluation::declared(&rig, None);
-        assert!(explain(&evaluation, None, None, &ScanOptions::default()).is_empty(), "nothing is flagged");
-        for explained in explain(&evaluation, Some(&[0, 1]), None, &ScanOptions::default()) {
+        assert!(explained(&evaluation, None).is_empty(), "nothing is flagged");
+        for explained in explained(&evaluation, Some(&[0, 1])) {
             assert_eq!(explained.causes.stretched_samples, 0, "{explained:?}");
             assert!(
                 explained.fixes.is_empty()

@@ -45,6 +45,31 @@ impl Rig {
             .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
     }
 
+    /// For each bone, whether a mesh shows where it goes: some skinned vertex is weighted to it, or an unskinned
+    /// mesh hangs from it.
+    pub fn shown_by_meshes(&self) -> Vec<bool> {
+        let mut shown = vec![false; self.skeleton.len()];
+        let mut show = |bone: usize| {
+            if let Some(slot) = shown.get_mut(bone) {
+                *slot = true;
+            }
+        };
+        for mesh in &self.meshes {
+            let Some(skin) = mesh.skin.and_then(|s| self.skins.get(s)) else {
+                show(mesh.bone);
+                continue;
+            };
+            for (joints, weights) in mesh.joints.iter().zip(&mesh.weights) {
+                for (&joint, &weight) in joints.iter().zip(weights) {
+                    if let Some(&bone) = skin.joints.get(usize::from(joint)).filter(|_| weight > 0.0) {
+                        show(bone);
+                    }
+                }
+            }
+        }
+        shown
+    }
+
     /// For each bone, whether it is a conversion node: one at the top of the hierarchy (a root, or below conversion
     /// nodes only) that only changes axes or units ([`Transform::only_converts`]) at rest and in every clip (which
     /// may key it, but only to hold one value) and that carries bones or a mesh. Exporters put such nodes above a character to state their axes and unit (Blender's

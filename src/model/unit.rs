@@ -37,6 +37,22 @@ impl Unit {
         self.metres
     }
 
+    /// `length` (in this unit, or in a rig's own numbers for `None`) for people: in m, cm, mm or µm as its size
+    /// asks, to three significant digits, or in units where the unit is not known.
+    pub fn readable(unit: Option<Unit>, length: f64) -> String {
+        let Some(unit) = unit else {
+            return format!("{} units", significant(length));
+        };
+        let metres = length * unit.metres;
+        let (scale, name) = match metres.abs() {
+            m if m >= 1.0 => (1.0, "m"),
+            m if m >= 0.01 => (100.0, "cm"),
+            m if m >= 1e-4 || m == 0.0 => (1000.0, "mm"),
+            _ => (1e6, "µm"),
+        };
+        format!("{} {name}", significant(metres * scale))
+    }
+
     /// How many `other`s one of this unit is: what a length in this unit is multiplied by to be in `other`.
     pub fn per(self, other: Unit) -> f64 {
         self.metres / other.metres
@@ -82,6 +98,19 @@ impl FromStr for Unit {
     }
 }
 
+/// `x` to three significant digits, without trailing zeros (scientific outside 1e-4..1e6).
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    if !(1e-4..1e6).contains(&x.abs()) {
+        return format!("{x:.2e}");
+    }
+    let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,5 +139,17 @@ mod tests {
         assert!((cmu.per(cm) - 2.54 / 0.45).abs() < 1e-12);
         assert_eq!(Unit::METRE.per(cm), 100.0);
         assert_eq!(Unit::named().count(), NAMED.len());
+    }
+
+    #[test]
+    fn lengths_read_in_the_unit_their_size_asks_for() {
+        let cm = Unit::metres(0.01);
+        assert_eq!(Unit::readable(cm, 0.04), "0.4 mm");
+        assert_eq!(Unit::readable(cm, 250.0), "2.5 m");
+        assert_eq!(Unit::readable(cm, 8.0), "8 cm");
+        assert_eq!(Unit::readable(Some(Unit::METRE), 1.234_56e-7), "0.123 µm");
+        assert_eq!(Unit::readable(Some(Unit::METRE), 0.0), "0 mm");
+        assert_eq!(Unit::readable(None, 0.012_345), "0.0123 units");
+        assert_eq!(Unit::readable(None, 3.0e-9), "3.00e-9 units");
     }
 }

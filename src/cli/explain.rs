@@ -1,0 +1,213 @@
+//! `bonescope explain`: whose scale shears a bone, and which fix costs least.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Args;
+
+use super::layers::LayerArgs;
+use super::options::parse_rate;
+use super::table::Table;
+use super::{EvalArgs, Format, ToleranceArgs};
+use crate::analysis::report::AnimationInfo;
+use crate::analysis::{ScanOptions, scan};
+use crate::eval::{Evaluation, LayerStack};
+use crate::explain::{Change, Explanation, Fix, Measured, explain};
+use crate::import;
+use crate::model::{InheritMode, Rig, Unit};
+
+#[derive(Debug, Args)]
+pub struct ExplainArgs {
+    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    pub file: PathBuf,
+    /// The bone to explain (repeatable; default: every stretched bone, the worst first).
+    #[arg(long, value_name = "NAME")]
+    pub bone: Vec<String>,
+    /// Show the chain at this time, in seconds (default: where each bone shears most).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub time: Option<f64>,
+    #[command(flatten)]
+    pub eval: EvalArgs,
+    /// Samples per second, on top of every key time.
+    #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate, value_parser = parse_rate)]
+    pub rate: f64,
+    #[arg(long, value_enum, default_value_t)]
+    pub format: Format,
+    #[command(flatten)]
+    pub tolerances: ToleranceArgs,
+    #[command(flatten)]
+    pub layers: LayerArgs,
+}
+
+/// `bonescope explain --format json`.
+#[derive(serde::Serialize)]
+struct ExplainReport<'a> {
+    file: String,
+    animation: Option<AnimationInfo>,
+    inherit: String,
+    rate: f64,
+    /// The rig's size, which the fixes' costs are fractions of, in its units.
+    unit: Option<Unit>,
+    bones: &'a [Explanation],
+}
+
+pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
+    let rig = import::load(&args.file)?;
+    let clip = args.eval.clip(&rig)?;
+    let modes = args.eval.modes(&rig)?;
+    if let Some(time) = args.time.filter(|t| !t.is_finite()) {
+        anyhow::bail!("--time must be a finite number of seconds, got {time}");
+    }
+    let bones = args
+        .bone
+        .iter()
+        .map(|name| rig.skeleton.find(name).with_context(|| format!("--bone: no bone named `{name}`")))
+        .collect::<anyhow::Result<Vec<usize>>>()?;
+    let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
+    let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
+    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(layers);
+    let before = scan(&evaluation, &options, &|_, _| {});
+    let asked = (!bones.is_empty()).then_some(bones.as_slice());
+    let explained = explain(&evaluation, &before, asked, args.time, &options);
+    let report = ExplainReport {
+        file: super::scan::shown(&args.file),
+        animation: clip.map(AnimationInfo::of),
+        inherit: args.eval.inherit_label(),
+        rate: args.rate,
+        unit: rig.unit,
+        bones: &explained,
+    };
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        Format::Table => print!("{}", render_table(&report, &rig, &modes)),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode]) -> String {
+    let animation = AnimationInfo::describe(report.animation.as_ref());
+    let mut out = format!("{}  {animation}  inherit: {}\n", report.file, report.inherit);
+    if report.bones.is_empty() {
+        out.push_str("  no stretched bones: nothing to explain\n");
+    }
+    for explained in report.bones {
+        out.push('\n');
+        out.push_str(&render_bone(explained, rig, modes, report.unit));
+    }
+    out
+}
+
+/// One bone: the chain at the detailed time, the main causes over the clip, the fixes, and what the declared modes
+/// on the chain are worth.
+fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: Option<Unit>) -> String {
+    let (causes, at) = (&explained.causes, &explained.causes.at);
+    let mut out = format!("{}\n", explained.headline(unit));
+    if causes.stretched_samples == 0 {
+        return out;
+    }
+    out.push_str(&format!(
+        "  shears {:.3}° at {:.4} s{}; flagged at {} of {} samples\n",
+        at.shear_deg,
+        at.time,
+        if at.stretched { "" } else { " (not flagged there)" },
+        causes.stretched_samples,
+        causes.samples
+    ));
+    let mut chain = Table::new(&[
+        ("chain, root first", false),
+        ("scale k", false),
+        ("unequal", true),
+        ("turn°", true),
+        ("shear left°", true),
+        ("causes°", true),
+        ("", false),
+    ]);
+    let main = at.main_cause().map(|l| l.bone);
+    for link in &at.chain {
+        let k = link.scale;
+        chain.row(vec![
+            format!("  {}", link.name),
+            format!("({:.4}, {:.4}, {:.4})", k.x, k.y, k.z),
+            format!("{:.2} %", 100.0 * link.anisotropy),
+            link.turn_deg.map_or_else(String::new, |t| format!("{t:.2}")),
+            format!("{:.3}", link.shear_left_deg),
+            format!("{:.3}", link.contribution_deg),
+            if Some(link.bone) == main { "◀ main cause".to_owned() } else { String::new() },
+        ]);
+    }
+    out.push_str(&chain.to_string());
+    let names: Vec<&str> = at.sufficient.iter().map(|&b| rig.skeleton.bone(b).name.as_str()).collect();
+    if !names.is_empty() {
+        out.push_str(&format!(
+            "  contributions need not add up (scales compound and cancel); uniform scale on {} alone removes it\n",
+            names.join(" and ")
+        ));
+    }
+    if !causes.spans.is_empty() {
+        let spans: Vec<String> =
+            causes.spans.iter().map(|s| format!("{} {:.4}–{:.4} s", s.name, s.from, s.to)).collect();
+        out.push_str(&format!("  main cause over the clip: {}\n", spans.join(", ")));
+    }
+    out.push_str(&render_fixes(&explained.fixes, unit));
+    out.push_str(&render_modes(explained, rig, modes, unit));
+    for note in &explained.notes {
+        out.push_str(&format!("  note: {note}\n"));
+    }
+    out
+}
+
+fn render_fixes(fixes: &[Fix], unit: Option<Unit>) -> String {
+    let mut table = Table::new(&[
+        ("  fixes, best first", false),
+        ("shear left°", true),
+        ("removes", false),
+        ("moves", true),
+        ("% of rig", true),
+        ("at s", true),
+        ("elsewhere", false),
+    ]);
+    for fix in fixes {
+        let mut elsewhere = Vec::new();
+        if !fix.cleared.is_empty() {
+            elsewhere.push(format!("clears {}", fix.cleared.join(", ")));
+        }
+        if !fix.newly_flagged.is_empty() {
+            elsewhere.push(format!("shears {}", fix.newly_flagged.join(", ")));
+        }
+        table.row(vec![
+            format!("  {}", fix.label),
+            format!("{:.3}", fix.shear_left_deg),
+            if fix.removes { "yes" } else { "no" }.to_owned(),
+            Unit::readable(unit, fix.cost.distance.max),
+            format!("{:.4}", 100.0 * fix.cost.fraction),
+            format!("{:.4}", fix.cost.distance.time),
+            elsewhere.join("; "),
+        ]);
+    }
+    table.to_string()
+}
+
+/// The chain's bones whose mode is not `full`, and what treating each as `full` (an engine that ignores the flag)
+/// would do: the mode matters where that shears or moves something.
+fn render_modes(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: Option<Unit>) -> String {
+    let mut out = String::new();
+    for fix in &explained.fixes {
+        let Change::Mode { bone, mode: InheritMode::Full } = fix.change else {
+            continue;
+        };
+        let moved = match fix.cost.measured {
+            Measured::Skin => "skin moves",
+            Measured::Bones => "bones move",
+        };
+        out.push_str(&format!(
+            "  mode on the chain: {} is {}; as full, {} shears {:.3}° and the {moved} {}\n",
+            rig.skeleton.bone(bone).name,
+            modes[bone],
+            explained.name,
+            fix.shear_left_deg,
+            Unit::readable(unit, fix.cost.distance.max),
+        ));
+    }
+    out
+}
