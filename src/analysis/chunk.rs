@@ -63,6 +63,7 @@ impl<'a> Plan<'a> {
             judged: match judged {
                 Judged::Every => (0..skeleton.len()).collect(),
                 Judged::CurveChains => with_ancestors(skeleton, plotted),
+                Judged::Subtree(top) => with_ancestors(skeleton, &skeleton.subtree(top)),
             },
         }
     }

@@ -38,4 +38,7 @@ pub enum Judged {
     /// Only the bones whose curves are asked for and their ancestors: the curves of a newly selected bone, without
     /// waiting for the rest of the rig (the other bones' summaries stay empty).
     CurveChains,
+    /// Only this bone, the bones below it and its ancestors: what a change to that bone alone can change (the
+    /// other bones' summaries stay empty).
+    Subtree(usize),
 }

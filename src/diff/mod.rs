@@ -27,7 +27,7 @@ use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::Components;
 use crate::eval::{Evaluation, Evaluator, over_runs};
-use crate::math::{AffineParts, angle_between, decompose_all};
+use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, sample_times};
 
 /// How far along each axis the probe points lie, as a fraction of the rig's size.
@@ -215,7 +215,7 @@ pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> 
     let rig_size = a.size(times);
     let probe_length = rig_size * PROBE_FRACTION;
     let runs = over_runs(times, |run| {
-        let mut worker = PairEvaluator::new(a, b);
+        let mut worker = PairEvaluator::new(a, b, pairs);
         let mut differences = Differences::new(a, b, pairs);
         for &time in run {
             worker.evaluate(&pairs.meshes, time);
@@ -294,6 +294,9 @@ impl Differences {
 struct PairEvaluator<'e, 'a> {
     a: Evaluator<'e, 'a>,
     b: Evaluator<'e, 'a>,
+    /// The paired bones of each side, whose matrices are decomposed.
+    bones_a: Vec<usize>,
+    bones_b: Vec<usize>,
     parts_a: Vec<AffineParts>,
     parts_b: Vec<AffineParts>,
     /// The paired meshes, skinned, in the order of the pairs.
@@ -302,10 +305,12 @@ struct PairEvaluator<'e, 'a> {
 }
 
 impl<'e, 'a> PairEvaluator<'e, 'a> {
-    fn new(a: &'e Evaluation<'a>, b: &'e Evaluation<'a>) -> Self {
+    fn new(a: &'e Evaluation<'a>, b: &'e Evaluation<'a>, pairs: &Pairs) -> Self {
         PairEvaluator {
             a: a.evaluator(),
             b: b.evaluator(),
+            bones_a: pairs.bones.pairs.iter().map(|p| p.0).collect(),
+            bones_b: pairs.bones.pairs.iter().map(|p| p.1).collect(),
             parts_a: Vec::new(),
             parts_b: Vec::new(),
             skinned_a: Vec::new(),
@@ -315,8 +320,8 @@ impl<'e, 'a> PairEvaluator<'e, 'a> {
 
     /// Evaluates both sides at `time`, skinning the paired `meshes`.
     fn evaluate(&mut self, meshes: &[(usize, usize)], time: f64) {
-        self.parts_a = decompose_all(&self.a.evaluate(time).model.model);
-        self.parts_b = decompose_all(&self.b.evaluate(time).model.model);
+        self.parts_a = decompose_bones(&self.a.evaluate(time).model.model, &self.bones_a);
+        self.parts_b = decompose_bones(&self.b.evaluate(time).model.model, &self.bones_b);
         self.skinned_a.resize_with(meshes.len(), Vec::new);
         self.skinned_b.resize_with(meshes.len(), Vec::new);
         for (k, &(i, j)) in meshes.iter().enumerate() {
@@ -324,6 +329,19 @@ impl<'e, 'a> PairEvaluator<'e, 'a> {
             self.b.evaluation().skin(&self.b.pose, j, &mut self.skinned_b[k]);
         }
     }
+}
+
+/// The polar parts of the matrices of `bones` (the identity's at every other bone): every matrix at once where all
+/// are asked for ([`decompose_all`], less time per matrix), else only theirs.
+fn decompose_bones(model: &[DMat4], bones: &[usize]) -> Vec<AffineParts> {
+    if bones.len() == model.len() {
+        return decompose_all(model);
+    }
+    let mut parts = vec![AffineParts::IDENTITY; model.len()];
+    for &bone in bones {
+        parts[bone] = decompose(&model[bone]);
+    }
+    parts
 }
 
 /// The model-space components of `bones` of `side` at `times`, one curve per bone: a second file's curves beside the

@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use crate::analysis::{ClipScan, ScanOptions, scan};
+use std::sync::atomic::AtomicBool;
+
+use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Engine, Request, Strategy};
 use crate::diff::{Comparison, Extreme, Pairs, compare, comparison_times};
 use crate::eval::{Evaluation, LayerStack};
@@ -53,6 +55,14 @@ impl Change {
                 Ok(source.clone().with_layers(stack))
             }
             Change::Bake { .. } => Err("a bake is evaluated from the rig it writes".to_owned()),
+        }
+    }
+
+    /// The bone below which (itself included) the change changes anything; `None` for the whole rig.
+    fn changed_below(&self) -> Option<usize> {
+        match *self {
+            Change::Mode { bone, .. } | Change::UniformScale { bone } => Some(bone),
+            Change::Bake { .. } => None,
         }
     }
 
@@ -124,33 +134,44 @@ pub(super) struct Outcome {
 }
 
 impl Outcome {
-    /// `change` applied to `source` and measured.
-    pub fn of(source: &Evaluation, change: Change, options: &ScanOptions) -> Result<Self, String> {
-        match change.baked(source) {
-            None => Ok(Outcome::measure(source, &change.apply(source)?, options, Some)),
-            Some(rig) => {
-                let rig = rig?;
-                let fixed = Evaluation::declared(&rig, rig.clips.first());
-                let skeleton = source.skeleton();
-                Ok(Outcome::measure(source, &fixed, options, |b| rig.skeleton.find(&skeleton.bone(b).name)))
-            }
-        }
+    /// `change` applied to `source` and measured; `before` is `source`'s scan with `options`.
+    pub fn of(source: &Evaluation, change: Change, before: &ClipScan, options: &ScanOptions) -> Result<Self, String> {
+        let Some(rig) = change.baked(source) else {
+            let fixed = change.apply(source)?;
+            return Ok(Outcome::measure(source, &fixed, change.changed_below(), before, options, Some));
+        };
+        let rig = rig?;
+        let fixed = Evaluation::declared(&rig, rig.clips.first());
+        let skeleton = source.skeleton();
+        Ok(Outcome::measure(source, &fixed, None, before, options, |b| rig.skeleton.find(&skeleton.bone(b).name)))
     }
 
-    /// `fixed` scanned and compared with `source`; `bone_of` finds a source bone in `fixed`'s rig.
+    /// `fixed` scanned and compared with `source`: only `top` and the bones below it when the change is to them
+    /// alone (every other bone is as `before` says, and its difference nothing); `bone_of` finds a source bone in
+    /// `fixed`'s rig.
     fn measure(
         source: &Evaluation,
         fixed: &Evaluation,
+        top: Option<usize>,
+        before: &ClipScan,
         options: &ScanOptions,
         bone_of: impl Fn(usize) -> Option<usize>,
     ) -> Self {
-        let summary: ClipScan = scan(fixed, options, &|_, _| {});
+        let judged = top.map_or(Judged::Every, Judged::Subtree);
+        let request = CurveRequest { judged, ..CurveRequest::default() };
+        let never = AtomicBool::new(false);
+        let summary = analyze(fixed, request, options, &|_, _| {}, &never).expect("never cancelled").scan;
+        let changed = top.map(|top| source.skeleton().subtree(top));
+        let is_changed = |b: usize| changed.as_ref().is_none_or(|bones| bones.binary_search(&b).is_ok());
         let shear = (0..source.skeleton().len())
-            .map(|b| {
-                bone_of(b).map_or((0.0, false), |f| (summary.bones[f].worst_shear_deg, summary.bones[f].stretched()))
+            .map(|b| match bone_of(b) {
+                Some(f) if is_changed(b) => (summary.bones[f].worst_shear_deg, summary.bones[f].stretched()),
+                Some(_) => (before.bones[b].worst_shear_deg, before.bones[b].stretched()),
+                None => (0.0, false),
             })
             .collect();
-        let pairs = Pairs::by_name(source, fixed);
+        let mut pairs = Pairs::by_name(source, fixed);
+        pairs.bones.pairs.retain(|&(a, _)| is_changed(a));
         let comparison = compare(source, fixed, &pairs, &comparison_times(source, fixed, options.rate));
         Outcome { shear, cost: Cost::of(&comparison, source.rig) }
     }

@@ -125,7 +125,7 @@ pub fn explain(
     distinct.sort_by_key(|c| format!("{c:?}"));
     distinct.dedup();
     let outcomes: HashMap<Change, Result<Outcome, String>> =
-        distinct.into_par_iter().map(|change| (change, Outcome::of(evaluation, change, options))).collect();
+        distinct.into_par_iter().map(|change| (change, Outcome::of(evaluation, change, before, options))).collect();
     let skeleton = evaluation.skeleton();
     bones
         .iter()

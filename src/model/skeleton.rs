@@ -179,6 +179,20 @@ impl Skeleton {
         chain
     }
 
+    /// `top` and every bone below it, in bone order.
+    pub fn subtree(&self, top: usize) -> Vec<usize> {
+        // Parents come first, so one pass in order finds them all.
+        let mut inside = vec![false; self.bones.len()];
+        let mut bones = Vec::new();
+        for b in top..self.bones.len() {
+            inside[b] = b == top || self.bones[b].parent.is_some_and(|p| inside[p]);
+            if inside[b] {
+                bones.push(b);
+            }
+        }
+        bones
+    }
+
     /// Whether `bone` is `ancestor` or lies below it.
     pub fn is_in_subtree(&self, bone: usize, ancestor: usize) -> bool {
         let mut current = Some(bone);
