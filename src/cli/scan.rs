@@ -17,6 +17,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{ScanOptions, scan};
 use crate::diff::{AnimationDiff, diff_files};
 use crate::eval::{Evaluation, LayerStack};
+use crate::explain::explain;
 use crate::import;
 use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
@@ -76,6 +77,10 @@ pub struct ScanArgs {
         conflicts_with_all = ["inherit", "inherit_bone", "fail_above"]
     )]
     pub compare_inherit: Option<[ModeChoice; 2]>,
+    /// Explain each stretched bone: the bone whose scale shears it most and the fix that moves the skin least
+    /// (`bonescope explain` has the whole story); a line per bone in the table, `explained` in the JSON.
+    #[arg(long, conflicts_with = "compare_inherit")]
+    pub explain: bool,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
     #[command(flatten)]
@@ -311,8 +316,14 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
     let scanned = load_layered(path, &args.eval, &args.layers).map(|loaded| {
         loaded.each_clip(|evaluation| {
             let result = scan(evaluation, options, &|_, _| {});
+            let explained = match args.explain {
+                true => explain(evaluation, &result, None, None, options),
+                false => Vec::new(),
+            };
             let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);
-            AnimationScan::new(skeleton, clip, args.eval.inherit_label(), options.rate, result)
+            let scanned = AnimationScan::new(skeleton, clip, args.eval.inherit_label(), options.rate, result);
+            let explained = explained.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
+            AnimationScan { explained, ..scanned }
         })
     });
     FileReport::new(file, scanned)
@@ -478,6 +489,9 @@ pub(super) fn render_animation(file: &str, scan: &AnimationScan) -> String {
         if !names.is_empty() {
             out.push_str(&format!("  {label}: {}\n", names.join(", ")));
         }
+    }
+    for explained in &scan.explained {
+        out.push_str(&format!("  why: {}\n", explained.line));
     }
     out.push('\n');
     out

@@ -30,6 +30,7 @@ use crate::analysis::report::ExplainedBone;
 use crate::analysis::{ClipScan, ScanOptions};
 use crate::eval::Evaluation;
 use crate::model::Unit;
+use crate::model::unit::significant;
 use fixes::{Outcome, candidates, rank};
 
 /// One bone explained over a clip.
@@ -75,14 +76,10 @@ impl Explanation {
         }
         let cause = match self.causes.at.main_cause() {
             Some(link) if link.bone == self.bone => "its own stretch".to_owned(),
-            Some(link) => format!(
-                "{}'s scale ({:.3}, {:.3}, {:.3}) under a {:.0}° turn",
-                link.name,
-                link.scale.x,
-                link.scale.y,
-                link.scale.z,
-                link.turn_deg.unwrap_or(0.0)
-            ),
+            Some(link) => {
+                let [x, y, z] = link.scale.to_array().map(significant);
+                format!("{}'s scale ({x}, {y}, {z}) under a {:.0}° turn", link.name, link.turn_deg.unwrap_or(0.0))
+            }
             None => "no single bone's scale".to_owned(),
         };
         match self.best_fix() {

@@ -7,7 +7,7 @@ mod skeleton;
 mod skin;
 mod timeline;
 mod transform;
-mod unit;
+pub(crate) mod unit;
 
 pub use choice::Choice;
 pub use clip::{

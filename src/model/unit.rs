@@ -99,7 +99,7 @@ impl FromStr for Unit {
 }
 
 /// `x` to three significant digits, without trailing zeros (scientific outside 1e-4..1e6).
-fn significant(x: f64) -> String {
+pub(crate) fn significant(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }

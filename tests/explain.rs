@@ -1,0 +1,231 @@
+//! `explain` against the analysis and `diff` applied for real: every fix's "shear left" is what a scan of the
+//! changed evaluation reports (the mode given with `--inherit-bone`, the scale made uniform with `--uniform-scale`,
+//! the clip baked by `bonescope bake` and read back from its file), and every cost is the largest difference `diff`
+//! measures between the two evaluations (skinned vertices, and the probe points of bones no mesh shows), on the
+//! demo, the Blender squash-and-stretch rig, the Maya mixed-inheritance file and the generated 200-bone rig.
+
+mod common;
+
+#[path = "../benches/support/generated_gltf.rs"]
+#[allow(dead_code)]
+mod generated_gltf;
+
+use bonescope::analysis::{ClipScan, ScanOptions, scan};
+use bonescope::diff::{Pairs, compare, comparison_times};
+use bonescope::eval::{Evaluation, LayerStack, Layers};
+use bonescope::explain::{Change, Explanation, Fix, Measured, explain};
+use bonescope::model::{InheritMode, Rig};
+use common::{asset, bonescope, json, load_asset};
+
+/// The rule a fix's cost follows, applied to `diff`'s own comparison of `a` with `b`: the largest vertex distance
+/// of any mesh, and the largest probe distance of any bone of the figure that no mesh shows.
+fn visible_distance(a: &Evaluation, b: &Evaluation, rate: f64) -> (f64, bool) {
+    let comparison = compare(a, b, &Pairs::by_name(a, b), &comparison_times(a, b, rate));
+    let (shown, figure) = (a.rig.shown_by_meshes(), a.rig.skeleton.figure());
+    let skin = comparison.meshes.iter().map(|m| m.distance.max).fold(0.0, f64::max);
+    let unseen = comparison.bones.iter().filter(|d| figure[d.a] && !shown[d.a]).map(|d| d.probe.max);
+    let bones = unseen.fold(0.0, f64::max);
+    (skin.max(bones), comparison.meshes.is_empty() || bones > skin)
+}
+
+/// `fix` of `bone` checked against `fixed`, the same change made independently: the bone's worst shear and flag
+/// in a scan of `fixed`, and the cost `diff` measures.
+fn check_fix(source: &Evaluation, fixed: &Evaluation, bone_in_fixed: usize, fix: &Fix, options: &ScanOptions) {
+    let scanned: ClipScan = scan(fixed, options, &|_, _| {});
+    let summary = &scanned.bones[bone_in_fixed];
+    assert!(
+        (summary.worst_shear_deg - fix.shear_left_deg).abs() < 1e-9,
+        "{}: {} against {fix:?}",
+        fix.label,
+        summary.worst_shear_deg
+    );
+    assert_eq!(summary.stretched(), !fix.removes, "{}", fix.label);
+    let (distance, on_bones) = visible_distance(source, fixed, options.rate);
+    let tolerance = 1e-12 * source.size(&[0.0]).max(1.0);
+    assert!((distance - fix.cost.distance.max).abs() <= tolerance, "{}: {distance} against {:?}", fix.label, fix.cost);
+    assert_eq!(on_bones, fix.cost.measured == Measured::Bones, "{}", fix.label);
+}
+
+/// Every mode and uniform-scale fix of every explained bone of `source`, made again here with the library's own
+/// evaluation types, checked ([`check_fix`]). Returns the explanations.
+fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Explanation> {
+    let before = scan(source, options, &|_, _| {});
+    let explained = explain(source, &before, None, None, options);
+    assert!(!explained.is_empty(), "something is flagged");
+    for explanation in &explained {
+        assert!(!explanation.fixes.is_empty(), "{}", explanation.name);
+        for fix in &explanation.fixes {
+            match fix.change {
+                Change::Mode { bone, mode } => {
+                    let mut modes = source.modes().to_vec();
+                    modes[bone] = mode;
+                    check_fix(source, &source.with_modes(&modes), explanation.bone, fix, options);
+                }
+                Change::UniformScale { bone } => {
+                    let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };
+                    let fixed = source.clone().with_layers(LayerStack::new(source.rig, &layers).unwrap());
+                    check_fix(source, &fixed, explanation.bone, fix, options);
+                }
+                Change::Bake { .. } => {}
+            }
+        }
+    }
+    explained
+}
+
+#[test]
+fn on_the_demo_every_fix_is_what_the_analysis_and_diff_say_of_it_applied() {
+    let rig = bonescope::import::demo_rig();
+    let source = Evaluation::declared(&rig, rig.clips.first());
+    let explained = check_fixes_in_memory(&source, &ScanOptions::default());
+    let forearm = explained.iter().find(|e| e.name == "forearm").expect("the demo's forearm shears");
+    let cause = forearm.causes.at.main_cause().expect("a main cause");
+    assert_ne!(cause.name, "forearm", "the forearm's own scale is uniform: an ancestor's squash shears it");
+    assert!(forearm.fixes[0].removes, "some fix removes the shear: {:?}", forearm.fixes[0]);
+}
+
+#[test]
+fn on_the_blender_rig_every_fix_holds_and_the_bakes_hold_as_the_files_bake_writes() {
+    let path = asset("blender/stretchy_full.glb");
+    let rig = load_asset("blender/stretchy_full.glb");
+    let options = ScanOptions::default();
+    let source = Evaluation::declared(&rig, rig.clips.first());
+    let explained = check_fixes_in_memory(&source, &options);
+    let forearm = explained.iter().find(|e| e.name == "forearm").unwrap();
+    assert_eq!(forearm.causes.at.main_cause().map(|l| l.name.as_str()), Some("chest"), "the chest squashes");
+    // The bakes, as `bonescope bake` writes them: scanned and compared from the files.
+    let dir = tempfile::tempdir().unwrap();
+    for fix in forearm.fixes.iter().filter(|f| matches!(f.change, Change::Bake { .. })) {
+        let Change::Bake { strategy } = fix.change else { unreachable!() };
+        let out = dir.path().join(format!("{strategy:?}.glb"));
+        let baked = bonescope(&[
+            "bake",
+            path.to_str().unwrap(),
+            "--anim",
+            "0",
+            "--strategy",
+            &format!("{strategy:?}").to_lowercase(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(baked.status.success(), "{}", String::from_utf8_lossy(&baked.stderr));
+        let baked: Rig = bonescope::import::load(&out).unwrap();
+        let fixed = Evaluation::declared(&baked, baked.clips.first());
+        check_fix(&source, &fixed, baked.skeleton.find("forearm").unwrap(), fix, &options);
+    }
+    // The same through the command line: a mode given to one bone, a scale made uniform.
+    let shear_with = |extra: &[&str]| {
+        let mut args = vec!["scan", path.to_str().unwrap(), "--anim", "0", "--format", "json"];
+        args.extend_from_slice(extra);
+        let report = json(&bonescope(&args));
+        let stretched = report[0]["animations"][0]["stretched"].as_array().unwrap().clone();
+        stretched.iter().find(|b| b["name"] == "forearm").map_or(0.0, |b| b["worst_shear_deg"].as_f64().unwrap())
+    };
+    for fix in forearm.fixes.iter().filter(|f| f.removes || matches!(f.change, Change::UniformScale { .. })) {
+        let shear = match fix.change {
+            Change::Mode { bone, mode } => {
+                shear_with(&["--inherit-bone", &format!("{}={mode}", rig.skeleton.bone(bone).name)])
+            }
+            Change::UniformScale { bone } => shear_with(&["--uniform-scale", &rig.skeleton.bone(bone).name]),
+            Change::Bake { .. } => continue,
+        };
+        let expected = if fix.removes { 0.0 } else { fix.shear_left_deg };
+        assert!((shear - expected).abs() < 1e-9, "{}: the scan says {shear}", fix.label);
+    }
+}
+
+#[test]
+fn on_the_maya_file_explain_names_the_modes_that_matter_and_their_cost() {
+    // Maya's segment scale compensate on Left_Tip, Right and Right_Tip: an engine that ignores it (full) shears
+    // them or moves the skin, and explain says how much, bone by bone.
+    let file = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
+    let rig = load_asset(file);
+    let source = Evaluation::declared(&rig, rig.clips.first());
+    let explained = check_fixes_in_memory(&source, &ScanOptions::default());
+    let compensated: Vec<usize> =
+        (0..rig.skeleton.len()).filter(|&b| rig.skeleton.bone(b).inherit == InheritMode::SegmentCompensate).collect();
+    assert!(!compensated.is_empty());
+    let as_full: Vec<&Fix> = explained
+        .iter()
+        .flat_map(|e| &e.fixes)
+        .filter(|f| matches!(f.change, Change::Mode { bone, mode: InheritMode::Full } if compensated.contains(&bone)))
+        .collect();
+    assert!(as_full.iter().any(|f| f.cost.distance.max > 0.0), "some declared mode matters: {as_full:?}");
+    let table = bonescope(&["explain", asset(file).to_str().unwrap()]);
+    assert!(table.status.success(), "{}", String::from_utf8_lossy(&table.stderr));
+    let text = String::from_utf8(table.stdout).unwrap();
+    for bone in &compensated {
+        let name = &rig.skeleton.bone(*bone).name;
+        if as_full.iter().any(|f| matches!(f.change, Change::Mode { bone: b, .. } if b == *bone)) {
+            assert!(
+                text.contains(&format!("mode on the chain: {name} is segment-compensate; as full")),
+                "{name}:\n{text}"
+            );
+        }
+    }
+}
+
+#[test]
+fn on_the_generated_rig_the_fixes_of_a_sheared_bone_hold() {
+    // 200 bones, every 25th squashing, 6,000 frames: the last flagged bone (the mildest shear) explained at its
+    // key times, and its four best fixes other than a bake made again here.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("generated.glb");
+    std::fs::write(&path, generated_gltf::glb()).unwrap();
+    let rig = bonescope::import::load(&path).unwrap();
+    let options = ScanOptions { rate: 0.0, ..ScanOptions::default() };
+    let source = Evaluation::declared(&rig, rig.clips.first());
+    let before = scan(&source, &options, &|_, _| {});
+    let flagged = bonescope::explain::flagged(&before);
+    let bone = *flagged.last().expect("the squashes shear the bones below them");
+    let explained = explain(&source, &before, Some(&[bone]), None, &options);
+    let explanation = &explained[0];
+    let cause = explanation.causes.at.main_cause().expect("a squash causes it");
+    assert!(rig.skeleton.is_in_subtree(bone, cause.bone) && cause.bone != bone, "{cause:?}");
+    for fix in explanation.fixes.iter().filter(|f| !matches!(f.change, Change::Bake { .. })).take(4) {
+        let fixed = match fix.change {
+            Change::Mode { bone, mode } => {
+                let mut modes = source.modes().to_vec();
+                modes[bone] = mode;
+                source.with_modes(&modes)
+            }
+            Change::UniformScale { bone } => {
+                let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };
+                source.clone().with_layers(LayerStack::new(&rig, &layers).unwrap())
+            }
+            Change::Bake { .. } => unreachable!(),
+        };
+        check_fix(&source, &fixed, bone, fix, &options);
+    }
+}
+
+#[test]
+fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
+    let path = asset("blender/stretchy_full.glb");
+    let file = path.to_str().unwrap();
+    let report = json(&bonescope(&["explain", file, "--bone", "neck", "--format", "json"]));
+    let neck = &report["bones"][0];
+    assert_eq!(neck["name"], "neck");
+    assert_eq!(report["bones"].as_array().unwrap().len(), 1, "only the bone asked for");
+    let chain = neck["causes"]["at"]["chain"].as_array().unwrap();
+    assert_eq!(chain.last().unwrap()["name"], "neck", "the chain ends at the bone: {chain:?}");
+    assert!(neck["fixes"][0]["cost"]["distance"]["max"].as_f64().is_some(), "{neck}");
+    // At a time asked for, the chain is shown there.
+    let at = json(&bonescope(&["explain", file, "--bone", "neck", "--time", "1", "--format", "json"]));
+    assert_eq!(at["bones"][0]["causes"]["at"]["time"], 1.0);
+    let unknown = bonescope(&["explain", file, "--bone", "tail"]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unknown.stderr).contains("--bone: no bone named `tail`"));
+    // scan --explain: a line per stretched bone in the table, the brief in the JSON lines.
+    let scanned = bonescope(&["scan", file, "--explain"]);
+    let text = String::from_utf8(scanned.stdout).unwrap();
+    assert!(text.contains("  why: forearm: chest's scale ("), "{text}");
+    let lines = bonescope(&["scan", file, "--explain", "--format", "jsonl"]);
+    let record: serde_json::Value =
+        serde_json::from_slice(lines.stdout.split(|&b| b == b'\n').next().unwrap()).unwrap();
+    let explained = record["animations"][0]["explained"].as_array().unwrap();
+    let stretched = record["animations"][0]["stretched"].as_array().unwrap();
+    assert_eq!(explained.len(), stretched.len());
+    assert_eq!(explained[0]["main_cause"], "chest");
+    assert!(explained[0]["fix_cost"].as_f64().unwrap() > 0.0 && explained[0]["best_fix"].is_string());
+}
