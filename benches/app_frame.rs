@@ -79,22 +79,8 @@ fn clip_analysis(c: &mut Criterion) {
     group.finish();
 }
 
-/// The CMU walk with its motion repeated `times` times (the frame count and lines of the file's MOTION part).
-fn repeated_cmu_walk(times: usize) -> bonescope::model::Rig {
-    let path = shared_assets::asset("bvh/cmu_12_01_walk.bvh");
-    let text = std::fs::read_to_string(&path).expect("../shared/assets/bvh/cmu_12_01_walk.bvh");
-    let (header, motion) = text.split_once("MOTION").unwrap();
-    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
-    let frames: usize = lines.next().unwrap().trim().trim_start_matches("Frames:").trim().parse().unwrap();
-    let frame_time = lines.next().unwrap();
-    let values: Vec<&str> = lines.collect();
-    let repeated = vec![values.join("\n"); times].join("\n");
-    let bytes = format!("{header}MOTION\nFrames: {}\n{frame_time}\n{repeated}\n", frames * times);
-    bonescope::import::load_bytes(&path, bytes.as_bytes()).unwrap()
-}
-
 fn selection_curves(c: &mut Criterion) {
-    let rig = repeated_cmu_walk(40);
+    let rig = shared_assets::repeated_cmu_walk(40);
     let clip = rig.clips.first();
     eprintln!("repeated CMU walk: {:.1} s, {} bones", clip.map_or(0.0, |c| c.duration()), rig.skeleton.len());
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());

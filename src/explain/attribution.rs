@@ -278,7 +278,8 @@ fn link(
         anisotropy: anisotropy(local.scale),
         turn_deg: turn,
         shear_left_deg: shear_left,
-        contribution_deg: shear - shear_left,
+        // A difference within rounding is none (and never prints as −0).
+        contribution_deg: if (shear - shear_left).abs() < 1e-9 { 0.0 } else { shear - shear_left },
     }
 }
 

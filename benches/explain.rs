@@ -1,0 +1,63 @@
+//! `explain` on long mocap: the CMU walk (`../shared/assets/bvh`, 120 Hz) repeated 40 times (175 s), a squash keyed
+//! at every frame on the spine bone three levels above the first hand (1 + 0.3·sin t, 1 − 0.2·sin t, 1), so the hand
+//! shears under it. Measured after the rig-wide analysis, as the app and `scan --explain` run it: the hand's
+//! causes over the whole clip (the chain at its worst time, the main causes' time spans; target ≤ 50 ms), and the
+//! whole explanation with every fix measured (no target).
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use bonescope::analysis::{ScanOptions, scan};
+use bonescope::eval::Evaluation;
+use bonescope::explain::{causes, explain};
+use bonescope::model::{BoneTracks, Interpolation, Rig, Track};
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+
+#[path = "support/shared_assets.rs"]
+mod shared_assets;
+
+/// The repeated walk with a squash on the hand's third ancestor; the rig and the hand.
+fn squashed_walk() -> (Rig, usize) {
+    let mut rig = shared_assets::repeated_cmu_walk(40);
+    let hand = rig.skeleton.bones().iter().position(|b| b.name.contains("Hand")).expect("a hand");
+    let chain = rig.skeleton.chain(hand);
+    let squashed = chain[chain.len() - 4];
+    let clip = &rig.clips[0];
+    let times: Arc<[f64]> = clip.key_times().into();
+    let squash: Vec<Vec3> =
+        times.iter().map(|&t| Vec3::new(1.0 + 0.3 * t.sin() as f32, 1.0 - 0.2 * t.sin() as f32, 1.0)).collect();
+    let mut tracks: Vec<BoneTracks> = clip.tracks().to_vec();
+    match tracks.iter_mut().find(|t| t.bone == squashed) {
+        Some(track) => track.scale = Some(Track::new(times.clone(), squash, Interpolation::Linear).unwrap()),
+        None => {
+            let mut track = BoneTracks::new(squashed);
+            track.scale = Some(Track::new(times.clone(), squash, Interpolation::Linear).unwrap());
+            tracks.push(track);
+        }
+    }
+    rig.clips[0] = bonescope::model::Clip::new(0, clip.name.clone(), tracks, Vec::new());
+    (rig, hand)
+}
+
+fn explain_on_mocap(c: &mut Criterion) {
+    let (rig, hand) = squashed_walk();
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let options = ScanOptions { rate: 120.0, ..ScanOptions::default() };
+    let before = scan(&evaluation, &options, &|_, _| {});
+    assert!(before.bones[hand].stretched(), "the squash shears the hand");
+    let times = evaluation.times(options.rate);
+    eprintln!("squashed CMU walk ×40: {} samples, {} bones, hand {hand}", times.len(), rig.skeleton.len());
+    let mut group = c.benchmark_group("explain");
+    group.sample_size(10);
+    group.bench_function("the hand's causes over 175 s at 120 Hz", |b| {
+        b.iter(|| black_box(causes(&evaluation, hand, &times, None, &options.tolerances)))
+    });
+    group.bench_function("the hand explained, every fix measured", |b| {
+        b.iter(|| black_box(explain(&evaluation, &before, Some(&[hand]), None, &options)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, explain_on_mocap);
+criterion_main!(benches);
