@@ -46,6 +46,22 @@ fn check_fix(source: &Evaluation, fixed: &Evaluation, bone_in_fixed: usize, fix:
     assert_eq!(on_bones, fix.cost.measured == Measured::Bones, "{}", fix.label);
 }
 
+/// `change` made to `source` with the library's own evaluation types (`None` for a bake, which needs its file).
+fn made_again<'a>(source: &Evaluation<'a>, change: Change) -> Option<Evaluation<'a>> {
+    match change {
+        Change::Mode { bone, mode } => {
+            let mut modes = source.modes().to_vec();
+            modes[bone] = mode;
+            Some(source.with_modes(&modes))
+        }
+        Change::UniformScale { bone } => {
+            let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };
+            Some(source.clone().with_layers(LayerStack::new(source.rig, &layers).unwrap()))
+        }
+        Change::Bake { .. } => None,
+    }
+}
+
 /// Every mode and uniform-scale fix of every explained bone of `source`, made again here with the library's own
 /// evaluation types, checked ([`check_fix`]). Returns the explanations.
 fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Explanation> {
@@ -55,18 +71,8 @@ fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Expl
     for explanation in &explained {
         assert!(!explanation.fixes.is_empty(), "{}", explanation.name);
         for fix in &explanation.fixes {
-            match fix.change {
-                Change::Mode { bone, mode } => {
-                    let mut modes = source.modes().to_vec();
-                    modes[bone] = mode;
-                    check_fix(source, &source.with_modes(&modes), explanation.bone, fix, options);
-                }
-                Change::UniformScale { bone } => {
-                    let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };
-                    let fixed = source.clone().with_layers(LayerStack::new(source.rig, &layers).unwrap());
-                    check_fix(source, &fixed, explanation.bone, fix, options);
-                }
-                Change::Bake { .. } => {}
+            if let Some(fixed) = made_again(source, fix.change) {
+                check_fix(source, &fixed, explanation.bone, fix, options);
             }
         }
     }
@@ -183,19 +189,7 @@ fn on_the_generated_rig_the_fixes_of_a_sheared_bone_hold() {
     let cause = explanation.causes.at.main_cause().expect("a squash causes it");
     assert!(rig.skeleton.is_in_subtree(bone, cause.bone) && cause.bone != bone, "{cause:?}");
     for fix in explanation.fixes.iter().filter(|f| !matches!(f.change, Change::Bake { .. })).take(4) {
-        let fixed = match fix.change {
-            Change::Mode { bone, mode } => {
-                let mut modes = source.modes().to_vec();
-                modes[bone] = mode;
-                source.with_modes(&modes)
-            }
-            Change::UniformScale { bone } => {
-                let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };
-                source.clone().with_layers(LayerStack::new(&rig, &layers).unwrap())
-            }
-            Change::Bake { .. } => unreachable!(),
-        };
-        check_fix(&source, &fixed, bone, fix, &options);
+        check_fix(&source, &made_again(&source, fix.change).unwrap(), bone, fix, &options);
     }
 }
 

@@ -177,16 +177,18 @@ mod tests {
         Transform::from_trs(DVec3::X, DQuat::from_axis_angle(axis, degrees.to_radians()), DVec3::ONE)
     }
 
+    /// A root scaled by `scale` and a child one along X, turned `degrees` about Z.
+    fn parent_and_child(scale: DVec3, degrees: f64) -> Rig {
+        let parent = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, scale);
+        rig(vec![Bone::joint("parent", None, parent), Bone::joint("child", Some(0), turned(DVec3::Z, degrees))], vec![])
+    }
+
     #[test]
     fn a_squashed_parent_over_a_turned_child_is_all_of_its_shear() {
         // Parent scaled (2, 1, 1), child turned 45° about Z: the child's X and Y axes are diag(2,1,1)·(c, s, 0)
         // and diag(2,1,1)·(−s, c, 0) with c = s = 1/√2, i.e. (√2, 1/√2, 0) and (−√2, 1/√2, 0): cos = (−2 + 1/2)/(5/2)
         // = −3/5, a shear of asin(3/5) = 36.87°. Without the parent's squash there is none.
-        let parent = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
-        let rig = rig(
-            vec![Bone::joint("parent", None, parent), Bone::joint("child", Some(0), turned(DVec3::Z, 45.0))],
-            vec![],
-        );
+        let rig = parent_and_child(DVec3::new(2.0, 1.0, 1.0), 45.0);
         let evaluation = Evaluation::declared(&rig, None);
         let explained = explained(&evaluation, None);
         assert_eq!(explained.len(), 1, "only the child is flagged");
@@ -252,11 +254,7 @@ mod tests {
     #[test]
     fn a_bone_scaled_along_its_own_axes_has_nothing_to_explain() {
         // Scaled (2, 1, 1) with its child along the same axes: non-uniform, but no shear anywhere.
-        let scaled = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(2.0, 1.0, 1.0));
-        let rig = rig(
-            vec![Bone::joint("scaled", None, scaled), Bone::joint("child", Some(0), turned(DVec3::Z, 90.0))],
-            vec![],
-        );
+        let rig = parent_and_child(DVec3::new(2.0, 1.0, 1.0), 90.0);
         let evaluation = Evaluation::declared(&rig, None);
         assert!(explained(&evaluation, None).is_empty(), "nothing is flagged");
         for explained in explained(&evaluation, Some(&[0, 1])) {
