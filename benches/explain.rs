@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use bonescope::analysis::{ScanOptions, scan};
 use bonescope::eval::Evaluation;
-use bonescope::explain::{causes, explain};
+use bonescope::explain::{Question, causes, explain};
 use bonescope::model::{BoneTracks, Interpolation, Rig, Track};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -54,7 +54,8 @@ fn explain_on_mocap(c: &mut Criterion) {
         b.iter(|| black_box(causes(&evaluation, hand, &times, None, &options.tolerances)))
     });
     group.bench_function("the hand explained, every fix measured", |b| {
-        b.iter(|| black_box(explain(&evaluation, &before, Some(&[hand]), None, &options)))
+        let question = Question { bones: Some(&[hand]), ..Question::default() };
+        b.iter(|| black_box(explain(&evaluation, &before, question, &options)))
     });
     group.finish();
 }

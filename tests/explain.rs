@@ -13,7 +13,7 @@ mod generated_gltf;
 use bonescope::analysis::{ClipScan, ScanOptions, scan};
 use bonescope::diff::{Pairs, compare, comparison_times};
 use bonescope::eval::{Evaluation, LayerStack, Layers};
-use bonescope::explain::{Change, Explanation, Fix, Measured, explain};
+use bonescope::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use bonescope::model::{InheritMode, Rig};
 use common::{asset, bonescope, json, load_asset};
 
@@ -66,7 +66,7 @@ fn made_again<'a>(source: &Evaluation<'a>, change: Change) -> Option<Evaluation<
 /// evaluation types, checked ([`check_fix`]). Returns the explanations.
 fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Explanation> {
     let before = scan(source, options, &|_, _| {});
-    let explained = explain(source, &before, None, None, options);
+    let explained = explain(source, &before, Question::default(), options);
     assert!(!explained.is_empty(), "something is flagged");
     for explanation in &explained {
         assert!(!explanation.fixes.is_empty(), "{}", explanation.name);
@@ -184,7 +184,7 @@ fn on_the_generated_rig_the_fixes_of_a_sheared_bone_hold() {
     let before = scan(&source, &options, &|_, _| {});
     let flagged = bonescope::explain::flagged(&before);
     let bone = *flagged.last().expect("the squashes shear the bones below them");
-    let explained = explain(&source, &before, Some(&[bone]), None, &options);
+    let explained = explain(&source, &before, Question { bones: Some(&[bone]), ..Question::default() }, &options);
     let explanation = &explained[0];
     let cause = explanation.causes.at.main_cause().expect("a squash causes it");
     assert!(rig.skeleton.is_in_subtree(bone, cause.bone) && cause.bone != bone, "{cause:?}");
@@ -222,4 +222,26 @@ fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
     assert_eq!(explained.len(), stretched.len());
     assert_eq!(explained[0]["main_cause"], "chest");
     assert!(explained[0]["fix_cost"].as_f64().unwrap() > 0.0 && explained[0]["best_fix"].is_string());
+}
+
+#[test]
+fn costing_only_the_contenders_finds_the_same_best_fix() {
+    // `scan --explain` costs only the fixes that can rank first; the best fix is the one the whole ranking finds.
+    for file in [
+        "blender/stretchy_full.glb",
+        "blender/stretchy_noinherit.fbx",
+        "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
+    ] {
+        let rig = load_asset(file);
+        let options = ScanOptions::default();
+        let source = Evaluation::declared(&rig, rig.clips.first());
+        let before = scan(&source, &options, &|_, _| {});
+        let every = explain(&source, &before, Question::default(), &options);
+        let best = explain(&source, &before, Question { costs: Costs::Best, ..Question::default() }, &options);
+        assert!(!every.is_empty(), "{file}");
+        for (all, brief) in every.iter().zip(&best) {
+            assert_eq!(all.best_fix(), brief.best_fix(), "{file}: {}", all.name);
+            assert!(brief.fixes.len() <= all.fixes.len());
+        }
+    }
 }

@@ -13,7 +13,7 @@ use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
 use crate::eval::{Evaluation, LayerStack};
-use crate::explain::{Change, Explanation, Fix, Measured, explain};
+use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
 
@@ -69,7 +69,8 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(layers);
     let before = scan(&evaluation, &options, &|_, _| {});
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
-    let explained = explain(&evaluation, &before, asked, args.time, &options);
+    let question = Question { bones: asked, at: args.time, costs: Costs::Every };
+    let explained = explain(&evaluation, &before, question, &options);
     let report = ExplainReport {
         file: super::scan::shown(&args.file),
         animation: clip.map(AnimationInfo::of),

@@ -17,7 +17,7 @@ use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, stor
 use crate::analysis::{ScanOptions, scan};
 use crate::diff::{AnimationDiff, diff_files};
 use crate::eval::{Evaluation, LayerStack};
-use crate::explain::explain;
+use crate::explain::{Costs, Question, explain};
 use crate::import;
 use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
@@ -317,7 +317,7 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
         loaded.each_clip(|evaluation| {
             let result = scan(evaluation, options, &|_, _| {});
             let explained = match args.explain {
-                true => explain(evaluation, &result, None, None, options),
+                true => explain(evaluation, &result, Question { costs: Costs::Best, ..Question::default() }, options),
                 false => Vec::new(),
             };
             let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);

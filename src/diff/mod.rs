@@ -212,7 +212,11 @@ pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
 /// Compares `a` and `b` at `times` (sorted), in the units each is measured in: to compare two files, measure `b` in
 /// `a`'s rig's unit first ([`Evaluation::measured_in`]), so that lengths are in A's unit.
 pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
-    let rig_size = a.size(times);
+    compare_at_size(a, b, pairs, times, a.size(times))
+}
+
+/// [`compare`], A's size over `times` ([`Evaluation::size`]) already known: one evaluation compared with many.
+pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64], rig_size: f64) -> Comparison {
     let probe_length = rig_size * PROBE_FRACTION;
     let runs = over_runs(times, |run| {
         let mut worker = PairEvaluator::new(a, b, pairs);

@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Engine, Request, Strategy};
-use crate::diff::{Comparison, Extreme, Pairs, compare, comparison_times};
+use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, comparison_times};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, Rig, Skeleton, Unit};
@@ -109,72 +109,122 @@ pub struct Cost {
     pub measured: Measured,
 }
 
-impl Cost {
-    /// The cost `comparison` (of the rig `rig` against a change of it) shows: the largest distance of any mesh's
-    /// vertices, and of the probe points of every bone of the figure that no mesh shows
-    /// ([`Rig::shown_by_meshes`]); a skin that stays put does not hide a neck that moves.
-    pub fn of(comparison: &Comparison, rig: &Rig) -> Self {
-        let (shown, figure) = (rig.shown_by_meshes(), rig.skeleton.figure());
+/// What every change is measured against, found once: the evaluation explained, its scan, its times and size (for
+/// `diff`'s comparison), which bones a mesh shows, and the options.
+pub(super) struct Baseline<'e, 'a> {
+    pub source: &'e Evaluation<'a>,
+    pub before: &'e ClipScan,
+    pub options: &'e ScanOptions,
+    /// The source's own comparison times, and its size over them.
+    times: Vec<f64>,
+    size: f64,
+    /// Per bone: whether a mesh shows it ([`Rig::shown_by_meshes`]), and whether it is part of the figure.
+    shown: Vec<bool>,
+    figure: Vec<bool>,
+}
+
+impl<'e, 'a> Baseline<'e, 'a> {
+    pub fn new(source: &'e Evaluation<'a>, before: &'e ClipScan, options: &'e ScanOptions) -> Self {
+        let times = comparison_times(source, source, options.rate);
+        let size = source.size(&times);
+        let (shown, figure) = (source.rig.shown_by_meshes(), source.skeleton().figure());
+        Baseline { source, before, options, times, size, shown, figure }
+    }
+
+    /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
+    /// vertices, and of the probe points of every bone of the figure that no mesh shows; a skin that stays put does
+    /// not hide a neck that moves.
+    fn visible(&self, comparison: &Comparison) -> Cost {
         let skin = comparison.meshes.iter().map(|m| m.distance).fold(Extreme::default(), Extreme::merge);
-        let unseen = comparison.bones.iter().filter(|b| figure[b.a] && !shown[b.a]).map(|b| b.probe);
+        let unseen = comparison.bones.iter().filter(|b| self.figure[b.a] && !self.shown[b.a]).map(|b| b.probe);
         let bones = unseen.fold(Extreme::default(), Extreme::merge);
-        let (distance, measured) = if bones.max > skin.max { (bones, Measured::Bones) } else { (skin, Measured::Skin) };
-        let measured = if comparison.meshes.is_empty() { Measured::Bones } else { measured };
+        let (distance, measured) = if bones.max > skin.max || self.source.rig.meshes.is_empty() {
+            (bones, Measured::Bones)
+        } else {
+            (skin, Measured::Skin)
+        };
         Cost { distance, fraction: distance.max / comparison.rig_size, measured }
     }
-}
 
-/// What one change does to the whole rig: every source bone's worst shear and flag under it, and its cost.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Outcome {
-    /// By the source's bone index: the worst shear in degrees and whether the bone is flagged anywhere (a bone the
-    /// changed rig lacks counts as neither).
-    pub shear: Vec<(f64, bool)>,
-    pub cost: Cost,
-}
-
-impl Outcome {
-    /// `change` applied to `source` and measured; `before` is `source`'s scan with `options`.
-    pub fn of(source: &Evaluation, change: Change, before: &ClipScan, options: &ScanOptions) -> Result<Self, String> {
-        let Some(rig) = change.baked(source) else {
-            let fixed = change.apply(source)?;
-            return Ok(Outcome::measure(source, &fixed, change.changed_below(), before, options, Some));
-        };
-        let rig = rig?;
-        let fixed = Evaluation::declared(&rig, rig.clips.first());
-        let skeleton = source.skeleton();
-        Ok(Outcome::measure(source, &fixed, None, before, options, |b| rig.skeleton.find(&skeleton.bone(b).name)))
-    }
-
-    /// `fixed` scanned and compared with `source`: only `top` and the bones below it when the change is to them
-    /// alone (every other bone is as `before` says, and its difference nothing); `bone_of` finds a source bone in
-    /// `fixed`'s rig.
-    fn measure(
-        source: &Evaluation,
-        fixed: &Evaluation,
-        top: Option<usize>,
-        before: &ClipScan,
-        options: &ScanOptions,
-        bone_of: impl Fn(usize) -> Option<usize>,
-    ) -> Self {
-        let judged = top.map_or(Judged::Every, Judged::Subtree);
+    /// `change` made to the source and scanned: on the changed bone's subtree alone when the change is to it (every
+    /// other bone is as the source's scan says), on the whole baked rig for a bake.
+    pub fn apply(&self, change: Change) -> Result<Applied, String> {
+        let baked = change.baked(self.source).transpose()?;
+        let fixed = self.fixed(change, baked.as_ref())?;
+        let judged = change.changed_below().map_or(Judged::Every, Judged::Subtree);
         let request = CurveRequest { judged, ..CurveRequest::default() };
         let never = AtomicBool::new(false);
-        let summary = analyze(fixed, request, options, &|_, _| {}, &never).expect("never cancelled").scan;
-        let changed = top.map(|top| source.skeleton().subtree(top));
-        let is_changed = |b: usize| changed.as_ref().is_none_or(|bones| bones.binary_search(&b).is_ok());
-        let shear = (0..source.skeleton().len())
+        let summary = analyze(&fixed, request, self.options, &|_, _| {}, &never).expect("never cancelled").scan;
+        let (skeleton, changed) = (self.source.skeleton(), self.changed(change));
+        let bone_of = |b: usize| match &baked {
+            Some(rig) => rig.skeleton.find(&skeleton.bone(b).name),
+            None => Some(b),
+        };
+        let shear = (0..skeleton.len())
             .map(|b| match bone_of(b) {
-                Some(f) if is_changed(b) => (summary.bones[f].worst_shear_deg, summary.bones[f].stretched()),
-                Some(_) => (before.bones[b].worst_shear_deg, before.bones[b].stretched()),
+                Some(f) if changed(b) => (summary.bones[f].worst_shear_deg, summary.bones[f].stretched()),
+                Some(_) => (self.before.bones[b].worst_shear_deg, self.before.bones[b].stretched()),
                 None => (0.0, false),
             })
             .collect();
-        let mut pairs = Pairs::by_name(source, fixed);
-        pairs.bones.pairs.retain(|&(a, _)| is_changed(a));
-        let comparison = compare(source, fixed, &pairs, &comparison_times(source, fixed, options.rate));
-        Outcome { shear, cost: Cost::of(&comparison, source.rig) }
+        Ok(Applied { baked, shear })
     }
+
+    /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the
+    /// changed bones and the meshes that follow them (nothing else differs).
+    pub fn cost(&self, change: Change, applied: &Applied) -> Result<Cost, String> {
+        let fixed = self.fixed(change, applied.baked.as_ref())?;
+        let changed = self.changed(change);
+        let mut pairs = Pairs::by_name(self.source, &fixed);
+        pairs.bones.pairs.retain(|&(a, _)| changed(a));
+        pairs.meshes.retain(|&(a, _)| follows(self.source.rig, a).any(&changed));
+        let times = comparison_times(self.source, &fixed, self.options.rate);
+        // A change that keeps the clip's times (any but a bake) keeps the size found once.
+        let size = if times == self.times { self.size } else { self.source.size(&times) };
+        Ok(self.visible(&compare_at_size(self.source, &fixed, &pairs, &times, size)))
+    }
+
+    /// The evaluation `change` gives: the baked rig's own, for a bake.
+    fn fixed<'r>(&self, change: Change, baked: Option<&'r Rig>) -> Result<Evaluation<'r>, String>
+    where
+        'a: 'r,
+    {
+        match baked {
+            Some(rig) => Ok(Evaluation::declared(rig, rig.clips.first())),
+            None => change.apply(self.source),
+        }
+    }
+
+    /// Whether a source bone may change under `change`: every bone for a bake.
+    fn changed(&self, change: Change) -> impl Fn(usize) -> bool + use<> {
+        let below = change.changed_below().map(|top| self.source.skeleton().subtree(top));
+        move |b: usize| below.as_ref().is_none_or(|bones| bones.binary_search(&b).is_ok())
+    }
+}
+
+/// A change made and scanned: for a bake, the baked rig read back; and by the source's bone index, each bone's worst
+/// shear in degrees and whether it is flagged anywhere (a bone the changed rig lacks counts as neither).
+pub(super) struct Applied {
+    baked: Option<Rig>,
+    pub shear: Vec<(f64, bool)>,
+}
+
+impl Applied {
+    /// Where a fix by this change for `bone` ranks before its cost is known: fixes that leave the bone unflagged
+    /// first, then by the shear they leave ([`rank`]).
+    pub fn standing(&self, bone: usize) -> (bool, f64) {
+        let (shear, flagged) = self.shear[bone];
+        (flagged, if flagged { shear } else { 0.0 })
+    }
+}
+
+/// The bones mesh `mesh` of `rig` may move with: the bone it hangs from, and every joint a vertex is weighted to.
+fn follows(rig: &Rig, mesh: usize) -> impl Iterator<Item = usize> + '_ {
+    let mesh = &rig.meshes[mesh];
+    let joints = mesh.skin.and_then(|s| rig.skins.get(s)).map_or(&[][..], |skin| &skin.joints[..]);
+    let weighted = mesh.joints.iter().zip(&mesh.weights).flat_map(|(js, ws)| js.iter().zip(ws));
+    let bones = weighted.filter(|(_, w)| **w > 0.0).filter_map(|(&j, _)| joints.get(usize::from(j)).copied());
+    std::iter::once(mesh.bone).chain(bones)
 }
 
 /// One fix for one bone.
@@ -194,14 +244,21 @@ pub struct Fix {
 }
 
 impl Fix {
-    /// The fix `change` is for `bone`, given what it does (`outcome`) and what the clip did before (`before`).
-    pub(super) fn new(skeleton: &Skeleton, bone: usize, change: Change, outcome: &Outcome, before: &ClipScan) -> Self {
-        let (shear_left, still) = outcome.shear[bone];
+    /// The fix `change` (made: `applied`, costing `cost`) is for `bone`, given what the clip did before.
+    pub(super) fn new(
+        skeleton: &Skeleton,
+        bone: usize,
+        change: Change,
+        applied: &Applied,
+        cost: Cost,
+        before: &ClipScan,
+    ) -> Self {
+        let (shear_left, still) = applied.shear[bone];
         let others = |was: bool| {
             let changed = before
                 .bones
                 .iter()
-                .zip(&outcome.shear)
+                .zip(&applied.shear)
                 .filter(|(b, (_, now))| b.index != bone && b.stretched() == was && *now != was);
             changed.map(|(b, _)| skeleton.bone(b.index).name.clone()).collect()
         };
@@ -212,12 +269,10 @@ impl Fix {
             removes: !still,
             newly_flagged: others(false),
             cleared: others(true),
-            cost: outcome.cost,
+            cost,
         }
     }
-}
 
-impl Fix {
     /// "forearm → segment-compensate, moves the skin 0.4 mm" (and the shear it leaves, where it leaves some),
     /// lengths in `unit` (the rig's).
     pub fn summary(&self, unit: Option<Unit>) -> String {

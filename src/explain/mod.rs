@@ -31,7 +31,7 @@ use crate::analysis::{ClipScan, ScanOptions};
 use crate::eval::Evaluation;
 use crate::model::Unit;
 use crate::model::unit::significant;
-use fixes::{Outcome, candidates, rank};
+use fixes::{Applied, Baseline, candidates, rank};
 
 /// One bone explained over a clip.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -96,19 +96,37 @@ pub fn flagged(scan: &ClipScan) -> Vec<usize> {
     bones.into_iter().map(|b| b.index).collect()
 }
 
-/// Explains each of `bones` over `evaluation`'s clip (every flagged bone, the worst first, for `None`), with the
-/// detail at time `at` (each bone's worst time for `None`). `before` is the clip's scan with `options` (what the
-/// fixes change). Fixes shared by several bones are measured once.
+/// Which fixes an explanation measures the cost of.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Costs {
+    /// Every candidate's: the whole ranking (`explain`, the app).
+    #[default]
+    Every,
+    /// Only those that can rank first once their shear is known: the best fix alone (`scan --explain`).
+    Best,
+}
+
+/// What to explain: which bones (every flagged bone, the worst first, for `None`), the time to detail (each bone's
+/// worst for `None`), and which fixes to cost.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Question<'q> {
+    pub bones: Option<&'q [usize]>,
+    pub at: Option<f64>,
+    pub costs: Costs,
+}
+
+/// Explains the bones `question` asks about over `evaluation`'s clip. `before` is the clip's scan with `options`
+/// (what the fixes change). A change shared by several bones' fixes is made and measured once.
 pub fn explain(
     evaluation: &Evaluation,
     before: &ClipScan,
-    bones: Option<&[usize]>,
-    at: Option<f64>,
+    question: Question,
     options: &ScanOptions,
 ) -> Vec<Explanation> {
-    let bones = bones.map_or_else(|| flagged(before), <[usize]>::to_vec);
+    let bones = question.bones.map_or_else(|| flagged(before), <[usize]>::to_vec);
     let times = evaluation.times(options.rate);
     let tolerances = &options.tolerances;
+    let at = question.at;
     let causes: Vec<Causes> = bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at, tolerances)).collect();
     let changes: Vec<Vec<Change>> = bones
         .iter()
@@ -118,29 +136,54 @@ pub fn explain(
             _ => candidates(evaluation, bone, &scaled(causes, tolerances.min_anisotropy)),
         })
         .collect();
-    let mut distinct: Vec<Change> = changes.iter().flatten().copied().collect();
+    let baseline = Baseline::new(evaluation, before, options);
+    let applied: HashMap<Change, Result<Applied, String>> = distinct(changes.iter().flatten().copied())
+        .into_par_iter()
+        .map(|change| (change, baseline.apply(change)))
+        .collect();
+    let costed = bones.iter().zip(&changes).flat_map(|(&bone, changes)| match question.costs {
+        Costs::Every => changes.clone(),
+        Costs::Best => contenders(bone, changes, &applied),
+    });
+    let costs: HashMap<Change, Result<Cost, String>> = distinct(costed)
+        .into_par_iter()
+        .filter_map(|change| Some((change, baseline.cost(change, applied[&change].as_ref().ok()?))))
+        .collect();
+    let skeleton = evaluation.skeleton();
+    let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
+        let mut fixes = Vec::new();
+        let mut notes = Vec::new();
+        for change in changes {
+            match (&applied[&change], costs.get(&change)) {
+                (Ok(made), Some(Ok(cost))) => fixes.push(Fix::new(skeleton, bone, change, made, *cost, before)),
+                (Err(why), _) | (_, Some(Err(why))) => notes.push(format!("{}: {why}", change.describe(skeleton))),
+                (Ok(_), None) => {}
+            }
+        }
+        rank(&mut fixes);
+        Explanation { bone, name: skeleton.bone(bone).name.clone(), causes, fixes, notes }
+    });
+    explained.collect()
+}
+
+/// Each change once, in a stable order.
+fn distinct(changes: impl IntoIterator<Item = Change>) -> Vec<Change> {
+    let mut distinct: Vec<Change> = changes.into_iter().collect();
     distinct.sort_by_key(|c| format!("{c:?}"));
     distinct.dedup();
-    let outcomes: HashMap<Change, Result<Outcome, String>> =
-        distinct.into_par_iter().map(|change| (change, Outcome::of(evaluation, change, before, options))).collect();
-    let skeleton = evaluation.skeleton();
-    bones
-        .iter()
-        .zip(causes)
-        .zip(changes)
-        .map(|((&bone, causes), changes)| {
-            let mut fixes = Vec::new();
-            let mut notes = Vec::new();
-            for change in changes {
-                match &outcomes[&change] {
-                    Ok(outcome) => fixes.push(Fix::new(skeleton, bone, change, outcome, before)),
-                    Err(why) => notes.push(format!("{}: {why}", change.describe(skeleton))),
-                }
-            }
-            rank(&mut fixes);
-            Explanation { bone, name: skeleton.bone(bone).name.clone(), causes, fixes, notes }
-        })
-        .collect()
+    distinct
+}
+
+/// The changes of `bone`'s fixes that can rank first once their shear is known: those that stand best
+/// ([`Applied::standing`]), the shear left equal to within 1e-9°.
+fn contenders(bone: usize, changes: &[Change], applied: &HashMap<Change, Result<Applied, String>>) -> Vec<Change> {
+    let standing = |change: &Change| applied[change].as_ref().ok().map(|a| a.standing(bone));
+    let best = changes.iter().filter_map(standing).min_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let Some((flagged, shear)) = best else {
+        return Vec::new();
+    };
+    let ties = |s: (bool, f64)| s.0 == flagged && (s.1 - shear).abs() <= 1e-9;
+    changes.iter().copied().filter(|c| standing(c).is_some_and(ties)).collect()
 }
 
 /// The bones of the chain that squash where the bone is flagged: every main cause, and every unequally scaled
@@ -170,7 +213,7 @@ mod tests {
     fn explained(evaluation: &Evaluation, bones: Option<&[usize]>) -> Vec<Explanation> {
         let options = ScanOptions::default();
         let before = crate::analysis::scan(evaluation, &options, &|_, _| {});
-        explain(evaluation, &before, bones, None, &options)
+        explain(evaluation, &before, Question { bones, ..Question::default() }, &options)
     }
 
     fn turned(axis: DVec3, degrees: f64) -> Transform {
