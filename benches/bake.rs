@@ -13,6 +13,8 @@
 #[allow(dead_code)]
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
+// The repeated mocap walk is for the benchmarks of long clips.
+#[allow(dead_code)]
 #[path = "support/shared_assets.rs"]
 mod shared_assets;
 

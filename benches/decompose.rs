@@ -16,6 +16,8 @@
 //! fastest of many interleaved passes on the sheared sets, are measured once in the setup and printed to stderr (see
 //! `BENCHMARKS.md`).
 
+// The repeated mocap walk is for the benchmarks of long clips.
+#[allow(dead_code)]
 #[path = "support/shared_assets.rs"]
 mod shared_assets;
 

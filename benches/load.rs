@@ -9,6 +9,8 @@
 
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
+// The repeated mocap walk is for the benchmarks of long clips.
+#[allow(dead_code)]
 #[path = "support/shared_assets.rs"]
 mod shared_assets;
 

@@ -9,6 +9,8 @@
 //! scale track so its descendants shear under full inheritance; 10 s at 30 keys/s), and Blender's
 //! `stretchy_full.glb` from the shared assets when it is there and loads.
 
+// The repeated mocap walk is for the benchmarks of long clips.
+#[allow(dead_code)]
 #[path = "support/shared_assets.rs"]
 mod shared_assets;
 

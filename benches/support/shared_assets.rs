@@ -1,6 +1,4 @@
 //! The shared assets beside the repository (`../shared/assets`), for the benchmarks and examples that load them.
-//! (Each benchmark uses some of them.)
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 
