@@ -99,6 +99,11 @@ fn on_the_blender_rig_every_fix_holds_and_the_bakes_hold_as_the_files_bake_write
     let explained = check_fixes_in_memory(&source, &options);
     let forearm = explained.iter().find(|e| e.name == "forearm").unwrap();
     assert_eq!(forearm.causes.at.main_cause().map(|l| l.name.as_str()), Some("chest"), "the chest squashes");
+    // The same scene as FBX (its frames baked by Blender's exporter, a conversion node above the armature).
+    let fbx = load_asset("blender/stretchy_full.fbx");
+    let from_fbx = check_fixes_in_memory(&Evaluation::declared(&fbx, fbx.clips.first()), &options);
+    let names = |explained: &[Explanation]| explained.iter().map(|e| e.name.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&from_fbx), names(&explained), "the same bones shear, in the same order");
     // The bakes, as `bonescope bake` writes them: scanned and compared from the files.
     let dir = tempfile::tempdir().unwrap();
     for fix in forearm.fixes.iter().filter(|f| matches!(f.change, Change::Bake { .. })) {
