@@ -13,7 +13,7 @@ use super::clip_analysis::{BoneSummary, Components};
 use super::findings::{Judge, Verdict};
 use super::request::{CurveRequest, Judged, ScanOptions};
 use super::stretch::{CursorAt, Stretch};
-use crate::eval::{BoneCursor, Chains, Evaluation, Evaluator, Hierarchy};
+use crate::eval::{BoneCursor, BonesEvaluator, Chains, Evaluation, Hierarchy};
 use crate::math::{decompose_near, decompose_with_stretch};
 use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
 
@@ -127,7 +127,7 @@ pub(super) fn analyze_chunk(
             let plotted = chunk.judge_by_bone(clip, &mut result);
             chunk.plot_by_bone(clip, &plotted, &mut curves);
         }
-        None => chunk.judge_by_pose(&mut evaluation.evaluator(), &mut result, &mut curves),
+        None => chunk.judge_by_pose(&mut BonesEvaluator::new(evaluation, &plan.judged), &mut result, &mut curves),
     }
     if let Some(ghost) = request.ghost {
         chunk.plot_ghost(ghost, &mut curves.ghost_model);
@@ -240,16 +240,11 @@ impl Chunk<'_> {
     /// the plotted bones and their ancestors are sampled and evaluated; through layers, whole poses.
     fn plot_ghost(&self, ghost: &Evaluation, curves: &mut [&mut [Components]]) {
         let bones = self.request.bones;
-        let by_bone = ghost.clip.filter(|_| ghost.layers().is_none());
-        let mut chains = by_bone.map(|clip| Chains::new(ghost.skeleton(), clip, &self.plan.modelled));
-        let mut whole = ghost.evaluator();
+        let mut evaluator = BonesEvaluator::new(ghost, &self.plan.modelled);
         // Where each ghost curve's decomposition starts: its stretch frame at the previous sample.
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
         for (sample, &time) in self.times.iter().enumerate() {
-            let pose = match &mut chains {
-                Some(chains) => chains.evaluate(time, &ghost.hierarchy),
-                None => whole.evaluate(time),
-            };
+            let pose = evaluator.evaluate(time);
             for ((curve, &bone), start) in curves.iter_mut().zip(bones).zip(&mut starts) {
                 let components = Components::of_matrix(&pose.model.model[bone], *start);
                 *start = components.stretch.as_dquat();
@@ -258,9 +253,9 @@ impl Chunk<'_> {
         }
     }
 
-    /// Judges every bone from whole poses, one sample after another (layers, or bones that do not inherit
-    /// fully), keeping the plotted bones' curves on the way.
-    fn judge_by_pose(&self, evaluator: &mut Evaluator, result: &mut ChunkResult, curves: &mut CurveSlices) {
+    /// Judges the bones from poses, one sample after another (layers, or bones that do not inherit fully): of the
+    /// judged bones alone where the clip reads bone by bone, else whole. Keeps the plotted bones' curves on the way.
+    fn judge_by_pose(&self, evaluator: &mut BonesEvaluator, result: &mut ChunkResult, curves: &mut CurveSlices) {
         let (plan, plotted) = (self.plan, self.request.bones);
         let bones = self.evaluation.skeleton().len();
         let mut stretches = vec![Stretch::NONE; bones];

@@ -1,7 +1,7 @@
 //! A few bones of a big rig evaluated without the rest: each read from the clip one track at a time and combined
 //! under the hierarchy, for curves of one bone or an explanation of its shear over a long clip.
 
-use super::{BoneCursor, Hierarchy, Pose};
+use super::{BoneCursor, Evaluation, Evaluator, Hierarchy, Pose};
 use crate::model::{Clip, Skeleton, Transform};
 
 /// Some bones (plotted ones and all their ancestors) read from a clip one bone at a time and evaluated under a
@@ -28,5 +28,33 @@ impl<'a> Chains<'a> {
         }
         hierarchy.evaluate_bones(&self.pose.local, self.bones, &mut self.pose.model);
         &self.pose
+    }
+}
+
+/// Some bones of an evaluation (each with its ancestors, parents first), evaluated time after time: by [`Chains`]
+/// where the clip can be read bone by bone (no layers, lengths in the rig's own unit), else as whole poses. Only
+/// those bones' entries of a pose are meaningful.
+pub enum BonesEvaluator<'e, 'a> {
+    Chains(Box<Chains<'e>>, &'e Hierarchy),
+    Whole(Box<Evaluator<'e, 'a>>),
+}
+
+impl<'e, 'a> BonesEvaluator<'e, 'a> {
+    /// `bones` (sorted, with every ancestor of each) of `evaluation`; all of them read whole poses.
+    pub fn new(evaluation: &'e Evaluation<'a>, bones: &'e [usize]) -> Self {
+        let every = bones.len() == evaluation.skeleton().len();
+        match evaluation.clip.filter(|_| !every && evaluation.reads_bone_by_bone()) {
+            Some(clip) => {
+                BonesEvaluator::Chains(Box::new(Chains::new(evaluation.skeleton(), clip, bones)), &evaluation.hierarchy)
+            }
+            None => BonesEvaluator::Whole(Box::new(evaluation.evaluator())),
+        }
+    }
+
+    pub fn evaluate(&mut self, time: f64) -> &Pose {
+        match self {
+            BonesEvaluator::Chains(chains, hierarchy) => chains.evaluate(time, hierarchy),
+            BonesEvaluator::Whole(evaluator) => evaluator.evaluate(time),
+        }
     }
 }

@@ -17,7 +17,7 @@ pub mod skinning;
 
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
 pub(crate) use bind::{invert, median};
-pub use chains::Chains;
+pub use chains::{BonesEvaluator, Chains};
 pub use cursor::BoneCursor;
 pub use evaluation::{Evaluation, Evaluator};
 pub use hierarchy::{Hierarchy, ModelPose};

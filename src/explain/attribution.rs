@@ -4,7 +4,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use crate::analysis::{Assessment, Tolerances};
 use crate::eval::layers::uniform_scale;
-use crate::eval::{Chains, Evaluation, Evaluator, Hierarchy, ModelPose, over_runs};
+use crate::eval::{BonesEvaluator, Evaluation, Hierarchy, ModelPose, over_runs};
 use crate::math::{AffineParts, shear_deg};
 use crate::model::{Skeleton, Transform};
 
@@ -108,13 +108,14 @@ pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f6
     let skeleton = evaluation.skeleton();
     let chain = skeleton.chain(bone);
     let samples: Vec<Sample> = over_runs(times, |run| {
-        let mut source = ChainSource::new(evaluation, &chain);
+        let mut source = BonesEvaluator::new(evaluation, &chain);
         let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
         let mut local = vec![Transform::IDENTITY; skeleton.len()];
         let mut start = DQuat::IDENTITY;
         run.iter()
             .map(|&time| {
-                source.local_at(time, &chain, &mut local);
+                let pose = source.evaluate(time);
+                chain.iter().for_each(|&b| local[b] = pose.local[b]);
                 probe.sample(&mut local, &mut start, tolerances)
             })
             .collect::<Vec<_>>()
@@ -161,35 +162,6 @@ fn spans(skeleton: &Skeleton, samples: &[Sample], times: &[f64]) -> Vec<CauseSpa
         }
     }
     spans
-}
-
-/// Where the chain's local transforms come from at each time: the clip read bone by bone (no layers), or whole
-/// poses through the layers.
-enum ChainSource<'e, 'a> {
-    Bones(Box<Chains<'e>>, &'e Hierarchy),
-    Poses(Box<Evaluator<'e, 'a>>),
-}
-
-impl<'e, 'a> ChainSource<'e, 'a> {
-    fn new(evaluation: &'e Evaluation<'a>, chain: &'e [usize]) -> Self {
-        match evaluation.clip.filter(|_| evaluation.layers().is_none()) {
-            Some(clip) => {
-                ChainSource::Bones(Box::new(Chains::new(evaluation.skeleton(), clip, chain)), &evaluation.hierarchy)
-            }
-            None => ChainSource::Poses(Box::new(evaluation.evaluator())),
-        }
-    }
-
-    /// Writes the chain's local transforms at `time` into `local`.
-    fn local_at(&mut self, time: f64, chain: &[usize], local: &mut [Transform]) {
-        let pose = match self {
-            ChainSource::Bones(chains, hierarchy) => chains.evaluate(time, hierarchy),
-            ChainSource::Poses(evaluator) => evaluator.evaluate(time),
-        };
-        for &bone in chain {
-            local[bone] = pose.local[bone];
-        }
-    }
 }
 
 /// The explained bone's model matrix with some scales of its chain made uniform.

@@ -141,14 +141,19 @@ pub fn explain(
         .into_par_iter()
         .map(|change| (change, baseline.apply(change)))
         .collect();
-    let costed = bones.iter().zip(&changes).flat_map(|(&bone, changes)| match question.costs {
-        Costs::Every => changes.clone(),
-        Costs::Best => contenders(bone, changes, &applied),
-    });
-    let costs: HashMap<Change, Result<Cost, String>> = distinct(costed)
-        .into_par_iter()
-        .filter_map(|change| Some((change, baseline.cost(change, applied[&change].as_ref().ok()?))))
-        .collect();
+    let costs: HashMap<Change, Result<Cost, String>> = match question.costs {
+        Costs::Every => distinct(changes.iter().flatten().copied())
+            .into_par_iter()
+            .filter_map(|change| Some((change, baseline.cost(change, applied[&change].as_ref().ok()?))))
+            .collect(),
+        Costs::Best => {
+            let mut costs = HashMap::new();
+            for (&bone, changes) in bones.iter().zip(&changes) {
+                cheapest(&baseline, &contenders(bone, changes, &applied), &applied, &mut costs);
+            }
+            costs
+        }
+    };
     let skeleton = evaluation.skeleton();
     let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
         let mut fixes = Vec::new();
@@ -164,6 +169,33 @@ pub fn explain(
         Explanation { bone, name: skeleton.bone(bone).name.clone(), causes, fixes, notes }
     });
     explained.collect()
+}
+
+/// Costs enough of `contenders` into `costs` for the cheapest to be among them, exactly: lower bounds of every cost
+/// first ([`Baseline::cost_bound`]), then exact costs in the order of their bounds until the next bound exceeds the
+/// cheapest exact cost found (ties included, so the ranking's order among equal costs is kept).
+fn cheapest(
+    baseline: &Baseline,
+    contenders: &[Change],
+    applied: &HashMap<Change, Result<Applied, String>>,
+    costs: &mut HashMap<Change, Result<Cost, String>>,
+) {
+    let made = |change: &Change| applied[change].as_ref().ok();
+    let mut bounds: Vec<(f64, Change)> = contenders
+        .par_iter()
+        .filter_map(|&change| Some((baseline.cost_bound(change, made(&change)?).ok()?, change)))
+        .collect();
+    bounds.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut cheapest = f64::INFINITY;
+    for (bound, change) in bounds {
+        if bound > cheapest {
+            break;
+        }
+        let cost = costs.entry(change).or_insert_with(|| baseline.cost(change, made(&change).expect("bounded")));
+        if let Ok(cost) = cost {
+            cheapest = cheapest.min(cost.distance.max);
+        }
+    }
 }
 
 /// Each change once, in a stable order.
