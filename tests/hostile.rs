@@ -1,5 +1,5 @@
 //! Hostile and huge files never take bonescope down: every case of the generated corpus (`hostile/corpus.rs`) goes
-//! through the built binary's `inspect` (table and JSON), `scan` (JSON and JUnit) and `export`, each under a 2 GiB
+//! through the built binary's `inspect` (table and JSON), `scan` (JSON with `--explain`, and JUnit) and `export`, each under a 2 GiB
 //! address-space limit and a time limit; none may panic, abort, hang, print a number that is not finite or an error
 //! that is not one escaped line naming the file and the place.
 
@@ -185,7 +185,7 @@ fn check_case(case: &Case, file: &Path, out: &Path) -> Vec<String> {
     let runs = [
         (bonescope(&["inspect", f]), "table"),
         (bonescope(&["inspect", f, "--format", "json"]), "json"),
-        (bonescope(&["scan", f, "--format", "json"]), "json"),
+        (bonescope(&["scan", f, "--explain", "--format", "json"]), "json"),
         (bonescope(&["scan", f, "--format", "junit"]), "junit"),
         (bonescope(&["export", f, "--time", "0", "--format", "obj", "--out", obj.to_str().unwrap()]), "obj"),
     ];
