@@ -1,7 +1,7 @@
 //! Hostile and huge files never take bonescope down: every case of the generated corpus (`hostile/corpus.rs`) goes
-//! through the built binary's `inspect` (table and JSON), `scan` (JSON with `--explain`, and JUnit) and `export`, each under a 2 GiB
-//! address-space limit and a time limit; none may panic, abort, hang, print a number that is not finite or an error
-//! that is not one escaped line naming the file and the place.
+//! through the built binary's `inspect` (table and JSON), `scan` (JSON with `--explain`, and JUnit) and `export`,
+//! each under a 2 GiB address-space limit and a time limit; none may panic, abort, hang, print a number that is not
+//! finite or an error that is not one escaped line naming the file and the place.
 
 #[path = "hostile/corpus.rs"]
 mod corpus;
