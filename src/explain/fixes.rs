@@ -2,7 +2,6 @@
 //! compared with the declared evaluation as `diff` compares two.
 
 use std::path::Path;
-
 use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
@@ -20,8 +19,9 @@ pub enum Change {
     Mode { bone: usize, mode: InheritMode },
     /// One bone's local scale replaced by its uniform part (`eval::layers::uniform_part`) at every time.
     UniformScale { bone: usize },
-    /// The clip baked to plain glTF: exact (helper nodes carry the stretch; the shear stays, playable by any
-    /// engine) or TRS (the closest transform per bone; the shear goes, at its cost).
+    /// The clip baked to plain glTF as `bake` writes it: exact (helper nodes carry the stretch; the shear stays,
+    /// playable by any engine) or TRS (one node per bone, the closest TRS under its baked parent; what differs is
+    /// its cost). Either reproduces a source in which every bone inherits fully, shear and all.
     Bake { strategy: Strategy },
 }
 
