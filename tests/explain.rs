@@ -226,6 +226,12 @@ fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
     let stretched = record["animations"][0]["stretched"].as_array().unwrap();
     assert_eq!(explained.len(), stretched.len());
     assert_eq!(explained[0]["main_cause"], "chest");
+    // JUnit: each stretched bone's failure says why.
+    let junit = String::from_utf8(bonescope(&["scan", file, "--explain", "--format", "junit"]).stdout).unwrap();
+    assert!(
+        junit.contains("why: forearm: chest&apos;s scale") || junit.contains("why: forearm: chest's scale"),
+        "{junit}"
+    );
     assert!(explained[0]["fix_cost"].as_f64().unwrap() > 0.0 && explained[0]["best_fix"].is_string());
 }
 

@@ -1,7 +1,7 @@
 //! A scan as JUnit XML, the report CI systems show (GitLab, Jenkins, Azure DevOps, GitHub test reporters): one test
-//! suite per file, one test case per clip, a failure per stretched bone (its worst shear and when), and a file that
-//! could not be loaded as an error. Reports that judge nothing (`scan --compare-inherit`, `storage`) give passing cases
-//! with their table as the case's output.
+//! suite per file, one test case per clip, a failure per stretched bone (its worst shear and when, and with
+//! `scan --explain` its cause and cheapest fix), and a file that could not be loaded as an error. Reports that judge
+//! nothing (`scan --compare-inherit`, `storage`) give passing cases with their table as the case's output.
 
 use std::borrow::Cow;
 use std::io;
@@ -174,13 +174,17 @@ fn stretch_case(clip: &AnimationScan) -> Case {
                 "`{}` stretched: worst shear {:.2}° at {:.3} s",
                 bone.name, summary.worst_shear_deg, summary.worst_shear_time
             );
-            let details = format!(
+            let mut details = format!(
                 "{} of {} samples flagged, first at {:.3} s; worst stretch angle {:.2}°",
                 summary.flagged_samples,
                 clip.samples,
                 summary.first_flagged_time.unwrap_or_default(),
                 summary.worst_stretch_deg
             );
+            // With `scan --explain`: whose scale does it, and the cheapest fix.
+            if let Some(why) = clip.explained.iter().find(|e| e.name == bone.name) {
+                details.push_str(&format!("\nwhy: {}", why.line));
+            }
             (message, details)
         })
         .collect();
