@@ -5,18 +5,16 @@
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
 //! reported, not applied).
 
-use std::sync::Arc;
-
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
-use super::job::{Job, Progress};
-use super::{Document, Ghost, Shared};
+use super::job::{DocumentKey, Job, Progress};
+use super::{Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{BindCheck, BindTolerance, check_bind};
 use crate::eval::Layers;
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
-use crate::model::{Choice, InheritMode, Rig, Skeleton, Transform};
+use crate::model::{Choice, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
 /// The panel's own state: results computed on request, kept while they still describe the document.
@@ -26,29 +24,6 @@ pub struct LayersPanel {
     storage: Job<DocumentKey, StorageReport>,
     /// The bind check of the document: off the UI thread (where joints are off their bind, it walks the whole clip).
     bind: Job<DocumentKey, BindCheck>,
-}
-
-/// What the panel's measurements depend on: the document's rig (this one, not an equal one: another file opened
-/// with the same bones is measured anew), its clip, modes and layers.
-#[derive(Clone)]
-struct DocumentKey {
-    rig: Arc<Rig>,
-    clip: Option<usize>,
-    modes: Vec<InheritMode>,
-    layers: Layers,
-}
-
-impl DocumentKey {
-    fn of(doc: &Document) -> Self {
-        DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
-    }
-}
-
-impl PartialEq for DocumentKey {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.rig, &other.rig)
-            && (self.clip, &self.modes, &self.layers) == (other.clip, &other.modes, &other.layers)
-    }
 }
 
 impl LayersPanel {

@@ -359,8 +359,7 @@ impl BonescopeApp {
             ghost: None,
             layers: self.doc.layers().clone(),
             plotted: Vec::new(),
-            // The clip's own frames, and at least 30 a second, so a clip keyed sparsely is examined between keys.
-            rate: self.doc.frame_rate().max(crate::model::DEFAULT_FRAME_RATE),
+            rate: self.doc.analysis_rate(),
             tolerances: self.settings.tolerances,
             judged: Judged::Every,
         }
