@@ -79,6 +79,19 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
         self.running = Some(Running { key, progress, result });
     }
 
+    /// Whether work for another key than `key` is still running; if so it is asked to stop (it stops where it
+    /// checks). Work that cannot stop half way waits for this before [`Job::update`], so that at most one runs.
+    pub fn busy_with_other(&mut self, key: &K) -> bool {
+        self.collect();
+        match &self.running {
+            Some(running) if running.key != *key => {
+                running.progress.cancel.store(true, Ordering::Relaxed);
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Takes the running work's result if it has finished.
     pub fn collect(&mut self) {
         let Some(running) = &self.running else { return };
