@@ -910,3 +910,98 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
     assert!(after < before / 2.0, "{before} then {after}");
     harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh");
 }
+
+/// The node labelled `label` inside the Inspector (the skeleton's rows name the same bones).
+fn in_inspector<'h>(harness: &'h Harness<'static, BonescopeApp>, label: &'h str) -> egui_kittest::Node<'h> {
+    let inspector = harness.state().pane_rect(bonescope::app::Pane::Inspector).unwrap();
+    let mut nodes = harness.get_all_by_label(label);
+    nodes.find(|n| inspector.contains(n.rect().center())).unwrap_or_else(|| panic!("no {label} in the Inspector"))
+}
+
+/// The demo with the forearm inspected and its Why? section open, explained.
+fn why_forearm() -> Harness<'static, BonescopeApp> {
+    let mut harness = demo_app();
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    harness.get_by_label("Why?").click();
+    settle(&mut harness);
+    harness.get_by_label("Fixes, best first");
+    harness
+}
+
+/// The fixes the library ranks for `bone` of the app's document, as `bonescope explain` ranks them.
+fn ranked_fixes(app: &BonescopeApp, bone: usize) -> Vec<bonescope::explain::Fix> {
+    let evaluation = app.doc.evaluation();
+    let options =
+        bonescope::analysis::ScanOptions { rate: app.doc.analysis_rate(), tolerances: app.settings.tolerances };
+    let before = bonescope::analysis::scan(&evaluation, &options, &|_, _| {});
+    bonescope::explain::explain(&evaluation, &before, Some(&[bone]), None, &options).remove(0).fixes
+}
+
+#[test]
+fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
+    use bonescope::app::{Ghost, ModeChoice};
+    use bonescope::explain::Change;
+    let mut harness = why_forearm();
+    let (forearm, upper_arm) = (bone(&harness, "forearm"), bone(&harness, "upper_arm"));
+    // The upper arm's squash under the elbow's turn shears the forearm.
+    harness.get_by_label_contains("forearm: upper_arm's scale (");
+    harness.get_by_label("main");
+    // A bone of the chain is a click away: it is selected as the skeleton's row selects it.
+    in_inspector(&harness, "upper_arm").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().selection, vec![upper_arm]);
+    harness.get_by_label("not sheared: nothing to explain");
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    // The first fix that is a setting of the document is a mode on the forearm; Try sets it on that bone alone.
+    let declared = harness.state().doc.modes.clone();
+    let fixes = ranked_fixes(harness.state(), forearm);
+    let first = fixes.iter().find(|f| !matches!(f.change, Change::Bake { .. })).unwrap();
+    let Change::Mode { bone: fixed, mode } = first.change else { panic!("{first:?}") };
+    assert_eq!((fixed, first.removes), (forearm, true));
+    in_inspector(&harness, "Try").click();
+    settle(&mut harness);
+    let app = harness.state();
+    assert_eq!(app.doc.modes[forearm], mode);
+    assert!(app.doc.modes.iter().zip(&declared).enumerate().all(|(b, (m, d))| b == forearm || m == d));
+    assert!(!app.analysis().unwrap().scan.bones[forearm].stretched(), "the analysis no longer flags the forearm");
+    // The ghost shows the declared modes, as the clip was before.
+    assert_eq!(app.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));
+    harness.get_by_label("not sheared: nothing to explain");
+}
+
+#[test]
+fn why_tries_a_uniform_scale_that_the_layers_panel_removes() {
+    use bonescope::app::Ghost;
+    let mut harness = why_forearm();
+    let (forearm, upper_arm) = (bone(&harness, "forearm"), bone(&harness, "upper_arm"));
+    if harness.query_by_label("upper_arm's scale made uniform").is_none() {
+        harness.get_by_label_contains(" more").click();
+        settle(&mut harness);
+    }
+    let row = harness.get_by_label("upper_arm's scale made uniform");
+    row.scroll_to_me();
+    harness.run();
+    let row = harness.get_by_label("upper_arm's scale made uniform").rect();
+    let mut tries = harness.get_all_by_label("Try");
+    tries.find(|t| (t.rect().center().y - row.center().y).abs() < 4.0).expect("its Try button").click();
+    drop(tries);
+    settle(&mut harness);
+    let app = harness.state();
+    assert_eq!(app.doc.layers().uniform_scale, vec![upper_arm]);
+    assert!(!app.analysis().unwrap().scan.bones[forearm].stretched());
+    assert_eq!(app.doc.ghost, Some(Ghost::Unlayered), "the ghost shows the clip without the layer");
+    // The Layers panel lists the layer (its section opens for it) with a remove button that undoes it.
+    harness.state_mut().settings.show_layers = true;
+    settle(&mut harness);
+    harness.get_by_label("Uniform scale");
+    let remove = harness.get_by_label("remove");
+    remove.scroll_to_me();
+    harness.run();
+    harness.get_by_label("remove").click();
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.doc.layers().uniform_scale.is_empty());
+    assert!(app.analysis().unwrap().scan.bones[forearm].stretched(), "flagged again");
+}

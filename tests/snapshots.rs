@@ -45,6 +45,23 @@ fn demo_perspective_with_ghost() {
     app(|_| {}).snapshot("demo_perspective_with_ghost");
 }
 
+/// The Inspector's Why? section open on the demo's forearm: the upper arm's squash as the main cause, its time
+/// spans, and the fixes ranked with their costs. Also the README's picture of the section (`assets/readme/`).
+#[test]
+fn demo_why_forearm() {
+    let mut harness = app(|_| {});
+    harness.get_by_label("Why?").click();
+    // The explanation starts once the section is open: wait for it before the fixed frames.
+    for _ in 0..20 {
+        finish_analysis(&mut harness);
+        if harness.query_by_label("Fixes, best first").is_some() {
+            break;
+        }
+    }
+    settle_for_snapshot(&mut harness);
+    harness.snapshot("demo_why_forearm");
+}
+
 #[test]
 fn demo_front_view_with_ghost() {
     app(|s| s.camera.view = ViewKind::Front).snapshot("demo_front_view_with_ghost");

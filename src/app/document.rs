@@ -155,6 +155,12 @@ impl Document {
         self.frame_rate_override.or_else(|| self.clip().map(Clip::frame_rate)).unwrap_or(DEFAULT_FRAME_RATE)
     }
 
+    /// Samples per second of the whole-clip analysis: the clip's own frames, and at least 30 a second, so that a
+    /// clip keyed sparsely is examined between its keys.
+    pub fn analysis_rate(&self) -> f64 {
+        self.frame_rate().max(DEFAULT_FRAME_RATE)
+    }
+
     /// How long the timeline runs: the clip's duration, or what the layers make of it (a synced blend's cycle, a
     /// crossfade into a longer clip).
     pub fn duration(&self) -> f64 {

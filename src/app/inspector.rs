@@ -1,21 +1,40 @@
-//! The selected bone at the current time: local and model matrices, every decomposed part, the findings, the
-//! morph-target weights of the meshes it carries, and a button that copies the same JSON `bonescope inspect` prints.
+//! The selected bone at the current time: local and model matrices, every decomposed part, the findings, why it
+//! shears (the Why? section), the morph-target weights of the meshes it carries, and a button that copies the same
+//! JSON `bonescope inspect` prints.
 
 use egui::{Grid, RichText, Ui};
 use glam::DMat4;
 
 use super::Shared;
 use super::text::compact;
+use super::why::Why;
 use super::{ModeChoice, ModeScope};
 use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
 use crate::view::Badge;
 
-pub fn ui(ui: &mut Ui, shared: &mut Shared) {
-    let Some(bone) = shared.inspected() else {
-        ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
-        return;
-    };
+/// The panel's own state: the Why? section's explanation.
+#[derive(Default)]
+pub struct Inspector {
+    why: Why,
+}
+
+impl Inspector {
+    /// Waits for an explanation under way (tests and headless renders want a settled state).
+    pub fn settle(&mut self) {
+        self.why.settle();
+    }
+
+    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        let Some(bone) = shared.inspected() else {
+            ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
+            return;
+        };
+        bone_ui(ui, shared, bone, &mut self.why);
+    }
+}
+
+fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize, why: &mut Why) {
     let reports =
         BoneReport::all(&shared.doc.rig.skeleton, &shared.doc.modes, &shared.frame.pose, &shared.settings.tolerances);
     let report = &reports[bone];
@@ -32,8 +51,12 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared) {
     let explanation = badges.iter().map(|b| b.explanation()).collect::<Vec<_>>().join("; ");
     ui.label(RichText::new(text).color(color).strong()).on_hover_text(explanation);
     ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
-    copy_button(ui, shared, &reports);
+    ui.horizontal_wrapped(|ui| {
+        copy_button(ui, shared, &reports);
+        why.header(ui, shared, bone);
+    });
     egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+        why.ui(ui, shared, bone);
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;

@@ -8,7 +8,7 @@ use std::sync::mpsc::{Receiver, channel};
 use super::{Document, Ghost};
 use crate::analysis::{ClipAnalysis, CurveRequest, Judged, ScanOptions, Tolerances, analyze};
 use crate::eval::Layers;
-use crate::model::InheritMode;
+use crate::model::{InheritMode, Rig};
 
 /// How far a piece of work has come, and whether it should stop (a newer one replaced it).
 #[derive(Clone, Default)]
@@ -79,6 +79,19 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
         self.running = Some(Running { key, progress, result });
     }
 
+    /// Whether work for another key than `key` is still running; if so it is asked to stop (it stops where it
+    /// checks). Work that cannot stop half way waits for this before [`Job::update`], so that at most one runs.
+    pub fn busy_with_other(&mut self, key: &K) -> bool {
+        self.collect();
+        match &self.running {
+            Some(running) if running.key != *key => {
+                running.progress.cancel.store(true, Ordering::Relaxed);
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Takes the running work's result if it has finished.
     pub fn collect(&mut self) {
         let Some(running) = &self.running else { return };
@@ -115,6 +128,29 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
         {
             self.finished = Some((running.key, Arc::new(result)));
         }
+    }
+}
+
+/// What a measurement of the document depends on: its rig (this one, not an equal one: another file opened with the
+/// same bones is measured anew), its clip, modes and layers.
+#[derive(Clone)]
+pub struct DocumentKey {
+    rig: Arc<Rig>,
+    clip: Option<usize>,
+    modes: Vec<InheritMode>,
+    layers: Layers,
+}
+
+impl DocumentKey {
+    pub fn of(doc: &Document) -> Self {
+        DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
+    }
+}
+
+impl PartialEq for DocumentKey {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.rig, &other.rig)
+            && (self.clip, &self.modes, &self.layers) == (other.clip, &other.modes, &other.layers)
     }
 }
 

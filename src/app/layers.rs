@@ -1,22 +1,20 @@
 //! The Layers panel: the runtime techniques layered on the clip (bind weight, interpolation, blend, additive,
-//! crossfade, shake, targets), the bind pose check and the stretch-quaternion storage report.
+//! crossfade, shake, uniform scale, targets), the bind pose check and the stretch-quaternion storage report.
 //!
 //! A technique's section starts open when its layer is on. Edits go to a copy of the document's layers; the
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
 //! reported, not applied).
 
-use std::sync::Arc;
-
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
-use super::job::{Job, Progress};
-use super::{Document, Ghost, Shared};
+use super::job::{DocumentKey, Job, Progress};
+use super::{Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{BindCheck, BindTolerance, check_bind};
 use crate::eval::Layers;
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
-use crate::model::{Choice, InheritMode, Rig, Skeleton, Transform};
+use crate::model::{Choice, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
 /// The panel's own state: results computed on request, kept while they still describe the document.
@@ -26,29 +24,9 @@ pub struct LayersPanel {
     storage: Job<DocumentKey, StorageReport>,
     /// The bind check of the document: off the UI thread (where joints are off their bind, it walks the whole clip).
     bind: Job<DocumentKey, BindCheck>,
-}
-
-/// What the panel's measurements depend on: the document's rig (this one, not an equal one: another file opened
-/// with the same bones is measured anew), its clip, modes and layers.
-#[derive(Clone)]
-struct DocumentKey {
-    rig: Arc<Rig>,
-    clip: Option<usize>,
-    modes: Vec<InheritMode>,
-    layers: Layers,
-}
-
-impl DocumentKey {
-    fn of(doc: &Document) -> Self {
-        DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
-    }
-}
-
-impl PartialEq for DocumentKey {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.rig, &other.rig)
-            && (self.clip, &self.modes, &self.layers) == (other.clip, &other.modes, &other.layers)
-    }
+    /// How many bones the uniform-scale layer had in the last frame: a bone added elsewhere (the Inspector's Why?
+    /// section) opens its section, where it is undone.
+    uniform_bones: usize,
 }
 
 impl LayersPanel {
@@ -67,6 +45,7 @@ impl LayersPanel {
             additive_section(ui, shared, &mut layers);
             crossfade_section(ui, shared, &mut layers);
             shake_section(ui, shared, &mut layers);
+            uniform_section(ui, shared, &mut layers, std::mem::take(&mut self.uniform_bones));
             targets_section(ui, shared, &mut layers);
             self.storage_section(ui, shared);
         });
@@ -75,6 +54,7 @@ impl LayersPanel {
         {
             ui.colored_label(Badge::Stretched.color(), error.to_string());
         }
+        self.uniform_bones = shared.doc.layers().uniform_scale.len();
     }
 
     /// The bind weight, and the bind check: joints whose bind matrices break the skin (a warning), and joints the
@@ -260,6 +240,40 @@ fn shake_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
         });
         vector(ui, "translation", &mut p.translation);
         vector(ui, "rotation (rad)", &mut p.rotation);
+    });
+}
+
+/// The bones whose local scale is replaced by its uniform part (the volume kept, `∛|k₁·k₂·k₃|` on every axis): a
+/// squash that shears the bones below no longer does. Opens when a bone was added since the last frame (`before`
+/// bones then), so that the Why? section's fix is seen here and undone with its remove button.
+fn uniform_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers, before: usize) {
+    let skeleton = &shared.doc.rig.skeleton;
+    let added = layers.uniform_scale.len() > before;
+    let header = CollapsingHeader::new("Uniform scale").default_open(!layers.uniform_scale.is_empty());
+    header.open(added.then_some(true)).show(ui, |ui| {
+        if let Some(bone) = shared.inspected().filter(|b| !layers.uniform_scale.contains(b))
+            && ui.button(format!("Make {}'s scale uniform", skeleton.bone(bone).name)).clicked()
+        {
+            layers.uniform_scale.push(bone);
+        }
+        let mut removed = None;
+        for (i, &bone) in layers.uniform_scale.iter().enumerate() {
+            ui.horizontal(|ui| {
+                ui.label(&skeleton.bone(bone).name);
+                if ui.small_button("remove").clicked() {
+                    removed = Some(i);
+                }
+            });
+        }
+        if let Some(i) = removed {
+            layers.uniform_scale.remove(i);
+        }
+        if layers.uniform_scale.is_empty() {
+            ui.label(
+                RichText::new("Select a bone and make its scale uniform: its squash then shears no bone below it.")
+                    .weak(),
+            );
+        }
     });
 }
 

@@ -105,6 +105,7 @@ pub fn take_layout(settings: &mut Settings, width: f32) -> Layout {
 pub struct Panes<'p, 's> {
     pub shared: &'p mut Shared<'s>,
     pub outliner: &'p mut outliner::Outliner,
+    pub inspector: &'p mut inspector::Inspector,
     pub plots: &'p mut plots::Plots,
     pub viewport: &'p mut viewport::Viewport,
     pub layers: &'p mut layers::LayersPanel,
@@ -127,7 +128,7 @@ impl egui_tiles::Behavior<Pane> for Panes<'_, '_> {
             ui.set_min_size(ui.available_size());
             match pane {
                 Pane::Outliner => self.outliner.ui(ui, shared),
-                Pane::Inspector => inspector::ui(ui, shared),
+                Pane::Inspector => self.inspector.ui(ui, shared),
                 Pane::Layers => self.layers.ui(ui, shared),
                 Pane::Plots => self.plots.ui(ui, shared),
                 Pane::Viewport => unreachable!("drawn above"),

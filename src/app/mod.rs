@@ -22,6 +22,7 @@ mod timeline;
 mod toolbar;
 mod viewport;
 mod watch;
+mod why;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -176,6 +177,7 @@ pub struct BonescopeApp {
     /// For waking the UI from background threads (the file watcher).
     repaint: Option<egui::Context>,
     outliner: outliner::Outliner,
+    inspector: inspector::Inspector,
     plots: plots::Plots,
     viewport: viewport::Viewport,
     layers: layers::LayersPanel,
@@ -209,6 +211,7 @@ impl BonescopeApp {
             browser: None,
             repaint: None,
             outliner: outliner::Outliner::default(),
+            inspector: inspector::Inspector::default(),
             plots: plots::Plots::default(),
             viewport: viewport::Viewport::default(),
             layers: layers::LayersPanel::default(),
@@ -359,8 +362,7 @@ impl BonescopeApp {
             ghost: None,
             layers: self.doc.layers().clone(),
             plotted: Vec::new(),
-            // The clip's own frames, and at least 30 a second, so a clip keyed sparsely is examined between keys.
-            rate: self.doc.frame_rate().max(crate::model::DEFAULT_FRAME_RATE),
+            rate: self.doc.analysis_rate(),
             tolerances: self.settings.tolerances,
             judged: Judged::Every,
         }
@@ -450,6 +452,7 @@ impl BonescopeApp {
         self.request_analyses(ctx);
         self.compare_jobs.curves.wait();
         self.layers.settle();
+        self.inspector.settle();
     }
 
     /// Each bone's largest difference from the compared file, if computed for the current state.
@@ -538,6 +541,7 @@ impl BonescopeApp {
                     let mut panes = layout::Panes {
                         shared: &mut shared,
                         outliner: &mut self.outliner,
+                        inspector: &mut self.inspector,
                         plots: &mut self.plots,
                         viewport: &mut self.viewport,
                         layers: &mut self.layers,

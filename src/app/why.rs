@@ -1,0 +1,482 @@
+//! The Inspector's Why? section, for a bone the whole-clip analysis flags: whose scale shears it (its chain at the
+//! worst time, each bone's contribution), when (the main cause's time spans), and the fixes ranked
+//! ([`crate::explain`]). The explanation is computed off the UI thread, one at a time (it cannot stop half way).
+//!
+//! A fix that is a setting of the document can be tried on it: a mode goes to the bone's own mode (undone from the
+//! skeleton's menu or the toolbar's declared modes), a uniform scale to the layers (undone in the Layers panel).
+//! The ghost then shows the clip as it was, beside the fixed pose.
+
+use egui::collapsing_header::{CollapsingState, paint_default_icon};
+use egui::{
+    Align, Align2, Button, CollapsingHeader, Color32, Layout, Rect, RichText, Sense, Stroke, StrokeKind, TextStyle, Ui,
+};
+use egui::{pos2, vec2};
+
+use super::job::{DocumentKey, Job, Progress};
+use super::text::{compact, name_label, text_width};
+use super::{Document, Ghost, ModeChoice, ModeScope, Shared};
+use crate::analysis::{CurveRequest, ScanOptions, Tolerances, analyze};
+use crate::explain::{Change, Explanation, Fix, Link, Measured, explain};
+use crate::model::{Choice, Unit};
+use crate::view::Badge;
+
+/// What an explanation depends on: the document, the bone, and how the clip is sampled and judged (as the
+/// whole-clip analysis samples and judges it, so that both flag the same samples).
+#[derive(Clone, PartialEq)]
+struct WhyKey {
+    document: DocumentKey,
+    bone: usize,
+    rate: f64,
+    tolerances: Tolerances,
+}
+
+/// The section's state: the latest explanation, and the one being computed.
+#[derive(Default)]
+pub struct Why {
+    job: Job<WhyKey, Explanation>,
+}
+
+/// At most this many fixes are listed; the rest fold under "N more".
+const SHOWN_FIXES: usize = 8;
+/// At most this many time spans are listed; the rest fold under "N more".
+const SHOWN_SPANS: usize = 6;
+
+/// The bar of a bone whose squash counters the shear (a negative contribution): a colour no finding uses.
+const COUNTERS: Color32 = Color32::from_rgb(60, 175, 160);
+
+/// Below this a shear left by a fix is floating-point noise, not a measurement.
+const NOISE_DEG: f64 = 1e-9;
+
+impl Why {
+    /// Waits for an explanation under way (tests and headless renders want a settled state).
+    pub fn settle(&mut self) {
+        self.job.wait();
+    }
+
+    /// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a
+    /// toggle when the whole-clip analysis flags the bone, a note otherwise.
+    pub fn header(&mut self, ui: &mut Ui, shared: &Shared, bone: usize) {
+        match flagged(shared, bone) {
+            None => {
+                ui.label(RichText::new("Why? once the clip is analysed").weak());
+            }
+            Some(false) => {
+                ui.label(RichText::new("not sheared: nothing to explain").weak());
+            }
+            Some(true) => {
+                let mut state = collapsing(ui.ctx());
+                ui.horizontal(|ui| {
+                    ui.spacing_mut().item_spacing.x = 0.0;
+                    state.show_toggle_button(ui, paint_default_icon);
+                    let label = egui::Label::new(RichText::new("Why?").strong()).sense(Sense::click());
+                    if ui.add(label).on_hover_text("whose scale shears this bone, when, and the fixes").clicked() {
+                        state.toggle(ui);
+                    }
+                });
+                state.store(ui.ctx());
+            }
+        }
+    }
+
+    /// The section's body, while its header is open: the explanation, computed off the UI thread.
+    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared, bone: usize) {
+        if flagged(shared, bone) != Some(true) {
+            return;
+        }
+        collapsing(ui.ctx()).show_body_unindented(ui, |ui| ui.indent("why-body", |ui| self.body(ui, shared, bone)));
+    }
+
+    fn body(&mut self, ui: &mut Ui, shared: &mut Shared, bone: usize) {
+        // The flag above may be the previous state's: explain once the analysis of this one is there.
+        if shared.progress.is_some() {
+            spinner(ui, "waiting for the whole-clip analysis…");
+            return;
+        }
+        let key = WhyKey {
+            document: DocumentKey::of(shared.doc),
+            bone,
+            rate: shared.doc.analysis_rate(),
+            tolerances: shared.settings.tolerances,
+        };
+        if !self.job.busy_with_other(&key) {
+            let doc = &*shared.doc;
+            let work = || {
+                let (doc, key) = (doc.clone(), key.clone());
+                move |progress: &Progress| explanation(&doc, &key, progress)
+            };
+            let waker = ui.ctx().clone();
+            self.job.update(key.clone(), work, move || waker.request_repaint());
+        }
+        match self.job.for_key(&key).cloned() {
+            Some(explained) => explanation_ui(ui, shared, &explained),
+            None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
+        }
+    }
+}
+
+/// Whether the whole-clip analysis flags `bone` anywhere in the clip; `None` before the first analysis.
+fn flagged(shared: &Shared, bone: usize) -> Option<bool> {
+    Some(shared.analysis?.scan.bones.get(bone).is_some_and(|b| b.stretched()))
+}
+
+/// Whether the section is open: one state for every bone, so that it stays open while the selection changes.
+fn collapsing(ctx: &egui::Context) -> CollapsingState {
+    CollapsingState::load_with_default_open(ctx, egui::Id::unique("inspector-why"), false)
+}
+
+/// `key.bone` of `doc` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was scanned.
+fn explanation(doc: &Document, key: &WhyKey, progress: &Progress) -> Option<Explanation> {
+    let evaluation = doc.evaluation();
+    let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
+    explain(&evaluation, &before, Some(&[key.bone]), None, &options).pop()
+}
+
+/// The library's words in the app's font, which has no arrow: "forearm → segment-compensate" reads "forearm to
+/// segment-compensate".
+fn drawable(text: &str) -> String {
+    text.replace('→', "to")
+}
+
+fn spinner(ui: &mut Ui, text: &str) {
+    ui.horizontal(|ui| {
+        ui.spinner();
+        ui.label(RichText::new(text).weak());
+    });
+}
+
+fn explanation_ui(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+    ui.label(drawable(&explained.headline(shared.doc.rig.unit)));
+    if explained.causes.stretched_samples == 0 {
+        return;
+    }
+    ui.add_space(4.0);
+    chain(ui, shared, explained);
+    ui.add_space(4.0);
+    spans(ui, shared, explained);
+    ui.add_space(4.0);
+    fixes(ui, shared, explained);
+    for note in &explained.notes {
+        ui.label(RichText::new(drawable(&format!("note: {note}"))).small().weak());
+    }
+}
+
+/// The widths of a chain row's columns: the name, the bar, the contribution and the main-cause mark.
+struct Columns {
+    name: f32,
+    bar: f32,
+    mark: f32,
+}
+
+impl Columns {
+    fn of(ui: &Ui) -> Columns {
+        let spacing = ui.spacing().item_spacing.x;
+        let number = text_width(ui, &format!("{:>8}°", ""), &TextStyle::Monospace.resolve(ui.style()));
+        let mark = text_width(ui, "main", &TextStyle::Body.resolve(ui.style()));
+        let available = ui.available_width();
+        let name = (0.34 * available).clamp(60.0, 140.0);
+        Columns { name, bar: (available - name - number - mark - 4.0 * spacing).max(24.0), mark }
+    }
+}
+
+/// The chain at the worst time, root first: each bone's name (a click selects it), a bar as long as the share of
+/// the shear its squash causes, the contribution in degrees, and the scale where it is unequal.
+fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+    let at = &explained.causes.at;
+    ui.horizontal_wrapped(|ui| {
+        let hint = "each bone's contribution: the shear minus what is left with its scale made uniform (all else as \
+                    evaluated); scales compound and cancel, so contributions need not add up";
+        ui.label(RichText::new("Chain at").strong()).on_hover_text(hint);
+        let time = shared.settings.time_unit.format(at.time, shared.doc.frame_rate());
+        if ui.link(time).on_hover_text("go to the time the bone shears most").clicked() {
+            go_to(shared, at.time);
+        }
+        let shear = RichText::new(format!("shear {}°", compact(at.shear_deg)));
+        ui.label(shear).on_hover_text(format!("{}°", at.shear_deg));
+    });
+    let main = at.main_cause().map(|l| l.bone);
+    let columns = Columns::of(ui);
+    let tolerance = shared.settings.tolerances.min_anisotropy;
+    for link in &at.chain {
+        link_row(ui, shared, link, at.shear_deg, Some(link.bone) == main, &columns);
+        if link.anisotropy > tolerance {
+            ui.horizontal(|ui| {
+                ui.add_space(ui.spacing().indent);
+                let k = link.scale;
+                let turn = link.turn_deg.map_or_else(String::new, |t| format!(" · turned {}°", compact(t)));
+                let text = format!("scale {} {} {}{turn}", compact(k.x), compact(k.y), compact(k.z));
+                ui.label(text).on_hover_text(link_hint(link, at.shear_deg));
+            });
+        }
+    }
+    if !at.sufficient.is_empty() {
+        let names: Vec<&str> = at.sufficient.iter().map(|&b| shared.doc.rig.skeleton.bone(b).name.as_str()).collect();
+        let text = match names.as_slice() {
+            [one] => format!("{one}'s scale made uniform alone unflags it"),
+            _ => format!("{}'s scales made uniform together unflag it", names.join(" and ")),
+        };
+        ui.label(RichText::new(text).weak());
+    }
+}
+
+fn link_row(ui: &mut Ui, shared: &mut Shared, link: &Link, shear: f64, main: bool, columns: &Columns) {
+    ui.horizontal(|ui| {
+        let selected = shared.selection.contains(&link.bone);
+        let name = name_label(ui, &link.name, columns.name, Some(selected));
+        let room = columns.name - name.rect.width();
+        if name.clicked() {
+            shared.select(link.bone, false);
+        }
+        ui.add_space(room.max(0.0));
+        let hint = link_hint(link, shear);
+        bar(ui, columns.bar, link.contribution_deg, shear, main).on_hover_text(&hint);
+        let number = RichText::new(format!("{:>7}°", compact(link.contribution_deg + 0.0))).monospace();
+        ui.label(number).on_hover_text(&hint);
+        if main {
+            let mark = RichText::new("main").strong().color(Badge::Stretched.color());
+            ui.label(mark).on_hover_text("the main cause: its squash causes the most shear");
+        } else {
+            ui.add_space(columns.mark);
+        }
+    });
+}
+
+/// A bar `width` long, filled in proportion to `contribution / shear` (at most whole), in the shear's colour or,
+/// for a squash that counters it, another; outlined for the main cause.
+fn bar(ui: &mut Ui, width: f32, contribution: f64, shear: f64, main: bool) -> egui::Response {
+    let (rect, response) = ui.allocate_exact_size(vec2(width, ui.spacing().interact_size.y), Sense::hover());
+    let track = Rect::from_min_size(pos2(rect.left(), rect.center().y - 4.0), vec2(rect.width(), 8.0));
+    let painter = ui.painter();
+    painter.rect_filled(track, 2.0, ui.visuals().extreme_bg_color);
+    let share = if shear > 0.0 { (contribution.abs() / shear).min(1.0) as f32 } else { 0.0 };
+    let color = if contribution < 0.0 { COUNTERS } else { Badge::Stretched.color() };
+    painter.rect_filled(Rect::from_min_size(track.min, vec2(track.width() * share, track.height())), 2.0, color);
+    if main {
+        painter.rect_stroke(track, 2.0, Stroke::new(1.0, ui.visuals().strong_text_color()), StrokeKind::Outside);
+    }
+    response
+}
+
+/// A chain bone's numbers, exact.
+fn link_hint(link: &Link, shear: f64) -> String {
+    let k = link.scale;
+    let mut text =
+        format!("{}'s local scale ({}, {}, {}), unequal by {} %", link.name, k.x, k.y, k.z, 100.0 * link.anisotropy);
+    if let Some(turn) = link.turn_deg {
+        text.push_str(&format!("; its axes turned {turn}° from the bone's"));
+    }
+    text.push_str(&format!(
+        "\nmade uniform, {}° of the {shear}° shear is left: it causes {}°",
+        link.shear_left_deg, link.contribution_deg
+    ));
+    text
+}
+
+/// The main cause's time spans: a click goes to the start of one.
+fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+    let spans = &explained.causes.spans;
+    if spans.is_empty() {
+        return;
+    }
+    ui.label(RichText::new("Main cause over the clip").strong());
+    let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
+    listed(ui, "why-more-spans", spans, SHOWN_SPANS, |ui, span| {
+        let text = format!("{}  {} – {}", span.name, unit.format(span.from, rate), unit.format(span.to, rate));
+        let hint =
+            format!("go to {}, where {}'s squash starts to be the main cause", unit.format(span.from, rate), span.name);
+        if ui.link(text).on_hover_text(hint).clicked() {
+            go_to(shared, span.from);
+        }
+    });
+}
+
+/// The fixes, best first: each with what it leaves and what it moves, in columns; a Try button on those that are
+/// settings of the document.
+fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+    if explained.fixes.is_empty() {
+        return;
+    }
+    ui.label(RichText::new("Fixes, best first").strong());
+    let unit = shared.doc.rig.unit;
+    let columns = FixColumns::of(ui, &explained.fixes, unit);
+    listed(ui, "why-more-fixes", &explained.fixes, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns));
+}
+
+/// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
+/// numbers of every fix line up).
+struct FixColumns {
+    button: f32,
+    effect: f32,
+    distance: f32,
+    unit: Option<Unit>,
+}
+
+impl FixColumns {
+    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>) -> FixColumns {
+        let body = TextStyle::Body.resolve(ui.style());
+        let widest = |text: &dyn Fn(&Fix) -> String| {
+            fixes.iter().map(|fix| text_width(ui, &text(fix), &body)).fold(0.0, f32::max)
+        };
+        FixColumns {
+            button: text_width(ui, "Try", &TextStyle::Button.resolve(ui.style())) + 2.0 * ui.spacing().button_padding.x,
+            effect: widest(&effect),
+            distance: widest(&|fix| distance(fix, unit)),
+            unit,
+        }
+    }
+}
+
+/// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
+fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
+    let hint = fix_hint(fix, columns.unit);
+    ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
+        match fix.change {
+            Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
+            change => try_button(ui, shared, change, columns.button),
+        }
+        ui.vertical(|ui| {
+            // Rows as tall as their text, so that the label and its numbers read as one entry.
+            ui.spacing_mut().interact_size.y = 0.0;
+            ui.spacing_mut().item_spacing.y = 1.0;
+            let label = RichText::new(drawable(&fix.label));
+            let label = if fix.removes { label.strong() } else { label };
+            ui.add(egui::Label::new(label).truncate()).on_hover_text(&hint);
+            ui.horizontal_wrapped(|ui| {
+                let effect = RichText::new(effect(fix));
+                let effect = if fix.removes { effect } else { effect.color(Badge::Stretched.color()) };
+                slot(ui, effect, columns.effect).on_hover_text(&hint);
+                slot(ui, RichText::new(distance(fix, columns.unit)), columns.distance).on_hover_text(&hint);
+                // Whole or on the next row, never broken in the middle.
+                let share = format!("{} % of rig", compact(100.0 * fix.cost.fraction));
+                ui.add(egui::Label::new(share).extend()).on_hover_text(&hint);
+            });
+            if !fix.newly_flagged.is_empty() {
+                let text = format!("shears {}", fix.newly_flagged.join(", "));
+                let text = RichText::new(text).color(Badge::Stretched.color());
+                ui.add(egui::Label::new(text).wrap())
+                    .on_hover_text("bones the analysis flags with the fix, not before");
+            }
+        });
+    });
+}
+
+/// Tries a change on the document.
+fn try_button(ui: &mut Ui, shared: &mut Shared, change: Change, width: f32) {
+    let what = match change {
+        Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
+        _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
+    };
+    let hint = format!("{what}; the ghost then shows the clip as it was");
+    if ui.add(Button::new("Try").small().min_size(vec2(width, 0.0))).on_hover_text(hint).clicked() {
+        try_fix(shared, change);
+    }
+}
+
+/// A bake is a new file, not a setting of the document: where the Try button would be, the command that makes it.
+fn bake_slot(ui: &mut Ui, strategy: crate::bake::Strategy, width: f32) {
+    let (rect, response) = ui.allocate_exact_size(vec2(width, ui.spacing().interact_size.y), Sense::hover());
+    let font = TextStyle::Body.resolve(ui.style());
+    ui.painter().text(rect.center(), Align2::CENTER_CENTER, "CLI", font, ui.visuals().weak_text_color());
+    response.on_hover_text(format!(
+        "a bake writes a new file: use `bonescope bake FILE --strategy {} --out BAKED.glb`",
+        strategy.id()
+    ));
+}
+
+/// A label in a column `width` wide (the label at its start).
+fn slot(ui: &mut Ui, text: RichText, width: f32) -> egui::Response {
+    let response = ui.label(text);
+    ui.add_space((width - response.rect.width()).max(0.0));
+    response
+}
+
+/// What a fix leaves of the shear: "removes", "removes (0.04° left)" (within the tolerances), "leaves 38.078°".
+fn effect(fix: &Fix) -> String {
+    let left = compact(fix.shear_left_deg);
+    match (fix.removes, fix.shear_left_deg < NOISE_DEG) {
+        (true, true) => "removes".to_owned(),
+        (true, false) => format!("removes ({left}° left)"),
+        (false, _) => format!("leaves {left}°"),
+    }
+}
+
+/// How far a fix moves what is seen, at worst: "skin 69.3 cm", or "bones 1.2 mm" where no mesh shows the bones.
+fn distance(fix: &Fix, unit: Option<Unit>) -> String {
+    let seen = match fix.cost.measured {
+        Measured::Skin => "skin",
+        Measured::Bones => "bones",
+    };
+    format!("{seen} {}", Unit::readable(unit, fix.cost.distance.max))
+}
+
+/// A fix's numbers, exact.
+fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
+    let flagged = if fix.removes { "no longer flagged" } else { "still flagged" };
+    let what = match fix.cost.measured {
+        Measured::Skin => "the skin",
+        Measured::Bones => "the bones' probe points",
+    };
+    let distance = fix.cost.distance;
+    let mut text = format!(
+        "{}: {}° of shear left over the clip ({flagged})\nmoves {what} at most {} in the rig's units ({}) at {} s, {} % \
+         of the rig's size",
+        drawable(&fix.label),
+        fix.shear_left_deg,
+        distance.max,
+        Unit::readable(unit, distance.max),
+        distance.time,
+        100.0 * fix.cost.fraction
+    );
+    if !fix.cleared.is_empty() {
+        text.push_str(&format!("\nalso clears {}", fix.cleared.join(", ")));
+    }
+    if !fix.newly_flagged.is_empty() {
+        text.push_str(&format!("\nshears {}, not flagged before", fix.newly_flagged.join(", ")));
+    }
+    text
+}
+
+/// Applies a fix to the document and shows the clip as it was as the ghost: the modes as they were (declared for a
+/// document as opened; declared too where they were mixed) for a mode, the clip without its layers for a uniform
+/// scale (the declared modes' ghost would be the fixed pose itself).
+fn try_fix(shared: &mut Shared, change: Change) {
+    let doc = &mut *shared.doc;
+    match change {
+        Change::Mode { bone, mode } => {
+            let before = doc.current_choice(0, ModeScope::All).unwrap_or(ModeChoice::Declared);
+            doc.set_mode(bone, ModeScope::Bone, ModeChoice::Mode(mode));
+            doc.ghost = Some(Ghost::Modes(before));
+        }
+        Change::UniformScale { bone } => {
+            let mut layers = doc.layers().clone();
+            if !layers.uniform_scale.contains(&bone) {
+                layers.uniform_scale.push(bone);
+            }
+            if doc.set_layers(&layers).is_ok() {
+                doc.ghost = Some(Ghost::Unlayered);
+            }
+        }
+        Change::Bake { .. } => {}
+    }
+}
+
+fn go_to(shared: &mut Shared, time: f64) {
+    *shared.playing = false;
+    *shared.time = time;
+}
+
+/// The first `shown` of `items`, then the rest under a collapsed "N more".
+fn listed<T>(ui: &mut Ui, id: &str, items: &[T], shown: usize, mut row: impl FnMut(&mut Ui, &T)) {
+    for item in items.iter().take(shown) {
+        row(ui, item);
+    }
+    if items.len() > shown {
+        // Unindented: the rows keep the width their columns were measured for.
+        CollapsingHeader::new(format!("{} more", items.len() - shown)).id_salt(id).show_unindented(ui, |ui| {
+            for item in &items[shown..] {
+                row(ui, item);
+            }
+        });
+    }
+}
