@@ -16,7 +16,7 @@ use super::job::{DocumentKey, Job, Progress};
 use super::text::{compact, name_label, text_width};
 use super::{Document, Ghost, ModeChoice, ModeScope, Shared};
 use crate::analysis::{CurveRequest, ScanOptions, Tolerances, analyze};
-use crate::explain::{Change, Explanation, Fix, Link, Measured, explain};
+use crate::explain::{Change, Explanation, Fix, Link, Measured, Question, explain};
 use crate::model::{Choice, Unit};
 use crate::view::Badge;
 
@@ -130,7 +130,8 @@ fn explanation(doc: &Document, key: &WhyKey, progress: &Progress) -> Option<Expl
     let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
     let report = |done: usize, total: usize| progress.report(done, total);
     let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
-    explain(&evaluation, &before, Some(&[key.bone]), None, &options).pop()
+    let question = Question { bones: Some(&[key.bone]), ..Question::default() };
+    explain(&evaluation, &before, question, &options).pop()
 }
 
 /// The library's words in the app's font, which has no arrow: "forearm → segment-compensate" reads "forearm to
