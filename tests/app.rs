@@ -935,7 +935,8 @@ fn ranked_fixes(app: &BonescopeApp, bone: usize) -> Vec<bonescope::explain::Fix>
     let options =
         bonescope::analysis::ScanOptions { rate: app.doc.analysis_rate(), tolerances: app.settings.tolerances };
     let before = bonescope::analysis::scan(&evaluation, &options, &|_, _| {});
-    bonescope::explain::explain(&evaluation, &before, Some(&[bone]), None, &options).remove(0).fixes
+    let question = bonescope::explain::Question { bones: Some(&[bone]), ..Default::default() };
+    bonescope::explain::explain(&evaluation, &before, question, &options).remove(0).fixes
 }
 
 #[test]
