@@ -46,7 +46,7 @@ fn demo_perspective_with_ghost() {
 }
 
 /// The Inspector's Why? section open on the demo's forearm: the upper arm's squash as the main cause, its time
-/// spans, and the fixes ranked with their costs. Also the README's picture of the section (`assets/readme/`).
+/// spans, and the fixes ranked with their costs. The README shows this snapshot as the picture of the section.
 #[test]
 fn demo_why_forearm() {
     let mut harness = app(|_| {});
