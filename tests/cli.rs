@@ -367,6 +367,8 @@ fn inspect_echoes_the_layers_it_evaluated_through() {
         "speed=20",
         "--target",
         "Head=0,0,0,1@0.5",
+        "--uniform-scale",
+        "Spine",
         "--interp",
         "cubic",
         "--rot-interp",
@@ -379,7 +381,8 @@ fn inspect_echoes_the_layers_it_evaluated_through() {
         "json",
     ]));
     let layers = &out["layers"];
-    assert_eq!(keys(layers), ["additive", "bind_weight", "blend", "crossfade", "interpolation", "shake", "targets"]);
+    let names = ["additive", "bind_weight", "blend", "crossfade", "interpolation", "shake", "targets", "uniform_scale"];
+    assert_eq!(keys(layers), names);
     assert_eq!(layers["bind_weight"], 0.75);
     assert_eq!(layers["interpolation"]["keys"], "cubic");
     assert_eq!(layers["interpolation"]["rotation"], "nlerp");
@@ -392,6 +395,7 @@ fn inspect_echoes_the_layers_it_evaluated_through() {
     assert_eq!(layers["shake"]["params"]["amplitude"], 0.3, "the seed's default");
     assert_eq!(layers["targets"][0]["rotation"], serde_json::json!([0.0, 0.0, 0.0, 1.0]));
     assert_eq!(layers["targets"][0]["weight"], 0.5);
+    assert_eq!(layers["uniform_scale"], serde_json::json!([11]), "Spine is bone 11");
 }
 
 #[test]

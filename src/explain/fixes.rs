@@ -312,8 +312,8 @@ pub(super) fn rank(fixes: &mut [Fix]) {
 
 /// The changes worth trying for `bone`, whose chain holds the unequally scaled bones `scaled`: each bone of the
 /// chain below one of them under every other mode (only a bone below a squash inherits it), each of them made
-/// uniform, and both bakes.
-pub(super) fn candidates(evaluation: &Evaluation, bone: usize, scaled: &[usize]) -> Vec<Change> {
+/// uniform, and both bakes where `bakes` asks for them.
+pub(super) fn candidates(evaluation: &Evaluation, bone: usize, scaled: &[usize], bakes: bool) -> Vec<Change> {
     let skeleton = evaluation.skeleton();
     let chain = skeleton.chain(bone);
     let top = chain.iter().position(|b| scaled.contains(b));
@@ -323,6 +323,14 @@ pub(super) fn candidates(evaluation: &Evaluation, bone: usize, scaled: &[usize])
         InheritMode::ALL.into_iter().filter(move |&m| m != current).map(move |mode| Change::Mode { bone: b, mode })
     });
     let uniform = chain.iter().filter(|b| scaled.contains(b)).map(|&bone| Change::UniformScale { bone });
-    let bakes = Strategy::ALL.iter().map(|&strategy| Change::Bake { strategy });
+    let bakes = Strategy::ALL.iter().filter(|_| bakes).map(|&strategy| Change::Bake { strategy });
     modes.chain(uniform).chain(bakes).collect()
+}
+
+/// Whether a bake of `evaluation` reproduces it, shear and all: every bone inherits fully (a root's mode changes
+/// nothing) and no layer changes the clip, so each bone's local transform is already the TRS a glTF node holds.
+pub(super) fn bakes_reproduce(evaluation: &Evaluation) -> bool {
+    let skeleton = evaluation.skeleton();
+    let full = |b: usize| skeleton.parent(b).is_none() || evaluation.modes()[b] == InheritMode::Full;
+    evaluation.layers().is_none() && (0..skeleton.len()).all(full)
 }

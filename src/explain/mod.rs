@@ -31,7 +31,7 @@ use crate::analysis::{ClipScan, ScanOptions};
 use crate::eval::Evaluation;
 use crate::model::Unit;
 use crate::model::unit::significant;
-use fixes::{Applied, Baseline, candidates, rank};
+use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -102,7 +102,8 @@ pub enum Costs {
     /// Every candidate's: the whole ranking (`explain`, the app).
     #[default]
     Every,
-    /// Only those that can rank first once their shear is known: the best fix alone (`scan --explain`).
+    /// Only those that can rank first once their shear is known, and no bake that reproduces the clip (it removes
+    /// nothing): the best fix alone (`scan --explain`).
     Best,
 }
 
@@ -128,12 +129,14 @@ pub fn explain(
     let tolerances = &options.tolerances;
     let at = question.at;
     let causes: Vec<Causes> = bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at, tolerances)).collect();
+    // A bake that reproduces the clip leaves every shear where it was: no candidate for the best fix.
+    let bakes = question.costs == Costs::Every || !bakes_reproduce(evaluation);
     let changes: Vec<Vec<Change>> = bones
         .iter()
         .zip(&causes)
         .map(|(&bone, causes)| match causes.stretched_samples {
             0 => Vec::new(),
-            _ => candidates(evaluation, bone, &scaled(causes, tolerances.min_anisotropy)),
+            _ => candidates(evaluation, bone, &scaled(causes, tolerances.min_anisotropy), bakes),
         })
         .collect();
     let baseline = Baseline::new(evaluation, before, options);
