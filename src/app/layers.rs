@@ -256,18 +256,9 @@ fn uniform_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers, before
         {
             layers.uniform_scale.push(bone);
         }
-        let mut removed = None;
-        for (i, &bone) in layers.uniform_scale.iter().enumerate() {
-            ui.horizontal(|ui| {
-                ui.label(&skeleton.bone(bone).name);
-                if ui.small_button("remove").clicked() {
-                    removed = Some(i);
-                }
-            });
-        }
-        if let Some(i) = removed {
-            layers.uniform_scale.remove(i);
-        }
+        removable_rows(ui, &mut layers.uniform_scale, |ui, bone| {
+            ui.label(&skeleton.bone(*bone).name);
+        });
         if layers.uniform_scale.is_empty() {
             ui.label(
                 RichText::new("Select a bone and make its scale uniform: its squash then shears no bone below it.")
@@ -275,6 +266,22 @@ fn uniform_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers, before
             );
         }
     });
+}
+
+/// One row per item, drawn by `row`, each with a "remove" button that takes it out of `items`.
+fn removable_rows<T>(ui: &mut Ui, items: &mut Vec<T>, mut row: impl FnMut(&mut Ui, &mut T)) {
+    let mut removed = None;
+    for (i, item) in items.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            row(ui, item);
+            if ui.small_button("remove").clicked() {
+                removed = Some(i);
+            }
+        });
+    }
+    if let Some(i) = removed {
+        items.remove(i);
+    }
 }
 
 fn targets_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
@@ -287,19 +294,10 @@ fn targets_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
             layers.targets.retain(|t| t.bone != bone);
             layers.targets.push(Target { bone, rotation, weight: 1.0 });
         }
-        let mut removed = None;
-        for (i, target) in layers.targets.iter_mut().enumerate() {
-            ui.horizontal(|ui| {
-                ui.label(&skeleton.bone(target.bone).name);
-                weight_slider(ui, &mut target.weight, "weight");
-                if ui.small_button("remove").clicked() {
-                    removed = Some(i);
-                }
-            });
-        }
-        if let Some(i) = removed {
-            layers.targets.remove(i);
-        }
+        removable_rows(ui, &mut layers.targets, |ui, target| {
+            ui.label(&skeleton.bone(target.bone).name);
+            weight_slider(ui, &mut target.weight, "weight");
+        });
         if layers.targets.is_empty() {
             ui.label(
                 RichText::new("Select a bone and pin it: its model rotation then holds while the rest moves.").weak(),
