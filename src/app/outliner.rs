@@ -8,7 +8,7 @@ use egui::{RichText, Sense, vec2};
 
 use super::{ModeChoice, ModeScope, Shared, text};
 use crate::analysis::Findings;
-use crate::model::{InheritMode, NodeRole};
+use crate::model::NodeRole;
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -185,7 +185,7 @@ impl Notes {
         });
         Notes {
             difference: difference_text(shared, bone),
-            mode: Some(RichText::new(mode_abbreviation(shared.doc.modes[bone])).weak().small()),
+            mode: Some(RichText::new(shared.doc.modes[bone].abbreviation()).weak().small()),
             worst,
         }
     }
@@ -241,21 +241,6 @@ impl Notes {
 
 fn stretched_summary<'a>(shared: &Shared<'a>, bone: usize) -> Option<&'a crate::analysis::BoneSummary> {
     shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched())
-}
-
-/// A mode in a few letters for the list (the full name and what it does on hover).
-fn mode_abbreviation(mode: InheritMode) -> &'static str {
-    match mode {
-        InheritMode::Full => "full",
-        InheritMode::UnscaledParent => "no-scale",
-        InheritMode::SegmentCompensate => "SSC",
-        InheritMode::Componentwise => "comp",
-        InheritMode::BlenderFixShear => "B fix",
-        InheritMode::BlenderAligned => "B align",
-        InheritMode::BlenderAverage => "B avg",
-        InheritMode::BlenderNone => "B none",
-        InheritMode::BlenderNoneLegacy => "B legacy",
-    }
 }
 
 /// How far the compared file's partner of `bone` strays from it over the clip, when that is more than the threshold

@@ -61,6 +61,22 @@ impl InheritMode {
         }
     }
 
+    /// A few characters for tight places (the outliner's rows): `SSC` for segment scale compensate, `B align` for
+    /// Blender's Aligned.
+    pub fn abbreviation(self) -> &'static str {
+        match self {
+            InheritMode::Full => "full",
+            InheritMode::UnscaledParent => "no-scale",
+            InheritMode::SegmentCompensate => "SSC",
+            InheritMode::Componentwise => "comp",
+            InheritMode::BlenderFixShear => "B fix",
+            InheritMode::BlenderAligned => "B align",
+            InheritMode::BlenderAverage => "B avg",
+            InheritMode::BlenderNone => "B none",
+            InheritMode::BlenderNoneLegacy => "B legacy",
+        }
+    }
+
     /// One line on what the mode models, for help texts and tooltips.
     pub fn description(self) -> &'static str {
         match self {
