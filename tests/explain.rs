@@ -215,6 +215,8 @@ fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
     let unknown = bonescope(&["explain", file, "--bone", "tail"]);
     assert_eq!(unknown.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("--bone: no bone named `tail`"));
+    let by_index = json(&bonescope(&["explain", file, "--bone", &neck["bone"].to_string(), "--format", "json"]));
+    assert_eq!(by_index["bones"][0]["name"], "neck", "a bone by its index too");
     // scan --explain: a line per stretched bone in the table, the brief in the JSON lines.
     let scanned = bonescope(&["scan", file, "--explain"]);
     let text = String::from_utf8(scanned.stdout).unwrap();

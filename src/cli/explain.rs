@@ -3,10 +3,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Args;
 
-use super::layers::LayerArgs;
+use super::layers::{LayerArgs, bone_index};
 use super::options::parse_rate;
 use super::table::Table;
 use super::{EvalArgs, Format, ToleranceArgs};
@@ -21,8 +20,8 @@ use crate::model::{InheritMode, Rig, Unit};
 pub struct ExplainArgs {
     /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
     pub file: PathBuf,
-    /// The bone to explain (repeatable; default: every stretched bone, the worst first).
-    #[arg(long, value_name = "NAME")]
+    /// The bone to explain, by name or index (repeatable; default: every stretched bone, the worst first).
+    #[arg(long, value_name = "NAME|INDEX")]
     pub bone: Vec<String>,
     /// Show the chain at this time, in seconds (default: where each bone shears most).
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
@@ -59,11 +58,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     if let Some(time) = args.time.filter(|t| !t.is_finite()) {
         anyhow::bail!("--time must be a finite number of seconds, got {time}");
     }
-    let bones = args
-        .bone
-        .iter()
-        .map(|name| rig.skeleton.find(name).with_context(|| format!("--bone: no bone named `{name}`")))
-        .collect::<anyhow::Result<Vec<usize>>>()?;
+    let bones = args.bone.iter().map(|name| bone_index(&rig, "--bone", name)).collect::<anyhow::Result<Vec<_>>>()?;
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
     let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
     let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(layers);

@@ -184,7 +184,7 @@ fn clip_index(rig: &Rig, option: &str, name: &str) -> anyhow::Result<usize> {
 }
 
 /// The bone named `name`, or with index `name`.
-fn bone_index(rig: &Rig, option: &str, name: &str) -> anyhow::Result<usize> {
+pub(super) fn bone_index(rig: &Rig, option: &str, name: &str) -> anyhow::Result<usize> {
     let skeleton = &rig.skeleton;
     skeleton
         .find(name)
