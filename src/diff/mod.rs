@@ -215,26 +215,44 @@ pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> 
     compare_at_size(a, b, pairs, times, a.size(times))
 }
 
-/// [`compare`], A's size over `times` ([`Evaluation::size`]) already known: one evaluation compared with many.
+/// [`compare`], A's size over `times` ([`Evaluation::size`]) already known.
 pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64], rig_size: f64) -> Comparison {
+    compare_each(a, &[(b, pairs)], times, rig_size).pop().expect("one comparison per side")
+}
+
+/// `a` compared with each of `sides` (an evaluation and its pairs with `a`) at `times`, A's size there being
+/// `rig_size`: [`compare_at_size`] of each, in one pass over time that evaluates, decomposes and skins A once per
+/// time for all of them (one evaluation weighed against many changes of it).
+pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f64], rig_size: f64) -> Vec<Comparison> {
     let probe_length = rig_size * PROBE_FRACTION;
+    let fresh = || sides.iter().map(|&(b, pairs)| Differences::new(a, b, pairs)).collect::<Vec<_>>();
     let runs = over_runs(times, |run| {
-        let mut worker = PairEvaluator::new(a, b, pairs);
-        let mut differences = Differences::new(a, b, pairs);
+        let bones_a = sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0));
+        let meshes_a = sides.iter().flat_map(|(_, pairs)| pairs.meshes.iter().map(|p| p.0));
+        let mut side_a = Side::new(a, bones_a, meshes_a);
+        let mut others: Vec<Side> = sides
+            .iter()
+            .map(|&(b, pairs)| Side::new(b, pairs.bones.pairs.iter().map(|p| p.1), pairs.meshes.iter().map(|p| p.1)))
+            .collect();
+        let mut differences = fresh();
         for &time in run {
-            worker.evaluate(&pairs.meshes, time);
-            differences.add(&worker, probe_length, time);
+            side_a.evaluate(time);
+            for (side_b, found) in others.iter_mut().zip(&mut differences) {
+                side_b.evaluate(time);
+                found.add(&side_a, side_b, probe_length, time);
+            }
         }
         differences
     });
-    let totals = runs.into_iter().reduce(Differences::merge).unwrap_or_else(|| Differences::new(a, b, pairs));
+    let totals =
+        runs.into_iter().reduce(|earlier, later| earlier.into_iter().zip(later).map(|(x, y)| x.merge(y)).collect());
     let count = times.len().max(1) as f64;
-    let meshes = totals
-        .meshes
-        .into_iter()
-        .map(|m| MeshDifference { mean: m.sum / (count * m.vertices.max(1) as f64), ..m })
-        .collect();
-    Comparison { samples: times.len(), rig_size, bones: totals.bones, meshes }
+    let finish = |found: Differences| {
+        let mean = |m: MeshDifference| MeshDifference { mean: m.sum / (count * m.vertices.max(1) as f64), ..m };
+        let meshes = found.meshes.into_iter().map(mean).collect();
+        Comparison { samples: times.len(), rig_size, bones: found.bones, meshes }
+    };
+    totals.unwrap_or_else(fresh).into_iter().map(finish).collect()
 }
 
 /// The differences found over some of the times.
@@ -270,19 +288,19 @@ impl Differences {
         Differences { bones, meshes }
     }
 
-    fn add(&mut self, worker: &PairEvaluator, probe_length: f64, time: f64) {
-        let (model_a, model_b) = (&worker.a.pose.model.model, &worker.b.pose.model.model);
+    fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
+        let (model_a, model_b) = (&a.evaluator.pose.model.model, &b.evaluator.pose.model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
-            let (pa, pb) = (&worker.parts_a[difference.a], &worker.parts_b[difference.b]);
+            let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
             difference.probe.add(probe_distance(wa, wb, probe_length), time);
             difference.orientation_deg.add(angle_between(pa.rotation, pb.rotation).to_degrees(), time);
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
         }
-        for (k, difference) in self.meshes.iter_mut().enumerate() {
-            let (va, vb) = (&worker.skinned_a[k], &worker.skinned_b[k]);
+        for difference in &mut self.meshes {
+            let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
             let mut largest: f64 = 0.0;
             for (p, q) in va.iter().zip(vb) {
                 let d = p.distance(*q);
@@ -294,43 +312,39 @@ impl Differences {
     }
 }
 
-/// One thread's evaluations and buffers.
-struct PairEvaluator<'e, 'a> {
-    a: Evaluator<'e, 'a>,
-    b: Evaluator<'e, 'a>,
-    /// The paired bones of each side, whose matrices are decomposed.
-    bones_a: Vec<usize>,
-    bones_b: Vec<usize>,
-    parts_a: Vec<AffineParts>,
-    parts_b: Vec<AffineParts>,
-    /// The paired meshes, skinned, in the order of the pairs.
-    skinned_a: Vec<Vec<DVec3>>,
-    skinned_b: Vec<Vec<DVec3>>,
+/// One side of a comparison as one thread evaluates it, one time after another: its pose, the polar parts of the
+/// bones compared (the identity's elsewhere) and the meshes compared, skinned (by mesh index; empty elsewhere).
+struct Side<'e, 'a> {
+    evaluator: Evaluator<'e, 'a>,
+    /// Sorted, each once.
+    bones: Vec<usize>,
+    meshes: Vec<usize>,
+    parts: Vec<AffineParts>,
+    skinned: Vec<Vec<DVec3>>,
 }
 
-impl<'e, 'a> PairEvaluator<'e, 'a> {
-    fn new(a: &'e Evaluation<'a>, b: &'e Evaluation<'a>, pairs: &Pairs) -> Self {
-        PairEvaluator {
-            a: a.evaluator(),
-            b: b.evaluator(),
-            bones_a: pairs.bones.pairs.iter().map(|p| p.0).collect(),
-            bones_b: pairs.bones.pairs.iter().map(|p| p.1).collect(),
-            parts_a: Vec::new(),
-            parts_b: Vec::new(),
-            skinned_a: Vec::new(),
-            skinned_b: Vec::new(),
-        }
+impl<'e, 'a> Side<'e, 'a> {
+    fn new(
+        evaluation: &'e Evaluation<'a>,
+        bones: impl Iterator<Item = usize>,
+        meshes: impl Iterator<Item = usize>,
+    ) -> Self {
+        let distinct = |items: &mut Vec<usize>| {
+            items.sort_unstable();
+            items.dedup();
+        };
+        let (mut bones, mut meshes): (Vec<usize>, Vec<usize>) = (bones.collect(), meshes.collect());
+        distinct(&mut bones);
+        distinct(&mut meshes);
+        let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
+        Side { evaluator: evaluation.evaluator(), bones, meshes, parts: Vec::new(), skinned }
     }
 
-    /// Evaluates both sides at `time`, skinning the paired `meshes`.
-    fn evaluate(&mut self, meshes: &[(usize, usize)], time: f64) {
-        self.parts_a = decompose_bones(&self.a.evaluate(time).model.model, &self.bones_a);
-        self.parts_b = decompose_bones(&self.b.evaluate(time).model.model, &self.bones_b);
-        self.skinned_a.resize_with(meshes.len(), Vec::new);
-        self.skinned_b.resize_with(meshes.len(), Vec::new);
-        for (k, &(i, j)) in meshes.iter().enumerate() {
-            self.a.evaluation().skin(&self.a.pose, i, &mut self.skinned_a[k]);
-            self.b.evaluation().skin(&self.b.pose, j, &mut self.skinned_b[k]);
+    /// Evaluates the side at `time`.
+    fn evaluate(&mut self, time: f64) {
+        self.parts = decompose_bones(&self.evaluator.evaluate(time).model.model, &self.bones);
+        for &mesh in &self.meshes {
+            self.evaluator.evaluation().skin(&self.evaluator.pose, mesh, &mut self.skinned[mesh]);
         }
     }
 }

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Engine, Request, Strategy};
-use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, comparison_times};
+use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, compare_each, comparison_times};
 use crate::eval::{Evaluation, LayerStack};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, Rig, Skeleton, Unit};
@@ -109,6 +109,10 @@ pub struct Cost {
     pub measured: Measured,
 }
 
+/// How many changes one pass over the clip compares with the source ([`Baseline::costs`]): each holds its poses and
+/// skinned meshes while the pass runs.
+const BATCH: usize = 16;
+
 /// About how many times a lower bound of a cost compares ([`Baseline::cost_bound`]).
 const BOUND_TIMES: usize = 64;
 
@@ -179,6 +183,30 @@ impl<'e, 'a> Baseline<'e, 'a> {
         self.cost_at(change, applied, 1)
     }
 
+    /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
+    /// bakes) compared [`BATCH`] at a time in one pass that evaluates and skins the source once per time for the
+    /// batch, a bake on its own.
+    pub fn costs(&self, changes: &[(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
+        let (bakes, kept): (Vec<_>, Vec<_>) = changes.iter().partition(|(c, _)| c.changed_below().is_none());
+        let mut costs: Vec<_> = bakes.into_iter().map(|&(change, made)| (change, self.cost(change, made))).collect();
+        for batch in kept.chunks(BATCH) {
+            let mut fixed = Vec::new();
+            for &&(change, made) in batch {
+                match self.fixed(change, made.baked.as_ref()) {
+                    Ok(evaluation) => {
+                        let pairs = self.pairs(change, &evaluation);
+                        fixed.push((change, evaluation, pairs));
+                    }
+                    Err(why) => costs.push((change, Err(why))),
+                }
+            }
+            let sides: Vec<(&Evaluation, &Pairs)> = fixed.iter().map(|(_, e, p)| (e, p)).collect();
+            let compared = compare_each(self.source, &sides, &self.times, self.size);
+            costs.extend(fixed.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c)))));
+        }
+        costs
+    }
+
     /// A lower bound of [`Baseline::cost`] for a fraction of the work: the same comparison at every
     /// of about [`BOUND_TIMES`] evenly spread times only (a largest distance over fewer times is never larger).
     pub fn cost_bound(&self, change: Change, applied: &Applied) -> Result<f64, String> {
@@ -189,15 +217,22 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// The cost of `change` compared at every `stride`th time.
     fn cost_at(&self, change: Change, applied: &Applied, stride: usize) -> Result<Cost, String> {
         let fixed = self.fixed(change, applied.baked.as_ref())?;
-        let changed = self.changed(change);
-        let mut pairs = Pairs::by_name(self.source, &fixed);
-        pairs.bones.pairs.retain(|&(a, _)| changed(a));
-        pairs.meshes.retain(|&(a, _)| follows(self.source.rig, a).any(&changed));
+        let pairs = self.pairs(change, &fixed);
         let times = comparison_times(self.source, &fixed, self.options.rate);
         // A change that keeps the clip's times (any but a bake) keeps the size found once.
         let size = if times == self.times { self.size } else { self.source.size(&times) };
         let compared: Vec<f64> = times.iter().copied().step_by(stride).collect();
         Ok(self.visible(&compare_at_size(self.source, &fixed, &pairs, &compared, size)))
+    }
+
+    /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones that change and the
+    /// meshes that follow them (nothing else differs).
+    fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
+        let changed = self.changed(change);
+        let mut pairs = Pairs::by_name(self.source, fixed);
+        pairs.bones.pairs.retain(|&(a, _)| changed(a));
+        pairs.meshes.retain(|&(a, _)| follows(self.source.rig, a).any(&changed));
+        pairs
     }
 
     /// The evaluation `change` gives: the baked rig's own, for a bake.

@@ -145,10 +145,11 @@ pub fn explain(
         .map(|change| (change, baseline.apply(change)))
         .collect();
     let costs: HashMap<Change, Result<Cost, String>> = match question.costs {
-        Costs::Every => distinct(changes.iter().flatten().copied())
-            .into_par_iter()
-            .filter_map(|change| Some((change, baseline.cost(change, applied[&change].as_ref().ok()?))))
-            .collect(),
+        Costs::Every => {
+            let made = distinct(changes.iter().flatten().copied()).into_iter();
+            let made: Vec<_> = made.filter_map(|change| Some((change, applied[&change].as_ref().ok()?))).collect();
+            baseline.costs(&made).into_iter().collect()
+        }
         Costs::Best => {
             let mut costs = HashMap::new();
             for (&bone, changes) in bones.iter().zip(&changes) {
