@@ -28,13 +28,8 @@ for tool in assimp hyperfine; do
     exit 0
   fi
 done
-assets=../shared/assets
-if [ ! -d "$assets" ]; then
-  echo "skipped: the shared assets are not in $assets"
-  exit 0
-fi
-
-target=${CARGO_TARGET_DIR:-target}
+# shellcheck source=support/assets.sh
+source benches/support/assets.sh
 if [ -z "${BONESCOPE:-}" ]; then
   cargo build --quiet --release --locked --bin bonescope
   BONESCOPE=$target/release/bonescope

@@ -11,12 +11,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 rounds=${1:-9}
-assets=../shared/assets
-if [ ! -d "$assets" ]; then
-  echo "skipped: the shared assets are not in $assets"
-  exit 0
-fi
-target=${CARGO_TARGET_DIR:-target}
+# shellcheck source=support/assets.sh
+source benches/support/assets.sh
 if [ -z "${BONESCOPE:-}" ]; then
   cargo build --quiet --release --locked --no-default-features --bin bonescope
   BONESCOPE=$target/release/bonescope
