@@ -46,6 +46,28 @@ fn check_fix(source: &Evaluation, fixed: &Evaluation, bone_in_fixed: usize, fix:
     assert_eq!(on_bones, fix.cost.measured == Measured::Bones, "{}", fix.label);
 }
 
+/// What `fix` of `bone` says of the other bones, against scans of the rig before and with the change: every bone
+/// whose flag changes, or whose worst shear moves by more than the shear tolerance while flagged, with its figures.
+fn check_elsewhere(before: &ClipScan, after: &ClipScan, bone: usize, fix: &Fix, options: &ScanOptions) {
+    let tolerance = options.tolerances.min_shear_deg;
+    let expected: Vec<usize> = (0..before.bones.len())
+        .filter(|&b| b != bone)
+        .filter(|&b| {
+            let (was, now) = (&before.bones[b], &after.bones[b]);
+            let flagged = was.stretched() || now.stretched();
+            was.stretched() != now.stretched()
+                || (flagged && (now.worst_shear_deg - was.worst_shear_deg).abs() > tolerance)
+        })
+        .collect();
+    let listed: Vec<usize> = fix.elsewhere.iter().map(|e| e.bone).collect();
+    assert_eq!(listed, expected, "{}", fix.label);
+    for other in &fix.elsewhere {
+        let now = &after.bones[other.bone];
+        assert!((other.after_deg - now.worst_shear_deg).abs() < 1e-9, "{}: {other:?}", fix.label);
+        assert_eq!(other.flagged_after, now.stretched(), "{}: {other:?}", fix.label);
+    }
+}
+
 /// `change` made to `source` with the library's own evaluation types (`None` for a bake, which needs its file).
 fn made_again<'a>(source: &Evaluation<'a>, change: Change) -> Option<Evaluation<'a>> {
     match change {
@@ -73,6 +95,7 @@ fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Expl
         for fix in &explanation.fixes {
             if let Some(fixed) = made_again(source, fix.change) {
                 check_fix(source, &fixed, explanation.bone, fix, options);
+                check_elsewhere(&before, &scan(&fixed, options, &|_, _| {}), explanation.bone, fix, options);
             }
         }
     }

@@ -352,8 +352,8 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
                 let share = format!("{} % of rig", compact(100.0 * fix.cost.fraction));
                 ui.add(egui::Label::new(share).extend()).on_hover_text(&hint);
             });
-            if !fix.newly_flagged.is_empty() {
-                let text = format!("shears {}", fix.newly_flagged.join(", "));
+            if !fix.newly_flagged().is_empty() {
+                let text = format!("shears {}", fix.newly_flagged().join(", "));
                 let text = RichText::new(text).color(Badge::Stretched.color());
                 ui.add(egui::Label::new(text).wrap())
                     .on_hover_text("bones the analysis flags with the fix, not before");
@@ -429,11 +429,11 @@ fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
         distance.time,
         100.0 * fix.cost.fraction
     );
-    if !fix.cleared.is_empty() {
-        text.push_str(&format!("\nalso clears {}", fix.cleared.join(", ")));
+    if !fix.cleared().is_empty() {
+        text.push_str(&format!("\nalso clears {}", fix.cleared().join(", ")));
     }
-    if !fix.newly_flagged.is_empty() {
-        text.push_str(&format!("\nshears {}, not flagged before", fix.newly_flagged.join(", ")));
+    if !fix.newly_flagged().is_empty() {
+        text.push_str(&format!("\nshears {}, not flagged before", fix.newly_flagged().join(", ")));
     }
     text
 }

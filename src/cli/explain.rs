@@ -165,11 +165,11 @@ fn render_fixes(fixes: &[Fix], unit: Option<Unit>) -> String {
     ]);
     for fix in fixes {
         let mut elsewhere = Vec::new();
-        if !fix.cleared.is_empty() {
-            elsewhere.push(format!("clears {}", fix.cleared.join(", ")));
+        if !fix.cleared().is_empty() {
+            elsewhere.push(format!("clears {}", fix.cleared().join(", ")));
         }
-        if !fix.newly_flagged.is_empty() {
-            elsewhere.push(format!("shears {}", fix.newly_flagged.join(", ")));
+        if !fix.newly_flagged().is_empty() {
+            elsewhere.push(format!("shears {}", fix.newly_flagged().join(", ")));
         }
         table.row(vec![
             format!("  {}", fix.label),

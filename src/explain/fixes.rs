@@ -288,40 +288,67 @@ pub struct Fix {
     pub shear_left_deg: f64,
     /// Whether the bone is no longer flagged anywhere in the clip.
     pub removes: bool,
-    /// Other bones flagged under the change that were not before, and flagged before that no longer are.
-    pub newly_flagged: Vec<String>,
-    pub cleared: Vec<String>,
+    /// The other bones whose verdict the change changes, or whose worst shear it moves by more than the shear
+    /// tolerance while they are flagged, in bone order.
+    pub elsewhere: Vec<ShearElsewhere>,
     pub cost: Cost,
 }
 
+/// Another bone's worst shear over the clip before and with a change, and whether it is flagged.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ShearElsewhere {
+    pub bone: usize,
+    pub name: String,
+    pub before_deg: f64,
+    pub after_deg: f64,
+    pub flagged_before: bool,
+    pub flagged_after: bool,
+}
+
 impl Fix {
-    /// The fix `change` (made: `applied`, costing `cost`) is for `bone`, given what the clip did before.
+    /// The fix `change` (made: `applied`, costing `cost`) is for `bone`, given what the clip did before (scanned
+    /// with `min_shear_deg` as the shear tolerance).
     pub(super) fn new(
         skeleton: &Skeleton,
         bone: usize,
         change: Change,
         applied: &Applied,
         cost: Cost,
-        before: &ClipScan,
+        (before, min_shear_deg): (&ClipScan, f64),
     ) -> Self {
         let (shear_left, still) = applied.shear[bone];
-        let others = |was: bool| {
-            let changed = before
-                .bones
-                .iter()
-                .zip(&applied.shear)
-                .filter(|(b, (_, now))| b.index != bone && b.stretched() == was && *now != was);
-            changed.map(|(b, _)| skeleton.bone(b.index).name.clone()).collect()
-        };
+        let elsewhere = before.bones.iter().zip(&applied.shear).filter(|(b, _)| b.index != bone).filter_map(
+            |(was, &(after_deg, flagged_after))| {
+                let (before_deg, flagged_before) = (was.worst_shear_deg, was.stretched());
+                let moved = (flagged_before || flagged_after) && (after_deg - before_deg).abs() > min_shear_deg;
+                (moved || flagged_before != flagged_after).then(|| ShearElsewhere {
+                    bone: was.index,
+                    name: skeleton.bone(was.index).name.clone(),
+                    before_deg,
+                    after_deg,
+                    flagged_before,
+                    flagged_after,
+                })
+            },
+        );
         Fix {
             change,
             label: change.describe(skeleton),
             shear_left_deg: shear_left,
             removes: !still,
-            newly_flagged: others(false),
-            cleared: others(true),
+            elsewhere: elsewhere.collect(),
             cost,
         }
+    }
+
+    /// The other bones the change flags that were not flagged before.
+    pub fn newly_flagged(&self) -> Vec<&str> {
+        self.elsewhere.iter().filter(|e| e.flagged_after && !e.flagged_before).map(|e| e.name.as_str()).collect()
+    }
+
+    /// The other bones flagged before that the change leaves unflagged.
+    pub fn cleared(&self) -> Vec<&str> {
+        self.elsewhere.iter().filter(|e| e.flagged_before && !e.flagged_after).map(|e| e.name.as_str()).collect()
     }
 
     /// "forearm → segment-compensate, moves the skin 0.4 mm" (and the shear it leaves, where it leaves some),

@@ -20,7 +20,7 @@ mod attribution;
 mod fixes;
 
 pub use attribution::{Attribution, CauseSpan, Causes, Link, attribute, causes};
-pub use fixes::{Change, Cost, Fix, Measured};
+pub use fixes::{Change, Cost, Fix, Measured, ShearElsewhere};
 
 use std::collections::HashMap;
 
@@ -159,12 +159,13 @@ pub fn explain(
         }
     };
     let skeleton = evaluation.skeleton();
+    let scanned = (before, tolerances.min_shear_deg);
     let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
         let mut fixes = Vec::new();
         let mut notes = Vec::new();
         for change in changes {
             match (&applied[&change], costs.get(&change)) {
-                (Ok(made), Some(Ok(cost))) => fixes.push(Fix::new(skeleton, bone, change, made, *cost, before)),
+                (Ok(made), Some(Ok(cost))) => fixes.push(Fix::new(skeleton, bone, change, made, *cost, scanned)),
                 (Err(why), _) | (_, Some(Err(why))) => notes.push(format!("{}: {why}", change.describe(skeleton))),
                 (Ok(_), None) => {}
             }
