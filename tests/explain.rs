@@ -238,6 +238,12 @@ fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
     // At a time asked for, the chain is shown there.
     let at = json(&bonescope(&["explain", file, "--bone", "neck", "--time", "1", "--format", "json"]));
     assert_eq!(at["bones"][0]["causes"]["at"]["time"], 1.0);
+    // Through layers: the table says which, the JSON echoes them.
+    let layered = bonescope(&["explain", file, "--bone", "forearm", "--uniform-scale", "chest"]);
+    assert!(String::from_utf8_lossy(&layered.stdout).contains("  layers: uniform scale `chest`"));
+    let layered =
+        json(&bonescope(&["explain", file, "--bone", "forearm", "--uniform-scale", "chest", "--format", "json"]));
+    assert_eq!(layered["layers"]["uniform_scale"].as_array().map(Vec::len), Some(1));
     let unknown = bonescope(&["explain", file, "--bone", "tail"]);
     assert_eq!(unknown.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("--bone: no bone named `tail`"));

@@ -11,7 +11,7 @@ use super::table::Table;
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
-use crate::eval::{Evaluation, LayerStack};
+use crate::eval::{Evaluation, LayerStack, Layers};
 use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
@@ -46,7 +46,9 @@ struct ExplainReport<'a> {
     animation: Option<AnimationInfo>,
     inherit: String,
     rate: f64,
-    /// The rig's size, which the fixes' costs are fractions of, in its units.
+    /// The layers the clip plays through (the default for none).
+    layers: Layers,
+    /// The rig's unit, where its file states one: every length (the fixes' costs) is in it.
     unit: Option<Unit>,
     bones: &'a [Explanation],
 }
@@ -60,8 +62,8 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     }
     let bones = args.bone.iter().map(|name| bone_index(&rig, "--bone", name)).collect::<anyhow::Result<Vec<_>>>()?;
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
-    let layers = LayerStack::new(&rig, &args.layers.layers(&rig)?)?;
-    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(layers);
+    let layers = args.layers.layers(&rig)?;
+    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(LayerStack::new(&rig, &layers)?);
     let before = scan(&evaluation, &options, &|_, _| {});
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
     let question = Question { bones: asked, at: args.time, costs: Costs::Every };
@@ -71,6 +73,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
         animation: clip.map(AnimationInfo::of),
         inherit: args.eval.inherit_label(),
         rate: args.rate,
+        layers,
         unit: rig.unit,
         bones: &explained,
     };
@@ -84,6 +87,10 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
 fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode]) -> String {
     let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {animation}  inherit: {}\n", report.file, report.inherit);
+    let layers = report.layers.summary(rig, report.animation.as_ref().and_then(|a| rig.clips.get(a.index)));
+    if !layers.is_empty() {
+        out.push_str(&format!("  layers: {layers}\n"));
+    }
     if report.bones.is_empty() {
         out.push_str("  no stretched bones: nothing to explain\n");
     }
