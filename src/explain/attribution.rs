@@ -143,22 +143,21 @@ struct Sample {
     main_cause: Option<usize>,
 }
 
-/// The runs of samples with one main cause.
+/// The runs of samples with one main cause: each span reaches the next sample's time while that sample is still
+/// in it or is the first one after it.
 fn spans(skeleton: &Skeleton, samples: &[Sample], times: &[f64]) -> Vec<CauseSpan> {
     let mut spans: Vec<CauseSpan> = Vec::new();
-    let mut open = false;
+    let mut open: Option<&mut CauseSpan> = None;
     for (sample, &time) in samples.iter().zip(times) {
-        if open && spans.last().is_some_and(|span| Some(span.bone) != sample.main_cause) {
-            spans.last_mut().expect("an open span").to = time;
-            open = false;
+        if let Some(span) = open.take() {
+            span.to = time;
+            open = (Some(span.bone) == sample.main_cause).then_some(span);
         }
-        match sample.main_cause {
-            Some(bone) if !open => {
-                spans.push(CauseSpan { bone, name: skeleton.bone(bone).name.clone(), from: time, to: time });
-                open = true;
-            }
-            Some(_) => spans.last_mut().expect("an open span").to = time,
-            None => {}
+        if open.is_none()
+            && let Some(bone) = sample.main_cause
+        {
+            spans.push(CauseSpan { bone, name: skeleton.bone(bone).name.clone(), from: time, to: time });
+            open = spans.last_mut();
         }
     }
     spans
@@ -170,19 +169,22 @@ struct Probe<'a> {
     chain: &'a [usize],
     bone: usize,
     model: ModelPose,
+    /// The local transforms a call replaces, put back after it (kept: the call is made per sample and bone).
+    saved: Vec<Transform>,
 }
 
 impl<'a> Probe<'a> {
     fn new(hierarchy: &'a Hierarchy, chain: &'a [usize], bone: usize) -> Self {
-        Probe { hierarchy, chain, bone, model: ModelPose::default() }
+        Probe { hierarchy, chain, bone, model: ModelPose::default(), saved: Vec::new() }
     }
 
     /// The bone's model matrix with the scales of `uniform` made uniform in `local` (which is left as it was).
     fn matrix(&mut self, local: &mut [Transform], uniform: &[usize]) -> DMat4 {
-        let saved: Vec<Transform> = uniform.iter().map(|&b| local[b]).collect();
+        self.saved.clear();
+        self.saved.extend(uniform.iter().map(|&b| local[b]));
         uniform.iter().for_each(|&b| uniform_scale(&mut local[b]));
         self.hierarchy.evaluate_bones(local, self.chain, &mut self.model);
-        uniform.iter().zip(saved).for_each(|(&b, t)| local[b] = t);
+        uniform.iter().zip(&self.saved).for_each(|(&b, t)| local[b] = *t);
         self.model.model[self.bone]
     }
 
