@@ -254,7 +254,7 @@ fn uniform_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers, before
         if let Some(bone) = shared.inspected().filter(|b| !layers.uniform_scale.contains(b))
             && ui.button(format!("Make {}'s scale uniform", skeleton.bone(bone).name)).clicked()
         {
-            layers.uniform_scale.push(bone);
+            layers.make_scale_uniform(bone);
         }
         removable_rows(ui, &mut layers.uniform_scale, |ui, bone| {
             ui.label(&skeleton.bone(*bone).name);

@@ -451,9 +451,7 @@ fn try_fix(shared: &mut Shared, change: Change) {
         }
         Change::UniformScale { bone } => {
             let mut layers = doc.layers().clone();
-            if !layers.uniform_scale.contains(&bone) {
-                layers.uniform_scale.push(bone);
-            }
+            layers.make_scale_uniform(bone);
             if doc.set_layers(&layers).is_ok() {
                 doc.ghost = Some(Ghost::Unlayered);
             }

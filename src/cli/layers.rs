@@ -164,7 +164,7 @@ impl LayerArgs {
             layers.shake = Some(Shake { bone: bone_index(rig, "--shake", name)?, params });
         }
         for name in &self.uniform_scale {
-            layers.uniform_scale.push(bone_index(rig, "--uniform-scale", name)?);
+            layers.make_scale_uniform(bone_index(rig, "--uniform-scale", name)?);
         }
         for target in &self.target {
             layers.targets.push(Target {

@@ -48,9 +48,7 @@ impl Change {
             }
             Change::UniformScale { bone } => {
                 let mut layers = source.layers().map(|s| s.layers().clone()).unwrap_or_default();
-                if !layers.uniform_scale.contains(&bone) {
-                    layers.uniform_scale.push(bone);
-                }
+                layers.make_scale_uniform(bone);
                 let stack = LayerStack::new(source.rig, &layers).map_err(|e| e.to_string())?;
                 Ok(source.clone().with_layers(stack))
             }

@@ -138,6 +138,13 @@ impl Layers {
         parts.join("; ")
     }
 
+    /// Adds `bone` to the bones whose local scale is made uniform ([`uniform_part`]), once.
+    pub fn make_scale_uniform(&mut self, bone: usize) {
+        if !self.uniform_scale.contains(&bone) {
+            self.uniform_scale.push(bone);
+        }
+    }
+
     /// Whether these layers leave the clip exactly as sampled.
     pub fn is_empty(&self) -> bool {
         *self == Layers::default()
