@@ -212,8 +212,8 @@ fn on_the_generated_rig_the_fixes_of_a_sheared_bone_hold() {
     let options = ScanOptions { rate: 0.0, ..ScanOptions::default() };
     let source = Evaluation::declared(&rig, rig.clips.first());
     let before = scan(&source, &options, &|_, _| {});
-    let flagged = bonescope::explain::flagged(&before);
-    let bone = *flagged.last().expect("the squashes shear the bones below them");
+    let flagged = before.stretched_worst_first();
+    let bone = flagged.last().expect("the squashes shear the bones below them").index;
     let explained = explain(&source, &before, Question { bones: Some(&[bone]), ..Question::default() }, &options);
     let explanation = &explained[0];
     let cause = explanation.causes.at.main_cause().expect("a squash causes it");

@@ -106,6 +106,15 @@ pub struct ClipScan {
     pub bones: Vec<BoneSummary>,
 }
 
+impl ClipScan {
+    /// The bones stretched somewhere in the clip, the worst shear first (ties in bone order).
+    pub fn stretched_worst_first(&self) -> Vec<&BoneSummary> {
+        let mut bones: Vec<&BoneSummary> = self.bones.iter().filter(|b| b.stretched()).collect();
+        bones.sort_by(|a, b| b.worst_shear_deg.total_cmp(&a.worst_shear_deg));
+        bones
+    }
+}
+
 /// The decomposed parts of one matrix at one sample, in single precision (plots need no more, and long clips
 /// stay small).
 #[derive(Clone, Copy, Debug, PartialEq)]

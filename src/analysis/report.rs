@@ -187,13 +187,9 @@ impl AnimationScan {
         let non_uniform = names_where(|b| b.non_uniform_samples);
         let mirrored = names_where(|b| b.mirrored_samples);
         let degenerate = names_where(|b| b.degenerate_samples);
-        let mut stretched: Vec<BoneScanReport> = scan
-            .bones
-            .into_iter()
-            .filter(|b| b.stretched())
-            .map(|summary| BoneScanReport { name: name(summary.index), summary })
-            .collect();
-        stretched.sort_by(|a, b| b.summary.worst_shear_deg.total_cmp(&a.summary.worst_shear_deg));
+        let stretched = scan.stretched_worst_first();
+        let stretched = stretched.into_iter().map(|b| BoneScanReport { name: name(b.index), summary: b.clone() });
+        let stretched = stretched.collect();
         AnimationScan {
             animation: clip.map(AnimationInfo::of),
             inherit,

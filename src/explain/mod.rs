@@ -89,13 +89,6 @@ impl Explanation {
     }
 }
 
-/// The bones `scan` flags, the worst shear first.
-pub fn flagged(scan: &ClipScan) -> Vec<usize> {
-    let mut bones: Vec<_> = scan.bones.iter().filter(|b| b.stretched()).collect();
-    bones.sort_by(|a, b| b.worst_shear_deg.total_cmp(&a.worst_shear_deg).then(a.index.cmp(&b.index)));
-    bones.into_iter().map(|b| b.index).collect()
-}
-
 /// Which fixes an explanation measures the cost of.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Costs {
@@ -124,7 +117,8 @@ pub fn explain(
     question: Question,
     options: &ScanOptions,
 ) -> Vec<Explanation> {
-    let bones = question.bones.map_or_else(|| flagged(before), <[usize]>::to_vec);
+    let flagged = || before.stretched_worst_first().iter().map(|b| b.index).collect();
+    let bones = question.bones.map_or_else(flagged, <[usize]>::to_vec);
     let times = evaluation.times(options.rate);
     let tolerances = &options.tolerances;
     let at = question.at;
