@@ -205,6 +205,13 @@ fn the_bind_pose_section_warns_of_a_broken_skin_and_notes_a_stored_pose() {
         .get_by_label_contains("note: the stored pose is not the bind pose: 1 joint (forearm) is posed up to 20.00°");
     assert!(harness.query_by_label_contains("disagree").is_none());
     assert!(harness.query_by_label_contains("agree with the rest pose").is_none());
+    // The check reads the clip as authored: a layer edit (the clip weight) keeps its result on screen, no new check.
+    let mut harness = harness;
+    let layers = bonescope::eval::Layers { bind_weight: 0.5, ..Default::default() };
+    harness.state_mut().doc.set_layers(&layers).unwrap();
+    harness.step();
+    harness.get_by_label_contains("note: the stored pose is not the bind pose");
+    assert!(harness.query_by_label_contains("checking the bind matrices").is_none());
 }
 
 #[test]

@@ -145,6 +145,12 @@ impl DocumentKey {
     pub fn of(doc: &Document) -> Self {
         DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
     }
+
+    /// The key of a measurement of the clip as authored, which no layer changes (the bind check): a layer edit,
+    /// a dragged weight slider, starts no new one.
+    pub fn authored(doc: &Document) -> Self {
+        DocumentKey { layers: Layers::default(), ..DocumentKey::of(doc) }
+    }
 }
 
 impl PartialEq for DocumentKey {

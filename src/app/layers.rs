@@ -68,7 +68,8 @@ impl LayersPanel {
                 ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
                 return;
             }
-            let key = DocumentKey::of(doc);
+            // The check reads the clip as authored: its key leaves the layers out.
+            let key = DocumentKey::authored(doc);
             let work = || {
                 let doc = doc.clone();
                 move |_: &Progress| Some(check_bind(&doc.evaluation(), &BindTolerance::default()))
