@@ -4,7 +4,7 @@
 //! file that was written, as that runtime plays it, not the intentions behind it.
 
 use super::{Baked, Engine, Request, Strategy};
-use crate::diff::{Comparison, Extreme, MeshDifference, Pairs, compare};
+use crate::diff::{Comparison, Extreme, MeshDifference, Pairs, compare_each};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Rig};
@@ -102,9 +102,7 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
             let source = &request.clips[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
             let pairs = Pairs::by_name(source, &result);
-            let comparison = played(request.engine, |rotation| {
-                compare(source, &result.clone().played_with(rotation), &pairs, &animation.times)
-            });
+            let comparison = played(request.engine, source, &result, &pairs, &animation.times);
             let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {
                 (Strategy::Trs, _) => BoneNodes::Trs,
                 (Strategy::Exact, true) => BoneNodes::Helper,
@@ -144,9 +142,13 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
     }
 }
 
-/// The worse of the comparisons `compare` makes under each rotation interpolation `engine` plays keys with.
-fn played(engine: Engine, compare: impl Fn(RotationInterpolation) -> Comparison) -> Comparison {
-    let rotations = engine.rotations().iter().map(|&rotation| compare(rotation));
+/// The worse of the comparisons of `source` with `result` played under each rotation interpolation `engine` plays
+/// keys with, made in one pass (the source evaluated once per time for all of them).
+fn played(engine: Engine, source: &Evaluation, result: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
     // Every engine plays keys some way; glTF's way stands in for none.
-    rotations.reduce(Comparison::worse).unwrap_or_else(|| compare(RotationInterpolation::Slerp))
+    let rotations = Some(engine.rotations()).filter(|r| !r.is_empty()).unwrap_or(&[RotationInterpolation::Slerp]);
+    let played: Vec<Evaluation> = rotations.iter().map(|&r| result.clone().played_with(r)).collect();
+    let sides: Vec<(&Evaluation, &Pairs)> = played.iter().map(|e| (e, pairs)).collect();
+    let comparisons = compare_each(source, &sides, times, source.size(times));
+    comparisons.into_iter().reduce(Comparison::worse).expect("one comparison per rotation interpolation")
 }
