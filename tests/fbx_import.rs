@@ -636,6 +636,6 @@ fn nodes_have_the_role_of_their_fbx_attribute() {
     }
     // Nodes 0 to 13 and 82, 83 are the cameras, their targets and the sky light, 15 the biped's footsteps (a `Null`
     // below the hips); the rest is the biped.
-    let figure: Vec<bool> = walk.skeleton.figure();
+    let figure: &[bool] = walk.skeleton.figure();
     assert!(figure.iter().enumerate().all(|(b, &f)| f == ((14..82).contains(&b) && b != 15)), "{figure:?}");
 }

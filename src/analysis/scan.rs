@@ -50,7 +50,7 @@ pub fn analyze(
         })
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
-    Some(assemble(&skeleton.figure(), times, curves, chunks))
+    Some(assemble(skeleton.figure(), times, curves, chunks))
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.

@@ -174,8 +174,7 @@ impl<'a> Evaluation<'a> {
         let mut size: f64 = 0.0;
         for (i, &time) in times.iter().enumerate() {
             let pose = evaluator.evaluate(time);
-            let origins =
-                pose.model.model.iter().zip(&character).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
+            let origins = pose.model.model.iter().zip(character).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
             let vertices = if i == 0 { self.skin_all(pose).concat() } else { Vec::new() };
             size = size.max(diagonal(origins.chain(vertices)));
         }

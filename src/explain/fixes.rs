@@ -123,17 +123,16 @@ pub(super) struct Baseline<'e, 'a> {
     /// The source's own comparison times, and its size over them.
     times: Vec<f64>,
     size: f64,
-    /// Per bone: whether a mesh shows it ([`Rig::shown_by_meshes`]), and whether it is part of the figure.
+    /// Per bone, whether a mesh shows it ([`Rig::shown_by_meshes`]).
     shown: Vec<bool>,
-    figure: Vec<bool>,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
     pub fn new(source: &'e Evaluation<'a>, before: &'e ClipScan, options: &'e ScanOptions) -> Self {
         let times = comparison_times(source, source, options.rate);
         let size = source.size(&times);
-        let (shown, figure) = (source.rig.shown_by_meshes(), source.skeleton().figure());
-        Baseline { source, before, options, times, size, shown, figure }
+        let shown = source.rig.shown_by_meshes();
+        Baseline { source, before, options, times, size, shown }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -141,7 +140,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// not hide a neck that moves.
     fn visible(&self, comparison: &Comparison) -> Cost {
         let skin = comparison.meshes.iter().map(|m| m.distance).fold(Extreme::default(), Extreme::merge);
-        let unseen = comparison.bones.iter().filter(|b| self.figure[b.a] && !self.shown[b.a]).map(|b| b.probe);
+        let figure = self.source.skeleton().figure();
+        let unseen = comparison.bones.iter().filter(|b| figure[b.a] && !self.shown[b.a]).map(|b| b.probe);
         let bones = unseen.fold(Extreme::default(), Extreme::merge);
         let (distance, measured) = if bones.max > skin.max || self.source.rig.meshes.is_empty() {
             (bones, Measured::Bones)

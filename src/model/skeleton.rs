@@ -69,6 +69,8 @@ impl NodeRole {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Skeleton {
     bones: Vec<Bone>,
+    /// [`Skeleton::figure`], found once: the roles do not change after [`Skeleton::new`].
+    figure: Vec<bool>,
 }
 
 /// A bone list that is not in parents-first order.
@@ -98,7 +100,9 @@ impl Skeleton {
                 bones[parent].role = NodeRole::Joint;
             }
         }
-        Ok(Skeleton { bones })
+        let figure: Vec<bool> = bones.iter().map(|b| b.role.is_figure()).collect();
+        let figure = if figure.contains(&true) { figure } else { vec![true; figure.len()] };
+        Ok(Skeleton { bones, figure })
     }
 
     pub fn len(&self) -> usize {
@@ -143,9 +147,8 @@ impl Skeleton {
 
     /// Per bone, whether it belongs to the figure ([`NodeRole::is_figure`]); every bone when none does (a file of
     /// nulls or of rigid meshes has nothing else to show).
-    pub fn figure(&self) -> Vec<bool> {
-        let figure: Vec<bool> = self.bones.iter().map(|b| b.role.is_figure()).collect();
-        if figure.contains(&true) { figure } else { vec![true; figure.len()] }
+    pub fn figure(&self) -> &[bool] {
+        &self.figure
     }
 
     /// The rest pose, one local transform per bone.

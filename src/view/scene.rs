@@ -181,9 +181,6 @@ pub struct Scene<'a> {
     /// so a centimetre rig under a 0.01 conversion gets triads of `gizmo_size`, while a bone scaled or sheared
     /// relative to the rest shows it in the lengths and angles of its axes.
     pub gizmo_unit: f64,
-    /// Per bone, whether it belongs to the figure ([`Skeleton::figure`](crate::model::Skeleton::figure)), found
-    /// once.
-    figure: Vec<bool>,
     /// Each bone's first child of the figure (a helper below a joint, a camera's target, say, does not end its
     /// bone), found once: the tail of every bone is asked for each frame.
     first_child: Vec<Option<usize>>,
@@ -211,7 +208,6 @@ impl<'a> Scene<'a> {
             options,
             gizmo_size,
             gizmo_unit,
-            figure,
             first_child,
         }
     }
@@ -219,7 +215,9 @@ impl<'a> Scene<'a> {
     /// Whether `bone` is drawn: a bone of the figure, a helper when they are shown, or anything selected (picked in
     /// the outliner's list of helpers, a camera shows where it is).
     pub fn shows(&self, bone: usize) -> bool {
-        self.figure.get(bone).copied().unwrap_or(false) || self.options.helpers || self.selected.contains(&bone)
+        self.rig.skeleton.figure().get(bone).copied().unwrap_or(false)
+            || self.options.helpers
+            || self.selected.contains(&bone)
     }
 
     /// The tail of a bone: the head of its first child, or for a leaf a third of its parent's length further on. An
@@ -238,7 +236,13 @@ impl<'a> Scene<'a> {
 
     /// What framing the camera on this pose should keep in view: the figure's joints and the meshes.
     pub fn bounds(&self) -> Option<Bounds> {
-        let heads = self.primary.model.iter().zip(&self.figure).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
+        let heads = self
+            .primary
+            .model
+            .iter()
+            .zip(self.rig.skeleton.figure())
+            .filter(|(_, f)| **f)
+            .map(|(m, _)| m.w_axis.truncate());
         let vertices = self.primary.meshes.iter().flatten().copied();
         Bounds::of(heads.chain(vertices))
     }
@@ -293,7 +297,7 @@ pub fn motion_bounds(
             let model = pose_at(time);
             morph.evaluate(clip, time);
             let meshes = skin_meshes(rig, &model, &morph);
-            let heads = model.iter().zip(&framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
+            let heads = model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
             Bounds::of(heads.chain(meshes.into_iter().flatten()))
         })
         .reduce(Bounds::union)?;
