@@ -235,7 +235,7 @@ fn checked_skins(rig: &Rig) -> Vec<CheckedSkin> {
         .iter()
         .enumerate()
         .map(|(s, skin)| {
-            let weighted = weighted_joints(rig, s, skin.joints.len());
+            let weighted = rig.weighted_joints(s);
             let mut joints = Vec::new();
             for (k, (&bone, ibm)) in skin.joints.iter().zip(&skin.inverse_bind).enumerate() {
                 if !weighted[k] || seen.get(bone) != Some(&false) {
@@ -262,21 +262,6 @@ fn checked_skins(rig: &Rig) -> Vec<CheckedSkin> {
             CheckedSkin { joints }
         })
         .collect()
-}
-
-/// Per joint of skin `skin` (`count` of them), whether some vertex of a mesh it deforms has a weight on it.
-fn weighted_joints(rig: &Rig, skin: usize, count: usize) -> Vec<bool> {
-    let mut weighted = vec![false; count];
-    for mesh in rig.meshes.iter().filter(|m| m.skin == Some(skin)) {
-        for (joints, weights) in mesh.joints.iter().zip(&mesh.weights) {
-            for (&j, &w) in joints.iter().zip(weights) {
-                if let Some(slot) = weighted.get_mut(usize::from(j)).filter(|_| w > 0.0) {
-                    *slot = true;
-                }
-            }
-        }
-    }
-    weighted
 }
 
 /// The frame of `authored`'s clip (at its frame rate, thinned past [`MAX_FRAMES`] as every whole-clip pass is)

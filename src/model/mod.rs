@@ -45,8 +45,25 @@ impl Rig {
             .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
     }
 
-    /// For each bone, whether a mesh shows where it goes: some skinned vertex is weighted to it, or an unskinned
-    /// mesh hangs from it.
+    /// Per joint of skin `skin` (in the skin's joint order), whether some vertex of a mesh it deforms has a positive
+    /// weight on it.
+    pub fn weighted_joints(&self, skin: usize) -> Vec<bool> {
+        let count = self.skins.get(skin).map_or(0, |s| s.joints.len());
+        let mut weighted = vec![false; count];
+        for mesh in self.meshes.iter().filter(|m| m.skin == Some(skin)) {
+            for (joints, weights) in mesh.joints.iter().zip(&mesh.weights) {
+                for (&j, &w) in joints.iter().zip(weights) {
+                    if let Some(slot) = weighted.get_mut(usize::from(j)).filter(|_| w > 0.0) {
+                        *slot = true;
+                    }
+                }
+            }
+        }
+        weighted
+    }
+
+    /// For each bone, whether a mesh shows where it goes: some skinned vertex is weighted to it
+    /// ([`Rig::weighted_joints`]), or an unskinned mesh hangs from it.
     pub fn shown_by_meshes(&self) -> Vec<bool> {
         let mut shown = vec![false; self.skeleton.len()];
         let mut show = |bone: usize| {
@@ -54,18 +71,12 @@ impl Rig {
                 *slot = true;
             }
         };
-        for mesh in &self.meshes {
-            let Some(skin) = mesh.skin.and_then(|s| self.skins.get(s)) else {
-                show(mesh.bone);
-                continue;
-            };
-            for (joints, weights) in mesh.joints.iter().zip(&mesh.weights) {
-                for (&joint, &weight) in joints.iter().zip(weights) {
-                    if let Some(&bone) = skin.joints.get(usize::from(joint)).filter(|_| weight > 0.0) {
-                        show(bone);
-                    }
-                }
-            }
+        for mesh in self.meshes.iter().filter(|m| m.skin.is_none_or(|s| s >= self.skins.len())) {
+            show(mesh.bone);
+        }
+        for (s, skin) in self.skins.iter().enumerate() {
+            let weighted = self.weighted_joints(s);
+            skin.joints.iter().zip(weighted).filter(|(_, w)| *w).for_each(|(&bone, _)| show(bone));
         }
         shown
     }
