@@ -71,9 +71,7 @@ fn copy_button(ui: &mut Ui, shared: &Shared, reports: &[BoneReport]) {
     let copied_at = ui.scope_id().with("copied-at");
     let now = ui.input(|i| i.time);
     let copied = ui.data(|d| d.get_temp::<f64>(copied_at)).is_some_and(|t| now - t < COPIED_SECONDS);
-    let width = super::text::text_width(ui, "Copy as JSON", &egui::TextStyle::Button.resolve(ui.style()));
-    let button = egui::Button::new(if copied { "Copied" } else { "Copy as JSON" })
-        .min_size(egui::vec2(width + 2.0 * ui.spacing().button_padding.x, 0.0));
+    let button = super::text::steady_button(ui, if copied { "Copied" } else { "Copy as JSON" }, "Copy as JSON");
     let hint = "every bone now, as `bonescope inspect FILE --time T --format json` prints it";
     if ui.add(button).on_hover_text(hint).clicked()
         && let Ok(json) = serde_json::to_string_pretty(&inspect_report(shared, reports.to_vec()))

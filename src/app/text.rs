@@ -72,6 +72,13 @@ pub fn text_width(ui: &Ui, text: &str, font: &FontId) -> f32 {
     ui.fonts_mut(|fonts| fonts.layout_no_wrap(text.to_owned(), font.clone(), egui::Color32::WHITE).size().x)
 }
 
+/// A button showing `label`, as wide as `widest` would make it: a button whose label changes ("Play"/"Pause",
+/// "Copy as JSON"/"Copied") keeps its width, so nothing beside or below it moves.
+pub fn steady_button(ui: &Ui, label: &str, widest: &str) -> egui::Button<'static> {
+    let width = text_width(ui, widest, &egui::TextStyle::Button.resolve(ui.style()));
+    egui::Button::new(label.to_owned()).min_size(egui::vec2(width + 2.0 * ui.spacing().button_padding.x, 0.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -61,9 +61,7 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     let rate = shared.doc.frame_rate();
     frame_button(ui, shared, "Previous frame", "← key", false, rate, duration);
     let play_label = if *shared.playing { "Pause" } else { "Play" };
-    // As wide as its wider label, so that nothing after it moves when it changes.
-    let width = super::text::text_width(ui, "Pause", &egui::TextStyle::Button.resolve(ui.style()));
-    let play = egui::Button::new(play_label).min_size(vec2(width + 2.0 * ui.spacing().button_padding.x, 0.0));
+    let play = super::text::steady_button(ui, play_label, "Pause");
     if ui.add(play).on_hover_text("Space; Home and End go to the ends").clicked() {
         toggle_play(shared.playing, shared.time, shared.settings.looping, duration);
     }

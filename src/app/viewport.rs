@@ -30,12 +30,12 @@ pub struct Viewport {
 }
 
 impl Viewport {
-    /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
     /// Where the canvas was drawn in the last frame (messages go in its corner).
     pub fn rect(&self) -> Option<egui::Rect> {
         self.rect
     }
 
+    /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;

@@ -29,8 +29,7 @@ use rayon::prelude::*;
 use crate::analysis::report::ExplainedBone;
 use crate::analysis::{ClipScan, ScanOptions};
 use crate::eval::Evaluation;
-use crate::model::Unit;
-use crate::model::unit::significant;
+use crate::model::{Unit, significant};
 use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.

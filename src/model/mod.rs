@@ -7,7 +7,7 @@ mod skeleton;
 mod skin;
 mod timeline;
 mod transform;
-pub(crate) mod unit;
+mod unit;
 
 pub use choice::Choice;
 pub use clip::{
@@ -20,6 +20,7 @@ pub use skeleton::{Bone, NodeRole, ParentOrderError, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};
+pub(crate) use unit::significant;
 pub use unit::{Unit, UnknownUnit};
 
 /// Everything bonescope knows about one file.
