@@ -284,3 +284,22 @@ fn gizmos_are_visible_at_the_opening_view() {
         assert!(percent > 0.4, "{file}: axes and boxes change {changed} pixels, {percent:.2} % of the picture");
     }
 }
+
+#[test]
+fn a_selected_bone_shows_its_axes_with_the_axes_toggle_off() {
+    // What the Why? section's chain relies on: picking an ancestor shows its scale in its triad. Pixels of the Y
+    // axis's green (80, 200, 90) count the triads of a bones-only render of the demo.
+    let dir = TempDir::new().unwrap();
+    let greens = |extra: &[&str]| {
+        let out = path(&dir, &format!("{}.png", extra.len()));
+        let mut args = vec!["render", "--show", "bones", "--time", "0.5", "--out", arg(&out)];
+        args.extend_from_slice(extra);
+        succeeds(&bonescope(&args));
+        let image = image::open(out).unwrap().to_rgba8();
+        let near = |p: &image::Rgba<u8>| [80i32, 200, 90].iter().zip(p.0).all(|(&c, v)| (c - i32::from(v)).abs() <= 12);
+        image.pixels().filter(|p| near(p)).count()
+    };
+    let (none, selected) = (greens(&[]), greens(&["--select", "forearm"]));
+    assert!(none <= 2, "no triad without the toggle or a selection: {none} green pixels");
+    assert!(selected >= 10, "the selected forearm's triad: {selected} green pixels");
+}

@@ -61,7 +61,7 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
             paint_boxes(&painter, &projection, scene, ghost, |bone| faded(box_color(ghost, bone, palette)));
         }
         if options.axes {
-            paint_axes(&painter, &projection, scene, ghost, faded);
+            paint_axes(&painter, &projection, scene, ghost, |_| true, faded);
         }
     }
     if options.bones {
@@ -76,9 +76,15 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         let drawn = &scene.primary;
         paint_boxes(&painter, &projection, scene, drawn, |bone| box_color(drawn, bone, palette));
     }
-    if options.axes {
-        paint_axes(&painter, &projection, scene, &scene.primary, |c| c);
-    }
+    // The selection's axes always, as its name: a bone picked (in the Why? section's chain, say) shows its scale.
+    paint_axes(
+        &painter,
+        &projection,
+        scene,
+        &scene.primary,
+        |bone| options.axes || scene.selected.contains(&bone),
+        |c| c,
+    );
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
         paint_legend(&painter, rect, scene, palette);
@@ -313,17 +319,18 @@ fn paint_boxes(
     }
 }
 
-/// Axis triads of the shown bones from their model matrix columns times [`gizmo_unit`]: their lengths show scale,
-/// their angles show shear.
+/// Axis triads of the shown bones `which` picks, from their model matrix columns times [`gizmo_unit`]: their
+/// lengths show scale, their angles show shear.
 fn paint_axes(
     painter: &Painter,
     projection: &Projection,
     scene: &Scene,
     drawn: &DrawnPose,
+    which: impl Fn(usize) -> bool,
     tint: impl Fn(Color32) -> Color32,
 ) {
     let palette_axes = Palette::new(true).axes;
-    for (_, model) in drawn.model.iter().enumerate().filter(|(b, _)| scene.shows(*b)) {
+    for (_, model) in drawn.model.iter().enumerate().filter(|&(b, _)| scene.shows(b) && which(b)) {
         let origin = model.w_axis.truncate();
         let unit = gizmo_unit(scene, projection, origin);
         for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
