@@ -28,6 +28,10 @@ pub(super) struct Plan<'a> {
     inherits: Vec<bool>,
     /// How many children each bone has: a bone's stretches are dropped once they are all judged.
     children: Vec<usize>,
+    /// What a root inherits: the stretch of the skeleton's unit conversion (a uniform scale).
+    root: Run,
+    /// Per bone, what its model scale factors are divided by to be the authored ones ([`Skeleton::length_scales`]).
+    length_scales: Vec<f64>,
     /// Whether the clip changes each bone's scale, and its rotation, over time (constant tracks do not).
     varying_scale: Vec<bool>,
     varying_rotation: Vec<bool>,
@@ -51,12 +55,15 @@ impl<'a> Plan<'a> {
         };
         let mut children = vec![0; parents.len()];
         parents.iter().flatten().for_each(|&p| children[p] += 1);
+        let conversion = skeleton.placement().conversion;
         Plan {
             hierarchy,
             by_bone,
             inherits,
             parents,
             children,
+            root: Run::Fixed(Stretch::uniform(conversion.determinant().abs().cbrt())),
+            length_scales: skeleton.length_scales(),
             varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
             varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
             modelled: with_ancestors(skeleton, plotted),
@@ -146,8 +153,6 @@ enum Run {
     Done,
 }
 
-const ROOT: Run = Run::Fixed(Stretch::NONE);
-
 impl Run {
     /// The stretch at `sample`.
     fn at(&self, sample: usize) -> Stretch {
@@ -178,7 +183,7 @@ impl Chunk<'_> {
         let mut spare: Vec<Vec<Stretch>> = Vec::new();
         for &bone in &plan.judged {
             let mut cursor = BoneCursor::new(skeleton, clip, bone);
-            let above = plan.parents[bone].map_or(&ROOT, |p| &runs[p]);
+            let above = plan.parents[bone].map_or(&plan.root, |p| &runs[p]);
             // A bone the clip does not scale, under a fixed stretch that is uniform or with a rotation that does
             // not change, keeps one stretch throughout.
             let fixed = match above {
@@ -228,7 +233,7 @@ impl Chunk<'_> {
             return;
         }
         let mut chains = Chains::new(self.evaluation.skeleton(), clip, &plan.modelled);
-        let mut plot = Plotter::new(bones.len());
+        let mut plot = Plotter::new(bones.len(), &self.plan.length_scales);
         for (sample, &time) in self.times.iter().enumerate() {
             let pose = chains.evaluate(time, plan.hierarchy);
             let stretches = stretches.iter().map(|run| run.at(sample));
@@ -246,7 +251,9 @@ impl Chunk<'_> {
         for (sample, &time) in self.times.iter().enumerate() {
             let pose = evaluator.evaluate(time);
             for ((curve, &bone), start) in curves.iter_mut().zip(bones).zip(&mut starts) {
-                let components = Components::of_matrix(&pose.model.model[bone], *start);
+                let parts = decompose_near(&pose.model.model[bone], *start);
+                let components =
+                    Components::of_parts(&parts.authored(self.plan.length_scales[bone]), &pose.model.model[bone]);
                 *start = components.stretch.as_dquat();
                 curve[sample] = components;
             }
@@ -259,7 +266,7 @@ impl Chunk<'_> {
         let (plan, plotted) = (self.plan, self.request.bones);
         let bones = self.evaluation.skeleton().len();
         let mut stretches = vec![Stretch::NONE; bones];
-        let mut plot = Plotter::new(plotted.len());
+        let mut plot = Plotter::new(plotted.len(), &plan.length_scales);
         for (sample, &time) in self.times.iter().enumerate() {
             let pose = evaluator.evaluate(time);
             for &bone in &plan.judged {
@@ -267,7 +274,7 @@ impl Chunk<'_> {
                 let stretch = match plan.parents[bone] {
                     _ if !plan.inherits[bone] => Stretch::of_matrix(&pose.model.model[bone], start),
                     Some(parent) => stretches[parent].child(&mut &pose.local[bone], start, &self.judge),
-                    None => Stretch::NONE.child(&mut &pose.local[bone], start, &self.judge),
+                    None => plan.root.at(sample).child(&mut &pose.local[bone], start, &self.judge),
                 };
                 stretches[bone] = stretch;
                 result.add(bone, sample, time, &stretch.verdict(&self.judge));
@@ -279,14 +286,16 @@ impl Chunk<'_> {
 }
 
 /// Writes the plotted bones' components, sample by sample.
-struct Plotter {
+struct Plotter<'a> {
     /// Where each plotted bone's decomposition starts: its stretch frame at the previous sample.
     starts: Vec<DQuat>,
+    /// [`Plan::length_scales`].
+    length_scales: &'a [f64],
 }
 
-impl Plotter {
-    fn new(bones: usize) -> Self {
-        Plotter { starts: vec![DQuat::IDENTITY; bones] }
+impl<'a> Plotter<'a> {
+    fn new(bones: usize, length_scales: &'a [f64]) -> Self {
+        Plotter { starts: vec![DQuat::IDENTITY; bones], length_scales }
     }
 
     /// Sample `sample` of `bones`, given every bone's local transform and model matrix (only the plotted ones are
@@ -311,7 +320,7 @@ impl Plotter {
                 .and_then(|(frame, scale, sign)| decompose_with_stretch(m, frame, scale, sign))
                 .unwrap_or_else(|| decompose_near(m, *start));
             *start = parts.stretch;
-            model_curve[sample] = Components::of_parts(&parts, m);
+            model_curve[sample] = Components::of_parts(&parts.authored(self.length_scales[bone]), m);
             local_curve[sample] = Components::of_matrix(&local[bone].matrix(), DQuat::IDENTITY);
         }
     }

@@ -77,6 +77,8 @@ pub struct BoneReport {
     pub parent: Option<usize>,
     pub inherit: InheritMode,
     pub local: Parts,
+    /// The model matrix in bonescope's space, its scale factors the authored ones (over the unit conversion above
+    /// the bone, [`Skeleton::length_scales`]).
     pub model: Parts,
     pub stretched: bool,
     pub shear_deg: f64,
@@ -90,6 +92,7 @@ impl BoneReport {
     /// Every bone of an evaluated pose.
     pub fn all(skeleton: &Skeleton, modes: &[InheritMode], pose: &Pose, tolerances: &Tolerances) -> Vec<BoneReport> {
         let assessments = Assessment::all(&pose.model.model, tolerances);
+        let length_scales = skeleton.length_scales();
         skeleton
             .bones()
             .iter()
@@ -105,7 +108,7 @@ impl BoneReport {
                     parent: bone.parent,
                     inherit: modes[index],
                     local: Parts::new(&local, &decompose(&local)),
-                    model: Parts::new(&model, &assessment.parts),
+                    model: Parts::new(&model, &assessment.parts.authored(length_scales[index])),
                     stretched: assessment.findings.stretched,
                     shear_deg: assessment.shear_deg,
                     mirrored: assessment.findings.mirrored,

@@ -80,6 +80,11 @@ impl Stretch {
     /// The stretch of the identity: what a root bone inherits.
     pub const NONE: Stretch = Stretch::Factored { frame: DQuat::IDENTITY, scale: DVec3::ONE, sign: 1.0 };
 
+    /// The stretch of a uniform scale by `factor` (a unit conversion above the roots).
+    pub fn uniform(factor: f64) -> Self {
+        Stretch::Factored { frame: DQuat::IDENTITY, scale: DVec3::splat(factor), sign: 1.0 }
+    }
+
     /// The stretch of a model matrix, decomposed with the search starting from `start`.
     pub fn of_matrix(m: &DMat4, start: DQuat) -> Self {
         let parts = decompose_near(m, start);

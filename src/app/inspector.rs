@@ -60,7 +60,8 @@ fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize, why: &mut Why) {
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;
-        section(ui, "Model", &shared.frame.pose.model.model[bone], &assessment.parts, tolerance);
+        let authored = assessment.parts.authored(shared.doc.rig.skeleton.length_scales()[bone]);
+        section(ui, "Model", &shared.frame.pose.model.model[bone], &authored, tolerance);
         section(ui, "Local", &local, &crate::math::decompose(&local), tolerance);
     });
 }

@@ -3,8 +3,8 @@
 //! sampled time ([`crate::diff::compare`]; the worse of the interpolations per bone), so the report measures the
 //! file that was written, as that runtime plays it, not the intentions behind it.
 
-use super::{Baked, Engine, Request, Strategy};
-use crate::diff::{Comparison, Extreme, MeshDifference, Pairs, compare_each};
+use super::{Baked, BakedAnimation, Engine, Request, Strategy};
+use crate::diff::{Comparison, DEFAULT_RATE, Extreme, MeshDifference, Pairs, compare_each, comparison_times};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Rig};
@@ -102,7 +102,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
             let source = &request.clips[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
             let pairs = Pairs::by_name(source, &result);
-            let comparison = played(request.engine, source, &result, &pairs, &animation.times);
+            let comparison =
+                played(request.engine, source, &result, &pairs, &checked_times(source, &result, animation));
             let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {
                 (Strategy::Trs, _) => BoneNodes::Trs,
                 (Strategy::Exact, true) => BoneNodes::Helper,
@@ -140,6 +141,19 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
         animations,
         notes: baked.notes.clone(),
     }
+}
+
+/// The times a bake is checked at, so that its worst is one `bonescope diff` of the two files never exceeds: every
+/// baked time and the midpoint between each two (where a sampled curve strays most from its chord), and the times
+/// `diff` compares at (both sides' keys and [`DEFAULT_RATE`] a second).
+fn checked_times(source: &Evaluation, result: &Evaluation, animation: &BakedAnimation) -> Vec<f64> {
+    let baked = &animation.times;
+    let midpoints = baked.windows(2).map(|w| 0.5 * (w[0] + w[1]));
+    let mut times: Vec<f64> =
+        baked.iter().copied().chain(midpoints).chain(comparison_times(source, result, DEFAULT_RATE)).collect();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
 }
 
 /// The worse of the comparisons of `source` with `result` played under each rotation interpolation `engine` plays

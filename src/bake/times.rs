@@ -44,6 +44,9 @@ pub fn bake_times(side: &Evaluation) -> BakeTimes {
             }
         }
     }
+    let mut source_keys: Vec<f64> = keys.iter().map(|&t| in_single_precision(t)).collect();
+    source_keys.sort_by(f64::total_cmp);
+    source_keys.dedup();
     keys.extend(steps.iter().map(|t| (t - STEP_LEAD).max(0.0)));
     keys.extend(inside);
     let mut times = sample_times(keys, 0.0, end(side), rate, MAX_FRAMES).times;
@@ -51,30 +54,44 @@ pub fn bake_times(side: &Evaluation) -> BakeTimes {
     times.dedup();
     steps.sort_by(f64::total_cmp);
     steps.dedup();
-    let times = spaced(times, &steps);
+    let times = spaced(times, &steps, &source_keys);
     steps.retain(|s| times.binary_search_by(|t| t.total_cmp(s)).is_ok());
     BakeTimes { times, steps }
 }
 
-/// `times` (sorted) thinned to [`MIN_KEY_SPACING`]: of two closer times (a frame and a key of the source a fraction of
-/// a millisecond off it) the earlier stays, unless the later is the clip's end or a stepped key (a jump, kept where it
-/// is); two such times both stay, and so does the start.
-fn spaced(times: Vec<f64>, steps: &[f64]) -> Vec<f64> {
+/// `times` (sorted) thinned to [`MIN_KEY_SPACING`]. Of two closer times the one that matters more stays: the clip's
+/// start and end and stepped keys (jumps, kept where they are; two such times both stay), then the source's keys
+/// (where a linear track kinks: a frame between would cut the corner), then frames; of two alike, the earlier.
+fn spaced(times: Vec<f64>, steps: &[f64], keys: &[f64]) -> Vec<f64> {
     let last = times.last().copied();
-    let kept = |t: f64| Some(t) == last || steps.binary_search_by(|s| s.total_cmp(&t)).is_ok();
+    let listed = |list: &[f64], t: f64| list.binary_search_by(|s| s.total_cmp(&t)).is_ok();
+    let rank = |t: f64| match () {
+        _ if Some(t) == last || listed(steps, t) => Rank::Kept,
+        _ if listed(keys, t) => Rank::Key,
+        _ => Rank::Frame,
+    };
     let mut spaced: Vec<f64> = Vec::with_capacity(times.len());
     for t in times {
-        let start = spaced.len() == 1;
+        let previous_rank =
+            if spaced.len() == 1 { Rank::Kept } else { spaced.last().map_or(Rank::Frame, |&p| rank(p)) };
         match spaced.last_mut() {
-            Some(previous) if t - *previous < MIN_KEY_SPACING => match (kept(t), start || kept(*previous)) {
-                (true, false) => *previous = t,
-                (true, true) => spaced.push(t),
-                (false, _) => {}
+            Some(previous) if t - *previous < MIN_KEY_SPACING => match (rank(t), previous_rank) {
+                (Rank::Kept, Rank::Kept) => spaced.push(t),
+                (later, earlier) if later > earlier => *previous = t,
+                _ => {}
             },
             _ => spaced.push(t),
         }
     }
     spaced
+}
+
+/// How much a baked time matters when two lie too close ([`spaced`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Rank {
+    Frame,
+    Key,
+    Kept,
 }
 
 /// Where sampling ends: the duration, or for a synced blend's cycle, which wraps to its start at its length, the
@@ -153,10 +170,13 @@ mod tests {
     #[test]
     fn times_closer_than_a_hundredth_of_a_frame_are_thinned() {
         let close = 0.5 * MIN_KEY_SPACING;
-        // A key just after a frame goes; a stepped key just after one stays in its place; the start and end stay.
+        // Of two frames the earlier stays; a source key just after a frame takes its place, and so does a stepped
+        // key; the start and end stay.
         let times = vec![0.0, close, 0.5, 0.5 + close, 1.0 - close, 1.0];
-        assert_eq!(spaced(times.clone(), &[]), [0.0, 0.5, 1.0]);
-        assert_eq!(spaced(times, &[0.5 + close]), [0.0, 0.5 + close, 1.0]);
-        assert_eq!(spaced(vec![0.0, 0.25, 0.5], &[]), [0.0, 0.25, 0.5], "frames apart stay");
+        assert_eq!(spaced(times.clone(), &[], &[]), [0.0, 0.5, 1.0]);
+        assert_eq!(spaced(times.clone(), &[0.5 + close], &[]), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(times.clone(), &[], &[0.5 + close]), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(times, &[], &[0.5]), [0.0, 0.5, 1.0], "a key before a frame stays");
+        assert_eq!(spaced(vec![0.0, 0.25, 0.5], &[], &[]), [0.0, 0.25, 0.5], "frames apart stay");
     }
 }

@@ -49,12 +49,12 @@ pub struct DiffArgs {
     #[arg(long, value_parser = choice::<RotationInterpolation>(), value_name = "MODE", default_value = RotationInterpolation::default().id())]
     pub interp: RotationInterpolation,
     /// Samples per second over the shorter clip, on top of both files' key times.
-    #[arg(long, value_name = "HZ", default_value_t = 60.0, value_parser = parse_rate)]
+    #[arg(long, value_name = "HZ", default_value_t = crate::diff::DEFAULT_RATE, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
     /// Exit with status 1 when a bone's origin or axis probe, or a vertex, differs by more than this: a distance in
-    /// the first file's unit, or a percentage of the first rig's size (`0.01%`).
+    /// the first file's unit, or a percentage (`0.01%`) of the larger rig's size.
     #[arg(long, value_name = "DIST", value_parser = parse_distance)]
     pub fail_above: Option<Distance>,
 }

@@ -6,14 +6,17 @@
 //! are compared through their polar decompositions:
 //! - **position**: the distance between the two origins;
 //! - **probe**: the largest distance of a point of the bone's frame — its origin and one point on each of its axes,
-//!   [`PROBE_FRACTION`] of the rig's size from the origin in A — between where A and B put it (rotation, scale and
-//!   shear errors all show here, in model units);
+//!   [`PROBE_FRACTION`] of the rig's size from the origin, along A's axes and along B's — between where A and B put
+//!   it (rotation, scale and shear errors all show here, in model units);
 //! - **orientation**: the angle between the two polar rotations `R`;
 //! - **scale**: the largest ratio between corresponding stretch factors `K` (sorted, so the frame does not matter);
 //! - **stretch**: the angle between the two stretch frames `U`, ignoring turns that leave `U·K·Uᵀ` the same.
 //!
 //! Meshes are paired by name and vertex count; each pair is skinned on both sides and the vertex distances kept
 //! (largest, and mean over every vertex and time). Every largest value comes with the first time it happens.
+//!
+//! Two files or two sets of modes compare the same whichever is A: the rig's size is the larger of the two sides'
+//! and the probe points lie along both sides' axes, so a tolerance passes or fails whatever the argument order.
 
 mod matching;
 mod report;
@@ -29,6 +32,9 @@ use crate::analysis::Components;
 use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, sample_times};
+
+/// How many times a second two evaluations are compared between their keys, unless a user says otherwise.
+pub const DEFAULT_RATE: f64 = 60.0;
 
 /// How far along each axis the probe points lie, as a fraction of the rig's size.
 pub const PROBE_FRACTION: f64 = 0.1;
@@ -210,17 +216,18 @@ pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
 }
 
 /// Compares `a` and `b` at `times` (sorted), in the units each is measured in: to compare two files, measure `b` in
-/// `a`'s rig's unit first ([`Evaluation::measured_in`]), so that lengths are in A's unit.
+/// `a`'s rig's unit first ([`Evaluation::measured_in`]), so that lengths are in A's unit. The rig's size is the larger
+/// of the two's over `times`, so that swapping the two changes nothing.
 pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
-    compare_at_size(a, b, pairs, times, a.size(times))
+    compare_at_size(a, b, pairs, times, a.size(times).max(b.size(times)))
 }
 
-/// [`compare`], A's size over `times` ([`Evaluation::size`]) already known.
+/// [`compare`] at a rig size already known.
 pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64], rig_size: f64) -> Comparison {
     compare_each(a, &[(b, pairs)], times, rig_size).pop().expect("one comparison per side")
 }
 
-/// `a` compared with each of `sides` (an evaluation and its pairs with `a`) at `times`, A's size there being
+/// `a` compared with each of `sides` (an evaluation and its pairs with `a`) at `times`, the rig's size there being
 /// `rig_size`: [`compare_at_size`] of each, in one pass over time that evaluates, decomposes and skins A once per
 /// time for all of them (one evaluation weighed against many changes of it).
 pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f64], rig_size: f64) -> Vec<Comparison> {
@@ -294,7 +301,8 @@ impl Differences {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
-            difference.probe.add(probe_distance(wa, wb, probe_length), time);
+            let probe = probe_distance(wa, wb, probe_length).max(probe_distance(wb, wa, probe_length));
+            difference.probe.add(probe, time);
             difference.orientation_deg.add(angle_between(pa.rotation, pb.rotation).to_degrees(), time);
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
@@ -319,7 +327,10 @@ struct Side<'e, 'a> {
     /// Sorted, each once.
     bones: Vec<usize>,
     meshes: Vec<usize>,
+    /// The bones' parts, their scale factors the authored ones ([`Evaluation::length_scales`]): a change of units
+    /// moves positions, not scale factors.
     parts: Vec<AffineParts>,
+    length_scales: Vec<f64>,
     skinned: Vec<Vec<DVec3>>,
 }
 
@@ -337,12 +348,16 @@ impl<'e, 'a> Side<'e, 'a> {
         distinct(&mut bones);
         distinct(&mut meshes);
         let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
-        Side { evaluator: evaluation.evaluator(), bones, meshes, parts: Vec::new(), skinned }
+        let length_scales = evaluation.length_scales();
+        Side { evaluator: evaluation.evaluator(), bones, meshes, parts: Vec::new(), length_scales, skinned }
     }
 
     /// Evaluates the side at `time`.
     fn evaluate(&mut self, time: f64) {
         self.parts = decompose_bones(&self.evaluator.evaluate(time).model.model, &self.bones);
+        for &bone in &self.bones {
+            self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
+        }
         for &mesh in &self.meshes {
             self.evaluator.evaluation().skin(&self.evaluator.pose, mesh, &mut self.skinned[mesh]);
         }

@@ -28,7 +28,7 @@ pub struct AnimationDiff {
     pub a: String,
     pub b: String,
     pub samples: usize,
-    /// The size of A's rig, which percentages are of.
+    /// The larger of the two rigs' sizes, which percentages are of.
     pub rig_size: f64,
     /// The largest distance of any bone's probe points or any vertex.
     pub worst: Extreme,

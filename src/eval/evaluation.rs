@@ -96,6 +96,12 @@ impl<'a> Evaluation<'a> {
         self.hierarchy.modes()
     }
 
+    /// Per bone, what its model matrix's scale factors are divided by to be the ones the file's author set: the
+    /// unit conversion above it ([`Skeleton::length_scales`]) and the unit it is measured in.
+    pub fn length_scales(&self) -> Vec<f64> {
+        self.rig.skeleton.length_scales().into_iter().map(|s| s * self.length_scale).collect()
+    }
+
     pub fn layers(&self) -> Option<&LayerStack> {
         self.layers.as_ref()
     }

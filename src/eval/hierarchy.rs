@@ -5,11 +5,16 @@
 //! rotations only (the first pass of a two-pass "don't inherit scale"), and the scale vectors ufbx carries for
 //! componentwise inheritance.
 //! They are computed only where some bone needs them, so an all-`full` rig costs one matrix product per bone.
+//!
+//! Every mode is evaluated in the file's own space: a file's unit and axes conversion and its conversion nodes
+//! ([`Placement`]) are the world to the bones below them, as an armature object's transform is to Blender's bones
+//! and a unit conversion is to Maya's joints, so no mode compensates them. The model matrices are then placed:
+//! `W = C·W_file`, with `C` the conversion above the bone.
 
 use glam::{DMat4, DVec3};
 
 use super::blender;
-use crate::model::{InheritMode, Skeleton, Transform};
+use crate::model::{InheritMode, Placement, Skeleton, Transform};
 
 /// The model-space result of one evaluation.
 #[derive(Clone, Debug, Default)]
@@ -22,6 +27,8 @@ pub struct ModelPose {
     inherit_scale: Vec<DVec3>,
     /// The `inherit_scale` of ufbx's `inherit_scale_node`: what a compensating child multiplies its scale by.
     carried_scale: Vec<DVec3>,
+    /// For conversion nodes: their placed matrix, the conversion the bones below them stand in.
+    conversions: Vec<DMat4>,
 }
 
 /// A skeleton's parent links and modes, prepared once and evaluated for any number of poses.
@@ -33,6 +40,11 @@ pub struct Hierarchy {
     offsets: Vec<Option<(DMat4, DMat4)>>,
     needs_unscaled: Vec<bool>,
     needs_rigid: bool,
+    /// The skeleton's conversion and conversion nodes.
+    placement: Placement,
+    /// Per bone, the conversion node whose placed matrix places it (itself for a conversion node), or `None` for
+    /// the skeleton's conversion; empty where nothing is placed.
+    placed_by: Vec<Option<usize>>,
 }
 
 impl Hierarchy {
@@ -60,7 +72,9 @@ impl Hierarchy {
             }
         }
         let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
-        Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid }
+        let placement = skeleton.placement().clone();
+        let placed_by = if placement.is_identity() { Vec::new() } else { skeleton.placed_by() };
+        Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid, placement, placed_by }
     }
 
     pub fn modes(&self) -> &[InheritMode] {
@@ -73,6 +87,7 @@ impl Hierarchy {
         for (i, bone_local) in local.iter().enumerate() {
             self.evaluate_bone(i, bone_local, out);
         }
+        self.place(0..local.len(), out);
     }
 
     /// Model matrices of `bones` only (in increasing order, with every ancestor of each), for a few bones of a big
@@ -81,6 +96,21 @@ impl Hierarchy {
         self.size(local, out);
         for &i in bones {
             self.evaluate_bone(i, &local[i], out);
+        }
+        self.place(bones.iter().copied(), out);
+    }
+
+    /// `W = C·W_file` for `bones`, evaluated in the file's space, once every bone they hang from is.
+    fn place(&self, bones: impl Iterator<Item = usize>, out: &mut ModelPose) {
+        if self.placed_by.is_empty() {
+            return;
+        }
+        for i in bones {
+            out.model[i] = match self.placed_by[i] {
+                Some(node) if node == i => out.conversions[i],
+                Some(node) => out.conversions[node] * out.model[i],
+                None => self.placement.conversion * out.model[i],
+            };
         }
     }
 
@@ -92,9 +122,23 @@ impl Hierarchy {
         }
         out.inherit_scale.resize(n, DVec3::ONE);
         out.carried_scale.resize(n, DVec3::ONE);
+        if !self.placed_by.is_empty() {
+            out.conversions.resize(n, DMat4::IDENTITY);
+        }
     }
 
     fn evaluate_bone(&self, i: usize, local: &Transform, out: &mut ModelPose) {
+        if self.placement.is_conversion(i) {
+            // Above the rig (every ancestor is a conversion too): to the bones below, the world.
+            let above = self.parents[i].map_or(self.placement.conversion, |p| out.conversions[p]);
+            out.conversions[i] = above * local.matrix();
+            out.model[i] = DMat4::IDENTITY;
+            out.unscaled[i] = DMat4::IDENTITY;
+            out.rigid[i] = DMat4::IDENTITY;
+            out.inherit_scale[i] = DVec3::ONE;
+            out.carried_scale[i] = DVec3::ONE;
+            return;
+        }
         let Some(p) = self.parents[i] else {
             out.model[i] = local.matrix();
             out.unscaled[i] = local.rigid_matrix();

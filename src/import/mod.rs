@@ -20,7 +20,7 @@ use std::fmt;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use crate::model::{Bone, Rig, Skeleton};
+use crate::model::{Bone, Placement, Rig, Skeleton};
 
 pub use fbx::{memory_limit as fbx_memory_limit, ufbx_load_opts as fbx_load_opts};
 
@@ -60,7 +60,18 @@ impl ImportError {
 /// made printable.
 fn finish(path: &Path, rig: Rig) -> Result<Rig, ImportError> {
     magnitude::check(&rig).map_err(|f| f.with_path(path))?;
-    Ok(printable_rig(rig))
+    Ok(with_conversion_nodes(printable_rig(rig)))
+}
+
+/// The rig with its conversion nodes ([`Rig::conversion_nodes`]) placed outside it, beside the file's conversion.
+fn with_conversion_nodes(mut rig: Rig) -> Rig {
+    let conversion_nodes = rig.conversion_nodes();
+    if conversion_nodes.contains(&true) {
+        let conversion = rig.skeleton.placement().conversion;
+        let skeleton = std::mem::take(&mut rig.skeleton);
+        rig.skeleton = skeleton.placed(Placement { conversion, conversion_nodes });
+    }
+    rig
 }
 
 /// The rig with every name and note from the file printable, and names cut to a readable length ([`text::name`]).
@@ -75,7 +86,7 @@ fn printable_rig(mut rig: Rig) -> Rig {
         let bones = rig.skeleton.bones().iter().map(|b| Bone { name: text::name(&b.name), ..b.clone() }).collect();
         // The same bones in the same order: a skeleton already.
         if let Ok(skeleton) = Skeleton::new(bones) {
-            rig.skeleton = skeleton;
+            rig.skeleton = skeleton.placed(rig.skeleton.placement().clone());
         }
     }
     rig.clips.iter_mut().filter_map(|c| c.name.as_mut()).for_each(tidy);

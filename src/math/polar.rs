@@ -60,6 +60,12 @@ impl AffineParts {
         sign: 1.0,
     };
 
+    /// The same with the scale factors over `length_scale`: a model matrix's over the unit conversion above its
+    /// bone are the factors the file's author set.
+    pub fn authored(self, length_scale: f64) -> Self {
+        AffineParts { scale: self.scale / length_scale, ..self }
+    }
+
     /// The matrix these parts describe.
     pub fn matrix(&self) -> DMat4 {
         affine(self.linear(), self.translation)

@@ -16,7 +16,7 @@ pub use clip::{
 pub use inherit::{InheritMode, ModeChoice, UnknownInheritMode, UnknownModeChoice};
 #[cfg(test)]
 pub(crate) use skeleton::named as named_skeleton;
-pub use skeleton::{Bone, NodeRole, ParentOrderError, Skeleton};
+pub use skeleton::{Bone, NodeRole, ParentOrderError, Placement, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
 pub use transform::{Transform, affine};

@@ -71,6 +71,32 @@ pub struct Skeleton {
     bones: Vec<Bone>,
     /// [`Skeleton::figure`], found once: the roles do not change after [`Skeleton::new`].
     figure: Vec<bool>,
+    /// The file's own unit and axes in bonescope's space ([`Skeleton::placement`]).
+    placement: Placement,
+}
+
+/// Where a file's space sits in bonescope's (Y-up metres): the conversion of its unit and axes, above every root,
+/// and the conversion nodes at the top of its hierarchy. Both stand outside the rig: every inheritance mode is
+/// evaluated in the file's own space, where no bone's parent carries them, and the result is then placed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Placement {
+    /// A similarity about the origin (a rotation between axes times a uniform scale between units): identity where
+    /// the file is already in Y-up metres or is read in its own space.
+    pub conversion: glam::DMat4,
+    /// Per bone, whether it is a conversion node ([`crate::model::Rig::conversion_nodes`]); empty for none.
+    pub conversion_nodes: Vec<bool>,
+}
+
+impl Placement {
+    /// Whether every bone is placed as it is.
+    pub fn is_identity(&self) -> bool {
+        self.conversion == glam::DMat4::IDENTITY && !self.conversion_nodes.contains(&true)
+    }
+
+    /// Whether `bone` is a conversion node.
+    pub fn is_conversion(&self, bone: usize) -> bool {
+        self.conversion_nodes.get(bone).copied().unwrap_or(false)
+    }
 }
 
 /// A bone list that is not in parents-first order.
@@ -102,7 +128,49 @@ impl Skeleton {
         }
         let figure: Vec<bool> = bones.iter().map(|b| b.role.is_figure()).collect();
         let figure = if figure.contains(&true) { figure } else { vec![true; figure.len()] };
-        Ok(Skeleton { bones, figure })
+        Ok(Skeleton { bones, figure, placement: Placement::default() })
+    }
+
+    /// The same bones placed by `placement` (its conversion nodes, where given, one flag per bone).
+    pub fn placed(mut self, placement: Placement) -> Self {
+        debug_assert!(placement.conversion_nodes.is_empty() || placement.conversion_nodes.len() == self.len());
+        self.placement = placement;
+        self
+    }
+
+    /// Where the file's space sits in bonescope's.
+    pub fn placement(&self) -> &Placement {
+        &self.placement
+    }
+
+    /// Per bone, the conversion node that places it (itself for a conversion node), or `None` for the skeleton's
+    /// conversion.
+    pub fn placed_by(&self) -> Vec<Option<usize>> {
+        let mut placed_by: Vec<Option<usize>> = Vec::with_capacity(self.len());
+        for (i, bone) in self.bones.iter().enumerate() {
+            let own = self.placement.is_conversion(i).then_some(i);
+            placed_by.push(own.or_else(|| bone.parent.and_then(|p| placed_by[p])));
+        }
+        placed_by
+    }
+
+    /// Per bone, the uniform scale of the conversion above it at rest (1 where none): what its model matrix's scale
+    /// factors are divided by to be the ones the file's author set, in the file's unit.
+    pub fn length_scales(&self) -> Vec<f64> {
+        if self.placement.is_identity() {
+            return vec![1.0; self.len()];
+        }
+        let rest = self.rest_model_matrices();
+        let placed_by = self.placed_by();
+        let uniform_scale = |m: &glam::DMat4| m.determinant().abs().cbrt();
+        let above =
+            |bone: Option<usize>| bone.map_or(uniform_scale(&self.placement.conversion), |b| uniform_scale(&rest[b]));
+        (0..self.len())
+            .map(|i| match placed_by[i] {
+                Some(node) if node == i => above(self.bones[i].parent),
+                node => above(node),
+            })
+            .collect()
     }
 
     pub fn len(&self) -> usize {
@@ -156,12 +224,13 @@ impl Skeleton {
         self.bones.iter().map(|b| b.rest).collect()
     }
 
-    /// Model matrices of the rest pose with plain (full) inheritance.
+    /// Model matrices of the rest pose with plain (full) inheritance, placed (under full inheritance a conversion
+    /// node is an ordinary parent).
     pub fn rest_model_matrices(&self) -> Vec<glam::DMat4> {
         let mut model: Vec<glam::DMat4> = Vec::with_capacity(self.bones.len());
         for bone in &self.bones {
             let local = bone.rest.matrix();
-            model.push(bone.parent.map_or(local, |p| model[p] * local));
+            model.push(bone.parent.map_or(self.placement.conversion * local, |p| model[p] * local));
         }
         model
     }

@@ -9,10 +9,11 @@
 //! - every animation stack becomes a clip sampled by ufbx at every frame and key time ([`anim`]);
 //! - meshes with their skins ([`mesh`]).
 //!
-//! Units and axes: [`Space::YUpMetres`] asks ufbx to convert to right-handed Y-up metres by adjusting the
-//! transforms of the top-level nodes (`UFBX_SPACE_CONVERSION_ADJUST_TRANSFORMS`, which keeps every node's inherit
-//! mode; converting at the root would turn top-level compensating nodes into normal ones). [`Space::File`] leaves
-//! the file's own axes and units.
+//! Units and axes: [`Space::YUpMetres`] asks ufbx for the conversion to right-handed Y-up metres on its root
+//! (`UFBX_SPACE_CONVERSION_TRANSFORM_ROOT`), which becomes the skeleton's placement: every node keeps the
+//! transform the file gives it, so the inheritance modes compensate the scales the file's author set and never
+//! the unit's (adjusting the top-level nodes instead folds the unit into their scale). [`Space::File`] leaves the
+//! file's own axes and units.
 //!
 //! Hostile files: ufbx is fuzzed upstream and never trusts a count; on top of that its allocators get a memory limit
 //! proportional to the file's size ([`memory_limit`]), so an array claiming 2³² values fails instead of allocating.
@@ -124,7 +125,7 @@ pub fn ufbx_load_opts(options: &Options, file_size: usize) -> ufbx::LoadOpts<'st
         // Keep the file's inherit types (also the default) and its geometric transforms.
         inherit_mode_handling: ufbx::InheritModeHandling::Preserve,
         geometry_transform_handling: ufbx::GeometryTransformHandling::Preserve,
-        space_conversion: ufbx::SpaceConversion::AdjustTransforms,
+        space_conversion: ufbx::SpaceConversion::TransformRoot,
         ignore_embedded: true,
         clean_skin_weights: true,
         ..Default::default()
@@ -176,11 +177,11 @@ fn space_note(scene: &ufbx::Scene, space: Space) -> String {
     let unit = file_unit(scene).map_or_else(|| "no unit stated".to_owned(), |u| u.to_string());
     let stated = settings.axes.up != ufbx::CoordinateAxis::Unknown;
     match space {
-        Space::YUpMetres if stated => format!(
-            "units and axes: in the file {up}, {unit}; converted to Y-up metres by ufbx (top-level nodes adjusted)"
-        ),
+        Space::YUpMetres if stated => {
+            format!("units and axes: in the file {up}, {unit}; converted to Y-up metres above the roots")
+        }
         Space::YUpMetres => format!(
-            "units and axes: in the file {up}, {unit}; converted to metres by ufbx (top-level nodes adjusted), axes \
+            "units and axes: in the file {up}, {unit}; converted to metres above the roots, axes \
              left as they are"
         ),
         Space::File => format!("units and axes: the file's own ({up}, {unit}), not converted"),

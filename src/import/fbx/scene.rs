@@ -1,17 +1,17 @@
 //! ufbx's nodes as a parents-first [`Skeleton`].
 //!
-//! Every node below ufbx's synthetic root becomes a bone, depth first, children in file order. The root itself
-//! becomes a bone only when it carries a transform (it does not with the options bonescope loads with, but a bone
-//! list must not silently drop one). The walk uses an explicit stack.
+//! Every node below ufbx's synthetic root becomes a bone, depth first, children in file order. The root carries
+//! ufbx's unit and axes conversion, which becomes the skeleton's [`Placement`]; it becomes a bone itself only when
+//! it carries anything else (a bone list must not silently drop a transform). The walk uses an explicit stack.
 //!
 //! Each node's role comes from its FBX node attribute ([`role`]): limb nodes and the nodes skin clusters bind to are
 //! joints, cameras and lights are what they say, and a null, a marker (HumanIK's effectors) or anything else is a
 //! helper, unless joints hang from it ([`Skeleton::new`]).
 
-use glam::{DQuat, DVec3};
+use glam::{DMat4, DQuat, DVec3};
 
 use super::{Failure, Result, node_name};
-use crate::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
+use crate::model::{Bone, InheritMode, NodeRole, Placement, Skeleton, Transform};
 
 /// The skeleton and the node ↔ bone mapping.
 pub(super) struct SceneBones {
@@ -26,7 +26,9 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
     let mut bone_of_node = vec![None; node_count];
     let mut bones: Vec<Bone> = Vec::new();
     let mut stack: Vec<(&ufbx::Node, Option<usize>)> = Vec::new();
-    if is_identity(&root.local_transform) {
+    // ufbx puts the unit and axes conversion on its root: outside the rig, where no mode can compensate it.
+    let conversion = from_ufbx(&root.local_transform).filter(Transform::only_converts);
+    if conversion.is_some() {
         stack.extend(root.children.iter().rev().map(|c| (c.as_ref(), None)));
     } else {
         stack.push((root, None));
@@ -49,7 +51,7 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
         }
         let bone = bones.len();
         *slot = Some(bone);
-        let inherit = inherit_mode(node.inherit_mode);
+        let inherit = declared_mode(node);
         counts[match inherit {
             InheritMode::SegmentCompensate => 1,
             InheritMode::Componentwise => 2,
@@ -69,6 +71,8 @@ pub(super) fn read(scene: &ufbx::Scene, notes: &mut Vec<String>) -> Result<Scene
         notes.push(format!("{unreached} nodes outside the root's hierarchy are not bones"));
     }
     let skeleton = Skeleton::new(bones).map_err(|e| Failure::whole(e.to_string()))?;
+    let conversion = conversion.map_or(DMat4::IDENTITY, |c| c.matrix());
+    let skeleton = skeleton.placed(Placement { conversion, conversion_nodes: Vec::new() });
     Ok(SceneBones { skeleton, bone_of_node })
 }
 
@@ -82,6 +86,18 @@ fn role(node: &ufbx::Node) -> NodeRole {
         }
         ufbx::ElementType::Light => NodeRole::Light,
         _ => NodeRole::Helper,
+    }
+}
+
+/// The node's InheritType as the file declares it. ufbx reads it into `inherit_mode`, but makes a top-level node's
+/// normal where it converts at the root; that mode changes nothing (a root's model matrix is its local one in every
+/// mode) but is what the file says, so it is read from the property there.
+fn declared_mode(node: &ufbx::Node) -> InheritMode {
+    let top_level = node.parent.as_ref().is_some_and(|p| p.is_root);
+    match node.element.props.find_prop("InheritType").map(|p| p.value_int) {
+        Some(0) if top_level => InheritMode::Componentwise,
+        Some(2) if top_level => InheritMode::SegmentCompensate,
+        _ => inherit_mode(node.inherit_mode),
     }
 }
 
@@ -105,8 +121,4 @@ pub(super) fn from_ufbx(t: &ufbx::Transform) -> Option<Transform> {
 
 fn transform(node: &ufbx::Node) -> Result<Transform> {
     from_ufbx(&node.local_transform).ok_or_else(|| Failure::at(node_name(node), "transform is not finite"))
-}
-
-fn is_identity(t: &ufbx::Transform) -> bool {
-    from_ufbx(t).is_some_and(|t| t == Transform::IDENTITY)
 }
