@@ -30,6 +30,9 @@ const DEMO: &str = "demo";
 /// Exact: 1e-6 of the rig's size.
 const EXACT: f64 = 1e-6;
 
+/// A diff rate that visits the frames and their midpoints at 24, 30, 60 and 120 fps (and 25 times between).
+const DENSE_RATE: f64 = 1200.0;
+
 /// `None` is each bone's declared mode.
 fn modes() -> Vec<Option<InheritMode>> {
     std::iter::once(None).chain(InheritMode::ALL.into_iter().map(Some)).collect()
@@ -300,7 +303,7 @@ fn diff_worst(args: &[&str]) -> f64 {
 }
 
 #[test]
-fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
+fn trs_reports_a_bound_of_what_diff_measures_and_never_more_than_the_local_trs() {
     let folder = tempfile::tempdir().unwrap();
     let cases = [
         ("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", None),
@@ -315,15 +318,31 @@ fn trs_reports_what_diff_measures_and_never_more_than_the_local_trs() {
         bake::save(&baked, &b.baked.glb).unwrap();
         let report = bake::report(&request(source, mode, Strategy::Trs, 0.0), &b.baked, &b.rig);
         let reported = report.worst().max;
-        // Every sample is a key, so diff at the clip's own rate visits exactly the sampled times.
-        let rate = RIGS[source].clips[0].frame_rate().to_string();
+        // Every sample is a key at the clip's frames (and its keys); the report checks them, the midpoints between
+        // and diff's own times, so diff at the clip's rate, at twice it (the midpoints) and at its default rate
+        // finds no more, and a dense diff finds within 1% as much (the report is a bound, not a guess).
+        let frame_rate = RIGS[source].clips[0].frame_rate();
         let (path, inherit) = (asset(source).display().to_string(), label(mode));
-        let measured = diff_worst(&[&path, &baked.display().to_string(), "--inherit-a", inherit, "--rate", &rate]);
+        // The report takes the worse of the engines' two ways to play rotation keys, slerp and nlerp.
+        let measured = |rate: f64| {
+            let (rate, baked) = (rate.to_string(), baked.display().to_string());
+            let played = |interp: &str| {
+                diff_worst(&[&path, &baked, "--inherit-a", inherit, "--rate", &rate, "--interp", interp])
+            };
+            played("slerp").max(played("nlerp"))
+        };
+        let slack = EXACT * b.baked.rig_size;
+        for rate in [frame_rate, 2.0 * frame_rate, bonescope::diff::DEFAULT_RATE] {
+            let found = measured(rate);
+            assert!(found <= reported + slack, "{source} ({inherit}): reported {reported}, diff at {rate} Hz {found}");
+        }
+        let dense = measured(DENSE_RATE);
         assert!(
-            (reported - measured).abs() <= EXACT * b.baked.rig_size,
-            "{source} ({inherit}): {reported} vs {measured}"
+            reported <= 1.01 * dense + slack,
+            "{source} ({inherit}): reported {reported}, diff at {DENSE_RATE} Hz {dense}"
         );
         // Keeping each bone's own local TRS is the source evaluated with glTF's full inheritance.
+        let rate = (2.0 * frame_rate).to_string();
         let local_trs = diff_worst(&[&path, &path, "--inherit-a", inherit, "--inherit-b", "full", "--rate", &rate]);
         assert!(reported <= local_trs + EXACT * b.baked.rig_size, "{source} ({inherit}): {reported} > {local_trs}");
     }
@@ -402,7 +421,7 @@ fn each_engine_plays_its_bake_within_the_tolerance_as_it_interpolates() {
 }
 
 #[test]
-fn unreal_gets_one_trs_node_per_bone_and_its_report_is_what_diff_measures_under_nlerp() {
+fn unreal_gets_one_trs_node_per_bone_and_its_report_bounds_what_diff_measures_under_nlerp() {
     // Maya's file with every bone under an unscaled parent, which shears; every sample a key (tolerance 0), so
     // diff at the clip's own rate visits exactly the sampled times.
     let source = "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx";
@@ -415,10 +434,18 @@ fn unreal_gets_one_trs_node_per_bone_and_its_report_is_what_diff_measures_under_
     assert!(bones.iter().all(|b| b["nodes"] == "trs"), "one TRS node per bone");
     assert!(report["helpers"].as_array().unwrap().is_empty());
     let reported = report["animations"][0]["worst"]["max"].as_f64().unwrap();
-    let rate = RIGS[source].clips[0].frame_rate().to_string();
     let (path, baked) = (asset(source).display().to_string(), out.display().to_string());
-    let measured = diff_worst(&[&path, &baked, "--inherit-a", inherit, "--interp", "nlerp", "--rate", &rate]);
+    let measured = |rate: f64| {
+        diff_worst(&[&path, &baked, "--inherit-a", inherit, "--interp", "nlerp", "--rate", &rate.to_string()])
+    };
+    // The report checks every key and the midpoints between: diff at the clip's rate and at twice it finds no
+    // more, a dense diff within 1% as much.
+    let frame_rate = RIGS[source].clips[0].frame_rate();
     let size = report["rig_size"].as_f64().unwrap();
-    assert!((reported - measured).abs() <= EXACT * size, "{reported} vs {measured}");
+    assert!(measured(frame_rate) <= reported + EXACT * size, "{reported} vs {}", measured(frame_rate));
+    let at_midpoints = measured(2.0 * frame_rate);
+    assert!(at_midpoints <= reported + EXACT * size, "{reported} vs {at_midpoints}");
+    let dense = measured(DENSE_RATE);
+    assert!(reported <= 1.01 * dense + EXACT * size, "{reported} vs {dense} at {DENSE_RATE} Hz");
     assert!(reported > bake::DEFAULT_TOLERANCE * size, "the shear is beyond a TRS: {reported:e}");
 }

@@ -253,10 +253,9 @@ fn a_blender_fbx_export_pairs_with_its_gltf_take_by_take_conversion_nodes_aside(
 
 #[test]
 fn a_bvh_is_compared_in_the_unit_it_is_given() {
-    // ProAnimationBank's run is in centimetres, converted to metres on import as a scale of 0.01 above the roots;
-    // every bone's frame carries it. The CMU walk states no unit: taken as it is, each bone's scale is 100× the
-    // run's; given centimetres, the two agree (to the FBX's single precision); given CMU's own 1/0.45 inch, they
-    // differ by the ratio of the units, 2.54 / 0.45.
+    // ProAnimationBank's run is in centimetres, converted to metres above the roots; the CMU walk states no unit. A
+    // unit moves positions, never scale factors: every bone's scale ratio is 1 whatever unit the walk is given (both
+    // rigs' authored scales are 1), while the walk's size follows its unit (CMU's 1/0.45 inch is 2.54 / 0.45 cm).
     let (run, walk) = (path(&asset("fbx-proanimationbank/run.fbx")), path(&asset("bvh/cmu_12_01_walk.bvh")));
     let diff = |unit: &[&str]| {
         let args = [&["diff", run.as_str(), walk.as_str(), "--anim-a", "0", "--anim-b", "0", "--format", "json"], unit]
@@ -269,17 +268,16 @@ fn a_bvh_is_compared_in_the_unit_it_is_given() {
     };
     let as_written = diff(&[]);
     assert_eq!(as_written["unit_b"], Value::Null);
-    assert!(
-        scale_ratios(&as_written).iter().all(|r| (r / 100.0 - 1.0).abs() < 1e-5),
-        "{:?}",
-        scale_ratios(&as_written)
-    );
     let centimetres = diff(&["--unit-b", "cm"]);
     assert_eq!((centimetres["unit_a"].as_f64(), centimetres["unit_b"].as_f64()), (Some(1.0), Some(0.01)));
-    let ratios = scale_ratios(&centimetres);
-    assert!(ratios.len() >= 20 && ratios.iter().all(|r| (r - 1.0).abs() < 1e-5), "{ratios:?}");
     let cmu = diff(&["--unit-b", "cmu"]);
-    assert!(scale_ratios(&cmu).iter().all(|r| (r / (2.54 / 0.45) - 1.0).abs() < 1e-5), "{:?}", scale_ratios(&cmu));
+    for report in [&as_written, &centimetres, &cmu] {
+        let ratios = scale_ratios(report);
+        assert!(ratios.len() >= 20 && ratios.iter().all(|r| (r - 1.0).abs() < 1e-5), "{ratios:?}");
+    }
+    // The larger rig's size: the walk taken in metres is some 40 m tall; in centimetres both are human-sized.
+    let rig_size = |report: &Value| report["animations"][0]["rig_size"].as_f64().unwrap();
+    assert!(rig_size(&as_written) > 20.0 && (1.5..3.0).contains(&rig_size(&centimetres)), "{}", rig_size(&as_written));
     // The table states the unit given and the scale B's lengths took.
     let table = bonescope(&["diff", &run, &walk, "--anim-a", "0", "--anim-b", "0", "--unit-b", "cmu"]);
     let text = String::from_utf8_lossy(&table.stdout);

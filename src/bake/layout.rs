@@ -2,12 +2,13 @@
 //! its stretch rotation, one node for any other; where meshes hang (on their bone's node, primitives of one glTF mesh
 //! where they can share it); and the document's nodes, meshes and skins with the rest pose as default TRS.
 
-use glam::DQuat;
+use glam::{DMat4, DQuat};
 
 use super::document::{GltfDocument, MeshGroup, Node};
 use super::nodes::{NodeSample, Sampled};
-use super::skins::skins;
+use super::skins::{skins, unique_name};
 use crate::diff::HELPER_SUFFIX;
+use crate::math::decompose;
 use crate::model::{Mesh, Rig};
 
 /// Which glTF node each bone and helper becomes, and which meshes hang where.
@@ -101,9 +102,27 @@ impl Layout {
         for node in &mut document.nodes {
             node.skin = node.mesh.and_then(|m| document.meshes[m].primitives[0].skin);
         }
+        conversion(rig, &mut document);
         skins(rig, &self.bone_node, &mut document, notes);
         document
     }
+}
+
+/// Where the source's space is converted (an FBX file in centimetres, or Z-up), a top node `conversion` carrying it,
+/// the roots below it: the baked bones keep the file's own numbers, and a reader that places conversion nodes
+/// outside the rig, as bonescope does, reads the scale factors the file's author set.
+fn conversion(rig: &Rig, document: &mut GltfDocument) {
+    let conversion = rig.skeleton.placement().conversion;
+    if conversion == DMat4::IDENTITY {
+        return;
+    }
+    let node = document.nodes.len();
+    for root in document.nodes.iter_mut().filter(|n| n.parent.is_none()) {
+        root.parent = Some(node);
+    }
+    let parts = decompose(&conversion);
+    let sample = NodeSample { rotation: parts.rotation, scale: parts.scale * parts.sign, ..NodeSample::IDENTITY };
+    document.nodes.push(node_with(&unique_name(&document.nodes, "conversion"), None, &sample));
 }
 
 /// A node named `name` with the TRS of `sample` (its stretch is carried by the bone's own node, not here).

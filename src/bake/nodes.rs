@@ -1,7 +1,8 @@
 //! What each bone's glTF nodes hold at each sampled time.
 //!
 //! A bone's baked local matrix is `L = W'_parent⁻¹ · W_bone`: what it needs under its already-baked parent so that
-//! plain glTF composition (full inheritance) gives back the source's model matrix `W_bone`. Its polar decomposition
+//! plain glTF composition (full inheritance) gives back the source's model matrix `W_bone` (a root's parent is the
+//! source's unit and axes conversion, which the baked file carries on a node of its own). Its polar decomposition
 //! `L = T·F·R·U·K·Uᵀ` becomes a [`NodeSample`] `T · Q · S · Vᵀ`:
 //! - [`Strategy::Exact`]: `Q = R·U`, `S = F·K`, `V = U`. A bone that ever needs `U` (a stretched local matrix) gets a
 //!   helper node carrying `T, Q, S` above itself, and carries `Vᵀ = Uᵀ` (a rotation) itself: exact, since
@@ -197,6 +198,10 @@ pub struct NodeSolver<'e, 'a> {
     source: Evaluator<'e, 'a>,
     strategy: Strategy,
     parents: Vec<Option<usize>>,
+    /// The source's unit and axes conversion and its inverse: the baked roots hang from a node that carries it
+    /// ([`super::layout`]), as the source's roots stand in it.
+    conversion: DMat4,
+    conversion_inverse: DMat4,
     /// `W'`: the model matrices the baked nodes give.
     baked: Vec<DMat4>,
     /// The previous time's stretch of each bone, where the search for this time's starts.
@@ -214,6 +219,8 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
             source: source.evaluator(),
             strategy,
             parents,
+            conversion: source.skeleton().placement().conversion,
+            conversion_inverse: source.skeleton().placement().conversion.inverse(),
             baked: vec![DMat4::IDENTITY; bones],
             previous: vec![DQuat::IDENTITY; bones],
             row: vec![NodeSample::IDENTITY; bones],
@@ -236,7 +243,7 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
         let pose = &self.source.pose;
         let source = pose.model.model[bone];
         let local = match parent {
-            None => source,
+            None => self.conversion_inverse * source,
             Some(p) => match affine_inverse(&self.baked[p]) {
                 Some(inverse) => inverse * source,
                 None => {
@@ -257,7 +264,8 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
             }
             Strategy::Trs => {
                 let sample = NodeSample::trs(&parts);
-                self.baked[bone] = parent.map_or(DMat4::IDENTITY, |p| self.baked[p]) * sample.matrix();
+                let above = parent.map_or(self.conversion, |p| self.baked[p]);
+                self.baked[bone] = above * sample.matrix();
                 sample
             }
         }

@@ -69,7 +69,7 @@ fn root_of(nodes: &[Node], mut node: usize) -> usize {
 }
 
 /// `base`, or `base.1`, `base.2`, … whichever no node is called yet.
-fn unique_name(nodes: &[Node], base: &str) -> String {
+pub(super) fn unique_name(nodes: &[Node], base: &str) -> String {
     let taken = |name: &str| nodes.iter().any(|n| n.name == name);
     if !taken(base) {
         return base.to_owned();

@@ -149,6 +149,22 @@ pub struct Pairs {
 }
 
 impl Pairs {
+    /// The size a comparison is measured against: the larger of the two sides' sizes ([`Evaluation::size_of`]) over
+    /// what both sides show, the paired bones that are of the figure in both and the paired meshes. Swapping A and
+    /// B changes nothing, and what one side shows and the other lacks (a camera a bake wrote as a plain node) does
+    /// not count.
+    pub fn size(&self, a: &Evaluation, b: &Evaluation, times: &[f64]) -> f64 {
+        let (figure_a, figure_b) = (a.skeleton().character(), b.skeleton().character());
+        let (mut shown_a, mut shown_b) = (vec![false; figure_a.len()], vec![false; figure_b.len()]);
+        for &(i, j) in &self.bones.pairs {
+            let shown = figure_a[i] && figure_b[j];
+            shown_a[i] = shown;
+            shown_b[j] = shown;
+        }
+        let (meshes_a, meshes_b): (Vec<usize>, Vec<usize>) = self.meshes.iter().copied().unzip();
+        a.size_of(times, &shown_a, &meshes_a).max(b.size_of(times, &shown_b, &meshes_b))
+    }
+
     /// Bones by name and meshes by name and vertex count.
     pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
         let bones = match_bones(a.rig, b.rig);
@@ -217,9 +233,9 @@ pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
 
 /// Compares `a` and `b` at `times` (sorted), in the units each is measured in: to compare two files, measure `b` in
 /// `a`'s rig's unit first ([`Evaluation::measured_in`]), so that lengths are in A's unit. The rig's size is the larger
-/// of the two's over `times`, so that swapping the two changes nothing.
+/// of the two's over `times` ([`Pairs::size`]), so that swapping the two changes nothing.
 pub fn compare(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f64]) -> Comparison {
-    compare_at_size(a, b, pairs, times, a.size(times).max(b.size(times)))
+    compare_at_size(a, b, pairs, times, pairs.size(a, b, times))
 }
 
 /// [`compare`] at a rig size already known.

@@ -172,17 +172,30 @@ impl<'a> Evaluation<'a> {
     }
 
     /// The size differences and tolerances are measured against: the largest bounding-box diagonal of the
-    /// character over `times` (the origins of the figure's bones, [`Skeleton::figure`], at each time, with every
-    /// skinned mesh at the first time); 1 when that is zero (a single bone), so relative figures stay meaningful.
+    /// character over `times` (the origins of its bones, [`Skeleton::character`], at each time, with every skinned
+    /// mesh at the first time); 1 when that is zero (a single bone), so relative figures stay meaningful.
     pub fn size(&self, times: &[f64]) -> f64 {
-        let character = self.rig.skeleton.figure();
+        let meshes: Vec<usize> = (0..self.rig.meshes.len()).collect();
+        self.size_of(times, &self.rig.skeleton.character(), &meshes)
+    }
+
+    /// [`Evaluation::size`] of some of the character: the bones flagged in `bones` and the meshes `meshes`.
+    pub fn size_of(&self, times: &[f64], bones: &[bool], meshes: &[usize]) -> f64 {
         let mut evaluator = self.evaluator();
+        let mut vertices = Vec::new();
         let mut size: f64 = 0.0;
         for (i, &time) in times.iter().enumerate() {
             let pose = evaluator.evaluate(time);
-            let origins = pose.model.model.iter().zip(character).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
-            let vertices = if i == 0 { self.skin_all(pose).concat() } else { Vec::new() };
-            size = size.max(diagonal(origins.chain(vertices)));
+            let origins = pose.model.model.iter().zip(bones).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
+            vertices.clear();
+            if i == 0 {
+                for &mesh in meshes {
+                    let mut skinned = Vec::new();
+                    self.skin(pose, mesh, &mut skinned);
+                    vertices.extend(skinned);
+                }
+            }
+            size = size.max(diagonal(origins.chain(vertices.iter().copied())));
         }
         if size > 0.0 && size.is_finite() { size } else { 1.0 }
     }

@@ -219,6 +219,12 @@ impl Skeleton {
         &self.figure
     }
 
+    /// Per bone, whether it is of the character: of the figure and not a conversion node (which stands outside the
+    /// rig, however many bones hang from it).
+    pub fn character(&self) -> Vec<bool> {
+        self.figure.iter().enumerate().map(|(i, &figure)| figure && !self.placement.is_conversion(i)).collect()
+    }
+
     /// The rest pose, one local transform per bone.
     pub fn rest_pose(&self) -> Vec<Transform> {
         self.bones.iter().map(|b| b.rest).collect()

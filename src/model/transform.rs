@@ -1,5 +1,6 @@
 //! A bone's local transform: translation, rotation, scale, and the rare stretch rotation of a sheared rest matrix.
 
+use super::Unit;
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 /// How far from an axis, relative to its length, a converted axis may point: exporters write quarter turns in
@@ -53,7 +54,8 @@ impl Transform {
     }
 
     /// Whether the transform only changes axis conventions and units: no translation, and a linear part that maps
-    /// each axis onto ± another, all scaled alike (quarter turns, mirrors, a uniform scale), to within `CONVERTS` of its length.
+    /// each axis onto ± another, all scaled alike by a ratio of units ([`Unit::is_ratio`]: quarter turns, mirrors,
+    /// 0.01 or 100, not an authored 0.03), to within `CONVERTS` of its length.
     pub fn only_converts(&self) -> bool {
         let linear = DMat3::from_quat(self.rotation) * self.scale_matrix();
         let scale = linear.x_axis.length();
@@ -65,7 +67,7 @@ impl Transform {
             let off_axis = (column - DVec3::AXES[axis] * column[axis]).length();
             fresh && (column[axis].abs() - scale).abs() <= tolerance && off_axis <= tolerance
         });
-        scale > 0.0 && scale.is_finite() && self.translation.length() <= tolerance && onto_axes
+        Unit::is_ratio(scale) && self.translation.length() <= tolerance && onto_axes
     }
 
     /// The full local matrix `T·R·U·S·Uᵀ`.

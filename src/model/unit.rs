@@ -25,6 +25,9 @@ const NAMED: [(&str, &str, f64); 6] = [
 /// How close two lengths in metres must be for a unit to take a name (a file's single-precision factor included).
 const SAME_LENGTH: f64 = 1e-6;
 
+/// How close a scale must be to a ratio of units to be one: a few single-precision roundings.
+const RATIO_PRECISION: f64 = 1e-6;
+
 impl Unit {
     pub const METRE: Unit = Unit { metres: 1.0 };
 
@@ -56,6 +59,13 @@ impl Unit {
     /// How many `other`s one of this unit is: what a length in this unit is multiplied by to be in `other`.
     pub fn per(self, other: Unit) -> f64 {
         self.metres / other.metres
+    }
+
+    /// Whether `factor` turns lengths in one named unit into another (1, 100, 0.01, 2.54, …): a scale whose only job
+    /// is a change of units, to single precision.
+    pub fn is_ratio(factor: f64) -> bool {
+        let named = || NAMED.into_iter().map(|(_, _, metres)| metres);
+        named().any(|from| named().any(|to| (factor * to / from - 1.0).abs() < RATIO_PRECISION))
     }
 
     /// The units people name (`m`, `cm`, …), for pickers.
@@ -129,6 +139,16 @@ mod tests {
             assert!(bad.parse::<Unit>().is_err(), "{bad}");
         }
         assert_eq!(Unit::metres(f64::NAN), None);
+    }
+
+    #[test]
+    fn ratios_of_units_are_told_from_other_scales() {
+        for ratio in [1.0, 100.0, 0.01, 1000.0, 0.001, 10.0, 2.54, 1.0 / 0.0254, 12.0, f64::from(0.01f32)] {
+            assert!(Unit::is_ratio(ratio), "{ratio}");
+        }
+        for scale in [0.03, 2.0, 0.5, 0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(!Unit::is_ratio(scale), "{scale}");
+        }
     }
 
     #[test]
