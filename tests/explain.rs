@@ -11,7 +11,7 @@ mod common;
 mod generated_gltf;
 
 use bonescope::analysis::{ClipScan, ScanOptions, scan};
-use bonescope::diff::{Pairs, compare, comparison_times};
+use bonescope::diff::{Pairs, compare_at_size, comparison_times};
 use bonescope::eval::{Evaluation, LayerStack, Layers};
 use bonescope::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use bonescope::model::{InheritMode, Rig};
@@ -20,7 +20,9 @@ use common::{asset, bonescope, json, load_asset};
 /// The rule a fix's cost follows, applied to `diff`'s own comparison of `a` with `b`: the largest vertex distance
 /// of any mesh, and the largest probe distance of any bone of the figure that no mesh shows.
 fn visible_distance(a: &Evaluation, b: &Evaluation, rate: f64) -> (f64, bool) {
-    let comparison = compare(a, b, &Pairs::by_name(a, b), &comparison_times(a, b, rate));
+    // Costs are measured against the rig as it is (the source's size sets the probe points' reach).
+    let times = comparison_times(a, b, rate);
+    let comparison = compare_at_size(a, b, &Pairs::by_name(a, b), &times, a.size(&times));
     let (shown, figure) = (a.rig.shown_by_meshes(), a.rig.skeleton.figure());
     let skin = comparison.meshes.iter().map(|m| m.distance.max).fold(0.0, f64::max);
     let unseen = comparison.bones.iter().filter(|d| figure[d.a] && !shown[d.a]).map(|d| d.probe.max);

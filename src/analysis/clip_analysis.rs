@@ -4,7 +4,7 @@
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
-use super::findings::{Verdict, shear_cosine};
+use super::findings::{Tolerances, Verdict, shear_cosine};
 use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg_of_cosine};
 
 /// One bone over a whole clip. Times are in seconds.
@@ -144,14 +144,16 @@ impl Components {
         Components::of_parts(&decompose_near(m, start), m)
     }
 
-    /// The components of `m` decomposed into `parts`.
+    /// The components of `m` decomposed into `parts`; the stretch frame is the one the findings judge (factors
+    /// within the default anisotropy tolerance count as equal: [`AffineParts::stretch_within`]), so a plotted
+    /// stretch angle is the scan's and the Inspector's.
     pub(super) fn of_parts(parts: &AffineParts, m: &DMat4) -> Self {
         let shear_deg = shear_deg_of_cosine(shear_cosine(parts, m));
         Components {
             translation: parts.translation.as_vec3(),
             rotation: parts.rotation.as_quat(),
             scale: parts.scale.as_vec3(),
-            stretch: parts.stretch.as_quat(),
+            stretch: parts.stretch_within(Tolerances::default().min_anisotropy).as_quat(),
             sign: parts.sign as f32,
             shear_deg: shear_deg as f32,
         }

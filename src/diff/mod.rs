@@ -28,7 +28,7 @@ pub use report::{AnimationDiff, FileDiff, FileSide, diff_files};
 
 use glam::{DMat4, DQuat, DVec3};
 
-use crate::analysis::Components;
+use crate::analysis::{Components, Tolerances};
 use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, sample_times};
@@ -38,10 +38,6 @@ pub const DEFAULT_RATE: f64 = 60.0;
 
 /// How far along each axis the probe points lie, as a fraction of the rig's size.
 pub const PROBE_FRACTION: f64 = 0.1;
-
-/// Stretch factors within this fraction of each other count as equal when stretch frames are compared (the frame
-/// of equal factors is free, so its turn is no difference).
-const EQUAL_FACTORS: f64 = 1e-4;
 
 /// The largest value of a quantity over time, and the first time it happens.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -453,7 +449,8 @@ fn stretch_difference_deg(a: &AffineParts, b: &AffineParts) -> f64 {
         return angle_between(DQuat::IDENTITY, relative).to_degrees();
     }
     let seen_from = |relative: DQuat, parts: &AffineParts| {
-        AffineParts { stretch: relative, ..*parts }.stretch_angle_deg_within(EQUAL_FACTORS)
+        // Factors the findings count as equal leave the frame free between them, so its turn is no difference.
+        AffineParts { stretch: relative, ..*parts }.stretch_angle_deg_within(Tolerances::default().min_anisotropy)
     };
     seen_from(relative, b).max(seen_from(relative.conjugate(), a))
 }

@@ -68,9 +68,10 @@ pub fn bind_model_matrices(rig: &Rig) -> Vec<DMat4> {
             }
         }
     }
+    let placement = rig.skeleton.placement().conversion;
     let mut model: Vec<DMat4> = Vec::with_capacity(bones.len());
     for (bone, bound) in bones.iter().zip(bound) {
-        let below_parent = || bone.parent.map_or(DMat4::IDENTITY, |p| model[p]) * bone.rest.matrix();
+        let below_parent = || bone.parent.map_or(placement, |p| model[p]) * bone.rest.matrix();
         model.push(bound.unwrap_or_else(below_parent));
     }
     model
@@ -80,12 +81,14 @@ pub fn bind_model_matrices(rig: &Rig) -> Vec<DMat4> {
 /// in the stretch rotation, a mirror in the scale's sign). The rest pose for a rig without skins.
 pub fn bind_pose(rig: &Rig) -> Vec<Transform> {
     let model = bind_model_matrices(rig);
+    // A root's bind matrix stands in the file's unit and axes conversion, as its rest does.
+    let placement_inverse = rig.skeleton.placement().conversion.inverse();
     rig.skeleton
         .bones()
         .iter()
         .zip(&model)
         .map(|(bone, m)| match bone.parent {
-            None => decompose(m).transform(),
+            None => decompose(&(placement_inverse * *m)).transform(),
             Some(p) => match invert(&model[p]) {
                 Some(parent_inverse) => decompose(&(parent_inverse * *m)).transform(),
                 None => bone.rest,

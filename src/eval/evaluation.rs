@@ -26,7 +26,7 @@ pub struct Evaluation<'a> {
 impl<'a> Evaluation<'a> {
     /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says.
     pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Self {
-        let hierarchy = Hierarchy::new(&rig.skeleton, modes);
+        let hierarchy = Hierarchy::of_rig(rig, modes);
         Evaluation { rig, clip, hierarchy, layers: None, skinning: SkinningMethod::AsFile, length_scale: 1.0 }
     }
 
@@ -68,7 +68,7 @@ impl<'a> Evaluation<'a> {
 
     /// The same clip through the same layers under other modes (a ghost: "what if every bone were …").
     pub fn with_modes(&self, modes: &[InheritMode]) -> Self {
-        Evaluation { hierarchy: Hierarchy::new(&self.rig.skeleton, modes), ..self.clone() }
+        Evaluation { hierarchy: Hierarchy::of_rig(self.rig, modes), ..self.clone() }
     }
 
     /// The same clip, without layers, its linear rotation tracks interpolated by `rotation`: as a runtime that

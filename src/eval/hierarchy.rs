@@ -14,7 +14,7 @@
 use glam::{DMat4, DVec3};
 
 use super::blender;
-use crate::model::{InheritMode, Placement, Skeleton, Transform};
+use crate::model::{InheritMode, Placement, Rig, Skeleton, Transform};
 
 /// The model-space result of one evaluation.
 #[derive(Clone, Debug, Default)]
@@ -27,8 +27,10 @@ pub struct ModelPose {
     inherit_scale: Vec<DVec3>,
     /// The `inherit_scale` of ufbx's `inherit_scale_node`: what a compensating child multiplies its scale by.
     carried_scale: Vec<DVec3>,
-    /// For conversion nodes: their placed matrix, the conversion the bones below them stand in.
+    /// For conversion nodes: their placed matrix, the conversion the bones below them stand in, and whether it is
+    /// the identity (an exporter's `Armature` at rest: nothing to place).
     conversions: Vec<DMat4>,
+    identity_conversions: Vec<bool>,
 }
 
 /// A skeleton's parent links and modes, prepared once and evaluated for any number of poses.
@@ -48,17 +50,33 @@ pub struct Hierarchy {
 }
 
 impl Hierarchy {
-    /// `modes` holds one mode per bone.
+    /// `modes` holds one mode per bone; the Blender modes' bone offsets are the rest pose's.
     pub fn new(skeleton: &Skeleton, modes: &[InheritMode]) -> Self {
+        Hierarchy::with_bone_rest(skeleton, modes, &skeleton.rest_pose())
+    }
+
+    /// The hierarchy of `rig` under `modes`: the Blender modes' bone offsets are the bind pose, which is what
+    /// Blender's bones rest in (an FBX file's nodes may hold another pose by default).
+    pub fn of_rig(rig: &Rig, modes: &[InheritMode]) -> Self {
+        if modes.iter().any(|m| m.is_blender()) {
+            Hierarchy::with_bone_rest(&rig.skeleton, modes, &super::bind_pose(rig))
+        } else {
+            Hierarchy::new(&rig.skeleton, modes)
+        }
+    }
+
+    /// `modes` holds one mode per bone, `bone_rest` the local transform each bone rests in for the Blender modes
+    /// (their bone offset `O`: its translation and rotation).
+    pub fn with_bone_rest(skeleton: &Skeleton, modes: &[InheritMode], bone_rest: &[Transform]) -> Self {
         assert_eq!(modes.len(), skeleton.len(), "one inheritance mode per bone");
+        assert_eq!(bone_rest.len(), skeleton.len(), "one rest transform per bone");
         let parents: Vec<Option<usize>> = skeleton.bones().iter().map(|b| b.parent).collect();
-        let offsets = skeleton
-            .bones()
+        let offsets = bone_rest
             .iter()
             .zip(modes)
-            .map(|(bone, mode)| {
+            .map(|(rest, mode)| {
                 mode.is_blender().then(|| {
-                    let offset = bone.rest.rigid_matrix();
+                    let offset = rest.rigid_matrix();
                     (offset, offset.inverse())
                 })
             })
@@ -106,11 +124,13 @@ impl Hierarchy {
             return;
         }
         for i in bones {
-            out.model[i] = match self.placed_by[i] {
-                Some(node) if node == i => out.conversions[i],
-                Some(node) => out.conversions[node] * out.model[i],
-                None => self.placement.conversion * out.model[i],
-            };
+            match self.placed_by[i] {
+                Some(node) if node == i => out.model[i] = out.conversions[i],
+                Some(node) if out.identity_conversions[node] => {}
+                Some(node) => out.model[i] = out.conversions[node] * out.model[i],
+                None if self.placement.conversion == DMat4::IDENTITY => {}
+                None => out.model[i] = self.placement.conversion * out.model[i],
+            }
         }
     }
 
@@ -124,6 +144,7 @@ impl Hierarchy {
         out.carried_scale.resize(n, DVec3::ONE);
         if !self.placed_by.is_empty() {
             out.conversions.resize(n, DMat4::IDENTITY);
+            out.identity_conversions.resize(n, true);
         }
     }
 
@@ -132,6 +153,7 @@ impl Hierarchy {
             // Above the rig (every ancestor is a conversion too): to the bones below, the world.
             let above = self.parents[i].map_or(self.placement.conversion, |p| out.conversions[p]);
             out.conversions[i] = above * local.matrix();
+            out.identity_conversions[i] = out.conversions[i] == DMat4::IDENTITY;
             out.model[i] = DMat4::IDENTITY;
             out.unscaled[i] = DMat4::IDENTITY;
             out.rigid[i] = DMat4::IDENTITY;

@@ -105,6 +105,12 @@ impl AffineParts {
         angle_of_half_cosine(stretch_half_cosine_within(self.stretch, self.scale, relative_tolerance))
     }
 
+    /// The stretch rotation once scale factors within `relative_tolerance` of each other count as equal: the frame
+    /// whose angle is [`AffineParts::stretch_angle_deg_within`] (what plots show, beside the findings).
+    pub fn stretch_within(&self, relative_tolerance: f64) -> DQuat {
+        canonical_stretch(self.stretch, self.scale, relative_tolerance).0
+    }
+
     /// How unequal the stretch factors are: `max/min − 1` (0 for uniform scale, infinite when one is 0).
     pub fn anisotropy(&self) -> f64 {
         let (min, max) = (self.scale.min_element(), self.scale.max_element());

@@ -83,22 +83,32 @@ impl Rig {
     }
 
     /// For each bone, whether it is a conversion node: one at the top of the hierarchy (a root, or below conversion
-    /// nodes only) that only changes axes or units ([`Transform::only_converts`]) at rest and in every clip (which
-    /// may key it, but only to hold one value) and that carries bones or a mesh. Exporters put such nodes above a character to state their axes and unit (Blender's
-    /// FBX armature turned −90° about X, a glTF exporter's "Armature" at identity); two files of one character hold
-    /// them or not, under any name, so comparisons recognise them by this role instead of pairing them by name.
+    /// nodes only) that only changes axes or units ([`Transform::only_converts`]: a ratio of units, quarter turns)
+    /// at rest and in every clip (which may key it, but only to hold one value), that carries bones or a mesh, that
+    /// the file does not call a joint, and whose children the file says inherit it fully. Exporters put such nodes
+    /// above a character to state its axes and unit (Blender's FBX armature turned −90° about X and scaled 100, a
+    /// glTF exporter's `Armature`); two files of one character hold them or not, under any name, so comparisons
+    /// recognise them by this role, and every mode leaves them outside the rig. A node whose children the file
+    /// says compensate its scale (HumanIK's `Reference` null scaled 0.01 over segment-compensating hips) is part of
+    /// the rig: its file evaluates it so.
     pub fn conversion_nodes(&self) -> Vec<bool> {
         let bones = self.skeleton.bones();
-        let mut carries = vec![false; bones.len()];
-        for parent in bones.iter().filter_map(|b| b.parent).chain(self.meshes.iter().map(|m| m.bone)) {
-            if let Some(c) = carries.get_mut(parent) {
+        let (mut carries, mut inherited_fully) = (vec![false; bones.len()], vec![true; bones.len()]);
+        for bone in bones.iter().filter(|b| b.parent.is_some()) {
+            let parent = bone.parent.unwrap_or_default();
+            carries[parent] = true;
+            inherited_fully[parent] &= bone.inherit == InheritMode::Full;
+        }
+        for mesh in &self.meshes {
+            if let Some(c) = carries.get_mut(mesh.bone) {
                 *c = true;
             }
         }
         let mut conversion = vec![false; bones.len()];
         for (i, bone) in bones.iter().enumerate() {
             let on_top = bone.parent.is_none_or(|p| conversion[p]);
-            conversion[i] = on_top && carries[i] && self.only_converts(i, &bone.rest);
+            let outside = carries[i] && inherited_fully[i] && !self.skeleton.declared_figure(i);
+            conversion[i] = on_top && outside && self.only_converts(i, &bone.rest);
         }
         conversion
     }
@@ -120,7 +130,9 @@ mod tests {
 
     #[test]
     fn conversion_nodes_are_static_tops_that_only_convert_and_carry_something() {
-        let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
+        // Nodes the file does not call joints (nulls, an armature object), unless said otherwise.
+        let bone = |name: &str, parent, rest| Bone { role: NodeRole::Helper, ..Bone::joint(name, parent, rest) };
+        let centimetres = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::splat(0.01));
         let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
         let up = Transform::from_trs(DVec3::Y, DQuat::IDENTITY, DVec3::ONE);
         let bones = vec![
@@ -134,6 +146,14 @@ mod tests {
             bone("passenger", Some(6), up),
             bone("keyed", None, Transform::IDENTITY), // keyed, but to hold a quarter turn throughout
             bone("rider", Some(8), up),
+            Bone::joint("reference", None, centimetres), // the file calls it a joint
+            Bone::joint("pelvis", Some(10), up),
+            bone("null", None, centimetres), // a child compensates its scale: part of the rig
+            Bone { inherit: InheritMode::SegmentCompensate, ..Bone::joint("compensating", Some(12), up) },
+            bone("grown", None, Transform { scale: DVec3::splat(0.03), ..Transform::IDENTITY }), // not a unit
+            Bone::joint("grown_hips", Some(14), up),
+            bone("units", None, centimetres), // converts centimetres to metres
+            Bone::joint("units_hips", Some(16), up),
         ];
         let times: Arc<[f64]> = Arc::from([0.0, 1.0]);
         let track = Track::new(times.clone(), vec![Vec3::ZERO, Vec3::X], Interpolation::Linear).unwrap();
@@ -150,6 +170,13 @@ mod tests {
             meshes: vec![Mesh { bone: 4, ..Mesh::default() }],
             ..Rig::default()
         };
-        assert_eq!(rig.conversion_nodes(), [true, true, false, false, true, false, false, false, true, false]);
+        let conversion: Vec<&str> = rig
+            .conversion_nodes()
+            .iter()
+            .zip(rig.skeleton.bones())
+            .filter(|(c, _)| **c)
+            .map(|(_, b)| b.name.as_str())
+            .collect();
+        assert_eq!(conversion, ["Armature", "Scene", "skin", "keyed", "units"]);
     }
 }

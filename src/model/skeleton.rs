@@ -71,6 +71,8 @@ pub struct Skeleton {
     bones: Vec<Bone>,
     /// [`Skeleton::figure`], found once: the roles do not change after [`Skeleton::new`].
     figure: Vec<bool>,
+    /// Per bone, whether the file made it something else than a joint and [`Skeleton::new`] made it one.
+    promoted: Vec<bool>,
     /// The file's own unit and axes in bonescope's space ([`Skeleton::placement`]).
     placement: Placement,
 }
@@ -118,17 +120,19 @@ impl Skeleton {
             }
         }
         // Children come after their parents: walking backwards reaches every descendant before its ancestors.
+        let mut promoted = vec![false; bones.len()];
         for index in (0..bones.len()).rev() {
             if let Some(parent) = bones[index].parent
                 && bones[index].role.is_figure()
                 && !bones[parent].role.is_figure()
             {
                 bones[parent].role = NodeRole::Joint;
+                promoted[parent] = true;
             }
         }
         let figure: Vec<bool> = bones.iter().map(|b| b.role.is_figure()).collect();
         let figure = if figure.contains(&true) { figure } else { vec![true; figure.len()] };
-        Ok(Skeleton { bones, figure, placement: Placement::default() })
+        Ok(Skeleton { bones, figure, promoted, placement: Placement::default() })
     }
 
     /// The same bones placed by `placement` (its conversion nodes, where given, one flag per bone).
@@ -217,6 +221,12 @@ impl Skeleton {
     /// nulls or of rigid meshes has nothing else to show).
     pub fn figure(&self) -> &[bool] {
         &self.figure
+    }
+
+    /// Whether the file itself made `bone` a joint or an end site (rather than a node joints hang from, made a
+    /// joint by [`Skeleton::new`]).
+    pub fn declared_figure(&self, bone: usize) -> bool {
+        self.bones[bone].role.is_figure() && !self.promoted[bone]
     }
 
     /// Per bone, whether it is of the character: of the figure and not a conversion node (which stands outside the
