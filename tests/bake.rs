@@ -449,3 +449,54 @@ fn unreal_gets_one_trs_node_per_bone_and_its_report_bounds_what_diff_measures_un
     assert!(reported <= 1.01 * dense + EXACT * size, "{reported} vs {dense} at {DENSE_RATE} Hz");
     assert!(reported > bake::DEFAULT_TOLERANCE * size, "the shear is beyond a TRS: {reported:e}");
 }
+
+/// The worst `diff` at its default rate finds between `source` and the bake read back as `back`, over every clip.
+fn diff_in_memory(source: &Rig, modes: &[InheritMode], back: &Rig) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (k, clip) in source.clips.iter().enumerate() {
+        let a = Evaluation::new(source, Some(clip), modes);
+        let b = Evaluation::declared(back, back.clips.get(k));
+        let times = comparison_times(&a, &b, bonescope::diff::DEFAULT_RATE);
+        worst = worst.max(compare(&a, &b, &Pairs::by_name(&a, &b), &times).worst_distance().max);
+    }
+    worst
+}
+
+#[test]
+fn a_bake_reports_a_bound_of_what_diff_finds_and_a_bake_of_a_bake_changes_nothing() {
+    // Every shared animation file (as declared) baked with the default keys, and that bake baked again: each bake's
+    // report is at least what `diff` of its input and its output finds (the report checks the keys, the midpoints
+    // between them and diff's own times), and the second bake stays within its tolerance of the first.
+    let failures: Vec<String> = sources()
+        .par_iter()
+        .flat_map(|&source| {
+            let rig = &RIGS[source];
+            let once = bake::bake(&request(source, None, Strategy::Exact, bake::DEFAULT_TOLERANCE));
+            let a = import::load_bytes(Path::new("a.glb"), &once.glb).unwrap();
+            let request_twice =
+                Request::every_clip(&Evaluation::declared(&a, None), None, Strategy::Exact, bake::DEFAULT_TOLERANCE);
+            let twice = bake::bake(&request_twice);
+            let b = import::load_bytes(Path::new("b.glb"), &twice.glb).unwrap();
+            let mut failures = Vec::new();
+            let reported =
+                |request: &Request, baked: &bake::Baked, back: &Rig| bake::report(request, baked, back).worst().max;
+            let first = (
+                reported(&request(source, None, Strategy::Exact, bake::DEFAULT_TOLERANCE), &once, &a),
+                diff_in_memory(rig, &rig.skeleton.declared_modes(), &a),
+            );
+            let second = (reported(&request_twice, &twice, &b), diff_in_memory(&a, &a.skeleton.declared_modes(), &b));
+            for (which, (report, found), size) in
+                [("bake", first, once.rig_size), ("bake of the bake", second, twice.rig_size)]
+            {
+                if found > report + EXACT * size {
+                    failures.push(format!("{source}, {which}: reported {report:e}, diff finds {found:e}"));
+                }
+            }
+            if second.1 > bake::DEFAULT_TOLERANCE * twice.rig_size {
+                failures.push(format!("{source}: the bake of the bake is {:e} off, beyond its tolerance", second.1));
+            }
+            failures
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

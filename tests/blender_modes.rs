@@ -33,7 +33,8 @@ fn fix_shear_leaves_the_forearm_as_full_inheritance_in_every_format() {
         for ((time, full), (_, fixed)) in
             forearm(&rig, InheritMode::Full).into_iter().zip(forearm(&rig, InheritMode::BlenderFixShear))
         {
-            assert!(fixed.abs_diff_eq(full, 1e-9), "{file} at {time}: {fixed} against {full}");
+            // To the bind pose's single precision (the FBX's bind matrices are read back through an inverse).
+            assert!(fixed.abs_diff_eq(full, 1e-6), "{file} at {time}: {fixed} against {full}");
         }
     }
 }

@@ -91,8 +91,15 @@ impl<'s> Unmatched<'s> {
     fn new(a: &'s Rig, b: &'s Rig) -> Self {
         let (helpers_a, helpers_b) = (helpers(&a.skeleton), helpers(&b.skeleton));
         let helpers = [&helpers_a, &helpers_b].iter().map(|h| h.iter().filter(|&&h| h).count()).sum();
-        let (conversion_a, left_a) = split(&a.conversion_nodes(), &helpers_a);
-        let (conversion_b, left_b) = split(&b.conversion_nodes(), &helpers_b);
+        // A conversion node the other file holds as a bone of the same name (its format knows no joints, and a
+        // bake's node converted nothing there) is paired like any bone.
+        let (nodes_a, nodes_b) = (a.conversion_nodes(), b.conversion_nodes());
+        let apart = |rig: &Rig, nodes: &[bool], other: &Rig, other_nodes: &[bool]| -> Vec<bool> {
+            let a_bone_there = |name: &str| other.skeleton.find(name).is_some_and(|i| !other_nodes[i]);
+            nodes.iter().zip(rig.skeleton.bones()).map(|(&c, bone)| c && !a_bone_there(&bone.name)).collect()
+        };
+        let (conversion_a, left_a) = split(&apart(a, &nodes_a, b, &nodes_b), &helpers_a);
+        let (conversion_b, left_b) = split(&apart(b, &nodes_b, a, &nodes_a), &helpers_b);
         Unmatched {
             a: &a.skeleton,
             b: &b.skeleton,
@@ -202,7 +209,7 @@ mod tests {
     use glam::{DQuat, DVec3};
 
     use super::*;
-    use crate::model::{Bone, Transform, named_skeleton};
+    use crate::model::{Bone, NodeRole, Transform, named_skeleton};
 
     /// A rig of bones named and parented, each a step along X from its parent (so that none is a conversion node).
     fn rig(bones: &[(&str, Option<usize>)]) -> Rig {
@@ -246,7 +253,9 @@ mod tests {
         let turned = Transform::from_trs(DVec3::ZERO, DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::ONE);
         for (rig, rest) in [(&mut a, turned), (&mut b, Transform::IDENTITY)] {
             let bones = rig.skeleton.bones().iter().enumerate();
-            let bones = bones.map(|(i, bone)| if i == 0 { Bone { rest, ..bone.clone() } } else { bone.clone() });
+            // The top node is an armature object or a null, not a joint.
+            let top = |bone: &Bone| Bone { rest, role: NodeRole::Helper, ..bone.clone() };
+            let bones = bones.map(|(i, bone)| if i == 0 { top(bone) } else { bone.clone() });
             rig.skeleton = Skeleton::new(bones.collect()).unwrap();
         }
         let m = match_bones(&a, &b);
