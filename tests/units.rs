@@ -203,10 +203,8 @@ fn joints_in_centimetres_under_a_conversion_node_move_as_the_same_joints_in_metr
     let (m, cm) = (write(false), write(true));
     assert_eq!(cm.skeleton.placement().conversion_nodes, [true, false, false, false], "the Armature only converts");
     for mode in InheritMode::ALL {
-        let (em, ecm) = (
-            Evaluation::new(&m, m.clips.first(), &vec![mode; 3]),
-            Evaluation::new(&cm, cm.clips.first(), &vec![mode; 4]),
-        );
+        let (em, ecm) =
+            (Evaluation::new(&m, m.clips.first(), &[mode; 3]), Evaluation::new(&cm, cm.clips.first(), &[mode; 4]));
         let scales_cm = ecm.length_scales();
         for time in [0.0, 0.25, 0.5, 0.8, 1.0] {
             let (pm, pcm) = (em.pose_at(time), ecm.pose_at(time));
@@ -221,7 +219,7 @@ fn joints_in_centimetres_under_a_conversion_node_move_as_the_same_joints_in_metr
     }
     // Under segment-compensate the spine compensates the hips' (1, 1, 2) and no unit: at 0.5 s its origin is half
     // a metre above the hips (1.5 m), whatever the file's unit.
-    let modes = vec![InheritMode::SegmentCompensate; 4];
+    let modes = [InheritMode::SegmentCompensate; 4];
     let spine = Evaluation::new(&cm, cm.clips.first(), &modes).pose_at(0.5).model.model[2].w_axis.truncate();
     assert!(spine.abs_diff_eq(DVec3::new(0.0, 1.5, 0.0), 1e-12), "{spine}");
 }
