@@ -320,3 +320,74 @@ fn nlerp_playback_departs_from_slerp_as_its_formula_says() {
     let at = |seconds: f64| (nlerp.time - seconds).abs() < 1e-9;
     assert!(at(13.0 / 60.0) || at(47.0 / 60.0), "nlerp leads, then lags by as much: {nlerp:?}");
 }
+
+#[test]
+fn swapping_the_files_changes_nothing() {
+    // Rig size, worst distance and every bone's figures are the same whichever file (or set of modes) is A, over
+    // the shared files under pairs of modes, and two exports of one scene: a `--fail-above` gate cannot depend on
+    // the order of the arguments (to 1e-12 of the rig).
+    let blender = |name: &str| path(&asset(&format!("blender/{name}")));
+    let maya = path(&asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx"));
+    let character = path(&asset("fbx-ufbx-corpus/maya_character_7500_binary.fbx"));
+    let cases: Vec<[String; 4]> = vec![
+        [blender("stretchy_full.glb"), blender("stretchy_full.glb"), "full".into(), "blender-none".into()],
+        [
+            blender("stretchy_full.fbx"),
+            blender("stretchy_noinherit.fbx"),
+            "segment-compensate".into(),
+            "componentwise".into(),
+        ],
+        [
+            blender("stretchy_full.glb"),
+            blender("stretchy_full.fbx"),
+            "blender-aligned".into(),
+            "unscaled-parent".into(),
+        ],
+        [maya.clone(), maya, "declared".into(), "unscaled-parent".into()],
+        [character.clone(), character, "segment-compensate".into(), "blender-none".into()],
+    ];
+    for [a, b, mode_a, mode_b] in cases {
+        let diff = |a: &str, b: &str, mode_a: &str, mode_b: &str| {
+            json(&bonescope(&["diff", a, b, "--inherit-a", mode_a, "--inherit-b", mode_b, "--format", "json"]))
+        };
+        let (forth, back) = (diff(&a, &b, &mode_a, &mode_b), diff(&b, &a, &mode_b, &mode_a));
+        let what = format!("{a} ({mode_a}) against {b} ({mode_b})");
+        for (x, y) in forth["animations"].as_array().unwrap().iter().zip(back["animations"].as_array().unwrap()) {
+            let size = x["rig_size"].as_f64().unwrap();
+            let same = |p: &Value, q: &Value| (p.as_f64().unwrap() - q.as_f64().unwrap()).abs() <= 1e-12 * size;
+            assert!(
+                same(&x["rig_size"], &y["rig_size"]),
+                "{what}: rig size {} against {}",
+                x["rig_size"],
+                y["rig_size"]
+            );
+            assert!(
+                same(&x["worst"]["max"], &y["worst"]["max"]),
+                "{what}: worst {} against {}",
+                x["worst"],
+                y["worst"]
+            );
+            let bones = |report: &Value| -> Vec<(String, Value, Value)> {
+                let mut bones: Vec<(String, Value, Value)> = report["bones"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|b| {
+                        (
+                            b["name"].as_str().unwrap().to_owned(),
+                            b["position"]["max"].clone(),
+                            b["probe"]["max"].clone(),
+                        )
+                    })
+                    .collect();
+                bones.sort_by(|p, q| p.0.cmp(&q.0));
+                bones
+            };
+            let (bx, by) = (bones(x), bones(y));
+            assert_eq!(bx.len(), by.len(), "{what}");
+            for ((name, position, probe), (_, position_back, probe_back)) in bx.iter().zip(&by) {
+                assert!(same(position, position_back) && same(probe, probe_back), "{what}: {name}");
+            }
+        }
+    }
+}

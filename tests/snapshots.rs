@@ -234,6 +234,20 @@ fn laptop_maya_human_ik() {
         .snapshot("laptop_maya_human_ik");
 }
 
+/// HumanIK's character in centimetres with every bone under full inheritance, its declared segment-compensate as
+/// the ghost: the unit's 0.01 stands outside the rig, so neither mode compensates it and the ghost and the pose
+/// are one size (they once stood 100× apart).
+#[test]
+fn laptop_maya_character_full_with_a_compensating_ghost() {
+    use bonescope::app::{Ghost, ModeScope};
+    use bonescope::model::{InheritMode, ModeChoice};
+    let mut doc = asset_document("fbx-ufbx-corpus/maya_character_7500_binary.fbx");
+    doc.set_mode(0, ModeScope::All, ModeChoice::Mode(InheritMode::Full));
+    doc.ghost = Some(Ghost::Modes(ModeChoice::Mode(InheritMode::SegmentCompensate)));
+    laptop(egui::vec2(1280.0, 800.0), laptop_settings(), doc, "Character1_LeftForeArm", 0.0)
+        .snapshot("laptop_maya_character_full_with_a_compensating_ghost");
+}
+
 /// Axis-angle curves: the angle in degrees and the unit axis in two plots sharing the time axis, the legend above
 /// them.
 #[test]

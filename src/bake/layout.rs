@@ -9,7 +9,7 @@ use super::nodes::{NodeSample, Sampled};
 use super::skins::{skins, unique_name};
 use crate::diff::HELPER_SUFFIX;
 use crate::math::decompose;
-use crate::model::{Mesh, Rig};
+use crate::model::{Mesh, Rig, Skeleton};
 
 /// Which glTF node each bone and helper becomes, and which meshes hang where.
 pub struct Layout {
@@ -102,27 +102,42 @@ impl Layout {
         for node in &mut document.nodes {
             node.skin = node.mesh.and_then(|m| document.meshes[m].primitives[0].skin);
         }
-        conversion(rig, &mut document);
+        conversion(self, rig, &mut document);
         skins(rig, &self.bone_node, &mut document, notes);
         document
     }
 }
 
-/// Where the source's space is converted (an FBX file in centimetres, or Z-up), a top node `conversion` carrying it,
-/// the roots below it: the baked bones keep the file's own numbers, and a reader that places conversion nodes
-/// outside the rig, as bonescope does, reads the scale factors the file's author set.
-fn conversion(rig: &Rig, document: &mut GltfDocument) {
-    let conversion = rig.skeleton.placement().conversion;
-    if conversion == DMat4::IDENTITY {
+/// Where the source's space is converted (an FBX file in centimetres, or Z-up), a top node `conversion` carrying it
+/// above the roots [`under_conversion`] names: the baked bones keep the file's own numbers, and a reader that places
+/// conversion nodes outside the rig, as bonescope does, reads the scale factors the file's author set.
+fn conversion(layout: &Layout, rig: &Rig, document: &mut GltfDocument) {
+    // A bone's topmost node: its helper where it has one.
+    let top_node = |bone: usize| layout.helper_node[bone].unwrap_or(layout.bone_node[bone]);
+    let under: Vec<usize> = (under_conversion(&rig.skeleton).iter().enumerate())
+        .filter(|(_, under)| **under)
+        .map(|(bone, _)| top_node(bone))
+        .collect();
+    if under.is_empty() {
         return;
     }
     let node = document.nodes.len();
-    for root in document.nodes.iter_mut().filter(|n| n.parent.is_none()) {
-        root.parent = Some(node);
+    for &root in &under {
+        document.nodes[root].parent = Some(node);
     }
-    let parts = decompose(&conversion);
+    let parts = decompose(&rig.skeleton.placement().conversion);
     let sample = NodeSample { rotation: parts.rotation, scale: parts.scale * parts.sign, ..NodeSample::IDENTITY };
     document.nodes.push(node_with(&unique_name(&document.nodes, "conversion"), None, &sample));
+}
+
+/// Per bone, whether it is a root the baked file hangs from a node carrying the skeleton's unit and axes
+/// conversion: every root but the conversion nodes (which carry it themselves, as an exporter's armature scaled
+/// 100 under a centimetre file becomes one of scale 1), where there is a conversion.
+pub fn under_conversion(skeleton: &Skeleton) -> Vec<bool> {
+    let placement = skeleton.placement();
+    let converts = placement.conversion != DMat4::IDENTITY;
+    let roots = skeleton.bones().iter().enumerate();
+    roots.map(|(i, bone)| converts && bone.parent.is_none() && !placement.is_conversion(i)).collect()
 }
 
 /// A node named `name` with the TRS of `sample` (its stretch is carried by the bone's own node, not here).

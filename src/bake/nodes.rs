@@ -2,7 +2,8 @@
 //!
 //! A bone's baked local matrix is `L = W'_parent⁻¹ · W_bone`: what it needs under its already-baked parent so that
 //! plain glTF composition (full inheritance) gives back the source's model matrix `W_bone` (a root's parent is the
-//! source's unit and axes conversion, which the baked file carries on a node of its own). Its polar decomposition
+//! source's unit and axes conversion, which the baked file carries on a node of its own, unless the root is a
+//! conversion node and carries it itself). Its polar decomposition
 //! `L = T·F·R·U·K·Uᵀ` becomes a [`NodeSample`] `T · Q · S · Vᵀ`:
 //! - [`Strategy::Exact`]: `Q = R·U`, `S = F·K`, `V = U`. A bone that ever needs `U` (a stretched local matrix) gets a
 //!   helper node carrying `T, Q, S` above itself, and carries `Vᵀ = Uᵀ` (a rotation) itself: exact, since
@@ -198,10 +199,11 @@ pub struct NodeSolver<'e, 'a> {
     source: Evaluator<'e, 'a>,
     strategy: Strategy,
     parents: Vec<Option<usize>>,
-    /// The source's unit and axes conversion and its inverse: the baked roots hang from a node that carries it
-    /// ([`super::layout`]), as the source's roots stand in it.
+    /// The source's unit and axes conversion and its inverse, and per bone whether it is a root that hangs from a
+    /// node carrying it in the baked file ([`super::layout`]); a root that is a conversion node carries it itself.
     conversion: DMat4,
     conversion_inverse: DMat4,
+    under_conversion: Vec<bool>,
     /// `W'`: the model matrices the baked nodes give.
     baked: Vec<DMat4>,
     /// The previous time's stretch of each bone, where the search for this time's starts.
@@ -221,6 +223,7 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
             parents,
             conversion: source.skeleton().placement().conversion,
             conversion_inverse: source.skeleton().placement().conversion.inverse(),
+            under_conversion: super::layout::under_conversion(source.skeleton()),
             baked: vec![DMat4::IDENTITY; bones],
             previous: vec![DQuat::IDENTITY; bones],
             row: vec![NodeSample::IDENTITY; bones],
@@ -243,7 +246,8 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
         let pose = &self.source.pose;
         let source = pose.model.model[bone];
         let local = match parent {
-            None => self.conversion_inverse * source,
+            None if self.under_conversion[bone] => self.conversion_inverse * source,
+            None => source,
             Some(p) => match affine_inverse(&self.baked[p]) {
                 Some(inverse) => inverse * source,
                 None => {
@@ -264,7 +268,8 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
             }
             Strategy::Trs => {
                 let sample = NodeSample::trs(&parts);
-                let above = parent.map_or(self.conversion, |p| self.baked[p]);
+                let root_above = if self.under_conversion[bone] { self.conversion } else { DMat4::IDENTITY };
+                let above = parent.map_or(root_above, |p| self.baked[p]);
                 self.baked[bone] = above * sample.matrix();
                 sample
             }

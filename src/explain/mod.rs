@@ -118,6 +118,10 @@ pub fn explain(
 ) -> Vec<Explanation> {
     let flagged = || before.stretched_worst_first().iter().map(|b| b.index).collect();
     let bones = question.bones.map_or_else(flagged, <[usize]>::to_vec);
+    if bones.is_empty() {
+        // Nothing sheared, nothing asked: no baseline to measure (a whole evaluation of a long clip).
+        return Vec::new();
+    }
     let times = evaluation.times(options.rate);
     let tolerances = &options.tolerances;
     let at = question.at;
