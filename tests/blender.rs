@@ -11,14 +11,14 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use bonescope::bake::{self, Engine, Request};
 use bonescope::eval::Evaluation;
 use bonescope::import;
 use bonescope::model::{Choice, InheritMode, Rig};
-use common::{ANIMATED, asset, hausdorff};
+use common::{ANIMATED, asset, blender_python, hausdorff};
 use glam::DVec3;
 use serde_json::Value;
 
@@ -29,13 +29,6 @@ use serde_json::Value;
 /// first), which put Maya's mixed-inheritance file 2.6e-3 of the rig off at frame 1 and `locomotions.fbx` 5.4e-4, until
 /// the bake stopped writing keys closer than that (`bake::times::MIN_KEY_SPACING`).
 const KNOWN: &[(&str, &str)] = &[];
-
-/// The Python with Blender's module, when there is one.
-fn blender_python() -> Option<PathBuf> {
-    let python = PathBuf::from(std::env::var_os("BONESCOPE_BLENDER_PYTHON")?);
-    let imports = Command::new(&python).args(["-c", "import bpy"]).output().ok()?;
-    imports.status.success().then_some(python)
-}
 
 /// Every frame of `source`'s clip and every half frame, in seconds.
 fn frames_and_halves(source: &Evaluation) -> Vec<f64> {
@@ -107,13 +100,7 @@ fn played_beyond_tolerance(
 
 #[test]
 fn blender_plays_every_bake_within_its_tolerance() {
-    let Some(python) = blender_python() else {
-        eprintln!(
-            "skipped: set BONESCOPE_BLENDER_PYTHON to a Python 3.11 with Blender's module (`pip install \"bpy==4.5.*\"` \
-             in a virtual environment; .ci/run does) to judge the bakes by Blender's glTF importer"
-        );
-        return;
-    };
+    let Some(python) = blender_python() else { return };
     let folder = tempfile::tempdir().unwrap();
     let rigs: Vec<(&str, Rig)> = ANIMATED
         .iter()
@@ -143,10 +130,7 @@ fn blender_plays_every_bake_within_its_tolerance() {
 fn blender_plays_a_maya_character_baked_under_segment_compensate() {
     // HumanIK's character in centimetres with every joint compensating: the unit stands outside the rig, the bake
     // carries it on a `conversion` node, and Blender plays the result where bonescope evaluates it.
-    let Some(python) = blender_python() else {
-        eprintln!("skipped: set BONESCOPE_BLENDER_PYTHON to a Python 3.11 with Blender's module");
-        return;
-    };
+    let Some(python) = blender_python() else { return };
     let folder = tempfile::tempdir().unwrap();
     let file = "fbx-ufbx-corpus/maya_character_7500_binary.fbx";
     let rig = import::load(&asset(file)).unwrap();

@@ -3,13 +3,12 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::process::Command;
 
 use bonescope::eval::{Evaluation, bind_pose};
 use bonescope::math::shear_deg;
 use bonescope::model::{InheritMode, Rig};
-use common::load_asset;
+use common::{blender_python, load_asset};
 use glam::{DMat3, DMat4};
 use serde_json::Value;
 
@@ -47,21 +46,11 @@ fn an_fbx_node_posed_away_from_its_bind_pose_rests_in_the_bind_pose() {
     assert!(rest.angle_between(bound).to_degrees() > 10.0, "the file's node holds another pose than its bind pose");
 }
 
-/// The Python with Blender's module, when there is one.
-fn blender_python() -> Option<PathBuf> {
-    let python = PathBuf::from(std::env::var_os("BONESCOPE_BLENDER_PYTHON")?);
-    let imports = Command::new(&python).args(["-c", "import bpy"]).output().ok()?;
-    imports.status.success().then_some(python)
-}
-
 #[test]
 fn blender_itself_plays_the_forearm_the_same_under_full_and_fix_shear() {
     // The oracle of the test above, asked of Blender: every bone's world matrix under FIX_SHEAR equals FULL's for
     // the forearm at every frame of both files (to Blender's single precision).
-    let Some(python) = blender_python() else {
-        println!("skipped: BONESCOPE_BLENDER_PYTHON names no Python with Blender's module");
-        return;
-    };
+    let Some(python) = blender_python() else { return };
     let folder = tempfile::tempdir().unwrap();
     let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/blender/fix_shear.py");
     for file in FILES {

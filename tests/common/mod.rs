@@ -61,6 +61,22 @@ pub fn load_asset(path: &str) -> Rig {
     bonescope::import::load(&asset(path)).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The Python with Blender's module that `BONESCOPE_BLENDER_PYTHON` names (`.ci/run` installs it pinned); `None`,
+/// saying that the calling test is skipped and why, where there is none.
+pub fn blender_python() -> Option<PathBuf> {
+    let python = std::env::var_os("BONESCOPE_BLENDER_PYTHON").map(PathBuf::from);
+    let imports =
+        |python: &PathBuf| Command::new(python).args(["-c", "import bpy"]).output().is_ok_and(|o| o.status.success());
+    let found = python.filter(imports);
+    if found.is_none() {
+        eprintln!(
+            "skipped: set BONESCOPE_BLENDER_PYTHON to a Python 3.11 with Blender's module (`pip install \"bpy==4.5.*\"` \
+             in a virtual environment; .ci/run does) to judge bonescope by Blender"
+        );
+    }
+    found
+}
+
 /// The `bonescope` command run with `args`.
 pub fn bonescope(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bonescope")).args(args).output().expect("bonescope runs")
