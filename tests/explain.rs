@@ -189,6 +189,12 @@ fn on_the_maya_file_explain_names_the_modes_that_matter_and_their_cost() {
         .filter(|f| matches!(f.change, Change::Mode { bone, mode: InheritMode::Full } if compensated.contains(&bone)))
         .collect();
     assert!(as_full.iter().any(|f| f.cost.distance.max > 0.0), "some declared mode matters: {as_full:?}");
+    // The file is in centimetres, 18 cm tall: no fix moves anything by more than the rig's size (when the unit
+    // was compensated with the scales its author set, `Mid → segment-compensate` cost 12.9 m).
+    let size = source.size(&source.times(ScanOptions::default().rate));
+    for fix in explained.iter().flat_map(|e| &e.fixes) {
+        assert!(fix.cost.distance.max < size, "{}: {:?} on a rig of {size}", fix.label, fix.cost);
+    }
     let table = bonescope(&["explain", asset(file).to_str().unwrap()]);
     assert!(table.status.success(), "{}", String::from_utf8_lossy(&table.stderr));
     let text = String::from_utf8(table.stdout).unwrap();
