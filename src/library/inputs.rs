@@ -3,9 +3,10 @@
 //! - A file is scanned as named, whatever its content (a file that is not an animation then fails to load, which
 //!   the report says).
 //! - A folder is walked recursively (symbolic links followed, loops detected by walkdir) and the files in it with an
-//!   animation's extension (`.gltf`, `.glb`, `.fbx`, `.bvh`, any case) or whose content bonescope recognises
-//!   ([`crate::import::detect`] on their first 64 KiB) are scanned: a broken export is an error in the report, never
-//!   passed over, and only a file foreign by both name and content is left out;
+//!   animation's extension (`.gltf`, `.glb`, `.fbx`, `.bvh`, any case) or, without one, an unmistakable signature in
+//!   their first 64 KiB (GLB or FBX magic, FBX's ASCII header, BVH's `HIERARCHY`, JSON whose top-level `asset`
+//!   states a `version`: [`recognised`]) are scanned: a broken export is an error in the report, never passed over,
+//!   and a library's other files (manifests, reports, a test suite's `assets.json`) are left out;
 //!   `--include`/`--exclude` globs narrow that down by path relative to the folder (a pattern without a `/`
 //!   matches the file name, as `*.fbx`).
 //! - A pattern with glob characters that names nothing as written (`'exports/**/*.fbx'`, quoted so the shell left it)
@@ -201,19 +202,26 @@ fn has_animation_extension(path: &Path) -> bool {
     extension.is_some_and(|e| ANIMATION_EXTENSIONS.contains(&e.as_str()))
 }
 
-/// Whether a file's first bytes are a format bonescope reads. JSON counts as glTF only with an `"asset"` key in
-/// view (every glTF has one), so the other JSON of a library (tool reports, configuration) is left out; a JSON file
-/// larger than what is read is given the benefit of the doubt.
+/// Whether a file not named as an animation carries a signature that cannot be mistaken, as a pipeline tells its
+/// files apart: GLB's magic, FBX's binary magic or ASCII header, BVH's `HIERARCHY`, or JSON whose top-level `asset`
+/// states a `version` (every glTF's does; a manifest's `{"asset": {"generator": …}}`, a test suite's `assets.json` or
+/// a tool's report does not). JSON larger than what is read cannot show that whole, and is left out.
 fn recognised(path: &Path) -> bool {
     let mut head = Vec::new();
     let read = std::fs::File::open(path).and_then(|f| f.take(SNIFF_BYTES).read_to_end(&mut head));
     match (read, crate::import::detect(&head)) {
         (Ok(_), Some(crate::import::Format::Gltf)) if !head.starts_with(b"glTF") => {
-            head.len() as u64 == SNIFF_BYTES || head.windows(7).any(|w| w == b"\"asset\"")
+            (head.len() as u64) < SNIFF_BYTES && states_gltf_version(&head)
         }
         (Ok(_), format) => format.is_some(),
         (Err(_), _) => false,
     }
+}
+
+/// Whether `json` is an object whose `asset` states a `version`.
+fn states_gltf_version(json: &[u8]) -> bool {
+    let value: Option<serde_json::Value> = serde_json::from_slice(json).ok();
+    value.is_some_and(|v| v.get("asset").and_then(|asset| asset.get("version")).is_some())
 }
 
 #[cfg(test)]
@@ -266,15 +274,21 @@ mod tests {
     #[test]
     fn folders_give_their_animations_by_content_sorted() {
         let dir = library();
+        let root = dir.path();
+        std::fs::write(root.join("mocap/manifest.json"), br#"{"asset": {"generator": "x"}}"#).unwrap();
+        std::fs::write(root.join("mocap/assets.json"), br#"[{"asset": {"version": "2.0"}}]"#).unwrap();
+        std::fs::write(root.join("mocap/model.json"), br#"{"asset": {"version": "2.0"}, "nodes": []}"#).unwrap();
         let inputs = collect(&[dir.path().to_owned()], &Filter::default(), &mut std::io::empty());
         let expected = [
             "chars/hero/idle.gltf",
             "chars/hero/run.fbx",
             "chars/hero/walk.glb",
+            "mocap/model.json",
             "mocap/renamed.txt",
             "mocap/take1.bvh",
         ];
-        assert_eq!(names(&inputs, dir.path()), expected, "not the JSON report");
+        // Not the JSON report, nor a manifest whose `asset` states no version, nor a list of assets.
+        assert_eq!(names(&inputs, dir.path()), expected);
         assert!(inputs.problems.is_empty(), "{:?}", inputs.problems);
     }
 
