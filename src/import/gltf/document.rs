@@ -21,10 +21,17 @@ const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// Extensions bonescope evaluates.
 const EVALUATED: &[&str] = &["KHR_mesh_quantization", "KHR_animation_pointer"];
-/// Prefixes of extensions that only touch materials (`KHR_techniques_webgl`: shaders), textures, images or lights,
-/// which bonescope does not draw.
-const NOT_DRAWN: &[&str] =
-    &["KHR_materials_", "KHR_techniques_", "KHR_texture_", "EXT_texture_", "KHR_lights_", "EXT_lights_"];
+/// Prefixes of extensions that only touch materials (`KHR_techniques_webgl`: shaders, and `KHR_technique_webgl`, its
+/// draft's singular name, which old exporters still write), textures, images or lights, which bonescope does not draw.
+const NOT_DRAWN: &[&str] = &[
+    "KHR_materials_",
+    "KHR_techniques_",
+    "KHR_technique_",
+    "KHR_texture_",
+    "EXT_texture_",
+    "KHR_lights_",
+    "EXT_lights_",
+];
 
 /// The parsed document with the GLB `BIN` chunk, if any.
 pub(super) struct Parsed<'a> {
@@ -241,6 +248,9 @@ mod tests {
         assert!(check_required_extensions(&root(r#"["KHR_mesh_quantization"]"#)).unwrap().is_empty());
         let notes = check_required_extensions(&root(r#"["KHR_texture_basisu", "KHR_texture_basisu"]"#)).unwrap();
         assert_eq!(notes.len(), 1);
+        // The techniques draft under its singular name (assimp's `BoxTextured-glTF-techniqueWebGL`) only shades.
+        let shaded = check_required_extensions(&root(r#"["KHR_technique_webgl"]"#)).unwrap();
+        assert_eq!(shaded.len(), 1, "{shaded:?}");
         let refused = check_required_extensions(&root(r#"["KHR_texture_basisu", "KHR_draco_mesh_compression"]"#));
         let failure = refused.unwrap_err();
         assert_eq!(failure.place.as_deref(), Some("extensionsRequired[1]"));
