@@ -181,6 +181,8 @@ struct Tally {
     beyond_four: usize,
     /// Primitives whose indices end in an incomplete triangle.
     incomplete: Vec<String>,
+    /// Primitives with triangles that index past their vertices, and how many such triangles each dropped.
+    out_of_range: Vec<(String, usize)>,
 }
 
 impl Tally {
@@ -214,6 +216,11 @@ impl Tally {
             let places = self.incomplete.join(", ");
             notes
                 .push(format!("indices that do not make whole triangles: the incomplete last one left out ({places})"));
+        }
+        if !self.out_of_range.is_empty() {
+            let places: Vec<String> =
+                self.out_of_range.iter().map(|(place, dropped)| format!("{dropped} in {place}")).collect();
+            notes.push(format!("triangles whose indices pass their vertices left out: {}", places.join(", ")));
         }
     }
 }
@@ -342,7 +349,8 @@ fn strongest(joints: [[u16; 4]; 2], weights: [[f32; 4]; 2]) -> ([u16; 4], [f32; 
 }
 
 /// The triangle list of a primitive drawn as `mode` (list, strip or fan): the `indices` accessor, or `0..n` without
-/// one; an incomplete last triangle of a list is left out (and noted).
+/// one; an incomplete last triangle of a list is left out, and so is a triangle with an index past the vertices
+/// (both noted: the rest of the mesh still shows, as other readers show it).
 fn triangle_indices(
     primitive: &schema::Primitive,
     accessors: &Accessors,
@@ -358,10 +366,7 @@ fn triangle_indices(
             (0..n).collect()
         }
     };
-    if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertices) {
-        return Err(Failure::at(place, format!("index {bad} is out of range ({vertices} vertices)")));
-    }
-    Ok(match mode {
+    let triangles = match mode {
         TRIANGLE_STRIP => strip_triangles(&indices),
         TRIANGLE_FAN => fan_triangles(&indices),
         _ => {
@@ -371,7 +376,14 @@ fn triangle_indices(
             }
             indices
         }
-    })
+    };
+    let inside = |triangle: &[u32]| triangle.iter().all(|&i| (i as usize) < vertices);
+    let kept: Vec<u32> = triangles.chunks_exact(3).filter(|t| inside(t)).flatten().copied().collect();
+    let dropped = (triangles.len() - kept.len()) / 3;
+    if dropped > 0 {
+        tally.out_of_range.push((place.to_owned(), dropped));
+    }
+    Ok(kept)
 }
 
 /// A triangle strip as a list: triangle `i` is `v[i], v[i+(1+i%2)], v[i+(2−i%2)]` (the glTF specification's: every
