@@ -6,17 +6,23 @@
 //! (at rest or at any key, tangents included; rotations are unit quaternions and never grow a matrix), its model matrix's linear part below `A = A_parent · max(s, 1)` and
 //! its origin below `T = T_parent + A_parent · t`. (The factor of at least 1 keeps the bound an upper one under the
 //! inheritance modes that leave a parent's scale out.) A bone whose bound passes [`LIMIT`] is refused by name, with
-//! the time of its largest key. The limit leaves room for what evaluation does with a matrix: products of three
-//! entries (determinants), squares of sums (decomposition), and vertices in single precision under it.
+//! the time of its largest key: only there would numbers stop being finite. The limit leaves room for what
+//! evaluation does with a matrix: products of three entries (determinants), squares of squares (the decomposition's
+//! Gram matrices), and single precision for what is drawn and plotted (a vertex 1e8 from its bone under it). Bones
+//! past [`EXTREME`] load, and a note names the first: no runtime keeps such numbers to a useful precision.
 
 use glam::{DVec3, Vec3};
 
 use super::failure::{Failure, Result};
 use crate::model::{Clip, Rig, Track};
 
-/// The largest model-matrix entry bonescope computes with: 1e20 cubed stays far from `f64::MAX` (1.8e308), and a
-/// vertex 1e15 from its bone (beyond any rig) under it stays a finite single-precision number.
-pub const LIMIT: f64 = 1e20;
+/// The largest model-matrix entry bonescope computes with: its fourth power (1e120) stays far from `f64::MAX`
+/// (1.8e308), and a vertex 1e8 from its bone under it stays a finite single-precision number (below 3.4e38).
+pub const LIMIT: f64 = 1e30;
+
+/// Model-matrix entries past this load with a note: a runtime's single precision keeps seven digits of them, so a
+/// bone at 1e20 moves in steps of 1e13.
+pub const EXTREME: f64 = 1e20;
 
 /// The largest magnitude a bone's local part takes, and when (`None`: at rest).
 #[derive(Clone, Copy)]
@@ -37,8 +43,9 @@ impl Largest {
     }
 }
 
-/// Refuses `rig` when some bone's model matrix can pass [`LIMIT`] at rest or in some clip.
-pub(super) fn check(rig: &Rig) -> Result<()> {
+/// Refuses `rig` when some bone's model matrix can pass [`LIMIT`] at rest or in some clip; else the note to add where
+/// some can pass [`EXTREME`].
+pub(super) fn check(rig: &Rig) -> Result<Option<String>> {
     let bones = rig.skeleton.bones();
     let mut scale: Vec<Largest> = bones.iter().map(|b| Largest::at_rest(b.rest.scale.abs().max_element())).collect();
     let mut translation: Vec<Largest> = bones.iter().map(|b| Largest::at_rest(length(b.rest.translation))).collect();
@@ -47,6 +54,7 @@ pub(super) fn check(rig: &Rig) -> Result<()> {
     }
     let mut linear = vec![1.0f64; bones.len()];
     let mut origin = vec![0.0f64; bones.len()];
+    let mut extreme: Option<(usize, usize)> = None;
     for (index, bone) in bones.iter().enumerate() {
         let (parent_linear, parent_origin) = bone.parent.map_or((1.0, 0.0), |p| (linear[p], origin[p]));
         linear[index] = parent_linear * scale[index].value.max(1.0);
@@ -65,8 +73,19 @@ pub(super) fn check(rig: &Rig) -> Result<()> {
             );
             return Err(Failure::at(format!("bone `{}`", bone.name), message));
         }
+        if linear[index].max(origin[index]) > EXTREME {
+            let (first, count) = extreme.unwrap_or((index, 0));
+            extreme = Some((first, count + 1));
+        }
     }
-    Ok(())
+    Ok(extreme.map(|(first, count)| {
+        let reach = linear[first].max(origin[first]);
+        format!(
+            "model matrices can reach {reach:.1e} at bone `{}` ({count} bones past {EXTREME:.0e}): evaluated, but no \
+             runtime's single precision keeps such numbers",
+            bones[first].name
+        )
+    }))
 }
 
 /// Widens each bone's largest scale and translation by the keys of `clip`.
@@ -128,15 +147,19 @@ mod tests {
 
     #[test]
     fn chains_within_the_limit_pass() {
-        assert!(check(&chain(12, 10.0, 1e3)).is_ok(), "1e12 scale, origins near 1e14");
-        assert!(check(&chain(500, 0.5, 1e3)).is_ok(), "shrinking scales never grow");
+        assert!(matches!(check(&chain(12, 10.0, 1e3)), Ok(None)), "1e12 scale, origins near 1e14");
+        assert!(matches!(check(&chain(500, 0.5, 1e3)), Ok(None)), "shrinking scales never grow");
+        // A scale of 1e12 twice: 1e24, finite everywhere, loads with a note naming the first bone past 1e20.
+        let note = check(&chain(2, 1e12, 1.0)).unwrap().expect("a note");
+        assert!(note.starts_with("model matrices can reach 1.0e24 at bone `b1` (1 bones past 1e20)"), "{note}");
     }
 
     #[test]
     fn a_chain_of_large_scales_is_refused_at_the_bone_that_passes() {
-        // 1e5 per level: the fifth bone reaches 1e25, the fourth 1e20 (the limit itself).
+        // 1e5 per level: the sixth bone reaches 1e30, the limit, where the product of six 1e5s rounds just past it;
+        // the fifth (1e25) loads.
         let failure = check(&chain(12, 1e5, 1.0)).unwrap_err();
-        assert_eq!(failure.place.as_deref(), Some("bone `b4`"));
+        assert_eq!(failure.place.as_deref(), Some("bone `b5`"));
         assert!(failure.message.contains("at rest"), "{}", failure.message);
         // Offsets of 1e308 pass the limit at the first bone, without any scale.
         let failure = check(&chain(4, 1.0, 1e308)).unwrap_err();
@@ -158,11 +181,11 @@ mod tests {
         let mut tracks = BoneTracks::new(1);
         tracks.scale = Some(Track::new(times, values, Interpolation::Linear).unwrap());
         rig.clips.push(Clip::new(0, None, vec![tracks], vec![]));
-        assert!(check(&rig).is_ok(), "1e15 is under the limit");
+        assert!(matches!(check(&rig), Ok(None)), "1e15 is under the limit");
         rig.clips[0] = {
             let mut tracks = BoneTracks::new(2);
             let times: Arc<[f64]> = Arc::from([0.0, 0.5]);
-            tracks.scale = Some(Track::new(times, vec![Vec3::ONE, Vec3::splat(1e30)], Interpolation::Linear).unwrap());
+            tracks.scale = Some(Track::new(times, vec![Vec3::ONE, Vec3::splat(1e35)], Interpolation::Linear).unwrap());
             Clip::new(0, None, vec![tracks], vec![])
         };
         let failure = check(&rig).unwrap_err();

@@ -56,10 +56,11 @@ impl ImportError {
     }
 }
 
-/// What every loaded rig goes through: refused when its numbers can overflow ([`magnitude`]), its names and notes
-/// made printable.
-fn finish(path: &Path, rig: Rig) -> Result<Rig, ImportError> {
-    magnitude::check(&rig).map_err(|f| f.with_path(path))?;
+/// What every loaded rig goes through: refused when its numbers can overflow ([`magnitude`], noted when they grow
+/// past what a runtime keeps), its names and notes made printable.
+fn finish(path: &Path, mut rig: Rig) -> Result<Rig, ImportError> {
+    let extreme = magnitude::check(&rig).map_err(|f| f.with_path(path))?;
+    rig.notes.extend(extreme);
     Ok(with_conversion_nodes(printable_rig(rig)))
 }
 
