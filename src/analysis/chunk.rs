@@ -55,15 +55,14 @@ impl<'a> Plan<'a> {
         };
         let mut children = vec![0; parents.len()];
         parents.iter().flatten().for_each(|&p| children[p] += 1);
-        let conversion = skeleton.placement().conversion;
         Plan {
             hierarchy,
             by_bone,
             inherits,
             parents,
             children,
-            root: Run::Fixed(Stretch::uniform(conversion.determinant().abs().cbrt())),
-            length_scales: skeleton.length_scales(),
+            root: Run::Fixed(Stretch::uniform(skeleton.placement().conversion_scale())),
+            length_scales: skeleton.length_scales().to_vec(),
             varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
             varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
             modelled: with_ancestors(skeleton, plotted),

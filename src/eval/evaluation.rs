@@ -99,7 +99,7 @@ impl<'a> Evaluation<'a> {
     /// Per bone, what its model matrix's scale factors are divided by to be the ones the file's author set: the
     /// unit conversion above it ([`Skeleton::length_scales`]) and the unit it is measured in.
     pub fn length_scales(&self) -> Vec<f64> {
-        self.rig.skeleton.length_scales().into_iter().map(|s| s * self.length_scale).collect()
+        self.rig.skeleton.length_scales().iter().map(|s| s * self.length_scale).collect()
     }
 
     pub fn layers(&self) -> Option<&LayerStack> {

@@ -91,7 +91,7 @@ impl Hierarchy {
         }
         let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
         let placement = skeleton.placement().clone();
-        let placed_by = if placement.is_identity() { Vec::new() } else { skeleton.placed_by() };
+        let placed_by = skeleton.placed_by().to_vec();
         Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid, placement, placed_by }
     }
 

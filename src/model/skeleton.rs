@@ -73,8 +73,11 @@ pub struct Skeleton {
     figure: Vec<bool>,
     /// Per bone, whether the file made it something else than a joint and [`Skeleton::new`] made it one.
     promoted: Vec<bool>,
-    /// The file's own unit and axes in bonescope's space ([`Skeleton::placement`]).
+    /// The file's own unit and axes in bonescope's space ([`Skeleton::placement`]), and what follows from it, found
+    /// once when it is set: [`Skeleton::placed_by`] and [`Skeleton::length_scales`].
     placement: Placement,
+    placed_by: Vec<Option<usize>>,
+    length_scales: Vec<f64>,
 }
 
 /// Where a file's space sits in bonescope's (Y-up metres): the conversion of its unit and axes, above every root,
@@ -99,6 +102,16 @@ impl Placement {
     pub fn is_conversion(&self, bone: usize) -> bool {
         self.conversion_nodes.get(bone).copied().unwrap_or(false)
     }
+
+    /// The uniform scale of the conversion above the roots: what it multiplies lengths by.
+    pub fn conversion_scale(&self) -> f64 {
+        uniform_scale(&self.conversion)
+    }
+}
+
+/// The uniform scale of a similarity `m`: the cube root of its determinant's size.
+fn uniform_scale(m: &glam::DMat4) -> f64 {
+    m.determinant().abs().cbrt()
 }
 
 /// A bone list that is not in parents-first order.
@@ -132,13 +145,16 @@ impl Skeleton {
         }
         let figure: Vec<bool> = bones.iter().map(|b| b.role.is_figure()).collect();
         let figure = if figure.contains(&true) { figure } else { vec![true; figure.len()] };
-        Ok(Skeleton { bones, figure, promoted, placement: Placement::default() })
+        let length_scales = vec![1.0; bones.len()];
+        Ok(Skeleton { bones, figure, promoted, placement: Placement::default(), placed_by: Vec::new(), length_scales })
     }
 
     /// The same bones placed by `placement` (its conversion nodes, where given, one flag per bone).
     pub fn placed(mut self, placement: Placement) -> Self {
         debug_assert!(placement.conversion_nodes.is_empty() || placement.conversion_nodes.len() == self.len());
         self.placement = placement;
+        self.placed_by = if self.placement.is_identity() { Vec::new() } else { self.find_placed_by() };
+        self.length_scales = self.find_length_scales();
         self
     }
 
@@ -148,8 +164,18 @@ impl Skeleton {
     }
 
     /// Per bone, the conversion node that places it (itself for a conversion node), or `None` for the skeleton's
-    /// conversion.
-    pub fn placed_by(&self) -> Vec<Option<usize>> {
+    /// conversion; empty where nothing is placed.
+    pub fn placed_by(&self) -> &[Option<usize>] {
+        &self.placed_by
+    }
+
+    /// Per bone, the uniform scale of the conversion above it at rest (1 where none): what its model matrix's scale
+    /// factors are divided by to be the ones the file's author set, in the file's unit.
+    pub fn length_scales(&self) -> &[f64] {
+        &self.length_scales
+    }
+
+    fn find_placed_by(&self) -> Vec<Option<usize>> {
         let mut placed_by: Vec<Option<usize>> = Vec::with_capacity(self.len());
         for (i, bone) in self.bones.iter().enumerate() {
             let own = self.placement.is_conversion(i).then_some(i);
@@ -158,19 +184,14 @@ impl Skeleton {
         placed_by
     }
 
-    /// Per bone, the uniform scale of the conversion above it at rest (1 where none): what its model matrix's scale
-    /// factors are divided by to be the ones the file's author set, in the file's unit.
-    pub fn length_scales(&self) -> Vec<f64> {
+    fn find_length_scales(&self) -> Vec<f64> {
         if self.placement.is_identity() {
             return vec![1.0; self.len()];
         }
         let rest = self.rest_model_matrices();
-        let placed_by = self.placed_by();
-        let uniform_scale = |m: &glam::DMat4| m.determinant().abs().cbrt();
-        let above =
-            |bone: Option<usize>| bone.map_or(uniform_scale(&self.placement.conversion), |b| uniform_scale(&rest[b]));
+        let above = |bone: Option<usize>| bone.map_or(self.placement.conversion_scale(), |b| uniform_scale(&rest[b]));
         (0..self.len())
-            .map(|i| match placed_by[i] {
+            .map(|i| match self.placed_by[i] {
                 Some(node) if node == i => above(self.bones[i].parent),
                 node => above(node),
             })
