@@ -35,7 +35,7 @@ fn request(rig: &Rig, mode: Option<InheritMode>) -> Request<'_> {
 
 /// The source's first clip against the bake's, as `bonescope diff` compares them.
 fn diff(source: &Request, baked: &Rig) {
-    let a = source.clips[0].source.clone();
+    let a = source.clips()[0].source.clone();
     let b = Evaluation::declared(baked, baked.clips.first());
     let pairs = Pairs::by_name(&a, &b);
     compare(&a, &b, &pairs, &comparison_times(&a, &b, 60.0));

@@ -62,7 +62,7 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
     harness.get_by_role_and_label(Role::Button, "segment-compensate").click();
     settle(&mut harness);
     let app = harness.state();
-    assert!(app.doc.modes.iter().all(|&m| m == InheritMode::SegmentCompensate));
+    assert!(app.doc.modes().iter().all(|&m| m == InheritMode::SegmentCompensate));
     harness.get_by_label("findings: none");
     // The whole-clip analysis agrees: nothing is stretched any more.
     assert!(app.analysis().unwrap().scan.bones.iter().all(|b| !b.stretched()));
@@ -271,12 +271,12 @@ fn declared_modes_are_one_click_away_after_any_edit() {
     harness.run();
     harness.get_by_role_and_label(Role::Button, "segment-compensate").click();
     settle(&mut harness);
-    assert_ne!(harness.state().doc.modes, declared);
+    assert_ne!(harness.state().doc.modes(), declared);
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "declared").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes, declared);
+    assert_eq!(harness.state().doc.modes(), declared);
 }
 
 #[test]
@@ -290,7 +290,7 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
     harness.run();
     harness.get_by_role_and_label(Role::Button, "componentwise").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes[hand], InheritMode::Componentwise);
+    assert_eq!(harness.state().doc.modes()[hand], InheritMode::Componentwise);
     // The Inspector now names the bone too: the outliner's row is the button.
     harness.get_by_role_and_label(Role::Button, "hand").click_secondary();
     harness.run();
@@ -298,7 +298,7 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
     harness.run();
     harness.get_by_role_and_label(Role::Button, "declared").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes[hand], harness.state().doc.rig.skeleton.bone(hand).inherit);
+    assert_eq!(harness.state().doc.modes()[hand], harness.state().doc.rig.skeleton.bone(hand).inherit);
 }
 
 fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
@@ -603,12 +603,13 @@ fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged
     let folder = tempfile::tempdir().unwrap();
     let baked = maya_trs_bake(folder.path());
     let mut harness = asset_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
-    let bones = harness.state().doc.rig.skeleton.len();
-    harness.state_mut().doc.modes = vec![InheritMode::UnscaledParent; bones];
+    let unscaled = bonescope::model::ModeChoice::Mode(InheritMode::UnscaledParent);
+    harness.state_mut().doc.set_mode(0, bonescope::app::ModeScope::All, unscaled);
     harness.state_mut().compare(&baked);
     settle(&mut harness);
     let doc = &harness.state().doc;
-    assert!(matches!(&doc.ghost, Some(bonescope::app::Ghost::Compared(c)) if c.path == baked), "{:?}", doc.ghost);
+    assert_eq!(doc.ghost, Some(bonescope::app::Ghost::Compared));
+    assert_eq!(doc.compared.as_ref().map(|c| c.path.clone()), Some(baked.clone()));
     harness.get_by_label_contains("comparing with");
     // The TRS bake drops the stretch of `Mid` (it needed a helper): `Mid` and what hangs below it differ, the root
     // does not.
@@ -883,7 +884,7 @@ fn a_narrow_window_keeps_every_toolbar_control_with_a_long_take_name() {
 fn figure_and_ghost_heights(app: &BonescopeApp, time: f64) -> (f64, f64) {
     let doc = &app.doc;
     let compared = doc.compared.as_ref().expect("a compared file");
-    let (own, other) = (doc.evaluation().pose_at(time), compared.evaluation(doc.clip).pose_at(time));
+    let (own, other) = (doc.evaluation().pose_at(time), compared.evaluation(doc.setup().clip).pose_at(time));
     let height =
         |ys: Vec<f64>| ys.iter().copied().fold(f64::MIN, f64::max) - ys.iter().copied().fold(f64::MAX, f64::min);
     let paired: Vec<(usize, usize)> =
@@ -963,7 +964,7 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     // The first fix that is a setting of the document is a mode on the forearm; Try sets it on that bone alone.
-    let declared = harness.state().doc.modes.clone();
+    let declared = harness.state().doc.modes().to_vec();
     let fixes = ranked_fixes(harness.state(), forearm);
     let first = fixes.iter().find(|f| !matches!(f.change, Change::Bake { .. })).unwrap();
     let Change::Mode { bone: fixed, mode } = first.change else { panic!("{first:?}") };
@@ -971,8 +972,8 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     in_inspector(&harness, "Try").click();
     settle(&mut harness);
     let app = harness.state();
-    assert_eq!(app.doc.modes[forearm], mode);
-    assert!(app.doc.modes.iter().zip(&declared).enumerate().all(|(b, (m, d))| b == forearm || m == d));
+    assert_eq!(app.doc.modes()[forearm], mode);
+    assert!(app.doc.modes().iter().zip(&declared).enumerate().all(|(b, (m, d))| b == forearm || m == d));
     assert!(!app.analysis().unwrap().scan.bones[forearm].stretched(), "the analysis no longer flags the forearm");
     // The ghost shows the declared modes, as the clip was before.
     assert_eq!(app.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));

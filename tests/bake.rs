@@ -35,7 +35,7 @@ const DENSE_RATE: f64 = 1200.0;
 
 /// `None` is each bone's declared mode.
 fn modes() -> Vec<Option<InheritMode>> {
-    std::iter::once(None).chain(InheritMode::ALL.into_iter().map(Some)).collect()
+    std::iter::once(None).chain(InheritMode::ALL.iter().copied().map(Some)).collect()
 }
 
 fn label(mode: Option<InheritMode>) -> &'static str {
@@ -93,8 +93,8 @@ fn worst(
 ) -> (f64, f64) {
     let request = request(b.source, b.mode, strategy, 0.0);
     let mut worst: f64 = 0.0;
-    for k in 0..request.clips.len() {
-        let source = request.clips[k].source.clone();
+    for k in 0..request.clips().len() {
+        let source = request.clips()[k].source.clone();
         let baked = Evaluation::declared(&b.rig, b.rig.clips.get(k)).played_with(rotation);
         let pairs = Pairs::by_name(&source, &baked);
         let added: Vec<&str> = pairs.bones.only_b.iter().map(|&i| b.rig.skeleton.bone(i).name.as_str()).collect();
@@ -368,7 +368,7 @@ fn normals_morph_targets_and_their_weights_travel_with_the_meshes() {
     for (a, b) in source.normals.iter().zip(&result.normals) {
         assert!(a.abs_diff_eq(*b, 1e-6), "{a} against {b}");
     }
-    let a = request.clips[0].source.clone();
+    let a = request.clips()[0].source.clone();
     let b = Evaluation::declared(&back, back.clips.first());
     let pairs = Pairs::by_name(&a, &b);
     let comparison = compare(&a, &b, &pairs, &comparison_times(&a, &b, dense(&a)));

@@ -88,7 +88,7 @@ fn played_beyond_tolerance(
 ) -> Option<f64> {
     let times = frames_and_halves(source);
     let every = Request::every_clip(source, source.clip, engine.strategy(), bake::DEFAULT_TOLERANCE);
-    let baked = bake::bake(&Request { engine, ..every });
+    let baked = bake::bake(&every.for_engine(engine));
     let glb = folder.join("baked.glb");
     bake::save(&glb, &baked.glb).unwrap();
     let name = format!("{file} for {}", engine.id());

@@ -6,9 +6,10 @@ mod common;
 use std::path::Path;
 use std::sync::Arc;
 
-use bonescope::diff::{FileSide, diff_files};
+use bonescope::diff::{Clips, FileSide, diff_files};
+use bonescope::eval::Setup;
 use bonescope::eval::layers::RotationInterpolation;
-use bonescope::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+use bonescope::model::{Bone, BoneTracks, Clip, Interpolation, Rig, Skeleton, Track, Transform};
 use common::{asset, bonescope, json};
 use glam::Quat;
 use serde_json::Value;
@@ -301,16 +302,13 @@ fn nlerp_playback_departs_from_slerp_as_its_formula_says() {
     tracks.rotation = Some(Track::new(Arc::from([0.0, 1.0].as_slice()), keys, Interpolation::Linear).unwrap());
     let clip = Clip::new(0, Some("turn".into()), vec![tracks], vec![]);
     let rig = Rig { skeleton: Skeleton::new(vec![bone]).unwrap(), clips: vec![clip], ..Rig::default() };
-    let side = |interp| FileSide {
-        file: "turn".into(),
-        rig: &rig,
-        modes: vec![InheritMode::Full],
-        inherit: "declared".into(),
-        anim: None,
-        interp,
+    let side = |rotation| {
+        let mut setup = Setup::declared(&rig);
+        setup.layers.interpolation.rotation = rotation;
+        FileSide { file: "turn".into(), rig: &rig, setup }
     };
     let orientation = |interp| {
-        let diff = diff_files(&side(RotationInterpolation::Slerp), &side(interp), &[], 60.0).unwrap();
+        let diff = diff_files(&side(RotationInterpolation::Slerp), &side(interp), Clips::ByName, &[], 60.0).unwrap();
         assert_eq!(diff.interp_b, interp);
         diff.animations[0].bones[0].orientation_deg
     };

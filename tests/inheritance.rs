@@ -2,7 +2,7 @@
 
 use bonescope::eval::{Hierarchy, ModelPose};
 use bonescope::math::shear_deg;
-use bonescope::model::{Bone, InheritMode, NodeRole, Skeleton, Transform};
+use bonescope::model::{Bone, Choice, InheritMode, NodeRole, Skeleton, Transform};
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use proptest::prelude::*;
 
@@ -89,7 +89,7 @@ fn componentwise_applies_parent_scale_along_the_child_axes() {
 #[test]
 fn roots_are_their_local_matrix_in_every_mode() {
     let local = Transform::from_trs(DVec3::new(1.0, 2.0, 3.0), DQuat::from_rotation_x(0.3), DVec3::new(2.0, 0.5, 1.0));
-    for mode in InheritMode::ALL {
+    for &mode in InheritMode::ALL {
         assert!(evaluate(&[local], &[mode])[0].abs_diff_eq(local.matrix(), EPS), "{mode}");
     }
 }
@@ -211,7 +211,7 @@ fn blender_fix_shear_removes_rest_shear_only() {
 fn blender_heads_follow_the_full_parent_matrix() {
     // In every Blender mode the bone's head is P·O·c: here the parent's matrix applied to the offset (0, 1, 0).
     let head = blender_child(InheritMode::Full, true).w_axis;
-    for mode in InheritMode::ALL.into_iter().filter(|m| m.is_blender()) {
+    for mode in InheritMode::ALL.iter().copied().filter(|m| m.is_blender()) {
         assert!(blender_child(mode, true).w_axis.abs_diff_eq(head, 1e-12), "{mode}");
     }
 }

@@ -9,7 +9,7 @@ use bonescope::analysis::{Assessment, Components, CurveRequest, Judged, ScanOpti
 use bonescope::eval::{Evaluation, Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{
-    Bone, BoneTracks, Clip, InheritMode, Interpolation, MAX_FRAMES, NodeRole, Rig, Skeleton, Track, Transform,
+    Bone, BoneTracks, Choice, Clip, InheritMode, Interpolation, MAX_FRAMES, NodeRole, Rig, Skeleton, Track, Transform,
     sample_times,
 };
 use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
@@ -220,7 +220,7 @@ fn the_scan_agrees_with_decomposing_every_model_matrix() {
     }
     for (label, rig, clip) in subjects {
         let skeleton = &rig.skeleton;
-        for mode in InheritMode::ALL {
+        for &mode in InheritMode::ALL {
             let label = format!("{label}, all {}", mode.id());
             assert_scan_matches_brute_force(&label, rig, clip, &vec![mode; skeleton.len()]);
         }
@@ -264,7 +264,7 @@ fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes()
     let plotted = [7, 16, 25];
     let never = AtomicBool::new(false);
     let evaluation = Evaluation::declared(&rig, Some(clip));
-    for mode in InheritMode::ALL {
+    for &mode in InheritMode::ALL {
         let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]);
         let ghost = evaluation.with_modes(ghost_hierarchy.modes());
         let request = CurveRequest { bones: &plotted, ghost: Some(&ghost), ..Default::default() };

@@ -270,7 +270,8 @@ fn demo_compared_with_its_trs_bake() {
     let baked = folder.path().join("demo_trs.glb");
     bonescope::bake::save(&baked, &bonescope::bake::bake(&request).glb).unwrap();
     let mut doc = Document::demo();
-    doc.modes = modes;
+    let compensate = bonescope::model::ModeChoice::Mode(InheritMode::SegmentCompensate);
+    doc.set_mode(0, bonescope::app::ModeScope::All, compensate);
     doc.compare_with(bonescope::app::Compared::load(&baked, &doc.rig).unwrap());
     let mut settings = Settings::default();
     settings.scene.boxes = true;

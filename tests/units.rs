@@ -9,7 +9,7 @@ use base64::Engine;
 use bonescope::eval::Evaluation;
 use bonescope::import::{self, Options, Space};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, Clip, InheritMode, Placement, Rig, Skeleton, Transform};
+use bonescope::model::{Bone, Choice, Clip, InheritMode, Placement, Rig, Skeleton, Transform};
 use common::{asset, bonescope, json};
 use glam::{DMat4, DQuat, DVec3, Quat};
 use serde_json::{Value, json as object};
@@ -81,7 +81,7 @@ fn every_mode_in_the_files_own_space_then_converted_equals_it_in_bonescopes_spac
         // Each mode on one bone alone, on the bones with a parent (a few dozen of the big rigs').
         let step = declared.len().div_ceil(40);
         for bone in (1..declared.len()).step_by(step) {
-            for mode in InheritMode::ALL {
+            for &mode in InheritMode::ALL {
                 let mut modes = declared.clone();
                 modes[bone] = mode;
                 mode_sets.push((format!("{} alone on bone {bone}", mode.id()), modes));
@@ -119,7 +119,7 @@ fn a_file_written_in_metres_or_centimetres_gives_one_answer_under_every_mode() {
     let (centimetres, metres) =
         (with_unit_scale_factor(folder.path(), 1.0), with_unit_scale_factor(folder.path(), 100.0));
     let (cm, m) = (load(&centimetres, Space::YUpMetres), load(&metres, Space::YUpMetres));
-    for mode in InheritMode::ALL {
+    for &mode in InheritMode::ALL {
         let modes = vec![mode; cm.skeleton.len()];
         let (ecm, em) = (Evaluation::new(&cm, cm.clips.first(), &modes), Evaluation::new(&m, m.clips.first(), &modes));
         let size = em.size(&times(&m));
@@ -202,7 +202,7 @@ fn joints_in_centimetres_under_a_conversion_node_move_as_the_same_joints_in_metr
     };
     let (m, cm) = (write(false), write(true));
     assert_eq!(cm.skeleton.placement().conversion_nodes, [true, false, false, false], "the Armature only converts");
-    for mode in InheritMode::ALL {
+    for &mode in InheritMode::ALL {
         let (em, ecm) =
             (Evaluation::new(&m, m.clips.first(), &[mode; 3]), Evaluation::new(&cm, cm.clips.first(), &[mode; 4]));
         let scales_cm = ecm.length_scales();

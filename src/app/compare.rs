@@ -8,14 +8,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::job::{Job, Progress};
-use super::{Document, Ghost};
+use super::job::{Job, Key, Progress};
+use super::{Document, RigId};
 use crate::analysis::{Assessment, Components, Tolerances};
 use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
 use crate::eval::layers::RotationInterpolation;
-use crate::eval::{Evaluation, Layers, SkinningMethod};
+use crate::eval::{Evaluation, Setup, SkinningMethod};
 use crate::import::{self, ImportError};
-use crate::model::{Choice, Clip, InheritMode, Rig, Unit};
+use crate::model::{Choice, Clip, Rig, Unit};
 use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
@@ -23,7 +23,9 @@ use crate::view::DrawnPose;
 pub struct Compared {
     pub path: PathBuf,
     /// The file's rig; its unit the file's own, or the one the user gave it where the file states none.
-    pub rig: Rig,
+    pub rig: Arc<Rig>,
+    /// This rig paired with this document rig: a new pairing, or a unit given, is another.
+    pub rig_id: RigId,
     /// Whether the file states its unit.
     states_unit: bool,
     /// The unit the file is measured in: the document's, or the one the user gave the document where its file
@@ -69,14 +71,14 @@ impl Compared {
             clips[a] = Some(b);
         }
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
-        let played = RotationInterpolation::default();
-        Compared { path, rig, states_unit, document_unit, bones, conversion, meshes, clips, played }
+        let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
+        Compared { path, rig, rig_id, states_unit, document_unit, bones, conversion, meshes, clips, played }
     }
 
     /// The same file paired with another document rig (the document was reloaded), keeping the units given and
     /// how it is played.
     pub fn repaired(&self, document: &Rig) -> Self {
-        let repaired = Compared::pair(self.path.clone(), self.rig.clone(), document);
+        let repaired = Compared::pair(self.path.clone(), (*self.rig).clone(), document);
         let document_unit = document.unit.or(self.document_unit);
         Compared { states_unit: self.states_unit, document_unit, played: self.played, ..repaired }
     }
@@ -109,20 +111,33 @@ impl Compared {
         self.bones.iter().zip(&self.conversion).filter(|(b, c)| b.is_none() && !**c).count()
     }
 
-    /// The clip here that stands for the document's clip `clip` (an index; `None`: the rest pose, for which this
-    /// file plays its first clip).
-    pub fn clip_for(&self, clip: Option<usize>) -> Option<&Clip> {
-        let partner = match clip {
+    /// The clip here (an index) that stands for the document's clip `clip` (an index; `None`: the rest pose, for
+    /// which this file plays its first clip).
+    fn partner(&self, clip: Option<usize>) -> Option<usize> {
+        match clip {
             Some(clip) => self.clips.get(clip).copied().flatten(),
             None => (!self.rig.clips.is_empty()).then_some(0),
-        };
-        partner.map(|c| &self.rig.clips[c])
+        }
     }
 
-    /// This file evaluated as it declares, for the document's clip `clip` (an index), measured in the document's
-    /// unit, its rotation keys played as chosen.
+    /// The clip here that stands for the document's clip `clip`.
+    pub fn clip_for(&self, clip: Option<usize>) -> Option<&Clip> {
+        self.partner(clip).map(|c| &self.rig.clips[c])
+    }
+
+    /// What is evaluated of this file for the document's clip `clip` (an index): the clip that stands for it, as
+    /// the file declares, measured in the document's unit, its rotation keys played as chosen.
+    pub fn setup(&self, clip: Option<usize>) -> Setup {
+        let mut setup = Setup { clip: self.partner(clip), unit: self.document_unit, ..Setup::default() };
+        setup.layers.interpolation.rotation = self.played;
+        setup
+    }
+
+    /// This file evaluated as [`Compared::setup`] says.
     pub fn evaluation(&self, clip: Option<usize>) -> Evaluation<'_> {
-        Evaluation::declared(&self.rig, self.clip_for(clip)).measured_in(self.document_unit).played_with(self.played)
+        let setup = self.setup(clip);
+        // The clip is the file's own, and nothing names a bone or another clip.
+        Evaluation::of(&self.rig, &setup).unwrap_or_else(|_| Evaluation::declared(&self.rig, None))
     }
 
     /// The ghost at `time`: this file's pose on the document's bones (a bone without a partner stays where the
@@ -167,9 +182,9 @@ pub fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     if !compared.states_unit
         && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
     {
-        let mut changed = (*compared).clone();
-        changed.rig.unit = Some(unit);
-        replace(doc, changed);
+        let mut rig = (*compared.rig).clone();
+        rig.unit = Some(unit);
+        replace(doc, Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), ..(*compared).clone() });
     }
     if doc.rig.unit.is_none()
         && let Some(unit) = unit_picker(ui, &doc.title(), compared.document_unit, &compared.title())
@@ -210,28 +225,26 @@ fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -
     picked.filter(|_| picked != unit)
 }
 
-/// The document compared with `compared` instead, the ghost too where it showed the earlier comparison.
+/// The document compared with `compared` instead.
 fn replace(doc: &mut Document, compared: Compared) {
-    let compared = Arc::new(compared);
-    if matches!(doc.ghost, Some(Ghost::Compared(_))) {
-        doc.ghost = Some(Ghost::Compared(compared.clone()));
-    }
-    doc.compared = Some(compared);
+    doc.compared = Some(Arc::new(compared));
 }
 
-/// What the comparison over the clip depends on.
+/// What is asked of a comparison with the compared file: that file (this pairing of it) as evaluated, and how often
+/// the clip is sampled.
 #[derive(Clone, Debug, PartialEq)]
-pub struct CompareKey {
-    /// The document's and the compared file's loads.
-    pub generations: (u64, u64),
-    pub clip: Option<usize>,
-    pub modes: Vec<InheritMode>,
-    pub layers: Layers,
+pub struct CompareRequest {
+    pub compared: RigId,
+    pub setup: Setup,
     pub rate: f64,
-    /// The units the two files are taken in ([`Compared::units`]).
-    pub units: [Option<Unit>; 2],
-    /// How the compared file's rotation keys are played.
-    pub played: RotationInterpolation,
+}
+
+impl CompareRequest {
+    /// The comparison of `doc` with its compared file at `rate` samples a second, keyed.
+    pub fn of(doc: &Document, compared: &Compared, rate: f64) -> Key<CompareRequest> {
+        let setup = compared.setup(doc.setup().clip);
+        Key::of(doc, CompareRequest { compared: compared.rig_id, setup, rate })
+    }
 }
 
 /// Each document bone's largest difference from the compared file over the clip.
@@ -243,10 +256,10 @@ pub struct Differences {
     pub rig_size: f64,
 }
 
-/// What the compared curves depend on: the comparison's, the plotted bones, and the times of the document's curves.
+/// What is asked of the compared file's curves: the bones plotted (the document's), at the times of the document's
+/// own curves (the dashed curves share their axis).
 #[derive(Clone, Debug, PartialEq)]
-pub struct CurvesKey {
-    pub compare: CompareKey,
+pub struct CurvesRequest {
     pub plotted: Vec<usize>,
     pub times: Vec<f64>,
 }
@@ -257,24 +270,25 @@ pub type ComparedCurves = Vec<(usize, Vec<Components>)>;
 /// The background work of a comparison.
 #[derive(Default)]
 pub struct CompareJobs {
-    pub differences: Job<CompareKey, Differences>,
-    pub curves: Job<CurvesKey, ComparedCurves>,
+    pub differences: Job<Key<CompareRequest>, Differences>,
+    /// Keyed by the compared file as evaluated.
+    pub curves: Job<Key<CurvesRequest>, ComparedCurves>,
 }
 
-/// The differences `key` asks for, as work for a [`Job`]: the document (the one `key` was made from) against
+/// The differences `key` asks for, as work for a [`Job`]: the document's rig (the one `key` was made of) against
 /// `compared`.
 pub fn differences(
-    key: CompareKey,
-    doc: Document,
+    key: Key<CompareRequest>,
+    rig: Arc<Rig>,
     compared: Arc<Compared>,
 ) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
     move |_| {
-        let own = doc.evaluation();
-        let other = compared.evaluation(key.clip);
+        let own = key.evaluation(&rig)?;
+        let other = Evaluation::of(&compared.rig, &key.request.setup).ok()?;
         // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
         let pairs = Pairs { meshes: Vec::new(), ..Pairs::by_name(&own, &other) };
-        let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.rate));
-        let mut bones = vec![None; doc.rig.skeleton.len()];
+        let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.request.rate));
+        let mut bones = vec![None; rig.skeleton.len()];
         for difference in &comparison.bones {
             bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
         }
@@ -284,14 +298,15 @@ pub fn differences(
 
 /// The compared curves `key` asks for, as work for a [`Job`].
 pub fn curves(
-    key: CurvesKey,
+    key: Key<CurvesRequest>,
     compared: Arc<Compared>,
 ) -> impl FnOnce(&Progress) -> Option<ComparedCurves> + Send + 'static {
     move |_| {
+        let request = &key.request;
         let paired: Vec<(usize, usize)> =
-            key.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
+            request.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
         let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
-        let curves = model_curves(&compared.evaluation(key.compare.clip), &partners, &key.times);
+        let curves = model_curves(&key.evaluation(&compared.rig)?, &partners, &request.times);
         Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
     }
 }
@@ -354,7 +369,7 @@ mod tests {
         assert_eq!(loaded.units()[1], None, "a BVH states no unit");
         let centimetres: Unit = "cm".parse().unwrap();
         let mut given = loaded.clone();
-        given.rig.unit = Some(centimetres);
+        Arc::make_mut(&mut given.rig).unit = Some(centimetres);
         std::fs::write(&path, bvh.replace("0 1 0", "0 2 0")).unwrap();
         let reloaded = given.reloaded(&document).unwrap();
         assert_eq!(reloaded.units(), given.units(), "the unit picked survives the file's change");

@@ -1,71 +1,74 @@
-//! The open document: the loaded rig, where it came from, and the user's choices about it (clip, modes, ghost,
-//! layers).
+//! The open document: the loaded rig, where it came from, what is evaluated of it (its [`Setup`]: clip, modes,
+//! layers), the ghost and the compared file.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::compare::Compared;
-use crate::eval::layers::LayerError;
-use crate::eval::{Evaluation, LayerStack, Layers};
+use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};
-use crate::model::{Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Rig, Skeleton};
+use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton};
 
 /// A second pose drawn translucent over the first and plotted dashed.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ghost {
     /// The document's clip through the same layers under other modes.
     Modes(ModeChoice),
     /// The clip as authored: the document's modes without the layers.
     Unlayered,
     /// The file compared with the document (File → Compare with…): its pose on the paired bones.
-    Compared(Arc<Compared>),
-}
-
-impl PartialEq for Ghost {
-    fn eq(&self, other: &Ghost) -> bool {
-        match (self, other) {
-            (Ghost::Modes(a), Ghost::Modes(b)) => a == b,
-            (Ghost::Unlayered, Ghost::Unlayered) => true,
-            (Ghost::Compared(a), Ghost::Compared(b)) => Arc::ptr_eq(a, b),
-            _ => false,
-        }
-    }
+    Compared,
 }
 
 impl Ghost {
     pub fn label(&self) -> &'static str {
         match self {
-            Ghost::Modes(choice) => choice.label(),
+            Ghost::Modes(choice) => choice.id(),
             Ghost::Unlayered => "without layers",
-            Ghost::Compared(_) => "compared file",
+            Ghost::Compared => "compared file",
         }
     }
 
-    /// The ghost's evaluation of the document's rig, given the document's own; `None` for the compared file,
-    /// another rig, whose pose is paired bone by bone ([`Compared::ghost`]).
-    pub fn evaluation<'a>(&self, document: &Evaluation<'a>) -> Option<Evaluation<'a>> {
-        match self {
-            Ghost::Modes(choice) => Some(document.with_modes(&document.skeleton().modes(*choice))),
-            Ghost::Unlayered => Some(document.without_layers()),
-            Ghost::Compared(_) => None,
+    /// What the ghost evaluates of the document's rig, given what the document evaluates; `None` for the compared
+    /// file, another rig, whose pose is paired bone by bone ([`Compared::ghost`]).
+    pub fn setup(&self, document: &Setup) -> Option<Setup> {
+        match *self {
+            Ghost::Modes(choice) => Some(Setup { modes: Modes::all(choice), ..document.clone() }),
+            Ghost::Unlayered => Some(Setup { layers: Layers::default(), ..document.clone() }),
+            Ghost::Compared => None,
         }
     }
 }
 
-/// A loaded rig and the choices that change how it evaluates.
+/// One load of a rig: what every result computed from it is keyed by, so that another file, or the same file read
+/// again, is measured anew even where its bones are the same.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct RigId(u64);
+
+impl RigId {
+    /// An identity no rig had before.
+    pub fn fresh() -> RigId {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        RigId(NEXT.fetch_add(1, Ordering::Relaxed))
+    }
+}
+
+/// A loaded rig and what is evaluated of it.
 #[derive(Clone, Debug)]
 pub struct Document {
     /// `None` for the built-in demo.
     pub path: Option<PathBuf>,
     pub rig: Arc<Rig>,
-    /// One mode per bone, starting from what the file declares.
-    pub modes: Vec<InheritMode>,
-    /// Never a compared file other than `compared`.
-    pub ghost: Option<Ghost>,
-    /// Index into `rig.clips`.
-    pub clip: Option<usize>,
-    /// The runtime techniques layered on the clip, prepared for the rig.
+    pub rig_id: RigId,
+    /// What is evaluated: clip, modes, layers. Changed only through the checks of [`Document::set_setup`].
+    setup: Setup,
+    /// The setup's modes, one per bone.
+    modes: Vec<InheritMode>,
+    /// The setup's layers prepared for the rig.
     layers: LayerStack,
+    /// Never [`Ghost::Compared`] without a compared file.
+    pub ghost: Option<Ghost>,
     /// A frame rate the user chose instead of the clip's own.
     pub frame_rate_override: Option<f64>,
     /// A second file compared with this one.
@@ -84,17 +87,18 @@ impl Document {
         Ok(Document::new(Some(path.to_owned()), import::load(path)?))
     }
 
-    /// A document on a rig that is already loaded (or generated).
+    /// A document on a rig that is already loaded (or generated), as its file declares it.
     pub fn new(path: Option<PathBuf>, rig: Rig) -> Self {
+        let setup = Setup::declared(&rig);
         let modes = rig.skeleton.declared_modes();
-        let clip = (!rig.clips.is_empty()).then_some(0);
         Document {
             path,
             rig: Arc::new(rig),
+            rig_id: RigId::fresh(),
+            setup,
             modes,
-            ghost: None,
-            clip,
             layers: LayerStack::default(),
+            ghost: None,
             frame_rate_override: None,
             compared: None,
         }
@@ -103,35 +107,54 @@ impl Document {
     /// The same file re-read (after it changed on disk), keeping clip, modes, ghost and layers where they still
     /// fit. Layers naming clips or bones the new file lacks are dropped rather than kept half-valid: the error says
     /// why, for the user.
-    pub fn reloaded(&self, rig: Rig) -> (Self, Option<LayerError>) {
+    pub fn reloaded(&self, rig: Rig) -> (Self, Option<SetupError>) {
         let mut doc = Document::new(self.path.clone(), rig);
-        if doc.modes.len() == self.modes.len() {
-            doc.modes.clone_from(&self.modes);
-        }
         doc.frame_rate_override = self.frame_rate_override;
         doc.compared = self.compared.as_ref().map(|c| Arc::new(c.repaired(&doc.rig)));
-        doc.ghost = match &self.ghost {
-            Some(Ghost::Compared(_)) => doc.compared.clone().map(Ghost::Compared),
-            ghost => ghost.clone(),
+        doc.ghost = self.ghost.filter(|ghost| *ghost != Ghost::Compared || doc.compared.is_some());
+        // Bones given their own mode are kept where the bones are the same ones (as many as before).
+        let modes = match doc.rig.skeleton.len() == self.rig.skeleton.len() {
+            true => self.setup.modes.clone(),
+            false => Modes::all(self.setup.modes.all),
         };
-        doc.clip = self.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.clip);
-        let dropped = doc.set_layers(self.layers()).err();
+        let clip = self.setup.clip.filter(|&c| c < doc.rig.clips.len()).or(doc.setup.clip);
+        let kept = Setup { clip, modes, layers: Layers::default(), ..self.setup.clone() };
+        // The clip and the bones are the rig's: it fits.
+        let _ = doc.set_setup(kept);
+        let dropped = doc.set_layers(&self.setup.layers).err();
         (doc, dropped)
     }
 
-    pub fn layers(&self) -> &Layers {
-        self.layers.layers()
+    /// What is evaluated.
+    pub fn setup(&self) -> &Setup {
+        &self.setup
     }
 
-    /// The layers prepared for evaluating (a copy per evaluating thread: it holds scratch buffers).
-    pub fn layer_stack(&self) -> &LayerStack {
-        &self.layers
+    /// Evaluates `setup` from now on; on one that does not fit the rig, keeps the old one.
+    pub fn set_setup(&mut self, setup: Setup) -> Result<(), SetupError> {
+        self.layers = setup.prepare(&self.rig)?;
+        self.modes = setup.modes.resolve(&self.rig.skeleton);
+        self.setup = setup;
+        Ok(())
+    }
+
+    pub fn layers(&self) -> &Layers {
+        &self.setup.layers
     }
 
     /// Replaces the layers; on an index the rig does not have, keeps the old ones.
-    pub fn set_layers(&mut self, layers: &Layers) -> Result<(), LayerError> {
-        self.layers = LayerStack::new(&self.rig, layers)?;
-        Ok(())
+    pub fn set_layers(&mut self, layers: &Layers) -> Result<(), SetupError> {
+        self.set_setup(Setup { layers: layers.clone(), ..self.setup.clone() })
+    }
+
+    /// Plays the clip `clip` (an index into the rig's clips; `None`: the rest pose).
+    pub fn set_clip(&mut self, clip: Option<usize>) -> Result<(), SetupError> {
+        self.set_setup(Setup { clip, ..self.setup.clone() })
+    }
+
+    /// One mode per bone.
+    pub fn modes(&self) -> &[InheritMode] {
+        &self.modes
     }
 
     pub fn title(&self) -> String {
@@ -146,7 +169,7 @@ impl Document {
     }
 
     pub fn clip(&self) -> Option<&Clip> {
-        self.clip.and_then(|c| self.rig.clips.get(c))
+        self.setup.clip.and_then(|c| self.rig.clips.get(c))
     }
 
     /// Frames per second of the timeline: the user's choice, else the clip's own (the file's rate, or its key
@@ -169,26 +192,31 @@ impl Document {
 
     /// What the document shows: its clip under its modes, through its layers.
     pub fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::new(&self.rig, self.clip(), &self.modes).with_layers(self.layers.clone())
+        Evaluation::prepared(&self.rig, &self.setup, self.layers.clone())
+    }
+
+    /// What the ghost evaluates of this rig, when the ghost is one (a compared file's is its own).
+    pub fn ghost_setup(&self) -> Option<Setup> {
+        self.ghost?.setup(&self.setup)
     }
 
     /// The ghost's evaluation of this rig, when the ghost is one (a compared file's is its own:
     /// [`Compared::ghost`]).
     pub fn ghost_evaluation(&self) -> Option<Evaluation<'_>> {
-        self.ghost.as_ref()?.evaluation(&self.evaluation())
+        // A ghost's setup differs from the document's in modes or layers alone, which fit the rig as they did.
+        Evaluation::of(&self.rig, &self.ghost_setup()?).ok()
     }
 
     /// Compares this document with `compared`, drawn as the ghost.
     pub fn compare_with(&mut self, compared: Compared) {
-        let compared = Arc::new(compared);
-        self.compared = Some(compared.clone());
-        self.ghost = Some(Ghost::Compared(compared));
+        self.compared = Some(Arc::new(compared));
+        self.ghost = Some(Ghost::Compared);
     }
 
     /// Stops comparing (a compared ghost goes too).
     pub fn stop_comparing(&mut self) {
         self.compared = None;
-        if let Some(Ghost::Compared(_)) = self.ghost {
+        if self.ghost == Some(Ghost::Compared) {
             self.ghost = None;
         }
     }
@@ -196,11 +224,19 @@ impl Document {
     /// Sets the mode of one bone, of its subtree, or of all bones.
     pub fn set_mode(&mut self, bone: usize, scope: ModeScope, choice: ModeChoice) {
         let skeleton = &self.rig.skeleton;
-        for (b, m) in self.modes.iter_mut().enumerate() {
-            if scope.applies(skeleton, b, bone) {
-                *m = choice.mode_for(skeleton.bone(b).inherit);
+        let modes = match scope {
+            ModeScope::All => Modes::all(choice),
+            _ => {
+                let mut modes = self.setup.modes.clone();
+                for b in (0..skeleton.len()).filter(|&b| scope.applies(skeleton, b, bone)) {
+                    modes.set(skeleton, b, choice);
+                }
+                modes
             }
-        }
+        };
+        let setup = Setup { modes, ..self.setup.clone() };
+        // The modes name only the rig's bones, and nothing else changed.
+        let _ = self.set_setup(setup);
     }
 
     /// The choice every bone of `scope` (around `bone`) matches: declared when each has its own, a mode when all
@@ -210,7 +246,7 @@ impl Document {
         let in_scope = || (0..self.modes.len()).filter(move |&b| scope.applies(skeleton, b, bone));
         let matches =
             |choice: ModeChoice| in_scope().all(|b| self.modes[b] == choice.mode_for(skeleton.bone(b).inherit));
-        ModeChoice::all().find(|&choice| matches(choice))
+        ModeChoice::ALL.iter().copied().find(|&choice| matches(choice))
     }
 
     /// The mode every bone shares, if they all share one.
@@ -249,7 +285,7 @@ mod tests {
         let forearm = doc.rig.skeleton.find("forearm").unwrap();
         doc.set_mode(forearm, ModeScope::Subtree, ModeChoice::Mode(InheritMode::SegmentCompensate));
         let names: Vec<&str> = doc
-            .modes
+            .modes()
             .iter()
             .enumerate()
             .filter(|(_, m)| **m == InheritMode::SegmentCompensate)
@@ -277,32 +313,31 @@ mod tests {
         let mut doc = Document::new(None, rig);
         let declared = doc.rig.skeleton.declared_modes();
         doc.set_mode(0, ModeScope::All, ModeChoice::Mode(InheritMode::Full));
-        assert_ne!(doc.modes, declared);
+        assert_ne!(doc.modes(), declared);
         doc.set_mode(0, ModeScope::All, ModeChoice::Declared);
-        assert_eq!(doc.modes, declared);
+        assert_eq!(doc.modes(), declared);
         assert_eq!(doc.current_choice(0, ModeScope::All), Some(ModeChoice::Declared));
         assert_eq!(doc.current_choice(2, ModeScope::Bone), Some(ModeChoice::Declared), "declared wins over its mode");
         doc.set_layers(&Layers { bind_weight: 0.5, ..Layers::default() }).unwrap();
-        let ghost = Ghost::Modes(ModeChoice::Declared).evaluation(&doc.evaluation()).unwrap();
+        doc.ghost = Some(Ghost::Modes(ModeChoice::Declared));
+        let ghost = doc.ghost_evaluation().unwrap();
         assert_eq!((ghost.modes(), ghost.layers().is_some()), (declared.as_slice(), true), "the same layers");
-        let unlayered = Ghost::Unlayered.evaluation(&doc.evaluation()).unwrap();
-        assert_eq!((unlayered.modes(), unlayered.layers().is_none()), (doc.modes.as_slice(), true));
+        doc.ghost = Some(Ghost::Unlayered);
+        let unlayered = doc.ghost_evaluation().unwrap();
+        assert_eq!((unlayered.modes(), unlayered.layers().is_none()), (doc.modes(), true));
     }
 
     #[test]
     fn reloading_keeps_the_choices() {
         let mut doc = Document::demo();
-        doc.clip = Some(1);
+        doc.set_clip(Some(1)).unwrap();
         doc.set_mode(2, ModeScope::Bone, ModeChoice::Mode(InheritMode::BlenderAligned));
         let blend = crate::eval::layers::Blend { clip: 0, weight: 0.3, sync: true, rotation: Default::default() };
         doc.set_layers(&Layers { blend: Some(blend), ..Layers::default() }).unwrap();
         let (again, dropped) = doc.reloaded(import::demo_rig());
         assert_eq!(dropped, None);
-        assert_eq!(
-            (again.clip, again.modes.clone(), again.ghost.clone()),
-            (doc.clip, doc.modes.clone(), doc.ghost.clone())
-        );
-        assert_eq!(again.layers(), doc.layers());
+        assert_eq!((again.setup(), again.ghost), (doc.setup(), doc.ghost));
+        assert_ne!(again.rig_id, doc.rig_id, "a reload is another rig");
         // A file that lost the blended clip keeps the document but drops the layers that no longer fit.
         let mut one_clip = import::demo_rig();
         one_clip.clips.truncate(1);

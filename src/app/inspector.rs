@@ -8,9 +8,9 @@ use glam::DMat4;
 use super::Shared;
 use super::text::compact;
 use super::why::Why;
-use super::{ModeChoice, ModeScope};
 use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
+use crate::model::Choice;
 use crate::view::Badge;
 
 /// The panel's own state: the Why? section's explanation.
@@ -36,7 +36,7 @@ impl Inspector {
 
 fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize, why: &mut Why) {
     let reports =
-        BoneReport::all(&shared.doc.rig.skeleton, &shared.doc.modes, &shared.frame.pose, &shared.settings.tolerances);
+        BoneReport::all(&shared.doc.rig.skeleton, shared.doc.modes(), &shared.frame.pose, &shared.settings.tolerances);
     let report = &reports[bone];
     ui.label(RichText::new(&report.name).strong().size(16.0));
     ui.label(format!("bone {} · node {} · inherit {}", report.index, report.node, report.inherit.id()));
@@ -91,7 +91,7 @@ const COPIED_SECONDS: f64 = 2.0;
 /// What `inspect --format json` prints for the document at the current time: every bone, the layers, the bind check.
 fn inspect_report(shared: &Shared, bones: Vec<BoneReport>) -> LayeredInspectReport {
     let doc = &*shared.doc;
-    let inherit = doc.current_choice(0, ModeScope::All).map_or("mixed", ModeChoice::label).to_owned();
+    let inherit = doc.setup().modes.label().to_owned();
     let file = doc.path.as_ref().map_or_else(|| "demo".to_owned(), |p| p.display().to_string());
     let samples = vec![SampleReport { time: *shared.time, bones }];
     LayeredInspectReport::new(file, &doc.evaluation(), inherit, samples)

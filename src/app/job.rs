@@ -5,10 +5,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
-use super::{Document, Ghost};
+use super::{Document, RigId};
 use crate::analysis::{ClipAnalysis, CurveRequest, Judged, ScanOptions, Tolerances, analyze};
-use crate::eval::Layers;
-use crate::model::{InheritMode, Rig};
+use crate::eval::{Evaluation, Layers, Setup};
+use crate::model::Rig;
 
 /// How far a piece of work has come, and whether it should stop (a newer one replaced it).
 #[derive(Clone, Default)]
@@ -131,45 +131,38 @@ impl<K: Clone + PartialEq + Send + 'static, T: Send + Sync + 'static> Job<K, T> 
     }
 }
 
-/// What a measurement of the document depends on: its rig (this one, not an equal one: another file opened with the
-/// same bones is measured anew), its clip, modes and layers.
-#[derive(Clone)]
-pub struct DocumentKey {
-    rig: Arc<Rig>,
-    clip: Option<usize>,
-    modes: Vec<InheritMode>,
-    layers: Layers,
-}
-
-impl DocumentKey {
-    pub fn of(doc: &Document) -> Self {
-        DocumentKey { rig: doc.rig.clone(), clip: doc.clip, modes: doc.modes.clone(), layers: doc.layers().clone() }
-    }
-
-    /// The key of a measurement of the clip as authored, which no layer changes (the bind check): a layer edit,
-    /// a dragged weight slider, starts no new one.
-    pub fn authored(doc: &Document) -> Self {
-        DocumentKey { layers: Layers::default(), ..DocumentKey::of(doc) }
-    }
-}
-
-impl PartialEq for DocumentKey {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.rig, &other.rig)
-            && (self.clip, &self.modes, &self.layers) == (other.clip, &other.modes, &other.layers)
-    }
-}
-
-/// Everything a whole-clip analysis depends on: what the document's evaluation does, the ghost's, and what is
-/// asked of them.
+/// What a result computed of a rig depends on: the rig (this load of it, [`RigId`]), what is evaluated of it, and
+/// what is asked of that evaluation.
 #[derive(Clone, Debug, PartialEq)]
-pub struct JobKey {
-    /// Changes whenever a (re)loaded rig replaces the document's.
-    pub generation: u64,
-    pub clip: Option<usize>,
-    pub modes: Vec<InheritMode>,
-    pub ghost: Option<Ghost>,
-    pub layers: Layers,
+pub struct Key<R> {
+    pub rig: RigId,
+    pub setup: Setup,
+    pub request: R,
+}
+
+impl<R> Key<R> {
+    /// `request` of what `doc` evaluates.
+    pub fn of(doc: &Document, request: R) -> Self {
+        Key { rig: doc.rig_id, setup: doc.setup().clone(), request }
+    }
+
+    /// `request` of the clip as authored, which no layer changes (the bind check): a layer edit, a dragged weight
+    /// slider, starts no new one.
+    pub fn authored(doc: &Document, request: R) -> Self {
+        Key { setup: Setup { layers: Layers::default(), ..doc.setup().clone() }, ..Key::of(doc, request) }
+    }
+
+    /// The evaluation the key's setup makes of `rig` (the rig the key was made of); `None` if it does not fit.
+    pub fn evaluation<'a>(&self, rig: &'a Rig) -> Option<Evaluation<'a>> {
+        Evaluation::of(rig, &self.setup).ok()
+    }
+}
+
+/// What a whole-clip analysis is asked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnalysisRequest {
+    /// What the ghost evaluates of the same rig (its curves are plotted dashed).
+    pub ghost: Option<Setup>,
     pub plotted: Vec<usize>,
     pub rate: f64,
     pub tolerances: Tolerances,
@@ -178,17 +171,20 @@ pub struct JobKey {
 }
 
 /// The whole-clip analysis of the document.
-pub type AnalysisJob = Job<JobKey, ClipAnalysis>;
+pub type AnalysisJob = Job<Key<AnalysisRequest>, ClipAnalysis>;
 
-/// The analysis `key` asks of `doc` (the document `key` was made from), as work for a [`Job`].
-pub fn analysis(key: JobKey, doc: Document) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
+/// The analysis `key` asks of `rig` (the rig `key` was made of), as work for a [`Job`].
+pub fn analysis(
+    key: Key<AnalysisRequest>,
+    rig: Arc<Rig>,
+) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
     move |progress| {
-        let evaluation = doc.evaluation();
-        // A compared file's ghost is another file's evaluation, not the analysis's.
-        let ghost = key.ghost.as_ref().and_then(|ghost| ghost.evaluation(&evaluation));
-        let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
-        let request = CurveRequest { bones: &key.plotted, ghost: ghost.as_ref(), judged: key.judged };
+        let evaluation = key.evaluation(&rig)?;
+        let request = &key.request;
+        let ghost = request.ghost.as_ref().and_then(|ghost| Evaluation::of(&rig, ghost).ok());
+        let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
+        let curves = CurveRequest { bones: &request.plotted, ghost: ghost.as_ref(), judged: request.judged };
         let report = |done: usize, total: usize| progress.report(done, total);
-        analyze(&evaluation, request, &options, &report, progress.cancelled())
+        analyze(&evaluation, curves, &options, &report, progress.cancelled())
     }
 }

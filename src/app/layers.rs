@@ -8,7 +8,7 @@
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
-use super::job::{DocumentKey, Job, Progress};
+use super::job::{Job, Key, Progress};
 use super::{Ghost, Shared};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{BindCheck, BindTolerance, check_bind};
@@ -21,9 +21,9 @@ use crate::view::Badge;
 #[derive(Default)]
 pub struct LayersPanel {
     /// The storage report of one document state: measured off the UI thread (it walks the whole clip).
-    storage: Job<DocumentKey, StorageReport>,
+    storage: Job<Key<()>, StorageReport>,
     /// The bind check of the document: off the UI thread (where joints are off their bind, it walks the whole clip).
-    bind: Job<DocumentKey, BindCheck>,
+    bind: Job<Key<()>, BindCheck>,
     /// How many bones the uniform-scale layer had in the last frame: a bone added elsewhere (the Inspector's Why?
     /// section) opens its section, where it is undone.
     uniform_bones: usize,
@@ -69,10 +69,10 @@ impl LayersPanel {
                 return;
             }
             // The check reads the clip as authored: its key leaves the layers out.
-            let key = DocumentKey::authored(doc);
+            let key = Key::authored(doc, ());
             let work = || {
-                let doc = doc.clone();
-                move |_: &Progress| Some(check_bind(&doc.evaluation(), &BindTolerance::default()))
+                let (rig, key) = (doc.rig.clone(), key.clone());
+                move |_: &Progress| Some(check_bind(&key.evaluation(&rig)?, &BindTolerance::default()))
             };
             let waker = ui.ctx().clone();
             self.bind.update(key.clone(), work, move || waker.request_repaint());
@@ -93,10 +93,12 @@ impl LayersPanel {
     fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
         CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
             let doc = &*shared.doc;
-            let key = DocumentKey::of(doc);
+            let key = Key::of(doc, ());
             if ui.button("Measure the clip").clicked() {
-                let doc = doc.clone();
-                let work = || move |_: &Progress| Some(storage_report(&doc.evaluation(), &StorageOptions::default()));
+                let (rig, measured) = (doc.rig.clone(), key.clone());
+                let work = || {
+                    move |_: &Progress| Some(storage_report(&measured.evaluation(&rig)?, &StorageOptions::default()))
+                };
                 let waker = ui.ctx().clone();
                 self.storage.update(key.clone(), work, move || waker.request_repaint());
             }
@@ -158,7 +160,7 @@ fn interpolation_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) 
 
 fn blend_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
     let rig = shared.doc.rig.clone();
-    let main = shared.doc.clip;
+    let main = shared.doc.setup().clip;
     CollapsingHeader::new("Blend").default_open(layers.blend.is_some()).show(ui, |ui| {
         let default = || Blend { clip: other_clip(&rig, main), weight: 0.5, sync: true, rotation: Default::default() };
         enable(ui, "blend a second clip", &mut layers.blend, default);
@@ -179,7 +181,7 @@ fn blend_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
 
 fn additive_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
     let rig = shared.doc.rig.clone();
-    let main = shared.doc.clip;
+    let main = shared.doc.setup().clip;
     CollapsingHeader::new("Additive").default_open(layers.additive.is_some()).show(ui, |ui| {
         let default = || Additive {
             clip: other_clip(&rig, main),
@@ -199,7 +201,7 @@ fn additive_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
 
 fn crossfade_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
     let rig = shared.doc.rig.clone();
-    let main = shared.doc.clip;
+    let main = shared.doc.setup().clip;
     let duration = shared.doc.clip().map_or(0.0, |c| c.duration());
     CollapsingHeader::new("Crossfade").default_open(layers.crossfade.is_some()).show(ui, |ui| {
         let default = || Crossfade {

@@ -30,7 +30,7 @@ use std::sync::mpsc::Receiver;
 
 pub use crate::model::ModeChoice;
 pub use compare::Compared;
-pub use document::{Document, Ghost, ModeScope};
+pub use document::{Document, Ghost, ModeScope, RigId};
 pub use file_browser::NativeDialog;
 pub use layout::{Layout, Pane};
 pub use plots::plot_id;
@@ -39,9 +39,9 @@ pub use settings::{RotationFormat, Settings, TimeUnit};
 use crate::analysis::{ClipAnalysis, Judged, Tolerances};
 use crate::eval::{Pose, SkinningMethod};
 use crate::view::DrawnPose;
-use compare::{CompareJobs, CompareKey, ComparedCurves, CurvesKey, Differences};
+use compare::{CompareJobs, CompareRequest, ComparedCurves, CurvesRequest, Differences};
 use file_browser::{DialogOutcome, FileBrowser};
-use job::{AnalysisJob, JobKey};
+use job::{AnalysisJob, AnalysisRequest, Key};
 use notifications::Notifications;
 
 /// At most this many bones are plotted at once (the most recently selected).
@@ -59,8 +59,10 @@ impl CurrentPose {
         let rig = &doc.rig;
         let pose = doc.evaluation().pose_at(time);
         let primary = DrawnPose::from_model(rig, pose.model.model.clone(), &pose.morph, skinning, tolerances);
-        let ghost = match &doc.ghost {
-            Some(Ghost::Compared(compared)) => Some(compared.ghost(doc.clip, &primary, time, skinning, tolerances)),
+        let ghost = match (&doc.ghost, &doc.compared) {
+            (Some(Ghost::Compared), Some(compared)) => {
+                Some(compared.ghost(doc.setup().clip, &primary, time, skinning, tolerances))
+            }
             _ => doc.ghost_evaluation().map(|evaluation| {
                 let ghost = evaluation.pose_at(time);
                 DrawnPose::from_model(rig, ghost.model.model, &ghost.morph, skinning, tolerances)
@@ -157,12 +159,9 @@ pub struct BonescopeApp {
     pub time: f64,
     pub playing: bool,
     pub selection: Vec<usize>,
-    generation: u64,
     job: AnalysisJob,
     curves_job: AnalysisJob,
     compare_jobs: CompareJobs,
-    /// Changes whenever a compared file is (re)loaded.
-    compared_generation: u64,
     notifications: Notifications,
     watcher: Option<watch::FileWatcher>,
     compared_watcher: Option<watch::FileWatcher>,
@@ -197,11 +196,9 @@ impl BonescopeApp {
             time: 0.0,
             playing: false,
             selection: Vec::new(),
-            generation: 0,
             job: AnalysisJob::default(),
             curves_job: AnalysisJob::default(),
             compare_jobs: CompareJobs::default(),
-            compared_generation: 0,
             notifications: Notifications::default(),
             watcher: None,
             compared_watcher: None,
@@ -293,7 +290,6 @@ impl BonescopeApp {
     }
 
     fn compared_replaced(&mut self) {
-        self.compared_generation += 1;
         self.compared_watcher = self.doc.compared.as_ref().and_then(|c| self.watch(&c.path));
     }
 
@@ -341,7 +337,6 @@ impl BonescopeApp {
     }
 
     fn document_replaced(&mut self, frame_camera: bool) {
-        self.generation += 1;
         self.watcher = self.doc.path.as_deref().and_then(|path| self.watch(path));
         if self.doc.compared.is_none() {
             self.compared_watcher = None;
@@ -354,70 +349,57 @@ impl BonescopeApp {
 
     /// The rig-wide analysis the UI wants now: every bone judged over the clip, no curves. It does not change with
     /// the selection, so selecting a bone never waits for it.
-    fn job_key(&self) -> JobKey {
-        JobKey {
-            generation: self.generation,
-            clip: self.doc.clip,
-            modes: self.doc.modes.clone(),
+    fn job_key(&self) -> Key<AnalysisRequest> {
+        let request = AnalysisRequest {
             ghost: None,
-            layers: self.doc.layers().clone(),
             plotted: Vec::new(),
             rate: self.doc.analysis_rate(),
             tolerances: self.settings.tolerances,
             judged: Judged::Every,
-        }
+        };
+        Key::of(&self.doc, request)
     }
 
     /// The curves the plots want now: the plotted bones (and the ghost's), only their chains evaluated; `None`
     /// with nothing selected.
-    fn curves_key(&self) -> Option<JobKey> {
+    fn curves_key(&self) -> Option<Key<AnalysisRequest>> {
         let plotted = self.plotted();
-        (!plotted.is_empty()).then(|| JobKey {
-            plotted,
-            ghost: self.doc.ghost.clone(),
-            judged: Judged::CurveChains,
-            ..self.job_key()
-        })
+        let mut key = self.job_key();
+        key.request =
+            AnalysisRequest { plotted, ghost: self.doc.ghost_setup(), judged: Judged::CurveChains, ..key.request };
+        (!key.request.plotted.is_empty()).then_some(key)
     }
 
     /// What the comparison with the compared file depends on, when there is one.
-    fn compare_key(&self) -> Option<CompareKey> {
+    fn compare_key(&self) -> Option<Key<CompareRequest>> {
         let compared = self.doc.compared.as_ref()?;
-        let (units, played) = (compared.units(), compared.played);
-        let key = self.job_key();
-        Some(CompareKey {
-            generations: (self.generation, self.compared_generation),
-            clip: key.clip,
-            modes: key.modes,
-            layers: key.layers,
-            rate: key.rate,
-            units,
-            played,
-        })
+        Some(CompareRequest::of(&self.doc, compared, self.doc.analysis_rate()))
     }
 
-    /// What the compared file's curves depend on: the comparison, the plotted bones, and the times of the
-    /// document's own curves (the dashed curves share their axis).
-    fn compared_curves_key(&self) -> Option<CurvesKey> {
-        let curves = self.curves()?;
-        Some(CurvesKey { compare: self.compare_key()?, plotted: self.plotted(), times: curves.times.clone() })
+    /// What the compared file's curves depend on: the compared file as evaluated, the plotted bones, and the times
+    /// of the document's own curves (the dashed curves share their axis).
+    fn compared_curves_key(&self) -> Option<Key<CurvesRequest>> {
+        let times = self.curves()?.times.clone();
+        let compare = self.compare_key()?;
+        let request = CurvesRequest { plotted: self.plotted(), times };
+        Some(Key { rig: compare.request.compared, setup: compare.request.setup, request })
     }
 
     /// Starts the analyses the current state wants (each only when its key changed).
     fn request_analyses(&mut self, ctx: &egui::Context) {
-        let doc = &self.doc;
+        let rig = &self.doc.rig;
         let key = self.job_key();
         let waker = ctx.clone();
-        let work = || job::analysis(key.clone(), doc.clone());
+        let work = || job::analysis(key.clone(), rig.clone());
         self.job.update(key.clone(), work, move || waker.request_repaint());
         if let Some(key) = self.curves_key() {
             let waker = ctx.clone();
-            let work = || job::analysis(key.clone(), doc.clone());
+            let work = || job::analysis(key.clone(), rig.clone());
             self.curves_job.update(key.clone(), work, move || waker.request_repaint());
         }
         let Some(compared) = self.doc.compared.clone() else { return };
         if let Some(key) = self.compare_key() {
-            let work = || compare::differences(key.clone(), doc.clone(), compared.clone());
+            let work = || compare::differences(key.clone(), rig.clone(), compared.clone());
             let waker = ctx.clone();
             self.compare_jobs.differences.update(key.clone(), work, move || waker.request_repaint());
         }

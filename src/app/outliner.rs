@@ -8,7 +8,7 @@ use egui::{RichText, Sense, vec2};
 
 use super::{ModeChoice, ModeScope, Shared, text};
 use crate::analysis::Findings;
-use crate::model::NodeRole;
+use crate::model::{Choice, NodeRole};
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -185,7 +185,7 @@ impl Notes {
         });
         Notes {
             difference: difference_text(shared, bone),
-            mode: Some(RichText::new(shared.doc.modes[bone].abbreviation()).weak().small()),
+            mode: Some(RichText::new(shared.doc.modes()[bone].abbreviation()).weak().small()),
             worst,
         }
     }
@@ -218,7 +218,7 @@ impl Notes {
             ui.label(difference).on_hover_text(difference_hint(shared, bone));
         }
         if let Some(mode) = self.mode {
-            ui.label(mode).on_hover_text(shared.doc.modes[bone].description());
+            ui.label(mode).on_hover_text(shared.doc.modes()[bone].description());
         }
         if let (Some(worst), Some(summary)) = (self.worst, stretched_summary(shared, bone)) {
             let worst = ui.add(egui::Label::new(worst).sense(Sense::click())).on_hover_text(format!(
@@ -329,8 +329,8 @@ fn mode_menu(ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
     ] {
         ui.menu_button(title, |ui| {
             let current = shared.doc.current_choice(bone, scope);
-            for choice in ModeChoice::all() {
-                let marked = ui.selectable_label(current == Some(choice), choice.label());
+            for &choice in ModeChoice::ALL {
+                let marked = ui.selectable_label(current == Some(choice), choice.id());
                 if marked.on_hover_text(choice.description()).clicked() {
                     shared.doc.set_mode(bone, scope, choice);
                     ui.close();

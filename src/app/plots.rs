@@ -236,7 +236,7 @@ impl Plots {
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
-            compared: shared.compared_curves.filter(|_| matches!(shared.doc.ghost, Some(Ghost::Compared(_)))).cloned(),
+            compared: shared.compared_curves.filter(|_| shared.doc.ghost == Some(Ghost::Compared)).cloned(),
         };
         if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
             let groups = Group::split(build_series(&key, &shared.doc.rig.skeleton));

@@ -157,7 +157,7 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     // A take's name can be a path long: shortened in the middle, whole on hover and in the list.
     let font = egui::TextStyle::Button.resolve(ui.style());
     let shown = text::shorten_middle(&current, |t| text::text_width(ui, t, &font) <= CLIP_NAME_WIDTH);
-    let mut chosen = shared.doc.clip;
+    let mut chosen = shared.doc.setup().clip;
     egui::ComboBox::from_id_salt("animation")
         .selected_text(shown)
         .show_ui(ui, |ui| {
@@ -173,8 +173,7 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         .response
         .labelled_by(label.id)
         .on_hover_text(current);
-    if chosen != shared.doc.clip {
-        shared.doc.clip = chosen;
+    if chosen != shared.doc.setup().clip && shared.doc.set_clip(chosen).is_ok() {
         actions.clip_changed = true;
     }
 }
@@ -185,12 +184,12 @@ fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let current = shared.doc.current_choice(0, ModeScope::All);
     let mut chosen = None;
     egui::ComboBox::from_id_salt("inherit-all")
-        .selected_text(current.map_or("mixed", ModeChoice::label))
+        .selected_text(current.map_or("mixed", ModeChoice::id))
         .width(170.0)
         .show_ui(ui, |ui| {
-            for choice in ModeChoice::all() {
+            for &choice in ModeChoice::ALL {
                 if ui
-                    .selectable_label(current == Some(choice), choice.label())
+                    .selectable_label(current == Some(choice), choice.id())
                     .on_hover_text(choice.description())
                     .clicked()
                 {
@@ -228,18 +227,17 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .width(170.0)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
-            if let Some(compared) = shared.doc.compared.clone() {
+            if let Some(compared) = &shared.doc.compared {
                 let hint = format!("{}, bones paired by name", compared.path.display());
-                let ghost = Ghost::Compared(compared);
-                let label = ghost.label();
-                ui.selectable_value(&mut shared.doc.ghost, Some(ghost), label).on_hover_text(hint);
+                let label = Ghost::Compared.label();
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Compared), label).on_hover_text(hint);
             }
             if !shared.doc.layers().is_empty() {
                 ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Unlayered), Ghost::Unlayered.label())
                     .on_hover_text("the clip as authored, without the layers");
             }
-            for choice in ModeChoice::all() {
-                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Modes(choice)), choice.label())
+            for &choice in ModeChoice::ALL {
+                ui.selectable_value(&mut shared.doc.ghost, Some(Ghost::Modes(choice)), choice.id())
                     .on_hover_text(choice.description());
             }
         })

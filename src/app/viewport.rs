@@ -7,6 +7,7 @@ use egui::{Sense, Ui};
 use glam::DVec2;
 
 use super::{Document, Ghost, Shared};
+use crate::model::Choice;
 use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, ViewKind, motion_bounds, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
@@ -63,9 +64,9 @@ impl Viewport {
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
         scene.ghost = shared.frame.ghost.clone();
-        scene.ghost_label = match &shared.doc.ghost {
-            Some(Ghost::Compared(compared)) => format!("ghost: {}", compared.title()),
-            ghost => ghost.as_ref().map_or_else(String::new, |g| format!("ghost: {}", g.label())),
+        scene.ghost_label = match (&shared.doc.ghost, &shared.doc.compared) {
+            (Some(Ghost::Compared), Some(compared)) => format!("ghost: {}", compared.title()),
+            (ghost, _) => ghost.as_ref().map_or_else(String::new, |g| format!("ghost: {}", g.label())),
         };
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();

@@ -12,19 +12,18 @@ use egui::{
 };
 use egui::{pos2, vec2};
 
-use super::job::{DocumentKey, Job, Progress};
+use super::job::{Job, Key, Progress};
 use super::text::{compact, name_label, text_width};
-use super::{Document, Ghost, ModeChoice, ModeScope, Shared};
+use super::{Ghost, ModeChoice, ModeScope, Shared};
 use crate::analysis::{CurveRequest, ScanOptions, Tolerances, analyze};
 use crate::explain::{Change, Explanation, Fix, Link, Measured, Question, explain};
-use crate::model::{Choice, Unit};
+use crate::model::{Choice, Rig, Unit};
 use crate::view::Badge;
 
-/// What an explanation depends on: the document, the bone, and how the clip is sampled and judged (as the
-/// whole-clip analysis samples and judges it, so that both flag the same samples).
-#[derive(Clone, PartialEq)]
-struct WhyKey {
-    document: DocumentKey,
+/// What an explanation is asked: the bone, and how the clip is sampled and judged (as the whole-clip analysis
+/// samples and judges it, so that both flag the same samples).
+#[derive(Clone, Debug, PartialEq)]
+struct WhyRequest {
     bone: usize,
     rate: f64,
     tolerances: Tolerances,
@@ -33,7 +32,7 @@ struct WhyKey {
 /// The section's state: the latest explanation, and the one being computed.
 #[derive(Default)]
 pub struct Why {
-    job: Job<WhyKey, Explanation>,
+    job: Job<Key<WhyRequest>, Explanation>,
 }
 
 /// At most this many fixes are listed; the rest fold under "N more".
@@ -92,17 +91,12 @@ impl Why {
             spinner(ui, "waiting for the whole-clip analysis…");
             return;
         }
-        let key = WhyKey {
-            document: DocumentKey::of(shared.doc),
-            bone,
-            rate: shared.doc.analysis_rate(),
-            tolerances: shared.settings.tolerances,
-        };
+        let request = WhyRequest { bone, rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
+        let key = Key::of(shared.doc, request);
         if !self.job.busy_with_other(&key) {
-            let doc = &*shared.doc;
             let work = || {
-                let (doc, key) = (doc.clone(), key.clone());
-                move |progress: &Progress| explanation(&doc, &key, progress)
+                let (rig, key) = (shared.doc.rig.clone(), key.clone());
+                move |progress: &Progress| explanation(&rig, &key, progress)
             };
             let waker = ui.ctx().clone();
             self.job.update(key.clone(), work, move || waker.request_repaint());
@@ -124,13 +118,15 @@ fn collapsing(ctx: &egui::Context) -> CollapsingState {
     CollapsingState::load_with_default_open(ctx, egui::Id::unique("inspector-why"), false)
 }
 
-/// `key.bone` of `doc` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was scanned.
-fn explanation(doc: &Document, key: &WhyKey, progress: &Progress) -> Option<Explanation> {
-    let evaluation = doc.evaluation();
-    let options = ScanOptions { rate: key.rate, tolerances: key.tolerances };
+/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was
+/// scanned.
+fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<Explanation> {
+    let evaluation = key.evaluation(rig)?;
+    let request = &key.request;
+    let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
     let report = |done: usize, total: usize| progress.report(done, total);
     let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
-    let question = Question { bones: Some(&[key.bone]), ..Question::default() };
+    let question = Question { bones: Some(&[request.bone]), ..Question::default() };
     explain(&evaluation, &before, question, &options).pop()
 }
 
@@ -438,25 +434,19 @@ fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
     text
 }
 
-/// Applies a fix to the document and shows the clip as it was as the ghost: the modes as they were (declared for a
-/// document as opened; declared too where they were mixed) for a mode, the clip without its layers for a uniform
-/// scale (the declared modes' ghost would be the fixed pose itself).
+/// Applies a fix to the document, as `explain` applies it, and shows the clip as it was as the ghost: the modes as
+/// they were (declared for a document as opened; declared too where they were mixed) for a mode, the clip without
+/// its layers for a uniform scale (the declared modes' ghost would be the fixed pose itself).
 fn try_fix(shared: &mut Shared, change: Change) {
     let doc = &mut *shared.doc;
-    match change {
-        Change::Mode { bone, mode } => {
-            let before = doc.current_choice(0, ModeScope::All).unwrap_or(ModeChoice::Declared);
-            doc.set_mode(bone, ModeScope::Bone, ModeChoice::Mode(mode));
-            doc.ghost = Some(Ghost::Modes(before));
-        }
-        Change::UniformScale { bone } => {
-            let mut layers = doc.layers().clone();
-            layers.make_scale_uniform(bone);
-            if doc.set_layers(&layers).is_ok() {
-                doc.ghost = Some(Ghost::Unlayered);
-            }
-        }
-        Change::Bake { .. } => {}
+    let ghost = match change {
+        Change::Mode { .. } => Ghost::Modes(doc.current_choice(0, ModeScope::All).unwrap_or(ModeChoice::Declared)),
+        Change::UniformScale { .. } => Ghost::Unlayered,
+        Change::Bake { .. } => return,
+    };
+    let fixed = change.apply(doc.setup(), &doc.rig.skeleton);
+    if fixed.is_ok_and(|setup| doc.set_setup(setup).is_ok()) {
+        doc.ghost = Some(ghost);
     }
 }
 

@@ -94,13 +94,13 @@ pub struct ClipToBake<'a> {
     pub source: Evaluation<'a>,
 }
 
-/// What to bake.
+/// What to bake: clips of one rig under one set of modes, over that rig at rest under those modes.
 #[derive(Clone, Debug)]
 pub struct Request<'a> {
-    /// The rig at rest under the modes the source is evaluated with: what the nodes hold where no animation says
-    /// otherwise. Every clip's source is an evaluation of the same rig under the same modes.
-    pub rest: Evaluation<'a>,
-    pub clips: Vec<ClipToBake<'a>>,
+    /// The rig at rest under the modes the clips are evaluated with: what the nodes hold where no animation says
+    /// otherwise.
+    rest: Evaluation<'a>,
+    clips: Vec<ClipToBake<'a>>,
     pub strategy: Strategy,
     /// Between keys, the result stays within this fraction of the rig's size of the source (0 keeps every sample).
     pub tolerance: f64,
@@ -109,7 +109,40 @@ pub struct Request<'a> {
     pub engine: Engine,
 }
 
+/// Why clips cannot be baked together.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RequestError {
+    #[error("`{clip}` is an evaluation of another rig than the rest pose's")]
+    OtherRig { clip: String },
+    #[error("`{clip}` is evaluated under other modes than the rest pose: one file holds one hierarchy")]
+    OtherModes { clip: String },
+    #[error("nothing to bake: no clip, not even the rest pose")]
+    NoClip,
+}
+
 impl<'a> Request<'a> {
+    /// `clips` over `rest`, for every runtime; refused unless each is an evaluation of `rest`'s rig under `rest`'s
+    /// modes (the file written holds one hierarchy, and its nodes' rest transforms are `rest`'s).
+    pub fn new(
+        rest: Evaluation<'a>,
+        clips: Vec<ClipToBake<'a>>,
+        strategy: Strategy,
+        tolerance: f64,
+    ) -> Result<Self, RequestError> {
+        if clips.is_empty() {
+            return Err(RequestError::NoClip);
+        }
+        for clip in &clips {
+            if !std::ptr::eq(clip.source.rig, rest.rig) {
+                return Err(RequestError::OtherRig { clip: clip.name.clone() });
+            }
+            if clip.source.modes() != rest.modes() {
+                return Err(RequestError::OtherModes { clip: clip.name.clone() });
+            }
+        }
+        Ok(Request { rest, clips, strategy, tolerance, engine: Engine::Generic })
+    }
+
     /// Every clip of `source`'s rig (or the one `only` names) evaluated as `source` is, or its rest pose for a rig
     /// without clips (which the baked nodes then hold, with no animation in the file), for every runtime.
     pub fn every_clip(source: &Evaluation<'a>, only: Option<&'a Clip>, strategy: Strategy, tolerance: f64) -> Self {
@@ -127,8 +160,22 @@ impl<'a> Request<'a> {
         Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
 
+    /// The same for `engine`.
+    pub fn for_engine(self, engine: Engine) -> Self {
+        Request { engine, ..self }
+    }
+
     pub fn rig(&self) -> &'a Rig {
         self.rest.rig
+    }
+
+    /// The rig at rest under the clips' modes.
+    pub fn rest(&self) -> &Evaluation<'a> {
+        &self.rest
+    }
+
+    pub fn clips(&self) -> &[ClipToBake<'a>] {
+        &self.clips
     }
 }
 
@@ -160,15 +207,15 @@ pub struct Baked {
 /// Bakes `request` into a glTF binary.
 pub fn bake(request: &Request) -> Baked {
     let (rig, strategy) = (request.rig(), request.strategy);
-    let sources: Vec<&Evaluation> = request.clips.iter().map(|c| &c.source).collect();
+    let sources: Vec<&Evaluation> = request.clips().iter().map(|c| &c.source).collect();
     let base: Vec<BakeTimes> = sources.iter().map(|source| bake_times(source)).collect();
     let size = sources.iter().zip(&base).map(|(source, base)| source.size(&base.times)).fold(0.0, f64::max);
-    let size = if size > 0.0 { size } else { request.rest.size(&[0.0]) };
+    let size = if size > 0.0 { size } else { request.rest().size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
-    let metrics = Metrics::new(&request.rest, size, tolerance, request.engine.rotations());
+    let metrics = Metrics::new(request.rest(), size, tolerance, request.engine.rotations());
     let sampled: Vec<Sampled> =
         sources.iter().zip(&base).map(|(source, base)| sample_densely(source, strategy, base, &metrics)).collect();
-    let rest = nodes::sample(&request.rest, &[0.0], strategy);
+    let rest = nodes::sample(request.rest(), &[0.0], strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
         .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|s| s.stats.stretched[bone]))
         .collect();
@@ -176,7 +223,7 @@ pub fn bake(request: &Request) -> Baked {
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
-    for ((clip, base), sampled) in request.clips.iter().zip(&base).zip(&sampled) {
+    for ((clip, base), sampled) in request.clips().iter().zip(&base).zip(&sampled) {
         let samples = ClipSamples { name: &clip.name, source: &clip.source, base, sampled };
         let times = &sampled.times;
         if clip.source.clip.is_none() && clip.source.layers().is_none() {

@@ -93,13 +93,13 @@ impl BakeReport {
 
 /// Compares every animation of `request` with the same animation of `baked_rig` (the bake read back).
 pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
-    let skeleton = request.rest.skeleton();
+    let skeleton = request.rest().skeleton();
     let animations = baked
         .animations
         .iter()
         .enumerate()
         .map(|(k, animation)| {
-            let source = &request.clips[k].source;
+            let source = &request.clips()[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
             let pairs = Pairs::by_name(source, &result);
             let comparison =

@@ -6,12 +6,11 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use clap::Args;
 
-use super::layers::LayerArgs;
-use super::options::{Distance, choice, parse_distance};
+use super::options::{Distance, choice, evaluation, parse_distance};
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Engine, Request, Strategy};
-use crate::eval::{Evaluation, LayerStack};
+use crate::eval::Setup;
 use crate::import;
 use crate::model::Choice;
 
@@ -41,8 +40,6 @@ pub struct BakeArgs {
     pub fail_above: Option<Distance>,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
-    #[command(flatten)]
-    pub layers: LayerArgs,
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
@@ -56,31 +53,27 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     if rig.skeleton.is_empty() {
         bail!("{}: no nodes to bake", source_name(args));
     }
-    let source = Evaluation::new(&rig, None, &args.eval.modes(&rig)?);
-    let layers = args.layers.layers(&rig)?;
+    let setup = args.eval.setup(&rig)?;
+    let source = evaluation(&rig, &setup)?;
     let (strategy, tolerance) = (args.strategy.unwrap_or(args.engine.strategy()), args.tolerance);
-    let request = if layers.is_empty() {
-        let only = match &args.eval.anim {
-            Some(_) => args.eval.clip(&rig)?,
-            None => None,
-        };
-        Request { engine: args.engine, ..Request::every_clip(&source, only, strategy, tolerance) }
+    let request = if setup.layers.is_empty() {
+        let only = args.eval.anim.is_some().then_some(source.clip).flatten();
+        Request::every_clip(&source, only, strategy, tolerance)
     } else {
         // A layered result is one new clip, named after its main clip and what was layered on it.
-        let clip = args.eval.clip(&rig)?;
-        let main = clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
-        let name = format!("{main} + {}", layers.summary(&rig, clip));
-        let layered = source.clone().with_clip(clip).with_layers(LayerStack::new(&rig, &layers)?);
-        let clips = vec![ClipToBake { name, source: layered }];
-        Request { rest: source, clips, strategy, tolerance, engine: args.engine }
-    };
+        let main = source.clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
+        let name = format!("{main} + {}", setup.layers.summary(&rig, source.clip));
+        let rest = source.at_rest();
+        Request::new(rest, vec![ClipToBake { name, source }], strategy, tolerance)?
+    }
+    .for_engine(args.engine);
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
     let report = bake::report(&request, &baked, &baked_rig);
     bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        Format::Table => print!("{}", render_table(args, &report, baked.glb.len())),
+        Format::Table => print!("{}", render_table(args, &setup, &report, baked.glb.len())),
     }
     let worst = report.worst();
     let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));
@@ -92,7 +85,7 @@ fn source_name(args: &BakeArgs) -> String {
     args.file.as_ref().map_or_else(|| "the demo rig".to_owned(), |path| path.display().to_string())
 }
 
-fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
+fn render_table(args: &BakeArgs, setup: &Setup, report: &BakeReport, bytes: usize) -> String {
     let size = report.rig_size;
     let percent = |v: f64| format!("{:.6} %", 100.0 * v / size);
     let mut out = format!(
@@ -101,7 +94,7 @@ fn render_table(args: &BakeArgs, report: &BakeReport, bytes: usize) -> String {
         args.out.display(),
         report.engine.id(),
         report.strategy.id(),
-        args.eval.inherit_label()
+        setup.modes.label()
     );
     out.push_str(&format!("  {}\n", report.what_it_shows()));
     out.push_str(&format!(

@@ -3,16 +3,17 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::Args;
 
 use super::Format;
-use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
-
-use super::table::{Table, mesh_differences};
-use crate::diff::{AnimationDiff, FileDiff, FileSide, diff_files};
+use super::options::{Distance, choice, clip_index, parse_assignment, parse_distance, parse_rate};
+use super::table::{Table, mesh_differences, shown};
+use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
+use crate::eval::Setup;
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
-use crate::model::{Choice, ModeChoice, Rig, Unit};
+use crate::model::{Choice, ModeChoice, Modes, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -28,10 +29,10 @@ pub struct DiffArgs {
     #[arg(long, value_name = "NAME|INDEX")]
     pub anim_b: Option<String>,
     /// The first file's inheritance: `declared` (what its file says) or one mode for every bone.
-    #[arg(long, value_name = "MODE", default_value = "declared")]
+    #[arg(long, value_name = "MODE", value_parser = choice::<ModeChoice>(), default_value = ModeChoice::Declared.id())]
     pub inherit_a: ModeChoice,
     /// The second file's inheritance.
-    #[arg(long, value_name = "MODE", default_value = "declared")]
+    #[arg(long, value_name = "MODE", value_parser = choice::<ModeChoice>(), default_value = ModeChoice::Declared.id())]
     pub inherit_b: ModeChoice,
     /// Pair a bone of the first file with one of the second explicitly (repeatable); the rest pair by name, exactly,
     /// then ignoring case and namespace prefixes such as `mixamorig:` or `Armature|`.
@@ -62,15 +63,38 @@ pub struct DiffArgs {
 pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let rig_a = stated_unit(import::load(&args.a)?, args.unit_a, "--unit-a")?;
     let rig_b = stated_unit(import::load(&args.b)?, args.unit_b, "--unit-b")?;
-    let a = side(&args.a, &rig_a, args.inherit_a, &args.anim_a);
-    let b = FileSide { interp: args.interp, ..side(&args.b, &rig_b, args.inherit_b, &args.anim_b) };
-    let diff = diff_files(&a, &b, &args.map, args.rate)?;
+    let chosen = chosen_clips(args, &rig_a, &rig_b)?;
+    let [clip_a, clip_b] = chosen.map_or([None, None], |[a, b]| [Some(a), Some(b)]);
+    let a = side(&args.a, &rig_a, args.inherit_a, clip_a);
+    let mut b = side(&args.b, &rig_b, args.inherit_b, clip_b);
+    b.setup.layers.interpolation.rotation = args.interp;
+    let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
+    let diff = diff_files(&a, &b, clips, &args.map, args.rate)?;
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
         Format::Table => print!("{}", render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()])),
     }
     let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// The clips `--anim-a` and `--anim-b` choose, `[in A, in B]`: a name given for one side only is looked up on both
+/// (the other file's clip named as the chosen clip is). `None`: every clip, paired by name.
+fn chosen_clips(args: &DiffArgs, a: &Rig, b: &Rig) -> anyhow::Result<Option<[usize; 2]>> {
+    let find = |path: &Path, rig: &Rig, option: &str, name: &str| clip_index(rig, option, name).context(shown(path));
+    let named_alike = |rig: &Rig, clip: usize, given: &str| rig.clips[clip].name.clone().unwrap_or(given.to_owned());
+    Ok(Some(match (&args.anim_a, &args.anim_b) {
+        (None, None) => return Ok(None),
+        (Some(x), Some(y)) => [find(&args.a, a, "--anim-a", x)?, find(&args.b, b, "--anim-b", y)?],
+        (Some(x), None) => {
+            let i = find(&args.a, a, "--anim-a", x)?;
+            [i, find(&args.b, b, "--anim-a", &named_alike(a, i, x))?]
+        }
+        (None, Some(y)) => {
+            let j = find(&args.b, b, "--anim-b", y)?;
+            [find(&args.a, a, "--anim-b", &named_alike(b, j, y))?, j]
+        }
+    }))
 }
 
 /// `rig` in `unit` (given as `option`), which only a rig whose file states no unit may be given.
@@ -85,16 +109,9 @@ fn stated_unit(mut rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result
     Ok(rig)
 }
 
-/// `rig` (read from `path`) under `modes`, its clip `anim` (every clip, paired by name, for `None`), as authored.
-pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, anim: &Option<String>) -> FileSide<'a> {
-    FileSide {
-        file: super::scan::shown(path),
-        rig,
-        modes: rig.skeleton.modes(modes),
-        inherit: modes.label().to_owned(),
-        anim: anim.clone(),
-        interp: RotationInterpolation::default(),
-    }
+/// `rig` (read from `path`) under `modes`, its clip `clip` (where chosen), as authored.
+pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, clip: Option<usize>) -> FileSide<'a> {
+    FileSide { file: shown(path), rig, setup: Setup { clip, modes: Modes::all(modes), ..Setup::default() } }
 }
 
 /// The table of `diff`, saying which units were `given` (`--unit-a`, `--unit-b`).

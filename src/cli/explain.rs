@@ -5,13 +5,13 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use super::layers::{LayerArgs, bone_index};
-use super::options::parse_rate;
-use super::table::Table;
+use super::layers::bone_index;
+use super::options::{evaluation, parse_rate};
+use super::table::{Table, shown};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
-use crate::eval::{Evaluation, LayerStack, Layers};
+use crate::eval::Layers;
 use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
@@ -35,8 +35,6 @@ pub struct ExplainArgs {
     pub format: Format,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    #[command(flatten)]
-    pub layers: LayerArgs,
 }
 
 /// `bonescope explain --format json`.
@@ -55,31 +53,29 @@ struct ExplainReport<'a> {
 
 pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let rig = import::load(&args.file)?;
-    let clip = args.eval.clip(&rig)?;
-    let modes = args.eval.modes(&rig)?;
+    let setup = args.eval.setup(&rig)?;
     if let Some(time) = args.time.filter(|t| !t.is_finite()) {
         anyhow::bail!("--time must be a finite number of seconds, got {time}");
     }
     let bones = args.bone.iter().map(|name| bone_index(&rig, "--bone", name)).collect::<anyhow::Result<Vec<_>>>()?;
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
-    let layers = args.layers.layers(&rig)?;
-    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(LayerStack::new(&rig, &layers)?);
+    let evaluation = evaluation(&rig, &setup)?;
     let before = scan(&evaluation, &options, &|_, _| {});
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
     let question = Question { bones: asked, at: args.time, costs: Costs::Every };
     let explained = explain(&evaluation, &before, question, &options);
     let report = ExplainReport {
-        file: super::scan::shown(&args.file),
-        animation: clip.map(AnimationInfo::of),
-        inherit: args.eval.inherit_label(),
+        file: shown(&args.file),
+        animation: evaluation.clip.map(AnimationInfo::of),
+        inherit: setup.modes.label().to_owned(),
         rate: args.rate,
-        layers,
+        layers: setup.layers.clone(),
         unit: rig.unit,
         bones: &explained,
     };
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        Format::Table => print!("{}", render_table(&report, &rig, &modes)),
+        Format::Table => print!("{}", render_table(&report, &rig, evaluation.modes())),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -8,8 +8,8 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use super::options::choice;
-use crate::eval::{Evaluation, SkinningMethod};
+use super::options::{choice, evaluation};
+use crate::eval::{Setup, SkinningMethod};
 use crate::export::{EvaluatedMesh, write_obj};
 use crate::import::{self, Options, Space};
 use crate::model::Choice;
@@ -50,7 +50,8 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     if rig.meshes.is_empty() {
         bail!("{}: no meshes to export", args.file.display());
     }
-    let evaluation = Evaluation::new(&rig, args.eval.clip(&rig)?, &args.eval.modes(&rig)?).with_skinning(args.skinning);
+    let setup = Setup { skinning: args.skinning, ..args.eval.setup(&rig)? };
+    let evaluation = evaluation(&rig, &setup)?;
     let positions = evaluation.skin_all(&evaluation.pose_at(args.time));
     let clip = evaluation.clip;
     let meshes: Vec<EvaluatedMesh> = rig
@@ -65,10 +66,14 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
         format!(
             "{animation} at t = {} s, inherit: {}, skinning: {}",
             args.time,
-            args.eval.inherit_label(),
+            setup.modes.label(),
             args.skinning.label()
         ),
     ];
+    let layers = setup.layers.summary(&rig, clip);
+    if !layers.is_empty() {
+        header.push(format!("layers: {layers}"));
+    }
     header.extend(rig.notes.iter().cloned());
     let file = std::fs::File::create(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut out = BufWriter::new(file);

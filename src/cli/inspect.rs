@@ -6,12 +6,12 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use super::layers::LayerArgs;
-use super::table::{Table, vector};
+use super::options::evaluation;
+use super::table::{Table, shown, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};
-use crate::eval::{Evaluation, LayerStack};
 use crate::import;
+use crate::model::Choice;
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
@@ -26,32 +26,28 @@ pub struct InspectArgs {
     pub format: Format,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    #[command(flatten)]
-    pub layers: LayerArgs,
 }
 
 pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     let rig = import::load(&args.file)?;
-    let clip = args.eval.clip(&rig)?;
-    let modes = args.eval.modes(&rig)?;
+    let setup = args.eval.setup(&rig)?;
     let tolerances = args.tolerances.tolerances()?;
     if let Some(bad) = args.time.iter().find(|t| !t.is_finite()) {
         anyhow::bail!("--time must be a finite number of seconds, got {bad}");
     }
     let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
-    let layers = args.layers.layers(&rig)?;
-    let evaluation = Evaluation::new(&rig, clip, &modes).with_layers(LayerStack::new(&rig, &layers)?);
+    let evaluation = evaluation(&rig, &setup)?;
+    let modes = evaluation.modes();
     let mut evaluator = evaluation.evaluator();
     let samples = times
         .iter()
         .map(|&time| {
             let pose = evaluator.evaluate(time);
-            SampleReport { time, bones: BoneReport::all(&rig.skeleton, &modes, pose, &tolerances) }
+            SampleReport { time, bones: BoneReport::all(&rig.skeleton, modes, pose, &tolerances) }
         })
         .collect();
-    let summary = layers.summary(&rig, clip);
-    let report =
-        LayeredInspectReport::new(super::scan::shown(&args.file), &evaluation, args.eval.inherit_label(), samples);
+    let summary = setup.layers.summary(&rig, evaluation.clip);
+    let report = LayeredInspectReport::new(shown(&args.file), &evaluation, setup.modes.label().to_owned(), samples);
     match args.format {
         Format::Json => {
             // Written as it is serialised: a rig of a million bones prints gigabytes, never held in memory at once.

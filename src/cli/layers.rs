@@ -5,7 +5,7 @@ use anyhow::{Context, anyhow, bail};
 use clap::Args;
 use glam::DQuat;
 
-use super::options::{choice, find_clip};
+use super::options::{choice, clip_index};
 use crate::eval::layers::{
     Additive, AdditiveOrder, AdditiveReference, Blend, Crossfade, FadeCurve, KeyInterpolation, Layers, Resampling,
     RotationBlend, RotationInterpolation, Shake, ShakeParams, Target,
@@ -175,12 +175,6 @@ impl LayerArgs {
         }
         Ok(layers)
     }
-}
-
-/// The position in `rig.clips` of the clip `--option` names.
-fn clip_index(rig: &Rig, option: &str, name: &str) -> anyhow::Result<usize> {
-    let clip = find_clip(rig, name).with_context(|| option.to_owned())?;
-    rig.clips.iter().position(|c| std::ptr::eq(c, clip)).ok_or_else(|| anyhow!("{option}: no animation `{name}`"))
 }
 
 /// The bone named `name`, or with index `name`.

@@ -4,8 +4,10 @@ use anyhow::{Context, anyhow, bail};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, ValueEnum};
 
+use super::layers::LayerArgs;
 use crate::analysis::Tolerances;
-use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig};
+use crate::eval::{Evaluation, Setup};
+use crate::model::{Choice, Clip, InheritMode, ModeChoice, Modes, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -23,20 +25,21 @@ pub fn choice<T: Choice>() -> impl TypedValueParser<Value = T> {
     PossibleValuesParser::new(values).map(|id| T::from_id(&id).expect("an id of a listed value"))
 }
 
-/// Which clip, and which inheritance modes.
+/// What is evaluated: which clip, which inheritance modes, which layers. Every command that evaluates one file
+/// makes its [`Setup`] here ([`EvalArgs::setup`]).
 #[derive(Clone, Debug, Default, Args)]
 pub struct EvalArgs {
     /// The animation, by name or index (default: `inspect` the first, `scan` every one).
     #[arg(long, value_name = "NAME|INDEX")]
     pub anim: Option<String>,
-    /// Evaluate every bone with this mode instead of the one the file declares: full, unscaled-parent,
-    /// segment-compensate, componentwise, blender-fix-shear, blender-aligned, blender-average, blender-none,
-    /// blender-none-legacy.
-    #[arg(long, value_name = "MODE")]
-    pub inherit: Option<InheritMode>,
+    /// Evaluate every bone with this mode instead of the one the file declares.
+    #[arg(long, value_name = "MODE", value_parser = choice::<ModeChoice>(), default_value = ModeChoice::Declared.id())]
+    pub inherit: ModeChoice,
     /// Then give one bone its own mode (repeatable).
     #[arg(long = "inherit-bone", value_name = "NAME=MODE", value_parser = parse_bone_mode)]
     pub inherit_bone: Vec<(String, InheritMode)>,
+    #[command(flatten)]
+    pub layers: LayerArgs,
 }
 
 /// The clip named `name`, or with index `name`; the error lists the available ones.
@@ -105,37 +108,41 @@ pub fn parse_distance(s: &str) -> Result<Distance, String> {
 }
 
 impl EvalArgs {
-    /// The clip `--anim` names, or the first; `None` for a file without animations.
-    pub fn clip<'a>(&self, rig: &'a Rig) -> anyhow::Result<Option<&'a Clip>> {
-        match &self.anim {
-            None => Ok(rig.clips.first()),
-            Some(name) => find_clip(rig, name).map(Some),
-        }
-    }
-
-    /// One mode per bone: the file's, or `--inherit`'s, then the `--inherit-bone` overrides.
-    pub fn modes(&self, rig: &Rig) -> anyhow::Result<Vec<InheritMode>> {
-        let skeleton = &rig.skeleton;
-        let mut modes = match self.inherit {
-            Some(mode) => vec![mode; skeleton.len()],
-            None => skeleton.declared_modes(),
+    /// The setup these options ask of `rig`: the clip `--anim` names (else the first), the file's modes or
+    /// `--inherit`'s with the `--inherit-bone` overrides, and the layers.
+    pub fn setup(&self, rig: &Rig) -> anyhow::Result<Setup> {
+        let clip = match &self.anim {
+            None => Setup::declared(rig).clip,
+            Some(name) => Some(clip_index(rig, "--anim", name)?),
         };
+        let mut modes = Modes::all(self.inherit);
         for (name, mode) in &self.inherit_bone {
-            let bone = skeleton.find(name).with_context(|| format!("--inherit-bone: no bone named `{name}`"))?;
-            modes[bone] = *mode;
+            let bone = rig.skeleton.find(name).with_context(|| format!("--inherit-bone: no bone named `{name}`"))?;
+            modes.set(&rig.skeleton, bone, ModeChoice::Mode(*mode));
         }
-        Ok(modes)
+        Ok(Setup { clip, modes, layers: self.layers.layers(rig)?, ..Setup::default() })
     }
 
-    /// What the reports say the modes are: the global mode, or `declared`; `mixed` when single bones are given
-    /// their own (as the app says of a rig whose bones differ).
-    pub fn inherit_label(&self) -> String {
-        match self.inherit {
-            _ if !self.inherit_bone.is_empty() => "mixed".to_owned(),
-            Some(mode) => mode.id().to_owned(),
-            None => "declared".to_owned(),
-        }
+    /// The clips a whole-file command (`scan`, `storage`) visits: the one `--anim` names, else every clip (the
+    /// rest pose of a file without any).
+    pub fn clips(&self, rig: &Rig) -> anyhow::Result<Vec<Option<usize>>> {
+        Ok(match &self.anim {
+            Some(name) => vec![Some(clip_index(rig, "--anim", name)?)],
+            None if rig.clips.is_empty() => vec![None],
+            None => (0..rig.clips.len()).map(Some).collect(),
+        })
     }
+}
+
+/// `setup` of `rig`: the one evaluation every command makes of its options.
+pub fn evaluation<'a>(rig: &'a Rig, setup: &Setup) -> anyhow::Result<Evaluation<'a>> {
+    Ok(Evaluation::of(rig, setup)?)
+}
+
+/// The position in `rig.clips` of the clip `--option` names.
+pub fn clip_index(rig: &Rig, option: &str, name: &str) -> anyhow::Result<usize> {
+    let clip = find_clip(rig, name).with_context(|| option.to_owned())?;
+    rig.clips.iter().position(|c| std::ptr::eq(c, clip)).ok_or_else(|| anyhow!("{option}: no animation `{name}`"))
 }
 
 /// `A,B`: two mode choices to compare.
@@ -216,5 +223,7 @@ mod tests {
         parses_by_id::<AdditiveReference>();
         parses_by_id::<AdditiveOrder>();
         parses_by_id::<FadeCurve>();
+        parses_by_id::<InheritMode>();
+        parses_by_id::<ModeChoice>();
     }
 }

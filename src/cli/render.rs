@@ -8,7 +8,6 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use super::layers::LayerArgs;
 use super::options::choice;
 use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Settings};
 use crate::eval::SkinningMethod;
@@ -23,8 +22,6 @@ pub struct RenderArgs {
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
-    #[command(flatten)]
-    pub layers: LayerArgs,
     /// The time to render, in seconds (default 0).
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, conflicts_with = "frames")]
     pub time: Option<f64>,
@@ -240,14 +237,12 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
         None => Document::demo(),
     };
     let rig = doc.rig.clone();
-    doc.clip = args.eval.clip(&rig)?.map(|c| c.index);
-    doc.modes = args.eval.modes(&rig)?;
-    doc.set_layers(&args.layers.layers(&rig)?)?;
+    doc.set_setup(args.eval.setup(&rig)?)?;
     if let Some(path) = &args.compare {
         doc.compare_with(Compared::load(path, &doc.rig)?);
     }
     if let Some(GhostArg(ghost)) = &args.ghost {
-        doc.ghost = ghost.clone();
+        doc.ghost = *ghost;
     }
     let selection = args
         .select

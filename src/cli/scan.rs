@@ -9,19 +9,19 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Args, ValueEnum};
 
 use super::layers::LayerArgs;
-use super::options::{parse_angle, parse_comparison, parse_rate};
-use super::table::Table;
+use super::options::{clip_index, evaluation, parse_angle, parse_comparison, parse_rate};
+use super::table::{Table, shown};
 use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
 use crate::analysis::{ScanOptions, scan};
-use crate::diff::{AnimationDiff, diff_files};
-use crate::eval::{Evaluation, LayerStack};
+use crate::diff::{AnimationDiff, Clips, diff_files};
+use crate::eval::{Evaluation, Setup};
 use crate::explain::{Costs, Question, explain};
 use crate::import;
 use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
-use crate::model::{InheritMode, ModeChoice, Rig};
+use crate::model::{Choice, ModeChoice, Rig};
 
 /// The files a report over a library covers, how many at once, and how it is written: what `scan` and `storage`
 /// share.
@@ -83,8 +83,6 @@ pub struct ScanArgs {
     pub explain: bool,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    #[command(flatten)]
-    pub layers: LayerArgs,
 }
 
 /// `bonescope storage`: each clip's stretch-quaternion storage: the bones that need a stretch channel, bytes as plain
@@ -103,8 +101,6 @@ pub struct StorageArgs {
     pub probe_distance: f64,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    #[command(flatten)]
-    pub layers: LayerArgs,
 }
 
 /// How `scan` reports.
@@ -139,7 +135,7 @@ pub type FileStorage = FileReport<AnimationStorage>;
 pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
     if let Some(sides) = args.compare_inherit {
-        if args.layers != LayerArgs::default() {
+        if args.eval.layers != LayerArgs::default() {
             anyhow::bail!("--compare-inherit compares the clips as authored: it takes no layer options");
         }
         return run_comparison(args, sides);
@@ -301,11 +297,6 @@ impl Progress {
     }
 }
 
-/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
-pub(super) fn shown(path: &Path) -> String {
-    printable(&path.display().to_string()).into_owned()
-}
-
 /// 0 when every file loaded, 2 when one did not.
 fn loaded_code(all_loaded: bool) -> ExitCode {
     if all_loaded { ExitCode::SUCCESS } else { ExitCode::from(2) }
@@ -313,7 +304,8 @@ fn loaded_code(all_loaded: bool) -> ExitCode {
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = shown(path);
-    let scanned = load_layered(path, &args.eval, &args.layers).map(|loaded| {
+    let scanned = Loaded::read(path, &args.eval).and_then(|loaded| {
+        let inherit = loaded.setup.modes.label();
         loaded.each_clip(|evaluation| {
             let result = scan(evaluation, options, &|_, _| {});
             let explained = match args.explain {
@@ -321,7 +313,7 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
                 false => Vec::new(),
             };
             let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);
-            let scanned = AnimationScan::new(skeleton, clip, args.eval.inherit_label(), options.rate, result);
+            let scanned = AnimationScan::new(skeleton, clip, inherit.to_owned(), options.rate, result);
             let explained = explained.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
             AnimationScan { explained, ..scanned }
         })
@@ -329,35 +321,25 @@ fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> 
     FileReport::new(file, scanned)
 }
 
-/// A file loaded with its modes and layers resolved, and the clips `--anim` picks.
+/// A file loaded with what is evaluated of it, and the clips `--anim` picks.
 struct Loaded {
     rig: Rig,
-    modes: Vec<InheritMode>,
-    layers: LayerStack,
+    setup: Setup,
     /// Positions in `rig.clips`; `None` for the rest pose of a file without animations.
     clips: Vec<Option<usize>>,
 }
 
-fn load_layered(path: &std::path::Path, eval: &EvalArgs, layers: &LayerArgs) -> anyhow::Result<Loaded> {
-    let rig = import::load(path)?;
-    let modes = eval.modes(&rig)?;
-    let layers = LayerStack::new(&rig, &layers.layers(&rig)?)?;
-    let clips = match &eval.anim {
-        Some(_) => {
-            let clip = eval.clip(&rig)?;
-            vec![clip.and_then(|c| rig.clips.iter().position(|other| std::ptr::eq(other, c)))]
-        }
-        None if rig.clips.is_empty() => vec![None],
-        None => (0..rig.clips.len()).map(Some).collect(),
-    };
-    Ok(Loaded { rig, modes, layers, clips })
-}
-
 impl Loaded {
+    fn read(path: &Path, eval: &EvalArgs) -> anyhow::Result<Loaded> {
+        let rig = import::load(path)?;
+        let (setup, clips) = (eval.setup(&rig)?, eval.clips(&rig)?);
+        Ok(Loaded { rig, setup, clips })
+    }
+
     /// `f` of each clip's evaluation.
-    fn each_clip<T>(&self, mut f: impl FnMut(&Evaluation) -> T) -> Vec<T> {
-        let rest = Evaluation::new(&self.rig, None, &self.modes).with_layers(self.layers.clone());
-        self.clips.iter().map(|c| f(&rest.clone().with_clip(c.map(|i| &self.rig.clips[i])))).collect()
+    fn each_clip<T>(&self, mut f: impl FnMut(&Evaluation) -> T) -> anyhow::Result<Vec<T>> {
+        let setups = self.clips.iter().map(|&clip| Setup { clip, ..self.setup.clone() });
+        setups.map(|setup| Ok(f(&evaluation(&self.rig, &setup)?))).collect()
     }
 }
 
@@ -370,10 +352,11 @@ pub fn run_storage(args: &StorageArgs) -> anyhow::Result<ExitCode> {
     let storage = StorageOptions { rate, tolerances, probe_distance: args.probe_distance };
     let measure = |path: &Path| {
         let file = shown(path);
-        let measured = load_layered(path, &args.eval, &args.layers).map(|loaded| {
+        let measured = Loaded::read(path, &args.eval).and_then(|loaded| {
+            let inherit = loaded.setup.modes.label();
             loaded.each_clip(|evaluation| AnimationStorage {
                 animation: evaluation.clip.map(AnimationInfo::of),
-                inherit: args.eval.inherit_label(),
+                inherit: inherit.to_owned(),
                 rate: storage.rate,
                 report: storage_report(evaluation, &storage),
             })
@@ -419,7 +402,7 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 /// `--compare-inherit`: each file's clips [`diff_files`]-compared with themselves under the two sides' modes.
 fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<ExitCode> {
     let compare = |path: &Path| FileReport::new(shown(path), compare_animations(path, args, sides));
-    let [a, b] = sides.map(|side| side.label());
+    let [a, b] = sides.map(|side| side.id());
     let render = |file: &str, diff: &AnimationDiff| {
         format!("{file}  inherit: {a} against {b}\n{}\n", super::diff::render_animation(diff))
     };
@@ -437,8 +420,10 @@ fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Exi
 
 fn compare_animations(path: &Path, args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Vec<AnimationDiff>> {
     let rig = import::load(path)?;
-    let [a, b] = sides.map(|modes| super::diff::side(path, &rig, modes, &args.eval.anim));
-    Ok(diff_files(&a, &b, &[], args.rate)?.animations)
+    let clip = args.eval.anim.as_ref().map(|name| clip_index(&rig, "--anim", name)).transpose()?;
+    let [a, b] = sides.map(|modes| super::diff::side(path, &rig, modes, clip));
+    let clips = if clip.is_some() { Clips::Chosen } else { Clips::ByName };
+    Ok(diff_files(&a, &b, clips, &[], args.rate)?.animations)
 }
 
 /// The table form: per file its clips, or why it could not be loaded.

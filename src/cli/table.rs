@@ -1,4 +1,4 @@
-//! Aligned text tables for people.
+//! Aligned text tables for people, and the pieces every report shares (how a path is shown, a mesh table).
 
 use std::fmt;
 
@@ -100,4 +100,9 @@ mod tests {
         assert_eq!(t.to_string(), "  name    value\n  a         1.5\n  longer  10.25\n");
         assert_eq!(vector(&[-0.0, 1.0]), "(0.0000, 1.0000)");
     }
+}
+
+/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
+pub fn shown(path: &std::path::Path) -> String {
+    crate::import::text::printable(&path.display().to_string()).into_owned()
 }

@@ -24,7 +24,7 @@ mod report;
 pub use matching::{
     BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
 };
-pub use report::{AnimationDiff, FileDiff, FileSide, diff_files};
+pub use report::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
 
 use glam::{DMat4, DQuat, DVec3};
 
@@ -180,9 +180,9 @@ pub enum DiffError {
     /// An explicit pair names a bone that is not there (or is already paired).
     #[error("--map {map}: no unmatched bone `{name}` in the {file} file")]
     NoBone { map: String, name: String, file: &'static str },
-    /// A clip asked for by name or index is not in the file.
-    #[error("{file}: no animation `{name}`")]
-    NoClip { file: String, name: String },
+    /// What a side evaluates does not fit its file.
+    #[error("{file}: {error}")]
+    Setup { file: String, error: crate::eval::SetupError },
 }
 
 /// The result of comparing two evaluations.

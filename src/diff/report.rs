@@ -2,23 +2,27 @@
 //! had no partner listed.
 
 use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
-use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
-use crate::model::{Clip, InheritMode, Rig, Unit};
+use crate::eval::{Evaluation, Setup};
+use crate::model::{Rig, Unit};
 
-/// One side of a file comparison, before clips are chosen.
+/// One side of a file comparison: a file's rig and what is evaluated of it (its modes, how its keys are played; its
+/// clip where the clips are [`Clips::Chosen`]). Its lengths are measured in the first side's unit.
 #[derive(Clone, Debug)]
 pub struct FileSide<'a> {
     /// The file's name, as reports show it.
     pub file: String,
     pub rig: &'a Rig,
-    pub modes: Vec<InheritMode>,
-    /// What the modes are called in reports (`declared`, or a mode's id).
-    pub inherit: String,
-    /// The clip to compare (by name or index); every clip, paired by name, when neither side names one.
-    pub anim: Option<String>,
-    /// How its linear rotation tracks are interpolated: as the file says (slerp), or as a runtime plays them.
-    pub interp: RotationInterpolation,
+    pub setup: Setup,
+}
+
+/// Which clips a file comparison compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clips {
+    /// Every clip paired with the other file's of the same name (the rest poses, where neither file has clips).
+    ByName,
+    /// Each side's [`Setup::clip`].
+    Chosen,
 }
 
 /// One pair of animations compared.
@@ -67,16 +71,24 @@ pub struct FileDiff {
 
 /// Compares `a` with `b` at their key times and `rate` times a second, lengths in A's unit; `map` pairs bones by
 /// name explicitly.
-pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f64) -> Result<FileDiff, DiffError> {
-    let (pairs, only_a, only_b) = pair_clips(a, b)?;
+pub fn diff_files<'a>(
+    a: &FileSide<'a>,
+    b: &FileSide<'a>,
+    clips: Clips,
+    map: &[(String, String)],
+    rate: f64,
+) -> Result<FileDiff, DiffError> {
+    let (pairs, only_a, only_b) = pair_clips(a, b, clips);
     let label = |rig: &Rig, clip: Option<usize>| clip.map_or_else(|| "rest pose".to_owned(), |c| rig.clips[c].label());
+    let evaluation = |side: &FileSide<'a>, clip, unit| {
+        let setup = Setup { clip, unit, ..side.setup.clone() };
+        Evaluation::of(side.rig, &setup).map_err(|error| DiffError::Setup { file: side.file.clone(), error })
+    };
     let animations = pairs
         .iter()
         .map(|&(ca, cb)| {
-            let side_a = Evaluation::new(a.rig, ca.map(|c| &a.rig.clips[c]), &a.modes).played_with(a.interp);
-            let side_b = Evaluation::new(b.rig, cb.map(|c| &b.rig.clips[c]), &b.modes)
-                .measured_in(a.rig.unit)
-                .played_with(b.interp);
+            let side_a = evaluation(a, ca, None)?;
+            let side_b = evaluation(b, cb, a.rig.unit)?;
             let pairs = Pairs::mapped(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
@@ -99,12 +111,12 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
     Ok(FileDiff {
         a: a.file.clone(),
         b: b.file.clone(),
-        inherit_a: a.inherit.clone(),
-        inherit_b: b.inherit.clone(),
+        inherit_a: a.setup.modes.label().to_owned(),
+        inherit_b: b.setup.modes.label().to_owned(),
         unit_a: a.rig.unit,
         unit_b: b.rig.unit,
-        interp_a: a.interp,
-        interp_b: b.interp,
+        interp_a: a.setup.layers.interpolation.rotation,
+        interp_b: b.setup.layers.interpolation.rotation,
         rate,
         animations,
         clips_only_a: only_a.iter().map(|&c| label(a.rig, Some(c))).collect(),
@@ -115,33 +127,15 @@ pub fn diff_files(a: &FileSide, b: &FileSide, map: &[(String, String)], rate: f6
 /// Clip pairs `(in A, in B)` (`None`: the rest pose), and the clips of each side left out.
 type ClipPairs = (Vec<(Option<usize>, Option<usize>)>, Vec<usize>, Vec<usize>);
 
-/// The clips to compare: the ones named (a name given for one side only is looked up on both), else every clip
-/// paired by name; two files without clips compare their rest poses.
-fn pair_clips(a: &FileSide, b: &FileSide) -> Result<ClipPairs, DiffError> {
-    let find = |side: &FileSide, name: &str| -> Result<usize, DiffError> {
-        let no_clip = || DiffError::NoClip { file: side.file.clone(), name: name.to_owned() };
-        let clip = side.rig.find_clip(name).ok_or_else(no_clip)?;
-        Ok(side.rig.clips.iter().position(|c| std::ptr::eq(c, clip)).unwrap_or(0))
-    };
-    match (&a.anim, &b.anim) {
-        (None, None) if a.rig.clips.is_empty() && b.rig.clips.is_empty() => Ok((vec![(None, None)], vec![], vec![])),
-        (None, None) => {
+/// The clips to compare: the ones chosen, else every clip paired by name; two files without clips compare their rest
+/// poses.
+fn pair_clips(a: &FileSide, b: &FileSide, clips: Clips) -> ClipPairs {
+    match clips {
+        Clips::Chosen => (vec![(a.setup.clip, b.setup.clip)], vec![], vec![]),
+        Clips::ByName if a.rig.clips.is_empty() && b.rig.clips.is_empty() => (vec![(None, None)], vec![], vec![]),
+        Clips::ByName => {
             let (pairs, only_a, only_b) = match_clips(&a.rig.clips, &b.rig.clips);
-            Ok((pairs.into_iter().map(|(i, j)| (Some(i), Some(j))).collect(), only_a, only_b))
-        }
-        (Some(x), Some(y)) => Ok((vec![(Some(find(a, x)?), Some(find(b, y)?))], vec![], vec![])),
-        (Some(name), None) | (None, Some(name)) => {
-            let same = |side: &FileSide, other: &FileSide, index: usize| -> Result<usize, DiffError> {
-                let clip: &Clip = &other.rig.clips[index];
-                find(side, clip.name.as_deref().unwrap_or(name))
-            };
-            if a.anim.is_some() {
-                let i = find(a, name)?;
-                Ok((vec![(Some(i), Some(same(b, a, i)?))], vec![], vec![]))
-            } else {
-                let j = find(b, name)?;
-                Ok((vec![(Some(same(a, b, j)?), Some(j))], vec![], vec![]))
-            }
+            (pairs.into_iter().map(|(i, j)| (Some(i), Some(j))).collect(), only_a, only_b)
         }
     }
 }

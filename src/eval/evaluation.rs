@@ -7,7 +7,7 @@ use glam::{DMat4, DVec3, DVec4};
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose};
-use crate::model::{Clip, InheritMode, MAX_FRAMES, Rig, Skeleton, Unit, sample_times};
+use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Unit, sample_times};
 
 /// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
 #[derive(Clone, Debug)]
@@ -16,10 +16,15 @@ pub struct Evaluation<'a> {
     pub clip: Option<&'a Clip>,
     /// The bones' modes, ready to combine local transforms into model matrices.
     pub hierarchy: Hierarchy,
+    /// The modes as a [`Setup`](super::Setup) chose them (`--inherit full` on a rig that declares full is not
+    /// `declared`), where it did.
+    chosen: Option<Modes>,
     /// The layers the clip plays through; never a stack that leaves the clip as it is (that is `None`).
     layers: Option<LayerStack>,
     pub skinning: SkinningMethod,
-    /// What the model matrices multiply lengths by: 1 in the rig's own unit ([`Evaluation::measured_in`]).
+    /// The unit lengths are measured in: the rig's own for `None` ([`Evaluation::measured_in`]).
+    unit: Option<Unit>,
+    /// What the model matrices multiply lengths by: 1 in the rig's own unit.
     length_scale: f64,
 }
 
@@ -27,7 +32,8 @@ impl<'a> Evaluation<'a> {
     /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says.
     pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Self {
         let hierarchy = Hierarchy::of_rig(rig, modes);
-        Evaluation { rig, clip, hierarchy, layers: None, skinning: SkinningMethod::AsFile, length_scale: 1.0 }
+        let skinning = SkinningMethod::AsFile;
+        Evaluation { rig, clip, hierarchy, chosen: None, layers: None, skinning, unit: None, length_scale: 1.0 }
     }
 
     /// `clip` of `rig` with the modes its file declares.
@@ -59,6 +65,7 @@ impl<'a> Evaluation<'a> {
     /// commutes with every rotation and so with every mode). Where the rig or `unit` is not known, the rig's numbers
     /// are taken as they are.
     pub fn measured_in(mut self, unit: Option<Unit>) -> Self {
+        self.unit = unit;
         self.length_scale = match (self.rig.unit, unit) {
             (Some(own), Some(unit)) => own.per(unit),
             _ => 1.0,
@@ -68,7 +75,7 @@ impl<'a> Evaluation<'a> {
 
     /// The same clip through the same layers under other modes (a ghost: "what if every bone were …").
     pub fn with_modes(&self, modes: &[InheritMode]) -> Self {
-        Evaluation { hierarchy: Hierarchy::of_rig(self.rig, modes), ..self.clone() }
+        Evaluation { hierarchy: Hierarchy::of_rig(self.rig, modes), chosen: None, ..self.clone() }
     }
 
     /// The same clip, without layers, its linear rotation tracks interpolated by `rotation`: as a runtime that
@@ -96,10 +103,25 @@ impl<'a> Evaluation<'a> {
         self.hierarchy.modes()
     }
 
+    /// The modes as chosen: a setup's, or the file's with the bones that differ given their own.
+    pub fn chosen_modes(&self) -> Modes {
+        self.chosen.clone().unwrap_or_else(|| Modes::of_bones(self.skeleton(), self.modes()))
+    }
+
+    /// The same, its modes called `modes` (which are the ones it evaluates).
+    pub(super) fn chosen_as(self, modes: Modes) -> Self {
+        Evaluation { chosen: Some(modes), ..self }
+    }
+
     /// Per bone, what its model matrix's scale factors are divided by to be the ones the file's author set: the
     /// unit conversion above it ([`Skeleton::length_scales`]) and the unit it is measured in.
     pub fn length_scales(&self) -> Vec<f64> {
         self.rig.skeleton.length_scales().iter().map(|s| s * self.length_scale).collect()
+    }
+
+    /// The unit lengths are measured in, where not the rig's own.
+    pub fn unit(&self) -> Option<Unit> {
+        self.unit
     }
 
     pub fn layers(&self) -> Option<&LayerStack> {

@@ -13,6 +13,7 @@ mod morph;
 mod pose;
 mod runs;
 mod sample;
+mod setup;
 pub mod skinning;
 
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
@@ -26,4 +27,5 @@ pub use morph::MorphPose;
 pub use pose::Pose;
 pub use runs::{over_runs, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
+pub use setup::{Setup, SetupError};
 pub use skinning::{Method as SkinningMethod, skin_meshes};

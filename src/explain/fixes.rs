@@ -5,11 +5,11 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
-use crate::bake::{self, ClipToBake, Engine, Request, Strategy};
+use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, compare_each, comparison_times};
-use crate::eval::{Evaluation, LayerStack};
+use crate::eval::{Evaluation, Setup};
 use crate::import;
-use crate::model::{Choice, Clip, InheritMode, Rig, Skeleton, Unit};
+use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Unit};
 
 /// A change to how the clip is evaluated that may take a bone's shear away.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -37,23 +37,20 @@ impl Change {
         }
     }
 
-    /// The evaluation of `source`'s clip under this change (layers and modes kept). A bake needs the baked rig
-    /// ([`Change::baked`]) and is not one.
-    pub fn apply<'a>(&self, source: &Evaluation<'a>) -> Result<Evaluation<'a>, String> {
+    /// What is evaluated under this change, given what was (`setup`, of a rig with `skeleton`): the same clip,
+    /// modes and layers but for what the change changes. A bake needs the baked rig ([`Change::baked`]) and is not
+    /// one.
+    pub fn apply(&self, setup: &Setup, skeleton: &Skeleton) -> Result<Setup, String> {
+        let mut changed = setup.clone();
         match *self {
-            Change::Mode { bone, mode } => {
-                let mut modes = source.modes().to_vec();
-                *modes.get_mut(bone).ok_or("no such bone")? = mode;
-                Ok(source.with_modes(&modes))
+            Change::Mode { bone, .. } | Change::UniformScale { bone } if bone >= skeleton.len() => {
+                return Err(format!("no bone {bone}"));
             }
-            Change::UniformScale { bone } => {
-                let mut layers = source.layers().map(|s| s.layers().clone()).unwrap_or_default();
-                layers.make_scale_uniform(bone);
-                let stack = LayerStack::new(source.rig, &layers).map_err(|e| e.to_string())?;
-                Ok(source.clone().with_layers(stack))
-            }
-            Change::Bake { .. } => Err("a bake is evaluated from the rig it writes".to_owned()),
+            Change::Mode { bone, mode } => changed.modes.set(skeleton, bone, ModeChoice::Mode(mode)),
+            Change::UniformScale { bone } => changed.layers.make_scale_uniform(bone),
+            Change::Bake { .. } => return Err("a bake is evaluated from the rig it writes".to_owned()),
         }
+        Ok(changed)
     }
 
     /// The bone below which (itself included) the change changes anything; `None` for the whole rig.
@@ -71,14 +68,12 @@ impl Change {
             return None;
         };
         let name = source.clip.map_or_else(|| "rest pose".to_owned(), Clip::label);
-        let request = Request {
-            rest: source.at_rest(),
-            clips: vec![ClipToBake { name, source: source.clone() }],
-            strategy,
-            tolerance: bake::DEFAULT_TOLERANCE,
-            engine: Engine::Generic,
+        let clips = vec![ClipToBake { name, source: source.clone() }];
+        let request = Request::new(source.at_rest(), clips, strategy, bake::DEFAULT_TOLERANCE);
+        let baked = match request {
+            Ok(request) => bake::bake(&request),
+            Err(error) => return Some(Err(error.to_string())),
         };
-        let baked = bake::bake(&request);
         Some(
             import::load_bytes(Path::new("baked.glb"), &baked.glb)
                 .map_err(|e| format!("the bake does not read back: {e}")),
@@ -240,7 +235,10 @@ impl<'e, 'a> Baseline<'e, 'a> {
     {
         match baked {
             Some(rig) => Ok(Evaluation::declared(rig, rig.clips.first())),
-            None => change.apply(self.source),
+            None => {
+                let setup = change.apply(&self.source.setup(), self.source.skeleton())?;
+                Evaluation::of(self.source.rig, &setup).map_err(|e| e.to_string())
+            }
         }
     }
 
@@ -380,7 +378,7 @@ pub(super) fn candidates(evaluation: &Evaluation, bone: usize, scaled: &[usize],
     let below = top.map_or(&[][..], |top| &chain[top + 1..]);
     let modes = below.iter().flat_map(|&b| {
         let current = evaluation.modes()[b];
-        InheritMode::ALL.into_iter().filter(move |&m| m != current).map(move |mode| Change::Mode { bone: b, mode })
+        InheritMode::ALL.iter().copied().filter(move |&m| m != current).map(move |mode| Change::Mode { bone: b, mode })
     });
     let uniform = chain.iter().filter(|b| scaled.contains(b)).map(|&bone| Change::UniformScale { bone });
     let bakes = Strategy::ALL.iter().filter(|_| bakes).map(|&strategy| Change::Bake { strategy });

@@ -13,7 +13,7 @@ pub use choice::Choice;
 pub use clip::{
     BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
 };
-pub use inherit::{InheritMode, ModeChoice, UnknownInheritMode, UnknownModeChoice};
+pub use inherit::{InheritMode, ModeChoice, Modes, UnknownInheritMode, UnknownModeChoice};
 #[cfg(test)]
 pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, NodeRole, ParentOrderError, Placement, Skeleton};

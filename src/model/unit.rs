@@ -5,8 +5,8 @@ use std::str::FromStr;
 
 /// The length of one unit of a rig's numbers, in metres (positive and finite). glTF states metres; FBX states its
 /// `UnitScaleFactor` (and is converted to metres on import); BVH states nothing, and then a person does.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-#[serde(transparent)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(into = "f64", try_from = "f64")]
 pub struct Unit {
     metres: f64,
 }
@@ -27,6 +27,20 @@ const SAME_LENGTH: f64 = 1e-6;
 
 /// How close a scale must be to a ratio of units to be one: a few single-precision roundings.
 const RATIO_PRECISION: f64 = 1e-6;
+
+impl From<Unit> for f64 {
+    fn from(unit: Unit) -> f64 {
+        unit.metres
+    }
+}
+
+impl TryFrom<f64> for Unit {
+    type Error = String;
+
+    fn try_from(metres: f64) -> Result<Unit, String> {
+        Unit::metres(metres).ok_or_else(|| format!("a unit is a positive, finite length in metres, not {metres}"))
+    }
+}
 
 impl Unit {
     pub const METRE: Unit = Unit { metres: 1.0 };

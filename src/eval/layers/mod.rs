@@ -157,7 +157,7 @@ impl Layers {
 }
 
 /// Layers that name a clip or bone the rig does not have.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum LayerError {
     #[error("{layer}: no animation {index} (the file has {count})")]
     NoClip { layer: &'static str, index: usize, count: usize },
