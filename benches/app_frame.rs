@@ -35,7 +35,7 @@ fn app_frame(c: &mut Criterion) {
     // 1600×1000 with the default panels, and a small laptop window with Layers and Inspector open.
     let windows = [("", 1600.0, 1000.0, false), (", 1000×700 with Layers", 1000.0, 700.0, true)];
     for (name, width, height, show_layers) in windows {
-        let settings = Settings { show_layers, ..Settings::default() };
+        let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, show_layers);
         frame_in(c, &format!("app frame, 500 bones, 100k frames, 8 curves{name}"), settings, input(width, height));
     }
 }
@@ -44,8 +44,8 @@ fn frame_in(c: &mut Criterion, name: &str, settings: Settings, input: egui::RawI
     let rig = stress_rig(BONES, FRAMES, KEY_STEP);
     let mut app = BonescopeApp::new(settings, Document::new(None, rig));
     // The eight plotted bones sit below scaled bones, so they shear.
-    app.selection = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
-    app.time = 1234.5;
+    app.window.selection = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
+    app.window.time = 1234.5;
     let ctx = egui::Context::default();
     let started = Instant::now();
     app.settle(&ctx);

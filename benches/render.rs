@@ -39,7 +39,7 @@ fn cli(c: &mut Criterion) {
 
 fn frame(c: &mut Criterion) {
     let mut app = BonescopeApp::new(Settings::default(), Document::demo());
-    app.chrome = Chrome::ViewportOnly;
+    app.window.chrome = Chrome::ViewportOnly;
     let mut renderer = Renderer::new(app, 1280, 720, Background::Viewport).expect("a GPU or llvmpipe");
     let mut frame = 0u32;
     c.bench_function("render/frame only demo 1280x720 (render, read back)", |b| {

@@ -19,7 +19,7 @@ fn demo_app() -> Harness<'static, BonescopeApp> {
 }
 
 fn bone(harness: &Harness<'static, BonescopeApp>, name: &str) -> usize {
-    harness.state().doc.rig.skeleton.find(name).unwrap()
+    harness.state().session.doc.rig.skeleton.find(name).unwrap()
 }
 
 #[test]
@@ -40,11 +40,11 @@ fn opens_on_the_demo_rig_with_every_panel() {
 #[test]
 fn selecting_a_bone_shows_it_in_the_inspector_with_its_findings() {
     let mut harness = demo_app();
-    harness.state_mut().time = 0.5;
+    harness.state_mut().window.time = 0.5;
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     let forearm = bone(&harness, "forearm");
-    assert_eq!(harness.state().selection, vec![forearm]);
+    assert_eq!(harness.state().window.selection, vec![forearm]);
     harness.get_by_label_contains("inherit full");
     // At 0.5 s the upper arm is stretched to 1.6× and the forearm bent: under full inheritance it shears.
     harness.get_by_label("findings: stretched (shear)");
@@ -54,7 +54,7 @@ fn selecting_a_bone_shows_it_in_the_inspector_with_its_findings() {
 #[test]
 fn changing_every_bone_to_segment_compensate_removes_the_shear() {
     let mut harness = demo_app();
-    harness.state_mut().time = 0.5;
+    harness.state_mut().window.time = 0.5;
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
@@ -62,7 +62,7 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
     harness.get_by_role_and_label(Role::Button, "segment-compensate").click();
     settle(&mut harness);
     let app = harness.state();
-    assert!(app.doc.modes().iter().all(|&m| m == InheritMode::SegmentCompensate));
+    assert!(app.session.doc.modes().iter().all(|&m| m == InheritMode::SegmentCompensate));
     harness.get_by_label("findings: none");
     // The whole-clip analysis agrees: nothing is stretched any more.
     assert!(app.analysis().unwrap().scan.bones.iter().all(|b| !b.stretched()));
@@ -75,16 +75,16 @@ fn arrow_keys_step_one_frame_and_space_plays() {
     harness.run();
     harness.key_press(egui::Key::ArrowRight);
     harness.run();
-    assert!((harness.state().time - 2.0 / 30.0).abs() < 1e-12);
+    assert!((harness.state().window.time - 2.0 / 30.0).abs() < 1e-12);
     harness.key_press(egui::Key::ArrowLeft);
     harness.run();
-    assert!((harness.state().time - 1.0 / 30.0).abs() < 1e-12);
+    assert!((harness.state().window.time - 1.0 / 30.0).abs() < 1e-12);
     harness.key_press(egui::Key::Space);
     harness.step();
-    assert!(harness.state().playing);
+    assert!(harness.state().window.playing);
     harness.get_by_label("Pause").click();
     harness.run();
-    assert!(!harness.state().playing);
+    assert!(!harness.state().window.playing);
 }
 
 #[test]
@@ -95,7 +95,7 @@ fn a_file_that_fails_to_load_keeps_the_document_and_says_why() {
     std::fs::write(&broken, b"glTF\x02\x00\x00\x00").unwrap();
     harness.state_mut().open(&broken);
     harness.run();
-    assert!(harness.state().doc.path.is_none(), "still the demo");
+    assert!(harness.state().session.doc.path.is_none(), "still the demo");
     // The file's name first, then what is wrong with it.
     harness.get_by_label("broken.glb");
     harness.get_by_label_contains("broken.glb:");
@@ -128,7 +128,7 @@ fn the_layers_panel_turns_on_a_synced_blend_and_the_timeline_follows_its_cycle()
     settle(&mut harness);
     harness.get_by_label("blend a second clip").click();
     settle(&mut harness);
-    let doc = &harness.state().doc;
+    let doc = &harness.state().session.doc;
     let blend = doc.layers().blend.expect("the checkbox turned the blend on");
     // The demo's second clip ("bend"), half way, synced: the cycle is (T2 − T1)·a + T1.
     assert_eq!((blend.clip, blend.weight, blend.sync), (1, 0.5, true));
@@ -139,20 +139,20 @@ fn the_layers_panel_turns_on_a_synced_blend_and_the_timeline_follows_its_cycle()
     // Turning it off again restores the clip's own length.
     harness.get_by_label("blend a second clip").click();
     settle(&mut harness);
-    assert!(harness.state().doc.layers().is_empty());
-    assert_eq!(harness.state().doc.duration(), t1);
+    assert!(harness.state().session.doc.layers().is_empty());
+    assert_eq!(harness.state().session.doc.duration(), t1);
 }
 
 #[test]
 fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
     let mut harness = demo_app();
-    harness.state_mut().settings.show_layers = true;
+    harness.state_mut().settings.show(&bonescope::app::Pane::LAYERS, true);
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     let forearm = bone(&harness, "forearm");
     // The target's model rotation: the chain of local rotations from the root (scale plays no part).
     let rotation_at = |harness: &Harness<'static, BonescopeApp>, time: f64| {
-        let doc = &harness.state().doc;
+        let doc = &harness.state().session.doc;
         let local = doc.evaluation().pose_at(time).local;
         let skeleton = &doc.rig.skeleton;
         let mut rotation = local[forearm].rotation;
@@ -168,7 +168,7 @@ fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
     settle(&mut harness);
     harness.get_by_label("Pin forearm where it is now").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.layers().targets.len(), 1);
+    assert_eq!(harness.state().session.doc.layers().targets.len(), 1);
     let pinned = rotation_at(&harness, 0.0);
     for (time, free) in [0.25, 0.5, 1.0].into_iter().zip(unpinned) {
         // Without the pin the forearm turns with the bending arm; pinned, it keeps the rotation it had at 0 s.
@@ -180,7 +180,7 @@ fn pinning_a_bone_holds_its_model_rotation_while_the_clip_plays() {
 
 /// The app on `doc` with the Layers panel open, settled.
 fn layers_app(doc: Document) -> Harness<'static, BonescopeApp> {
-    let settings = Settings { show_layers: true, ..Settings::default() };
+    let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
@@ -208,7 +208,7 @@ fn the_bind_pose_section_warns_of_a_broken_skin_and_notes_a_stored_pose() {
     // The check reads the clip as authored: a layer edit (the clip weight) keeps its result on screen, no new check.
     let mut harness = harness;
     let layers = bonescope::eval::Layers { bind_weight: 0.5, ..Default::default() };
-    harness.state_mut().doc.set_layers(&layers).unwrap();
+    harness.state_mut().session.doc.set_layers(&layers).unwrap();
     harness.step();
     harness.get_by_label_contains("note: the stored pose is not the bind pose");
     assert!(harness.query_by_label_contains("checking the bind matrices").is_none());
@@ -217,7 +217,7 @@ fn the_bind_pose_section_warns_of_a_broken_skin_and_notes_a_stored_pose() {
 #[test]
 fn the_storage_report_is_measured_off_the_ui_thread_and_shown() {
     let mut harness = demo_app();
-    harness.state_mut().settings.show_layers = true;
+    harness.state_mut().settings.show(&bonescope::app::Pane::LAYERS, true);
     settle(&mut harness);
     harness.get_by_label("Stretch-quaternion storage").click();
     settle(&mut harness);
@@ -256,27 +256,27 @@ fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
         .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(Some(path), rig)));
     harness.get_by_label("pCube1").click();
     settle(&mut harness);
-    assert!(harness.state().doc.clip().unwrap().duration() > 333_000.0);
+    assert!(harness.state().session.doc.clip().unwrap().duration() > 333_000.0);
     harness.get_by_label("time bar");
     harness.get_by_label("Next frame").click();
     settle(&mut harness);
-    assert!((harness.state().time - 1.0 / 30.0).abs() < 1e-9, "one frame on: {}", harness.state().time);
+    assert!((harness.state().window.time - 1.0 / 30.0).abs() < 1e-9, "one frame on: {}", harness.state().window.time);
 }
 
 #[test]
 fn declared_modes_are_one_click_away_after_any_edit() {
     let mut harness = demo_app();
-    let declared = harness.state().doc.rig.skeleton.declared_modes();
+    let declared = harness.state().session.doc.rig.skeleton.declared_modes();
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "segment-compensate").click();
     settle(&mut harness);
-    assert_ne!(harness.state().doc.modes(), declared);
+    assert_ne!(harness.state().session.doc.modes(), declared);
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "declared").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes(), declared);
+    assert_eq!(harness.state().session.doc.modes(), declared);
 }
 
 #[test]
@@ -285,12 +285,12 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
     let hand = bone(&harness, "hand");
     harness.get_by_label("hand").click_secondary();
     harness.run();
-    assert_eq!(harness.state().selection, vec![hand], "right-clicking a row selects it");
+    assert_eq!(harness.state().window.selection, vec![hand], "right-clicking a row selects it");
     harness.get_by_label("Set mode of this bone").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "componentwise").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes()[hand], InheritMode::Componentwise);
+    assert_eq!(harness.state().session.doc.modes()[hand], InheritMode::Componentwise);
     // The Inspector now names the bone too: the outliner's row is the button.
     harness.get_by_role_and_label(Role::Button, "hand").click_secondary();
     harness.run();
@@ -298,7 +298,7 @@ fn the_outliner_menu_selects_its_row_and_sets_declared_modes() {
     harness.run();
     harness.get_by_role_and_label(Role::Button, "declared").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.modes()[hand], harness.state().doc.rig.skeleton.bone(hand).inherit);
+    assert_eq!(harness.state().session.doc.modes()[hand], harness.state().session.doc.rig.skeleton.bone(hand).inherit);
 }
 
 fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
@@ -314,31 +314,35 @@ fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
 fn frames_are_the_clips_own_and_whole() {
     // CMU mocap at 120 Hz: one press steps one source frame, and the rate is shown.
     let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
-    assert!((harness.state().doc.frame_rate() - 120.0).abs() < 0.01, "{}", harness.state().doc.frame_rate());
+    assert!(
+        (harness.state().session.doc.frame_rate() - 120.0).abs() < 0.01,
+        "{}",
+        harness.state().session.doc.frame_rate()
+    );
     harness.key_press(egui::Key::ArrowRight);
     harness.run();
-    assert!((harness.state().time - 0.008_333_3).abs() < 1e-9, "{}", harness.state().time);
+    assert!((harness.state().window.time - 0.008_333_3).abs() < 1e-9, "{}", harness.state().window.time);
     // From between two frames (a click on the time bar), a step lands on the next whole frame.
-    harness.state_mut().time = 17.98 / 120.005;
+    harness.state_mut().window.time = 17.98 / 120.005;
     harness.get_by_label("Next frame").click();
     harness.run();
-    let frames = harness.state().time * harness.state().doc.frame_rate();
+    let frames = harness.state().window.time * harness.state().session.doc.frame_rate();
     assert!((frames - 18.0).abs() < 1e-9, "frame {frames}");
     // End and Home go to the ends; Play at the end without Loop starts again.
     harness.key_press(egui::Key::End);
     harness.run();
-    assert_eq!(harness.state().time, harness.state().doc.duration());
+    assert_eq!(harness.state().window.time, harness.state().session.doc.duration());
     harness.get_by_label("Loop").click();
     harness.run();
     harness.get_by_label("Play").click();
     harness.step();
-    assert!(harness.state().playing && harness.state().time < 0.1, "{}", harness.state().time);
+    assert!(harness.state().window.playing && harness.state().window.time < 0.1, "{}", harness.state().window.time);
     harness.key_press(egui::Key::Space);
     harness.run();
-    assert!(!harness.state().playing);
+    assert!(!harness.state().window.playing);
     harness.key_press(egui::Key::Home);
     harness.run();
-    assert_eq!(harness.state().time, 0.0);
+    assert_eq!(harness.state().window.time, 0.0);
 }
 
 #[test]
@@ -350,7 +354,7 @@ fn the_time_readout_takes_a_typed_time() {
     harness.get_by_role_and_label(Role::SpinButton, "current time").type_text("1.25");
     harness.key_press(egui::Key::Enter);
     harness.run();
-    assert!((harness.state().time - 1.25).abs() < 1e-12, "{}", harness.state().time);
+    assert!((harness.state().window.time - 1.25).abs() < 1e-12, "{}", harness.state().window.time);
 }
 
 #[test]
@@ -362,9 +366,9 @@ fn clicking_a_bones_worst_shear_goes_there() {
     harness.get_all_by_label_contains("max 38.1°").nth(1).unwrap().click();
     settle(&mut harness);
     let hand = bone(&harness, "hand");
-    assert_eq!(harness.state().selection, vec![hand]);
+    assert_eq!(harness.state().window.selection, vec![hand]);
     let worst = harness.state().analysis().unwrap().scan.bones[hand].worst_shear_time;
-    assert_eq!(harness.state().time, worst);
+    assert_eq!(harness.state().window.time, worst);
 }
 
 #[test]
@@ -378,10 +382,10 @@ fn playback_follows_the_wall_clock_when_frames_are_slow() {
     settle(&mut harness);
     harness.key_press(egui::Key::Space);
     harness.step();
-    let start = harness.state().time;
+    let start = harness.state().window.time;
     harness.step();
     harness.step();
-    assert!((harness.state().time - start - 0.5).abs() < 1e-6, "{} after {start}", harness.state().time);
+    assert!((harness.state().window.time - start - 0.5).abs() < 1e-6, "{} after {start}", harness.state().window.time);
 }
 
 #[test]
@@ -408,7 +412,7 @@ fn thresholds_are_edited_in_the_view_menu_and_decide_the_flags() {
 fn selecting_a_bone_does_not_move_the_viewport() {
     // At 1000×700 with the Layers panel open, the Inspector's matrices are wider than its panel: they scroll, the
     // panels keep their widths and the viewport stays where it was.
-    let settings = Settings { show_layers: true, ..Settings::default() };
+    let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
         .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
@@ -439,7 +443,7 @@ fn f_frames_a_selected_bone_with_room_around_it() {
 fn copy_as_json_is_what_inspect_prints_and_says_so() {
     let path = asset("blender/stretchy_full.glb");
     let mut harness = asset_app("blender/stretchy_full.glb");
-    harness.state_mut().time = 0.5;
+    harness.state_mut().window.time = 0.5;
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     harness.get_by_label("Copy as JSON").click();
@@ -474,7 +478,7 @@ fn a_broken_file_is_remembered_watched_and_opens_once_fixed() {
     harness.state_mut().open(&file);
     harness.state_mut().open(&file);
     harness.run();
-    assert!(harness.state().doc.path.is_none(), "still the demo");
+    assert!(harness.state().session.doc.path.is_none(), "still the demo");
     assert_eq!(harness.state().settings.recent.first(), Some(&file), "listed in the recent files");
     let errors = harness.state().errors();
     assert_eq!((errors.len(), errors[0].1), (1, 2), "the same error twice is one message: {errors:?}");
@@ -484,11 +488,11 @@ fn a_broken_file_is_remembered_watched_and_opens_once_fixed() {
     for _ in 0..100 {
         std::thread::sleep(std::time::Duration::from_millis(20));
         harness.step();
-        if harness.state().doc.path.is_some() {
+        if harness.state().session.doc.path.is_some() {
             break;
         }
     }
-    assert_eq!(harness.state().doc.path.as_deref(), Some(file.as_path()));
+    assert_eq!(harness.state().session.doc.path.as_deref(), Some(file.as_path()));
     assert!(harness.state().errors().is_empty(), "{:?}", harness.state().errors());
 }
 
@@ -514,11 +518,11 @@ fn a_message_under_the_pointer_holds_still() {
 #[test]
 fn the_outliner_scrolls_to_a_bone_picked_elsewhere() {
     let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
-    let skeleton = &harness.state().doc.rig.skeleton;
+    let skeleton = &harness.state().session.doc.rig.skeleton;
     let (last, name) = (skeleton.len() - 1, skeleton.bone(skeleton.len() - 1).name.clone());
     assert!(harness.query_by_label(&name).is_none(), "{name} starts below the fold");
     // As a click in the viewport does.
-    harness.state_mut().selection = vec![last];
+    harness.state_mut().window.selection = vec![last];
     harness.step();
     let ctx = harness.ctx.clone();
     harness.state_mut().settle(&ctx);
@@ -531,7 +535,7 @@ fn the_outliner_scrolls_to_a_bone_picked_elsewhere() {
 #[test]
 fn file_open_without_a_desktop_dialog_uses_the_apps_own_browser() {
     let mut harness = demo_app();
-    harness.state_mut().native_dialog = bonescope::app::NativeDialog::Unavailable;
+    harness.state_mut().window.dialogs.native = bonescope::app::NativeDialog::Unavailable;
     harness.get_by_label("File").click();
     harness.run();
     harness.get_by_label("Open…").click();
@@ -549,7 +553,7 @@ fn file_open_without_a_desktop_dialog_uses_the_apps_own_browser() {
     harness.run();
     harness.get_by_label("cmu_12_01_walk.bvh").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.path.as_deref(), Some(folder.join("cmu_12_01_walk.bvh").as_path()));
+    assert_eq!(harness.state().session.doc.path.as_deref(), Some(folder.join("cmu_12_01_walk.bvh").as_path()));
     assert!(harness.query_by_label("Open a file").is_none(), "the browser closes once a file is chosen");
 }
 
@@ -579,7 +583,7 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
     // About the pointer: the time under it stays where it was on screen.
     let still = memory().transform().value_from_position(at).x;
     assert!((still - x_at).abs() < 0.02 * width_before, "{x_at} → {still}");
-    assert_eq!(harness.state().time, 0.0, "the wheel does not seek");
+    assert_eq!(harness.state().window.time, 0.0, "the wheel does not seek");
 }
 
 /// The file at `source` baked with every bone under `mode` by `strategy`, written to `out`.
@@ -604,10 +608,10 @@ fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged
     let baked = maya_trs_bake(folder.path());
     let mut harness = asset_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx");
     let unscaled = bonescope::model::ModeChoice::Mode(InheritMode::UnscaledParent);
-    harness.state_mut().doc.set_mode(0, bonescope::app::ModeScope::All, unscaled);
+    harness.state_mut().session.doc.set_mode(0, bonescope::app::ModeScope::All, unscaled);
     harness.state_mut().compare(&baked);
     settle(&mut harness);
-    let doc = &harness.state().doc;
+    let doc = &harness.state().session.doc;
     assert_eq!(doc.ghost, Some(bonescope::app::Ghost::Compared));
     assert_eq!(doc.compared.as_ref().map(|c| c.path.clone()), Some(baked.clone()));
     harness.get_by_label_contains("comparing with");
@@ -631,7 +635,7 @@ fn a_compared_file_is_the_ghost_its_curves_are_dashed_and_its_differences_badged
     harness.run();
     harness.get_by_label_contains("Stop comparing with").click();
     settle(&mut harness);
-    assert!(harness.state().doc.compared.is_none() && harness.state().doc.ghost.is_none());
+    assert!(harness.state().session.doc.compared.is_none() && harness.state().session.doc.ghost.is_none());
 }
 
 #[test]
@@ -641,7 +645,7 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     let source = asset("blender/stretchy_full.glb");
     std::fs::copy(&source, &copy).unwrap();
     let mut harness = asset_app("blender/stretchy_full.glb");
-    harness.state_mut().native_dialog = bonescope::app::NativeDialog::Unavailable;
+    harness.state_mut().window.dialogs.native = bonescope::app::NativeDialog::Unavailable;
     harness.get_by_label("File").click();
     harness.run();
     harness.get_by_label("Compare with…").click();
@@ -655,7 +659,7 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
     harness.run();
     harness.get_by_label("copy.glb").click();
     settle(&mut harness);
-    assert_eq!(harness.state().doc.compared.as_ref().map(|c| c.path.clone()), Some(copy.clone()));
+    assert_eq!(harness.state().session.doc.compared.as_ref().map(|c| c.path.clone()), Some(copy.clone()));
     let differences = &harness.state().differences().unwrap().bones;
     assert!(differences.iter().flatten().all(|&d| d == 0.0), "a file against its copy: {differences:?}");
     // The copy changes on disk (rewritten as the same clip under segment scale compensate): the comparison follows.
@@ -678,14 +682,14 @@ fn compare_with_asks_for_a_file_and_a_change_on_disk_reloads_it() {
 fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeApp> {
     let doc = Document::load(&asset(path)).unwrap();
     let index = doc.rig.skeleton.find(bone).unwrap();
-    let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     // Scrolling the outliner to a bone deep in a long list settles over a few more frames than the default allows.
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
         .with_max_steps(12)
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
-    harness.state_mut().time = time;
-    harness.state_mut().selection = vec![index];
+    harness.state_mut().window.time = time;
+    harness.state_mut().window.selection = vec![index];
     settle(&mut harness);
     harness
 }
@@ -695,8 +699,8 @@ fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeAp
 fn assert_nothing_cut(harness: &Harness<'static, BonescopeApp>) {
     use bonescope::app::Pane;
     let window = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 800.0));
-    for pane in [Pane::Outliner, Pane::Inspector, Pane::Layers] {
-        let rect = harness.state().pane_rect(pane).unwrap_or_else(|| panic!("{pane:?} is shown"));
+    for pane in ["Skeleton", "Inspector", "Layers"].map(Pane::named) {
+        let rect = harness.state().pane_rect(&pane).unwrap_or_else(|| panic!("{pane:?} is shown"));
         assert!(rect.width() >= 200.0, "{pane:?} is {} wide", rect.width());
         let nodes = harness.query_all_by_role(Role::Label).chain(harness.query_all_by_role(Role::Button));
         let mut checked = 0;
@@ -722,7 +726,7 @@ fn at_a_laptops_size_every_number_and_name_is_whole() {
     let harness = laptop_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", "Left_Tip", 0.5);
     assert_nothing_cut(&harness);
     // Both matrices whole, four columns each, within the Inspector.
-    let inspector = harness.state().pane_rect(bonescope::app::Pane::Inspector).unwrap();
+    let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
     let numbers = harness
         .query_all_by_role(Role::Label)
         .filter(|n| n.value().is_some_and(|l| l.trim().parse::<f64>().is_ok()))
@@ -742,35 +746,39 @@ fn a_pause_or_an_idle_spell_never_counts_as_playing() {
         harness.step();
     };
     at(&mut harness, 100.0);
-    harness.state_mut().time = 0.0;
+    harness.state_mut().window.time = 0.0;
     // Idle 3 s, then Play: the first frame adds nothing, the next ones their frame times.
     at(&mut harness, 103.0);
     harness.state_mut().toggle_play();
     at(&mut harness, 103.0);
     at(&mut harness, 103.05);
-    assert!((harness.state().time - 0.05).abs() < 1e-9, "{}", harness.state().time);
+    assert!((harness.state().window.time - 0.05).abs() < 1e-9, "{}", harness.state().window.time);
     harness.state_mut().toggle_play();
     at(&mut harness, 110.0);
     harness.state_mut().toggle_play();
     at(&mut harness, 110.0);
-    assert!((harness.state().time - 0.05).abs() < 1e-9, "the pause did not count: {}", harness.state().time);
-    harness.state_mut().playing = false;
+    assert!(
+        (harness.state().window.time - 0.05).abs() < 1e-9,
+        "the pause did not count: {}",
+        harness.state().window.time
+    );
+    harness.state_mut().window.playing = false;
     // At the end of a clip without Loop, Play after an idle spell plays from the start.
-    let end = harness.state().doc.duration();
+    let end = harness.state().session.doc.duration();
     harness.state_mut().settings.looping = false;
-    harness.state_mut().time = end;
+    harness.state_mut().window.time = end;
     at(&mut harness, 200.0);
     harness.state_mut().toggle_play();
     at(&mut harness, 200.0);
     at(&mut harness, 200.1);
-    assert!(harness.state().playing);
-    assert!((harness.state().time - 0.1).abs() < 1e-9, "{}", harness.state().time);
+    assert!(harness.state().window.playing);
+    assert!((harness.state().window.time - 0.1).abs() < 1e-9, "{}", harness.state().window.time);
 }
 
 #[test]
 fn every_key_repeat_of_a_held_arrow_is_a_frame() {
     let mut harness = asset_app("bvh/cmu_12_01_walk.bvh");
-    harness.state_mut().time = 0.0;
+    harness.state_mut().window.time = 0.0;
     // A slow frame receives five repeats of →: five frames of the 120 Hz take.
     for _ in 0..5 {
         harness.input_mut().events.push(egui::Event::Key {
@@ -782,8 +790,8 @@ fn every_key_repeat_of_a_held_arrow_is_a_frame() {
         });
     }
     harness.step();
-    let rate = harness.state().doc.frame_rate();
-    assert!((harness.state().time - 5.0 / rate).abs() < 1e-12, "{}", harness.state().time);
+    let rate = harness.state().session.doc.frame_rate();
+    assert!((harness.state().window.time - 5.0 / rate).abs() < 1e-12, "{}", harness.state().window.time);
 }
 
 #[test]
@@ -794,8 +802,8 @@ fn frames_are_frames_everywhere_once_chosen() {
         .with_size(egui::vec2(1280.0, 800.0))
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
     settle(&mut harness);
-    let rate = harness.state().doc.frame_rate();
-    let frames = (harness.state().doc.duration() * rate).round();
+    let rate = harness.state().session.doc.frame_rate();
+    let frames = (harness.state().session.doc.duration() * rate).round();
     harness.get_by_label(&format!("of {frames} frames"));
     // A click anywhere on the time bar lands on a whole frame.
     let bar = harness.get_by_label("time bar").rect();
@@ -810,8 +818,8 @@ fn frames_are_frames_everywhere_once_chosen() {
         });
     }
     harness.run();
-    assert!(harness.state().time > 0.0, "the click moved the time");
-    let frame = harness.state().time * rate;
+    assert!(harness.state().window.time > 0.0, "the click moved the time");
+    let frame = harness.state().window.time * rate;
     assert!((frame - frame.round()).abs() < 1e-9, "frame {frame}");
 }
 
@@ -827,7 +835,7 @@ fn messages_stack_in_the_viewport_wrap_and_cover_no_control() {
         harness.state_mut().open(&broken);
     }
     harness.run();
-    let viewport = harness.state().pane_rect(Pane::Viewport).unwrap();
+    let viewport = harness.state().pane_rect(&Pane::VIEWPORT).unwrap();
     let messages = harness.state().notifications_rect().unwrap();
     assert!(viewport.contains_rect(messages), "{messages:?} within {viewport:?}");
     // Both whole: each error's text wraps within the stack, and each has its Dismiss.
@@ -850,8 +858,8 @@ fn nothing_moves_when_play_turns_to_pause_or_json_is_copied() {
     let mut harness = demo_app();
     harness.get_by_label("forearm").click();
     settle(&mut harness);
-    let before = (harness.get_by_label("Loop").rect(), harness.state().pane_rect(Pane::Layers));
-    let inspector = harness.state().pane_rect(Pane::Inspector);
+    let before = (harness.get_by_label("Loop").rect(), harness.state().pane_rect(&Pane::LAYERS));
+    let inspector = harness.state().pane_rect(&Pane::named("Inspector"));
     harness.get_by_label("Play").click();
     harness.step();
     harness.step();
@@ -862,8 +870,8 @@ fn nothing_moves_when_play_turns_to_pause_or_json_is_copied() {
     harness.step();
     harness.step();
     harness.get_by_label("Copied");
-    assert_eq!(harness.state().pane_rect(Pane::Inspector), inspector);
-    assert_eq!(harness.state().pane_rect(Pane::Layers), before.1);
+    assert_eq!(harness.state().pane_rect(&Pane::named("Inspector")), inspector);
+    assert_eq!(harness.state().pane_rect(&Pane::LAYERS), before.1);
 }
 
 #[test]
@@ -882,7 +890,7 @@ fn a_narrow_window_keeps_every_toolbar_control_with_a_long_take_name() {
 /// The height (largest minus smallest Y) of the document's bones that have a partner in the compared file, in the
 /// document's pose at `time` and in the ghost's (the compared file's pose, as drawn).
 fn figure_and_ghost_heights(app: &BonescopeApp, time: f64) -> (f64, f64) {
-    let doc = &app.doc;
+    let doc = &app.session.doc;
     let compared = doc.compared.as_ref().expect("a compared file");
     let (own, other) = (doc.evaluation().pose_at(time), compared.evaluation(doc.setup().clip).pose_at(time));
     let height =
@@ -912,7 +920,10 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
     settle(&mut harness);
     let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
     assert!((ghost / figure - 1.0).abs() < 0.15, "in CMU units: {figure} against {ghost}");
-    assert_eq!(harness.state().doc.compared.as_ref().unwrap().units()[1].map(|u| u.in_metres()), Some(0.0254 / 0.45));
+    assert_eq!(
+        harness.state().session.doc.compared.as_ref().unwrap().units()[1].map(|u| u.in_metres()),
+        Some(0.0254 / 0.45)
+    );
     // The badges follow the unit: the bones now differ by what their motions do, not by a seventeenfold size.
     let after = worst(&harness.state().differences().expect("differences in the unit picked").bones);
     assert!(after < before / 2.0, "{before} then {after}");
@@ -921,7 +932,7 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
 
 /// The node labelled `label` inside the Inspector (the skeleton's rows name the same bones).
 fn in_inspector<'h>(harness: &'h Harness<'static, BonescopeApp>, label: &'h str) -> egui_kittest::Node<'h> {
-    let inspector = harness.state().pane_rect(bonescope::app::Pane::Inspector).unwrap();
+    let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
     let mut nodes = harness.get_all_by_label(label);
     nodes.find(|n| inspector.contains(n.rect().center())).unwrap_or_else(|| panic!("no {label} in the Inspector"))
 }
@@ -939,9 +950,9 @@ fn why_forearm() -> Harness<'static, BonescopeApp> {
 
 /// The fixes the library ranks for `bone` of the app's document, as `bonescope explain` ranks them.
 fn ranked_fixes(app: &BonescopeApp, bone: usize) -> Vec<bonescope::explain::Fix> {
-    let evaluation = app.doc.evaluation();
+    let evaluation = app.session.doc.evaluation();
     let options =
-        bonescope::analysis::ScanOptions { rate: app.doc.analysis_rate(), tolerances: app.settings.tolerances };
+        bonescope::analysis::ScanOptions { rate: app.session.doc.analysis_rate(), tolerances: app.settings.tolerances };
     let before = bonescope::analysis::scan(&evaluation, &options, &|_, _| {});
     let question = bonescope::explain::Question { bones: Some(&[bone]), ..Default::default() };
     bonescope::explain::explain(&evaluation, &before, question, &options).remove(0).fixes
@@ -949,8 +960,9 @@ fn ranked_fixes(app: &BonescopeApp, bone: usize) -> Vec<bonescope::explain::Fix>
 
 #[test]
 fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
-    use bonescope::app::{Ghost, ModeChoice};
+    use bonescope::app::Ghost;
     use bonescope::explain::Change;
+    use bonescope::model::ModeChoice;
     let mut harness = why_forearm();
     let (forearm, upper_arm) = (bone(&harness, "forearm"), bone(&harness, "upper_arm"));
     // The upper arm's squash under the elbow's turn shears the forearm.
@@ -959,12 +971,12 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     // A bone of the chain is a click away: it is selected as the skeleton's row selects it.
     in_inspector(&harness, "upper_arm").click();
     settle(&mut harness);
-    assert_eq!(harness.state().selection, vec![upper_arm]);
+    assert_eq!(harness.state().window.selection, vec![upper_arm]);
     harness.get_by_label("not sheared: nothing to explain");
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     // The first fix that is a setting of the document is a mode on the forearm; Try sets it on that bone alone.
-    let declared = harness.state().doc.modes().to_vec();
+    let declared = harness.state().session.doc.modes().to_vec();
     let fixes = ranked_fixes(harness.state(), forearm);
     let first = fixes.iter().find(|f| !matches!(f.change, Change::Bake { .. })).unwrap();
     let Change::Mode { bone: fixed, mode } = first.change else { panic!("{first:?}") };
@@ -972,11 +984,11 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     in_inspector(&harness, "Try").click();
     settle(&mut harness);
     let app = harness.state();
-    assert_eq!(app.doc.modes()[forearm], mode);
-    assert!(app.doc.modes().iter().zip(&declared).enumerate().all(|(b, (m, d))| b == forearm || m == d));
+    assert_eq!(app.session.doc.modes()[forearm], mode);
+    assert!(app.session.doc.modes().iter().zip(&declared).enumerate().all(|(b, (m, d))| b == forearm || m == d));
     assert!(!app.analysis().unwrap().scan.bones[forearm].stretched(), "the analysis no longer flags the forearm");
     // The ghost shows the declared modes, as the clip was before.
-    assert_eq!(app.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));
+    assert_eq!(app.session.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));
     harness.get_by_label("not sheared: nothing to explain");
 }
 
@@ -998,11 +1010,11 @@ fn why_tries_a_uniform_scale_that_the_layers_panel_removes() {
     drop(tries);
     settle(&mut harness);
     let app = harness.state();
-    assert_eq!(app.doc.layers().uniform_scale, vec![upper_arm]);
+    assert_eq!(app.session.doc.layers().uniform_scale, vec![upper_arm]);
     assert!(!app.analysis().unwrap().scan.bones[forearm].stretched());
-    assert_eq!(app.doc.ghost, Some(Ghost::Unlayered), "the ghost shows the clip without the layer");
+    assert_eq!(app.session.doc.ghost, Some(Ghost::Unlayered), "the ghost shows the clip without the layer");
     // The Layers panel lists the layer (its section opens for it) with a remove button that undoes it.
-    harness.state_mut().settings.show_layers = true;
+    harness.state_mut().settings.show(&bonescope::app::Pane::LAYERS, true);
     settle(&mut harness);
     harness.get_by_label("Uniform scale");
     let remove = harness.get_by_label("remove");
@@ -1011,6 +1023,141 @@ fn why_tries_a_uniform_scale_that_the_layers_panel_removes() {
     harness.get_by_label("remove").click();
     settle(&mut harness);
     let app = harness.state();
-    assert!(app.doc.layers().uniform_scale.is_empty());
+    assert!(app.session.doc.layers().uniform_scale.is_empty());
     assert!(app.analysis().unwrap().scan.bones[forearm].stretched(), "flagged again");
+}
+
+/// Ctrl+Z, as a person presses it.
+fn undo_key(harness: &mut Harness<'static, BonescopeApp>) {
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(harness);
+}
+
+/// Ctrl+Shift+Z.
+fn redo_key(harness: &mut Harness<'static, BonescopeApp>) {
+    harness.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    settle(harness);
+}
+
+/// What the document evaluates, and its ghost.
+fn state_of(harness: &Harness<'static, BonescopeApp>) -> (bonescope::eval::Setup, Option<bonescope::app::Ghost>) {
+    let doc = &harness.state().session.doc;
+    (doc.setup().clone(), doc.ghost)
+}
+
+#[test]
+fn a_fix_tried_is_undone_by_ctrl_z_with_its_ghost_and_redone_by_ctrl_shift_z() {
+    let mut harness = why_forearm();
+    let before = state_of(&harness);
+    in_inspector(&harness, "Try").click();
+    settle(&mut harness);
+    let tried = state_of(&harness);
+    assert_ne!(tried, before);
+    // The Edit menu says what Undo undoes (the app's font has no arrow: "to").
+    harness.get_by_label("Edit").click();
+    harness.run();
+    let forearm = bone(&harness, "forearm");
+    let mode = harness.state().session.doc.modes()[forearm];
+    harness.get_by_label_contains(&format!("Undo forearm to {mode}"));
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), before, "modes, layers and ghost as they were");
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness.get_by_label_contains(&format!("Redo forearm to {mode}"));
+    harness.key_press(egui::Key::Escape);
+    redo_key(&mut harness);
+    assert_eq!(state_of(&harness), tried);
+    // Ctrl+Y redoes too.
+    undo_key(&mut harness);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Y);
+    settle(&mut harness);
+    assert_eq!(state_of(&harness), tried);
+}
+
+#[test]
+fn a_subtree_mode_change_and_a_layer_added_are_one_step_each() {
+    let mut harness = demo_app();
+    let opened = state_of(&harness);
+    harness.get_by_label("forearm").click_secondary();
+    harness.run();
+    harness.get_by_label("Set mode of its subtree").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "blender-aligned").click();
+    settle(&mut harness);
+    let subtree = state_of(&harness);
+    let (forearm, hand) = (bone(&harness, "forearm"), bone(&harness, "hand"));
+    assert!([forearm, hand].iter().all(|&b| harness.state().session.doc.modes()[b] == InheritMode::BlenderAligned));
+    assert_eq!(harness.state().session.undo_label(), Some("forearm's subtree → blender-aligned"));
+    harness.get_by_role_and_label(Role::Button, "Layers").click();
+    settle(&mut harness);
+    harness.get_by_label("Blend").click();
+    settle(&mut harness);
+    harness.get_by_label("blend a second clip").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().session.undo_label(), Some("blend on"));
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), subtree, "the blend alone is undone");
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), opened, "then the subtree's modes, all at once");
+    redo_key(&mut harness);
+    redo_key(&mut harness);
+    assert!(harness.state().session.doc.layers().blend.is_some());
+}
+
+#[test]
+fn a_slider_dragged_over_many_frames_is_one_step() {
+    let mut harness = layers_app(Document::demo());
+    let before = state_of(&harness);
+    let slider = harness.get_by_role_and_label(Role::Slider, "clip weight").rect();
+    let (start, y) = (slider.left() + 0.98 * slider.width(), slider.center().y);
+    harness.drag_at(egui::pos2(start, y));
+    harness.run();
+    for step in 1..=10 {
+        harness.hover_at(egui::pos2(start - 0.05 * step as f32 * slider.width(), y));
+        harness.run();
+    }
+    harness.drop_at(egui::pos2(start - 0.5 * slider.width(), y));
+    settle(&mut harness);
+    let weight = harness.state().session.doc.layers().bind_weight;
+    assert!(weight < 0.9, "the slider moved: {weight}");
+    assert_eq!(harness.state().session.undo_label(), Some("bind weight on"));
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), before, "one undo takes the whole drag back");
+    assert_eq!(harness.state().session.undo_label(), None);
+}
+
+#[test]
+fn a_reload_keeps_the_history_and_another_file_starts_a_new_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("walk.bvh");
+    std::fs::copy(asset("bvh/bvh_test2.bvh"), &file).unwrap();
+    let mut harness = demo_app();
+    harness.state_mut().open(&file);
+    settle(&mut harness);
+    let opened = state_of(&harness);
+    harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "blender-none").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().session.undo_label(), Some("every bone → blender-none"));
+    // The file changes on disk: it is read again, its history kept.
+    std::fs::write(&file, std::fs::read_to_string(&file).unwrap().replace("Frame Time:", "Frame Time: ")).unwrap();
+    let before = harness.state().session.doc.rig_id;
+    for _ in 0..100 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        harness.step();
+        if harness.state().session.doc.rig_id != before {
+            break;
+        }
+    }
+    assert_ne!(harness.state().session.doc.rig_id, before, "reloaded");
+    assert_eq!(harness.state().session.undo_label(), Some("every bone → blender-none"));
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), opened);
+    // Another file: nothing to undo or redo there.
+    harness.state_mut().open(&asset("bvh/bvh_test3.bvh"));
+    settle(&mut harness);
+    assert_eq!((harness.state().session.undo_label(), harness.state().session.redo_label()), (None, None));
 }

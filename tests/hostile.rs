@@ -407,13 +407,18 @@ fn the_app_keeps_its_document_through_every_refused_file() {
         .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
     harness.state_mut().open(&good);
     harness.run();
-    assert_eq!(harness.state().doc.path.as_deref(), Some(good.as_path()));
+    assert_eq!(harness.state().session.doc.path.as_deref(), Some(good.as_path()));
     let refused = corpus::all().into_iter().filter(|c| !c.huge && matches!(c.expect, Expect::Refused(_)));
     for case in refused {
         let file = case.write(dir.path());
         harness.state_mut().open(&file);
         harness.run();
-        assert_eq!(harness.state().doc.path.as_deref(), Some(good.as_path()), "{}: the document stays", case.name);
+        assert_eq!(
+            harness.state().session.doc.path.as_deref(),
+            Some(good.as_path()),
+            "{}: the document stays",
+            case.name
+        );
     }
     harness.get_by_label_contains("fifo_file/a.gltf: not a regular file");
     // A notification names a file whose name would retitle a terminal, escaped (in an app of its own: at most four

@@ -16,7 +16,7 @@ fn window(settings: Settings, doc: Document, time: f64, bone: Option<&str>) -> H
         .with_render_cursor(false)
         .wgpu()
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
-    harness.state_mut().time = time;
+    harness.state_mut().window.time = time;
     if let Some(bone) = bone {
         harness.get_by_label(bone).click();
     }
@@ -94,7 +94,7 @@ fn demo_stretch_plots_with_ghost_and_only_flagged_bones() {
 fn long_clip_envelopes() {
     let rig = bonescope::import::stress_rig(20, 20_000, 5);
     let mut harness = window(Settings::default(), Document::new(None, rig), 300.0, None);
-    harness.state_mut().selection = vec![6, 16];
+    harness.state_mut().window.selection = vec![6, 16];
     settle_for_snapshot(&mut harness);
     harness.snapshot("long_clip_envelopes");
 }
@@ -116,7 +116,9 @@ fn demo_layers_blend_additive_shake() {
     };
     doc.set_layers(&layers).unwrap();
     doc.ghost = Some(Ghost::Unlayered);
-    let mut settings = Settings { show_layers: true, show_inspector: false, ..Settings::default() };
+    let mut settings = Settings::default()
+        .showing(&bonescope::app::Pane::LAYERS, true)
+        .showing(&bonescope::app::Pane::named("Inspector"), false);
     settings.scene.boxes = true;
     window(settings, doc, 0.4, Some("forearm")).snapshot("demo_layers_blend_additive_shake");
 }
@@ -145,7 +147,7 @@ fn fbx_blend_shapes_with_inbetweens() {
 /// bind check notes the stored pose, with no warning.
 #[test]
 fn fbx_stored_pose_noted_in_the_layers_panel() {
-    let settings = Settings { show_layers: true, ..Settings::default() };
+    let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     let doc = asset_document("blender/stretchy_full.fbx");
     window(settings, doc, 0.0, None).snapshot("fbx_stored_pose_noted_in_the_layers_panel");
 }
@@ -190,7 +192,7 @@ fn walk_outliner_with_cameras_and_helpers() {
 /// share a column, the toolbar wraps rather than cut its controls.
 #[test]
 fn small_window_with_layers_and_inspector() {
-    let settings = Settings { show_layers: true, show_inspector: true, ..Settings::default() };
+    let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     laptop(egui::vec2(1000.0, 700.0), settings, Document::demo(), "forearm", 0.5)
         .snapshot("small_window_with_layers_and_inspector");
 }
@@ -210,14 +212,14 @@ fn laptop(
         .with_render_cursor(false)
         .wgpu()
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
-    harness.state_mut().time = time;
-    harness.state_mut().selection = vec![index];
+    harness.state_mut().window.time = time;
+    harness.state_mut().window.selection = vec![index];
     settle_for_snapshot(&mut harness);
     harness
 }
 
 fn laptop_settings() -> Settings {
-    Settings { show_layers: true, show_inspector: true, ..Settings::default() }
+    Settings::default().showing(&bonescope::app::Pane::LAYERS, true)
 }
 
 #[test]

@@ -3,19 +3,18 @@
 //! plotted dashed beside the document's, and each bone's largest difference over the clip, which the outliner badges
 //! above a threshold; conversion nodes, which only state a file's axes and unit, are left out as `diff` leaves them.
 //! The compared file is measured in the document's unit; where a file states none (BVH), the user gives it one
-//! ([`unit_pickers`]). The file is watched and reloaded like the document.
+//! (the toolbar's unit pickers). The file is watched and reloaded like the document.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::job::{Job, Key, Progress};
-use super::{Document, RigId};
-use crate::analysis::{Assessment, Components, Tolerances};
-use crate::diff::{Pairs, compare, comparison_times, match_bones, match_clips, match_meshes, model_curves};
+use super::identity::RigId;
+use crate::analysis::{Assessment, Tolerances};
+use crate::diff::{match_bones, match_clips, match_meshes};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup, SkinningMethod};
 use crate::import::{self, ImportError};
-use crate::model::{Choice, Clip, Rig, Unit};
+use crate::model::{Clip, Rig, Unit};
 use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
@@ -92,6 +91,28 @@ impl Compared {
         }
         let fresh = Compared::pair(self.path.clone(), rig, document);
         Ok(Compared { document_unit: self.document_unit, played: self.played, ..fresh })
+    }
+
+    /// Whether the file states its unit (else the user gives it one).
+    pub fn states_unit(&self) -> bool {
+        self.states_unit
+    }
+
+    /// The same file taken in `unit` (it states none): another rig to compare.
+    pub fn given_unit(&self, unit: Unit) -> Self {
+        let mut rig = (*self.rig).clone();
+        rig.unit = Some(unit);
+        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), ..self.clone() }
+    }
+
+    /// The same measured in `unit`, the document's where its file states none.
+    pub fn in_document_unit(&self, unit: Unit) -> Self {
+        Compared { document_unit: Some(unit), ..self.clone() }
+    }
+
+    /// The same, its rotation keys played by `played`.
+    pub fn played_by(&self, played: RotationInterpolation) -> Self {
+        Compared { played, ..self.clone() }
     }
 
     /// The document's unit and the compared file's, as the comparison takes them.
@@ -172,142 +193,6 @@ impl Compared {
             shear_deg: assessments.iter().map(|a| a.shear_deg).collect(),
             meshes,
         }
-    }
-}
-
-/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in: the
-/// ghost, the dashed curves and the differences follow it.
-pub fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
-    let Some(compared) = doc.compared.clone() else { return };
-    if !compared.states_unit
-        && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
-    {
-        let mut rig = (*compared.rig).clone();
-        rig.unit = Some(unit);
-        replace(doc, Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), ..(*compared).clone() });
-    }
-    if doc.rig.unit.is_none()
-        && let Some(unit) = unit_picker(ui, &doc.title(), compared.document_unit, &compared.title())
-    {
-        replace(doc, Compared { document_unit: Some(unit), ..(*compared).clone() });
-    }
-}
-
-/// File → "Play compared rotations by" while comparing: how the compared file's rotation keys are played, to see
-/// a bake as Blender, Unity or Unreal (nlerp) will show it.
-pub fn rotation_menu(ui: &mut egui::Ui, doc: &mut Document) {
-    let Some(compared) = doc.compared.clone() else { return };
-    ui.menu_button("Play compared rotations by", |ui| {
-        for &played in RotationInterpolation::ALL {
-            let chosen =
-                ui.selectable_label(played == compared.played, played.id()).on_hover_text(played.description());
-            if chosen.clicked() && played != compared.played {
-                replace(doc, Compared { played, ..(*compared).clone() });
-            }
-        }
-    });
-}
-
-/// A picker of the unit `file` is in (`unit`, `None` while not given); the unit picked, if another.
-fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -> Option<Unit> {
-    let label = ui.label(format!("unit of {file}"));
-    let mut picked = unit;
-    egui::ComboBox::from_id_salt(("unit", file))
-        .selected_text(unit.map_or_else(|| "not stated".to_owned(), |u| u.to_string()))
-        .show_ui(ui, |ui| {
-            for named in Unit::named() {
-                ui.selectable_value(&mut picked, Some(named), named.to_string());
-            }
-        })
-        .response
-        .labelled_by(label.id)
-        .on_hover_text(format!("{file} states no unit: the one it is in, to compare it with {other} in one unit"));
-    picked.filter(|_| picked != unit)
-}
-
-/// The document compared with `compared` instead.
-fn replace(doc: &mut Document, compared: Compared) {
-    doc.compared = Some(Arc::new(compared));
-}
-
-/// What is asked of a comparison with the compared file: that file (this pairing of it) as evaluated, and how often
-/// the clip is sampled.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CompareRequest {
-    pub compared: RigId,
-    pub setup: Setup,
-    pub rate: f64,
-}
-
-impl CompareRequest {
-    /// The comparison of `doc` with its compared file at `rate` samples a second, keyed.
-    pub fn of(doc: &Document, compared: &Compared, rate: f64) -> Key<CompareRequest> {
-        let setup = compared.setup(doc.setup().clip);
-        Key::of(doc, CompareRequest { compared: compared.rig_id, setup, rate })
-    }
-}
-
-/// Each document bone's largest difference from the compared file over the clip.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Differences {
-    /// Per document bone: the largest distance of its origin and axis probes, as a fraction of the rig's size
-    /// (`None` without a partner, and for conversion nodes).
-    pub bones: Vec<Option<f64>>,
-    pub rig_size: f64,
-}
-
-/// What is asked of the compared file's curves: the bones plotted (the document's), at the times of the document's
-/// own curves (the dashed curves share their axis).
-#[derive(Clone, Debug, PartialEq)]
-pub struct CurvesRequest {
-    pub plotted: Vec<usize>,
-    pub times: Vec<f64>,
-}
-
-/// `(document bone, its partner's model-space components at the curves' times)` for the plotted bones that have one.
-pub type ComparedCurves = Vec<(usize, Vec<Components>)>;
-
-/// The background work of a comparison.
-#[derive(Default)]
-pub struct CompareJobs {
-    pub differences: Job<Key<CompareRequest>, Differences>,
-    /// Keyed by the compared file as evaluated.
-    pub curves: Job<Key<CurvesRequest>, ComparedCurves>,
-}
-
-/// The differences `key` asks for, as work for a [`Job`]: the document's rig (the one `key` was made of) against
-/// `compared`.
-pub fn differences(
-    key: Key<CompareRequest>,
-    rig: Arc<Rig>,
-    compared: Arc<Compared>,
-) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
-    move |_| {
-        let own = key.evaluation(&rig)?;
-        let other = Evaluation::of(&compared.rig, &key.request.setup).ok()?;
-        // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
-        let pairs = Pairs { meshes: Vec::new(), ..Pairs::by_name(&own, &other) };
-        let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.request.rate));
-        let mut bones = vec![None; rig.skeleton.len()];
-        for difference in &comparison.bones {
-            bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
-        }
-        Some(Differences { bones, rig_size: comparison.rig_size })
-    }
-}
-
-/// The compared curves `key` asks for, as work for a [`Job`].
-pub fn curves(
-    key: Key<CurvesRequest>,
-    compared: Arc<Compared>,
-) -> impl FnOnce(&Progress) -> Option<ComparedCurves> + Send + 'static {
-    move |_| {
-        let request = &key.request;
-        let paired: Vec<(usize, usize)> =
-            request.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
-        let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
-        let curves = model_curves(&key.evaluation(&compared.rig)?, &partners, &request.times);
-        Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
     }
 }
 

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::compare::Compared;
+use super::identity::RigId;
 use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};
 use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton};
@@ -38,19 +38,6 @@ impl Ghost {
             Ghost::Unlayered => Some(Setup { layers: Layers::default(), ..document.clone() }),
             Ghost::Compared => None,
         }
-    }
-}
-
-/// One load of a rig: what every result computed from it is keyed by, so that another file, or the same file read
-/// again, is measured anew even where its bones are the same.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct RigId(u64);
-
-impl RigId {
-    /// An identity no rig had before.
-    pub fn fresh() -> RigId {
-        static NEXT: AtomicU64 = AtomicU64::new(0);
-        RigId(NEXT.fetch_add(1, Ordering::Relaxed))
     }
 }
 

@@ -7,7 +7,10 @@
 //! files to click, and Up.
 
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
+
+use super::notifications::Notifications;
 
 /// File extensions bonescope reads, shown in the browser.
 const EXTENSIONS: [&str; 4] = ["glb", "gltf", "fbx", "bvh"];
@@ -55,7 +58,7 @@ impl DialogOutcome {
 }
 
 /// Runs the native dialog and times it.
-pub fn run_native_dialog() -> DialogOutcome {
+fn run_native_dialog() -> DialogOutcome {
     let started = Instant::now();
     let choice = rfd::FileDialog::new().add_filter("animation", &EXTENSIONS).add_filter("any file", &["*"]).pick_file();
     DialogOutcome::of(choice, started.elapsed())
@@ -149,6 +152,84 @@ impl FileBrowser {
         }
         chosen
     }
+}
+
+/// What a chosen file is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Purpose {
+    Open,
+    Compare,
+}
+
+/// The file dialog under way, if any: the desktop's (on its own thread, so the UI keeps drawing) or bonescope's.
+pub struct Dialogs {
+    /// Whether the desktop's dialog may be used (detected at start; tests set it).
+    pub native: NativeDialog,
+    pending: Option<(Receiver<DialogOutcome>, Purpose)>,
+    browser: Option<(FileBrowser, Purpose)>,
+}
+
+impl Default for Dialogs {
+    fn default() -> Self {
+        Dialogs { native: NativeDialog::detect(), pending: None, browser: None }
+    }
+}
+
+impl Dialogs {
+    /// Asks for a file for `purpose`: the desktop's dialog where there is one, else bonescope's own browser in
+    /// `folder`.
+    pub fn choose(&mut self, purpose: Purpose, ctx: &egui::Context, folder: &Path, notes: &mut Notifications) {
+        match self.native {
+            NativeDialog::Available => self.pending = Some((spawn_native_dialog(ctx.clone()), purpose)),
+            NativeDialog::Unavailable => self.browse(purpose, folder, notes),
+        }
+    }
+
+    /// Shows bonescope's own file browser (the desktop has no dialog).
+    fn browse(&mut self, purpose: Purpose, folder: &Path, notes: &mut Notifications) {
+        notes.info("no desktop file dialog here (no XDG portal): using bonescope's own".to_owned());
+        let title = match purpose {
+            Purpose::Open => "Open a file",
+            Purpose::Compare => "Compare with a file",
+        };
+        self.browser = Some((FileBrowser::new(title, folder), purpose));
+    }
+
+    /// Draws the browser while it is open; the file chosen in either dialog, and what for. A desktop dialog that
+    /// failed falls back to the browser.
+    pub fn ui(&mut self, ctx: &egui::Context, folder: &Path, notes: &mut Notifications) -> Option<(PathBuf, Purpose)> {
+        if let Some((dialog, purpose)) = &self.pending
+            && let Ok(outcome) = dialog.try_recv()
+        {
+            let purpose = *purpose;
+            self.pending = None;
+            match outcome {
+                DialogOutcome::Chosen(path) => return Some((path, purpose)),
+                DialogOutcome::Cancelled => {}
+                DialogOutcome::Failed => {
+                    self.native = NativeDialog::Unavailable;
+                    self.browse(purpose, folder, notes);
+                }
+            }
+        }
+        let (browser, purpose) = self.browser.as_mut()?;
+        let mut open = true;
+        let chosen = browser.ui(ctx, &mut open).map(|path| (path, *purpose));
+        if !open {
+            self.browser = None;
+        }
+        chosen
+    }
+}
+
+/// Runs the native file dialog on its own thread so the UI keeps drawing.
+fn spawn_native_dialog(ctx: egui::Context) -> Receiver<DialogOutcome> {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = sender.send(run_native_dialog());
+        ctx.request_repaint();
+    });
+    receiver
 }
 
 /// A folder's sub-folders and animation files (hidden ones left out), folders first, each sorted.

@@ -5,36 +5,38 @@
 use egui::{Grid, RichText, Ui};
 use glam::DMat4;
 
-use super::Shared;
+use super::pane::{Pane, Place};
+use super::panel::{Panel, Shared};
 use super::text::compact;
-use super::why::Why;
+use super::why;
 use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
 use crate::model::Choice;
 use crate::view::Badge;
 
-/// The panel's own state: the Why? section's explanation.
+/// The panel: all it shows is the shared state's.
 #[derive(Default)]
-pub struct Inspector {
-    why: Why,
-}
+pub struct Inspector;
 
-impl Inspector {
-    /// Waits for an explanation under way (tests and headless renders want a settled state).
-    pub fn settle(&mut self) {
-        self.why.settle();
+impl Panel for Inspector {
+    fn pane(&self) -> Pane {
+        Pane::named("Inspector")
     }
 
-    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+    fn place(&self) -> Place {
+        Place::Right(0.55)
+    }
+
+    fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         let Some(bone) = shared.inspected() else {
             ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
             return;
         };
-        bone_ui(ui, shared, bone, &mut self.why);
+        bone_ui(ui, shared, bone);
     }
 }
 
-fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize, why: &mut Why) {
+fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
     let reports =
         BoneReport::all(&shared.doc.rig.skeleton, shared.doc.modes(), &shared.frame.pose, &shared.settings.tolerances);
     let report = &reports[bone];
@@ -53,10 +55,10 @@ fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize, why: &mut Why) {
     ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
     ui.horizontal_wrapped(|ui| {
         copy_button(ui, shared, &reports);
-        why.header(ui, shared, bone);
+        why::header(ui, shared, bone);
     });
     egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-        why.ui(ui, shared, bone);
+        why::ui(ui, shared, bone);
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;

@@ -1,12 +1,12 @@
-//! Work computed off the UI thread and cached until what it depends on changes: the whole-clip analysis, and the
-//! comparison with a second file.
+//! One piece of work computed off the UI thread, kept until what it depends on changes ([`Key`]), cancelled when a
+//! newer one replaces it.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
-use super::{Document, RigId};
-use crate::analysis::{ClipAnalysis, CurveRequest, Judged, ScanOptions, Tolerances, analyze};
+use super::document::Document;
+use super::identity::RigId;
 use crate::eval::{Evaluation, Layers, Setup};
 use crate::model::Rig;
 
@@ -155,36 +155,5 @@ impl<R> Key<R> {
     /// The evaluation the key's setup makes of `rig` (the rig the key was made of); `None` if it does not fit.
     pub fn evaluation<'a>(&self, rig: &'a Rig) -> Option<Evaluation<'a>> {
         Evaluation::of(rig, &self.setup).ok()
-    }
-}
-
-/// What a whole-clip analysis is asked.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AnalysisRequest {
-    /// What the ghost evaluates of the same rig (its curves are plotted dashed).
-    pub ghost: Option<Setup>,
-    pub plotted: Vec<usize>,
-    pub rate: f64,
-    pub tolerances: Tolerances,
-    /// Every bone (the summary), or only the plotted bones' chains (their curves).
-    pub judged: Judged,
-}
-
-/// The whole-clip analysis of the document.
-pub type AnalysisJob = Job<Key<AnalysisRequest>, ClipAnalysis>;
-
-/// The analysis `key` asks of `rig` (the rig `key` was made of), as work for a [`Job`].
-pub fn analysis(
-    key: Key<AnalysisRequest>,
-    rig: Arc<Rig>,
-) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
-    move |progress| {
-        let evaluation = key.evaluation(&rig)?;
-        let request = &key.request;
-        let ghost = request.ghost.as_ref().and_then(|ghost| Evaluation::of(&rig, ghost).ok());
-        let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
-        let curves = CurveRequest { bones: &request.plotted, ghost: ghost.as_ref(), judged: request.judged };
-        let report = |done: usize, total: usize| progress.report(done, total);
-        analyze(&evaluation, curves, &options, &report, progress.cancelled())
     }
 }

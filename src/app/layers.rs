@@ -8,38 +8,42 @@
 use egui::{CollapsingHeader, DragValue, RichText, Slider, Ui};
 use glam::{DQuat, DVec3};
 
-use super::job::{Job, Key, Progress};
-use super::{Ghost, Shared};
-use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
-use crate::analysis::{BindCheck, BindTolerance, check_bind};
+use super::document::Ghost;
+use super::pane::{Pane, Place, Visibility};
+use super::panel::{Panel, Shared};
+use crate::analysis::BindCheck;
+use crate::analysis::storage::StorageReport;
 use crate::eval::Layers;
 use crate::eval::layers::{Additive, Blend, Crossfade, Shake, ShakeParams, SyncedCycle, Target};
 use crate::model::{Choice, Rig, Skeleton, Transform};
 use crate::view::Badge;
 
-/// The panel's own state: results computed on request, kept while they still describe the document.
+/// The panel's own state (the bind check and the storage report are the work's, computed off the UI thread: each
+/// walks the whole clip).
 #[derive(Default)]
 pub struct LayersPanel {
-    /// The storage report of one document state: measured off the UI thread (it walks the whole clip).
-    storage: Job<Key<()>, StorageReport>,
-    /// The bind check of the document: off the UI thread (where joints are off their bind, it walks the whole clip).
-    bind: Job<Key<()>, BindCheck>,
     /// How many bones the uniform-scale layer had in the last frame: a bone added elsewhere (the Inspector's Why?
     /// section) opens its section, where it is undone.
     uniform_bones: usize,
 }
 
-impl LayersPanel {
-    /// Waits for a measurement under way (tests and headless renders want a settled state).
-    pub fn settle(&mut self) {
-        self.storage.wait();
-        self.bind.wait();
+impl Panel for LayersPanel {
+    fn pane(&self) -> Pane {
+        Pane::LAYERS
     }
 
-    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+    fn place(&self) -> Place {
+        Place::Right(0.45)
+    }
+
+    fn visibility(&self) -> Visibility {
+        Visibility::Hidden
+    }
+
+    fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         let mut layers = shared.doc.layers().clone();
         egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-            self.bind_section(ui, shared, &mut layers);
+            bind_section(ui, shared, &mut layers);
             interpolation_section(ui, shared, &mut layers);
             blend_section(ui, shared, &mut layers);
             additive_section(ui, shared, &mut layers);
@@ -47,7 +51,7 @@ impl LayersPanel {
             shake_section(ui, shared, &mut layers);
             uniform_section(ui, shared, &mut layers, std::mem::take(&mut self.uniform_bones));
             targets_section(ui, shared, &mut layers);
-            self.storage_section(ui, shared);
+            storage_section(ui, shared);
         });
         if layers != *shared.doc.layers()
             && let Err(error) = shared.doc.set_layers(&layers)
@@ -56,67 +60,50 @@ impl LayersPanel {
         }
         self.uniform_bones = shared.doc.layers().uniform_scale.len();
     }
+}
 
-    /// The bind weight, and the bind check: joints whose bind matrices break the skin (a warning), and joints the
-    /// stored pose holds away from their bind (a note).
-    fn bind_section(&mut self, ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
-        CollapsingHeader::new("Bind pose").default_open(true).show(ui, |ui| {
-            weight_slider(ui, &mut layers.bind_weight, "clip weight").on_hover_text("0: the bind pose, 1: the clip");
-            ui.checkbox(&mut shared.settings.scene.bind_pose, "Show the bind pose");
-            let doc = &*shared.doc;
-            if doc.rig.skins.is_empty() {
-                ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
-                return;
+/// The bind weight, and the bind check: joints whose bind matrices break the skin (a warning), and joints the stored
+/// pose holds away from their bind (a note).
+fn bind_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
+    CollapsingHeader::new("Bind pose").default_open(true).show(ui, |ui| {
+        weight_slider(ui, &mut layers.bind_weight, "clip weight").on_hover_text("0: the bind pose, 1: the clip");
+        ui.checkbox(&mut shared.settings.scene.bind_pose, "Show the bind pose");
+        if shared.doc.rig.skins.is_empty() {
+            ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
+            return;
+        }
+        match shared.work.bind_check(shared.doc) {
+            Some(check) => bind_report(ui, check),
+            None => {
+                ui.horizontal(|ui| {
+                    ui.spinner();
+                    ui.label("checking the bind matrices…");
+                });
             }
-            // The check reads the clip as authored: its key leaves the layers out.
-            let key = Key::authored(doc, ());
-            let work = || {
-                let (rig, key) = (doc.rig.clone(), key.clone());
-                move |_: &Progress| Some(check_bind(&key.evaluation(&rig)?, &BindTolerance::default()))
-            };
-            let waker = ui.ctx().clone();
-            self.bind.update(key.clone(), work, move || waker.request_repaint());
-            match self.bind.for_key(&key) {
-                Some(check) => bind_report(ui, check),
-                None => {
-                    ui.horizontal(|ui| {
-                        ui.spinner();
-                        ui.label("checking the bind matrices…");
-                    });
-                }
-            }
-        });
-    }
+        }
+    });
+}
 
-    /// The stretch-quaternion storage of the current clip (`docs/decomposition.md`), measured when asked, off the UI
-    /// thread.
-    fn storage_section(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
-            let doc = &*shared.doc;
-            let key = Key::of(doc, ());
-            if ui.button("Measure the clip").clicked() {
-                let (rig, measured) = (doc.rig.clone(), key.clone());
-                let work = || {
-                    move |_: &Progress| Some(storage_report(&measured.evaluation(&rig)?, &StorageOptions::default()))
-                };
-                let waker = ui.ctx().clone();
-                self.storage.update(key.clone(), work, move || waker.request_repaint());
+/// The stretch-quaternion storage of the current clip (`docs/decomposition.md`), measured when asked, off the UI
+/// thread.
+fn storage_section(ui: &mut Ui, shared: &mut Shared) {
+    CollapsingHeader::new("Stretch-quaternion storage").show(ui, |ui| {
+        if ui.button("Measure the clip").clicked() {
+            shared.work.measure_storage(shared.doc);
+        }
+        match shared.work.storage(shared.doc) {
+            (Some(report), _) => storage_table(ui, report),
+            (None, true) => {
+                ui.horizontal(|ui| {
+                    ui.spinner();
+                    ui.label("measuring the clip…");
+                });
             }
-            self.storage.collect();
-            match self.storage.for_key(&key) {
-                Some(report) => storage_table(ui, report),
-                None if self.storage.progress().is_some() => {
-                    ui.horizontal(|ui| {
-                        ui.spinner();
-                        ui.label("measuring the clip…");
-                    });
-                }
-                None => {
-                    ui.label(RichText::new("Marks the bones stretched in any frame and prices their channel.").weak());
-                }
+            (None, false) => {
+                ui.label(RichText::new("Marks the bones stretched in any frame and prices their channel.").weak());
             }
-        });
-    }
+        }
+    });
 }
 
 fn bind_report(ui: &mut Ui, check: &BindCheck) {

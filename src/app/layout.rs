@@ -4,45 +4,10 @@
 
 use egui_tiles::{Container, Linear, LinearDir, SimplificationOptions, TileId, Tiles, UiResponse};
 
-use super::{Shared, inspector, layers, outliner, plots, viewport};
-use crate::app::Settings;
-
-/// One panel of the window.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub enum Pane {
-    Viewport,
-    Outliner,
-    Inspector,
-    Layers,
-    Plots,
-}
-
-impl Pane {
-    pub const ALL: [Pane; 5] = [Pane::Viewport, Pane::Outliner, Pane::Inspector, Pane::Layers, Pane::Plots];
-
-    pub fn title(self) -> &'static str {
-        match self {
-            Pane::Viewport => "Viewport",
-            Pane::Outliner => "Skeleton",
-            Pane::Inspector => "Inspector",
-            Pane::Layers => "Layers",
-            Pane::Plots => "Plots",
-        }
-    }
-
-    /// Whether the settings show this panel (the viewport and the skeleton always show).
-    fn shown(self, settings: &Settings) -> bool {
-        match self {
-            Pane::Viewport | Pane::Outliner => true,
-            Pane::Inspector => settings.show_inspector,
-            Pane::Layers => settings.show_layers,
-            Pane::Plots => settings.show_plots,
-        }
-    }
-}
-
-/// The arrangement of the panels.
-pub type Layout = egui_tiles::Tree<Pane>;
+use super::pane::{Layout, Pane, Place};
+use super::panel::{Panel, Shared};
+use super::settings::Settings;
+use super::viewport::Viewport;
 
 /// From this window width (points) on, the Inspector and the Layers stand side by side.
 pub const WIDE: f32 = 1600.0;
@@ -51,34 +16,41 @@ pub const WIDE: f32 = 1600.0;
 const OUTLINER_WIDTH: f32 = 280.0;
 const SIDE_WIDTH: f32 = 340.0;
 
-/// The share of the centre column's height the plots start with.
-const PLOTS_SHARE: f32 = 0.3;
-
-/// The first arrangement for a window `width` points wide: the skeleton left, the viewport over the plots in the
-/// middle, the Inspector and Layers right.
-pub fn default_layout(width: f32) -> Layout {
+/// The first arrangement of `panels` (each with where it goes) for a window `width` points wide: the left column,
+/// the centre one (the viewport over the plots), and the right-hand panels stacked in one column or, from [`WIDE`]
+/// on, side by side.
+pub fn default_layout(width: f32, panels: &[(Pane, Place)]) -> Layout {
     // A small window gives each side a share instead, so that the viewport keeps over 40 % of it.
     let (outliner_width, side_width) = (OUTLINER_WIDTH.min(0.22 * width), SIDE_WIDTH.min(0.32 * width));
     let mut tiles = Tiles::default();
-    let [viewport, outliner, inspector, layers, plots] = Pane::ALL.map(|pane| tiles.insert_pane(pane));
-    let centre = linear(&mut tiles, LinearDir::Vertical, &[(viewport, 1.0 - PLOTS_SHARE), (plots, PLOTS_SHARE)]);
-    let side = |tiles: &mut Tiles<Pane>| {
-        if width < WIDE {
-            vec![(linear(tiles, LinearDir::Vertical, &[(inspector, 0.55), (layers, 0.45)]), side_width)]
-        } else {
-            vec![(inspector, side_width), (layers, side_width)]
+    let (mut left, mut centre, mut right) = (Vec::new(), Vec::new(), Vec::new());
+    for (pane, place) in panels {
+        let tile = tiles.insert_pane(pane.clone());
+        match *place {
+            Place::Left => left.push((tile, 1.0)),
+            Place::Centre(share) => centre.push((tile, share)),
+            Place::Right(share) => right.push((tile, share)),
         }
+    }
+    let left = linear(&mut tiles, LinearDir::Vertical, &left);
+    let centre = linear(&mut tiles, LinearDir::Vertical, &centre);
+    let side = if width < WIDE {
+        vec![(linear(&mut tiles, LinearDir::Vertical, &right), side_width)]
+    } else {
+        right.iter().map(|&(tile, _)| (tile, side_width)).collect()
     };
-    let side = side(&mut tiles);
     let sides: f32 = side.iter().map(|(_, w)| w).sum();
-    let mut columns = vec![(outliner, outliner_width), (centre, (width - outliner_width - sides).max(200.0))];
+    let mut columns = vec![(left, outliner_width), (centre, (width - outliner_width - sides).max(200.0))];
     columns.extend(side);
     let root = linear(&mut tiles, LinearDir::Horizontal, &columns);
     egui_tiles::Tree::new(egui::Id::unique("bonescope-layout"), root, tiles)
 }
 
-/// A row or column of `children`, each with its share of the space.
+/// A row or column of `children`, each with its share of the space (one child is itself).
 fn linear(tiles: &mut Tiles<Pane>, dir: LinearDir, children: &[(TileId, f32)]) -> TileId {
+    if let [(only, _)] = children {
+        return *only;
+    }
     let mut container = Linear::new(dir, children.iter().map(|(id, _)| *id).collect());
     for &(id, share) in children {
         container.shares.set_share(id, share);
@@ -86,14 +58,22 @@ fn linear(tiles: &mut Tiles<Pane>, dir: LinearDir, children: &[(TileId, f32)]) -
     tiles.insert_container(Container::Linear(container))
 }
 
-/// The settings' arrangement, taken out of them for the frame (the panes borrow the settings): made for a window
-/// `width` wide when there is none or it lacks a panel (one saved by an older version); each panel shown or hidden
-/// as the settings say.
-pub fn take_layout(settings: &mut Settings, width: f32) -> Layout {
-    let complete = |layout: &Layout| Pane::ALL.iter().all(|pane| layout.tiles.find_pane(pane).is_some());
-    let mut layout = settings.layout.take().filter(complete).unwrap_or_else(|| default_layout(width));
-    for pane in Pane::ALL {
-        let shown = pane.shown(settings);
+/// The settings' arrangement of `panels`, taken out of them for the frame (the panes borrow the settings): made for
+/// a window `width` wide when there is none or it is not of these panels (one saved by another version); each panel
+/// shown or hidden as the settings say.
+pub fn take_layout(settings: &mut Settings, width: f32, panels: &[&dyn Panel]) -> Layout {
+    let places: Vec<(Pane, Place)> = panels.iter().map(|p| (p.pane(), p.place())).collect();
+    let ours = |layout: &Layout| {
+        let panes = layout.tiles.tiles().filter_map(|t| match t {
+            egui_tiles::Tile::Pane(pane) => Some(pane),
+            egui_tiles::Tile::Container(_) => None,
+        });
+        panes.count() == places.len() && places.iter().all(|(pane, _)| layout.tiles.find_pane(pane).is_some())
+    };
+    let mut layout = settings.layout.take().filter(ours).unwrap_or_else(|| default_layout(width, &places));
+    for panel in panels {
+        let pane = panel.pane();
+        let shown = settings.shows(&pane, panel.visibility());
         if let Some(tile) = layout.tiles.find_pane(&pane) {
             layout.tiles.set_visible(tile, shown);
         }
@@ -104,11 +84,8 @@ pub fn take_layout(settings: &mut Settings, width: f32) -> Layout {
 /// What the tiles draw: each pane's panel on the shared state.
 pub struct Panes<'p, 's> {
     pub shared: &'p mut Shared<'s>,
-    pub outliner: &'p mut outliner::Outliner,
-    pub inspector: &'p mut inspector::Inspector,
-    pub plots: &'p mut plots::Plots,
-    pub viewport: &'p mut viewport::Viewport,
-    pub layers: &'p mut layers::LayersPanel,
+    pub viewport: &'p mut Viewport,
+    pub panels: &'p mut [Box<dyn Panel>],
     /// The window's style: each tile's `Ui` starts from the context's global style, not from the window's.
     pub style: std::sync::Arc<egui::Style>,
 }
@@ -120,25 +97,20 @@ impl egui_tiles::Behavior<Pane> for Panes<'_, '_> {
     fn pane_ui(&mut self, ui: &mut egui::Ui, _tile: TileId, pane: &mut Pane) -> UiResponse {
         let shared = &mut *self.shared;
         ui.set_style(self.style.clone());
-        if *pane == Pane::Viewport {
+        if *pane == Pane::VIEWPORT {
             self.viewport.ui(ui, shared);
             return UiResponse::None;
         }
+        let Some(panel) = self.panels.iter_mut().find(|p| p.pane() == *pane) else { return UiResponse::None };
         egui::Frame::NONE.inner_margin(PANEL_MARGIN).show(ui, |ui| {
             ui.set_min_size(ui.available_size());
-            match pane {
-                Pane::Outliner => self.outliner.ui(ui, shared),
-                Pane::Inspector => self.inspector.ui(ui, shared),
-                Pane::Layers => self.layers.ui(ui, shared),
-                Pane::Plots => self.plots.ui(ui, shared),
-                Pane::Viewport => unreachable!("drawn above"),
-            }
+            panel.ui(ui, shared);
         });
         UiResponse::None
     }
 
     fn tab_title_for_pane(&mut self, pane: &Pane) -> egui::WidgetText {
-        pane.title().into()
+        pane.title().to_owned().into()
     }
 
     /// Every panel has its tab, by which it is dragged elsewhere.
@@ -169,7 +141,7 @@ mod tests {
 
     fn panes_under(tiles: &Tiles<Pane>, tile: TileId) -> Vec<Pane> {
         match tiles.get(tile) {
-            Some(Tile::Pane(pane)) => vec![*pane],
+            Some(Tile::Pane(pane)) => vec![pane.clone()],
             Some(Tile::Container(container)) => {
                 container.children().flat_map(|&child| panes_under(tiles, child)).collect()
             }
@@ -177,30 +149,46 @@ mod tests {
         }
     }
 
+    fn panels() -> Vec<Box<dyn Panel>> {
+        let mut panels: Vec<Box<dyn Panel>> = vec![Box::new(Viewport::default())];
+        panels.extend(crate::app::window::panels());
+        panels
+    }
+
+    fn places() -> Vec<(Pane, Place)> {
+        panels().iter().map(|p| (p.pane(), p.place())).collect()
+    }
+
     #[test]
     fn a_laptop_stacks_inspector_and_layers_and_a_wide_window_puts_them_side_by_side() {
-        use Pane::*;
-        assert_eq!(columns(&default_layout(1280.0)), [vec![Outliner], vec![Viewport, Plots], vec![Inspector, Layers]]);
+        let [viewport, outliner, inspector, layers, plots] =
+            ["Viewport", "Skeleton", "Inspector", "Layers", "Plots"].map(Pane::named);
         assert_eq!(
-            columns(&default_layout(1920.0)),
-            [vec![Outliner], vec![Viewport, Plots], vec![Inspector], vec![Layers]]
+            columns(&default_layout(1280.0, &places())),
+            [vec![outliner.clone()], vec![viewport.clone(), plots.clone()], vec![inspector.clone(), layers.clone()]]
+        );
+        assert_eq!(
+            columns(&default_layout(1920.0, &places())),
+            [vec![outliner], vec![viewport, plots], vec![inspector], vec![layers]]
         );
     }
 
     #[test]
     fn a_saved_layout_lacking_a_panel_is_made_anew_and_hidden_panels_are_invisible() {
+        let panels = panels();
+        let panels: Vec<&dyn Panel> = panels.iter().map(|p| p.as_ref()).collect();
         let mut settings = Settings::default();
-        let mut partial = default_layout(1280.0);
-        let layers = partial.tiles.find_pane(&Pane::Layers).unwrap();
+        let mut partial = default_layout(1280.0, &places());
+        let layers = partial.tiles.find_pane(&Pane::LAYERS).unwrap();
         partial.remove_recursively(layers);
         settings.layout = Some(partial);
-        let layout = take_layout(&mut settings, 1280.0);
-        assert!(Pane::ALL.iter().all(|pane| layout.tiles.find_pane(pane).is_some()));
-        let layers = layout.tiles.find_pane(&Pane::Layers).unwrap();
+        let layout = take_layout(&mut settings, 1280.0, &panels);
+        assert!(places().iter().all(|(pane, _)| layout.tiles.find_pane(pane).is_some()));
+        let layers = layout.tiles.find_pane(&Pane::LAYERS).unwrap();
         assert!(!layout.tiles.is_visible(layers), "the Layers panel starts hidden");
         settings.layout = Some(layout);
-        settings.show_layers = true;
-        let layout = take_layout(&mut settings, 1280.0);
+        settings.show(&Pane::LAYERS, true);
+        let layout = take_layout(&mut settings, 1280.0, &panels);
         assert!(layout.tiles.is_visible(layers));
         settings.layout = Some(layout);
         let json = serde_json::to_string(&settings).unwrap();

@@ -6,9 +6,12 @@ use std::collections::HashSet;
 
 use egui::{RichText, Sense, vec2};
 
-use super::{ModeChoice, ModeScope, Shared, text};
+use super::document::ModeScope;
+use super::pane::{Pane, Place, Visibility};
+use super::panel::{Panel, Shared};
+use super::text;
 use crate::analysis::Findings;
-use crate::model::{Choice, NodeRole};
+use crate::model::{Choice, ModeChoice, NodeRole};
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -24,8 +27,20 @@ pub struct Outliner {
 const ROW_HEIGHT: f32 = 20.0;
 const INDENT: f32 = 10.0;
 
-impl Outliner {
-    pub fn ui(&mut self, ui: &mut egui::Ui, shared: &mut Shared) {
+impl Panel for Outliner {
+    fn pane(&self) -> Pane {
+        Pane::named("Skeleton")
+    }
+
+    fn place(&self) -> Place {
+        Place::Left
+    }
+
+    fn visibility(&self) -> Visibility {
+        Visibility::Always
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, shared: &mut Shared) {
         // A narrow list puts "Only flagged" under the filter rather than past its edge (which would widen every
         // row below).
         ui.horizontal_wrapped(|ui| {
@@ -63,11 +78,13 @@ impl Outliner {
             self.shown = shared.selection.last().copied();
         }
     }
+}
 
+impl Outliner {
     /// Findings now, or at any time of the clip when the analysis is there.
     fn flagged(shared: &Shared, bone: usize) -> bool {
         let now = shared.frame.primary.findings[bone].any();
-        let ever = shared.analysis.and_then(|a| a.scan.bones.get(bone)).is_some_and(|s| {
+        let ever = shared.results.analysis.as_ref().and_then(|a| a.scan.bones.get(bone)).is_some_and(|s| {
             s.stretched() || s.non_uniform_samples > 0 || s.mirrored_samples > 0 || s.degenerate_samples > 0
         });
         now || ever
@@ -224,7 +241,7 @@ impl Notes {
             let worst = ui.add(egui::Label::new(worst).sense(Sense::click())).on_hover_text(format!(
                 "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s (click to go there)",
                 summary.flagged_samples,
-                shared.analysis.map_or(0, |a| a.scan.samples),
+                shared.results.analysis.as_ref().map_or(0, |a| a.scan.samples),
                 summary.first_flagged_time.unwrap_or_default(),
                 summary.worst_shear_deg,
                 summary.worst_shear_time
@@ -240,13 +257,13 @@ impl Notes {
 }
 
 fn stretched_summary<'a>(shared: &Shared<'a>, bone: usize) -> Option<&'a crate::analysis::BoneSummary> {
-    shared.analysis.and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched())
+    shared.results.analysis.as_ref().and_then(|a| a.scan.bones.get(bone)).filter(|s| s.stretched())
 }
 
 /// How far the compared file's partner of `bone` strays from it over the clip, when that is more than the threshold
 /// (a percentage of the rig's size); a bone without a partner says so.
 fn difference_text(shared: &Shared, bone: usize) -> Option<RichText> {
-    let differences = shared.differences?;
+    let differences = shared.results.differences.as_ref()?;
     shared.doc.compared.as_ref()?;
     match differences.bones.get(bone).copied().flatten() {
         Some(fraction) if 100.0 * fraction > shared.settings.compare_threshold_percent => {
@@ -261,7 +278,9 @@ fn difference_text(shared: &Shared, bone: usize) -> Option<RichText> {
 }
 
 fn difference_hint(shared: &Shared, bone: usize) -> String {
-    let (Some(differences), Some(compared)) = (shared.differences, &shared.doc.compared) else { return String::new() };
+    let (Some(differences), Some(compared)) = (&shared.results.differences, &shared.doc.compared) else {
+        return String::new();
+    };
     let name = &shared.doc.rig.skeleton.bone(bone).name;
     match differences.bones.get(bone).copied().flatten() {
         Some(fraction) => format!(

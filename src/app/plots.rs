@@ -9,8 +9,11 @@ use egui::{Color32, RichText, Ui};
 use egui_plot::{FilledArea, Line, Plot, PlotPoint, PlotPoints, VLine};
 use glam::{EulerRot, Quat};
 
-use super::compare::ComparedCurves;
-use super::{Ghost, RotationFormat, Shared};
+use super::document::Ghost;
+use super::pane::{Pane, Place};
+use super::panel::{Panel, Shared};
+use super::settings::RotationFormat;
+use super::work::ComparedCurves;
 use std::sync::Arc;
 
 use super::reduce::{Reduced, merge_spans, reduce};
@@ -195,8 +198,20 @@ struct Series {
     values: Vec<f64>,
 }
 
-impl Plots {
-    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+impl Panel for Plots {
+    fn pane(&self) -> Pane {
+        Pane::named("Plots")
+    }
+
+    fn place(&self) -> Place {
+        Place::Centre(0.3)
+    }
+
+    fn plots_curves(&self) -> bool {
+        true
+    }
+
+    fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         ui.horizontal_wrapped(|ui| {
             for c in Component::ALL {
                 ui.selectable_value(&mut self.component, c, c.label());
@@ -220,12 +235,14 @@ impl Plots {
                 self.reset = true;
             }
         });
-        let plotted = plotted_bones(shared);
+        let plotted = shared.plotted();
         if plotted.is_empty() {
             ui.label(RichText::new("Select bones to plot their components over the clip.").weak());
             return;
         }
-        let Some(analysis) = shared.curves.filter(|a| plotted.iter().all(|b| a.curves_of(*b).is_some())) else {
+        let Some(analysis) =
+            shared.results.curves.as_ref().filter(|a| plotted.iter().all(|b| a.curves_of(*b).is_some()))
+        else {
             ui.label(RichText::new("analysing the clip…").weak());
             return;
         };
@@ -236,7 +253,12 @@ impl Plots {
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
-            compared: shared.compared_curves.filter(|_| shared.doc.ghost == Some(Ghost::Compared)).cloned(),
+            compared: shared
+                .results
+                .compared_curves
+                .as_ref()
+                .filter(|_| shared.doc.ghost == Some(Ghost::Compared))
+                .cloned(),
         };
         if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
             let groups = Group::split(build_series(&key, &shared.doc.rig.skeleton));
@@ -416,13 +438,6 @@ fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Serie
 
 fn ui_cursor_color() -> Color32 {
     Color32::from_rgb(255, 200, 60)
-}
-
-fn plotted_bones(shared: &Shared) -> Vec<usize> {
-    let skip = shared.selection.len().saturating_sub(super::MAX_PLOTTED);
-    let mut bones = shared.selection[skip..].to_vec();
-    bones.sort_unstable();
-    bones
 }
 
 /// Quaternions flipped where needed so consecutive samples stay in one hemisphere: `q` and `−q` are the same

@@ -1,7 +1,9 @@
 //! What persists across restarts (eframe storage): theme, recent files, camera, view toggles, time display.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use super::pane::{Layout, Pane, Visibility};
 use crate::analysis::Tolerances;
 use crate::eval::layers::TICKS_PER_SECOND;
 use crate::view::{Camera, SceneOptions};
@@ -101,14 +103,12 @@ pub struct Settings {
     pub rotation_format: RotationFormat,
     /// Plot model-space components (else local).
     pub plot_model_space: bool,
-    pub show_plots: bool,
-    pub show_inspector: bool,
-    /// The Layers panel (runtime techniques on the clip).
-    pub show_layers: bool,
+    /// The panels shown or hidden in the View menu (the others as they start).
+    pub shown: BTreeMap<Pane, bool>,
     /// Bones farther than this percentage of the rig's size from their partner in a compared file are badged.
     pub compare_threshold_percent: f64,
     /// How the panels are arranged; `None` until the first frame makes one for the window's width.
-    pub layout: Option<super::Layout>,
+    pub layout: Option<Layout>,
 }
 
 impl Default for Settings {
@@ -124,9 +124,7 @@ impl Default for Settings {
             looping: true,
             rotation_format: RotationFormat::Quaternion,
             plot_model_space: true,
-            show_plots: true,
-            show_inspector: true,
-            show_layers: false,
+            shown: BTreeMap::new(),
             compare_threshold_percent: 0.01,
             layout: None,
         }
@@ -138,6 +136,25 @@ const RECENT_FILES: usize = 10;
 
 impl Settings {
     pub const STORAGE_KEY: &'static str = "bonescope-settings";
+
+    /// Whether the panel `pane` shows, given how it starts.
+    pub fn shows(&self, pane: &Pane, visibility: Visibility) -> bool {
+        match visibility {
+            Visibility::Always => true,
+            starts => self.shown.get(pane).copied().unwrap_or(starts == Visibility::Shown),
+        }
+    }
+
+    /// Shows or hides the panel `pane`.
+    pub fn show(&mut self, pane: &Pane, shown: bool) {
+        self.shown.insert(pane.clone(), shown);
+    }
+
+    /// The same with the panel `pane` shown or hidden.
+    pub fn showing(mut self, pane: &Pane, shown: bool) -> Self {
+        self.show(pane, shown);
+        self
+    }
 
     /// Puts `path` first in the recent files.
     pub fn remember(&mut self, path: PathBuf) {

@@ -4,6 +4,12 @@
 
 use egui::{FontId, Response, RichText, Sense, TextStyle, Ui, WidgetText};
 
+/// The library's words in the app's font, which has no arrow: "forearm → segment-compensate" reads "forearm to
+/// segment-compensate".
+pub fn drawable(text: &str) -> String {
+    text.replace('→', "to")
+}
+
 /// Below this a value is shown as 0: floating-point noise of a matrix, not a measurement.
 const NOISE: f64 = 1e-9;
 

@@ -4,7 +4,7 @@
 
 use egui_plot::{GridInput, GridMark};
 
-use super::TimeUnit;
+use super::settings::TimeUnit;
 use crate::eval::layers::TICKS_PER_SECOND;
 
 /// The smallest step of the form {1, 2, 5} × 10ⁿ that is at least `at_least` (positive and finite; else 1).

@@ -3,8 +3,9 @@
 
 use egui::{Color32, Rect, Sense, Stroke, pos2, vec2};
 
+use super::panel::Shared;
 use super::reduce::merge_spans;
-use super::{Shared, TimeUnit};
+use super::settings::TimeUnit;
 use crate::model::Clip;
 use crate::view::Badge;
 
@@ -83,7 +84,7 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
         .response
         .labelled_by(label.id);
     frame_rate_field(ui, shared, rate);
-    if let Some((done, total)) = shared.progress {
+    if let Some((done, total)) = shared.results.progress {
         ui.separator();
         let fraction = if total > 0 { done as f32 / total as f32 } else { 0.0 };
         ui.add(egui::ProgressBar::new(fraction).desired_width(140.0).text("analysing clip"));

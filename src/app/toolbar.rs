@@ -1,31 +1,63 @@
-//! The menu bar and the toolbar: files, the animation, the inheritance mode of every bone, the ghost mode.
+//! The menu bar and the toolbar: files, undo and redo, the view, the animation, the inheritance mode of every bone,
+//! the ghost, and the units of a comparison.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-use egui::RichText;
+use egui::{Key, KeyboardShortcut, Modifiers, RichText};
 
-use super::{Ghost, ModeChoice, ModeScope, Shared, text};
+use super::compare::Compared;
+use super::document::{Document, Ghost, ModeScope};
+use super::pane::{Pane, Visibility};
+use super::panel::Shared;
+use super::text;
 use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
-use crate::model::Choice;
+use crate::eval::layers::RotationInterpolation;
+use crate::model::{Choice, ModeChoice, Unit};
 
-/// What the toolbar asks the app to do after the frame (things that replace the document).
-#[derive(Default)]
+/// What the menus and keys ask of the session after the frame (things that replace or step the document).
+#[derive(Debug, Default)]
 pub struct Actions {
     pub open_dialog: bool,
     /// File → Compare with…
     pub compare_dialog: bool,
     pub stop_comparing: bool,
     pub open: Option<PathBuf>,
+    pub compare: Option<PathBuf>,
     pub open_demo: bool,
     pub frame_all: bool,
     pub clip_changed: bool,
+    pub undo: bool,
+    pub redo: bool,
 }
 
-pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+/// What the menus list that the panels' shared state does not hold: the steps the Edit menu undoes and redoes, and
+/// the panels the View menu shows and hides.
+pub struct Menus {
+    pub undo: Option<String>,
+    pub redo: Option<String>,
+    pub panels: Vec<(Pane, Visibility)>,
+}
+
+const UNDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+const REDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z);
+const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+
+/// Ctrl+Z undoes, Ctrl+Shift+Z and Ctrl+Y redo (⌘ on a Mac).
+pub fn history_keys(ctx: &egui::Context, actions: &mut Actions) {
+    // Ctrl+Z also matches Ctrl+Shift+Z (shift is not told apart): redo is looked for first.
+    ctx.input_mut(|i| {
+        actions.redo |= i.consume_shortcut(&REDO) || i.consume_shortcut(&REDO_Y);
+        actions.undo |= i.consume_shortcut(&UNDO);
+    });
+}
+
+pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut Actions) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| file_menu(ui, shared, actions));
-        ui.menu_button("View", |ui| view_menu(ui, shared, actions));
+        ui.menu_button("Edit", |ui| edit_menu(ui, menus, actions));
+        ui.menu_button("View", |ui| view_menu(ui, shared, menus, actions));
         ui.separator();
         ui.label(RichText::new(shared.doc.title()).strong());
     });
@@ -36,14 +68,17 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         mode_picker(ui, shared);
         ui.separator();
         ghost_picker(ui, shared);
-        super::compare::unit_pickers(ui, shared.doc);
+        unit_pickers(ui, shared.doc);
         ui.separator();
         if !shared.doc.rig.skins.is_empty() {
             skinning_picker(ui, shared);
             ui.separator();
         }
-        ui.toggle_value(&mut shared.settings.show_layers, "Layers")
-            .on_hover_text("blend, additive, crossfade, shake, targets, interpolation, bind pose, storage");
+        let mut layers = shared.settings.shows(&Pane::LAYERS, Visibility::Hidden);
+        let hint = "blend, additive, crossfade, shake, targets, interpolation, bind pose, storage";
+        if ui.toggle_value(&mut layers, Pane::LAYERS.title()).on_hover_text(hint).changed() {
+            shared.settings.show(&Pane::LAYERS, layers);
+        }
     });
 }
 
@@ -74,7 +109,7 @@ fn file_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     {
         actions.stop_comparing = true;
     }
-    super::compare::rotation_menu(ui, shared.doc);
+    rotation_menu(ui, shared.doc);
     ui.separator();
     if ui.button("Quit").clicked() {
         ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
@@ -124,15 +159,31 @@ fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances, compare_percent: &
     });
     if ui.button("Defaults").clicked() {
         *tolerances = Tolerances::default();
-        *compare_percent = crate::app::Settings::default().compare_threshold_percent;
+        *compare_percent = super::settings::Settings::default().compare_threshold_percent;
     }
 }
 
-fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+/// Undo and Redo, each saying what it undoes or redoes, with its keys.
+fn edit_menu(ui: &mut egui::Ui, menus: &Menus, actions: &mut Actions) {
+    for (step, name, shortcut, asked) in
+        [(&menus.undo, "Undo", UNDO, &mut actions.undo), (&menus.redo, "Redo", REDO, &mut actions.redo)]
+    {
+        let text = step.as_ref().map_or_else(|| name.to_owned(), |label| format!("{name} {}", text::drawable(label)));
+        let button = egui::Button::new(text).shortcut_text(ui.ctx().format_shortcut(&shortcut));
+        if ui.add_enabled(step.is_some(), button).clicked() {
+            *asked = true;
+        }
+    }
+}
+
+fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut Actions) {
     ui.checkbox(&mut shared.settings.dark, "Dark theme");
-    ui.checkbox(&mut shared.settings.show_plots, "Plots");
-    ui.checkbox(&mut shared.settings.show_inspector, "Inspector");
-    ui.checkbox(&mut shared.settings.show_layers, "Layers");
+    for (pane, visibility) in menus.panels.iter().filter(|(_, v)| *v != Visibility::Always) {
+        let mut shown = shared.settings.shows(pane, *visibility);
+        if ui.checkbox(&mut shown, pane.title()).changed() {
+            shared.settings.show(pane, shown);
+        }
+    }
     // Editing a number is a click inside the menu: it stays open until a click outside.
     let config =
         egui::containers::menu::MenuConfig::new().close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside);
@@ -243,4 +294,57 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         })
         .response
         .labelled_by(label.id);
+}
+
+/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in: the
+/// ghost, the dashed curves and the differences follow it.
+fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
+    let Some(compared) = doc.compared.clone() else { return };
+    if !compared.states_unit()
+        && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
+    {
+        replace(doc, compared.given_unit(unit));
+    }
+    if doc.rig.unit.is_none()
+        && let Some(unit) = unit_picker(ui, &doc.title(), compared.units()[0], &compared.title())
+    {
+        replace(doc, compared.in_document_unit(unit));
+    }
+}
+
+/// File → "Play compared rotations by" while comparing: how the compared file's rotation keys are played, to see
+/// a bake as Blender, Unity or Unreal (nlerp) will show it.
+fn rotation_menu(ui: &mut egui::Ui, doc: &mut Document) {
+    let Some(compared) = doc.compared.clone() else { return };
+    ui.menu_button("Play compared rotations by", |ui| {
+        for &played in RotationInterpolation::ALL {
+            let chosen =
+                ui.selectable_label(played == compared.played, played.id()).on_hover_text(played.description());
+            if chosen.clicked() && played != compared.played {
+                replace(doc, compared.played_by(played));
+            }
+        }
+    });
+}
+
+/// A picker of the unit `file` is in (`unit`, `None` while not given); the unit picked, if another.
+fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -> Option<Unit> {
+    let label = ui.label(format!("unit of {file}"));
+    let mut picked = unit;
+    egui::ComboBox::from_id_salt(("unit", file))
+        .selected_text(unit.map_or_else(|| "not stated".to_owned(), |u| u.to_string()))
+        .show_ui(ui, |ui| {
+            for named in Unit::named() {
+                ui.selectable_value(&mut picked, Some(named), named.to_string());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(format!("{file} states no unit: the one it is in, to compare it with {other} in one unit"));
+    picked.filter(|_| picked != unit)
+}
+
+/// The document compared with `compared` instead.
+fn replace(doc: &mut Document, compared: Compared) {
+    doc.compared = Some(Arc::new(compared));
 }

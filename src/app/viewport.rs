@@ -6,7 +6,9 @@
 use egui::{Sense, Ui};
 use glam::DVec2;
 
-use super::{Document, Ghost, Shared};
+use super::document::{Document, Ghost};
+use super::pane::{Pane, Place, Visibility};
+use super::panel::{Panel, Shared};
 use crate::model::Choice;
 use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, ViewKind, motion_bounds, paint};
 
@@ -48,12 +50,6 @@ impl Viewport {
         if let Some(bounds) = self.framing.take() {
             camera.frame(&bounds, aspect);
         }
-    }
-
-    /// The view toggles above the canvas.
-    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        toolbar(ui, shared);
-        self.canvas(ui, shared, CanvasFill::Painted);
     }
 
     /// The picture alone, filling the space left: what headless renders of the viewport show.
@@ -176,4 +172,24 @@ fn toggles(ui: &mut Ui, shared: &mut Shared) {
     ui.toggle_value(&mut o.names, "Names");
     ui.toggle_value(&mut o.grid, "Grid");
     ui.toggle_value(&mut o.legend, "Legend");
+}
+
+impl Panel for Viewport {
+    fn pane(&self) -> Pane {
+        Pane::VIEWPORT
+    }
+
+    fn place(&self) -> Place {
+        Place::Centre(0.7)
+    }
+
+    fn visibility(&self) -> Visibility {
+        Visibility::Always
+    }
+
+    /// The view toggles above the canvas.
+    fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        toolbar(ui, shared);
+        self.canvas(ui, shared, CanvasFill::Painted);
+    }
 }

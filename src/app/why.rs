@@ -2,8 +2,8 @@
 //! worst time, each bone's contribution), when (the main cause's time spans), and the fixes ranked
 //! ([`crate::explain`]). The explanation is computed off the UI thread, one at a time (it cannot stop half way).
 //!
-//! A fix that is a setting of the document can be tried on it: a mode goes to the bone's own mode (undone from the
-//! skeleton's menu or the toolbar's declared modes), a uniform scale to the layers (undone in the Layers panel).
+//! A fix that is a setting of the document can be tried on it (one step of the history: Edit → Undo takes it back,
+//! the ghost with it): a mode goes to the bone's own mode, a uniform scale to the layers.
 //! The ghost then shows the clip as it was, beside the fixed pose.
 
 use egui::collapsing_header::{CollapsingState, paint_default_icon};
@@ -12,28 +12,13 @@ use egui::{
 };
 use egui::{pos2, vec2};
 
-use super::job::{Job, Key, Progress};
-use super::text::{compact, name_label, text_width};
-use super::{Ghost, ModeChoice, ModeScope, Shared};
-use crate::analysis::{CurveRequest, ScanOptions, Tolerances, analyze};
-use crate::explain::{Change, Explanation, Fix, Link, Measured, Question, explain};
-use crate::model::{Choice, Rig, Unit};
+use super::document::{Ghost, ModeScope};
+use super::panel::Shared;
+use super::text::{compact, drawable, name_label, text_width};
+use super::work::WhyRequest;
+use crate::explain::{Change, Explanation, Fix, Link, Measured};
+use crate::model::{Choice, ModeChoice, Unit};
 use crate::view::Badge;
-
-/// What an explanation is asked: the bone, and how the clip is sampled and judged (as the whole-clip analysis
-/// samples and judges it, so that both flag the same samples).
-#[derive(Clone, Debug, PartialEq)]
-struct WhyRequest {
-    bone: usize,
-    rate: f64,
-    tolerances: Tolerances,
-}
-
-/// The section's state: the latest explanation, and the one being computed.
-#[derive(Default)]
-pub struct Why {
-    job: Job<Key<WhyRequest>, Explanation>,
-}
 
 /// At most this many fixes are listed; the rest fold under "N more".
 const SHOWN_FIXES: usize = 8;
@@ -46,94 +31,60 @@ const COUNTERS: Color32 = Color32::from_rgb(60, 175, 160);
 /// Below this a shear left by a fix is floating-point noise, not a measurement.
 const NOISE_DEG: f64 = 1e-9;
 
-impl Why {
-    /// Waits for an explanation under way (tests and headless renders want a settled state).
-    pub fn settle(&mut self) {
-        self.job.wait();
-    }
-
-    /// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a
-    /// toggle when the whole-clip analysis flags the bone, a note otherwise.
-    pub fn header(&mut self, ui: &mut Ui, shared: &Shared, bone: usize) {
-        match flagged(shared, bone) {
-            None => {
-                ui.label(RichText::new("Why? once the clip is analysed").weak());
-            }
-            Some(false) => {
-                ui.label(RichText::new("not sheared: nothing to explain").weak());
-            }
-            Some(true) => {
-                let mut state = collapsing(ui.ctx());
-                ui.horizontal(|ui| {
-                    ui.spacing_mut().item_spacing.x = 0.0;
-                    state.show_toggle_button(ui, paint_default_icon);
-                    let label = egui::Label::new(RichText::new("Why?").strong()).sense(Sense::click());
-                    if ui.add(label).on_hover_text("whose scale shears this bone, when, and the fixes").clicked() {
-                        state.toggle(ui);
-                    }
-                });
-                state.store(ui.ctx());
-            }
+/// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a toggle
+/// when the whole-clip analysis flags the bone, a note otherwise.
+pub fn header(ui: &mut Ui, shared: &Shared, bone: usize) {
+    match flagged(shared, bone) {
+        None => {
+            ui.label(RichText::new("Why? once the clip is analysed").weak());
+        }
+        Some(false) => {
+            ui.label(RichText::new("not sheared: nothing to explain").weak());
+        }
+        Some(true) => {
+            let mut state = collapsing(ui.ctx());
+            ui.horizontal(|ui| {
+                ui.spacing_mut().item_spacing.x = 0.0;
+                state.show_toggle_button(ui, paint_default_icon);
+                let label = egui::Label::new(RichText::new("Why?").strong()).sense(Sense::click());
+                if ui.add(label).on_hover_text("whose scale shears this bone, when, and the fixes").clicked() {
+                    state.toggle(ui);
+                }
+            });
+            state.store(ui.ctx());
         }
     }
+}
 
-    /// The section's body, while its header is open: the explanation, computed off the UI thread.
-    pub fn ui(&mut self, ui: &mut Ui, shared: &mut Shared, bone: usize) {
-        if flagged(shared, bone) != Some(true) {
-            return;
-        }
-        collapsing(ui.ctx()).show_body_unindented(ui, |ui| ui.indent("why-body", |ui| self.body(ui, shared, bone)));
+/// The section's body, while its header is open: the explanation, computed off the UI thread.
+pub fn ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+    if flagged(shared, bone) != Some(true) {
+        return;
     }
+    collapsing(ui.ctx()).show_body_unindented(ui, |ui| ui.indent("why-body", |ui| body(ui, shared, bone)));
+}
 
-    fn body(&mut self, ui: &mut Ui, shared: &mut Shared, bone: usize) {
-        // The flag above may be the previous state's: explain once the analysis of this one is there.
-        if shared.progress.is_some() {
-            spinner(ui, "waiting for the whole-clip analysis…");
-            return;
-        }
-        let request = WhyRequest { bone, rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
-        let key = Key::of(shared.doc, request);
-        if !self.job.busy_with_other(&key) {
-            let work = || {
-                let (rig, key) = (shared.doc.rig.clone(), key.clone());
-                move |progress: &Progress| explanation(&rig, &key, progress)
-            };
-            let waker = ui.ctx().clone();
-            self.job.update(key.clone(), work, move || waker.request_repaint());
-        }
-        match self.job.for_key(&key).cloned() {
-            Some(explained) => explanation_ui(ui, shared, &explained),
-            None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
-        }
+fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+    // The flag above may be the previous state's: explain once the analysis of this one is there.
+    if shared.results.progress.is_some() {
+        spinner(ui, "waiting for the whole-clip analysis…");
+        return;
+    }
+    let request = WhyRequest { bone, rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
+    match shared.work.explanation(shared.doc, request).cloned() {
+        Some(explained) => explanation_ui(ui, shared, &explained),
+        None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
     }
 }
 
 /// Whether the whole-clip analysis flags `bone` anywhere in the clip; `None` before the first analysis.
 fn flagged(shared: &Shared, bone: usize) -> Option<bool> {
-    Some(shared.analysis?.scan.bones.get(bone).is_some_and(|b| b.stretched()))
+    Some(shared.results.analysis.as_ref()?.scan.bones.get(bone).is_some_and(|b| b.stretched()))
 }
 
 /// Whether the section is open: one state for every bone, so that it stays open while the selection changes.
 fn collapsing(ctx: &egui::Context) -> CollapsingState {
     CollapsingState::load_with_default_open(ctx, egui::Id::unique("inspector-why"), false)
-}
-
-/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was
-/// scanned.
-fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<Explanation> {
-    let evaluation = key.evaluation(rig)?;
-    let request = &key.request;
-    let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
-    let report = |done: usize, total: usize| progress.report(done, total);
-    let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
-    let question = Question { bones: Some(&[request.bone]), ..Question::default() };
-    explain(&evaluation, &before, question, &options).pop()
-}
-
-/// The library's words in the app's font, which has no arrow: "forearm → segment-compensate" reads "forearm to
-/// segment-compensate".
-fn drawable(text: &str) -> String {
-    text.replace('→', "to")
 }
 
 fn spinner(ui: &mut Ui, text: &str) {

@@ -2,14 +2,14 @@
 //! its stretch rotation, one node for any other; where meshes hang (on their bone's node, primitives of one glTF mesh
 //! where they can share it); and the document's nodes, meshes and skins with the rest pose as default TRS.
 
-use glam::{DMat4, DQuat};
+use glam::DQuat;
 
 use super::document::{GltfDocument, MeshGroup, Node};
-use super::nodes::{NodeSample, Sampled};
+use super::nodes::{NodeSample, Sampled, under_conversion};
 use super::skins::{skins, unique_name};
 use crate::diff::HELPER_SUFFIX;
 use crate::math::decompose;
-use crate::model::{Mesh, Rig, Skeleton};
+use crate::model::{Mesh, Rig};
 
 /// Which glTF node each bone and helper becomes, and which meshes hang where.
 pub struct Layout {
@@ -128,16 +128,6 @@ fn conversion(layout: &Layout, rig: &Rig, document: &mut GltfDocument) {
     let parts = decompose(&rig.skeleton.placement().conversion);
     let sample = NodeSample { rotation: parts.rotation, scale: parts.scale * parts.sign, ..NodeSample::IDENTITY };
     document.nodes.push(node_with(&unique_name(&document.nodes, "conversion"), None, &sample));
-}
-
-/// Per bone, whether it is a root the baked file hangs from a node carrying the skeleton's unit and axes
-/// conversion: every root but the conversion nodes (which carry it themselves, as an exporter's armature scaled
-/// 100 under a centimetre file becomes one of scale 1), where there is a conversion.
-pub fn under_conversion(skeleton: &Skeleton) -> Vec<bool> {
-    let placement = skeleton.placement();
-    let converts = placement.conversion != DMat4::IDENTITY;
-    let roots = skeleton.bones().iter().enumerate();
-    roots.map(|(i, bone)| converts && bone.parent.is_none() && !placement.is_conversion(i)).collect()
 }
 
 /// A node named `name` with the TRS of `sample` (its stretch is carried by the bone's own node, not here).

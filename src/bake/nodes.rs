@@ -22,7 +22,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 use super::Strategy;
 use crate::eval::{Evaluation, Evaluator, over_runs};
 use crate::math::{AffineParts, decompose_near, stretch_nearest};
-use crate::model::affine;
+use crate::model::{Skeleton, affine};
 
 /// A stretch rotation matters when dropping it moves `U·K·Uᵀ` by more than this fraction of the largest factor: a
 /// few single-precision roundings. Less is the noise of a file's `f32` numbers (factors 1e-7 apart, whose frame
@@ -200,7 +200,7 @@ pub struct NodeSolver<'e, 'a> {
     strategy: Strategy,
     parents: Vec<Option<usize>>,
     /// The source's unit and axes conversion and its inverse, and per bone whether it is a root that hangs from a
-    /// node carrying it in the baked file ([`super::layout`]); a root that is a conversion node carries it itself.
+    /// node carrying it in the baked file ([`under_conversion`]); a root that is a conversion node carries it itself.
     conversion: DMat4,
     conversion_inverse: DMat4,
     under_conversion: Vec<bool>,
@@ -223,7 +223,7 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
             parents,
             conversion: source.skeleton().placement().conversion,
             conversion_inverse: source.skeleton().placement().conversion.inverse(),
-            under_conversion: super::layout::under_conversion(source.skeleton()),
+            under_conversion: under_conversion(source.skeleton()),
             baked: vec![DMat4::IDENTITY; bones],
             previous: vec![DQuat::IDENTITY; bones],
             row: vec![NodeSample::IDENTITY; bones],
@@ -345,6 +345,16 @@ pub fn align(current: &mut NodeSample, previous: &NodeSample) {
 /// `q` or `−q`, whichever is nearer `reference`.
 fn same_hemisphere(q: DQuat, reference: DQuat) -> DQuat {
     if q.dot(reference) < 0.0 { -q } else { q }
+}
+
+/// Per bone, whether it is a root the baked file hangs from a node carrying the skeleton's unit and axes
+/// conversion: every root but the conversion nodes (which carry it themselves, as an exporter's armature scaled
+/// 100 under a centimetre file becomes one of scale 1), where there is a conversion.
+pub fn under_conversion(skeleton: &Skeleton) -> Vec<bool> {
+    let placement = skeleton.placement();
+    let converts = placement.conversion != DMat4::IDENTITY;
+    let roots = skeleton.bones().iter().enumerate();
+    roots.map(|(i, bone)| converts && bone.parent.is_none() && !placement.is_conversion(i)).collect()
 }
 
 #[cfg(test)]

@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use clap::Args;
 
-use super::options::{Distance, choice, evaluation, parse_distance};
+use super::options::{Distance, choice, parse_distance};
+use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, Format};
 use crate::bake::{self, BakeReport, ClipToBake, Engine, Request, Strategy};

@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use clap::Args;
 
 use super::layers::bone_index;
-use super::options::{evaluation, parse_rate};
+use super::options::parse_rate;
+use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;

@@ -8,7 +8,8 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use super::options::{choice, evaluation};
+use super::options::choice;
+use super::setup::evaluation;
 use crate::eval::{Setup, SkinningMethod};
 use crate::export::{EvaluatedMesh, write_obj};
 use crate::import::{self, Options, Space};

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use super::options::evaluation;
+use super::setup::evaluation;
 use super::table::{Table, shown, vector};
 use super::{EvalArgs, Format, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};

@@ -18,6 +18,7 @@ mod options;
 mod render;
 mod report;
 mod scan;
+mod setup;
 mod table;
 
 use std::process::ExitCode;
@@ -25,7 +26,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use layers::{LayerArgs, TargetArg};
-pub use options::{EvalArgs, Format, ToleranceArgs};
+pub use options::{Format, ToleranceArgs};
+pub use setup::EvalArgs;
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's
 /// matrices, stretched (sheared) bones, and what each scale-inheritance mode makes of them.

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
 use super::options::choice;
-use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Settings};
+use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Pane, Settings};
 use crate::eval::SkinningMethod;
 use crate::import;
 use crate::model::Choice;
@@ -251,7 +251,8 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
         .collect::<anyhow::Result<Vec<usize>>>()?;
     // With layers, the whole window shows the panel that describes them.
     let show_layers = !doc.layers().is_empty();
-    let mut settings = Settings { dark: args.theme == Theme::Dark, show_layers, ..Settings::default() };
+    let settings = Settings { dark: args.theme == Theme::Dark, ..Settings::default() };
+    let mut settings = settings.showing(&Pane::LAYERS, show_layers);
     settings.scene = SceneOptions { skinning: args.skinning, ..args.show.unwrap_or_default() };
     settings.camera.view = args.view;
     if let Some([yaw, pitch, _]) = args.camera {
@@ -263,8 +264,8 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
         app.frame_now(f64::from(args.size.0) / f64::from(args.size.1.max(1)));
         app.settings.camera.distance = distance;
     }
-    app.selection = selection;
-    app.chrome = if args.ui { Chrome::Window } else { Chrome::ViewportOnly };
+    app.window.selection = selection;
+    app.window.chrome = if args.ui { Chrome::Window } else { Chrome::ViewportOnly };
     Ok(app)
 }
 

@@ -9,7 +9,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Args, ValueEnum};
 
 use super::layers::LayerArgs;
-use super::options::{clip_index, evaluation, parse_angle, parse_comparison, parse_rate};
+use super::options::{clip_index, parse_angle, parse_comparison, parse_rate};
+use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};

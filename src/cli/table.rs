@@ -88,6 +88,11 @@ pub fn vector(values: &[f64]) -> String {
     format!("({})", parts.join(", "))
 }
 
+/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
+pub fn shown(path: &std::path::Path) -> String {
+    crate::import::text::printable(&path.display().to_string()).into_owned()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,9 +105,4 @@ mod tests {
         assert_eq!(t.to_string(), "  name    value\n  a         1.5\n  longer  10.25\n");
         assert_eq!(vector(&[-0.0, 1.0]), "(0.0000, 1.0000)");
     }
-}
-
-/// A path as reports print it: a file's name may hold control characters, which must not reach a terminal.
-pub fn shown(path: &std::path::Path) -> String {
-    crate::import::text::printable(&path.display().to_string()).into_owned()
 }

@@ -5,7 +5,7 @@
 
 use super::layers::LayerError;
 use super::{Evaluation, LayerStack, Layers, SkinningMethod};
-use crate::model::{Modes, Rig, Unit};
+use crate::model::{Choice, Clip, Modes, Rig, Skeleton, Unit};
 
 /// Everything that decides an evaluation of a rig, the rig aside.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -50,6 +50,70 @@ impl Setup {
         }
         Ok(LayerStack::new(rig, &self.layers)?)
     }
+}
+
+impl Setup {
+    /// What changed from `before` to this setup of `rig`, in a few words for people ("forearm → blender-aligned",
+    /// "every bone → full", "blend on"); empty where nothing did.
+    pub fn change_from(&self, before: &Setup, rig: &Rig) -> String {
+        let mut parts = Vec::new();
+        if self.clip != before.clip {
+            parts.push(self.clip.and_then(|c| rig.clips.get(c)).map_or_else(|| "rest pose".to_owned(), Clip::label));
+        }
+        if self.modes != before.modes {
+            parts.push(mode_change(&before.modes, &self.modes, &rig.skeleton));
+        }
+        parts.extend(layer_changes(&before.layers, &self.layers, &rig.skeleton));
+        if self.skinning != before.skinning {
+            parts.push(format!("skinning {}", self.skinning.id()));
+        }
+        if self.unit != before.unit {
+            parts.push(self.unit.map_or_else(|| "the rig's own unit".to_owned(), |u| format!("unit {u}")));
+        }
+        parts.join(", ")
+    }
+}
+
+/// The modes `after` gives, as it differs from `before`: every bone's, one bone's, a subtree's, or a count.
+fn mode_change(before: &Modes, after: &Modes, skeleton: &Skeleton) -> String {
+    let (old, new) = (before.resolve(skeleton), after.resolve(skeleton));
+    let changed: Vec<usize> = (0..new.len()).filter(|&b| old.get(b) != new.get(b)).collect();
+    let choice = |bone: usize| after.bones.get(&bone).map_or(after.all.id(), |m| m.id());
+    let name = |bone: usize| skeleton.bone(bone).name.as_str();
+    match changed.as_slice() {
+        _ if after.bones.is_empty() && after.all != before.all => format!("every bone → {}", after.all.id()),
+        [] => format!("modes → {}", after.label()),
+        [bone] => format!("{} → {}", name(*bone), choice(*bone)),
+        [top, ..] if skeleton.subtree(*top) == changed => format!("{}'s subtree → {}", name(*top), choice(*top)),
+        bones => format!("{} bones' modes", bones.len()),
+    }
+}
+
+/// Each layer `after` changes from `before`: turned on or off, or changed.
+fn layer_changes(before: &Layers, after: &Layers, skeleton: &Skeleton) -> Vec<String> {
+    let mut parts = Vec::new();
+    let mut toggled = |name: &str, was: bool, is: bool, same: bool| match (was, is) {
+        (false, true) => parts.push(format!("{name} on")),
+        (true, false) => parts.push(format!("{name} off")),
+        _ if !same => parts.push(name.to_owned()),
+        _ => {}
+    };
+    toggled("bind weight", before.bind_weight < 1.0, after.bind_weight < 1.0, before.bind_weight == after.bind_weight);
+    let interpolation = before.interpolation == after.interpolation;
+    toggled("interpolation", false, false, interpolation);
+    toggled("blend", before.blend.is_some(), after.blend.is_some(), before.blend == after.blend);
+    toggled("additive", before.additive.is_some(), after.additive.is_some(), before.additive == after.additive);
+    toggled("crossfade", before.crossfade.is_some(), after.crossfade.is_some(), before.crossfade == after.crossfade);
+    toggled("shake", before.shake.is_some(), after.shake.is_some(), before.shake == after.shake);
+    toggled("targets", !before.targets.is_empty(), !after.targets.is_empty(), before.targets == after.targets);
+    let name = |bone: &usize| skeleton.bones().get(*bone).map_or("?", |b| b.name.as_str());
+    for bone in after.uniform_scale.iter().filter(|b| !before.uniform_scale.contains(b)) {
+        parts.push(format!("{}'s scale made uniform", name(bone)));
+    }
+    for bone in before.uniform_scale.iter().filter(|b| !after.uniform_scale.contains(b)) {
+        parts.push(format!("{}'s scale as authored", name(bone)));
+    }
+    parts
 }
 
 impl<'a> Evaluation<'a> {
@@ -141,5 +205,39 @@ mod tests {
         let blend = Blend { clip: 5, weight: 0.5, sync: false, rotation: Default::default() };
         let layered = Setup { layers: Layers { blend: Some(blend), ..Layers::default() }, ..Setup::default() };
         assert!(Evaluation::of(&rig, &layered).unwrap_err().to_string().contains("no animation 5"));
+    }
+
+    #[test]
+    fn a_change_of_setup_is_said_in_a_few_words() {
+        let rig = demo_rig();
+        let skeleton = &rig.skeleton;
+        let (forearm, upper_arm) = (skeleton.find("forearm").unwrap(), skeleton.find("upper_arm").unwrap());
+        let before = Setup::declared(&rig);
+        let with = |f: &dyn Fn(&mut Setup)| {
+            let mut after = before.clone();
+            f(&mut after);
+            after.change_from(&before, &rig)
+        };
+        assert_eq!(with(&|_| {}), "");
+        let aligned = ModeChoice::Mode(InheritMode::BlenderAligned);
+        assert_eq!(with(&|s| s.modes.set(skeleton, forearm, aligned)), "forearm → blender-aligned");
+        let subtree = |s: &mut Setup| {
+            (0..skeleton.len())
+                .filter(|&b| skeleton.is_in_subtree(b, upper_arm))
+                .for_each(|b| s.modes.set(skeleton, b, aligned))
+        };
+        assert_eq!(with(&subtree), "upper_arm's subtree → blender-aligned");
+        assert_eq!(with(&|s| s.modes = Modes::all(aligned)), "every bone → blender-aligned");
+        assert_eq!(with(&|s| s.clip = Some(1)), "bend");
+        assert_eq!(with(&|s| s.layers.make_scale_uniform(upper_arm)), "upper_arm's scale made uniform");
+        let blend = Blend { clip: 1, weight: 0.5, sync: false, rotation: Default::default() };
+        assert_eq!(with(&|s| s.layers.blend = Some(blend)), "blend on");
+        assert_eq!(
+            with(&|s| {
+                s.layers.bind_weight = 0.5;
+                s.clip = None;
+            }),
+            "rest pose, bind weight on"
+        );
     }
 }

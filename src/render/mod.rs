@@ -66,7 +66,7 @@ impl Renderer {
             .build_eframe(move |_cc| app);
         harness.step();
         let ctx = harness.ctx.clone();
-        if harness.state().chrome == Chrome::Window {
+        if harness.state().window.chrome == Chrome::Window {
             harness.state_mut().settle(&ctx);
         }
         harness.run_steps(WARM_UP_FRAMES);
@@ -75,14 +75,14 @@ impl Renderer {
 
     /// The picture at `time` (seconds).
     pub fn render(&mut self, time: f64) -> Result<RgbaImage, RenderError> {
-        self.harness.state_mut().time = time;
+        self.harness.state_mut().window.time = time;
         // The viewport evaluates the pose at the start of its frame and paints it in the same pass; the panels of
         // the window size themselves to their new content over the next frames.
-        let frames = if self.app().chrome == Chrome::Window { WINDOW_SETTLE_FRAMES } else { 1 };
+        let frames = if self.app().window.chrome == Chrome::Window { WINDOW_SETTLE_FRAMES } else { 1 };
         self.harness.run_steps(frames);
         let mut image = self.harness.render().map_err(RenderError::Gpu)?;
         // The whole window paints its own panels; the viewport alone is drawn without its background.
-        if self.app().chrome == Chrome::ViewportOnly {
+        if self.app().window.chrome == Chrome::ViewportOnly {
             match self.background {
                 Background::Viewport => composite(&mut image, Palette::new(self.app().settings.dark).background),
                 Background::Transparent => unpremultiply(&mut image),

@@ -1,0 +1,331 @@
+//! The work: everything computed off the UI thread, in one place that starts it when what it depends on changes
+//! (each result keyed by the rig's identity, a [`Setup`](crate::eval::Setup) and the request: [`Key`]), stops what
+//! is no longer wanted, and waits for it where a settled state is wanted (tests, headless renders). Panels ask it for
+//! results; they own no threads.
+
+use std::sync::Arc;
+
+use super::compare::Compared;
+use super::document::Document;
+use super::identity::RigId;
+use super::job::{Job, Key, Progress};
+use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
+use crate::analysis::{
+    BindCheck, BindTolerance, ClipAnalysis, Components, CurveRequest, Judged, ScanOptions, Tolerances, analyze,
+    check_bind,
+};
+use crate::diff::{Pairs, compare, comparison_times, model_curves};
+use crate::eval::{Evaluation, Setup};
+use crate::explain::{Explanation, Question, explain};
+use crate::model::Rig;
+
+/// What a whole-clip analysis is asked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnalysisRequest {
+    /// What the ghost evaluates of the same rig (its curves are plotted dashed).
+    pub ghost: Option<Setup>,
+    pub plotted: Vec<usize>,
+    pub rate: f64,
+    pub tolerances: Tolerances,
+    /// Every bone (the summary), or only the plotted bones' chains (their curves).
+    pub judged: Judged,
+}
+
+/// What an explanation is asked: the bone, and how the clip is sampled and judged (as the whole-clip analysis
+/// samples and judges it, so that both flag the same samples).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WhyRequest {
+    pub bone: usize,
+    pub rate: f64,
+    pub tolerances: Tolerances,
+}
+
+/// What a comparison with the compared file is asked: that file (this pairing of it) as evaluated, and how often
+/// the clip is sampled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompareRequest {
+    pub compared: RigId,
+    pub setup: Setup,
+    pub rate: f64,
+}
+
+/// What the compared file's curves are asked: the document's bones plotted, at the times of the document's own
+/// curves (the dashed curves share their axis). Keyed by the compared file as evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvesRequest {
+    pub plotted: Vec<usize>,
+    pub times: Vec<f64>,
+}
+
+/// Each document bone's largest difference from the compared file over the clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Differences {
+    /// Per document bone: the largest distance of its origin and axis probes, as a fraction of the rig's size
+    /// (`None` without a partner, and for conversion nodes).
+    pub bones: Vec<Option<f64>>,
+    pub rig_size: f64,
+}
+
+/// `(document bone, its partner's model-space components at the curves' times)` for the plotted bones that have one.
+pub type ComparedCurves = Vec<(usize, Vec<Components>)>;
+
+/// What the window asks to be analysed this frame.
+pub struct Wanted<'a> {
+    pub doc: &'a Document,
+    pub tolerances: Tolerances,
+    /// The bones whose curves are plotted (none: no curves wanted).
+    pub plotted: Vec<usize>,
+}
+
+/// The latest results the panels show (possibly for an older state while a newer one is computed).
+#[derive(Clone, Default)]
+pub struct Results {
+    /// The rig-wide analysis: every bone's summary and stretched samples.
+    pub analysis: Option<Arc<ClipAnalysis>>,
+    /// The plotted bones' curves (a separate, quick analysis of their chains).
+    pub curves: Option<Arc<ClipAnalysis>>,
+    /// `(done, total)` samples while the whole-clip analysis runs.
+    pub progress: Option<(usize, usize)>,
+    /// Each bone's largest difference from the compared file over the clip.
+    pub differences: Option<Arc<Differences>>,
+    /// The compared file's curves of the plotted bones.
+    pub compared_curves: Option<Arc<ComparedCurves>>,
+}
+
+/// Every background job of the app.
+#[derive(Default)]
+pub struct Work {
+    analysis: Job<Key<AnalysisRequest>, ClipAnalysis>,
+    curves: Job<Key<AnalysisRequest>, ClipAnalysis>,
+    differences: Job<Key<CompareRequest>, Differences>,
+    compared_curves: Job<Key<CurvesRequest>, ComparedCurves>,
+    bind: Job<Key<()>, BindCheck>,
+    storage: Job<Key<()>, StorageReport>,
+    explanation: Job<Key<WhyRequest>, Explanation>,
+    /// Woken when a job finishes, so that the UI shows its result.
+    waker: Option<egui::Context>,
+}
+
+impl Work {
+    pub fn wake(&mut self, ctx: egui::Context) {
+        self.waker = Some(ctx);
+    }
+
+    /// `job` computing `work()` for `key`, started when `key` is not the one it has or computes (see [`Job::update`]).
+    fn start<K, T, W>(waker: &Option<egui::Context>, job: &mut Job<K, T>, key: K, work: impl FnOnce() -> W)
+    where
+        K: Clone + PartialEq + Send + 'static,
+        T: Send + Sync + 'static,
+        W: FnOnce(&Progress) -> Option<T> + Send + 'static,
+    {
+        let waker = waker.clone();
+        job.update(key, work, move || waker.iter().for_each(egui::Context::request_repaint));
+    }
+
+    /// Starts what `wanted` needs: the rig-wide analysis, the plotted bones' curves, and with a compared file the
+    /// differences and its curves (each only when its key changed).
+    pub fn analyse(&mut self, wanted: &Wanted) {
+        let rig = &wanted.doc.rig;
+        let key = analysis_key(wanted);
+        Work::start(&self.waker, &mut self.analysis, key.clone(), || analysis(key, rig.clone()));
+        if let Some(key) = curves_key(wanted) {
+            Work::start(&self.waker, &mut self.curves, key.clone(), || analysis(key, rig.clone()));
+        }
+        let Some(compared) = wanted.doc.compared.clone() else { return };
+        let key = compare_key(wanted.doc, &compared);
+        Work::start(&self.waker, &mut self.differences, key.clone(), || {
+            differences(key, rig.clone(), compared.clone())
+        });
+        if let Some(key) = self.compared_curves_key(wanted) {
+            Work::start(&self.waker, &mut self.compared_curves, key.clone(), || compared_curves(key, compared));
+        }
+    }
+
+    /// What the compared file's curves depend on: the compared file as evaluated, the plotted bones, and the times
+    /// of the document's own curves, once they are there.
+    fn compared_curves_key(&self, wanted: &Wanted) -> Option<Key<CurvesRequest>> {
+        let times = self.curves.for_key(&curves_key(wanted)?)?.times.clone();
+        let compare = compare_key(wanted.doc, wanted.doc.compared.as_ref()?);
+        let request = CurvesRequest { plotted: wanted.plotted.clone(), times };
+        Some(Key { rig: compare.request.compared, setup: compare.request.setup, request })
+    }
+
+    /// The latest results, for the panels; a comparison's only while there is one.
+    pub fn results(&self, doc: &Document) -> Results {
+        let comparing = doc.compared.is_some();
+        Results {
+            analysis: self.analysis.latest().map(|(_, a)| a.clone()),
+            curves: self.curves.latest().map(|(_, c)| c.clone()),
+            progress: self.analysis.progress(),
+            differences: self.differences.latest().filter(|_| comparing).map(|(_, d)| d.clone()),
+            compared_curves: self.compared_curves.latest().filter(|_| comparing).map(|(_, c)| c.clone()),
+        }
+    }
+
+    /// The whole-clip analysis of what `wanted` shows, if computed.
+    pub fn analysis(&self, wanted: &Wanted) -> Option<&Arc<ClipAnalysis>> {
+        self.analysis.for_key(&analysis_key(wanted))
+    }
+
+    /// The plotted bones' curves of what `wanted` shows, if computed.
+    pub fn curves(&self, wanted: &Wanted) -> Option<&Arc<ClipAnalysis>> {
+        self.curves.for_key(&curves_key(wanted)?)
+    }
+
+    /// Each bone's largest difference from the compared file, if computed for what `wanted` shows.
+    pub fn differences(&self, wanted: &Wanted) -> Option<&Arc<Differences>> {
+        self.differences.for_key(&compare_key(wanted.doc, wanted.doc.compared.as_ref()?))
+    }
+
+    /// The bind check of `doc`'s clip as authored: started when it changed, `None` until done.
+    pub fn bind_check(&mut self, doc: &Document) -> Option<&Arc<BindCheck>> {
+        // The check reads the clip as authored: its key leaves the layers out.
+        let key = Key::authored(doc, ());
+        let (rig, checked) = (doc.rig.clone(), key.clone());
+        let work = || move |_: &Progress| Some(check_bind(&checked.evaluation(&rig)?, &BindTolerance::default()));
+        Work::start(&self.waker, &mut self.bind, key.clone(), work);
+        self.bind.for_key(&key)
+    }
+
+    /// Starts measuring the stretch-quaternion storage of what `doc` evaluates.
+    pub fn measure_storage(&mut self, doc: &Document) {
+        let key = Key::of(doc, ());
+        let (rig, measured) = (doc.rig.clone(), key.clone());
+        let work = || move |_: &Progress| Some(storage_report(&measured.evaluation(&rig)?, &StorageOptions::default()));
+        Work::start(&self.waker, &mut self.storage, key, work);
+    }
+
+    /// The storage report of what `doc` evaluates, once measured; and whether a measurement is under way.
+    pub fn storage(&mut self, doc: &Document) -> (Option<&Arc<StorageReport>>, bool) {
+        self.storage.collect();
+        let running = self.storage.progress().is_some();
+        (self.storage.for_key(&Key::of(doc, ())), running)
+    }
+
+    /// The explanation `request` asks of what `doc` evaluates: started when asked anew (one at a time: it cannot
+    /// stop half way, so a newer one waits for the one under way to finish), `None` until done.
+    pub fn explanation(&mut self, doc: &Document, request: WhyRequest) -> Option<&Arc<Explanation>> {
+        let key = Key::of(doc, request);
+        if !self.explanation.busy_with_other(&key) {
+            let (rig, explained) = (doc.rig.clone(), key.clone());
+            let work = || move |progress: &Progress| explanation(&rig, &explained, progress);
+            Work::start(&self.waker, &mut self.explanation, key.clone(), work);
+        }
+        self.explanation.for_key(&key)
+    }
+
+    /// Whether the analyses of the window's state are still being computed.
+    pub fn analysing(&self) -> bool {
+        [self.analysis.progress(), self.curves.progress(), self.differences.progress(), self.compared_curves.progress()]
+            .iter()
+            .any(Option::is_some)
+    }
+
+    /// Waits for every job under way, starting what `wanted` needs first (the compared curves wait for the
+    /// document's).
+    pub fn settle(&mut self, wanted: &Wanted) {
+        self.analyse(wanted);
+        self.analysis.wait();
+        self.curves.wait();
+        self.differences.wait();
+        self.analyse(wanted);
+        self.compared_curves.wait();
+        self.bind.wait();
+        self.storage.wait();
+        self.explanation.wait();
+    }
+}
+
+/// The rig-wide analysis the window wants: every bone judged over the clip, no curves. It does not change with the
+/// selection, so selecting a bone never waits for it.
+fn analysis_key(wanted: &Wanted) -> Key<AnalysisRequest> {
+    let rate = wanted.doc.analysis_rate();
+    let request = AnalysisRequest {
+        ghost: None,
+        plotted: Vec::new(),
+        rate,
+        tolerances: wanted.tolerances,
+        judged: Judged::Every,
+    };
+    Key::of(wanted.doc, request)
+}
+
+/// The curves the plots want: the plotted bones (and the ghost's), only their chains evaluated; `None` with
+/// nothing plotted.
+fn curves_key(wanted: &Wanted) -> Option<Key<AnalysisRequest>> {
+    let mut key = analysis_key(wanted);
+    key.request.plotted = wanted.plotted.clone();
+    key.request.ghost = wanted.doc.ghost_setup();
+    key.request.judged = Judged::CurveChains;
+    (!key.request.plotted.is_empty()).then_some(key)
+}
+
+/// The comparison of `doc` with `compared` at the analysis's rate.
+fn compare_key(doc: &Document, compared: &Compared) -> Key<CompareRequest> {
+    let setup = compared.setup(doc.setup().clip);
+    Key::of(doc, CompareRequest { compared: compared.rig_id, setup, rate: doc.analysis_rate() })
+}
+
+/// The analysis `key` asks of `rig` (the rig `key` was made of), as work for a [`Job`].
+fn analysis(
+    key: Key<AnalysisRequest>,
+    rig: Arc<Rig>,
+) -> impl FnOnce(&Progress) -> Option<ClipAnalysis> + Send + 'static {
+    move |progress| {
+        let evaluation = key.evaluation(&rig)?;
+        let request = &key.request;
+        let ghost = request.ghost.as_ref().and_then(|ghost| Evaluation::of(&rig, ghost).ok());
+        let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
+        let curves = CurveRequest { bones: &request.plotted, ghost: ghost.as_ref(), judged: request.judged };
+        let report = |done: usize, total: usize| progress.report(done, total);
+        analyze(&evaluation, curves, &options, &report, progress.cancelled())
+    }
+}
+
+/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was
+/// scanned.
+fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<Explanation> {
+    let evaluation = key.evaluation(rig)?;
+    let request = &key.request;
+    let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
+    let report = |done: usize, total: usize| progress.report(done, total);
+    let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
+    let question = Question { bones: Some(&[request.bone]), ..Question::default() };
+    explain(&evaluation, &before, question, &options).pop()
+}
+
+/// The differences `key` asks for, as work for a [`Job`]: the document's rig (the one `key` was made of) against
+/// `compared`.
+fn differences(
+    key: Key<CompareRequest>,
+    rig: Arc<Rig>,
+    compared: Arc<Compared>,
+) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
+    move |_| {
+        let own = key.evaluation(&rig)?;
+        let other = Evaluation::of(&compared.rig, &key.request.setup).ok()?;
+        // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
+        let pairs = Pairs { meshes: Vec::new(), ..Pairs::by_name(&own, &other) };
+        let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.request.rate));
+        let mut bones = vec![None; rig.skeleton.len()];
+        for difference in &comparison.bones {
+            bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
+        }
+        Some(Differences { bones, rig_size: comparison.rig_size })
+    }
+}
+
+/// The compared curves `key` asks for, as work for a [`Job`].
+fn compared_curves(
+    key: Key<CurvesRequest>,
+    compared: Arc<Compared>,
+) -> impl FnOnce(&Progress) -> Option<ComparedCurves> + Send + 'static {
+    move |_| {
+        let request = &key.request;
+        let paired: Vec<(usize, usize)> =
+            request.plotted.iter().filter_map(|&b| compared.bones.get(b).copied().flatten().map(|p| (b, p))).collect();
+        let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
+        let curves = model_curves(&key.evaluation(&compared.rig)?, &partners, &request.times);
+        Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
+    }
+}
