@@ -65,7 +65,7 @@ fn frame_in(c: &mut Criterion, name: &str, settings: Settings, input: egui::RawI
 fn clip_analysis(c: &mut Criterion) {
     let rig = stress_rig(BONES, FRAMES, KEY_STEP);
     let modes = rig.skeleton.declared_modes();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &modes);
+    let hierarchy = Hierarchy::new(&rig.skeleton, &modes).unwrap();
     let plotted: Vec<usize> = (0..PLOTTED).map(|i| 6 + 10 * i).collect();
     let options = ScanOptions { rate: bonescope::model::DEFAULT_FRAME_RATE, ..ScanOptions::default() };
     let mut group = c.benchmark_group("whole-clip analysis");
@@ -83,7 +83,7 @@ fn selection_curves(c: &mut Criterion) {
     let rig = shared_assets::repeated_cmu_walk(40);
     let clip = rig.clips.first();
     eprintln!("repeated CMU walk: {:.1} s, {} bones", clip.map_or(0.0, |c| c.duration()), rig.skeleton.len());
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let hand = rig.skeleton.bones().iter().position(|b| b.name.contains("Hand")).unwrap_or(rig.skeleton.len() - 1);
     let options = ScanOptions { rate: clip.map_or(30.0, |c| c.frame_rate()), ..ScanOptions::default() };
     let mut group = c.benchmark_group("selection curves");
@@ -107,7 +107,7 @@ fn analyze_clip(
     options: &ScanOptions,
 ) -> Option<bonescope::analysis::ClipAnalysis> {
     let never = std::sync::atomic::AtomicBool::new(false);
-    let evaluation = Evaluation::new(rig, rig.clips.first(), hierarchy.modes());
+    let evaluation = Evaluation::new(rig, rig.clips.first(), hierarchy.modes()).unwrap();
     analyze(&evaluation, request, options, &|_, _| {}, &never)
 }
 

@@ -30,7 +30,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 
 fn request(rig: &Rig, mode: Option<InheritMode>) -> Request<'_> {
     let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
-    Request::every_clip(&Evaluation::new(rig, None, &modes), None, Strategy::Exact, bake::DEFAULT_TOLERANCE)
+    Request::every_clip(&Evaluation::new(rig, None, &modes).unwrap(), None, Strategy::Exact, bake::DEFAULT_TOLERANCE)
 }
 
 /// The source's first clip against the bake's, as `bonescope diff` compares them.

@@ -45,7 +45,7 @@ fn layered_evaluation(c: &mut Criterion) {
     let mut stack = LayerStack::new(&rig, &layers).expect("the layers fit the rig");
     let cycle = stack.synced_cycle(&rig, Some(main)).expect("a synced blend").length;
     let times: Vec<f64> = (0..TIMES).map(|i| cycle * i as f64 / TIMES as f64).collect();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut group = c.benchmark_group("layers_500");
     let mut local = Vec::new();
     group.bench_function("single_clip", |b| {
@@ -117,7 +117,7 @@ fn storage(c: &mut Criterion) {
     let mut group = c.benchmark_group("storage");
     group.sample_size(10);
     for (name, mode) in [("full", InheritMode::Full), ("compensate", InheritMode::SegmentCompensate)] {
-        let evaluation = Evaluation::new(&rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]);
+        let evaluation = Evaluation::new(&rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]).unwrap();
         let report = storage_report(&evaluation, &options);
         assert_eq!(report.frames, 10_001);
         println!(

@@ -161,7 +161,7 @@ impl Case {
     }
 
     fn evaluation(&self) -> Evaluation<'_> {
-        Evaluation::new(&self.rig, self.rig.clips.first(), self.hierarchy.modes())
+        Evaluation::new(&self.rig, self.rig.clips.first(), self.hierarchy.modes()).unwrap()
     }
 }
 
@@ -170,7 +170,7 @@ fn generated_case(squash: Squash) -> Case {
     let skeleton = generated_skeleton(&mut rng);
     let scaled = squash.scaled_bones(&mut rng);
     let clip = generated_clip(&mut rng, &skeleton, &scaled);
-    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&skeleton, &skeleton.declared_modes()).unwrap();
     let name = match squash {
         Squash::Limbs => "generated_100".into(),
         Squash::Spine => "generated_100_spine_squash".into(),
@@ -183,7 +183,8 @@ fn generated_case(squash: Squash) -> Case {
 /// bone is judged from its decomposed model matrix.
 fn compensating_case() -> Case {
     let case = generated_case(Squash::Limbs);
-    let hierarchy = Hierarchy::new(&case.rig.skeleton, &vec![InheritMode::SegmentCompensate; case.rig.skeleton.len()]);
+    let hierarchy =
+        Hierarchy::new(&case.rig.skeleton, &vec![InheritMode::SegmentCompensate; case.rig.skeleton.len()]).unwrap();
     Case { name: "generated_100_compensate".into(), hierarchy, ..case }
 }
 
@@ -201,7 +202,7 @@ fn blender_case() -> Option<Case> {
         }
     };
     let clip = rig.find_clip("squash_stretch").or(rig.clips.first())?.clone();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     Some(Case::new("stretchy_full".into(), rig.skeleton, clip, hierarchy))
 }
 

@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use bonescope::analysis::{CurveRequest, ScanOptions, analyze};
-use bonescope::eval::{Evaluation, Hierarchy};
+use bonescope::eval::Evaluation;
 use bonescope::import::stress_rig;
 use bonescope::model::InheritMode;
 
@@ -21,12 +21,11 @@ fn setting(name: &str, default: usize) -> usize {
 fn main() {
     let frames = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(10_000);
     let rig = stress_rig(500, frames, 5);
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
     let plotted: Vec<usize> = (0..setting("PLOT", 8)).map(|i| 6 + 10 * i).collect();
     let ghost_mode = std::env::var("GHOST").ok().map(|id| id.parse::<InheritMode>().expect("a mode id"));
-    let ghost_hierarchy = ghost_mode.map(|mode| Hierarchy::new(&rig.skeleton, &vec![mode; rig.skeleton.len()]));
-    let evaluation = Evaluation::new(&rig, rig.clips.first(), hierarchy.modes());
-    let ghost = ghost_hierarchy.as_ref().map(|ghost| evaluation.with_modes(ghost.modes()));
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let ghost =
+        ghost_mode.map(|mode| evaluation.with_modes(&vec![mode; rig.skeleton.len()]).expect("one mode per bone"));
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let never = AtomicBool::new(false);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(setting("THREADS", 1)).build().expect("a thread pool");

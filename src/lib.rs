@@ -32,6 +32,7 @@ pub mod analysis;
 #[cfg(feature = "gui")]
 pub mod app;
 pub mod bake;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod diff;
 pub mod eval;

@@ -589,7 +589,7 @@ fn the_wheel_zooms_the_plots_time_about_the_pointer() {
 /// The file at `source` baked with every bone under `mode` by `strategy`, written to `out`.
 fn bake(source: &std::path::Path, mode: InheritMode, strategy: bonescope::bake::Strategy, out: &std::path::Path) {
     let rig = bonescope::import::load(source).unwrap();
-    let source = bonescope::eval::Evaluation::new(&rig, None, &vec![mode; rig.skeleton.len()]);
+    let source = bonescope::eval::Evaluation::new(&rig, None, &vec![mode; rig.skeleton.len()]).unwrap();
     let request = bonescope::bake::Request::every_clip(&source, None, strategy, bonescope::bake::DEFAULT_TOLERANCE);
     bonescope::bake::save(out, &bonescope::bake::bake(&request).glb).unwrap();
 }

@@ -63,7 +63,7 @@ struct Baked {
 fn request(source: &'static str, mode: Option<InheritMode>, strategy: Strategy, tolerance: f64) -> Request<'static> {
     let rig = &RIGS[source];
     let modes = mode.map_or_else(|| rig.skeleton.declared_modes(), |m| vec![m; rig.skeleton.len()]);
-    Request::every_clip(&Evaluation::new(rig, None, &modes), None, strategy, tolerance)
+    Request::every_clip(&Evaluation::new(rig, None, &modes).unwrap(), None, strategy, tolerance)
 }
 
 fn bake_all(strategy: Strategy, tolerance: f64) -> Vec<Baked> {
@@ -454,7 +454,7 @@ fn unreal_gets_one_trs_node_per_bone_and_its_report_bounds_what_diff_measures_un
 fn diff_in_memory(source: &Rig, modes: &[InheritMode], back: &Rig) -> f64 {
     let mut worst: f64 = 0.0;
     for (k, clip) in source.clips.iter().enumerate() {
-        let a = Evaluation::new(source, Some(clip), modes);
+        let a = Evaluation::new(source, Some(clip), modes).unwrap();
         let b = Evaluation::declared(back, back.clips.get(k));
         let times = comparison_times(&a, &b, bonescope::diff::DEFAULT_RATE);
         worst = worst.max(compare(&a, &b, &Pairs::by_name(&a, &b), &times).worst_distance().max);

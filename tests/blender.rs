@@ -134,7 +134,8 @@ fn blender_plays_a_maya_character_baked_under_segment_compensate() {
     let folder = tempfile::tempdir().unwrap();
     let file = "fbx-ufbx-corpus/maya_character_7500_binary.fbx";
     let rig = import::load(&asset(file)).unwrap();
-    let source = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]);
+    let source =
+        Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]).unwrap();
     let worst = played_beyond_tolerance(&python, folder.path(), &source, Engine::Generic, file);
     assert!(worst.is_none(), "{file} under segment-compensate: {worst:?} of the rig size");
 }

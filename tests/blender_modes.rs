@@ -16,7 +16,7 @@ const FILES: [&str; 2] = ["blender/stretchy_full.glb", "blender/stretchy_full.fb
 
 /// The forearm's model matrix under every bone's `mode` at every key time of the first clip.
 fn forearm(rig: &Rig, mode: InheritMode) -> Vec<(f64, DMat4)> {
-    let evaluation = Evaluation::new(rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]);
+    let evaluation = Evaluation::new(rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]).unwrap();
     let forearm = rig.skeleton.find("forearm").expect("a forearm");
     evaluation.key_times().into_iter().map(|t| (t, evaluation.pose_at(t).model.model[forearm])).collect()
 }

@@ -70,7 +70,7 @@ fn a_root_with_rotations_before_positions_reads_its_position_channels() {
     // rotation_first_root.bvh: `CHANNELS 6 Zrotation Xrotation Yrotation Xposition Yposition Zposition`, first
     // frame `5 -3 0 10 50 -20 …`: the root stands at (10, 50, −20), turned Rz(5°)·Rx(−3°)·Ry(0°).
     let rig = import::load(&asset("bvh/rotation_first_root.bvh")).unwrap();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, 0.0);
     let root = pose.model.model[0];
@@ -102,7 +102,7 @@ fn hand_written_bvh_matches_matrices_computed_by_hand() {
     let rig = load_text("hand.bvh", HAND).unwrap();
     let names: Vec<&str> = rig.skeleton.bones().iter().map(|b| b.name.as_str()).collect();
     assert_eq!(names, ["Hips", "Arm", "Arm_end"]);
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     let model = |pose: &mut Pose, t: f64| {
         pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, t);

@@ -93,7 +93,7 @@ fn made_again<'a>(source: &Evaluation<'a>, change: Change) -> Option<Evaluation<
         Change::Mode { bone, mode } => {
             let mut modes = source.modes().to_vec();
             modes[bone] = mode;
-            Some(source.with_modes(&modes))
+            Some(source.with_modes(&modes).unwrap())
         }
         Change::UniformScale { bone } => {
             let layers = Layers { uniform_scale: vec![bone], ..Layers::default() };

@@ -223,7 +223,7 @@ fn clip_time(fbx: &Path, rig: &Rig, when: When) -> (Option<usize>, f64) {
 /// Every vertex of every mesh of `fbx` as bonescope evaluates `reference`'s pose, in the file's own space.
 fn evaluated(fbx: &Path, rig: &Rig, reference: &Reference) -> Vec<DVec3> {
     let (clip, time) = clip_time(fbx, rig, reference.when);
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     pose.evaluate(&rig.skeleton, clip.map(|c| &rig.clips[c]), &hierarchy, time);
     skin_meshes(rig, &pose.model.model, &pose.morph).concat()
@@ -358,7 +358,7 @@ fn synthetic_bind_to_root_shows_the_stored_pose_not_frame_0() {
     let reference = common::obj_positions(&corpus().join("synthetic_bind_to_root.obj"));
     let joint2 = rig.skeleton.bones().iter().position(|b| b.name == "joint2").unwrap();
     let error_at = |clip: Option<usize>| {
-        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
         let mut pose = Pose::default();
         pose.evaluate(&rig.skeleton, clip.map(|c| &rig.clips[c]), &hierarchy, 0.0);
         let turned = pose.local[joint2].rotation.to_axis_angle().1.to_degrees();

@@ -92,7 +92,7 @@ fn proanimationbank_files_have_the_manifest_takes() {
         }
         // Centimetres, converted to metres: the hips stand about a metre high at the first frame.
         let hips = rig.skeleton.find("Hips").unwrap();
-        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
         let mut pose = Pose::default();
         pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, 0.0);
         let height = pose.model.model[hips].w_axis.y;
@@ -214,7 +214,7 @@ fn oracle(path: &Path, space: Space) -> (f64, String, usize) {
     let bytes = std::fs::read(path).unwrap();
     let rig = import::load_bytes_with(path, &bytes, &Options { space }).unwrap();
     let scene = ufbx_scene(&bytes, space);
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     let (mut worst, mut at, mut samples) = (0.0, String::new(), 0);
     let mut check = |pose: &Pose, nodes: &ufbx::RefList<ufbx::Node>, what: &str| {
@@ -265,7 +265,7 @@ fn model_matrices_equal_ufbx_node_to_world_for_every_fbx_file() {
 /// Every mesh of the file at `time` (first clip), as `export` evaluates it, in the file's own space.
 fn exported(path: &Path, time: f64) -> Vec<DVec3> {
     let rig = import::load_with(path, &Options { space: Space::File }).unwrap();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, time);
     let mut all = Vec::new();
@@ -459,7 +459,7 @@ fn a_take_of_ten_thousand_years_loads_sampled_at_its_keys() {
     let original = import::load_bytes(&path, text.as_bytes()).unwrap();
     for time in [0.0, 1.0 / 24.0, 4.0 / 24.0] {
         let pose = |rig: &Rig| {
-            let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+            let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
             let mut pose = Pose::default();
             pose.evaluate(&rig.skeleton, rig.clips.first(), &hierarchy, time);
             pose.model.model.clone()
@@ -557,7 +557,7 @@ fn every_inherit_type_under_every_other_matches_ufbx() {
             .collect();
         assert_eq!(rig.skeleton.declared_modes(), expected, "InheritType 0, 1, 2 as ufbx reads them");
         let scene = ufbx_scene(text.as_bytes(), Space::File);
-        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+        let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
         let mut pose = Pose::default();
         pose.evaluate(&rig.skeleton, None, &hierarchy, 0.0);
         for (bone, model) in rig.skeleton.bones().iter().zip(&pose.model.model) {

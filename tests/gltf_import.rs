@@ -1028,7 +1028,7 @@ fn morph_targets_displace_vertices_with_their_default_and_animated_weights() {
     let rig = load_glb(&sample).unwrap();
     assert_eq!(rig.meshes[0].morph_targets.len(), 2);
     assert_eq!(rig.meshes[0].morph_weights, [0.5, 0.0]);
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let positions = |clip: Option<&Clip>, time: f64| {
         let mut pose = Pose::default();
         pose.evaluate(&rig.skeleton, clip, &hierarchy, time);

@@ -27,7 +27,7 @@ fn chain(locals: &[Transform]) -> Skeleton {
 fn evaluate(locals: &[Transform], modes: &[InheritMode]) -> Vec<DMat4> {
     let skeleton = chain(locals);
     let mut pose = ModelPose::default();
-    Hierarchy::new(&skeleton, modes).evaluate(locals, &mut pose);
+    Hierarchy::new(&skeleton, modes).unwrap().evaluate(locals, &mut pose);
     pose.model
 }
 
@@ -182,7 +182,7 @@ fn blender_child(mode: InheritMode, child_animated: bool) -> DMat4 {
     // The rest pose (Blender's offset O) is the unanimated case; the animation adds the channel C.
     let skeleton = chain(&blender_case(false));
     let mut pose = ModelPose::default();
-    Hierarchy::new(&skeleton, &[InheritMode::Full, mode]).evaluate(&blender_case(child_animated), &mut pose);
+    Hierarchy::new(&skeleton, &[InheritMode::Full, mode]).unwrap().evaluate(&blender_case(child_animated), &mut pose);
     pose.model[1]
 }
 

@@ -172,7 +172,7 @@ fn a_target_pins_the_model_rotation() {
     let target = DQuat::from_rotation_y(30f64.to_radians());
     let layers = Layers { targets: vec![Target { bone: 2, rotation: target, weight: 1.0 }], ..Layers::default() };
     let mut stack = LayerStack::new(&rig, &layers).unwrap();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut pose = Pose::default();
     for time in [0.0, 0.7, 1.3] {
         pose.evaluate_layered(&rig, Some(&rig.clips[1]), &hierarchy, &mut stack, time);
@@ -233,7 +233,7 @@ fn indices_are_checked_and_bad_values_never_panic() {
 #[test]
 fn the_default_layers_are_the_clip_as_sampled() {
     let rig = demo_rig();
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut stack = LayerStack::new(&rig, &Layers::default()).unwrap();
     let (mut plain, mut layered) = (Pose::default(), Pose::default());
     for time in [0.0, 0.25, 1.9] {
@@ -326,7 +326,7 @@ fn locomotions() -> Rig {
 /// height range of its lowest (model-space height, `steps` evenly spaced phases of a cycle of `length` seconds of
 /// clip `clip` under `layers`). The lowest point alone is no good: a walking foot lies flat for half the cycle.
 fn stance_phase(rig: &Rig, clip: usize, layers: &Layers, length: f64, bone: usize, steps: usize) -> f64 {
-    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let mut stack = LayerStack::new(rig, layers).unwrap();
     let mut pose = Pose::default();
     let heights: Vec<f64> = (0..steps)

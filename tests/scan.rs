@@ -70,7 +70,8 @@ fn the_child_is_stretched_from_the_first_sample_after_zero_and_worst_at_the_end(
 #[test]
 fn segment_compensation_removes_the_stretch() {
     let rig = rig_of(growing_parent());
-    let evaluation = Evaluation::new(&rig, rig.clips.first(), &[InheritMode::Full, InheritMode::SegmentCompensate]);
+    let evaluation =
+        Evaluation::new(&rig, rig.clips.first(), &[InheritMode::Full, InheritMode::SegmentCompensate]).unwrap();
     let result = scan(&evaluation, &ScanOptions::default(), &|_, _| {});
     assert!(result.bones.iter().all(|b| !b.stretched()));
 }
@@ -150,10 +151,10 @@ struct BruteSummary {
 /// 1e-9 degrees, the reported worst-shear time one where the shear is that worst, and every sample's flag.
 fn assert_scan_matches_brute_force(label: &str, rig: &Rig, clip: usize, modes: &[InheritMode]) {
     let (skeleton, clip) = (&rig.skeleton, &rig.clips[clip]);
-    let hierarchy = Hierarchy::new(skeleton, modes);
+    let hierarchy = Hierarchy::new(skeleton, modes).unwrap();
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let never = AtomicBool::new(false);
-    let evaluation = Evaluation::new(rig, Some(clip), modes);
+    let evaluation = Evaluation::new(rig, Some(clip), modes).unwrap();
     let analysis = analyze(&evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
     let expected = brute_force(skeleton, clip, &hierarchy, &options);
     for (got, want) in analysis.scan.bones.iter().zip(&expected) {
@@ -259,14 +260,14 @@ fn assert_components(got: &Components, matrix: &DMat4, label: &str) {
 fn curves_match_the_whole_pose_and_ghost_curves_the_pose_under_the_ghost_modes() {
     let rig = stress_rig(30, 150, 5);
     let (skeleton, clip) = (&rig.skeleton, &rig.clips[0]);
-    let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes());
+    let hierarchy = Hierarchy::new(skeleton, &skeleton.declared_modes()).unwrap();
     let options = ScanOptions { rate: 30.0, ..ScanOptions::default() };
     let plotted = [7, 16, 25];
     let never = AtomicBool::new(false);
     let evaluation = Evaluation::declared(&rig, Some(clip));
     for &mode in InheritMode::ALL {
-        let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]);
-        let ghost = evaluation.with_modes(ghost_hierarchy.modes());
+        let ghost_hierarchy = Hierarchy::new(skeleton, &vec![mode; skeleton.len()]).unwrap();
+        let ghost = evaluation.with_modes(ghost_hierarchy.modes()).unwrap();
         let request = CurveRequest { bones: &plotted, ghost: Some(&ghost), ..Default::default() };
         let analysis = analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap();
         let (mut pose, mut ghost_pose) = (Pose::default(), Pose::default());
@@ -322,7 +323,7 @@ fn curves_of_the_chains_alone_equal_those_of_the_whole_analysis() {
     let plotted = [7, 16, 25];
     let never = AtomicBool::new(false);
     for modes in [skeleton.declared_modes(), vec![InheritMode::SegmentCompensate; skeleton.len()]] {
-        let evaluation = Evaluation::new(&rig, Some(clip), &modes);
+        let evaluation = Evaluation::new(&rig, Some(clip), &modes).unwrap();
         let analysis = |judged| {
             let request = CurveRequest { bones: &plotted, ghost: None, judged };
             analyze(&evaluation, request, &options, &|_, _| {}, &never).unwrap()

@@ -266,7 +266,7 @@ fn demo_compared_with_its_trs_bake() {
     let folder = tempfile::tempdir().unwrap();
     let rig = bonescope::import::demo_rig();
     let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-    let source = bonescope::eval::Evaluation::new(&rig, None, &modes);
+    let source = bonescope::eval::Evaluation::new(&rig, None, &modes).unwrap();
     let (trs, tolerance) = (bonescope::bake::Strategy::Trs, bonescope::bake::DEFAULT_TOLERANCE);
     let request = bonescope::bake::Request::every_clip(&source, None, trs, tolerance);
     let baked = folder.path().join("demo_trs.glb");

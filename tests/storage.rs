@@ -54,7 +54,7 @@ fn compensating_child() -> Rig {
 
 fn report(rig: &Rig, modes: &[InheritMode], rate: f64) -> StorageReport {
     let options = StorageOptions { rate, ..StorageOptions::default() };
-    storage_report(&Evaluation::new(rig, rig.clips.first(), modes), &options)
+    storage_report(&Evaluation::new(rig, rig.clips.first(), modes).unwrap(), &options)
 }
 
 #[test]

@@ -41,7 +41,7 @@ fn times(rig: &Rig) -> Vec<f64> {
 
 /// Every bone's model matrix and every skinned vertex of `modes` at `time`.
 fn evaluated(rig: &Rig, modes: &[InheritMode], time: f64) -> (Vec<DMat4>, Vec<DVec3>) {
-    let evaluation = Evaluation::new(rig, rig.clips.first(), modes);
+    let evaluation = Evaluation::new(rig, rig.clips.first(), modes).unwrap();
     let pose = evaluation.pose_at(time);
     let vertices = evaluation.skin_all(&pose).concat();
     (pose.model.model, vertices)
@@ -121,7 +121,10 @@ fn a_file_written_in_metres_or_centimetres_gives_one_answer_under_every_mode() {
     let (cm, m) = (load(&centimetres, Space::YUpMetres), load(&metres, Space::YUpMetres));
     for &mode in InheritMode::ALL {
         let modes = vec![mode; cm.skeleton.len()];
-        let (ecm, em) = (Evaluation::new(&cm, cm.clips.first(), &modes), Evaluation::new(&m, m.clips.first(), &modes));
+        let (ecm, em) = (
+            Evaluation::new(&cm, cm.clips.first(), &modes).unwrap(),
+            Evaluation::new(&m, m.clips.first(), &modes).unwrap(),
+        );
         let size = em.size(&times(&m));
         let (scales_cm, scales_m) = (ecm.length_scales(), em.length_scales());
         for time in times(&m) {
@@ -203,8 +206,10 @@ fn joints_in_centimetres_under_a_conversion_node_move_as_the_same_joints_in_metr
     let (m, cm) = (write(false), write(true));
     assert_eq!(cm.skeleton.placement().conversion_nodes, [true, false, false, false], "the Armature only converts");
     for &mode in InheritMode::ALL {
-        let (em, ecm) =
-            (Evaluation::new(&m, m.clips.first(), &[mode; 3]), Evaluation::new(&cm, cm.clips.first(), &[mode; 4]));
+        let (em, ecm) = (
+            Evaluation::new(&m, m.clips.first(), &[mode; 3]).unwrap(),
+            Evaluation::new(&cm, cm.clips.first(), &[mode; 4]).unwrap(),
+        );
         let scales_cm = ecm.length_scales();
         for time in [0.0, 0.25, 0.5, 0.8, 1.0] {
             let (pm, pcm) = (em.pose_at(time), ecm.pose_at(time));
@@ -220,7 +225,7 @@ fn joints_in_centimetres_under_a_conversion_node_move_as_the_same_joints_in_metr
     // Under segment-compensate the spine compensates the hips' (1, 1, 2) and no unit: at 0.5 s its origin is half
     // a metre above the hips (1.5 m), whatever the file's unit.
     let modes = [InheritMode::SegmentCompensate; 4];
-    let spine = Evaluation::new(&cm, cm.clips.first(), &modes).pose_at(0.5).model.model[2].w_axis.truncate();
+    let spine = Evaluation::new(&cm, cm.clips.first(), &modes).unwrap().pose_at(0.5).model.model[2].w_axis.truncate();
     assert!(spine.abs_diff_eq(DVec3::new(0.0, 1.5, 0.0), 1e-12), "{spine}");
 }
 
@@ -240,7 +245,7 @@ fn a_centimetre_root_scaled_one_one_two_is_all_a_compensating_child_compensates(
     let conversion = DMat4::from_scale(DVec3::splat(0.01));
     let skeleton = Skeleton::new(bones).unwrap().placed(Placement { conversion, conversion_nodes: Vec::new() });
     let rig = Rig { skeleton, ..Rig::default() };
-    let evaluation = Evaluation::new(&rig, None, &[InheritMode::Full, InheritMode::SegmentCompensate]);
+    let evaluation = Evaluation::new(&rig, None, &[InheritMode::Full, InheritMode::SegmentCompensate]).unwrap();
     let model = evaluation.pose_at(0.0).model.model;
     assert!(model[1].w_axis.truncate().abs_diff_eq(DVec3::new(0.0, 0.0, 0.2), 1e-15), "{}", model[1]);
     let expected_linear = glam::DMat3::from_quat(DQuat::from_rotation_x(90f64.to_radians()))

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::compare::Compared;
+use super::compared::Compared;
 use super::identity::RigId;
 use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};

@@ -116,7 +116,7 @@ mod tests {
         let aligned = doc.setup().clone();
         doc.set_clip(Some(1)).unwrap();
         history.record(&doc);
-        assert_eq!(history.undo_label(), Some("bend"));
+        assert_eq!(history.undo_label(), Some("animation bend"));
         history.undo(&mut doc).unwrap();
         assert_eq!((doc.setup(), history.undo_label()), (&aligned, Some("forearm → blender-aligned")));
         history.undo(&mut doc).unwrap();
@@ -124,7 +124,7 @@ mod tests {
         history.undo(&mut doc).unwrap();
         assert_eq!(doc.setup(), &opened, "nothing before the first state");
         history.redo(&mut doc).unwrap();
-        assert_eq!((doc.setup(), history.redo_label()), (&aligned, Some("bend")));
+        assert_eq!((doc.setup(), history.redo_label()), (&aligned, Some("animation bend")));
         doc.set_mode(0, ModeScope::All, ModeChoice::Mode(InheritMode::Full));
         history.record(&doc);
         assert_eq!((history.undo_label(), history.redo_label()), (Some("every bone → full"), None));

@@ -6,7 +6,7 @@
 //! the viewport in the middle. Loading never replaces the document unless it succeeded; errors become
 //! notifications.
 
-mod compare;
+mod compared;
 mod document;
 mod file_browser;
 mod frame;
@@ -36,7 +36,7 @@ mod work;
 
 use std::path::{Path, PathBuf};
 
-pub use compare::Compared;
+pub use compared::Compared;
 pub use document::{Document, Ghost, ModeScope};
 pub use file_browser::NativeDialog;
 pub use identity::RigId;
@@ -46,7 +46,7 @@ pub use plots::plot_id;
 pub use session::Session;
 pub use settings::{RotationFormat, Settings, TimeUnit};
 pub use window::{Chrome, Window};
-pub use work::{Differences, Work};
+pub use work::{LargestDifferences, Work};
 
 use crate::analysis::ClipAnalysis;
 use file_browser::Purpose;
@@ -180,7 +180,7 @@ impl BonescopeApp {
     }
 
     /// Each bone's largest difference from the compared file, if computed for the current state.
-    pub fn differences(&self) -> Option<&Differences> {
+    pub fn differences(&self) -> Option<&LargestDifferences> {
         self.work.differences(&self.window.wanted(&self.session.doc, &self.settings)).map(AsRef::as_ref)
     }
 

@@ -304,11 +304,31 @@ fn legend(ui: &mut Ui, groups: &[Group]) {
 /// One plot of the stack: its curves reduced to the visible range, the stretched bands, the cursor. The wheel
 /// zooms time about the pointer (all plots together, their time axes linked); a click seeks.
 fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, place: PlotPlace) {
-    let (y_min, y_max) = group.range;
-    let (series, reduced_cache) = (&group.series, &mut group.reduced);
-    let times = &key.analysis.times;
-    let time = *shared.time;
-    let stretched = shared.stretched;
+    let (time, stretched) = (*shared.time, shared.stretched);
+    let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
+    let range = group.range;
+    let response = frame(shared, &place).show(ui, |plot_ui| {
+        let scroll = plot_ui.ctx().input(|i| i.smooth_scroll_delta.y);
+        if plot_ui.response().hovered() && scroll != 0.0 {
+            plot_ui.zoom_bounds_around_hovered(egui::Vec2::new((scroll * 0.0026).exp(), 1.0));
+            plot_ui.set_auto_bounds(egui::Vec2b::new(false, true));
+        }
+        curves(plot_ui, &key.analysis.times, group);
+        stretched_bands(plot_ui, stretched, range);
+        plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
+        plot_ui.pointer_coordinate()
+    });
+    if response.response.clicked()
+        && let Some(at) = response.inner
+    {
+        *shared.playing = false;
+        *shared.time = unit.snap(at.x, rate).clamp(0.0, shared.doc.duration());
+    }
+}
+
+/// The plot at `place`: the whole clip's time axis in the chosen unit, linked to the other plots' (the wheel zooms
+/// here, not egui_plot), reset when asked.
+fn frame<'a>(shared: &Shared, place: &PlotPlace) -> Plot<'a> {
     let mut plot = Plot::new(("components", place.index))
         .id(plot_id(place.index))
         .height(place.height)
@@ -333,59 +353,53 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
     if place.reset {
         plot = plot.reset();
     }
-    let response = plot.show(ui, |plot_ui| {
-        let scroll = plot_ui.ctx().input(|i| i.smooth_scroll_delta.y);
-        if plot_ui.response().hovered() && scroll != 0.0 {
-            plot_ui.zoom_bounds_around_hovered(egui::Vec2::new((scroll * 0.0026).exp(), 1.0));
-            plot_ui.set_auto_bounds(egui::Vec2b::new(false, true));
-        }
-        let bounds = plot_ui.plot_bounds();
-        let rect = plot_ui.response().rect;
-        let reduced_key =
-            ReducedKey { x_min: bounds.min()[0], x_max: bounds.max()[0], columns: rect.width().max(1.0) as usize };
-        if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
-            let range = reduced_key.x_min..=reduced_key.x_max;
-            let drawn = series
-                .iter()
-                .map(|s| reduce(times, |i| s.values[i], range.clone(), reduced_key.columns).into())
-                .collect();
-            *reduced_cache = Some((reduced_key, drawn));
-        }
-        let drawn = reduced_cache.as_ref().map(|(_, d)| d.as_slice()).unwrap_or_default();
-        // Half a pixel in plot units either side of an envelope keeps flat stretches visible.
-        let half_pixel = 0.5 * (bounds.max()[1] - bounds.min()[1]) / f64::from(rect.height().max(1.0));
-        for (s, drawn) in series.iter().zip(drawn) {
-            match drawn {
-                Drawn::Line(points) => {
-                    let line = Line::new(s.name.clone(), PlotPoints::Borrowed(points)).color(s.color);
-                    plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
-                }
-                Drawn::Envelope { xs, lows, highs } => {
-                    let lows: Vec<f64> = lows.iter().map(|v| v - half_pixel).collect();
-                    let highs: Vec<f64> = highs.iter().map(|v| v + half_pixel).collect();
-                    plot_ui.add(FilledArea::new(s.name.clone(), xs, &lows, &highs).fill_color(s.color));
-                }
+    plot
+}
+
+/// The group's curves over `times`, reduced to the visible range (kept until the range or the width changes): a
+/// line where the samples are few enough, else an envelope at least a pixel thick.
+fn curves<'a>(plot_ui: &mut egui_plot::PlotUi<'a>, times: &[f64], group: &'a mut Group) {
+    let bounds = plot_ui.plot_bounds();
+    let rect = plot_ui.response().rect;
+    let reduced_key =
+        ReducedKey { x_min: bounds.min()[0], x_max: bounds.max()[0], columns: rect.width().max(1.0) as usize };
+    let (series, reduced_cache) = (&group.series, &mut group.reduced);
+    if reduced_cache.as_ref().is_none_or(|(k, _)| *k != reduced_key) {
+        let range = reduced_key.x_min..=reduced_key.x_max;
+        let drawn =
+            series.iter().map(|s| reduce(times, |i| s.values[i], range.clone(), reduced_key.columns).into()).collect();
+        *reduced_cache = Some((reduced_key, drawn));
+    }
+    let drawn = reduced_cache.as_ref().map(|(_, d)| d.as_slice()).unwrap_or_default();
+    // Half a pixel in plot units either side of an envelope keeps flat stretches visible.
+    let half_pixel = 0.5 * (bounds.max()[1] - bounds.min()[1]) / f64::from(rect.height().max(1.0));
+    for (s, drawn) in series.iter().zip(drawn) {
+        match drawn {
+            Drawn::Line(points) => {
+                let line = Line::new(s.name.clone(), PlotPoints::Borrowed(points)).color(s.color);
+                plot_ui.line(if s.ghost { line.style(egui_plot::LineStyle::dashed_loose()) } else { line });
+            }
+            Drawn::Envelope { xs, lows, highs } => {
+                let lows: Vec<f64> = lows.iter().map(|v| v - half_pixel).collect();
+                let highs: Vec<f64> = highs.iter().map(|v| v + half_pixel).collect();
+                plot_ui.add(FilledArea::new(s.name.clone(), xs, &lows, &highs).fill_color(s.color));
             }
         }
-        // When the inspected bone is stretched, in the colour the viewport and outliner use for it. The bands span
-        // the curves' own range: spanning the plot's bounds would feed back into auto-bounds.
-        let pixel = (bounds.max()[0] - bounds.min()[0]) / f64::from(rect.width().max(1.0));
-        for (from, to) in merge_spans(stretched, pixel) {
-            let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
-            plot_ui.polygon(
-                egui_plot::Polygon::new("stretched", PlotPoints::from(corners))
-                    .fill_color(Badge::Stretched.color().gamma_multiply(0.12))
-                    .stroke(egui::Stroke::NONE),
-            );
-        }
-        plot_ui.vline(VLine::new("now", time).color(ui_cursor_color()));
-        plot_ui.pointer_coordinate()
-    });
-    if response.response.clicked()
-        && let Some(at) = response.inner
-    {
-        *shared.playing = false;
-        *shared.time = unit.snap(at.x, rate).clamp(0.0, shared.doc.duration());
+    }
+}
+
+/// When the inspected bone is stretched, in the colour the viewport and outliner use for it. The bands span the
+/// curves' own range `(y_min, y_max)`: spanning the plot's bounds would feed back into auto-bounds.
+fn stretched_bands(plot_ui: &mut egui_plot::PlotUi, stretched: &[(f64, f64)], (y_min, y_max): (f64, f64)) {
+    let bounds = plot_ui.plot_bounds();
+    let pixel = (bounds.max()[0] - bounds.min()[0]) / f64::from(plot_ui.response().rect.width().max(1.0));
+    for (from, to) in merge_spans(stretched, pixel) {
+        let corners = vec![[from, y_min], [to, y_min], [to, y_max], [from, y_max]];
+        plot_ui.polygon(
+            egui_plot::Polygon::new("stretched", PlotPoints::from(corners))
+                .fill_color(Badge::Stretched.color().gamma_multiply(0.12))
+                .stroke(egui::Stroke::NONE),
+        );
     }
 }
 

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::compare::Compared;
+use super::compared::Compared;
 use super::document::Document;
 use super::history::History;
 use super::notifications::Notifications;

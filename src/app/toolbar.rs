@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use egui::{Key, KeyboardShortcut, Modifiers, RichText};
 
-use super::compare::Compared;
+use super::compared::Compared;
 use super::document::{Document, Ghost, ModeScope};
 use super::pane::{Pane, Visibility};
 use super::panel::Shared;
@@ -74,10 +74,12 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut A
             skinning_picker(ui, shared);
             ui.separator();
         }
-        let mut layers = shared.settings.shows(&Pane::LAYERS, Visibility::Hidden);
-        let hint = "blend, additive, crossfade, shake, targets, interpolation, bind pose, storage";
-        if ui.toggle_value(&mut layers, Pane::LAYERS.title()).on_hover_text(hint).changed() {
-            shared.settings.show(&Pane::LAYERS, layers);
+        if let Some((pane, visibility)) = menus.panels.iter().find(|(pane, _)| *pane == Pane::LAYERS) {
+            let mut shown = shared.settings.shows(pane, *visibility);
+            let hint = "blend, additive, crossfade, shake, targets, interpolation, bind pose, storage";
+            if ui.toggle_value(&mut shown, pane.title()).on_hover_text(hint).changed() {
+                shared.settings.show(pane, shown);
+            }
         }
     });
 }

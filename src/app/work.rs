@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::compare::Compared;
+use super::compared::Compared;
 use super::document::Document;
 use super::identity::RigId;
 use super::job::{Job, Key, Progress};
@@ -59,7 +59,7 @@ pub struct CurvesRequest {
 
 /// Each document bone's largest difference from the compared file over the clip.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Differences {
+pub struct LargestDifferences {
     /// Per document bone: the largest distance of its origin and axis probes, as a fraction of the rig's size
     /// (`None` without a partner, and for conversion nodes).
     pub bones: Vec<Option<f64>>,
@@ -87,7 +87,7 @@ pub struct Results {
     /// `(done, total)` samples while the whole-clip analysis runs.
     pub progress: Option<(usize, usize)>,
     /// Each bone's largest difference from the compared file over the clip.
-    pub differences: Option<Arc<Differences>>,
+    pub differences: Option<Arc<LargestDifferences>>,
     /// The compared file's curves of the plotted bones.
     pub compared_curves: Option<Arc<ComparedCurves>>,
 }
@@ -97,7 +97,7 @@ pub struct Results {
 pub struct Work {
     analysis: Job<Key<AnalysisRequest>, ClipAnalysis>,
     curves: Job<Key<AnalysisRequest>, ClipAnalysis>,
-    differences: Job<Key<CompareRequest>, Differences>,
+    differences: Job<Key<CompareRequest>, LargestDifferences>,
     compared_curves: Job<Key<CurvesRequest>, ComparedCurves>,
     bind: Job<Key<()>, BindCheck>,
     storage: Job<Key<()>, StorageReport>,
@@ -173,7 +173,7 @@ impl Work {
     }
 
     /// Each bone's largest difference from the compared file, if computed for what `wanted` shows.
-    pub fn differences(&self, wanted: &Wanted) -> Option<&Arc<Differences>> {
+    pub fn differences(&self, wanted: &Wanted) -> Option<&Arc<LargestDifferences>> {
         self.differences.for_key(&compare_key(wanted.doc, wanted.doc.compared.as_ref()?))
     }
 
@@ -300,7 +300,7 @@ fn differences(
     key: Key<CompareRequest>,
     rig: Arc<Rig>,
     compared: Arc<Compared>,
-) -> impl FnOnce(&Progress) -> Option<Differences> + Send + 'static {
+) -> impl FnOnce(&Progress) -> Option<LargestDifferences> + Send + 'static {
     move |_| {
         let own = key.evaluation(&rig)?;
         let other = Evaluation::of(&compared.rig, &key.request.setup).ok()?;
@@ -311,7 +311,7 @@ fn differences(
         for difference in &comparison.bones {
             bones[difference.a] = Some(difference.probe.max / comparison.rig_size);
         }
-        Some(Differences { bones, rig_size: comparison.rig_size })
+        Some(LargestDifferences { bones, rig_size: comparison.rig_size })
     }
 }
 

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property};
 use super::keys::{Metrics, reduce, weights_error};
-use super::layout::{Layout, unit};
+use super::layout::{NodePlan, unit};
 use super::nodes::{NodeSample, Sampled};
 use super::times::BakeTimes;
 use crate::eval::{Evaluation, MorphPose};
@@ -27,7 +27,7 @@ pub struct ClipSamples<'a> {
 }
 
 /// The channels of `clip` for the nodes of `layout` in `document`.
-pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Animation {
+pub fn animation(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Animation {
     let per_bone: Vec<Vec<Channel>> = (0..clip.sampled.series.len())
         .into_par_iter()
         .map(|bone| bone_channels(layout, clip, metrics, document, bone))
@@ -49,7 +49,7 @@ pub fn animation(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, documen
 
 /// The channels of one bone's nodes.
 fn bone_channels(
-    layout: &Layout,
+    layout: &NodePlan,
     clip: &ClipSamples,
     metrics: &Metrics,
     document: &GltfDocument,
@@ -134,7 +134,7 @@ impl NodeValues {
 }
 
 /// The morph weights of every mesh group whose bone the clip animates them on.
-fn weight_channels(layout: &Layout, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
+fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
     let Some(source) = clip.source.clip else { return Vec::new() };
     let (times, rig) = (&clip.base.times, clip.source.rig);
     let mut channels = Vec::new();

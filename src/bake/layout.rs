@@ -12,7 +12,7 @@ use crate::math::decompose;
 use crate::model::{Mesh, Rig};
 
 /// Which glTF node each bone and helper becomes, and which meshes hang where.
-pub struct Layout {
+pub struct NodePlan {
     /// The node of each bone.
     pub bone_node: Vec<usize>,
     /// The helper node above each bone that has one.
@@ -24,7 +24,7 @@ pub struct Layout {
     pub notes: Vec<String>,
 }
 
-impl Layout {
+impl NodePlan {
     pub fn new(rig: &Rig, helpers: &[bool]) -> Self {
         // A helper node comes just before its bone's node.
         let mut bone_node = Vec::with_capacity(helpers.len());
@@ -36,7 +36,7 @@ impl Layout {
             bone_node.push(nodes);
             nodes += 1;
         }
-        let mut layout = Layout { bone_node, helper_node, groups: Vec::new(), extra: Vec::new(), notes: Vec::new() };
+        let mut layout = NodePlan { bone_node, helper_node, groups: Vec::new(), extra: Vec::new(), notes: Vec::new() };
         layout.place_meshes(rig);
         layout
     }
@@ -111,7 +111,7 @@ impl Layout {
 /// Where the source's space is converted (an FBX file in centimetres, or Z-up), a top node `conversion` carrying it
 /// above the roots [`under_conversion`] names: the baked bones keep the file's own numbers, and a reader that places
 /// conversion nodes outside the rig, as bonescope does, reads the scale factors the file's author set.
-fn conversion(layout: &Layout, rig: &Rig, document: &mut GltfDocument) {
+fn conversion(layout: &NodePlan, rig: &Rig, document: &mut GltfDocument) {
     // A bone's topmost node: its helper where it has one.
     let top_node = |bone: usize| layout.helper_node[bone].unwrap_or(layout.bone_node[bone]);
     let under: Vec<usize> = (under_conversion(&rig.skeleton).iter().enumerate())

@@ -38,7 +38,7 @@ pub use times::{BakeTimes, bake_times};
 
 use channels::ClipSamples;
 use keys::Metrics;
-use layout::Layout;
+use layout::NodePlan;
 use nodes::{NodeSample, Sampled};
 use rayon::prelude::*;
 use refine::refine;
@@ -219,7 +219,7 @@ pub fn bake(request: &Request) -> Baked {
     let helpers: Vec<bool> = (0..rig.skeleton.len())
         .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|s| s.stats.stretched[bone]))
         .collect();
-    let layout = Layout::new(rig, &helpers);
+    let layout = NodePlan::new(rig, &helpers);
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();

@@ -367,7 +367,7 @@ mod tests {
     fn exact_samples_give_back_every_model_matrix() {
         let rig = demo_rig();
         let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=20).map(|k| f64::from(k) * side.duration() / 20.0).collect();
         let mut sampled = sample(&side, &times, Strategy::Exact);
         let helper = sampled.stats.stretched.clone();

@@ -155,7 +155,7 @@ mod tests {
     fn only_the_bones_that_miss_are_halved_further() {
         let rig = demo_rig();
         let modes = vec![InheritMode::Full; rig.skeleton.len()];
-        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) * 0.25).collect();
         let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
         let missing = 2;
@@ -179,7 +179,7 @@ mod tests {
         // (the next halves, 1/3072 s, would be closer than that), so 63 midpoints an interval.
         let rig = demo_rig();
         let modes = vec![InheritMode::Full; rig.skeleton.len()];
-        let side = Evaluation::new(&rig, rig.clips.first(), &modes);
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) / 24.0).collect();
         let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
         let refined = refine(&side, Strategy::Exact, &[false; 5], base, &|bone, _, _, _: &_| bone == 2);

@@ -9,7 +9,7 @@ use clap::Args;
 use super::options::{Distance, choice, parse_distance};
 use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
-use super::{EvalArgs, Format};
+use super::{EvalArgs, OutputFormat};
 use crate::bake::{self, BakeReport, ClipToBake, Engine, Request, Strategy};
 use crate::eval::Setup;
 use crate::import;
@@ -40,7 +40,7 @@ pub struct BakeArgs {
     #[arg(long, value_name = "D", value_parser = parse_distance, alias = "max-error")]
     pub fail_above: Option<Distance>,
     #[arg(long, value_enum, default_value_t)]
-    pub format: Format,
+    pub format: OutputFormat,
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
@@ -73,8 +73,8 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     let report = bake::report(&request, &baked, &baked_rig);
     bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        Format::Table => print!("{}", render_table(args, &setup, &report, baked.glb.len())),
+        OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        OutputFormat::Table => print!("{}", render_table(args, &setup, &report, baked.glb.len())),
     }
     let worst = report.worst();
     let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));

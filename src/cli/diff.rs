@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Args;
 
-use super::Format;
+use super::OutputFormat;
 use super::options::{Distance, choice, clip_index, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
 use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
@@ -53,7 +53,7 @@ pub struct DiffArgs {
     #[arg(long, value_name = "HZ", default_value_t = crate::diff::DEFAULT_RATE, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
-    pub format: Format,
+    pub format: OutputFormat,
     /// Exit with status 1 when a bone's origin or axis probe, or a vertex, differs by more than this: a distance in
     /// the first file's unit, or a percentage (`0.01%`) of the larger rig's size.
     #[arg(long, value_name = "DIST", value_parser = parse_distance)]
@@ -71,8 +71,8 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
     let diff = diff_files(&a, &b, clips, &args.map, args.rate)?;
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
-        Format::Table => print!("{}", render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()])),
+        OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
+        OutputFormat::Table => print!("{}", render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()])),
     }
     let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })

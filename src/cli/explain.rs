@@ -9,7 +9,7 @@ use super::layers::bone_index;
 use super::options::parse_rate;
 use super::setup::evaluation;
 use super::table::{Table, shown};
-use super::{EvalArgs, Format, ToleranceArgs};
+use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
 use crate::eval::Layers;
@@ -33,7 +33,7 @@ pub struct ExplainArgs {
     #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
-    pub format: Format,
+    pub format: OutputFormat,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
 }
@@ -75,8 +75,8 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
         bones: &explained,
     };
     match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        Format::Table => print!("{}", render_table(&report, &rig, evaluation.modes())),
+        OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        OutputFormat::Table => print!("{}", render_table(&report, &rig, evaluation.modes())),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::setup::evaluation;
 use super::table::{Table, shown, vector};
-use super::{EvalArgs, Format, ToleranceArgs};
+use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};
 use crate::import;
 use crate::model::Choice;
@@ -23,7 +23,7 @@ pub struct InspectArgs {
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub time: Vec<f64>,
     #[arg(long, value_enum, default_value_t)]
-    pub format: Format,
+    pub format: OutputFormat,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
 }
@@ -49,14 +49,14 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     let summary = setup.layers.summary(&rig, evaluation.clip);
     let report = LayeredInspectReport::new(shown(&args.file), &evaluation, setup.modes.label().to_owned(), samples);
     match args.format {
-        Format::Json => {
+        OutputFormat::Json => {
             // Written as it is serialised: a rig of a million bones prints gigabytes, never held in memory at once.
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             serde_json::to_writer_pretty(&mut out, &report)?;
             writeln!(out)?;
             out.flush()?;
         }
-        Format::Table => print!("{}", render_table(&report, &summary)),
+        OutputFormat::Table => print!("{}", render_table(&report, &summary)),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -26,7 +26,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use layers::{LayerArgs, TargetArg};
-pub use options::{Format, ToleranceArgs};
+pub use options::{OutputFormat, ToleranceArgs};
 pub use setup::EvalArgs;
 
 /// See what a skeletal animation really does to every bone: polar decomposition (T·F·R·U·K·Uᵀ) of every bone's

@@ -8,7 +8,7 @@ use crate::analysis::Tolerances;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum Format {
+pub enum OutputFormat {
     /// Aligned columns for people; flagged bones marked.
     #[default]
     Table,

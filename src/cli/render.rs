@@ -13,7 +13,7 @@ use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Pane, Settings
 use crate::eval::SkinningMethod;
 use crate::import;
 use crate::model::Choice;
-use crate::render::{Background, Difference, Renderer, compare};
+use crate::render::{Background, Difference, Renderer, pixel_difference};
 use crate::view::{SceneOptions, ViewKind};
 
 #[derive(Debug, Args)]
@@ -274,7 +274,7 @@ fn check(args: &RenderArgs, shot: &Shot, image: &image::RgbaImage, reference: &P
     let expected = image::open(reference)
         .with_context(|| format!("cannot read the reference picture {}", reference.display()))?
         .to_rgba8();
-    let difference = compare(&expected, image);
+    let difference = pixel_difference(&expected, image);
     let within = difference.percent() <= args.threshold;
     println!("{}", summary(reference, &difference, args.threshold, within));
     if !within && let Some(diff) = &difference.image {

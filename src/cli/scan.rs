@@ -211,7 +211,7 @@ fn report_files<T: serde::Serialize + Send>(
     let format = args.format;
     // Ctrl-C stops starting files; what is done is still written (a second handler, in tests, is refused: fine).
     let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::Relaxed));
-    let mut progress = Progress::new(paths.len(), args.progress);
+    let mut progress = StderrProgress::new(paths.len(), args.progress);
     let mut files = Vec::with_capacity(paths.len());
     let mut out = std::io::stdout().lock();
     let mut written = Ok(());
@@ -248,16 +248,16 @@ fn report_files<T: serde::Serialize + Send>(
 /// Set by Ctrl-C: no more files are started.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-/// Progress on standard error: a bar (files done of total, files per second, time left, the current file) when it
+/// StderrProgress on standard error: a bar (files done of total, files per second, time left, the current file) when it
 /// is a terminal; with `--progress` elsewhere (CI logs), a line per file; nothing otherwise.
-struct Progress {
+struct StderrProgress {
     bar: Option<indicatif::ProgressBar>,
     lines: bool,
     total: usize,
     done: usize,
 }
 
-impl Progress {
+impl StderrProgress {
     fn new(total: usize, forced: bool) -> Self {
         let terminal = std::io::stderr().is_terminal();
         let bar = terminal.then(|| {
@@ -266,7 +266,7 @@ impl Progress {
                     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
             indicatif::ProgressBar::new(total as u64).with_style(style)
         });
-        Progress { bar, lines: forced && !terminal, total, done: 0 }
+        StderrProgress { bar, lines: forced && !terminal, total, done: 0 }
     }
 
     fn file_done(&mut self, path: &Path) {

@@ -485,9 +485,10 @@ mod tests {
     fn two_modes_differ_where_the_shear_goes() {
         // The demo's forearm shears under full inheritance and not under segment scale compensate.
         let rig = demo_rig();
-        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
+        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]).unwrap();
         let compensated =
-            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()]);
+            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()])
+                .unwrap();
         let pairs = Pairs::by_name(&full, &compensated);
         let comparison = compare(&full, &compensated, &pairs, &comparison_times(&full, &compensated, 30.0));
         let root = &comparison.bones[0];
@@ -510,8 +511,8 @@ mod tests {
         let bone = |name: &str, parent, rest| Bone::joint(name, parent, rest);
         let bones = vec![bone("root", None, root), bone("mid", Some(0), mid), bone("tip", Some(1), rz(30.0))];
         let rig = Rig { skeleton: Skeleton::new(bones).unwrap(), ..Rig::default() };
-        let unscaled = Evaluation::new(&rig, None, &[InheritMode::UnscaledParent; 3]);
-        let full = Evaluation::new(&rig, None, &[InheritMode::Full; 3]);
+        let unscaled = Evaluation::new(&rig, None, &[InheritMode::UnscaledParent; 3]).unwrap();
+        let full = Evaluation::new(&rig, None, &[InheritMode::Full; 3]).unwrap();
         let result =
             compare(&unscaled, &full, &Pairs::by_name(&unscaled, &full), &comparison_times(&unscaled, &full, 60.0));
         assert_eq!(result.samples, 1);

@@ -50,7 +50,7 @@ pub(crate) fn median(matrices: impl Iterator<Item = DMat4>) -> Option<DMat4> {
 /// The rest pose's model matrices under the file's own modes.
 pub fn rest_model_matrices(rig: &Rig) -> Vec<DMat4> {
     let mut rest = ModelPose::default();
-    Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).evaluate(&rig.skeleton.rest_pose(), &mut rest);
+    Hierarchy::declared(&rig.skeleton).evaluate(&rig.skeleton.rest_pose(), &mut rest);
     rest.model
 }
 

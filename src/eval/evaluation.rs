@@ -4,6 +4,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
+use super::hierarchy::HierarchyError;
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose};
@@ -29,16 +30,21 @@ pub struct Evaluation<'a> {
 }
 
 impl<'a> Evaluation<'a> {
-    /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says.
-    pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Self {
-        let hierarchy = Hierarchy::of_rig(rig, modes);
+    /// `clip` of `rig` with one mode per bone, as sampled, skinned as the file says; refused unless the modes
+    /// are one per bone.
+    pub fn new(rig: &'a Rig, clip: Option<&'a Clip>, modes: &[InheritMode]) -> Result<Self, HierarchyError> {
+        Ok(Evaluation::under(rig, clip, Hierarchy::of_rig(rig, modes)?))
+    }
+
+    /// `clip` of `rig` under `hierarchy` (the rig's), as sampled, skinned as the file says.
+    pub(super) fn under(rig: &'a Rig, clip: Option<&'a Clip>, hierarchy: Hierarchy) -> Self {
         let skinning = SkinningMethod::AsFile;
         Evaluation { rig, clip, hierarchy, chosen: None, layers: None, skinning, unit: None, length_scale: 1.0 }
     }
 
     /// `clip` of `rig` with the modes its file declares.
     pub fn declared(rig: &'a Rig, clip: Option<&'a Clip>) -> Self {
-        Evaluation::new(rig, clip, &rig.skeleton.declared_modes())
+        Evaluation::under(rig, clip, Hierarchy::of_rig_fitting(rig, &rig.skeleton.declared_modes()))
     }
 
     /// The same through `layers` (built, and so checked, for this rig). Layers that change nothing are no layers:
@@ -73,9 +79,10 @@ impl<'a> Evaluation<'a> {
         self
     }
 
-    /// The same clip through the same layers under other modes (a ghost: "what if every bone were …").
-    pub fn with_modes(&self, modes: &[InheritMode]) -> Self {
-        Evaluation { hierarchy: Hierarchy::of_rig(self.rig, modes), chosen: None, ..self.clone() }
+    /// The same clip through the same layers under other modes, one per bone (a ghost: "what if every bone
+    /// were …").
+    pub fn with_modes(&self, modes: &[InheritMode]) -> Result<Self, HierarchyError> {
+        Ok(Evaluation { hierarchy: Hierarchy::of_rig(self.rig, modes)?, chosen: None, ..self.clone() })
     }
 
     /// The same clip, without layers, its linear rotation tracks interpolated by `rotation`: as a runtime that
@@ -345,7 +352,8 @@ mod tests {
     #[test]
     fn an_evaluator_matches_a_fresh_pose_at_every_time() {
         let rig = demo_rig();
-        let evaluation = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]);
+        let evaluation =
+            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]).unwrap();
         let mut evaluator = evaluation.evaluator();
         for &time in &evaluation.times(12.0) {
             let reused = evaluator.evaluate(time).model.model.clone();

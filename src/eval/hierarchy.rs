@@ -49,27 +49,61 @@ pub struct Hierarchy {
     placed_by: Vec<Option<usize>>,
 }
 
+/// Modes or rest transforms that are not one per bone.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{given} {what} for a skeleton of {bones} bones: one per bone")]
+pub struct HierarchyError {
+    pub what: &'static str,
+    pub given: usize,
+    pub bones: usize,
+}
+
+/// `given` things of `what` for `skeleton`, refused unless one per bone.
+fn one_per_bone(skeleton: &Skeleton, given: usize, what: &'static str) -> Result<(), HierarchyError> {
+    let bones = skeleton.len();
+    if given == bones { Ok(()) } else { Err(HierarchyError { what, given, bones }) }
+}
+
 impl Hierarchy {
-    /// `modes` holds one mode per bone; the Blender modes' bone offsets are the rest pose's.
-    pub fn new(skeleton: &Skeleton, modes: &[InheritMode]) -> Self {
+    /// `modes`, one mode per bone; the Blender modes' bone offsets are the rest pose's.
+    pub fn new(skeleton: &Skeleton, modes: &[InheritMode]) -> Result<Self, HierarchyError> {
         Hierarchy::with_bone_rest(skeleton, modes, &skeleton.rest_pose())
     }
 
-    /// The hierarchy of `rig` under `modes`: the Blender modes' bone offsets are the bind pose, which is what
-    /// Blender's bones rest in (an FBX file's nodes may hold another pose by default).
-    pub fn of_rig(rig: &Rig, modes: &[InheritMode]) -> Self {
-        if modes.iter().any(|m| m.is_blender()) {
-            Hierarchy::with_bone_rest(&rig.skeleton, modes, &super::bind_pose(rig))
-        } else {
-            Hierarchy::new(&rig.skeleton, modes)
-        }
+    /// The modes `skeleton`'s file declares; the Blender modes' bone offsets are the rest pose's.
+    pub fn declared(skeleton: &Skeleton) -> Self {
+        Hierarchy::build(skeleton, &skeleton.declared_modes(), &skeleton.rest_pose())
     }
 
-    /// `modes` holds one mode per bone, `bone_rest` the local transform each bone rests in for the Blender modes
+    /// The hierarchy of `rig` under `modes`, one per bone: the Blender modes' bone offsets are the bind pose, which
+    /// is what Blender's bones rest in (an FBX file's nodes may hold another pose by default).
+    pub fn of_rig(rig: &Rig, modes: &[InheritMode]) -> Result<Self, HierarchyError> {
+        one_per_bone(&rig.skeleton, modes.len(), "inheritance modes")?;
+        Ok(Hierarchy::of_rig_fitting(rig, modes))
+    }
+
+    /// [`Hierarchy::of_rig`] of modes known to be one per bone (resolved from the rig's own skeleton).
+    pub(super) fn of_rig_fitting(rig: &Rig, modes: &[InheritMode]) -> Self {
+        let skeleton = &rig.skeleton;
+        let blender = modes.iter().any(|m| m.is_blender());
+        let bone_rest = if blender { super::bind_pose(rig) } else { skeleton.rest_pose() };
+        Hierarchy::build(skeleton, modes, &bone_rest)
+    }
+
+    /// `modes`, one mode per bone, and `bone_rest`, the local transform each bone rests in for the Blender modes
     /// (their bone offset `O`: its translation and rotation).
-    pub fn with_bone_rest(skeleton: &Skeleton, modes: &[InheritMode], bone_rest: &[Transform]) -> Self {
-        assert_eq!(modes.len(), skeleton.len(), "one inheritance mode per bone");
-        assert_eq!(bone_rest.len(), skeleton.len(), "one rest transform per bone");
+    pub fn with_bone_rest(
+        skeleton: &Skeleton,
+        modes: &[InheritMode],
+        bone_rest: &[Transform],
+    ) -> Result<Self, HierarchyError> {
+        one_per_bone(skeleton, modes.len(), "inheritance modes")?;
+        one_per_bone(skeleton, bone_rest.len(), "rest transforms")?;
+        Ok(Hierarchy::build(skeleton, modes, bone_rest))
+    }
+
+    /// The hierarchy of `modes` and `bone_rest`, each one per bone of `skeleton`.
+    fn build(skeleton: &Skeleton, modes: &[InheritMode], bone_rest: &[Transform]) -> Self {
         let parents: Vec<Option<usize>> = skeleton.bones().iter().map(|b| b.parent).collect();
         let offsets = bone_rest
             .iter()

@@ -21,7 +21,7 @@ pub(crate) use bind::{invert, median};
 pub use chains::{BonesEvaluator, Chains};
 pub use cursor::BoneCursor;
 pub use evaluation::{Evaluation, Evaluator};
-pub use hierarchy::{Hierarchy, ModelPose};
+pub use hierarchy::{Hierarchy, HierarchyError, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use morph::MorphPose;
 pub use pose::Pose;

@@ -4,8 +4,8 @@
 //! [`Evaluation::of`] makes one an evaluation of a rig.
 
 use super::layers::LayerError;
-use super::{Evaluation, LayerStack, Layers, SkinningMethod};
-use crate::model::{Choice, Clip, Modes, Rig, Skeleton, Unit};
+use super::{Evaluation, Hierarchy, LayerStack, Layers, SkinningMethod};
+use crate::model::{Choice, Modes, Rig, Skeleton, Unit};
 
 /// Everything that decides an evaluation of a rig, the rig aside.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -54,11 +54,12 @@ impl Setup {
 
 impl Setup {
     /// What changed from `before` to this setup of `rig`, in a few words for people ("forearm → blender-aligned",
-    /// "every bone → full", "blend on"); empty where nothing did.
+    /// "every bone → full", "animation walk", "blend on"); empty where nothing did.
     pub fn change_from(&self, before: &Setup, rig: &Rig) -> String {
         let mut parts = Vec::new();
         if self.clip != before.clip {
-            parts.push(self.clip.and_then(|c| rig.clips.get(c)).map_or_else(|| "rest pose".to_owned(), Clip::label));
+            let clip = self.clip.and_then(|c| rig.clips.get(c));
+            parts.push(clip.map_or_else(|| "rest pose".to_owned(), |c| format!("animation {}", c.label())));
         }
         if self.modes != before.modes {
             parts.push(mode_change(&before.modes, &self.modes, &rig.skeleton));
@@ -126,7 +127,7 @@ impl<'a> Evaluation<'a> {
     /// often).
     pub fn prepared(rig: &'a Rig, setup: &Setup, layers: LayerStack) -> Self {
         let clip = setup.clip.and_then(|c| rig.clips.get(c));
-        Evaluation::new(rig, clip, &setup.modes.resolve(&rig.skeleton))
+        Evaluation::under(rig, clip, Hierarchy::of_rig_fitting(rig, &setup.modes.resolve(&rig.skeleton)))
             .with_layers(layers)
             .with_skinning(setup.skinning)
             .measured_in(setup.unit)
@@ -174,6 +175,7 @@ mod tests {
         assert_eq!(evaluation.setup(), setup);
         let modes = setup.modes.resolve(&rig.skeleton);
         let built = Evaluation::new(&rig, rig.clips.first(), &modes)
+            .unwrap()
             .with_layers(LayerStack::new(&rig, &setup.layers).unwrap())
             .with_skinning(SkinningMethod::DualQuaternion)
             .measured_in("cm".parse().ok());
@@ -228,7 +230,7 @@ mod tests {
         };
         assert_eq!(with(&subtree), "upper_arm's subtree → blender-aligned");
         assert_eq!(with(&|s| s.modes = Modes::all(aligned)), "every bone → blender-aligned");
-        assert_eq!(with(&|s| s.clip = Some(1)), "bend");
+        assert_eq!(with(&|s| s.clip = Some(1)), "animation bend");
         assert_eq!(with(&|s| s.layers.make_scale_uniform(upper_arm)), "upper_arm's scale made uniform");
         let blend = Blend { clip: 1, weight: 0.5, sync: false, rotation: Default::default() };
         assert_eq!(with(&|s| s.layers.blend = Some(blend)), "blend on");

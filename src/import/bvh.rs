@@ -194,11 +194,7 @@ fn read(bytes: &[u8]) -> Result<Rig> {
 
 /// `HIERARCHY` up to and including `MOTION`.
 fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
-    let mut joints: Vec<Joint> = Vec::new();
-    // Joints whose `{` has been read and whose `}` has not, innermost last.
-    let mut open: Vec<usize> = Vec::new();
-    // A joint declared on a line before its `{`.
-    let mut pending: Option<usize> = None;
+    let mut tree = Tree::default();
     let mut seen_hierarchy = false;
     for (line, text) in lines.by_ref() {
         let words = words(text);
@@ -211,92 +207,124 @@ fn read_hierarchy(lines: &mut Lines) -> Result<Vec<Joint>> {
             seen_hierarchy = true;
             continue;
         }
-        if let Some(joint) = pending
+        if let Some(joint) = tree.pending
             && keyword != "{"
         {
-            return Err(on_line(line, format!("expected `{{` after `{}`", joints[joint].name)));
+            return Err(on_line(line, format!("expected `{{` after `{}`", tree.joints[joint].name)));
         }
         match keyword.as_str() {
-            "ROOT" | "JOINT" | "END" => {
-                let (end_site, opens) = declaration(&keyword, &words, open.is_empty(), line)?;
-                let parent = open.last().copied();
-                if let Some(p) = parent
-                    && joints[p].end_site
-                {
-                    return Err(on_line(line, "an End Site cannot have children"));
-                }
-                let name = if end_site {
-                    format!("{}_end", parent.map_or("", |p| joints[p].name.as_str()))
-                } else {
-                    let last = if opens { words.len() - 1 } else { words.len() };
-                    let name = words[1..last].join(" ");
-                    if name.is_empty() { format!("joint{}", joints.len()) } else { name }
-                };
-                joints.push(Joint { name, parent, offset: None, channels: Vec::new(), end_site, line });
-                if opens {
-                    open.push(joints.len() - 1);
-                } else {
-                    pending = Some(joints.len() - 1);
-                }
-            }
-            "{" => {
-                let Some(joint) = pending.take() else {
-                    return Err(on_line(line, "`{` without a ROOT, JOINT or End Site before it"));
-                };
-                if words.len() > 1 {
-                    return Err(on_line(line, format!("unexpected `{}` after `{{`", words[1])));
-                }
-                open.push(joint);
-            }
-            "}" => {
-                let Some(joint) = open.pop() else {
-                    return Err(on_line(line, "`}` without a matching `{`"));
-                };
-                if joints[joint].offset.is_none() {
-                    return Err(on_line(line, format!("`{}` has no OFFSET", joints[joint].name)));
-                }
-                if words.len() > 1 {
-                    return Err(on_line(line, format!("unexpected `{}` after `}}`", words[1])));
-                }
-            }
-            "OFFSET" => {
-                let joint = current(&open, line, "OFFSET")?;
-                if joints[joint].offset.is_some() {
-                    return Err(on_line(line, format!("a second OFFSET for `{}`", joints[joint].name)));
-                }
-                if words.len() != 4 {
-                    return Err(on_line(line, format!("OFFSET needs 3 numbers, found {}", words.len() - 1)));
-                }
-                let mut offset = DVec3::ZERO;
-                for axis in 0..3 {
-                    offset[axis] = number(&words[axis + 1], line, "OFFSET")?;
-                }
-                joints[joint].offset = Some(offset);
-            }
-            "CHANNELS" => {
-                let joint = current(&open, line, "CHANNELS")?;
-                if joints[joint].end_site {
-                    return Err(on_line(line, "an End Site has no CHANNELS"));
-                }
-                if !joints[joint].channels.is_empty() {
-                    return Err(on_line(line, format!("a second CHANNELS for `{}`", joints[joint].name)));
-                }
-                joints[joint].channels = channels(&words, line)?;
-            }
-            "MOTION" => {
-                if let Some(&joint) = open.last() {
-                    return Err(on_line(line, format!("MOTION before the `}}` of `{}`", joints[joint].name)));
-                }
-                if joints.is_empty() {
-                    return Err(on_line(line, "MOTION before any ROOT"));
-                }
-                return Ok(joints);
-            }
+            "ROOT" | "JOINT" | "END" => tree.declare(&keyword, &words, line)?,
+            "{" => tree.open(&words, line)?,
+            "}" => tree.close(&words, line)?,
+            "OFFSET" => tree.offset(&words, line)?,
+            "CHANNELS" => tree.channels(&words, line)?,
+            "MOTION" => return tree.finished(line),
             _ => return Err(on_line(line, format!("unexpected `{}` in the hierarchy", words[0]))),
         }
     }
     let place = on_line(lines.number, "the file ends before MOTION");
     Err(if seen_hierarchy { place } else { on_line(lines.number, "empty file: expected `HIERARCHY`") })
+}
+
+/// The joints of a hierarchy as far as it is read.
+#[derive(Default)]
+struct Tree {
+    joints: Vec<Joint>,
+    /// Joints whose `{` has been read and whose `}` has not, innermost last.
+    open: Vec<usize>,
+    /// A joint declared on a line before its `{`.
+    pending: Option<usize>,
+}
+
+impl Tree {
+    /// A `ROOT name`, `JOINT name` or `End Site` line (its `{` on it, or on the next line).
+    fn declare(&mut self, keyword: &str, words: &[String], line: usize) -> Result<()> {
+        let (end_site, opens) = declaration(keyword, words, self.open.is_empty(), line)?;
+        let parent = self.open.last().copied();
+        if let Some(p) = parent
+            && self.joints[p].end_site
+        {
+            return Err(on_line(line, "an End Site cannot have children"));
+        }
+        let name = if end_site {
+            format!("{}_end", parent.map_or("", |p| self.joints[p].name.as_str()))
+        } else {
+            let last = if opens { words.len() - 1 } else { words.len() };
+            let name = words[1..last].join(" ");
+            if name.is_empty() { format!("joint{}", self.joints.len()) } else { name }
+        };
+        self.joints.push(Joint { name, parent, offset: None, channels: Vec::new(), end_site, line });
+        if opens {
+            self.open.push(self.joints.len() - 1);
+        } else {
+            self.pending = Some(self.joints.len() - 1);
+        }
+        Ok(())
+    }
+
+    /// A `{` on a line of its own.
+    fn open(&mut self, words: &[String], line: usize) -> Result<()> {
+        let Some(joint) = self.pending.take() else {
+            return Err(on_line(line, "`{` without a ROOT, JOINT or End Site before it"));
+        };
+        if words.len() > 1 {
+            return Err(on_line(line, format!("unexpected `{}` after `{{`", words[1])));
+        }
+        self.open.push(joint);
+        Ok(())
+    }
+
+    fn close(&mut self, words: &[String], line: usize) -> Result<()> {
+        let Some(joint) = self.open.pop() else {
+            return Err(on_line(line, "`}` without a matching `{`"));
+        };
+        if self.joints[joint].offset.is_none() {
+            return Err(on_line(line, format!("`{}` has no OFFSET", self.joints[joint].name)));
+        }
+        if words.len() > 1 {
+            return Err(on_line(line, format!("unexpected `{}` after `}}`", words[1])));
+        }
+        Ok(())
+    }
+
+    fn offset(&mut self, words: &[String], line: usize) -> Result<()> {
+        let joint = current(&self.open, line, "OFFSET")?;
+        if self.joints[joint].offset.is_some() {
+            return Err(on_line(line, format!("a second OFFSET for `{}`", self.joints[joint].name)));
+        }
+        if words.len() != 4 {
+            return Err(on_line(line, format!("OFFSET needs 3 numbers, found {}", words.len() - 1)));
+        }
+        let mut offset = DVec3::ZERO;
+        for axis in 0..3 {
+            offset[axis] = number(&words[axis + 1], line, "OFFSET")?;
+        }
+        self.joints[joint].offset = Some(offset);
+        Ok(())
+    }
+
+    fn channels(&mut self, words: &[String], line: usize) -> Result<()> {
+        let joint = current(&self.open, line, "CHANNELS")?;
+        if self.joints[joint].end_site {
+            return Err(on_line(line, "an End Site has no CHANNELS"));
+        }
+        if !self.joints[joint].channels.is_empty() {
+            return Err(on_line(line, format!("a second CHANNELS for `{}`", self.joints[joint].name)));
+        }
+        self.joints[joint].channels = channels(words, line)?;
+        Ok(())
+    }
+
+    /// The joints, at `MOTION`: every one closed.
+    fn finished(self, line: usize) -> Result<Vec<Joint>> {
+        if let Some(&joint) = self.open.last() {
+            return Err(on_line(line, format!("MOTION before the `}}` of `{}`", self.joints[joint].name)));
+        }
+        if self.joints.is_empty() {
+            return Err(on_line(line, "MOTION before any ROOT"));
+        }
+        Ok(self.joints)
+    }
 }
 
 /// Checks a `ROOT name`, `JOINT name` or `End Site` line: whether it is an end site, and whether it ends in `{`.

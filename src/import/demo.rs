@@ -232,7 +232,7 @@ mod tests {
 
     fn stretched_bones(clip: usize, mode: InheritMode) -> Vec<String> {
         let rig = demo_rig();
-        let evaluation = Evaluation::new(&rig, Some(&rig.clips[clip]), &vec![mode; rig.skeleton.len()]);
+        let evaluation = Evaluation::new(&rig, Some(&rig.clips[clip]), &vec![mode; rig.skeleton.len()]).unwrap();
         let result = scan(&evaluation, &ScanOptions::default(), &|_, _| {});
         result.bones.iter().filter(|b| b.stretched()).map(|b| rig.skeleton.bone(b.index).name.clone()).collect()
     }

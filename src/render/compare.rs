@@ -30,7 +30,7 @@ impl Difference {
 const UNCHANGED_BLEND: f32 = 0.1;
 
 /// Compares `rendered` with `reference`.
-pub fn compare(reference: &RgbaImage, rendered: &RgbaImage) -> Difference {
+pub fn pixel_difference(reference: &RgbaImage, rendered: &RgbaImage) -> Difference {
     let total = u64::from(reference.width()) * u64::from(reference.height());
     if reference.dimensions() != rendered.dimensions() {
         let (w, h) = reference.dimensions();
@@ -69,7 +69,7 @@ mod tests {
     #[test]
     fn identical_pictures_do_not_differ() {
         let a = picture(8, 4, [10, 20, 30, 255]);
-        let d = compare(&a, &a.clone());
+        let d = pixel_difference(&a, &a.clone());
         assert_eq!((d.differing, d.total, d.percent()), (0, 32, 0.0));
     }
 
@@ -80,7 +80,7 @@ mod tests {
         for x in 0..10 {
             b.put_pixel(x, 5, Rgba([255, 255, 255, 255]));
         }
-        let d = compare(&a, &b);
+        let d = pixel_difference(&a, &b);
         assert_eq!(d.differing, 10);
         assert!((d.percent() - 10.0).abs() < 1e-12);
         let diff = d.image.expect("a diff image");
@@ -92,12 +92,12 @@ mod tests {
     fn a_barely_changed_colour_is_not_a_difference() {
         let a = picture(4, 4, [100, 100, 100, 255]);
         let b = picture(4, 4, [100, 100, 101, 255]);
-        assert_eq!(compare(&a, &b).differing, 0);
+        assert_eq!(pixel_difference(&a, &b).differing, 0);
     }
 
     #[test]
     fn different_sizes_differ_everywhere() {
-        let d = compare(&picture(4, 4, [0; 4]), &picture(4, 5, [0; 4]));
+        let d = pixel_difference(&picture(4, 4, [0; 4]), &picture(4, 5, [0; 4]));
         assert_eq!((d.differing, d.total), (16, 16));
         assert_eq!(d.sizes, Some(([4, 4], [4, 5])));
         assert!(d.image.is_none());

@@ -9,7 +9,7 @@ use egui_kittest::Harness;
 use egui_kittest::wgpu::WgpuTestRenderer;
 use image::RgbaImage;
 
-pub use compare::{Difference, PIXEL_THRESHOLD, compare};
+pub use compare::{Difference, PIXEL_THRESHOLD, pixel_difference};
 
 use egui::Color32;
 

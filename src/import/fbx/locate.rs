@@ -41,97 +41,144 @@ fn path(stack: &[Open], name: &str) -> String {
 const MAX_DEPTH: usize = 32;
 
 fn binary(bytes: &[u8]) -> Option<String> {
-    const HEADER: usize = 27;
-    let len = bytes.len() as u64;
+    const HEADER: u64 = 27;
     let Some(version) = int(bytes, 23, 4) else {
         return Some(format!("byte {}: the file ends inside the 27-byte header", bytes.len()));
     };
     let width = if version >= 7500 { 8 } else { 4 };
-    let record_header = 3 * width + 1;
-    let mut pos = HEADER as u64;
-    let mut stack: Vec<Open> = Vec::new();
+    let mut walk = Walk { bytes, width, pos: HEADER, stack: Vec::new() };
     loop {
-        while let Some(open) = stack.last() {
-            if pos < open.end {
+        if let Err(problem) = walk.leave_finished() {
+            return Some(problem);
+        }
+        match walk.record() {
+            Ok(true) => {}
+            Ok(false) => return None,
+            Err(problem) => return Some(problem),
+        }
+    }
+}
+
+/// A walk through a binary file's records: where it is, and the records it is inside.
+struct Walk<'b> {
+    bytes: &'b [u8],
+    /// The width of a record header's integers: 8 bytes from version 7500, else 4.
+    width: usize,
+    pos: u64,
+    stack: Vec<Open>,
+}
+
+impl Walk<'_> {
+    fn len(&self) -> u64 {
+        self.bytes.len() as u64
+    }
+
+    /// Leaves the records that end where the walk is; one that ends inside its last child, or past the file's end,
+    /// is the problem.
+    fn leave_finished(&mut self) -> Result<(), String> {
+        let len = self.len();
+        while let Some(open) = self.stack.last() {
+            if self.pos < open.end {
                 break;
             }
-            let outer = &stack[..stack.len() - 1];
+            let outer = &self.stack[..self.stack.len() - 1];
             if open.claimed_end > len {
-                let here = path(outer, &open.name);
-                return Some(format!(
-                    "byte {len}: the file ends inside node `{here}`, which claims to end at byte {}",
-                    open.claimed_end
+                let (here, claimed) = (path(outer, &open.name), open.claimed_end);
+                return Err(format!(
+                    "byte {len}: the file ends inside node `{here}`, which claims to end at byte {claimed}"
                 ));
             }
-            if pos > open.end {
-                return Some(format!(
+            if self.pos > open.end {
+                return Err(format!(
                     "byte {}: node `{}` ends inside its last child",
                     open.end,
                     path(outer, &open.name)
                 ));
             }
-            stack.pop();
+            self.stack.pop();
         }
-        let at = pos as usize;
+        Ok(())
+    }
+
+    /// Reads the record where the walk is: a null record closes a list of children (`false` at the top level: the
+    /// end of the nodes), any other is checked and entered.
+    fn record(&mut self) -> Result<bool, String> {
+        let (at, width, len) = (self.pos as usize, self.width, self.len());
         let (Some(end), Some(count), Some(list_len), Some(name_len)) = (
-            int(bytes, at, width),
-            int(bytes, at + width, width),
-            int(bytes, at + 2 * width, width),
-            int(bytes, at + 3 * width, 1),
+            int(self.bytes, at, width),
+            int(self.bytes, at + width, width),
+            int(self.bytes, at + 2 * width, width),
+            int(self.bytes, at + 3 * width, 1),
         ) else {
-            return Some(match stack.split_last() {
+            return Err(match self.stack.split_last() {
                 Some((open, outer)) => format!("byte {len}: the file ends inside node `{}`", path(outer, &open.name)),
                 None => format!("byte {len}: the file ends before the end of the top-level node list"),
             });
         };
+        let header = (3 * width + 1) as u64;
         if end == 0 && count == 0 && list_len == 0 && name_len == 0 {
-            // The null record that closes a list of children; at the top level, the end of the nodes.
-            if stack.is_empty() {
-                return None;
-            }
-            pos += record_header as u64;
-            continue;
+            self.pos += header;
+            return Ok(!self.stack.is_empty());
         }
-        let name_start = pos + record_header as u64;
-        let name = bytes
+        let name_start = self.pos + header;
+        let name = self
+            .bytes
             .get(name_start as usize..(name_start + name_len) as usize)
             .map(crate::import::text::printable_bytes)
             .unwrap_or_else(|| "(name cut off)".to_owned());
+        self.enter(Record { end, count, list_len, properties: name_start + name_len, name })?;
+        Ok(true)
+    }
+
+    /// Checks a record's extent and properties against its parent and the file, and enters its children.
+    fn enter(&mut self, record: Record) -> Result<(), String> {
+        let (pos, len, Record { end, count, list_len, properties, name }) = (self.pos, self.len(), record);
         // Only a message needs the path: built per record, it made a deep file's walk quadratic.
-        let here = || path(&stack, &name);
-        let properties = name_start + name_len;
-        if let Some(parent) = stack.last()
+        let here = || path(&self.stack, &name);
+        if let Some(parent) = self.stack.last()
             && end > parent.claimed_end
         {
             let parent_end = parent.claimed_end;
-            return Some(format!(
+            return Err(format!(
                 "byte {pos}: node `{}` ends at byte {end}, after its parent (byte {parent_end})",
                 here()
             ));
         }
         if end < properties {
-            return Some(format!("byte {pos}: node `{}` claims to end at byte {end}, inside its own header", here()));
+            return Err(format!("byte {pos}: node `{}` claims to end at byte {end}, inside its own header", here()));
         }
         // A record that claims more than the file holds is walked up to the file's end: the innermost one is the place.
         let reachable = end.min(len);
         let Some(children) = properties.checked_add(list_len).filter(|&c| c <= reachable) else {
             if end > len {
-                return Some(format!("byte {len}: the file ends inside the properties of node `{}`", here()));
+                return Err(format!("byte {len}: the file ends inside the properties of node `{}`", here()));
             }
-            return Some(format!(
+            return Err(format!(
                 "byte {pos}: node `{}` has {list_len} bytes of properties, more than fit before its end (byte {end})",
                 here()
             ));
         };
-        if let Some(problem) = check_properties(bytes, properties, children, count) {
-            return Some(format!("node `{}`: {problem}", here()));
+        if let Some(problem) = check_properties(self.bytes, properties, children, count) {
+            return Err(format!("node `{}`: {problem}", here()));
         }
-        if stack.len() == MAX_DEPTH {
-            return Some(format!("byte {pos}: node `{}` is nested deeper than FBX readers go ({MAX_DEPTH})", here()));
+        if self.stack.len() == MAX_DEPTH {
+            return Err(format!("byte {pos}: node `{}` is nested deeper than FBX readers go ({MAX_DEPTH})", here()));
         }
-        pos = children;
-        stack.push(Open { end: reachable, name, claimed_end: end });
+        self.pos = children;
+        self.stack.push(Open { end: reachable, name, claimed_end: end });
+        Ok(())
     }
+}
+
+/// A record's header, as read.
+struct Record {
+    /// Where it claims to end.
+    end: u64,
+    /// How many properties it has, in how many bytes, from where.
+    count: u64,
+    list_len: u64,
+    properties: u64,
+    name: String,
 }
 
 /// Checks that `count` properties fit between `start` and `end`, array sizes included.
