@@ -62,6 +62,29 @@ fn demo_why_forearm() {
     harness.snapshot("demo_why_forearm");
 }
 
+/// The first fix tried (the forearm's mode), then the Edit menu open: Undo says what it takes back, with its key;
+/// the ghost shows the clip as it was.
+#[test]
+fn demo_edit_menu_after_a_fix_tried() {
+    let mut harness = app(|_| {});
+    harness.get_by_label("Why?").click();
+    for _ in 0..20 {
+        finish_analysis(&mut harness);
+        if harness.query_by_label("Fixes, best first").is_some() {
+            break;
+        }
+    }
+    settle_for_snapshot(&mut harness);
+    let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
+    let mut tries = harness.get_all_by_label("Try");
+    tries.find(|t| inspector.contains(t.rect().center())).expect("a Try button").click();
+    drop(tries);
+    settle_for_snapshot(&mut harness);
+    harness.get_by_label("Edit").click();
+    harness.run_steps(4);
+    harness.snapshot("demo_edit_menu_after_a_fix_tried");
+}
+
 #[test]
 fn demo_front_view_with_ghost() {
     app(|s| s.camera.view = ViewKind::Front).snapshot("demo_front_view_with_ghost");
