@@ -2,7 +2,7 @@
 //! feeds them to that format's parser (`import::load_bytes_as`), looking for panics, hangs and runaway memory.
 //!
 //! ```sh
-//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh), minutes [, seed [, skip]]
+//! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh, usd), minutes [, seed [, skip]]
 //! ```
 //!
 //! Seeds: every file of that format under `../shared/assets`. Each input is a seed with 1–8 mutations: byte
@@ -88,7 +88,8 @@ fn parse_format(format: &str) -> Format {
         "gltf" => Format::Gltf,
         "fbx" => Format::Fbx,
         "bvh" => Format::Bvh,
-        other => panic!("unknown format `{other}` (gltf, fbx, bvh)"),
+        "usd" => Format::Usd,
+        other => panic!("unknown format `{other}` (gltf, fbx, bvh, usd)"),
     }
 }
 
@@ -97,6 +98,7 @@ fn seeds(format: &str) -> Vec<(PathBuf, Vec<u8>)> {
         Format::Gltf => &["gltf", "glb"],
         Format::Fbx => &["fbx"],
         Format::Bvh => &["bvh"],
+        Format::Usd => &["usda", "usdc", "usdz"],
     };
     let mut files = Vec::new();
     for folder in std::fs::read_dir(shared_assets::root()).expect("../shared/assets") {

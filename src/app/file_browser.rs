@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use super::notifications::Notifications;
 
 /// File extensions bonescope reads, shown in the browser.
-const EXTENSIONS: [&str; 4] = ["glb", "gltf", "fbx", "bvh"];
+const EXTENSIONS: [&str; 8] = ["glb", "gltf", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
 
 /// A native dialog that answers sooner than this without a file did not really open.
 const TOO_FAST: Duration = Duration::from_millis(300);

@@ -17,7 +17,7 @@ use crate::model::Choice;
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content); without one, the built-in demo rig.
+    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content); without one, the built-in demo rig.
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,

@@ -17,7 +17,7 @@ use crate::model::{Choice, ModeChoice, Modes, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
-    /// The first file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    /// The first file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
     pub a: PathBuf,
     /// The second file.
     pub b: PathBuf,

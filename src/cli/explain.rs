@@ -19,7 +19,7 @@ use crate::model::{InheritMode, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct ExplainArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
     pub file: PathBuf,
     /// The bone to explain, by name or index (repeatable; default: every stretched bone, the worst first).
     #[arg(long, value_name = "NAME|INDEX")]

@@ -24,7 +24,7 @@ pub enum ExportFormat {
 
 #[derive(Debug, Args)]
 pub struct ExportArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH).
+    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz).
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,

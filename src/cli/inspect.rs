@@ -15,7 +15,7 @@ use crate::model::Choice;
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH; recognised by content).
+    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,

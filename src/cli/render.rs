@@ -18,7 +18,7 @@ use crate::view::{SceneOptions, ViewKind};
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH); without one, the built-in demo rig.
+    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz); without one, the built-in demo rig.
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,

@@ -28,7 +28,7 @@ use crate::model::{Choice, ModeChoice, Rig};
 /// share.
 #[derive(Debug, Args)]
 pub struct LibraryArgs {
-    /// The animation files (glTF .gltf/.glb, FBX, BVH; recognised by content), folders (walked: every file in them
+    /// The animation files (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content), folders (walked: every file in them
     /// that is an animation), globs (`'exports/**/*.fbx'`), or `-` for a list of paths on standard input.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,

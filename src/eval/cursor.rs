@@ -53,9 +53,10 @@ impl<'a> BoneCursor<'a> {
         }
     }
 
-    /// The stretch rotation of the local transform (clips do not animate it: the rest's).
+    /// The stretch rotation of the local transform: the clip's where it sets one, else the rest's (clips do not
+    /// animate it).
     pub fn stretch(&self) -> DQuat {
-        self.rest.stretch
+        self.tracks.and_then(|t| t.stretch).unwrap_or(self.rest.stretch)
     }
 
     /// Every channel.

@@ -226,6 +226,7 @@ pub(crate) fn sample_clip_with(
         if let Some(track) = &tracks.scale {
             local.scale = sampler.vector(track, time, &mut hint[2]);
         }
+        local.stretch = tracks.stretch.unwrap_or(local.stretch);
     }
 }
 

@@ -1,6 +1,7 @@
 //! Turning files into a [`Rig`]: one module per format and one [`load`] entry that picks the format by content.
 //!
-//! Formats: glTF 2.0 (`gltf`), FBX binary and ASCII through ufbx (`fbx`), BVH (`bvh`). Every reader turns any
+//! Formats: glTF 2.0 (`gltf`), FBX binary and ASCII through ufbx (`fbx`), BVH (`bvh`), OpenUSD's UsdSkel through
+//! the `openusd` crate (`usd`). Every reader turns any
 //! problem into an [`ImportError`] naming the file and the place in it; none may panic or allocate much more than
 //! the file's size suggests, whatever the bytes (the fuzz targets in `fuzz/` and `examples/fuzz_import.rs` check).
 
@@ -12,6 +13,7 @@ mod fbx;
 mod gltf;
 mod magnitude;
 pub mod text;
+mod usd;
 
 pub use demo::{demo_rig, stress_rig};
 
@@ -113,6 +115,8 @@ pub enum Format {
     Fbx,
     /// Biovision Hierarchy motion capture.
     Bvh,
+    /// OpenUSD (UsdSkel), text (`.usda`), binary (`.usdc`) or packaged (`.usdz`).
+    Usd,
 }
 
 /// The space the model matrices of a loaded rig live in.
@@ -141,8 +145,13 @@ const FBX_ASCII_LOOKAHEAD: usize = 64 * 1024;
 /// - glTF: binary `glTF` magic, or JSON (the first non-blank byte is `{`);
 /// - FBX: the binary magic `Kaydara FBX Binary  \0`, or text that starts with `; FBX` or holds `FBXHeaderExtension`
 ///   in its first 64 KiB;
-/// - BVH: text whose first word is `HIERARCHY`.
+/// - BVH: text whose first word is `HIERARCHY`;
+/// - USD: text that starts with `#usda`, the binary magic `PXR-USDC`, or a zip archive whose first entry is a USD
+///   layer (`.usdz`).
 pub fn detect(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(b"#usda") || bytes.starts_with(b"PXR-USDC") || is_usdz(bytes) {
+        return Some(Format::Usd);
+    }
     let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let start = text.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(text.len());
     let text = &text[start..];
@@ -161,6 +170,17 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
         return Some(Format::Bvh);
     }
     None
+}
+
+/// Whether `bytes` start a zip archive whose first entry is a USD layer: a `.usdz` package.
+fn is_usdz(bytes: &[u8]) -> bool {
+    // A zip local file header: its magic, the name's length at byte 26, the name from byte 30.
+    let Some(name_len) = bytes.get(26..28).map(|n| usize::from(u16::from_le_bytes([n[0], n[1]]))) else {
+        return false;
+    };
+    let name = bytes.get(30..30 + name_len).unwrap_or_default();
+    let layer = [b".usd".as_slice(), b".usda", b".usdc"].iter().any(|ext| name.to_ascii_lowercase().ends_with(ext));
+    bytes.starts_with(b"PK\x03\x04") && layer
 }
 
 /// Reads and parses the file at `path`, whatever its format, into bonescope's space (Y-up metres).
@@ -186,6 +206,7 @@ pub fn load_with(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     match detect(&bytes) {
         Some(Format::Gltf) => return gltf::load_file(path, &file).and_then(|rig| finish(path, rig)),
         Some(Format::Fbx) => return fbx::load_file(path, file, &bytes, options).and_then(|rig| finish(path, rig)),
+        Some(Format::Usd) => return usd::load(path, options).and_then(|rig| finish(path, rig)),
         _ => {}
     }
     let size = file.metadata().map_or(0, |m| usize::try_from(m.len()).unwrap_or(0));
@@ -206,7 +227,8 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &Options) -> Result<R
         None => Err(ImportError::new(
             path,
             None,
-            "not a recognised animation file (expected glTF 2.0 .gltf/.glb, FBX binary or ASCII, or BVH)",
+            "not a recognised animation file (expected glTF 2.0 .gltf/.glb, FBX binary or ASCII, BVH, or USD \
+             .usda/.usdc/.usdz)",
         )),
     }
 }
@@ -217,6 +239,7 @@ pub fn load_bytes_as(format: Format, path: &Path, bytes: &[u8], options: &Option
         Format::Gltf => gltf::load(path, bytes),
         Format::Fbx => fbx::load(path, bytes, options),
         Format::Bvh => bvh::load(path, bytes),
+        Format::Usd => usd::load_bytes(path, bytes, options),
     };
     rig.and_then(|rig| finish(path, rig))
 }
@@ -238,6 +261,17 @@ mod tests {
         assert_eq!(detect(b"Kaydara FBX Binary"), None, "a truncated magic is not FBX");
         assert_eq!(detect(b""), None);
         assert_eq!(detect(b"   "), None);
+        assert_eq!(detect(b"#usda 1.0\n(\n)"), Some(Format::Usd));
+        assert_eq!(detect(b"PXR-USDC\0\0"), Some(Format::Usd));
+        let mut usdz = b"PK\x03\x04".to_vec();
+        usdz.extend([0; 22]);
+        usdz.extend(9u16.to_le_bytes());
+        usdz.extend([0; 2]);
+        usdz.extend(b"root.usdc");
+        assert_eq!(detect(&usdz), Some(Format::Usd));
+        usdz.truncate(30);
+        usdz.extend(b"root.png\0");
+        assert_eq!(detect(&usdz), None, "a zip of something else is no USD");
     }
 
     #[test]

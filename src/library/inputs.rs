@@ -194,7 +194,7 @@ fn is_glob(path: &Path) -> bool {
 }
 
 /// The extensions of the formats bonescope reads.
-const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh"];
+const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
 
 /// Whether `path` is named as an animation file.
 fn has_animation_extension(path: &Path) -> bool {
@@ -203,7 +203,7 @@ fn has_animation_extension(path: &Path) -> bool {
 }
 
 /// Whether a file not named as an animation carries a signature that cannot be mistaken, as a pipeline tells its
-/// files apart: GLB's magic, FBX's binary magic or ASCII header, BVH's `HIERARCHY`, or JSON whose top-level `asset`
+/// files apart: GLB's magic, FBX's binary magic or ASCII header, BVH's `HIERARCHY`, USD's `#usda` or `PXR-USDC`, or JSON whose top-level `asset`
 /// states a `version` (every glTF's does; a manifest's `{"asset": {"generator": …}}`, a test suite's `assets.json` or
 /// a tool's report does not). JSON larger than what is read cannot show that whole, and is left out.
 fn recognised(path: &Path) -> bool {

@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
+use glam::{DQuat, Quat, Vec3};
 
 use super::Transform;
 
@@ -251,11 +251,14 @@ pub struct BoneTracks {
     pub translation: Option<Track<Vec3>>,
     pub rotation: Option<Track<Quat>>,
     pub scale: Option<Track<Vec3>>,
+    /// The stretch rotation while the clip plays, where the clip sets it (a format whose animation gives a whole
+    /// local transform, as UsdSkel's translations, rotations and scales do: no stretch); the rest's where `None`.
+    pub stretch: Option<DQuat>,
 }
 
 impl BoneTracks {
     pub fn new(bone: usize) -> Self {
-        BoneTracks { bone, translation: None, rotation: None, scale: None }
+        BoneTracks { bone, translation: None, rotation: None, scale: None, stretch: None }
     }
 
     /// The transform the bone holds throughout when every track holds one value (`rest` where it has no track).
@@ -270,6 +273,7 @@ impl BoneTracks {
         if let Some(track) = &self.scale {
             held.scale = track.held()?.as_dvec3();
         }
+        held.stretch = self.stretch.unwrap_or(held.stretch);
         Some(held)
     }
 

@@ -64,15 +64,28 @@ pub fn load_asset(path: &str) -> Rig {
 /// The Python with Blender's module that `BONESCOPE_BLENDER_PYTHON` names (`.ci/run` installs it pinned); `None`,
 /// saying that the calling test is skipped and why, where there is none.
 pub fn blender_python() -> Option<PathBuf> {
-    let python = std::env::var_os("BONESCOPE_BLENDER_PYTHON").map(PathBuf::from);
-    let imports =
-        |python: &PathBuf| Command::new(python).args(["-c", "import bpy"]).output().is_ok_and(|o| o.status.success());
+    let hint = "a Python 3.11 with Blender's module (`pip install \"bpy==4.5.*\"` in a virtual environment; .ci/run \
+                does) to judge bonescope by Blender";
+    python_with("BONESCOPE_BLENDER_PYTHON", "bpy", hint)
+}
+
+/// The Python with Pixar's USD module that `BONESCOPE_USD_PYTHON` names (`.ci/run` installs `usd-core` pinned);
+/// `None`, saying that the calling test is skipped and why, where there is none.
+pub fn usd_python() -> Option<PathBuf> {
+    let hint = "a Python with Pixar's USD (`pip install \"usd-core==26.11\"` in a virtual environment; .ci/run does) to \
+                judge bonescope by usd-core";
+    python_with("BONESCOPE_USD_PYTHON", "pxr", hint)
+}
+
+/// The Python that the environment variable `variable` names, if it imports `module`.
+fn python_with(variable: &str, module: &str, hint: &str) -> Option<PathBuf> {
+    let python = std::env::var_os(variable).map(PathBuf::from);
+    let imports = |python: &PathBuf| {
+        Command::new(python).args(["-c", &format!("import {module}")]).output().is_ok_and(|o| o.status.success())
+    };
     let found = python.filter(imports);
     if found.is_none() {
-        eprintln!(
-            "skipped: set BONESCOPE_BLENDER_PYTHON to a Python 3.11 with Blender's module (`pip install \"bpy==4.5.*\"` \
-             in a virtual environment; .ci/run does) to judge bonescope by Blender"
-        );
+        eprintln!("skipped: set {variable} to {hint}");
     }
     found
 }

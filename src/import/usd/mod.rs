@@ -1,0 +1,154 @@
+//! OpenUSD (`.usda`, `.usdc`, `.usdz`) through the `openusd` crate, which composes the stage (sublayers, references,
+//! payloads, `defaultPrim`, inactive prims left out) as Pixar's USD does. Every UsdSkel `Skeleton` of the stage
+//! becomes bones below a node standing for the Skeleton prim (its transform in the world, its Xform ancestors'
+//! included), and the `SkelAnimation` bound to it (`skel:animationSource`, on it or an ancestor) its tracks
+//! ([`skeleton`]). A stage has one timeline, on which every skeleton plays its animation: one clip holds them all.
+//!
+//! UsdSkel has no scale-inheritance modes: every joint inherits its parent fully, so each joint declares `full`.
+//! Times: a time code `t` is at `(t − startTimeCode) / timeCodesPerSecond` seconds. Units and axes: the stage's
+//! `metersPerUnit` (0.01 where unauthored, as USD says) and `upAxis` (Y where unauthored) are converted to Y-up
+//! metres above the roots, like an FBX file's; in the file's own space nothing is converted.
+//!
+//! Every asset the stage names (sublayers, references, payloads) must lie in the root layer's folder: the resolver
+//! finds nothing outside it.
+
+mod resolver;
+mod samples;
+mod skeleton;
+
+use std::path::Path;
+
+use glam::{DMat4, DVec3};
+use openusd::usd::{PrimPredicate, Stage};
+
+use super::{ImportError, Options, Space};
+use crate::model::{Clip, Placement, Rig, Skeleton, Unit};
+use resolver::FolderResolver;
+
+/// USD's `metersPerUnit` where a stage authors none: centimetres.
+const DEFAULT_METERS_PER_UNIT: f64 = 0.01;
+
+/// Reads the USD file at `path` (any of its three encodings) into a rig.
+pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
+    let fail = |place: Option<String>, message: String| ImportError::new(path, place, message);
+    let stage = open(path).map_err(|message| fail(None, message))?;
+    let conversion = Conversion::of(&stage);
+    let mut bones = Vec::new();
+    let mut animations = Vec::new();
+    let mut notes = vec![conversion.note(options.space)];
+    for skel in skeleton_paths(&stage).map_err(|message| fail(None, message))? {
+        let read = skeleton::read(&stage, &skel, bones.len(), &conversion.timing)
+            .map_err(|message| fail(Some(skel.as_str().to_owned()), message))?;
+        bones.extend(read.bones);
+        animations.extend(read.animation);
+    }
+    let clips = clip(animations, conversion.timing.codes_per_second).into_iter().collect();
+    notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
+    let skeleton = Skeleton::new(bones).map_err(|e| fail(None, e.to_string()))?;
+    let (skeleton, unit) = match options.space {
+        Space::YUpMetres => (skeleton.placed(conversion.placement()), Some(Unit::METRE)),
+        Space::File => (skeleton, Unit::metres(conversion.meters_per_unit)),
+    };
+    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), unit, notes })
+}
+
+/// The skeletons' animations as one clip, named after the animation where there is one; `None` for none.
+fn clip(animations: Vec<skeleton::Animation>, frame_rate: f64) -> Option<Clip> {
+    let name = match animations.as_slice() {
+        [] => return None,
+        [one] => one.name.clone(),
+        _ => None,
+    };
+    let tracks = animations.into_iter().flat_map(|a| a.tracks).collect();
+    Some(Clip::new(0, name, tracks, Vec::new()).with_frame_rate(frame_rate))
+}
+
+/// Reads a USD file already in memory: written to a folder of its own first (USD reads layers by path), so any
+/// layer it names is not found.
+pub fn load_bytes(path: &Path, bytes: &[u8], options: &Options) -> Result<Rig, ImportError> {
+    let fail = |e: std::io::Error| ImportError::new(path, None, format!("cannot stage the file for reading: {e}"));
+    let folder = tempfile::tempdir().map_err(fail)?;
+    let name = path.file_name().map_or_else(|| "layer.usd".into(), |n| n.to_owned());
+    let staged = folder.path().join(name);
+    std::fs::write(&staged, bytes).map_err(fail)?;
+    load(&staged, options).map_err(|e| ImportError { path: path.to_owned(), ..e })
+}
+
+/// The composed stage of the file at `path`, its assets confined to its folder.
+fn open(path: &Path) -> Result<Stage, String> {
+    let text = path.to_str().ok_or("the path is not valid UTF-8, which USD needs")?;
+    let resolver = FolderResolver::for_file(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    Stage::builder().resolver(resolver).open(text).map_err(|e| format!("{e:#}"))
+}
+
+/// The paths of the stage's Skeleton prims, in namespace order.
+fn skeleton_paths(stage: &Stage) -> Result<Vec<openusd::sdf::Path>, String> {
+    let mut found = Vec::new();
+    let mut failed = None;
+    stage
+        .traverse(PrimPredicate::DEFAULT, |path| match stage.prim(path.clone()).type_name() {
+            Ok(Some(name)) if name.as_str() == "Skeleton" => found.push(path.clone()),
+            Ok(_) => {}
+            Err(e) => failed = failed.take().or(Some(format!("{}: {e:#}", path.as_str()))),
+        })
+        .map_err(|e| format!("{e:#}"))?;
+    failed.map_or(Ok(found), Err)
+}
+
+/// How the stage's time codes are seconds.
+#[derive(Clone, Copy, Debug)]
+pub struct Timing {
+    pub codes_per_second: f64,
+    /// The time code at 0 s.
+    pub start: f64,
+}
+
+impl Timing {
+    pub fn seconds(&self, code: f64) -> f64 {
+        (code - self.start) / self.codes_per_second
+    }
+}
+
+/// The stage's units, axes and time.
+struct Conversion {
+    meters_per_unit: f64,
+    z_up: bool,
+    timing: Timing,
+}
+
+impl Conversion {
+    fn of(stage: &Stage) -> Conversion {
+        let meta = |field: &str| stage.stage_metadata(field).ok().flatten();
+        let meters_per_unit = match meta("metersPerUnit") {
+            Some(openusd::sdf::Value::Double(m)) if m > 0.0 && m.is_finite() => m,
+            Some(openusd::sdf::Value::Float(m)) if m > 0.0 && m.is_finite() => f64::from(m),
+            _ => DEFAULT_METERS_PER_UNIT,
+        };
+        let z_up = matches!(meta("upAxis"), Some(openusd::sdf::Value::Token(axis)) if axis.as_str() == "Z");
+        let codes_per_second = Some(stage.time_codes_per_second()).filter(|r| *r > 0.0 && r.is_finite());
+        let start = if stage.has_authored_time_code_range() { stage.start_time_code() } else { 0.0 };
+        let start = if start.is_finite() { start } else { 0.0 };
+        let timing = Timing { codes_per_second: codes_per_second.unwrap_or(24.0), start };
+        Conversion { meters_per_unit, z_up, timing }
+    }
+
+    /// The conversion to Y-up metres: Z up turns a quarter about X (Z onto Y, Y onto −Z), then the unit.
+    fn placement(&self) -> Placement {
+        let axes = if self.z_up { DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2) } else { DMat4::IDENTITY };
+        let conversion = DMat4::from_scale(DVec3::splat(self.meters_per_unit)) * axes;
+        Placement { conversion, conversion_nodes: Vec::new() }
+    }
+
+    fn note(&self, space: Space) -> String {
+        let up = if self.z_up { "Z up" } else { "Y up" };
+        let unit = Unit::metres(self.meters_per_unit).map_or_else(|| "no unit".to_owned(), |u| u.to_string());
+        let timing = &self.timing;
+        let time = format!("time code t at (t − {}) / {} s", timing.start, timing.codes_per_second);
+        match space {
+            Space::YUpMetres => {
+                format!("units and axes: in the file {up}, {unit}; converted to Y-up metres above the roots; {time}")
+            }
+            Space::File => format!("units and axes: the file's own ({up}, {unit}), not converted; {time}"),
+        }
+    }
+}

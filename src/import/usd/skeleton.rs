@@ -1,0 +1,223 @@
+//! One UsdSkel `Skeleton` as bones: a node standing for the Skeleton prim (where its Xform ancestors and its own
+//! transform put it in the world) and below it the joints, parents first as `joints` lists them (`A/B` is `B`
+//! under `A`), resting in their `restTransforms`. The `SkelAnimation` bound to it becomes a clip: per joint it names
+//! (in its own order, matched to the skeleton's by path), a track of translations, rotations and scales at every time
+//! code of the three attributes and every frame between, each read as UsdSkel reads it there ([`super::samples`]);
+//! the other joints rest.
+
+use std::sync::Arc;
+
+use glam::{DMat4, DQuat, Quat, Vec3};
+use openusd::schemas::geom::{Imageable, Xformable};
+use openusd::schemas::skel::{SkelAnimation, Skeleton};
+use openusd::sdf;
+use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
+
+use super::Timing;
+use super::samples::Channel;
+use crate::import::budget;
+use crate::math::decompose;
+use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
+
+/// A skeleton's bones and the tracks of its animation.
+pub struct Read {
+    pub bones: Vec<Bone>,
+    pub animation: Option<Animation>,
+}
+
+/// A SkelAnimation's tracks of one skeleton.
+pub struct Animation {
+    /// The SkelAnimation prim's name.
+    pub name: Option<String>,
+    pub tracks: Vec<BoneTracks>,
+}
+
+/// The skeleton at `path` as bones numbered from `first` (their parents too), and the tracks of its animation.
+pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> Result<Read, String> {
+    let text = |e: anyhow::Error| format!("{e:#}");
+    let skeleton = Skeleton::get(stage, path.clone()).map_err(text)?.ok_or("not a Skeleton")?;
+    let joints = skeleton.joints().map_err(text)?;
+    let parents = skeleton.joint_parent_indices().map_err(text)?;
+    let names = skeleton.joint_short_names().map_err(text)?;
+    let rest = rest_transforms(&skeleton, &joints, &parents)?;
+    let world = world_transform(stage, path, timing.start)?;
+    let name = path.name().unwrap_or("Skeleton").to_owned();
+    let mut bones = vec![Bone { node: first, ..Bone::joint(name, None, transform(&world)) }];
+    for (j, joint) in joints.iter().enumerate() {
+        let parent = match parents[j] {
+            Some(p) if p < j => first + 1 + p,
+            Some(_) => return Err(format!("joint `{joint}` comes before its parent in `joints`")),
+            None if joint.contains('/') => return Err(format!("joint `{joint}`: its parent is not a joint")),
+            None => first,
+        };
+        let bone = Bone::joint(names[j].clone(), Some(parent), transform(&rest[j]));
+        bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role: NodeRole::Joint, ..bone });
+    }
+    let animation = animation(stage, &skeleton, &joints, first + 1, timing)?;
+    Ok(Read { bones, animation })
+}
+
+/// A row-vector USD matrix as bonescope's column-vector one: the same sixteen numbers read by columns.
+fn matrix(m: &openusd::gf::Matrix4d) -> DMat4 {
+    DMat4::from_cols_array(&m.0)
+}
+
+/// A matrix as a local transform, its shear in the stretch rotation and a mirror in the scale's sign.
+fn transform(m: &DMat4) -> Transform {
+    decompose(m).transform()
+}
+
+/// Each joint's rest transform relative to its parent: `restTransforms`, or where it is not one per joint, what
+/// the world-space `bindTransforms` make of each joint under its parent.
+fn rest_transforms(skeleton: &Skeleton, joints: &[String], parents: &[Option<usize>]) -> Result<Vec<DMat4>, String> {
+    let text = |e: anyhow::Error| format!("{e:#}");
+    let rest = skeleton.rest_transforms().map_err(text)?;
+    if rest.len() == joints.len() {
+        return Ok(rest.iter().map(matrix).collect());
+    }
+    let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(text)?.iter().map(matrix).collect();
+    if bind.len() != joints.len() {
+        return Err(format!(
+            "{} joints, {} restTransforms and {} bindTransforms: neither is one per joint",
+            joints.len(),
+            rest.len(),
+            bind.len()
+        ));
+    }
+    Ok((0..joints.len()).map(|j| parents[j].map_or(bind[j], |p| bind[p].inverse() * bind[j])).collect())
+}
+
+/// Any prim, for reading its transform stack (`xformOpOrder`).
+struct Xformed(Prim);
+
+impl SchemaBase for Xformed {
+    const KIND: SchemaKind = SchemaKind::ConcreteTyped;
+
+    fn prim(&self) -> &Prim {
+        &self.0
+    }
+}
+
+impl Imageable for Xformed {}
+impl Xformable for Xformed {}
+
+/// Where the prim at `path` is in the world at time code `time`: its ancestors' transform stacks and its own,
+/// outermost first, from the nearest one that resets the stack.
+fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Result<DMat4, String> {
+    let mut world = DMat4::IDENTITY;
+    let mut prim_path = Some(path.clone());
+    while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {
+        let xformed = Xformed(stage.prim(current.clone()));
+        let local = xformed.local_to_parent_transform(TimeCode::new(time)).map_err(|e| format!("{e:#}"))?;
+        world = matrix(&local) * world;
+        if xformed.resets_xform_stack().map_err(|e| format!("{e:#}"))? {
+            break;
+        }
+        prim_path = current.parent();
+    }
+    Ok(world)
+}
+
+/// The tracks of the skeleton's bound animation (`skel:animationSource` on it or inherited), its joints' bones
+/// numbered from `first`; `None` without one.
+fn animation(
+    stage: &Stage,
+    skeleton: &Skeleton,
+    joints: &[String],
+    first: usize,
+    timing: &Timing,
+) -> Result<Option<Animation>, String> {
+    let text = |e: anyhow::Error| format!("{e:#}");
+    let Some(source) = animation_source(stage, skeleton.path())? else {
+        return Ok(None);
+    };
+    let anim = SkelAnimation::get(stage, source.clone()).map_err(text)?.ok_or("not a SkelAnimation")?;
+    let anim_joints = anim.joints().map_err(text)?;
+    let mapped = skeleton.map_anim_joints(&anim_joints).map_err(text)?;
+    let read = |attribute: Attribute| Channel::read(stage, &attribute);
+    let channels = [read(anim.translations_attr())?, read(anim.rotations_attr())?, read(anim.scales_attr())?];
+    // Samples before the start time code shape what is read from it on, but are not played.
+    let mut codes = sample_codes(&channels, timing.start)?;
+    codes.retain(|&code| code >= timing.start);
+    if codes.is_empty() {
+        codes.push(timing.start);
+    }
+    check_budget(codes.len(), mapped.len())?;
+    let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
+    let n = mapped.len();
+    let (mut translations, mut rotations, mut scales) = (vec![Vec::new(); n], vec![Vec::new(); n], vec![Vec::new(); n]);
+    let [translated, rotated, scaled] = &channels;
+    for &code in &codes {
+        // An array of another length than the joints' is no value for them: the identity.
+        let t = translated.as_ref().and_then(|c| c.vectors(code)).filter(|v| v.len() == n);
+        let r = rotated.as_ref().and_then(|c| c.rotations(code)).filter(|v| v.len() == n);
+        let s = scaled.as_ref().and_then(|c| c.vectors(code)).filter(|v| v.len() == n);
+        for a in 0..n {
+            translations[a].push(t.as_ref().map_or(Vec3::ZERO, |t| t[a]));
+            rotations[a].push(r.as_ref().map_or(Quat::IDENTITY, |r| r[a]));
+            scales[a].push(s.as_ref().map_or(Vec3::ONE, |s| s[a]));
+        }
+    }
+    let mut tracks = Vec::new();
+    for (a, joint) in mapped.iter().enumerate() {
+        let Some(j) = joint.filter(|&j| j < joints.len()) else { continue };
+        let mut bone = BoneTracks::new(first + j);
+        bone.translation = Some(linear(&times, std::mem::take(&mut translations[a]))?);
+        bone.rotation = Some(linear(&times, std::mem::take(&mut rotations[a]))?);
+        bone.scale = Some(linear(&times, std::mem::take(&mut scales[a]))?);
+        bone.stretch = Some(DQuat::IDENTITY);
+        tracks.push(bone);
+    }
+    Ok(Some(Animation { name: source.name().map(str::to_owned), tracks }))
+}
+
+/// A track of `values` at `times`, linear between them (slerp for rotations), as UsdSkel reads them.
+fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, String> {
+    Track::new(times.clone(), values, Interpolation::Linear).map_err(|e| e.to_string())
+}
+
+/// The animation a skeleton plays: the target of the nearest `skel:animationSource` on it or an ancestor (a
+/// `SkelRoot` may bind it for every skeleton below).
+fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::Path>, String> {
+    let mut path = Some(skeleton.clone());
+    while let Some(current) = path.filter(|p| !p.is_abs_root()) {
+        let relationship = stage.prim(current.clone()).relationship("skel:animationSource");
+        if let Some(target) = relationship.targets().map_err(|e| format!("{e:#}"))?.into_iter().next() {
+            return Ok(Some(target));
+        }
+        path = current.parent();
+    }
+    Ok(None)
+}
+
+/// The time codes an animation is sampled at: every time code of its translations, rotations and scales, and every
+/// whole time code between the first and the last (USD reads between samples in the precision of the values stored,
+/// [`samples`](super::samples): sampled at each frame, the clip holds what it reads there), sorted, once each;
+/// `start` where none is sampled (the attributes' defaults hold throughout).
+fn sample_codes(channels: &[Option<Channel>], start: f64) -> Result<Vec<f64>, String> {
+    let mut codes: Vec<f64> = channels.iter().flatten().flat_map(Channel::codes).collect();
+    codes.sort_by(f64::total_cmp);
+    let (Some(&first), Some(&last)) = (codes.first(), codes.last()) else {
+        return Ok(vec![start]);
+    };
+    let frames = (last.floor() - first.ceil()).max(0.0);
+    check_budget(frames as usize + codes.len(), 1)?;
+    codes.extend((0..=frames as u64).map(|k| first.ceil() + k as f64));
+    codes.sort_by(f64::total_cmp);
+    codes.dedup();
+    Ok(codes)
+}
+
+/// Refuses an animation whose tracks would take more memory than one file may use.
+fn check_budget(codes: usize, joints: usize) -> Result<(), String> {
+    // A translation, a rotation and a scale per joint and time, and the time itself.
+    let bytes = (codes as u64).saturating_mul(joints as u64).saturating_mul(40).saturating_add(codes as u64 * 8);
+    if bytes > budget::limit() {
+        return Err(format!(
+            "an animation of {joints} joints at {codes} time codes needs {}, over the memory limit of {}",
+            budget::size(bytes),
+            budget::size(budget::limit())
+        ));
+    }
+    Ok(())
+}
