@@ -78,7 +78,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], options: &Options) -> Result<Rig, I
 fn open(path: &Path) -> Result<Stage, String> {
     let text = path.to_str().ok_or("the path is not valid UTF-8, which USD needs")?;
     let resolver = FolderResolver::for_file(path).map_err(|e| format!("cannot read the file: {e}"))?;
-    Stage::builder().resolver(resolver).open(text).map_err(|e| format!("{e:#}"))
+    Stage::builder().resolver(resolver).open(text).map_err(said)
 }
 
 /// The paths of the stage's Skeleton prims, in namespace order.
@@ -89,10 +89,15 @@ fn skeleton_paths(stage: &Stage) -> Result<Vec<openusd::sdf::Path>, String> {
         .traverse(PrimPredicate::DEFAULT, |path| match stage.prim(path.clone()).type_name() {
             Ok(Some(name)) if name.as_str() == "Skeleton" => found.push(path.clone()),
             Ok(_) => {}
-            Err(e) => failed = failed.take().or(Some(format!("{}: {e:#}", path.as_str()))),
+            Err(e) => failed = failed.take().or(Some(format!("{}: {}", path.as_str(), said(e)))),
         })
-        .map_err(|e| format!("{e:#}"))?;
+        .map_err(said)?;
     failed.map_or(Ok(found), Err)
+}
+
+/// An error of the `openusd` crate in one line, its causes after its message.
+fn said(error: impl std::fmt::Display) -> String {
+    format!("{error:#}")
 }
 
 /// How the stage's time codes are seconds.

@@ -11,6 +11,8 @@ use openusd::gf::{self, f16};
 use openusd::sdf::Value;
 use openusd::usd::{Attribute, Stage};
 
+use super::said;
+
 /// One channel's samples, by time code, in the type the file stores them in.
 pub enum Channel {
     Half3(Samples<gf::Vec3h>),
@@ -28,11 +30,10 @@ impl Channel {
     /// The attribute's time samples, else its default value (held throughout); `None` where it has neither or
     /// holds another type.
     pub fn read(stage: &Stage, attribute: &Attribute) -> Result<Option<Channel>, String> {
-        let text = |e: anyhow::Error| format!("{e:#}");
-        let mut samples = stage.time_samples(attribute.path().clone()).map_err(text)?.unwrap_or_default();
+        let mut samples = stage.time_samples(attribute.path().clone()).map_err(said)?.unwrap_or_default();
         samples.retain(|(code, _)| code.is_finite());
         if samples.is_empty() {
-            let Some(default) = attribute.get::<Value>().map_err(text)? else { return Ok(None) };
+            let Some(default) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
             samples.push((0.0, default));
         }
         samples.sort_by(|a, b| a.0.total_cmp(&b.0));

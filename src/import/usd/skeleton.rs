@@ -13,8 +13,8 @@ use openusd::schemas::skel::{SkelAnimation, Skeleton};
 use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
-use super::Timing;
 use super::samples::Channel;
+use super::{Timing, said};
 use crate::import::budget;
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
@@ -34,11 +34,10 @@ pub struct Animation {
 
 /// The skeleton at `path` as bones numbered from `first` (their parents too), and the tracks of its animation.
 pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> Result<Read, String> {
-    let text = |e: anyhow::Error| format!("{e:#}");
-    let skeleton = Skeleton::get(stage, path.clone()).map_err(text)?.ok_or("not a Skeleton")?;
-    let joints = skeleton.joints().map_err(text)?;
-    let parents = skeleton.joint_parent_indices().map_err(text)?;
-    let names = skeleton.joint_short_names().map_err(text)?;
+    let skeleton = Skeleton::get(stage, path.clone()).map_err(said)?.ok_or("not a Skeleton")?;
+    let joints = skeleton.joints().map_err(said)?;
+    let parents = skeleton.joint_parent_indices().map_err(said)?;
+    let names = skeleton.joint_short_names().map_err(said)?;
     let rest = rest_transforms(&skeleton, &joints, &parents)?;
     let world = world_transform(stage, path, timing.start)?;
     let name = path.name().unwrap_or("Skeleton").to_owned();
@@ -70,12 +69,11 @@ fn transform(m: &DMat4) -> Transform {
 /// Each joint's rest transform relative to its parent: `restTransforms`, or where it is not one per joint, what
 /// the world-space `bindTransforms` make of each joint under its parent.
 fn rest_transforms(skeleton: &Skeleton, joints: &[String], parents: &[Option<usize>]) -> Result<Vec<DMat4>, String> {
-    let text = |e: anyhow::Error| format!("{e:#}");
-    let rest = skeleton.rest_transforms().map_err(text)?;
+    let rest = skeleton.rest_transforms().map_err(said)?;
     if rest.len() == joints.len() {
         return Ok(rest.iter().map(matrix).collect());
     }
-    let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(text)?.iter().map(matrix).collect();
+    let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
     if bind.len() != joints.len() {
         return Err(format!(
             "{} joints, {} restTransforms and {} bindTransforms: neither is one per joint",
@@ -108,9 +106,9 @@ fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Result<DMat4, 
     let mut prim_path = Some(path.clone());
     while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {
         let xformed = Xformed(stage.prim(current.clone()));
-        let local = xformed.local_to_parent_transform(TimeCode::new(time)).map_err(|e| format!("{e:#}"))?;
+        let local = xformed.local_to_parent_transform(TimeCode::new(time)).map_err(said)?;
         world = matrix(&local) * world;
-        if xformed.resets_xform_stack().map_err(|e| format!("{e:#}"))? {
+        if xformed.resets_xform_stack().map_err(said)? {
             break;
         }
         prim_path = current.parent();
@@ -127,13 +125,12 @@ fn animation(
     first: usize,
     timing: &Timing,
 ) -> Result<Option<Animation>, String> {
-    let text = |e: anyhow::Error| format!("{e:#}");
     let Some(source) = animation_source(stage, skeleton.path())? else {
         return Ok(None);
     };
-    let anim = SkelAnimation::get(stage, source.clone()).map_err(text)?.ok_or("not a SkelAnimation")?;
-    let anim_joints = anim.joints().map_err(text)?;
-    let mapped = skeleton.map_anim_joints(&anim_joints).map_err(text)?;
+    let anim = SkelAnimation::get(stage, source.clone()).map_err(said)?.ok_or("not a SkelAnimation")?;
+    let anim_joints = anim.joints().map_err(said)?;
+    let mapped = skeleton.map_anim_joints(&anim_joints).map_err(said)?;
     let read = |attribute: Attribute| Channel::read(stage, &attribute);
     let channels = [read(anim.translations_attr())?, read(anim.rotations_attr())?, read(anim.scales_attr())?];
     // Samples before the start time code shape what is read from it on, but are not played.
@@ -182,7 +179,7 @@ fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::P
     let mut path = Some(skeleton.clone());
     while let Some(current) = path.filter(|p| !p.is_abs_root()) {
         let relationship = stage.prim(current.clone()).relationship("skel:animationSource");
-        if let Some(target) = relationship.targets().map_err(|e| format!("{e:#}"))?.into_iter().next() {
+        if let Some(target) = relationship.targets().map_err(said)?.into_iter().next() {
             return Ok(Some(target));
         }
         path = current.parent();
