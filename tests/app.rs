@@ -119,15 +119,20 @@ fn the_timeline_strip_and_plots_follow_the_analysis() {
     assert!((0..analysis.times.len()).any(|s| analysis.stretched_at(forearm, s)));
 }
 
+/// Shows the Layers panel, opens its Blend section and ticks "blend a second clip".
+fn blend_a_second_clip(harness: &mut Harness<'static, BonescopeApp>) {
+    harness.get_by_role_and_label(Role::Button, "Layers").click();
+    settle(harness);
+    harness.get_by_label("Blend").click();
+    settle(harness);
+    harness.get_by_label("blend a second clip").click();
+    settle(harness);
+}
+
 #[test]
 fn the_layers_panel_turns_on_a_synced_blend_and_the_timeline_follows_its_cycle() {
     let mut harness = demo_app();
-    harness.get_by_role_and_label(Role::Button, "Layers").click();
-    settle(&mut harness);
-    harness.get_by_label("Blend").click();
-    settle(&mut harness);
-    harness.get_by_label("blend a second clip").click();
-    settle(&mut harness);
+    blend_a_second_clip(&mut harness);
     let doc = &harness.state().session.doc;
     let blend = doc.layers().blend.expect("the checkbox turned the blend on");
     // The demo's second clip ("bend"), half way, synced: the cycle is (T2 − T1)·a + T1.
@@ -1090,12 +1095,7 @@ fn a_subtree_mode_change_and_a_layer_added_are_one_step_each() {
     let (forearm, hand) = (bone(&harness, "forearm"), bone(&harness, "hand"));
     assert!([forearm, hand].iter().all(|&b| harness.state().session.doc.modes()[b] == InheritMode::BlenderAligned));
     assert_eq!(harness.state().session.undo_label(), Some("forearm's subtree → blender-aligned"));
-    harness.get_by_role_and_label(Role::Button, "Layers").click();
-    settle(&mut harness);
-    harness.get_by_label("Blend").click();
-    settle(&mut harness);
-    harness.get_by_label("blend a second clip").click();
-    settle(&mut harness);
+    blend_a_second_clip(&mut harness);
     assert_eq!(harness.state().session.undo_label(), Some("blend on"));
     undo_key(&mut harness);
     assert_eq!(state_of(&harness), subtree, "the blend alone is undone");

@@ -49,6 +49,11 @@ fn demo_perspective_with_ghost() {
 /// spans, and the fixes ranked with their costs. The README shows this snapshot as the picture of the section.
 #[test]
 fn demo_why_forearm() {
+    why_forearm().snapshot("demo_why_forearm");
+}
+
+/// The demo with the forearm's Why? section open and explained.
+fn why_forearm() -> Harness<'static, BonescopeApp> {
     let mut harness = app(|_| {});
     harness.get_by_label("Why?").click();
     // The explanation starts once the section is open: wait for it before the fixed frames.
@@ -59,22 +64,14 @@ fn demo_why_forearm() {
         }
     }
     settle_for_snapshot(&mut harness);
-    harness.snapshot("demo_why_forearm");
+    harness
 }
 
 /// The first fix tried (the forearm's mode), then the Edit menu open: Undo says what it takes back, with its key;
 /// the ghost shows the clip as it was.
 #[test]
 fn demo_edit_menu_after_a_fix_tried() {
-    let mut harness = app(|_| {});
-    harness.get_by_label("Why?").click();
-    for _ in 0..20 {
-        finish_analysis(&mut harness);
-        if harness.query_by_label("Fixes, best first").is_some() {
-            break;
-        }
-    }
-    settle_for_snapshot(&mut harness);
+    let mut harness = why_forearm();
     let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
     let mut tries = harness.get_all_by_label("Try");
     tries.find(|t| inspector.contains(t.rect().center())).expect("a Try button").click();
