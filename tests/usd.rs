@@ -114,3 +114,43 @@ fn blenders_usd_export_shears_as_its_gltf_export_and_both_encodings_agree() {
         assert_eq!(text, binary, "{name}: the text and binary encodings hold the same numbers");
     }
 }
+
+/// usd-core's world points of `file`'s meshes at every time code (see `tests/usd/world_points.py`).
+fn world_points(python: &Path, file: &Path) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/world_points.py");
+    let output = Command::new(python).arg(script).arg(file).output().expect("python runs");
+    assert!(output.status.success(), "{}: {}", file.display(), String::from_utf8_lossy(&output.stderr));
+    serde_json::from_slice(&output.stdout).expect("JSON")
+}
+
+#[test]
+fn skinned_points_are_pixars_baked_ones() {
+    // Pixar's own tests bake their skinning with `UsdSkel.BakeSkinning` into `baseline/*.baked.usda`: the points
+    // bonescope skins from the unbaked file are those, in the world, at every time code.
+    let Some(python) = usd_python() else { return };
+    let folder = common::asset("usd-openusd/usdSkel/testenv/testUsdSkelBakeSkinning");
+    for name in ["lbs", "dqs"] {
+        let rig = load_with(&folder.join(format!("{name}.usda")), &Options { space: Space::File }).unwrap();
+        let baked = world_points(&python, &folder.join(format!("baseline/{name}.baked.usda")));
+        let evaluation = Evaluation::declared(&rig, rig.clips.first());
+        let size = evaluation.size(&evaluation.times(24.0));
+        let start = baked["time_codes"][0].as_f64().unwrap();
+        let mut compared = 0;
+        for (path, frames) in baked["meshes"].as_object().unwrap() {
+            let mesh = rig.meshes.iter().position(|m| path.ends_with(&format!("/{}", m.name))).expect("the mesh");
+            for (k, frame) in frames.as_array().unwrap().iter().enumerate() {
+                let code = baked["time_codes"][k].as_f64().unwrap();
+                let pose = evaluation.pose_at((code - start) / 24.0);
+                let mut ours = Vec::new();
+                evaluation.skin(&pose, mesh, &mut ours);
+                for (v, point) in frame.as_array().unwrap().iter().enumerate() {
+                    let theirs: Vec<f64> = point.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
+                    let apart = (ours[v] - glam::DVec3::from_slice(&theirs)).length();
+                    assert!(apart <= 1e-5 * size, "{name} {path} vertex {v} at code {code}: {apart} apart ({size})");
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 1000, "{name}: {compared} points compared");
+    }
+}

@@ -3,6 +3,7 @@
 //! becomes bones below a node standing for the Skeleton prim (its transform in the world, its Xform ancestors'
 //! included), and the `SkelAnimation` bound to it (`skel:animationSource`, on it or an ancestor) its tracks
 //! ([`skeleton`]). A stage has one timeline, on which every skeleton plays its animation: one clip holds them all.
+//! Meshes bound to a skeleton are skinned as UsdSkel skins them, the others hang rigid where they are ([`mesh`]).
 //!
 //! UsdSkel has no scale-inheritance modes: every joint inherits its parent fully, so each joint declares `full`.
 //! Times: a time code `t` is at `(t − startTimeCode) / timeCodesPerSecond` seconds. Units and axes: the stage's
@@ -12,6 +13,7 @@
 //! Every asset the stage names (sublayers, references, payloads) must lie in the root layer's folder: the resolver
 //! finds nothing outside it.
 
+mod mesh;
 mod resolver;
 mod samples;
 mod skeleton;
@@ -33,14 +35,24 @@ pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     let fail = |place: Option<String>, message: String| ImportError::new(path, place, message);
     let stage = open(path).map_err(|message| fail(None, message))?;
     let conversion = Conversion::of(&stage);
-    let mut bones = Vec::new();
-    let mut animations = Vec::new();
+    let (skeletons, mesh_paths) = prims(&stage).map_err(|message| fail(None, message))?;
+    let (mut bones, mut animations, mut placed) = (Vec::new(), Vec::new(), Vec::new());
     let mut notes = vec![conversion.note(options.space)];
-    for skel in skeleton_paths(&stage).map_err(|message| fail(None, message))? {
+    for skel in skeletons {
         let read = skeleton::read(&stage, &skel, bones.len(), &conversion.timing)
             .map_err(|message| fail(Some(skel.as_str().to_owned()), message))?;
         bones.extend(read.bones);
         animations.extend(read.animation);
+        placed.push(read.placed);
+    }
+    let (mut meshes, mut skins) = (Vec::new(), Vec::new());
+    for path in mesh_paths {
+        let read = mesh::read(&stage, &path, bones.len(), skins.len(), &placed, conversion.timing.start)
+            .map_err(|message| fail(Some(path.as_str().to_owned()), message))?;
+        let Some(read) = read else { continue };
+        meshes.push(read.mesh);
+        skins.extend(read.skin);
+        bones.extend(read.node);
     }
     let clips = clip(animations, conversion.timing.codes_per_second).into_iter().collect();
     notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
@@ -49,7 +61,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         Space::YUpMetres => (skeleton.placed(conversion.placement()), Some(Unit::METRE)),
         Space::File => (skeleton, Unit::metres(conversion.meters_per_unit)),
     };
-    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), unit, notes })
+    Ok(Rig { skeleton, clips, skins, meshes, unit, notes })
 }
 
 /// The skeletons' animations as one clip, named after the animation where there is one; `None` for none.
@@ -81,18 +93,19 @@ fn open(path: &Path) -> Result<Stage, String> {
     Stage::builder().resolver(resolver).open(text).map_err(said)
 }
 
-/// The paths of the stage's Skeleton prims, in namespace order.
-fn skeleton_paths(stage: &Stage) -> Result<Vec<openusd::sdf::Path>, String> {
-    let mut found = Vec::new();
+/// The paths of the stage's Skeleton and Mesh prims, each in namespace order.
+fn prims(stage: &Stage) -> Result<(Vec<openusd::sdf::Path>, Vec<openusd::sdf::Path>), String> {
+    let (mut skeletons, mut meshes) = (Vec::new(), Vec::new());
     let mut failed = None;
     stage
         .traverse(PrimPredicate::DEFAULT, |path| match stage.prim(path.clone()).type_name() {
-            Ok(Some(name)) if name.as_str() == "Skeleton" => found.push(path.clone()),
+            Ok(Some(name)) if name.as_str() == "Skeleton" => skeletons.push(path.clone()),
+            Ok(Some(name)) if name.as_str() == "Mesh" => meshes.push(path.clone()),
             Ok(_) => {}
             Err(e) => failed = failed.take().or(Some(format!("{}: {}", path.as_str(), said(e)))),
         })
         .map_err(said)?;
-    failed.map_or(Ok(found), Err)
+    failed.map_or(Ok((skeletons, meshes)), Err)
 }
 
 /// An error of the `openusd` crate in one line, its causes after its message.

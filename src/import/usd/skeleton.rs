@@ -19,10 +19,22 @@ use crate::import::budget;
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
 
-/// A skeleton's bones and the tracks of its animation.
+/// A skeleton's bones, the tracks of its animation, and where it was placed.
 pub struct Read {
     pub bones: Vec<Bone>,
     pub animation: Option<Animation>,
+    pub placed: Placed,
+}
+
+/// Where a skeleton's bones are in the rig, for the meshes bound to it.
+pub struct Placed {
+    pub path: sdf::Path,
+    /// The bone standing for the Skeleton prim; its joints follow it, in their order.
+    pub node: usize,
+    /// The joints' paths (`A/B`).
+    pub joints: Vec<String>,
+    /// Each joint's `bindTransforms` (empty where they are not one per joint).
+    pub bind: Vec<DMat4>,
 }
 
 /// A SkelAnimation's tracks of one skeleton.
@@ -53,7 +65,9 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role: NodeRole::Joint, ..bone });
     }
     let animation = animation(stage, &skeleton, &joints, first + 1, timing)?;
-    Ok(Read { bones, animation })
+    let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
+    let bind = if bind.len() == joints.len() { bind } else { Vec::new() };
+    Ok(Read { bones, animation, placed: Placed { path: path.clone(), node: first, joints, bind } })
 }
 
 /// A row-vector USD matrix as bonescope's column-vector one: the same sixteen numbers read by columns.
@@ -62,7 +76,7 @@ fn matrix(m: &openusd::gf::Matrix4d) -> DMat4 {
 }
 
 /// A matrix as a local transform, its shear in the stretch rotation and a mirror in the scale's sign.
-fn transform(m: &DMat4) -> Transform {
+pub(super) fn transform(m: &DMat4) -> Transform {
     decompose(m).transform()
 }
 
@@ -101,7 +115,7 @@ impl Xformable for Xformed {}
 
 /// Where the prim at `path` is in the world at time code `time`: its ancestors' transform stacks and its own,
 /// outermost first, from the nearest one that resets the stack.
-fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Result<DMat4, String> {
+pub(super) fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Result<DMat4, String> {
     let mut world = DMat4::IDENTITY;
     let mut prim_path = Some(path.clone());
     while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {

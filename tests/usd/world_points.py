@@ -1,0 +1,31 @@
+"""Every mesh's points in the world, at every time code of the stage, as Pixar's USD places them: for Pixar's baked
+baselines (`UsdSkel.BakeSkinning`'s output), the skinned points bonescope must reproduce. Printed as one JSON
+document: {"time_codes": [...], "meshes": {"path": [[[x, y, z], ...] per time code]}}.
+
+Usage: python world_points.py FILE
+"""
+import json
+import sys
+
+from pxr import Usd, UsdGeom
+
+
+def main(path):
+    stage = Usd.Stage.Open(path)
+    start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+    codes = [start + i for i in range(int(round(end - start)) + 1)]
+    meshes = {}
+    for prim in stage.Traverse():
+        if not prim.IsA(UsdGeom.Mesh):
+            continue
+        points = UsdGeom.Mesh(prim).GetPointsAttr()
+        frames = []
+        for code in codes:
+            world = UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(code)
+            frames.append([list(world.Transform(p)) for p in points.Get(code)])
+        meshes[str(prim.GetPath())] = frames
+    print(json.dumps({"time_codes": codes, "meshes": meshes}))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
