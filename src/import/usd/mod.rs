@@ -13,6 +13,7 @@
 //! Every asset the stage names (sublayers, references, payloads) must lie in the root layer's folder: the resolver
 //! finds nothing outside it.
 
+mod guard;
 mod mesh;
 mod resolver;
 mod samples;
@@ -30,8 +31,17 @@ use resolver::FolderResolver;
 /// USD's `metersPerUnit` where a stage authors none: centimetres.
 const DEFAULT_METERS_PER_UNIT: f64 = 0.01;
 
-/// Reads the USD file at `path` (any of its three encodings) into a rig.
+/// Reads the USD file at `path` (any of its three encodings) into a rig. A panic inside the `openusd` crate (a bug
+/// there, which a hostile file may find) is that file's error, not the end of the process.
 pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
+    let read = guard::caught(|| read(path, options));
+    read.unwrap_or_else(|bug| {
+        Err(ImportError::new(path, None, format!("the USD reader failed (a bug in openusd): {bug}")))
+    })
+}
+
+/// [`load`], unguarded.
+fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     let fail = |place: Option<String>, message: String| ImportError::new(path, place, message);
     let stage = open(path).map_err(|message| fail(None, message))?;
     let conversion = Conversion::of(&stage);
