@@ -154,3 +154,55 @@ fn skinned_points_are_pixars_baked_ones() {
         assert!(compared > 1000, "{name}: {compared} points compared");
     }
 }
+
+/// The one-line error of loading `file`, which must fail.
+fn refused(file: &Path) -> String {
+    let error = bonescope::import::load(file).expect_err("refused").to_string();
+    assert!(!error.contains('\n'), "one line: {error}");
+    error
+}
+
+#[test]
+fn a_hostile_stage_reads_nothing_outside_its_folder_and_fails_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (root, inside) = (dir.path(), dir.path().join("shots"));
+    std::fs::create_dir(&inside).unwrap();
+    let skeleton = "#usda 1.0\n(\n    defaultPrim = \"Rig\"\n)\ndef Skeleton \"Rig\"\n{\n    uniform token[] joints = [\"a\"]\n    \
+                    uniform matrix4d[] restTransforms = [( (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1) )]\n}\n";
+    // A skeleton outside the folder, referenced from inside it: not read, so not there.
+    std::fs::write(root.join("secret.usda"), skeleton).unwrap();
+    let referencing = inside.join("shot.usda");
+    std::fs::write(&referencing, "#usda 1.0\ndef \"Shot\" (\n    prepend references = @../secret.usda@\n)\n{\n}\n")
+        .unwrap();
+    match bonescope::import::load(&referencing) {
+        Ok(rig) => assert!(rig.skeleton.is_empty(), "the outside skeleton was read"),
+        Err(error) => assert!(!error.to_string().contains('\n'), "{error}"),
+    }
+    // The same skeleton beside the file is read.
+    std::fs::write(inside.join("rig.usda"), skeleton).unwrap();
+    std::fs::write(&referencing, "#usda 1.0\ndef \"Shot\" (\n    prepend references = @./rig.usda@\n)\n{\n}\n")
+        .unwrap();
+    assert_eq!(bonescope::import::load(&referencing).unwrap().skeleton.len(), 2, "the node and its joint");
+    // Sublayers that include each other end.
+    let (a, b) = (inside.join("a.usda"), inside.join("b.usda"));
+    std::fs::write(&a, "#usda 1.0\n(\n    subLayers = [@./b.usda@]\n)\n").unwrap();
+    std::fs::write(&b, "#usda 1.0\n(\n    subLayers = [@./a.usda@]\n)\n").unwrap();
+    if let Err(error) = bonescope::import::load(&a) {
+        assert!(!error.to_string().contains('\n'), "{error}");
+    }
+    // A binary layer cut in half.
+    let usdc = std::fs::read(common::asset("blender/stretchy_full.usdc")).unwrap();
+    let cut = inside.join("cut.usdc");
+    std::fs::write(&cut, &usdc[..usdc.len() / 2]).unwrap();
+    assert!(refused(&cut).contains("cut.usdc"));
+    // Samples a trillion time codes apart would be a trillion frames: refused by the memory budget.
+    let far = inside.join("far.usda");
+    let animated = skeleton.replace(
+        "\n}\n",
+        "\n    rel skel:animationSource = </Rig/Anim>\n    def SkelAnimation \"Anim\"\n    {\n        uniform token[] joints = [\"a\"]\n        \
+         float3[] translations.timeSamples = {\n            1: [(0, 0, 0)],\n            1000000000000: [(1, 0, 0)],\n        }\n    }\n}\n",
+    );
+    std::fs::write(&far, animated).unwrap();
+    let error = refused(&far);
+    assert!(error.contains("memory limit"), "{error}");
+}
