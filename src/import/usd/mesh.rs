@@ -4,8 +4,8 @@
 //! by the `elementSize` influences `primvars:skel:jointIndices`/`jointWeights` give it (one set for every point where
 //! their interpolation is `constant`), the four strongest kept and renormalised, from the space
 //! `primvars:skel:geomBindTransform` puts it in: a joint's inverse bind matrix is `bindTransforms⁻¹ · geomBind`.
-//! `primvars:skel:skinningMethod` `dualQuaternion` (on it or an ancestor) skins it with dual quaternions. An unbound mesh hangs, rigid, on a node of
-//! its own where its transform puts it.
+//! `primvars:skel:skinningMethod` `dualQuaternion` (on it or an ancestor) skins it with dual quaternions. An unbound
+//! mesh, or one without joint influences, hangs rigid on a node of its own where its transform puts it.
 
 use glam::{DMat4, Vec3};
 use openusd::schemas::geom::{Mesh as UsdMesh, PointBased};
@@ -82,8 +82,11 @@ fn skinning_method(stage: &Stage, path: &sdf::Path) -> Result<Option<SkinningMet
 }
 
 /// The skeleton a mesh's binding names (on it or inherited), among the placed ones; `None` where it names none of
-/// them.
+/// them, or the mesh has no joint influences (UsdSkel then leaves its points to its blend shapes alone).
 fn binding(api: SkelBindingAPI, skeletons: &[Placed]) -> Result<Option<(SkelBindingAPI, &Placed)>, String> {
+    if api.joint_indices().map_err(said)?.is_empty() && api.joint_weights().map_err(said)?.is_empty() {
+        return Ok(None);
+    }
     let Some(skeleton) = api.inherited_skeleton().map_err(said)? else { return Ok(None) };
     Ok(skeletons.iter().find(|p| p.path == skeleton).map(|placed| (api, placed)))
 }

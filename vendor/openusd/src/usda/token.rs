@@ -123,9 +123,10 @@ pub enum Token<'source> {
     Varying,
 
     /// Numbers (int, float, scientific notation)
-    /// Examples: "42", "3.14", "1.23e-4", "-42", "+3.14", "-.67"
-    /// Matches unsigned numbers OR signed numbers (sign may be followed by dot)
-    #[regex(r"[0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?|[+-]([0-9]+(\.[0-9]+)?|\.[0-9]+)([eE][+-]?[0-9]+)?", |lex| lex.slice())]
+    /// Examples: "42", "3.14", "1.23e-4", "-42", "+3.14", "-.67", ".01"
+    /// bonescope: a number may start with its dot whether or not it has a sign (Pixar's USD reads
+    /// `metersPerUnit = .01`, which its own UsdSkel documentation example writes).
+    #[regex(r"[+-]?([0-9]+(\.[0-9]+)?|\.[0-9]+)([eE][+-]?[0-9]+)?", |lex| lex.slice())]
     Number(&'source str),
 
     /// Path references
