@@ -16,6 +16,7 @@ use super::document::{Ghost, ModeScope};
 use super::panel::Shared;
 use super::text::{compact, drawable, name_label, text_width};
 use super::work::WhyRequest;
+use crate::analysis::ScanOptions;
 use crate::explain::{Change, Explanation, Fix, Link, Measured};
 use crate::model::{Choice, ModeChoice, Unit};
 use crate::view::Badge;
@@ -70,7 +71,8 @@ fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
         spinner(ui, "waiting for the whole-clip analysis…");
         return;
     }
-    let request = WhyRequest { bone, rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
+    let options = ScanOptions { rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
+    let request = WhyRequest { bone, options };
     match shared.work.explanation(shared.doc, request).cloned() {
         Some(explained) => explanation_ui(ui, shared, &explained),
         None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),

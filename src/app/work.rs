@@ -25,8 +25,8 @@ pub struct AnalysisRequest {
     /// What the ghost evaluates of the same rig (its curves are plotted dashed).
     pub ghost: Option<Setup>,
     pub plotted: Vec<usize>,
-    pub rate: f64,
-    pub tolerances: Tolerances,
+    /// How the clip is sampled and judged.
+    pub options: ScanOptions,
     /// Every bone (the summary), or only the plotted bones' chains (their curves).
     pub judged: Judged,
 }
@@ -36,8 +36,7 @@ pub struct AnalysisRequest {
 #[derive(Clone, Debug, PartialEq)]
 pub struct WhyRequest {
     pub bone: usize,
-    pub rate: f64,
-    pub tolerances: Tolerances,
+    pub options: ScanOptions,
 }
 
 /// What a comparison with the compared file is asked: that file (this pairing of it) as evaluated, and how often
@@ -239,14 +238,8 @@ impl Work {
 /// The rig-wide analysis the window wants: every bone judged over the clip, no curves. It does not change with the
 /// selection, so selecting a bone never waits for it.
 fn analysis_key(wanted: &Wanted) -> Key<AnalysisRequest> {
-    let rate = wanted.doc.analysis_rate();
-    let request = AnalysisRequest {
-        ghost: None,
-        plotted: Vec::new(),
-        rate,
-        tolerances: wanted.tolerances,
-        judged: Judged::Every,
-    };
+    let options = ScanOptions { rate: wanted.doc.analysis_rate(), tolerances: wanted.tolerances };
+    let request = AnalysisRequest { ghost: None, plotted: Vec::new(), options, judged: Judged::Every };
     Key::of(wanted.doc, request)
 }
 
@@ -275,10 +268,9 @@ fn analysis(
         let evaluation = key.evaluation(&rig)?;
         let request = &key.request;
         let ghost = request.ghost.as_ref().and_then(|ghost| Evaluation::of(&rig, ghost).ok());
-        let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
         let curves = CurveRequest { bones: &request.plotted, ghost: ghost.as_ref(), judged: request.judged };
         let report = |done: usize, total: usize| progress.report(done, total);
-        analyze(&evaluation, curves, &options, &report, progress.cancelled())
+        analyze(&evaluation, curves, &request.options, &report, progress.cancelled())
     }
 }
 
@@ -286,12 +278,11 @@ fn analysis(
 /// scanned.
 fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<Explanation> {
     let evaluation = key.evaluation(rig)?;
-    let request = &key.request;
-    let options = ScanOptions { rate: request.rate, tolerances: request.tolerances };
+    let (bone, options) = (key.request.bone, &key.request.options);
     let report = |done: usize, total: usize| progress.report(done, total);
-    let before = analyze(&evaluation, CurveRequest::default(), &options, &report, progress.cancelled())?.scan;
-    let question = Question { bones: Some(&[request.bone]), ..Question::default() };
-    explain(&evaluation, &before, question, &options).pop()
+    let before = analyze(&evaluation, CurveRequest::default(), options, &report, progress.cancelled())?.scan;
+    let question = Question { bones: Some(&[bone]), ..Question::default() };
+    explain(&evaluation, &before, question, options).pop()
 }
 
 /// The differences `key` asks for, as work for a [`Job`]: the document's rig (the one `key` was made of) against
