@@ -190,8 +190,11 @@ impl Document {
     /// The ghost's evaluation of this rig, when the ghost is one (a compared file's is its own:
     /// [`Compared::ghost`]).
     pub fn ghost_evaluation(&self) -> Option<Evaluation<'_>> {
-        // A ghost's setup differs from the document's in modes or layers alone, which fit the rig as they did.
-        Evaluation::of(&self.rig, &self.ghost_setup()?).ok()
+        // A ghost's setup differs from the document's in its modes (the same layers: the stack prepared for the
+        // document serves, not prepared again every frame) or has no layers at all.
+        let setup = self.ghost_setup()?;
+        let layers = if setup.layers == self.setup.layers { self.layers.clone() } else { LayerStack::default() };
+        Some(Evaluation::prepared(&self.rig, &setup, layers))
     }
 
     /// Compares this document with `compared`, drawn as the ghost.
