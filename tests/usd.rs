@@ -205,4 +205,10 @@ fn a_hostile_stage_reads_nothing_outside_its_folder_and_fails_in_one_line() {
     std::fs::write(&far, animated).unwrap();
     let error = refused(&far);
     assert!(error.contains("memory limit"), "{error}");
+    // A rest transform that is not a number, and names that hold escape codes, are said in one escaped line.
+    let nan = inside.join("nan.usda");
+    std::fs::write(&nan, skeleton.replace("( (1, 0, 0, 0)", "( (nan, 0, 0, 0)").replace("[\"a\"]", "[\"a\\x1b[2J\"]"))
+        .unwrap();
+    let error = refused(&nan);
+    assert!(error.contains("is not finite") && !error.contains('\x1b'), "{error}");
 }

@@ -51,7 +51,13 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
     let parents = skeleton.joint_parent_indices().map_err(said)?;
     let names = skeleton.joint_short_names().map_err(said)?;
     let rest = rest_transforms(&skeleton, &joints, &parents)?;
+    if let Some(j) = rest.iter().position(|m| !m.is_finite()) {
+        return Err(format!("the rest transform of joint `{}` is not finite", joints[j]));
+    }
     let world = world_transform(stage, path, timing.start)?;
+    if !world.is_finite() {
+        return Err("its transform in the world is not finite".to_owned());
+    }
     let name = path.name().unwrap_or("Skeleton").to_owned();
     let mut bones = vec![Bone { node: first, ..Bone::joint(name, None, transform(&world)) }];
     for (j, joint) in joints.iter().enumerate() {
@@ -66,7 +72,8 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
     }
     let animation = animation(stage, &skeleton, &joints, first + 1, timing)?;
     let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
-    let bind = if bind.len() == joints.len() { bind } else { Vec::new() };
+    // Bind transforms that are not one per joint, or not finite, bind no mesh (it skins from the geometry's space).
+    let bind = if bind.len() == joints.len() && bind.iter().all(DMat4::is_finite) { bind } else { Vec::new() };
     Ok(Read { bones, animation, placed: Placed { path: path.clone(), node: first, joints, bind } })
 }
 
