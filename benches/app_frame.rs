@@ -48,7 +48,7 @@ fn frame_in(c: &mut Criterion, name: &str, settings: Settings, input: egui::RawI
     app.window.time = 1234.5;
     let ctx = egui::Context::default();
     let started = Instant::now();
-    app.settle(&ctx);
+    app.settle();
     eprintln!("whole-clip analysis in the app (settle): {:.2} s", started.elapsed().as_secs_f64());
     // Two warm-up frames: fonts, layout caches, the plot's first reduction.
     for _ in 0..2 {

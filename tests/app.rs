@@ -529,8 +529,7 @@ fn the_outliner_scrolls_to_a_bone_picked_elsewhere() {
     // As a click in the viewport does.
     harness.state_mut().window.selection = vec![last];
     harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
+    harness.state_mut().settle();
     // The list scrolls smoothly: a few frames.
     harness.run_steps(12);
     // The outliner's row (the Inspector names the bone too).

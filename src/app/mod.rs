@@ -164,7 +164,7 @@ impl BonescopeApp {
     }
 
     /// Waits for the background work to finish (for tests and headless renders).
-    pub fn settle(&mut self, _ctx: &egui::Context) {
+    pub fn settle(&mut self) {
         let wanted = self.window.wanted(&self.session.doc, &self.settings);
         self.work.settle(&wanted);
     }

@@ -65,9 +65,8 @@ impl Renderer {
             .renderer(WgpuTestRenderer::from_render_state(gpu::render_state()?))
             .build_eframe(move |_cc| app);
         harness.step();
-        let ctx = harness.ctx.clone();
         if harness.state().window.chrome == Chrome::Window {
-            harness.state_mut().settle(&ctx);
+            harness.state_mut().settle();
         }
         harness.run_steps(WARM_UP_FRAMES);
         Ok(Renderer { harness, background })

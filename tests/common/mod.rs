@@ -106,8 +106,7 @@ pub fn json(output: &Output) -> Value {
 #[cfg(feature = "gui")]
 pub fn finish_analysis(harness: &mut egui_kittest::Harness<'static, bonescope::app::BonescopeApp>) {
     harness.step();
-    let ctx = harness.ctx.clone();
-    harness.state_mut().settle(&ctx);
+    harness.state_mut().settle();
 }
 
 /// [`finish_analysis`], then lets the UI catch up. (A bare `run()` while the analysis runs would keep stepping until
