@@ -1,6 +1,7 @@
 """Every mesh's points in the world, at every time code of the stage, as Pixar's USD places them: for Pixar's baked
 baselines (`UsdSkel.BakeSkinning`'s output), the skinned points bonescope must reproduce. Printed as one JSON
-document: {"time_codes": [...], "meshes": {"path": [[[x, y, z], ...] per time code]}}.
+document: {"time_codes": [...], "meshes": [{"path": "/A/Mesh", "frames": [[[x, y, z], ...] per time code]}, ...]},
+the meshes in the stage's traversal order.
 
 Usage: python world_points.py FILE
 """
@@ -14,7 +15,7 @@ def main(path):
     stage = Usd.Stage.Open(path)
     start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
     codes = [start + i for i in range(int(round(end - start)) + 1)]
-    meshes = {}
+    meshes = []
     for prim in stage.Traverse():
         if not prim.IsA(UsdGeom.Mesh):
             continue
@@ -23,7 +24,7 @@ def main(path):
         for code in codes:
             world = UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(code)
             frames.append([list(world.Transform(p)) for p in points.Get(code)])
-        meshes[str(prim.GetPath())] = frames
+        meshes.append({"path": str(prim.GetPath()), "frames": frames})
     print(json.dumps({"time_codes": codes, "meshes": meshes}))
 
 

@@ -4,28 +4,36 @@
 //! by the `elementSize` influences `primvars:skel:jointIndices`/`jointWeights` give it (one set for every point where
 //! their interpolation is `constant`), the four strongest kept and renormalised, from the space
 //! `primvars:skel:geomBindTransform` puts it in: a joint's inverse bind matrix is `bindTransforms⁻¹ · geomBind`.
-//! `primvars:skel:skinningMethod` `dualQuaternion` (on it or an ancestor) skins it with dual quaternions. An unbound
-//! mesh, or one without joint influences, hangs rigid on a node of its own where its transform puts it.
+//! `primvars:skel:skinningMethod` `dualQuaternion` (on it or an ancestor) skins it with dual quaternions. Its blend
+//! shapes deform it first ([`blend`]). An unbound mesh, or one without joint influences, hangs rigid on a node of its
+//! own where its transform puts it.
 
 use glam::{DMat4, Vec3};
 use openusd::schemas::geom::{Mesh as UsdMesh, PointBased};
 use openusd::schemas::skel::{InfluenceInterpolation, SkelBindingAPI, SkinningMethod};
 use openusd::sdf::{self, Value};
-use openusd::usd::Stage;
+use openusd::usd::{Attribute, Stage, TimeCode};
 
+use super::blend;
 use super::said;
 use super::skeleton::{Placed, transform, world_transform};
-use crate::model::{Bone, Mesh, NodeRole, Skin};
+use crate::model::{Bone, Mesh, MorphWeights, NodeRole, Skin};
 
-/// A mesh read: itself, the skin it is bound with, and the node it hangs on where it is not skinned.
+/// A mesh read: itself, the skin it is bound with, the node it hangs on where it needs one, and its animated
+/// blend-shape weights.
 pub struct Read {
     pub mesh: Mesh,
     pub skin: Option<Skin>,
     pub node: Option<Bone>,
+    pub morph: Option<MorphWeights>,
 }
 
-/// The mesh at `path`; `bones` the rig's bones so far (an unbound mesh's node comes next), `skin_index` the index
-/// its skin will have; `skeletons` where each skeleton of the stage was placed. `None` for a mesh without points.
+/// The mesh at `path`; `bones` the rig's bones so far (its node, where it needs one, comes next), `skin_index` the
+/// index its skin will have; `skeletons` where each skeleton of the stage was placed. `None` for a mesh without
+/// points.
+///
+/// A skinned mesh hangs on its skeleton's node (skinning places it); one with blend shapes, whose weights are a
+/// node's, or one not skinned hangs on a node of its own, where its transform puts it.
 pub fn read(
     stage: &Stage,
     path: &sdf::Path,
@@ -35,36 +43,68 @@ pub fn read(
     start: f64,
 ) -> Result<Option<Read>, String> {
     let mesh = UsdMesh::get(stage, path.clone()).map_err(said)?.ok_or("not a Mesh")?;
-    let positions = points(mesh.points_attr().get::<Value>().map_err(said)?);
+    let at_start = |attribute: Attribute| attribute.get_at::<Value>(TimeCode::new(start)).map_err(said);
+    let positions = points(at_start(mesh.points_attr())?);
     if positions.is_empty() {
         return Ok(None);
     }
-    let counts = int_array(mesh.face_vertex_counts_attr().get::<Value>().map_err(said)?);
-    let indices = int_array(mesh.face_vertex_indices_attr().get::<Value>().map_err(said)?);
+    let counts = int_array(at_start(mesh.face_vertex_counts_attr())?);
+    let indices = int_array(at_start(mesh.face_vertex_indices_attr())?);
     let name = path.name().unwrap_or("Mesh").to_owned();
     let triangles = fans(&counts, &indices, positions.len());
     let mut read = Mesh { name: name.clone(), positions, indices: triangles, ..Mesh::default() };
-    let bound = SkelBindingAPI::get(stage, path.clone()).map_err(said)?;
-    let Some((api, placed)) = bound.map(|api| binding(api, skeletons)).transpose()?.flatten() else {
-        let world = world_transform(stage, path, start)?;
-        let node = Bone { node: bones, role: NodeRole::Mesh, ..Bone::joint(name, None, transform(&world)) };
-        return Ok(Some(Read { mesh: Mesh { bone: bones, ..read }, skin: None, node: Some(node) }));
+    let api = SkelBindingAPI::get(stage, path.clone()).map_err(said)?;
+    let bound = api.map(|api| binding(api, skeletons)).transpose()?.flatten();
+    let shapes = match &bound {
+        Some((api, placed)) => blend::read(stage, api, read.positions.len(), placed.weights.as_ref())?,
+        None => None,
     };
-    let joints = mesh_joints(&api, placed)?;
-    (read.joints, read.weights) = influences(&api, read.positions.len(), joints.len())?.into_iter().unzip();
+    let skin = match &bound {
+        Some((api, placed)) if has_influences(api)? => Some(skin(stage, path, api, placed, &mut read)?),
+        _ => None,
+    };
+    let own_node = skin.is_none() || shapes.is_some();
+    let bone = match &bound {
+        Some((_, placed)) if !own_node => placed.node,
+        _ => bones,
+    };
+    let node = own_node
+        .then(|| -> Result<Bone, String> {
+            let world = world_transform(stage, path, start)?;
+            Ok(Bone { node: bones, role: NodeRole::Mesh, ..Bone::joint(name, None, transform(&world)) })
+        })
+        .transpose()?;
+    let mut morph = None;
+    if let Some(shapes) = shapes {
+        read.morph_weights = vec![0.0; shapes.targets.len()];
+        read.morph_targets = shapes.targets;
+        morph = (!shapes.weights.is_empty()).then_some(MorphWeights { bone, weights: shapes.weights });
+    }
+    let mesh = Mesh { bone, skin: skin.is_some().then_some(skin_index), ..read };
+    Ok(Some(Read { mesh, skin, node, morph }))
+}
+
+/// The skin of a mesh bound to `placed` with joint influences, its joints and weights set on `read`.
+fn skin(
+    stage: &Stage,
+    path: &sdf::Path,
+    api: &SkelBindingAPI,
+    placed: &Placed,
+    read: &mut Mesh,
+) -> Result<Skin, String> {
+    let joints = mesh_joints(api, placed)?;
+    (read.joints, read.weights) = influences(api, read.positions.len(), joints.len())?.into_iter().unzip();
     if skinning_method(stage, path)? == Some(SkinningMethod::DualQuaternion) {
         read.dq_weights = vec![1.0; read.positions.len()];
     }
     let geom_bind = api.geom_bind_transform().map_err(said)?.map_or(DMat4::IDENTITY, |m| DMat4::from_cols_array(&m.0));
     let inverse_bind = joints.iter().map(|&j| placed.bind.get(j).map_or(geom_bind, |b| b.inverse() * geom_bind));
-    let skin = Skin {
-        name: Some(name),
+    Ok(Skin {
+        name: Some(read.name.clone()),
         joints: joints.iter().map(|&j| placed.node + 1 + j).collect(),
         inverse_bind: inverse_bind.collect(),
         node_bind: None,
-    };
-    let mesh = Mesh { bone: placed.node, skin: Some(skin_index), ..read };
-    Ok(Some(Read { mesh, skin: Some(skin), node: None }))
+    })
 }
 
 /// The nearest `primvars:skel:skinningMethod` on the prim at `path` or an ancestor (a constant primvar, inherited
@@ -82,13 +122,15 @@ fn skinning_method(stage: &Stage, path: &sdf::Path) -> Result<Option<SkinningMet
 }
 
 /// The skeleton a mesh's binding names (on it or inherited), among the placed ones; `None` where it names none of
-/// them, or the mesh has no joint influences (UsdSkel then leaves its points to its blend shapes alone).
+/// them.
 fn binding(api: SkelBindingAPI, skeletons: &[Placed]) -> Result<Option<(SkelBindingAPI, &Placed)>, String> {
-    if api.joint_indices().map_err(said)?.is_empty() && api.joint_weights().map_err(said)?.is_empty() {
-        return Ok(None);
-    }
     let Some(skeleton) = api.inherited_skeleton().map_err(said)? else { return Ok(None) };
     Ok(skeletons.iter().find(|p| p.path == skeleton).map(|placed| (api, placed)))
+}
+
+/// Whether the binding gives joint influences (without them, UsdSkel leaves the points to the blend shapes alone).
+fn has_influences(api: &SkelBindingAPI) -> Result<bool, String> {
+    Ok(!api.joint_indices().map_err(said)?.is_empty() || !api.joint_weights().map_err(said)?.is_empty())
 }
 
 /// The skeleton's joints (indices into its `joints`) the mesh's influences index: its own `skel:joints`, by path,

@@ -3,7 +3,8 @@
 //! becomes bones below a node standing for the Skeleton prim (its transform in the world, its Xform ancestors'
 //! included), and the `SkelAnimation` bound to it (`skel:animationSource`, on it or an ancestor) its tracks
 //! ([`skeleton`]). A stage has one timeline, on which every skeleton plays its animation: one clip holds them all.
-//! Meshes bound to a skeleton are skinned as UsdSkel skins them, the others hang rigid where they are ([`mesh`]).
+//! Meshes bound to a skeleton are skinned and blend-shaped as UsdSkel does it, the others hang rigid where they are
+//! ([`mesh`], [`blend`]).
 //!
 //! UsdSkel has no scale-inheritance modes: every joint inherits its parent fully, so each joint declares `full`.
 //! Times: a time code `t` is at `(t − startTimeCode) / timeCodesPerSecond` seconds. Units and axes: the stage's
@@ -13,6 +14,7 @@
 //! Every asset the stage names (sublayers, references, payloads) must lie in the root layer's folder: the resolver
 //! finds nothing outside it.
 
+mod blend;
 mod guard;
 mod mesh;
 mod resolver;
@@ -25,7 +27,7 @@ use glam::{DMat4, DVec3};
 use openusd::usd::{PrimPredicate, Stage};
 
 use super::{ImportError, Options, Space};
-use crate::model::{Clip, Placement, Rig, Skeleton, Unit};
+use crate::model::{Clip, MorphWeights, Placement, Rig, Skeleton, Unit};
 use resolver::FolderResolver;
 
 /// USD's `metersPerUnit` where a stage authors none: centimetres.
@@ -55,7 +57,7 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         animations.extend(read.animation);
         placed.push(read.placed);
     }
-    let (mut meshes, mut skins) = (Vec::new(), Vec::new());
+    let (mut meshes, mut skins, mut morph) = (Vec::new(), Vec::new(), Vec::new());
     for path in mesh_paths {
         let read = mesh::read(&stage, &path, bones.len(), skins.len(), &placed, conversion.timing.start)
             .map_err(|message| fail(Some(path.as_str().to_owned()), message))?;
@@ -63,8 +65,9 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         meshes.push(read.mesh);
         skins.extend(read.skin);
         bones.extend(read.node);
+        morph.extend(read.morph);
     }
-    let clips = clip(animations, conversion.timing.codes_per_second).into_iter().collect();
+    let clips = clip(animations, morph, conversion.timing.codes_per_second).into_iter().collect();
     notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
     let skeleton = Skeleton::new(bones).map_err(|e| fail(None, e.to_string()))?;
     let (skeleton, unit) = match options.space {
@@ -74,15 +77,16 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     Ok(Rig { skeleton, clips, skins, meshes, unit, notes })
 }
 
-/// The skeletons' animations as one clip, named after the animation where there is one; `None` for none.
-fn clip(animations: Vec<skeleton::Animation>, frame_rate: f64) -> Option<Clip> {
+/// The skeletons' animations, and the blend-shape weights they animate, as one clip, named after the animation
+/// where there is one; `None` for none.
+fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, frame_rate: f64) -> Option<Clip> {
     let name = match animations.as_slice() {
         [] => return None,
         [one] => one.name.clone(),
         _ => None,
     };
     let tracks = animations.into_iter().flat_map(|a| a.tracks).collect();
-    Some(Clip::new(0, name, tracks, Vec::new()).with_frame_rate(frame_rate))
+    Some(Clip::new(0, name, tracks, morph).with_frame_rate(frame_rate))
 }
 
 /// Reads a USD file already in memory: written to a folder of its own first (USD reads layers by path), so any
@@ -116,6 +120,11 @@ fn prims(stage: &Stage) -> Result<(Vec<openusd::sdf::Path>, Vec<openusd::sdf::Pa
         })
         .map_err(said)?;
     failed.map_or(Ok((skeletons, meshes)), Err)
+}
+
+/// Refuses what would take `bytes` beyond the memory one file may use.
+fn within_budget(bytes: u64, what: impl FnOnce() -> String) -> Result<(), String> {
+    super::budget::check(bytes, None, what).map_err(|failure| failure.message)
 }
 
 /// An error of the `openusd` crate in one line, its causes after its message.

@@ -1,4 +1,4 @@
-//! A SkelAnimation's translations, rotations or scales as USD reads them at any time code: held before the first
+//! A SkelAnimation's translations, rotations, scales or blend-shape weights as USD reads them at any time code: held before the first
 //! sample and after the last, a sample's own at its time, and between two samples of the same length interpolated
 //! with the arithmetic of Pixar's `Gf` types, which rounds every step to the attribute's precision: `GfLerp` is
 //! `(1 − t)·a + t·b` with both products and their sum rounded (a `half3` held between two equal samples reads a
@@ -21,6 +21,7 @@ pub enum Channel {
     Quath(Samples<gf::Quath>),
     Quatf(Samples<gf::Quatf>),
     Quatd(Samples<gf::Quatd>),
+    Float(Samples<f32>),
 }
 
 /// Time codes and the array at each, sorted by time code.
@@ -61,6 +62,7 @@ impl Channel {
             Value::QuathVec(_) => typed!(QuathVec, Quath),
             Value::QuatfVec(_) => typed!(QuatfVec, Quatf),
             Value::QuatdVec(_) => typed!(QuatdVec, Quatd),
+            Value::FloatVec(_) => typed!(FloatVec, Float),
             _ => None,
         }
     }
@@ -75,6 +77,14 @@ impl Channel {
             Channel::Double3(s) => {
                 Some(s.at(code).iter().map(|v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)).collect())
             }
+            _ => None,
+        }
+    }
+
+    /// The numbers at time code `code` (`None` for a vector or rotation channel).
+    pub fn numbers(&self, code: f64) -> Option<Vec<f32>> {
+        match self {
+            Channel::Float(s) => Some(s.at(code)),
             _ => None,
         }
     }
@@ -108,6 +118,7 @@ impl Channel {
             Channel::Quath(s) => codes(s),
             Channel::Quatf(s) => codes(s),
             Channel::Quatd(s) => codes(s),
+            Channel::Float(s) => codes(s),
         }
     }
 }
@@ -142,6 +153,13 @@ fn lerp_half(a: f16, b: f16, t: f64) -> f16 {
 /// `float(float(a·(1 − t)) + float(b·t))`: `GfVec3f`'s scaling and sum, each rounded to single precision.
 fn lerp_float(a: f32, b: f32, t: f64) -> f32 {
     (f64::from(a) * (1.0 - t)) as f32 + (f64::from(b) * t) as f32
+}
+
+/// `GfLerp` of two `float`s: computed in double precision, rounded once.
+impl Mix for f32 {
+    fn mix(a: &Self, b: &Self, t: f64) -> Self {
+        ((1.0 - t) * f64::from(*a) + t * f64::from(*b)) as f32
+    }
 }
 
 impl Mix for gf::Vec3h {

@@ -14,8 +14,7 @@ use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
 use super::samples::Channel;
-use super::{Timing, said};
-use crate::import::budget;
+use super::{Timing, said, within_budget};
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
 
@@ -26,7 +25,7 @@ pub struct Read {
     pub placed: Placed,
 }
 
-/// Where a skeleton's bones are in the rig, for the meshes bound to it.
+/// Where a skeleton's bones are in the rig, and what its animation weights, for the meshes bound to it.
 pub struct Placed {
     pub path: sdf::Path,
     /// The bone standing for the Skeleton prim; its joints follow it, in their order.
@@ -35,6 +34,16 @@ pub struct Placed {
     pub joints: Vec<String>,
     /// Each joint's `bindTransforms` (empty where they are not one per joint).
     pub bind: Vec<DMat4>,
+    /// Its animation's blend-shape weights, where it has any.
+    pub weights: Option<ShapeWeights>,
+}
+
+/// A SkelAnimation's blend-shape weights: the names it weights (`blendShapes`) and, at each time of the clip, one
+/// weight per name (`blendShapeWeights` as USD reads it there; all zero where its length is not theirs).
+pub struct ShapeWeights {
+    pub names: Vec<String>,
+    pub times: Arc<[f64]>,
+    pub values: Vec<Vec<f32>>,
 }
 
 /// A SkelAnimation's tracks of one skeleton.
@@ -70,11 +79,12 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         let bone = Bone::joint(names[j].clone(), Some(parent), transform(&rest[j]));
         bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role: NodeRole::Joint, ..bone });
     }
-    let animation = animation(stage, &skeleton, &joints, first + 1, timing)?;
+    let (animation, weights) = animation(stage, &skeleton, &joints, first + 1, timing)?.unzip();
     let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
     // Bind transforms that are not one per joint, or not finite, bind no mesh (it skins from the geometry's space).
     let bind = if bind.len() == joints.len() && bind.iter().all(DMat4::is_finite) { bind } else { Vec::new() };
-    Ok(Read { bones, animation, placed: Placed { path: path.clone(), node: first, joints, bind } })
+    let placed = Placed { path: path.clone(), node: first, joints, bind, weights: weights.flatten() };
+    Ok(Read { bones, animation, placed })
 }
 
 /// A row-vector USD matrix as bonescope's column-vector one: the same sixteen numbers read by columns.
@@ -138,14 +148,14 @@ pub(super) fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Res
 }
 
 /// The tracks of the skeleton's bound animation (`skel:animationSource` on it or inherited), its joints' bones
-/// numbered from `first`; `None` without one.
+/// numbered from `first`, and its blend-shape weights; `None` without one.
 fn animation(
     stage: &Stage,
     skeleton: &Skeleton,
     joints: &[String],
     first: usize,
     timing: &Timing,
-) -> Result<Option<Animation>, String> {
+) -> Result<Option<(Animation, Option<ShapeWeights>)>, String> {
     let Some(source) = animation_source(stage, skeleton.path())? else {
         return Ok(None);
     };
@@ -154,13 +164,15 @@ fn animation(
     let mapped = skeleton.map_anim_joints(&anim_joints).map_err(said)?;
     let read = |attribute: Attribute| Channel::read(stage, &attribute);
     let channels = [read(anim.translations_attr())?, read(anim.rotations_attr())?, read(anim.scales_attr())?];
+    let shape_names = anim.blend_shapes().map_err(said)?;
+    let shape_weights = read(anim.blend_shape_weights_attr())?;
     // Samples before the start time code shape what is read from it on, but are not played.
-    let mut codes = sample_codes(&channels, timing.start)?;
+    let mut codes = sample_codes(channels.iter().chain([&shape_weights]).flatten(), timing.start)?;
     codes.retain(|&code| code >= timing.start);
     if codes.is_empty() {
         codes.push(timing.start);
     }
-    check_budget(codes.len(), mapped.len())?;
+    check_budget(codes.len(), mapped.len() + shape_names.len().div_ceil(10))?;
     let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
     let n = mapped.len();
     let (mut translations, mut rotations, mut scales) = (vec![Vec::new(); n], vec![Vec::new(); n], vec![Vec::new(); n]);
@@ -186,7 +198,15 @@ fn animation(
         bone.stretch = Some(DQuat::IDENTITY);
         tracks.push(bone);
     }
-    Ok(Some(Animation { name: source.name().map(str::to_owned), tracks }))
+    let weights = (!shape_names.is_empty()).then(|| {
+        let count = shape_names.len();
+        let values = codes.iter().map(|&code| {
+            let read = shape_weights.as_ref().and_then(|c| c.numbers(code));
+            read.filter(|w| w.len() == count).unwrap_or_else(|| vec![0.0; count])
+        });
+        ShapeWeights { names: shape_names, times: times.clone(), values: values.collect() }
+    });
+    Ok(Some((Animation { name: source.name().map(str::to_owned), tracks }, weights)))
 }
 
 /// A track of `values` at `times`, linear between them (slerp for rotations), as UsdSkel reads them.
@@ -208,12 +228,13 @@ fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::P
     Ok(None)
 }
 
-/// The time codes an animation is sampled at: every time code of its translations, rotations and scales, and every
+/// The time codes an animation is sampled at: every time code of its translations, rotations, scales and blend-shape
+/// weights, and every
 /// whole time code between the first and the last (USD reads between samples in the precision of the values stored,
 /// [`samples`](super::samples): sampled at each frame, the clip holds what it reads there), sorted, once each;
 /// `start` where none is sampled (the attributes' defaults hold throughout).
-fn sample_codes(channels: &[Option<Channel>], start: f64) -> Result<Vec<f64>, String> {
-    let mut codes: Vec<f64> = channels.iter().flatten().flat_map(Channel::codes).collect();
+fn sample_codes<'a>(channels: impl Iterator<Item = &'a Channel>, start: f64) -> Result<Vec<f64>, String> {
+    let mut codes: Vec<f64> = channels.flat_map(Channel::codes).collect();
     codes.sort_by(f64::total_cmp);
     let (Some(&first), Some(&last)) = (codes.first(), codes.last()) else {
         return Ok(vec![start]);
@@ -226,16 +247,10 @@ fn sample_codes(channels: &[Option<Channel>], start: f64) -> Result<Vec<f64>, St
     Ok(codes)
 }
 
-/// Refuses an animation whose tracks would take more memory than one file may use.
+/// Refuses an animation whose tracks would take more memory than one file may use (`joints` counts ten
+/// blend-shape weights as one joint).
 fn check_budget(codes: usize, joints: usize) -> Result<(), String> {
     // A translation, a rotation and a scale per joint and time, and the time itself.
     let bytes = (codes as u64).saturating_mul(joints as u64).saturating_mul(40).saturating_add(codes as u64 * 8);
-    if bytes > budget::limit() {
-        return Err(format!(
-            "an animation of {joints} joints at {codes} time codes needs {}, over the memory limit of {}",
-            budget::size(bytes),
-            budget::size(budget::limit())
-        ));
-    }
-    Ok(())
+    within_budget(bytes, || format!("an animation of {joints} joints at {codes} time codes"))
 }
