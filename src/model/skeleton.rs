@@ -218,9 +218,30 @@ impl Skeleton {
         self.bones[index].parent
     }
 
-    /// The first bone with this exact name.
+    /// The first bone with this exact name, else the first whose [`path`](Skeleton::path) ends with `name` at a
+    /// `/` (`upper_arm/forearm`, or USD's joint path `hips/spine`): where names repeat (`Left/Hand`,
+    /// `Right/Hand`), the path says which.
     pub fn find(&self, name: &str) -> Option<usize> {
-        self.bones.iter().position(|b| b.name == name)
+        let by_name = self.bones.iter().position(|b| b.name == name);
+        by_name.or_else(|| {
+            let tail = name.trim_start_matches('/');
+            (!tail.is_empty() && tail.contains('/')).then(|| {
+                let ends = |path: String| path == tail || path.ends_with(&format!("/{tail}"));
+                (0..self.bones.len()).find(|&b| ends(self.path(b)))
+            })?
+        })
+    }
+
+    /// The names from the root down to `bone`, joined by `/` (`hips/spine/chest`).
+    pub fn path(&self, bone: usize) -> String {
+        let mut names = vec![self.bones[bone].name.as_str()];
+        let mut current = self.bones[bone].parent;
+        while let Some(parent) = current {
+            names.push(&self.bones[parent].name);
+            current = self.bones[parent].parent;
+        }
+        names.reverse();
+        names.join("/")
     }
 
     /// The bone that came from source node `node`.
@@ -358,6 +379,19 @@ mod tests {
         assert_eq!(s.depths(), vec![0, 1, 2, 1]);
         assert!(s.is_in_subtree(2, 1) && s.is_in_subtree(2, 0) && !s.is_in_subtree(3, 1));
         assert_eq!(s.find("c"), Some(3));
+    }
+
+    #[test]
+    fn a_path_finds_a_bone_whose_name_repeats() {
+        // Skel → Left → Hand, Skel → Right → Hand (USD names joints by path; their last elements may repeat).
+        let s = named(&[("Skel", None), ("Left", Some(0)), ("Hand", Some(1)), ("Right", Some(0)), ("Hand", Some(3))]);
+        assert_eq!(s.path(4), "Skel/Right/Hand");
+        assert_eq!(s.find("Hand"), Some(2), "a name: the first");
+        assert_eq!(s.find("Right/Hand"), Some(4));
+        assert_eq!(s.find("Skel/Right/Hand"), Some(4));
+        assert_eq!(s.find("/Skel/Left/Hand"), Some(2));
+        assert_eq!(s.find("ight/Hand"), None, "a path matches whole names");
+        assert_eq!(s.find("Up/Hand"), None);
     }
 
     #[test]
