@@ -8,6 +8,7 @@ use std::process::Command;
 
 use bonescope::eval::Evaluation;
 use bonescope::import::{Options, Space, load_with};
+use bonescope::model::Rig;
 use common::{assets, usd_python};
 use glam::DMat4;
 use serde_json::Value;
@@ -43,51 +44,107 @@ fn every_joint_is_where_usd_core_puts_it_at_every_time_code() {
     let Some(python) = usd_python() else { return };
     let mut compared = 0;
     for file in usd_files() {
-        // In the file's own space, which is usd-core's: no unit or axis conversion.
-        let rig = match load_with(&file, &Options { space: Space::File }) {
-            Ok(rig) => rig,
+        compared += match load_with(&file, &Options { space: Space::File }) {
+            Ok(rig) => joints_as_usd_core(&python, &file, &rig),
             Err(error) => {
                 // Only Pixar's own test of a misspelt type (`flaot`) is refused, naming it, in one line.
                 let error = error.to_string();
                 assert!(error.contains("unrecognized type: flaot") && !error.contains('\n'), "{error}");
-                continue;
+                0
             }
         };
-        let reference = reference(&python, &file);
-        let (rate, start) =
-            (reference["time_codes_per_second"].as_f64().unwrap(), reference["start_time_code"].as_f64());
-        let evaluation = Evaluation::declared(&rig, rig.clips.first());
-        let size = evaluation.size(&evaluation.times(rate));
-        // bonescope normalises rotation keys, as engines do; UsdSkel makes a matrix of the quaternion as authored
-        // (Pixar's test arm writes (0.7071, 0.7071, 0, 0), 1.5e-6 short): that much more is allowed, per unit.
-        let off_unit = rig.clips.iter().flat_map(|c| c.tracks()).filter_map(|t| t.rotation.as_ref());
-        let off_unit =
-            off_unit.flat_map(|r| r.values().iter()).fold(0.0f64, |m, q| m.max(f64::from((q.length() - 1.0).abs())));
-        let tolerance = (1e-6 + 4.0 * off_unit) * size;
-        // Each skeleton's bones: its node, then its joints in their order.
-        let mut bone = 0;
-        for skeleton in reference["skeletons"].as_array().unwrap() {
-            let joints = skeleton["joints"].as_array().unwrap().len();
-            assert_eq!(rig.skeleton.bone(bone).name, skeleton["path"].as_str().unwrap().rsplit('/').next().unwrap());
-            for sample in skeleton["samples"].as_array().unwrap() {
-                let time = sample["time_code"].as_f64().map_or(0.0, |code| (code - start.unwrap_or(0.0)) / rate);
-                let pose = evaluation.pose_at(time).model.model;
-                for (j, world) in sample["world"].as_array().unwrap().iter().enumerate() {
-                    let (ours, theirs) = (pose[bone + 1 + j], matrix(world));
-                    let apart = (ours - theirs).to_cols_array().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                    assert!(
-                        apart <= tolerance,
-                        "{}: joint {j} of {} at {time} s: {apart} apart (size {size})\nours {ours}\ntheirs {theirs}",
-                        file.display(),
-                        skeleton["path"]
-                    );
-                }
-                compared += 1;
-            }
-            bone += 1 + joints;
-        }
     }
     assert!(compared > 500, "{compared} skeleton poses compared");
+}
+
+#[test]
+fn a_skeleton_under_a_moving_xform_moves_with_it() {
+    // A character's Xform carried through a shot (translated and turned over time, its angles written as whole
+    // numbers), its skeleton's spine turning too: the joints are where usd-core puts them at every time code. The
+    // same animation bound where `SkelBindingAPI` is not applied plays for neither.
+    let Some(python) = usd_python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("shot.usda");
+    std::fs::write(
+        &file,
+        r#"#usda 1.0
+(
+    startTimeCode = 0
+    endTimeCode = 10
+    timeCodesPerSecond = 10
+)
+def Xform "Shot"
+{
+    double3 xformOp:translate.timeSamples = { 0: (0, 0, 0), 5: (2, 0, 1), 10: (4, 1, 0) }
+    float xformOp:rotateY.timeSamples = { 0: 0, 10: 90 }
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateY"]
+    def SkelRoot "Character"
+    {
+        def Skeleton "Skel" (
+            prepend apiSchemas = ["SkelBindingAPI"]
+        )
+        {
+            uniform token[] joints = ["hips", "hips/spine"]
+            uniform matrix4d[] restTransforms = [((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 1, 0, 1)), ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0.5, 0, 1))]
+            rel skel:animationSource = </Shot/Character/Skel/Anim>
+            def SkelAnimation "Anim"
+            {
+                uniform token[] joints = ["hips/spine"]
+                float3[] translations = [(0, 0.5, 0)]
+                quatf[] rotations.timeSamples = { 0: [(1, 0, 0, 0)], 10: [(0.70710677, 0, 0, 0.70710677)] }
+                half3[] scales = [(1, 1, 1)]
+            }
+        }
+    }
+}
+"#,
+    )
+    .unwrap();
+    let rig = load_with(&file, &Options { space: Space::File }).unwrap();
+    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11, "every time code");
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, text.replace("prepend apiSchemas = [\"SkelBindingAPI\"]", "")).unwrap();
+    let rig = load_with(&file, &Options { space: Space::File }).unwrap();
+    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11);
+    assert!(rig.clips[0].tracks().iter().all(|t| t.bone == 0), "only the skeleton's node moves");
+}
+
+/// Compares every joint's world transform in `rig` (loaded from `file` in its own space) with usd-core's at every
+/// time code; how many skeleton poses were compared.
+fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig) -> usize {
+    let reference = reference(python, file);
+    let (rate, start) = (reference["time_codes_per_second"].as_f64().unwrap(), reference["start_time_code"].as_f64());
+    let evaluation = Evaluation::declared(rig, rig.clips.first());
+    let size = evaluation.size(&evaluation.times(rate));
+    // bonescope normalises rotation keys, as engines do; UsdSkel makes a matrix of the quaternion as authored
+    // (Pixar's test arm writes (0.7071, 0.7071, 0, 0), 1.5e-6 short): that much more is allowed, per unit.
+    let off_unit = rig.clips.iter().flat_map(|c| c.tracks()).filter_map(|t| t.rotation.as_ref());
+    let off_unit =
+        off_unit.flat_map(|r| r.values().iter()).fold(0.0f64, |m, q| m.max(f64::from((q.length() - 1.0).abs())));
+    let tolerance = (1e-6 + 4.0 * off_unit) * size;
+    // Each skeleton's bones: its node, then its joints in their order.
+    let (mut bone, mut compared) = (0, 0);
+    for skeleton in reference["skeletons"].as_array().unwrap() {
+        let joints = skeleton["joints"].as_array().unwrap().len();
+        assert_eq!(rig.skeleton.bone(bone).name, skeleton["path"].as_str().unwrap().rsplit('/').next().unwrap());
+        for sample in skeleton["samples"].as_array().unwrap() {
+            let time = sample["time_code"].as_f64().map_or(0.0, |code| (code - start.unwrap_or(0.0)) / rate);
+            let pose = evaluation.pose_at(time).model.model;
+            for (j, world) in sample["world"].as_array().unwrap().iter().enumerate() {
+                let (ours, theirs) = (pose[bone + 1 + j], matrix(world));
+                let apart = (ours - theirs).to_cols_array().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(
+                    apart <= tolerance,
+                    "{}: joint {j} of {} at {time} s: {apart} apart (size {size})\nours {ours}\ntheirs {theirs}",
+                    file.display(),
+                    skeleton["path"]
+                );
+            }
+            compared += 1;
+        }
+        bone += 1 + joints;
+    }
+    compared
 }
 
 /// The worst shear of `bone` over the first clip of `file`, and when, as `scan` finds it.
@@ -206,7 +263,9 @@ fn a_hostile_stage_reads_nothing_outside_its_folder_and_fails_in_one_line() {
     assert!(refused(&cut).contains("cut.usdc"));
     // Samples a trillion time codes apart would be a trillion frames: refused by the memory budget.
     let far = inside.join("far.usda");
-    let animated = skeleton.replace(
+    let bound = skeleton
+        .replace("Skeleton \"Rig\"\n", "Skeleton \"Rig\" (\n    prepend apiSchemas = [\"SkelBindingAPI\"]\n)\n");
+    let animated = bound.replace(
         "\n}\n",
         "\n    rel skel:animationSource = </Rig/Anim>\n    def SkelAnimation \"Anim\"\n    {\n        uniform token[] joints = [\"a\"]\n        \
          float3[] translations.timeSamples = {\n            1: [(0, 0, 0)],\n            1000000000000: [(1, 0, 0)],\n        }\n    }\n}\n",

@@ -15,9 +15,9 @@ use openusd::sdf::{self, Value};
 use openusd::usd::{Attribute, Stage, TimeCode};
 
 use super::blend;
-use super::said;
-use super::skeleton::{Placed, transform, world_transform};
-use crate::model::{Bone, Mesh, MorphWeights, NodeRole, Skin};
+use super::skeleton::{Placed, moving_node, transform, world_transform};
+use super::{Timing, said};
+use crate::model::{Bone, BoneTracks, Mesh, MorphWeights, NodeRole, Skin};
 
 /// A mesh read: itself, the skin it is bound with, the node it hangs on where it needs one, and its animated
 /// blend-shape weights.
@@ -25,6 +25,8 @@ pub struct Read {
     pub mesh: Mesh,
     pub skin: Option<Skin>,
     pub node: Option<Bone>,
+    /// Where its node moves, that node's track.
+    pub moving: Option<BoneTracks>,
     pub morph: Option<MorphWeights>,
 }
 
@@ -40,8 +42,9 @@ pub fn read(
     bones: usize,
     skin_index: usize,
     skeletons: &[Placed],
-    start: f64,
+    timing: &Timing,
 ) -> Result<Option<Read>, String> {
+    let start = timing.start;
     let mesh = UsdMesh::get(stage, path.clone()).map_err(said)?.ok_or("not a Mesh")?;
     let at_start = |attribute: Attribute| attribute.get_at::<Value>(TimeCode::new(start)).map_err(said);
     let positions = points(at_start(mesh.points_attr())?);
@@ -74,6 +77,7 @@ pub fn read(
             Ok(Bone { node: bones, role: NodeRole::Mesh, ..Bone::joint(name, None, transform(&world)) })
         })
         .transpose()?;
+    let moving = if own_node { moving_node(stage, path, bones, timing)? } else { None };
     let mut morph = None;
     if let Some(shapes) = shapes {
         read.morph_weights = vec![0.0; shapes.targets.len()];
@@ -81,7 +85,7 @@ pub fn read(
         morph = (!shapes.weights.is_empty()).then_some(MorphWeights { bone, weights: shapes.weights });
     }
     let mesh = Mesh { bone, skin: skin.is_some().then_some(skin_index), ..read };
-    Ok(Some(Read { mesh, skin, node, morph }))
+    Ok(Some(Read { mesh, skin, node, moving, morph }))
 }
 
 /// The skin of a mesh bound to `placed` with joint influences, its joints and weights set on `read`.

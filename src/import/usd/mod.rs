@@ -58,14 +58,19 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         placed.push(read.placed);
     }
     let (mut meshes, mut skins, mut morph) = (Vec::new(), Vec::new(), Vec::new());
+    let mut moving = Vec::new();
     for path in mesh_paths {
-        let read = mesh::read(&stage, &path, bones.len(), skins.len(), &placed, conversion.timing.start)
+        let read = mesh::read(&stage, &path, bones.len(), skins.len(), &placed, &conversion.timing)
             .map_err(|message| fail(Some(path.as_str().to_owned()), message))?;
         let Some(read) = read else { continue };
         meshes.push(read.mesh);
         skins.extend(read.skin);
         bones.extend(read.node);
         morph.extend(read.morph);
+        moving.extend(read.moving);
+    }
+    if !moving.is_empty() {
+        animations.push(skeleton::Animation { name: None, tracks: moving });
     }
     let clips = clip(animations, morph, conversion.timing.codes_per_second).into_iter().collect();
     notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
@@ -77,12 +82,13 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     Ok(Rig { skeleton, clips, skins, meshes, unit, notes })
 }
 
-/// The skeletons' animations, and the blend-shape weights they animate, as one clip, named after the animation
-/// where there is one; `None` for none.
+/// The skeletons' animations (and the tracks of moving nodes), and the blend-shape weights they animate, as one
+/// clip, named after the animation where there is one; `None` for none.
 fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, frame_rate: f64) -> Option<Clip> {
-    let name = match animations.as_slice() {
-        [] => return None,
-        [one] => one.name.clone(),
+    let mut named = animations.iter().filter_map(|a| a.name.clone());
+    let name = match (named.next(), named.next()) {
+        _ if animations.is_empty() => return None,
+        (Some(one), None) => Some(one),
         _ => None,
     };
     let tracks = animations.into_iter().flat_map(|a| a.tracks).collect();

@@ -3,13 +3,13 @@
 //! under `A`), resting in their `restTransforms`. The `SkelAnimation` bound to it becomes a clip: per joint it names
 //! (in its own order, matched to the skeleton's by path), a track of translations, rotations and scales at every time
 //! code of the three attributes and every frame between, each read as UsdSkel reads it there ([`super::samples`]);
-//! the other joints rest.
+//! the other joints rest. Where the Skeleton prim's transform in the world moves, its node has a track too.
 
 use std::sync::Arc;
 
 use glam::{DMat4, DQuat, Quat, Vec3};
 use openusd::schemas::geom::{Imageable, Xformable};
-use openusd::schemas::skel::{SkelAnimation, Skeleton};
+use openusd::schemas::skel::{SkelAnimation, SkelBindingAPI, Skeleton};
 use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
@@ -79,7 +79,10 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         let bone = Bone::joint(names[j].clone(), Some(parent), transform(&rest[j]));
         bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role: NodeRole::Joint, ..bone });
     }
-    let (animation, weights) = animation(stage, &skeleton, &joints, first + 1, timing)?.unzip();
+    let (mut animation, weights) = animation(stage, &skeleton, &joints, first + 1, timing)?.unzip();
+    if let Some(moving) = moving_node(stage, path, first, timing)? {
+        animation.get_or_insert_with(|| Animation { name: None, tracks: Vec::new() }).tracks.push(moving);
+    }
     let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
     // Bind transforms that are not one per joint, or not finite, bind no mesh (it skins from the geometry's space).
     let bind = if bind.len() == joints.len() && bind.iter().all(DMat4::is_finite) { bind } else { Vec::new() };
@@ -215,13 +218,15 @@ fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, S
 }
 
 /// The animation a skeleton plays: the target of the nearest `skel:animationSource` on it or an ancestor (a
-/// `SkelRoot` may bind it for every skeleton below).
+/// `SkelRoot` may bind it for every skeleton below), among the prims that apply `SkelBindingAPI`: Pixar's UsdSkel
+/// reads the relationship on no other.
 fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::Path>, String> {
     let mut path = Some(skeleton.clone());
     while let Some(current) = path.filter(|p| !p.is_abs_root()) {
-        let relationship = stage.prim(current.clone()).relationship("skel:animationSource");
-        if let Some(target) = relationship.targets().map_err(said)?.into_iter().next() {
-            return Ok(Some(target));
+        if let Some(api) = SkelBindingAPI::get(stage, current.clone()).map_err(said)? {
+            if let Some(target) = api.animation_source_rel().targets().map_err(said)?.into_iter().next() {
+                return Ok(Some(target));
+            }
         }
         path = current.parent();
     }
@@ -229,12 +234,15 @@ fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::P
 }
 
 /// The time codes an animation is sampled at: every time code of its translations, rotations, scales and blend-shape
-/// weights, and every
-/// whole time code between the first and the last (USD reads between samples in the precision of the values stored,
-/// [`samples`](super::samples): sampled at each frame, the clip holds what it reads there), sorted, once each;
-/// `start` where none is sampled (the attributes' defaults hold throughout).
+/// weights, and every whole time code between the first and the last ([`every_frame`]).
 fn sample_codes<'a>(channels: impl Iterator<Item = &'a Channel>, start: f64) -> Result<Vec<f64>, String> {
-    let mut codes: Vec<f64> = channels.flat_map(Channel::codes).collect();
+    every_frame(channels.flat_map(Channel::codes).collect(), start)
+}
+
+/// `codes` and every whole time code between the first and the last (USD reads between samples in the precision of
+/// the values stored, [`samples`](super::samples): sampled at each frame, the clip holds what it reads there),
+/// sorted, once each; `start` where there are none (the attributes' defaults hold throughout).
+fn every_frame(mut codes: Vec<f64>, start: f64) -> Result<Vec<f64>, String> {
     codes.sort_by(f64::total_cmp);
     let (Some(&first), Some(&last)) = (codes.first(), codes.last()) else {
         return Ok(vec![start]);
@@ -242,6 +250,67 @@ fn sample_codes<'a>(channels: impl Iterator<Item = &'a Channel>, start: f64) -> 
     let frames = (last.floor() - first.ceil()).max(0.0);
     check_budget(frames as usize + codes.len(), 1)?;
     codes.extend((0..=frames as u64).map(|k| first.ceil() + k as f64));
+    codes.sort_by(f64::total_cmp);
+    codes.dedup();
+    Ok(codes)
+}
+
+/// A track for the node standing for the prim at `path` where its transform in the world moves (a time-sampled
+/// transform op on it or an ancestor, as a character's Xform carries it through a shot): its world transform at every
+/// time code of those ops and every frame between, from `start` on; `None` where it holds still. The stretch stays
+/// the rest's (an Xform that shears as it moves is read without the change of its shear).
+pub(super) fn moving_node(
+    stage: &Stage,
+    path: &sdf::Path,
+    node: usize,
+    timing: &Timing,
+) -> Result<Option<BoneTracks>, String> {
+    let authored = xform_codes(stage, path)?;
+    if authored.len() < 2 {
+        return Ok(None);
+    }
+    let mut codes = every_frame(authored, timing.start)?;
+    codes.retain(|&code| code >= timing.start);
+    if codes.is_empty() {
+        return Ok(None);
+    }
+    let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
+    let (mut translations, mut rotations, mut scales) = (Vec::new(), Vec::new(), Vec::new());
+    for &code in &codes {
+        let world = world_transform(stage, path, code)?;
+        if !world.is_finite() {
+            return Err(format!("its transform in the world at time code {code} is not finite"));
+        }
+        let local = transform(&world);
+        translations.push(local.translation.as_vec3());
+        rotations.push(local.rotation.as_quat());
+        scales.push(local.scale.as_vec3());
+    }
+    let mut tracks = BoneTracks::new(node);
+    tracks.translation = Some(linear(&times, translations)?);
+    tracks.rotation = Some(linear(&times, rotations)?);
+    tracks.scale = Some(linear(&times, scales)?);
+    Ok(Some(tracks))
+}
+
+/// The time codes of the transform ops of the prim at `path` and its ancestors, up to the nearest that resets the
+/// stack, sorted, once each.
+fn xform_codes(stage: &Stage, path: &sdf::Path) -> Result<Vec<f64>, String> {
+    let mut codes = Vec::new();
+    let mut prim_path = Some(path.clone());
+    while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {
+        let xformed = Xformed(stage.prim(current.clone()));
+        for op in xformed.xform_op_order().map_err(said)?.unwrap_or_default() {
+            let op = op.strip_prefix("!invert!").unwrap_or(&op);
+            let Ok(attribute) = current.append_property(op) else { continue };
+            let samples = stage.time_samples(attribute).map_err(said)?.unwrap_or_default();
+            codes.extend(samples.iter().map(|(code, _)| *code).filter(|c| c.is_finite()));
+        }
+        if xformed.resets_xform_stack().map_err(said)? {
+            break;
+        }
+        prim_path = current.parent();
+    }
     codes.sort_by(f64::total_cmp);
     codes.dedup();
     Ok(codes)

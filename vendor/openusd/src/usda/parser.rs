@@ -1322,7 +1322,12 @@ impl<'a> Parser<'a> {
         match self.peek_next() {
             Some(Ok(Token::Punctuation('('))) => is_tuple_type,
             Some(Ok(Token::Punctuation('['))) => is_tuple_type || info.is_array,
-            Some(Ok(Token::Number(_))) => info.ty == Type::TimeCode && !info.is_array,
+            // bonescope: a bare number sample of a real scalar (`float xformOp:rotateY.timeSamples = { 0: 0 }`) is
+            // read as the declared type, as Pixar's USD reads it; type-blind, `0` became an integer and was held
+            // where it should interpolate.
+            Some(Ok(Token::Number(_))) => {
+                !info.is_array && matches!(info.ty, Type::TimeCode | Type::Half | Type::Float | Type::Double)
+            }
             _ => false,
         }
     }
