@@ -223,10 +223,10 @@ fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, S
 fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::Path>, String> {
     let mut path = Some(skeleton.clone());
     while let Some(current) = path.filter(|p| !p.is_abs_root()) {
-        if let Some(api) = SkelBindingAPI::get(stage, current.clone()).map_err(said)? {
-            if let Some(target) = api.animation_source_rel().targets().map_err(said)?.into_iter().next() {
-                return Ok(Some(target));
-            }
+        let api = SkelBindingAPI::get(stage, current.clone()).map_err(said)?;
+        let targets = api.map(|api| api.animation_source_rel().targets()).transpose().map_err(said)?;
+        if let Some(target) = targets.and_then(|t| t.into_iter().next()) {
+            return Ok(Some(target));
         }
         path = current.parent();
     }
