@@ -6,6 +6,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use bonescope::analysis::{BindTolerance, check_bind};
+use bonescope::diff::{Pairs, compare, comparison_times};
 use bonescope::eval::Evaluation;
 use bonescope::import::{Options, Space, load_with};
 use bonescope::model::Rig;
@@ -219,6 +221,47 @@ fn skinned_and_blend_shaped_points_are_pixars_baked_ones() {
         }
         assert!(compared > 1000, "{name}: {compared} points compared");
     }
+}
+
+#[test]
+fn a_bind_scaled_entry_by_entry_as_maya_usd_wrote_it_is_named_broken() {
+    // Maya USD's `-unit m` export multiplied every entry of `bindTransforms` and `restTransforms` by the unit factor
+    // (`tests/usd/unit_bug.py` writes Blender's scene so with usd-core): the bind check names every weighted joint's
+    // bind as no rigid transform, the import notes both attributes, and `diff` against the file written right shows
+    // the skin scrambled while every bone is where it was.
+    let Some(python) = usd_python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let (good, bad) = (common::asset("blender/stretchy_full.usda"), dir.path().join("unit_m.usda"));
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/unit_bug.py");
+    let status = Command::new(python).arg(script).arg(&good).arg(&bad).status().expect("python runs");
+    assert!(status.success());
+    let (good, bad) = (load_with(&good, &Options::default()).unwrap(), load_with(&bad, &Options::default()).unwrap());
+    for attribute in ["restTransforms", "bindTransforms"] {
+        let note = bad.notes.iter().find(|n| n.starts_with(attribute)).expect("a note");
+        assert!(note.contains("8 of 8 joints") && note.contains("(0, 0, 0, 0.01)"), "{note}");
+    }
+    assert!(good.notes.iter().all(|n| !n.contains("rigid")), "{:?}", good.notes);
+    let (a, b) = (Evaluation::declared(&good, good.clips.first()), Evaluation::declared(&bad, bad.clips.first()));
+    let check = check_bind(&b, &BindTolerance::default());
+    let weighted: Vec<&str> = (0..bad.skins.len())
+        .flat_map(|s| bad.skins[s].joints.iter().zip(bad.weighted_joints(s)).filter(|(_, w)| *w).map(|(&j, _)| j))
+        .map(|j| bad.skeleton.bone(j).name.as_str())
+        .collect();
+    let broken: Vec<&str> = check.broken.iter().map(|m| m.name.as_str()).collect();
+    assert!(weighted.len() >= 5 && broken.len() == weighted.len(), "{broken:?} of {weighted:?}");
+    let scaled = |row: [f64; 4]| row[..3] == [0.0; 3] && (row[3] - 0.01).abs() < 1e-15;
+    assert!(check.broken.iter().all(|m| m.last_row.is_some_and(scaled)), "{:?}", check.broken);
+    assert!(
+        check.broken[0].says().contains("last row (0, 0, 0, 0.01), not (0, 0, 0, 1)"),
+        "{}",
+        check.broken[0].says()
+    );
+    assert!(check_bind(&a, &BindTolerance::default()).broken.is_empty());
+    let pairs = Pairs::by_name(&a, &b);
+    let compared = compare(&a, &b, &pairs, &comparison_times(&a, &b, 30.0));
+    assert!(compared.bones.iter().all(|bone| bone.position.max < 1e-9), "every bone where it was");
+    let skin = compared.meshes[0].distance.max / compared.rig_size;
+    assert!(skin > 0.5, "the skin lands {skin} of the rig's size away");
 }
 
 /// The one-line error of loading `file`, which must fail.

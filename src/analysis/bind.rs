@@ -18,6 +18,10 @@
 //! them behind (every child disagrees with it, but agrees with its anchor as if it were not there). So a joint is
 //! **broken** when its children say so, and **posed** otherwise. A moved leaf or root has no such witness and reads
 //! as posed.
+//!
+//! A bind matrix whose last row is not (0, 0, 0, 1) places nothing rigidly: every point it carries is divided by a
+//! homogeneous coordinate that skinning drops (an exporter that multiplied every entry by its unit factor scrambles
+//! the skin that way). Such a joint is broken whatever its neighbours hold, and said so.
 
 use glam::DMat4;
 use serde::Serialize;
@@ -87,6 +91,44 @@ pub struct BindMismatch {
     pub name: String,
     #[serde(flatten)]
     pub gap: BindGap,
+    /// The bind matrix's last row, where it is not (0, 0, 0, 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last_row: Option<[f64; 4]>,
+}
+
+impl BindMismatch {
+    /// What is wrong with the joint's bind, in a few words.
+    pub fn says(&self) -> String {
+        match self.last_row {
+            Some(row) => {
+                // To nine decimals: 0.01, not 0.010000000000000002.
+                let [x, y, z, w] = row.map(|v| (v * 1e9).round() / 1e9 + 0.0);
+                format!(
+                    "`{}`'s bind matrix has the last row ({x}, {y}, {z}, {w}), not (0, 0, 0, 1): it places nothing \
+                     rigidly",
+                    self.name
+                )
+            }
+            None => format!(
+                "`{}` is bound {:.6} units and {:.4}° (scale {:+.4} %) off the joints around it",
+                self.name,
+                self.gap.distance,
+                self.gap.angle_deg,
+                100.0 * self.gap.scale_change
+            ),
+        }
+    }
+}
+
+/// How far a bind matrix's last row may be from (0, 0, 0, 1): far below any unit factor, far above rounding.
+const LAST_ROW_TOLERANCE: f64 = 1e-9;
+
+/// The last row of `bind` where it is not (0, 0, 0, 1).
+fn not_affine(bind: &DMat4) -> Option<[f64; 4]> {
+    let row = bind.row(3).to_array();
+    let off = row.iter().zip([0.0, 0.0, 0.0, 1.0]).any(|(a, b): (&f64, f64)| (a - b).abs() > LAST_ROW_TOLERANCE);
+    // `+ 0.0` makes a negative zero 0.
+    off.then_some(row.map(|v| v + 0.0))
 }
 
 /// A frame of the clip.
@@ -143,8 +185,12 @@ pub fn check_bind(evaluation: &Evaluation, tolerance: &BindTolerance) -> BindChe
     let authored = evaluation.without_layers();
     let rest = authored.at_rest().pose_at(0.0).model.model;
     let mut check = BindCheck::default();
-    let mismatch =
-        |joint: &Joint, gap| BindMismatch { bone: joint.bone, name: rig.skeleton.bone(joint.bone).name.clone(), gap };
+    let mismatch = |joint: &Joint, gap| BindMismatch {
+        bone: joint.bone,
+        name: rig.skeleton.bone(joint.bone).name.clone(),
+        gap,
+        last_row: not_affine(&joint.bind),
+    };
     // Each skin with its broken joints.
     let mut judged = Vec::new();
     for mut skin in checked_skins(rig) {
@@ -154,7 +200,11 @@ pub fn check_bind(evaluation: &Evaluation, tolerance: &BindTolerance) -> BindChe
         // The others are judged from their nearest anchor that is not broken.
         skin.skip_anchors(&broken);
         let gaps = skin.gaps(&rest);
-        let posed = (0..skin.joints.len()).filter(|j| !broken.contains(j) && !gaps[*j].within(tolerance));
+        let projective =
+            (0..skin.joints.len()).filter(|j| !broken.contains(j) && not_affine(&skin.joints[*j].bind).is_some());
+        check.broken.extend(projective.map(|j| mismatch(&skin.joints[j], gaps[j])));
+        let broken_or_projective = |j: &usize| broken.contains(j) || not_affine(&skin.joints[*j].bind).is_some();
+        let posed = (0..skin.joints.len()).filter(|j| !broken_or_projective(j) && !gaps[*j].within(tolerance));
         check.posed.extend(posed.map(|j| mismatch(&skin.joints[j], gaps[j])));
         judged.push((skin, broken));
     }
@@ -320,6 +370,25 @@ mod tests {
     #[test]
     fn a_skin_bound_at_rest_is_neither_broken_nor_posed() {
         assert_eq!(checked(&demo_rig()), BindCheck::default());
+    }
+
+    #[test]
+    fn a_bind_matrix_scaled_entry_by_entry_is_named_not_rigid() {
+        // Every entry of every bind matrix times 0.01 (an exporter's unit factor applied to the whole matrix): the
+        // joints still agree with each other, so only their last row gives them away, and it is named.
+        let mut rig = demo_rig();
+        for ibm in &mut rig.skins[0].inverse_bind {
+            *ibm = (*ibm).inverse().mul_scalar(0.01).inverse();
+        }
+        let check = checked(&rig);
+        assert_eq!(names(&check.broken), ["upper_arm", "forearm", "hand"]);
+        assert!(check.posed.is_empty());
+        assert!(check.broken.iter().all(|m| m.last_row.is_some_and(|r| (r[3] - 0.01).abs() < 1e-15 && r[0] == 0.0)));
+        let said = check.broken[1].says();
+        assert_eq!(
+            said,
+            "`forearm`'s bind matrix has the last row (0, 0, 0, 0.01), not (0, 0, 0, 1): it places nothing rigidly"
+        );
     }
 
     #[test]

@@ -122,8 +122,12 @@ fn bind_report(ui: &mut Ui, check: &BindCheck) {
             ui.end_row();
             for m in check.broken.iter().take(12) {
                 ui.label(&m.name);
-                ui.monospace(format!("{:.4}", m.gap.distance));
-                ui.monospace(format!("{:.3}", m.gap.angle_deg));
+                if m.last_row.is_some() {
+                    ui.label("not rigid").on_hover_text(m.says());
+                } else {
+                    ui.monospace(format!("{:.4}", m.gap.distance));
+                    ui.monospace(format!("{:.3}", m.gap.angle_deg));
+                }
                 ui.end_row();
             }
         });

@@ -72,14 +72,7 @@ fn render_table(layered: &LayeredInspectReport, layers_summary: &str) -> String 
         out.push_str(&format!("  layers: {layers_summary}\n"));
     }
     for m in &layered.bind_mismatches {
-        out.push_str(&format!(
-            "  warning: `{}` is bound {:.6} units and {:.4}° (scale {:+.4} %) off the joints around it: the skin is \
-             broken there\n",
-            m.name,
-            m.gap.distance,
-            m.gap.angle_deg,
-            100.0 * m.gap.scale_change
-        ));
+        out.push_str(&format!("  warning: {}: the skin is broken there\n", m.says()));
     }
     for sample in &report.samples {
         out.push_str(&format!(

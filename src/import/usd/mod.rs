@@ -54,6 +54,7 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         let read = skeleton::read(&stage, &skel, bones.len(), &conversion.timing)
             .map_err(|message| fail(Some(skel.as_str().to_owned()), message))?;
         bones.extend(read.bones);
+        notes.extend(read.notes);
         animations.extend(read.animation);
         placed.push(read.placed);
     }

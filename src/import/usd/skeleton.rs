@@ -21,6 +21,8 @@ use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeR
 /// A skeleton's bones, the tracks of its animation, and where it was placed.
 pub struct Read {
     pub bones: Vec<Bone>,
+    /// What a user should know of how it was read.
+    pub notes: Vec<String>,
     pub animation: Option<Animation>,
     pub placed: Placed,
 }
@@ -84,10 +86,38 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         animation.get_or_insert_with(|| Animation { name: None, tracks: Vec::new() }).tracks.push(moving);
     }
     let bind: Vec<DMat4> = skeleton.bind_transforms().map_err(said)?.iter().map(matrix).collect();
+    let notes = [("restTransforms", &rest), ("bindTransforms", &bind)]
+        .into_iter()
+        .filter_map(|(attribute, matrices)| not_affine_note(path, attribute, matrices, &joints))
+        .collect();
     // Bind transforms that are not one per joint, or not finite, bind no mesh (it skins from the geometry's space).
     let bind = if bind.len() == joints.len() && bind.iter().all(DMat4::is_finite) { bind } else { Vec::new() };
     let placed = Placed { path: path.clone(), node: first, joints, bind, weights: weights.flatten() };
-    Ok(Read { bones, animation, placed })
+    Ok(Read { bones, notes, animation, placed })
+}
+
+/// Where some of `matrices` (one per joint) have a last column other than (0, 0, 0, 1) — no rigid transform, as an
+/// exporter writes who multiplied every entry by a unit factor — a note naming them: the rest is read without it,
+/// the bind check names the binds.
+fn not_affine_note(skeleton: &sdf::Path, attribute: &str, matrices: &[DMat4], joints: &[String]) -> Option<String> {
+    let off = |m: &&DMat4| (m.row(3) - glam::DVec4::W).abs().max_element() > 1e-9;
+    let named: Vec<(&String, &DMat4)> = joints.iter().zip(matrices).filter(|(_, m)| off(m)).collect();
+    let (first, matrix) = named.first()?;
+    let mut names: Vec<&str> = named.iter().take(4).map(|(n, _)| n.as_str()).collect();
+    if named.len() > names.len() {
+        names.push("…");
+    }
+    // To nine decimals (0.01, not 0.010000000000000002), a negative zero as 0.
+    let [x, y, z, w] = matrix.row(3).to_array().map(|v| (v * 1e9).round() / 1e9 + 0.0);
+    Some(format!(
+        "{} of {}: {} of {} joints ({}) have the last column ({x}, {y}, {z}, {w}) at `{first}`, not (0, 0, 0, 1): no \
+         rigid transform",
+        attribute,
+        skeleton.as_str(),
+        named.len(),
+        joints.len(),
+        names.join(", ")
+    ))
 }
 
 /// A row-vector USD matrix as bonescope's column-vector one: the same sixteen numbers read by columns.
