@@ -7,6 +7,8 @@
 mod corpus;
 #[path = "hostile/gltf.rs"]
 mod gltf;
+#[path = "hostile/usd.rs"]
+mod usd;
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};

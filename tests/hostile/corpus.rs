@@ -1,4 +1,4 @@
-//! The hostile corpus: malformed, extreme and amplifying BVH, FBX and glTF files, made on the fly (nothing stored),
+//! The hostile corpus: malformed, extreme and amplifying BVH, FBX, glTF and USD files (`usd.rs`), made on the fly (nothing stored),
 //! one [`Case`] per way a file can attack, grouped by the categories of what must never happen (1 memory, 2 time,
 //! 3 non-finite numbers, 4 malformed files read as another rig, 5 control characters, 6 reading outside the file's
 //! folder, 8 leniency; category 7, a scanned library, is built from these by the test).
@@ -42,16 +42,16 @@ pub struct Case {
 }
 
 impl Case {
-    fn new(name: &'static str, category: u8, main: &'static str, bytes: Vec<u8>, expect: Expect) -> Self {
+    pub fn new(name: &'static str, category: u8, main: &'static str, bytes: Vec<u8>, expect: Expect) -> Self {
         Case { name, category, main, entries: vec![(main, Entry::File(bytes))], expect, huge: false }
     }
 
-    fn huge(mut self) -> Self {
+    pub fn huge(mut self) -> Self {
         self.huge = true;
         self
     }
 
-    fn with(mut self, name: &'static str, entry: Entry) -> Self {
+    pub fn with(mut self, name: &'static str, entry: Entry) -> Self {
         self.entries.push((name, entry));
         self
     }
@@ -90,6 +90,7 @@ pub fn all() -> Vec<Case> {
     cases.extend(control_characters());
     cases.extend(outside_the_folder());
     cases.extend(leniency());
+    cases.extend(super::usd::cases());
     cases
 }
 
@@ -452,7 +453,7 @@ fn malformed() -> Vec<Case> {
 // 5. Control characters
 
 /// A name meant to retitle and clear a terminal, with a NUL and a line break, and long.
-const EVIL: &str = "\u{1b}]0;pwned\u{7}\u{1b}[2J\u{0}line\nbreak\r";
+pub const EVIL: &str = "\u{1b}]0;pwned\u{7}\u{1b}[2J\u{0}line\nbreak\r";
 
 fn control_characters() -> Vec<Case> {
     let long = format!("{EVIL}{}", "x".repeat(10_000));

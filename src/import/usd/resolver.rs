@@ -1,7 +1,9 @@
 //! Finding the assets a stage names (sublayers, references, payloads) as USD's default resolver does, but only
-//! inside the root layer's folder: a file may not make bonescope read anything outside it.
+//! inside the root layer's folder: a file may not make bonescope read anything outside it. Only regular files are
+//! read (a pipe would block, a device never end), and a text layer nested deeper than any scene is refused before
+//! it is parsed (the parser recurses into each level: a hundred thousand of them overflow the stack).
 
-use std::io;
+use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 
 use openusd::ar::{Asset, DefaultResolver, ResolvedPath, Resolver};
@@ -42,14 +44,94 @@ impl Resolver for FolderResolver {
     }
 
     fn open_asset(&self, resolved: &ResolvedPath) -> io::Result<Box<dyn Asset>> {
+        let text = resolved.to_string_lossy();
         if !self.inside(resolved) {
-            let message = format!("{} is outside the file's folder: not read", resolved.to_string_lossy());
+            let message = format!("{text} is outside the file's folder: not read");
             return Err(io::Error::new(io::ErrorKind::PermissionDenied, message));
         }
-        self.inner.open_asset(resolved)
+        let outer = text.split_once('[').map_or(&*text, |(package, _)| package);
+        if !std::fs::metadata(outer)?.is_file() {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("{outer} is not a regular file")));
+        }
+        let mut asset = self.inner.open_asset(resolved)?;
+        let mut bytes = Vec::new();
+        asset.read_to_end(&mut bytes)?;
+        if bytes.starts_with(b"#usda") {
+            check_nesting(&bytes).map_err(|message| io::Error::new(io::ErrorKind::InvalidData, message))?;
+        }
+        Ok(Box::new(io::Cursor::new(bytes)))
     }
 
     fn identity(&self) -> String {
         format!("bonescope folder {}", self.folder.display())
+    }
+}
+
+/// How deep a text layer's brackets may nest: a prim is one level, its metadata and values a few more.
+const MAX_NESTING: usize = 256;
+
+/// Refuses a text layer whose `{`, `(` and `[` nest deeper than [`MAX_NESTING`] (outside strings, asset paths and
+/// comments), naming the line.
+fn check_nesting(text: &[u8]) -> Result<(), String> {
+    let (mut depth, mut line, mut i) = (0usize, 1usize, 0usize);
+    while let Some(&byte) = text.get(i) {
+        match byte {
+            b'\n' => line += 1,
+            b'{' | b'(' | b'[' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(format!("line {line}: brackets nested deeper than {MAX_NESTING} levels"));
+                }
+            }
+            b'}' | b')' | b']' => depth = depth.saturating_sub(1),
+            b'#' => {
+                // On to the line's end, which is counted as any other.
+                i = skip_past(text, i, b"\n").saturating_sub(1).max(i + 1);
+                continue;
+            }
+            b'"' | b'\'' | b'@' => {
+                let quote = &text[i..i + if text[i..].starts_with(&[byte; 3]) { 3 } else { 1 }];
+                let end = skip_past(text, i + quote.len(), quote);
+                line += text[i..end.min(text.len())].iter().filter(|&&b| b == b'\n').count();
+                i = end.saturating_sub(1);
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    Ok(())
+}
+
+/// The index just past the first `end` at or after `from` (a backslash escapes the byte after it); the text's length
+/// where there is none.
+fn skip_past(text: &[u8], from: usize, end: &[u8]) -> usize {
+    let mut i = from;
+    while i < text.len() {
+        if text[i] == b'\\' && end != b"\n" {
+            i += 2;
+        } else if text[i..].starts_with(end) {
+            return i + end.len();
+        } else {
+            i += 1;
+        }
+    }
+    text.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nesting_counts_brackets_outside_strings_paths_and_comments() {
+        let deep = |n: usize| format!("#usda 1.0\n{}{}", "def X {\n".repeat(n), "}\n".repeat(n));
+        assert!(check_nesting(deep(MAX_NESTING).as_bytes()).is_ok());
+        assert_eq!(
+            check_nesting(deep(MAX_NESTING + 1).as_bytes()),
+            Err(format!("line {}: brackets nested deeper than {MAX_NESTING} levels", MAX_NESTING + 2))
+        );
+        let quoted = "#usda 1.0 {{{\ndef X \"{{{{\" ( doc = \"\"\"{{\n\\\"\"\"\" ) { asset a = @{{@ }\n# {{{{\n";
+        let inside = quoted.replace("{{", &"{".repeat(MAX_NESTING));
+        assert!(check_nesting(inside.as_bytes()).is_ok(), "{inside}");
     }
 }

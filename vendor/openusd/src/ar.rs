@@ -409,6 +409,14 @@ impl Resolver for DefaultResolver {
 
             let mut archive = open_package_archive(Path::new(&package))?;
             let mut entry = archive.by_name(&inner).map_err(io::Error::other)?;
+            // bonescope: USDZ stores its entries uncompressed (Pixar's reader reads no other), so an entry is no
+            // larger than the package; a compressed one could expand without bound (a zip bomb).
+            if entry.compression() != zip::CompressionMethod::Stored {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("{inner} in {package} is compressed; USDZ entries are stored uncompressed"),
+                ));
+            }
 
             let mut buffer = Vec::new();
             entry.read_to_end(&mut buffer)?;

@@ -3131,10 +3131,18 @@ impl Stage {
     /// inactive, unloaded, undefined, or abstract prims when the predicate
     /// excludes those regions.
     pub fn traverse(&self, predicate: PrimPredicate, mut visitor: impl FnMut(&sdf::Path)) -> Result<()> {
+        // bonescope: see the check below.
+        const MAX_NAMESPACE_DEPTH: usize = 128;
         let needed = predicate.consulted_bits();
         let mut stack = vec![sdf::Path::abs_root()];
 
         while let Some(path) = stack.pop() {
+            // bonescope: composing a prim costs time that grows with the cube of its depth; a file that nests prims
+            // deeper than any scene does is refused rather than composed for minutes.
+            if path.as_str().bytes().filter(|&b| b == b'/').count() > MAX_NAMESPACE_DEPTH {
+                let top = path.as_str().split('/').nth(1).unwrap_or_default();
+                anyhow::bail!("prims nested deeper than {MAX_NAMESPACE_DEPTH} levels, under /{top}");
+            }
             if path != sdf::Path::abs_root() {
                 // TODO(perf): each `prim_status_masked` call recomputes the
                 // inherited bits (active/loaded/defined/abstract/model) by
