@@ -7,6 +7,8 @@
 mod corpus;
 #[path = "../tests/hostile/gltf.rs"]
 mod gltf;
+#[path = "../tests/hostile/usd.rs"]
+mod usd;
 
 use std::path::Path;
 
