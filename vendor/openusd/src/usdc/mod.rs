@@ -5,6 +5,7 @@ use std::{borrow::Cow, cell::RefCell, collections::HashMap, fmt::Debug, io, mem,
 use anyhow::{Context, Result};
 use layout::ValueRep;
 
+pub mod budget;
 mod coding;
 mod layout;
 mod reader;

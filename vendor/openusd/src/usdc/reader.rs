@@ -570,6 +570,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
 
         // Decompress to output buffer (bonescope: no larger than the input can expand to).
         let most = input.len().saturating_mul(LZ4_MAX_RATIO) / mem::size_of::<T>().max(1) + 1;
+        super::budget::charge(estimated_count.min(most), mem::size_of::<T>())?;
         let mut output = vec![T::default(); estimated_count.min(most)];
         let actual_size = decompress_lz4(&input, cast_slice_mut(&mut output))?;
 
@@ -1558,7 +1559,9 @@ impl<R: io::Read> ReadExt for R {
         }
 
         // bonescope: a count from the file is believed only as far as the bytes that follow bear it out: read in
-        // chunks, so that a header claiming a huge array fails at the end of the data instead of allocating first.
+        // chunks, so that a header claiming a huge array fails at the end of the data instead of allocating first;
+        // and it is charged to the budget before anything is read.
+        super::budget::charge(count, mem::size_of::<T>())?;
         let chunk = (1 << 24) / mem::size_of::<T>().max(1);
         let mut vec: Vec<T> = Vec::new();
         while vec.len() < count {
