@@ -3,7 +3,7 @@
 //! read (a pipe would block, a device never end), and a text layer nested deeper than any scene is refused before
 //! it is parsed (the parser recurses into each level: a hundred thousand of them overflow the stack).
 
-use std::io::{self, Read};
+use std::io::{self, Read, Seek};
 use std::path::{Path, PathBuf};
 
 use openusd::ar::{Asset, DefaultResolver, ResolvedPath, Resolver};
@@ -54,12 +54,16 @@ impl Resolver for FolderResolver {
             return Err(io::Error::new(io::ErrorKind::InvalidInput, format!("{outer} is not a regular file")));
         }
         let mut asset = self.inner.open_asset(resolved)?;
-        let mut bytes = Vec::new();
-        asset.read_to_end(&mut bytes)?;
-        if bytes.starts_with(b"#usda") {
-            check_nesting(&bytes).map_err(|message| io::Error::new(io::ErrorKind::InvalidData, message))?;
+        let mut magic = [0u8; 5];
+        let read = asset.read(&mut magic)?;
+        asset.seek(io::SeekFrom::Start(0))?;
+        if magic[..read] != *b"#usda" {
+            return Ok(asset);
         }
-        Ok(Box::new(io::Cursor::new(bytes)))
+        let mut text = Vec::new();
+        asset.read_to_end(&mut text)?;
+        check_nesting(&text).map_err(|message| io::Error::new(io::ErrorKind::InvalidData, message))?;
+        Ok(Box::new(io::Cursor::new(text)))
     }
 
     fn identity(&self) -> String {

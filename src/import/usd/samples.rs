@@ -6,6 +6,8 @@
 //! normalised. The `openusd` crate rounds once and normalises a near-linear slerp: the same within the
 //! precision of a `float`, not to the bit UsdSkel computes.
 
+use std::borrow::Cow;
+
 use glam::{Quat, Vec3};
 use openusd::gf::{self, f16};
 use openusd::sdf::Value;
@@ -84,7 +86,7 @@ impl Channel {
     /// The numbers at time code `code` (`None` for a vector or rotation channel).
     pub fn numbers(&self, code: f64) -> Option<Vec<f32>> {
         match self {
-            Channel::Float(s) => Some(s.at(code)),
+            Channel::Float(s) => Some(s.at(code).into_owned()),
             _ => None,
         }
     }
@@ -108,33 +110,50 @@ impl Channel {
 
     /// The time codes of its samples.
     pub fn codes(&self) -> Vec<f64> {
-        fn codes<T>(s: &Samples<T>) -> Vec<f64> {
-            s.0.iter().map(|(c, _)| *c).collect()
+        each!(self, s => s.0.iter().map(|(c, _)| *c).collect())
+    }
+
+    /// Whether element `index` of every sample's array (each of length `len`) is the same: held throughout.
+    pub fn holds(&self, index: usize, len: usize) -> bool {
+        each!(self, s => s.holds(index, len))
+    }
+}
+
+/// `$body` with `$s` bound to the samples of whichever type `$channel` holds.
+macro_rules! each {
+    ($channel:expr, $s:ident => $body:expr) => {
+        match $channel {
+            Channel::Half3($s) => $body,
+            Channel::Float3($s) => $body,
+            Channel::Double3($s) => $body,
+            Channel::Quath($s) => $body,
+            Channel::Quatf($s) => $body,
+            Channel::Quatd($s) => $body,
+            Channel::Float($s) => $body,
         }
-        match self {
-            Channel::Half3(s) => codes(s),
-            Channel::Float3(s) => codes(s),
-            Channel::Double3(s) => codes(s),
-            Channel::Quath(s) => codes(s),
-            Channel::Quatf(s) => codes(s),
-            Channel::Quatd(s) => codes(s),
-            Channel::Float(s) => codes(s),
-        }
+    };
+}
+use each;
+
+impl<T: PartialEq> Samples<T> {
+    fn holds(&self, index: usize, len: usize) -> bool {
+        let first = self.0.first().and_then(|(_, a)| a.get(index));
+        self.0.iter().all(|(_, array)| array.len() == len && array.get(index) == first)
     }
 }
 
 impl<T: Mix> Samples<T> {
-    /// The array at time code `code`.
-    fn at(&self, code: f64) -> Vec<T> {
+    /// The array at time code `code`: a sample's own (borrowed) at its time and outside the samples, else mixed.
+    fn at(&self, code: f64) -> Cow<'_, [T]> {
         let samples = &self.0;
         let next = samples.partition_point(|(c, _)| *c <= code);
         match (next.checked_sub(1).map(|i| &samples[i]), samples.get(next)) {
             (Some((c0, a)), Some((c1, b))) if *c0 != code && a.len() == b.len() => {
                 let t = (code - c0) / (c1 - c0);
-                a.iter().zip(b).map(|(a, b)| T::mix(a, b, t)).collect()
+                Cow::Owned(a.iter().zip(b).map(|(a, b)| T::mix(a, b, t)).collect())
             }
-            (Some((_, a)), _) | (None, Some((_, a))) => a.clone(),
-            (None, None) => Vec::new(),
+            (Some((_, a)), _) | (None, Some((_, a))) => Cow::Borrowed(a),
+            (None, None) => Cow::Borrowed(&[]),
         }
     }
 }

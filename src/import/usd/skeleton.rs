@@ -208,26 +208,16 @@ fn animation(
     check_budget(codes.len(), mapped.len() + shape_names.len().div_ceil(10))?;
     let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
     let n = mapped.len();
-    let (mut translations, mut rotations, mut scales) = (vec![Vec::new(); n], vec![Vec::new(); n], vec![Vec::new(); n]);
     let [translated, rotated, scaled] = &channels;
-    for &code in &codes {
-        // An array of another length than the joints' is no value for them: the identity.
-        let t = translated.as_ref().and_then(|c| c.vectors(code)).filter(|v| v.len() == n);
-        let r = rotated.as_ref().and_then(|c| c.rotations(code)).filter(|v| v.len() == n);
-        let s = scaled.as_ref().and_then(|c| c.vectors(code)).filter(|v| v.len() == n);
-        for a in 0..n {
-            translations[a].push(t.as_ref().map_or(Vec3::ZERO, |t| t[a]));
-            rotations[a].push(r.as_ref().map_or(Quat::IDENTITY, |r| r[a]));
-            scales[a].push(s.as_ref().map_or(Vec3::ONE, |s| s[a]));
-        }
-    }
+    let translations = channel_tracks(translated.as_ref(), Channel::vectors, Vec3::ZERO, &codes, &times, n)?;
+    let rotations = channel_tracks(rotated.as_ref(), Channel::rotations, Quat::IDENTITY, &codes, &times, n)?;
+    let scales = channel_tracks(scaled.as_ref(), Channel::vectors, Vec3::ONE, &codes, &times, n)?;
     let mut tracks = Vec::new();
-    for (a, joint) in mapped.iter().enumerate() {
+    let joint_tracks = translations.into_iter().zip(rotations).zip(scales);
+    for (joint, ((translation, rotation), scale)) in mapped.iter().zip(joint_tracks) {
         let Some(j) = joint.filter(|&j| j < joints.len()) else { continue };
         let mut bone = BoneTracks::new(first + j);
-        bone.translation = Some(linear(&times, std::mem::take(&mut translations[a]))?);
-        bone.rotation = Some(linear(&times, std::mem::take(&mut rotations[a]))?);
-        bone.scale = Some(linear(&times, std::mem::take(&mut scales[a]))?);
+        (bone.translation, bone.rotation, bone.scale) = (Some(translation), Some(rotation), Some(scale));
         bone.stretch = Some(DQuat::IDENTITY);
         tracks.push(bone);
     }
@@ -245,6 +235,40 @@ fn animation(
 /// A track of `values` at `times`, linear between them (slerp for rotations), as UsdSkel reads them.
 fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, String> {
     Track::new(times.clone(), values, Interpolation::Linear).map_err(|e| e.to_string())
+}
+
+/// One channel's track for each of the animation's `joints` at `codes` (`times` their seconds): the value `read`
+/// gives there, `identity` where the channel has none or an array of another length. A joint whose samples all hold
+/// one value (an offset, most scales) is one key: a clip the size of its motion. (Between two equal samples USD's
+/// rounding may read a value a rounding step off; held, bonescope reads the value itself.)
+fn channel_tracks<T: KeyValue>(
+    channel: Option<&Channel>,
+    read: impl Fn(&Channel, f64) -> Option<Vec<T>>,
+    identity: T,
+    codes: &[f64],
+    times: &Arc<[f64]>,
+    joints: usize,
+) -> Result<Vec<Track<T>>, String> {
+    let at = |code: f64| channel.and_then(|c| read(c, code)).filter(|v| v.len() == joints);
+    let held: Vec<bool> = (0..joints).map(|a| channel.is_none_or(|c| c.holds(a, joints))).collect();
+    let mut moving: Vec<Vec<T>> =
+        held.iter().map(|&h| if h { Vec::new() } else { Vec::with_capacity(codes.len()) }).collect();
+    if held.contains(&false) {
+        for &code in codes {
+            let values = at(code);
+            for (a, track) in moving.iter_mut().enumerate().filter(|(a, _)| !held[*a]) {
+                track.push(values.as_ref().map_or(identity, |v| v[a]));
+            }
+        }
+    }
+    let first = at(codes[0]);
+    let once: Arc<[f64]> = Arc::from(&times[..1]);
+    let track = |(a, values): (usize, Vec<T>)| {
+        let value = || first.as_ref().map_or(identity, |v| v[a]);
+        let (times, values) = if held[a] { (once.clone(), vec![value()]) } else { (times.clone(), values) };
+        Track::new(times, values, Interpolation::Linear).map_err(|e| e.to_string())
+    };
+    moving.into_iter().enumerate().map(track).collect()
 }
 
 /// The animation a skeleton plays: the target of the nearest `skel:animationSource` on it or an ancestor (a
