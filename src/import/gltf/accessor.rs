@@ -8,11 +8,13 @@
 //! [`MAX_ZEROS`] bytes so a tiny hostile file cannot ask for gigabytes.
 
 use std::borrow::Cow;
+use std::cell::OnceCell;
 use std::ops::Range;
 
 use glam::{DMat4, Quat, Vec3};
 
 use super::buffers::Buffers;
+use super::meshopt;
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
 
@@ -100,11 +102,13 @@ const INDICES: Use = Use { what: "indices", kind: "SCALAR", components: VERTEX_I
 pub(super) struct Accessors<'a> {
     root: &'a Root,
     buffers: &'a Buffers<'a>,
+    /// Per buffer view, its bytes once decoded, where `EXT_meshopt_compression` compresses it.
+    decoded: Vec<OnceCell<std::result::Result<Vec<u8>, String>>>,
 }
 
 impl<'a> Accessors<'a> {
     pub fn new(root: &'a Root, buffers: &'a Buffers<'a>) -> Self {
-        Accessors { root, buffers }
+        Accessors { root, buffers, decoded: root.buffer_views.iter().map(|_| OnceCell::new()).collect() }
     }
 
     /// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
@@ -161,7 +165,8 @@ impl<'a> Accessors<'a> {
         let accessor = self.root.accessors.get(index.0)?;
         let sparse = accessor.sparse.iter().flat_map(|s| [s.indices.buffer_view, s.values.buffer_view]);
         let views = accessor.buffer_view.into_iter().chain(sparse);
-        let buffers = views.filter_map(|v| self.root.buffer_views.get(v.0)).map(|view| view.buffer);
+        let buffer = |view: &schema::BufferView| view.extensions.meshopt.as_ref().map_or(view.buffer, |c| c.buffer);
+        let buffers = views.filter_map(|v| self.root.buffer_views.get(v.0)).map(buffer);
         buffers.into_iter().find(|&b| !self.buffers.has_source(b))
     }
 
@@ -244,7 +249,7 @@ impl<'a> Accessors<'a> {
         layout: Layout,
         strided: bool,
         place: &str,
-    ) -> Result<Elements<'a>> {
+    ) -> Result<Elements<'_>> {
         let view = schema::item(&self.root.buffer_views, view_index, "bufferViews", place)?;
         let view_place = format!("bufferViews[{}]", view_index.0);
         let view_range = self.view_range(view, &view_place, place)?;
@@ -271,12 +276,43 @@ impl<'a> Accessors<'a> {
             );
             return Err(Failure::at(place, message));
         };
-        let bytes = self.buffers.read(view.buffer, view_range.start + offset..view_range.start + end, place)?;
+        let range = view_range.start + offset..view_range.start + end;
+        let bytes = match &view.extensions.meshopt {
+            Some(compressed) => Cow::Borrowed(&self.decoded(view_index, compressed, place)?[range]),
+            None => self.buffers.read(view.buffer, range, place)?,
+        };
         Ok(Elements { bytes, stride, layout })
     }
 
-    /// Where a buffer view (at `place`) lies in its buffer, checked to lie inside it; `user` needs it.
+    /// The bytes `bufferViews[index]` decodes to under `EXT_meshopt_compression`, decoded on first use.
+    fn decoded(&self, index: Uint, compressed: &meshopt::Compressed, user: &str) -> Result<&[u8]> {
+        let place = format!("bufferViews[{}].extensions.EXT_meshopt_compression", index.0);
+        let decoded = self.decoded[index.0].get_or_init(|| {
+            let (offset, length) = (compressed.byte_offset.0, compressed.byte_length.0);
+            let range = offset..offset.checked_add(length).ok_or("byteOffset + byteLength overflows")?;
+            let buffer_len = self.buffers.len(compressed.buffer, &place).map_err(|f| f.message)?;
+            if range.end > buffer_len {
+                return Err(format!(
+                    "bytes {}..{} lie outside buffers[{}]",
+                    range.start, range.end, compressed.buffer.0
+                ));
+            }
+            let encoded = self.buffers.read(compressed.buffer, range, &place).map_err(|f| f.message)?;
+            compressed.decode(&encoded)
+        });
+        decoded.as_deref().map_err(|why| Failure::at(user, format!("{place}: {why}")))
+    }
+
+    /// Where a buffer view (at `place`) lies in its buffer, checked to lie inside it; `user` needs it. A view
+    /// `EXT_meshopt_compression` compresses is its decoded bytes, `count × byteStride` from 0.
     fn view_range(&self, view: &schema::BufferView, place: &str, user: &str) -> Result<Range<usize>> {
+        if let Some(compressed) = &view.extensions.meshopt {
+            let length = compressed.decoded_len().filter(|&n| n == view.byte_length.0);
+            return length.map(|n| 0..n).ok_or_else(|| {
+                let message = format!("decodes to count × byteStride bytes, not its byteLength {}", view.byte_length.0);
+                Failure::at(place, message)
+            });
+        }
         let buffer_len = self.buffers.len(view.buffer, user)?;
         let (offset, length) = (view.byte_offset.0, view.byte_length.0);
         offset.checked_add(length).filter(|&end| end <= buffer_len).map(|end| offset..end).ok_or_else(|| {

@@ -9,12 +9,14 @@ use super::accessor::Accessors;
 use super::scene::SceneBones;
 use super::schema::{self, Root};
 use super::{Failure, Result};
-use crate::model::{Mesh, MorphTarget, Skin};
+use crate::model::{Mesh, MorphTarget, Skeleton, Skin};
 
 /// How far the last row of an inverse bind matrix, stored in single precision, may be from `0, 0, 0, 1`.
 const AFFINE_TOLERANCE: f64 = 1e-6;
 
 /// glTF's `mode`s of triangles: lists (the default), strips and fans.
+/// glTF's `componentType` of floats.
+const FLOAT: usize = 5126;
 const TRIANGLES: usize = 4;
 const TRIANGLE_STRIP: usize = 5;
 const TRIANGLE_FAN: usize = 6;
@@ -134,6 +136,10 @@ pub(super) fn read_meshes(
             };
             let mut read = Mesh { name, bone, ..Mesh::default() };
             read.positions = positions(primitive, accessors, &place)?;
+            if skin.is_some() && quantized_positions(root, primitive) {
+                dequantize_by_node(&mut read.positions, &scene.skeleton, bone);
+                tally.dequantized_by_node += 1;
+            }
             read.normals = normals(primitive, accessors, read.positions.len(), &place).unwrap_or_else(|failure| {
                 unread_normals.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
                 Vec::new()
@@ -183,6 +189,8 @@ struct Tally {
     incomplete: Vec<String>,
     /// Primitives with triangles that index past their vertices, and how many such triangles each dropped.
     out_of_range: Vec<(String, usize)>,
+    /// Skinned primitives whose quantized positions were put where their node is.
+    dequantized_by_node: usize,
 }
 
 impl Tally {
@@ -217,6 +225,13 @@ impl Tally {
             notes
                 .push(format!("indices that do not make whole triangles: the incomplete last one left out ({places})"));
         }
+        if self.dequantized_by_node > 0 {
+            notes.push(format!(
+                "{} skinned primitives with quantized positions are bound where their node puts them, as three.js \
+                 and Babylon.js bind them (the specification has a skinned mesh ignore its node)",
+                self.dequantized_by_node
+            ));
+        }
         if !self.out_of_range.is_empty() {
             let places: Vec<String> =
                 self.out_of_range.iter().map(|(place, dropped)| format!("{dropped} in {place}")).collect();
@@ -232,6 +247,27 @@ const GEOMETRY: [&str; 5] = ["POSITION", "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "W
 fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Option<schema::Uint> {
     let attributes = GEOMETRY.into_iter().filter_map(|a| primitive.attributes.get(a));
     attributes.copied().chain(primitive.indices).find_map(|accessor| accessors.unsupplied_buffer(accessor))
+}
+
+/// Whether the primitive's `POSITION` is integers (`KHR_mesh_quantization`), which need a transform to mean lengths.
+fn quantized_positions(root: &Root, primitive: &schema::Primitive) -> bool {
+    let accessor = primitive.attributes.get("POSITION").and_then(|a| root.accessors.get(a.0));
+    accessor.is_some_and(|a| a.component_type.0 != FLOAT)
+}
+
+/// Quantized positions of a skinned mesh, put where its node's transform at rest puts them. The specification has
+/// a skinned mesh ignore its node, so a quantizer (gltfpack) that puts the dequantization on the node relies on what
+/// renderers do: three.js and Babylon.js bind a skinned mesh where its node is when the file is read.
+fn dequantize_by_node(positions: &mut [glam::Vec3], skeleton: &Skeleton, bone: usize) {
+    let mut node = glam::DMat4::IDENTITY;
+    let mut current = Some(bone);
+    while let Some(b) = current {
+        node = skeleton.bone(b).rest.matrix() * node;
+        current = skeleton.parent(b);
+    }
+    for p in positions {
+        *p = node.transform_point3(p.as_dvec3()).as_vec3();
+    }
 }
 
 fn positions(primitive: &schema::Primitive, accessors: &Accessors, place: &str) -> Result<Vec<glam::Vec3>> {

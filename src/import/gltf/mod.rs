@@ -14,6 +14,7 @@ mod buffers;
 mod document;
 mod estimate;
 mod mesh;
+mod meshopt;
 mod scene;
 mod schema;
 mod source;

@@ -246,6 +246,15 @@ pub(super) struct BufferView {
     pub byte_length: Uint,
     #[serde(default)]
     pub byte_stride: Option<Uint>,
+    #[serde(default)]
+    pub extensions: ViewExtensions,
+}
+
+/// The extensions of a buffer view bonescope reads.
+#[derive(Debug, Default, Deserialize)]
+pub(super) struct ViewExtensions {
+    #[serde(rename = "EXT_meshopt_compression", default)]
+    pub meshopt: Option<super::meshopt::Compressed>,
 }
 
 #[derive(Debug, Deserialize)]
