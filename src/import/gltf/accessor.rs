@@ -14,9 +14,9 @@ use std::ops::Range;
 use glam::{DMat4, Quat, Vec3};
 
 use super::buffers::Buffers;
-use super::meshopt;
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
+use super::{draco, meshopt};
 
 /// The most bytes of elements an accessor may hold without a buffer view behind them.
 pub(super) const MAX_ZEROS: usize = 64 << 20;
@@ -104,11 +104,42 @@ pub(super) struct Accessors<'a> {
     buffers: &'a Buffers<'a>,
     /// Per buffer view, its bytes once decoded, where `EXT_meshopt_compression` compresses it.
     decoded: Vec<OnceCell<std::result::Result<Vec<u8>, String>>>,
+    /// Per accessor, the bytes a `KHR_draco_mesh_compression` primitive decoded for it (tightly packed).
+    supplied: Vec<OnceCell<Vec<u8>>>,
 }
 
 impl<'a> Accessors<'a> {
     pub fn new(root: &'a Root, buffers: &'a Buffers<'a>) -> Self {
-        Accessors { root, buffers, decoded: root.buffer_views.iter().map(|_| OnceCell::new()).collect() }
+        let decoded = root.buffer_views.iter().map(|_| OnceCell::new()).collect();
+        Accessors { root, buffers, decoded, supplied: root.accessors.iter().map(|_| OnceCell::new()).collect() }
+    }
+
+    /// Decodes a Draco-compressed primitive (at `place`): its accessors then read what it decodes to.
+    pub fn supply_draco(
+        &self,
+        primitive: &schema::Primitive,
+        compressed: &draco::Compressed,
+        place: &str,
+    ) -> Result<()> {
+        let place = format!("{place}.extensions.KHR_draco_mesh_compression");
+        let stream = self.view(compressed.buffer_view, &place)?;
+        let supplied = draco::decode(&stream, compressed, primitive, self.root, crate::import::budget::limit())
+            .map_err(|why| Failure::at(&place, why))?;
+        for (accessor, bytes) in supplied {
+            // An accessor two primitives share keeps the first one's bytes.
+            let _ = self.supplied.get(accessor).map(|cell| cell.set(bytes));
+        }
+        Ok(())
+    }
+
+    /// The whole of `bufferViews[index]`, for `user`.
+    fn view(&self, index: Uint, user: &str) -> Result<Cow<'_, [u8]>> {
+        let view = schema::item(&self.root.buffer_views, index, "bufferViews", user)?;
+        let range = self.view_range(view, &format!("bufferViews[{}]", index.0), user)?;
+        match &view.extensions.meshopt {
+            Some(compressed) => Ok(Cow::Borrowed(&self.decoded(index, compressed, user)?[range])),
+            None => self.buffers.read(view.buffer, range, user),
+        }
     }
 
     /// Keyframe times (`SCALAR` float), widened to seconds in `f64`.
@@ -183,6 +214,14 @@ impl<'a> Accessors<'a> {
         let place = format!("accessors[{}]", index.0);
         let data_type = check_type(accessor, usage, &place)?;
         let count = accessor.count.0;
+        let layout = Layout { data_type, normalized: accessor.normalized, components: N };
+        if let Some(bytes) = self.supplied[index.0].get() {
+            if bytes.len() != count * layout.element_size() {
+                return Err(Failure::at(place, "the Draco stream decoded to another size than its count"));
+            }
+            let elements = Elements { bytes: Cow::Borrowed(bytes), stride: layout.element_size(), layout };
+            return Ok(elements.decode(&element));
+        }
         let mut elements = match accessor.buffer_view {
             Some(view) => {
                 let layout = Layout { data_type, normalized: accessor.normalized, components: N };

@@ -107,6 +107,8 @@ pub(super) fn read_meshes(
     // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
     let mut unread_normals = Vec::new();
     let mut unsupplied = Vec::new();
+    // Draco streams that do not decode leave their primitive out, never the file.
+    let mut undecoded = Vec::new();
     for (bone, node_of_bone) in scene.skeleton.bones().iter().enumerate() {
         let node = &root.nodes[node_of_bone.node];
         let Some(mesh_index) = node.mesh else { continue };
@@ -134,6 +136,12 @@ pub(super) fn read_meshes(
                 1 => base.to_owned(),
                 _ => format!("{base}[{p}]"),
             };
+            if let Some(compressed) = &primitive.extensions.draco
+                && let Err(failure) = accessors.supply_draco(primitive, compressed, &place)
+            {
+                undecoded.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
+                continue;
+            }
             let mut read = Mesh { name, bone, ..Mesh::default() };
             read.positions = positions(primitive, accessors, &place)?;
             if skin.is_some() && quantized_positions(root, primitive) {
@@ -170,6 +178,9 @@ pub(super) fn read_meshes(
             "not drawn, their data lies in buffers without a uri (to be supplied by an application): {}",
             unsupplied.join(", ")
         ));
+    }
+    if !undecoded.is_empty() {
+        notes.push(format!("not drawn, their Draco geometry does not decode: {}", undecoded.join("; ")));
     }
     Ok(meshes)
 }

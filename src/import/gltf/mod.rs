@@ -12,6 +12,7 @@ mod accessor;
 mod animation;
 mod buffers;
 mod document;
+mod draco;
 mod estimate;
 mod mesh;
 mod meshopt;

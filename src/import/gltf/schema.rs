@@ -140,6 +140,14 @@ pub(super) struct Primitive {
     pub mode: Option<Uint>,
     /// Morph targets: displaced attributes per target.
     pub targets: Vec<Attributes>,
+    pub extensions: PrimitiveExtensions,
+}
+
+/// The extensions of a primitive bonescope reads.
+#[derive(Debug, Default, Deserialize)]
+pub(super) struct PrimitiveExtensions {
+    #[serde(rename = "KHR_draco_mesh_compression", default)]
+    pub draco: Option<super::draco::Compressed>,
 }
 
 #[derive(Debug, Deserialize, Default)]
