@@ -2,6 +2,10 @@
 //! mutated files that must fail cleanly instead of panicking.
 
 mod common;
+// The hostile corpus's glTF writer; this file uses a part of it.
+#[allow(dead_code)]
+#[path = "hostile/gltf.rs"]
+mod gltf_writer;
 
 use std::collections::{BTreeSet, HashSet};
 use std::path::Path;
@@ -1046,4 +1050,32 @@ fn morph_targets_displace_vertices_with_their_default_and_animated_weights() {
     assert_eq!(positions(clip, 0.25), expect([0.5, 0.5]), "halfway to the second key");
     assert_eq!(positions(clip, 0.75), expect([1.0, 0.75]));
     assert_eq!(positions(clip, 2.0), expect([1.0, 0.5]), "the last key holds");
+}
+
+#[test]
+fn gpu_instances_are_each_a_mesh_where_their_transform_puts_it() {
+    // A triangle drawn twice by `EXT_mesh_gpu_instancing` under a node 1 m up: once moved 2 m along X, once turned a
+    // quarter about Z and scaled 3×. Hand-derived: (1, 0, 0) lands at (3, 1, 0) and at (0, 4, 0).
+    let mut g = gltf_writer::Gltf::new();
+    let position = g.triangle_positions();
+    let mesh = g.mesh(json!({"attributes": {"POSITION": position}}));
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let translation = g.floats(&[2.0, 0.0, 0.0, 0.0, 0.0, 0.0], "VEC3", 3);
+    let rotation = g.floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, h, h], "VEC4", 4);
+    let scale = g.floats(&[1.0, 1.0, 1.0, 3.0, 3.0, 3.0], "VEC3", 3);
+    let attributes = json!({"TRANSLATION": translation, "ROTATION": rotation, "SCALE": scale});
+    g.node(json!({"mesh": mesh, "translation": [0.0, 1.0, 0.0], "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attributes}}}));
+    g.json["extensionsRequired"] = json!(["EXT_mesh_gpu_instancing"]);
+    let dir = tempfile::tempdir().unwrap();
+    let rig = load_file(dir.path(), "instanced.glb", &g.glb()).unwrap();
+    assert_eq!(rig.meshes.len(), 2);
+    let evaluation = bonescope::eval::Evaluation::declared(&rig, None);
+    let pose = evaluation.pose_at(0.0);
+    let corner = |mesh: usize| {
+        let mut points = Vec::new();
+        evaluation.skin(&pose, mesh, &mut points);
+        points[1]
+    };
+    assert!(corner(0).distance(DVec3::new(3.0, 1.0, 0.0)) < 1e-6, "{}", corner(0));
+    assert!(corner(1).distance(DVec3::new(0.0, 4.0, 0.0)) < 1e-6, "{}", corner(1));
 }

@@ -20,8 +20,13 @@ const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// Extensions bonescope evaluates.
-const EVALUATED: &[&str] =
-    &["KHR_mesh_quantization", "KHR_animation_pointer", "EXT_meshopt_compression", "KHR_draco_mesh_compression"];
+const EVALUATED: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_animation_pointer",
+    "EXT_meshopt_compression",
+    "KHR_draco_mesh_compression",
+    "EXT_mesh_gpu_instancing",
+];
 /// Prefixes of extensions that only touch materials (`KHR_techniques_webgl`: shaders, and `KHR_technique_webgl`, its
 /// draft's singular name, which old exporters still write), textures, images or lights, which bonescope does not draw.
 const NOT_DRAWN: &[&str] = &[

@@ -100,8 +100,12 @@ fn clips(root: &Root) -> Part {
 /// Every mesh once per node showing it, as read and as skinned.
 fn meshes(root: &Root) -> Part {
     let mut instances: HashMap<usize, u64> = HashMap::new();
-    for mesh in root.nodes.iter().filter_map(|n| n.mesh) {
-        *instances.entry(mesh.0).or_default() += 1;
+    for node in &root.nodes {
+        let Some(mesh) = node.mesh else { continue };
+        // A node drawing its mesh once per `EXT_mesh_gpu_instancing` instance holds as many copies.
+        let instancing = node.extensions.gpu_instancing.as_ref();
+        let copies = instancing.and_then(|i| i.attributes.values().map(|&a| count(root, a)).max()).unwrap_or(1);
+        *instances.entry(mesh.0).or_default() += copies;
     }
     let mut total = 0u64;
     let mut largest = (0u64, 0usize, 0u64, 0u64);

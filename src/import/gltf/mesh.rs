@@ -120,6 +120,9 @@ pub(super) fn read_meshes(
             }
             None => None,
         };
+        let node_place = format!("nodes[{}].extensions.EXT_mesh_gpu_instancing", node_of_bone.node);
+        let instances =
+            node.extensions.gpu_instancing.as_ref().map(|i| instances(i, accessors, &node_place)).transpose()?;
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let mode = primitive.mode.map_or(TRIANGLES, |m| m.0);
             if !matches!(mode, TRIANGLES | TRIANGLE_STRIP | TRIANGLE_FAN) {
@@ -166,7 +169,10 @@ pub(super) fn read_meshes(
             let weights = node.weights.as_ref().unwrap_or(&mesh.weights);
             read.morph_weights =
                 (0..read.morph_targets.len()).map(|k| weights.get(k).map_or(0.0, |&w| w as f32)).collect();
-            meshes.push(read);
+            match &instances {
+                Some(instances) => meshes.extend(instances.iter().enumerate().map(|(k, m)| instance(&read, k, m))),
+                None => meshes.push(read),
+            }
         }
     }
     tally.notes(notes);
@@ -258,6 +264,43 @@ const GEOMETRY: [&str; 5] = ["POSITION", "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "W
 fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Option<schema::Uint> {
     let attributes = GEOMETRY.into_iter().filter_map(|a| primitive.attributes.get(a));
     attributes.copied().chain(primitive.indices).find_map(|accessor| accessors.unsupplied_buffer(accessor))
+}
+
+/// The transform of each instance `EXT_mesh_gpu_instancing` gives, within its node: `T · R · S`.
+fn instances(instancing: &schema::Instancing, accessors: &Accessors, place: &str) -> Result<Vec<DMat4>> {
+    let attribute = |name: &str| instancing.attributes.get(name).copied();
+    let user = |name: &str| format!("{place}.attributes.{name}");
+    let translations = attribute("TRANSLATION").map(|a| accessors.vec3s(a, &user("TRANSLATION"), "TRANSLATION"));
+    let rotations = attribute("ROTATION").map(|a| accessors.rotations(a, &user("ROTATION")));
+    let scales = attribute("SCALE").map(|a| accessors.vec3s(a, &user("SCALE"), "SCALE"));
+    let (translations, rotations, scales) = (translations.transpose()?, rotations.transpose()?, scales.transpose()?);
+    let counts = [translations.as_ref().map(Vec::len), rotations.as_ref().map(Vec::len), scales.as_ref().map(Vec::len)];
+    let count = counts.iter().flatten().max().copied().unwrap_or(0);
+    if counts.iter().flatten().any(|&c| c != count) {
+        return Err(Failure::at(place, format!("its attributes hold {counts:?} instances, not one count")));
+    }
+    Ok((0..count)
+        .map(|k| {
+            let t = translations.as_ref().map_or(glam::Vec3::ZERO, |t| t[k]);
+            let r = rotations.as_ref().map_or(glam::Quat::IDENTITY, |r| r[k].normalize());
+            let s = scales.as_ref().map_or(glam::Vec3::ONE, |s| s[k]);
+            DMat4::from_scale_rotation_translation(s.as_dvec3(), r.as_dquat(), t.as_dvec3())
+        })
+        .collect())
+}
+
+/// Instance `k` of `mesh`, moved by `transform` within its node: positions, morph displacements and normals.
+fn instance(mesh: &Mesh, k: usize, transform: &DMat4) -> Mesh {
+    let linear = glam::DMat3::from_mat4(*transform);
+    let normal = if linear.determinant() != 0.0 { linear.inverse().transpose() } else { linear };
+    let point = |p: &glam::Vec3| transform.transform_point3(p.as_dvec3()).as_vec3();
+    let mut moved = Mesh { name: format!("{}#{k}", mesh.name), ..mesh.clone() };
+    moved.positions = mesh.positions.iter().map(point).collect();
+    moved.normals = mesh.normals.iter().map(|n| (normal * n.as_dvec3()).normalize_or_zero().as_vec3()).collect();
+    for target in &mut moved.morph_targets {
+        target.offsets.iter_mut().for_each(|o| *o = (linear * o.as_dvec3()).as_vec3());
+    }
+    moved
 }
 
 /// Whether the primitive's `POSITION` is integers (`KHR_mesh_quantization`), which need a transform to mean lengths.

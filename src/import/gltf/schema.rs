@@ -117,6 +117,17 @@ pub(super) struct NodeExtensions {
     /// A light of `KHR_lights_punctual` on the node; as for cameras, only its presence counts.
     #[serde(rename = "KHR_lights_punctual")]
     pub lights_punctual: Option<de::IgnoredAny>,
+    /// `EXT_mesh_gpu_instancing`: the node's mesh drawn once per instance, each moved within the node.
+    #[serde(rename = "EXT_mesh_gpu_instancing")]
+    pub gpu_instancing: Option<Instancing>,
+}
+
+/// `EXT_mesh_gpu_instancing`: per instance, a translation, rotation and scale (`TRANSLATION`, `ROTATION`, `SCALE`
+/// accessors of one count; one missing is the identity).
+#[derive(Debug, Deserialize, Default)]
+#[serde(default)]
+pub(super) struct Instancing {
+    pub attributes: Attributes,
 }
 
 #[derive(Debug, Deserialize, Default)]
