@@ -132,6 +132,14 @@ impl<'a> Accessors<'a> {
         Ok(())
     }
 
+    /// Decodes the meshopt-compressed buffer view of `accessors[index]`, if it has one, so that a stream that does
+    /// not decode is known before the accessor is read.
+    pub fn decodes(&self, index: Uint, user: &str) -> Result<()> {
+        let view = self.root.accessors.get(index.0).and_then(|a| a.buffer_view);
+        let compressed = view.and_then(|v| Some((v, self.root.buffer_views.get(v.0)?.extensions.meshopt.as_ref()?)));
+        compressed.map_or(Ok(()), |(view, compressed)| self.decoded(view, compressed, user).map(|_| ()))
+    }
+
     /// The whole of `bufferViews[index]`, for `user`.
     fn view(&self, index: Uint, user: &str) -> Result<Cow<'_, [u8]>> {
         let view = schema::item(&self.root.buffer_views, index, "bufferViews", user)?;

@@ -107,7 +107,7 @@ pub(super) fn read_meshes(
     // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
     let mut unread_normals = Vec::new();
     let mut unsupplied = Vec::new();
-    // Draco streams that do not decode leave their primitive out, never the file.
+    // Compressed geometry that does not decode leaves its primitive out, never the file.
     let mut undecoded = Vec::new();
     for (bone, node_of_bone) in scene.skeleton.bones().iter().enumerate() {
         let node = &root.nodes[node_of_bone.node];
@@ -139,9 +139,7 @@ pub(super) fn read_meshes(
                 1 => base.to_owned(),
                 _ => format!("{base}[{p}]"),
             };
-            if let Some(compressed) = &primitive.extensions.draco
-                && let Err(failure) = accessors.supply_draco(primitive, compressed, &place)
-            {
+            if let Err(failure) = decompress(primitive, accessors, &place) {
                 undecoded.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
                 continue;
             }
@@ -186,7 +184,7 @@ pub(super) fn read_meshes(
         ));
     }
     if !undecoded.is_empty() {
-        notes.push(format!("not drawn, their Draco geometry does not decode: {}", undecoded.join("; ")));
+        notes.push(format!("not drawn, their compressed geometry does not decode: {}", undecoded.join("; ")));
     }
     Ok(meshes)
 }
@@ -264,6 +262,17 @@ const GEOMETRY: [&str; 5] = ["POSITION", "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "W
 fn unsupplied_buffer(primitive: &schema::Primitive, accessors: &Accessors) -> Option<schema::Uint> {
     let attributes = GEOMETRY.into_iter().filter_map(|a| primitive.attributes.get(a));
     attributes.copied().chain(primitive.indices).find_map(|accessor| accessors.unsupplied_buffer(accessor))
+}
+
+/// Decodes what the primitive's geometry holds compressed (a Draco stream, meshopt buffer views), so that a stream
+/// that does not decode leaves the primitive out instead of the file.
+fn decompress(primitive: &schema::Primitive, accessors: &Accessors, place: &str) -> Result<()> {
+    if let Some(compressed) = &primitive.extensions.draco {
+        return accessors.supply_draco(primitive, compressed, place);
+    }
+    let targets = primitive.targets.iter().flat_map(|t| t.values());
+    let used = primitive.attributes.values().chain(targets).chain(&primitive.indices);
+    used.map(|&accessor| accessors.decodes(accessor, place)).collect()
 }
 
 /// The transform of each instance `EXT_mesh_gpu_instancing` gives, within its node: `T · R · S`.
