@@ -272,7 +272,7 @@ fn decompress(primitive: &schema::Primitive, accessors: &Accessors, place: &str)
     }
     let targets = primitive.targets.iter().flat_map(|t| t.values());
     let used = primitive.attributes.values().chain(targets).chain(&primitive.indices);
-    used.map(|&accessor| accessors.decodes(accessor, place)).collect()
+    used.try_for_each(|&accessor| accessors.decodes(accessor, place))
 }
 
 /// The transform of each instance `EXT_mesh_gpu_instancing` gives, within its node: `T · R · S`.
