@@ -271,7 +271,7 @@ fn decompress(primitive: &schema::Primitive, accessors: &Accessors, place: &str)
         return accessors.supply_draco(primitive, compressed, place);
     }
     let targets = primitive.targets.iter().flat_map(|t| t.values());
-    let used = primitive.attributes.values().chain(targets).chain(&primitive.indices);
+    let mut used = primitive.attributes.values().chain(targets).chain(&primitive.indices);
     used.try_for_each(|&accessor| accessors.decodes(accessor, place))
 }
 
