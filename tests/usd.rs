@@ -185,42 +185,65 @@ fn world_points(python: &Path, file: &Path) -> Value {
 #[test]
 fn skinned_and_blend_shaped_points_are_pixars_baked_ones() {
     // Pixar's own tests bake their skinning and blend shapes with `UsdSkel.BakeSkinning` into
-    // `baseline/*.baked.usda`: the points bonescope deforms from the unbaked file are those, in the world, at every
-    // time code. (`GroundTruth` is Pixar's expected result written as animated points, a point cache bonescope reads
-    // at the start only: it is not compared.)
+    // `baseline/*.baked.usda`; Blender's exports are baked here the same way (`tests/usd/bake_skinning.py`). The points
+    // bonescope deforms from the unbaked file are those, in the world, at every time code. (`GroundTruth` is Pixar's
+    // expected result written as animated points, a point cache bonescope reads at the start only: not compared.)
     let Some(python) = usd_python() else { return };
     let folder = common::asset("usd-openusd/usdSkel/testenv/testUsdSkelBakeSkinning");
-    for name in ["lbs", "dqs", "blendshapes", "blendshapesWithNormals"] {
-        let rig = load_with(&folder.join(format!("{name}.usda")), &Options { space: Space::File }).unwrap();
-        let baked = world_points(&python, &folder.join(format!("baseline/{name}.baked.usda")));
-        let clip = rig.clips.first();
-        let rate = clip.map(|c| c.frame_rate()).unwrap_or(24.0);
-        let evaluation = Evaluation::declared(&rig, clip);
-        let size = evaluation.size(&evaluation.times(rate));
-        let start = baked["time_codes"][0].as_f64().unwrap();
-        let mut compared = 0;
-        // bonescope's meshes are the stage's, in its traversal order.
-        for (mesh, baked_mesh) in baked["meshes"].as_array().unwrap().iter().enumerate() {
-            let path = baked_mesh["path"].as_str().unwrap();
-            assert!(path.ends_with(&format!("/{}", rig.meshes[mesh].name)), "{path}");
-            if path.starts_with("/GroundTruth") {
-                continue;
-            }
-            for (k, frame) in baked_mesh["frames"].as_array().unwrap().iter().enumerate() {
-                let code = baked["time_codes"][k].as_f64().unwrap();
-                let pose = evaluation.pose_at((code - start) / rate);
-                let mut ours = Vec::new();
-                evaluation.skin(&pose, mesh, &mut ours);
-                for (v, point) in frame.as_array().unwrap().iter().enumerate() {
-                    let theirs: Vec<f64> = point.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
-                    let apart = (ours[v] - glam::DVec3::from_slice(&theirs)).length();
-                    assert!(apart <= 1e-5 * size, "{name} {path} vertex {v} at code {code}: {apart} apart ({size})");
-                    compared += 1;
-                }
+    let mut pairs: Vec<(PathBuf, PathBuf)> = ["lbs", "dqs", "blendshapes", "blendshapesWithNormals"]
+        .iter()
+        .map(|name| (folder.join(format!("{name}.usda")), folder.join(format!("baseline/{name}.baked.usda"))))
+        .collect();
+    let baked = tempfile::tempdir().unwrap();
+    for name in ["stretchy_full.usdc", "stretchy_noinherit.usda"] {
+        let (file, out) = (common::asset(&format!("blender/{name}")), baked.path().join(format!("{name}.baked.usda")));
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/bake_skinning.py");
+        let status = Command::new(&python).arg(script).arg(&file).arg(&out).status().expect("python runs");
+        assert!(status.success(), "usd-core baked {name}");
+        pairs.push((file, out));
+    }
+    for (file, baked) in pairs {
+        let compared = points_as_baked(&python, &file, &baked);
+        assert!(compared > 1000, "{}: {compared} points compared", file.display());
+    }
+}
+
+/// Compares every point bonescope deforms from `file` with usd-core's world points of `baked` at every time code, to
+/// 1e-5 of the model's size; how many were compared.
+fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
+    let rig = load_with(file, &Options { space: Space::File }).unwrap();
+    let baked = world_points(python, baked);
+    let clip = rig.clips.first();
+    let rate = clip.map(|c| c.frame_rate()).unwrap_or(24.0);
+    let evaluation = Evaluation::declared(&rig, clip);
+    let size = evaluation.size(&evaluation.times(rate));
+    let start = baked["time_codes"][0].as_f64().unwrap();
+    let mut compared = 0;
+    // bonescope's meshes are the stage's, in its traversal order.
+    for (mesh, baked_mesh) in baked["meshes"].as_array().unwrap().iter().enumerate() {
+        let path = baked_mesh["path"].as_str().unwrap();
+        assert!(path.ends_with(&format!("/{}", rig.meshes[mesh].name)), "{path}");
+        if path.starts_with("/GroundTruth") {
+            continue;
+        }
+        for (k, frame) in baked_mesh["frames"].as_array().unwrap().iter().enumerate() {
+            let code = baked["time_codes"][k].as_f64().unwrap();
+            let pose = evaluation.pose_at((code - start) / rate);
+            let mut ours = Vec::new();
+            evaluation.skin(&pose, mesh, &mut ours);
+            for (v, point) in frame.as_array().unwrap().iter().enumerate() {
+                let theirs: Vec<f64> = point.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
+                let apart = (ours[v] - glam::DVec3::from_slice(&theirs)).length();
+                assert!(
+                    apart <= 1e-5 * size,
+                    "{}: {path} vertex {v} at code {code}: {apart} apart ({size})",
+                    file.display()
+                );
+                compared += 1;
             }
         }
-        assert!(compared > 1000, "{name}: {compared} points compared");
     }
+    compared
 }
 
 #[test]

@@ -66,12 +66,10 @@ impl Notifications {
     fn push(&mut self, text: String, error: bool, topic: Option<String>) {
         // A path or a name in a message may hold control characters: shown escaped, on one line.
         let text = crate::import::text::printable(&text).into_owned();
-        if let Some(same) = self.items.iter_mut().find(|n| n.text == text && n.error == error && n.topic == topic) {
-            same.count += 1;
-            same.shown_at = None;
-            return;
-        }
-        self.items.push(Notification { text, error, topic, count: 1, shown_at: None });
+        // Said again, a message counts once more and comes to the front, where the latest are shown.
+        let same = self.items.iter().position(|n| n.text == text && n.error == error && n.topic == topic);
+        let count = same.map_or(1, |i| self.items.remove(i).count + 1);
+        self.items.push(Notification { text, error, topic, count, shown_at: None });
     }
 
     /// Shows the messages in the lower right corner of `within` (the viewport).
