@@ -113,9 +113,10 @@ impl Channel {
         each!(self, s => s.0.iter().map(|(c, _)| *c).collect())
     }
 
-    /// Whether element `index` of every sample's array (each of length `len`) is the same: held throughout.
-    pub fn holds(&self, index: usize, len: usize) -> bool {
-        each!(self, s => s.holds(index, len))
+    /// Per element of arrays of length `len`, whether every sample's array has that length and holds the same
+    /// value there: held throughout.
+    pub fn held(&self, len: usize) -> Vec<bool> {
+        each!(self, s => s.held(len))
     }
 }
 
@@ -136,9 +137,17 @@ macro_rules! each {
 use each;
 
 impl<T: PartialEq> Samples<T> {
-    fn holds(&self, index: usize, len: usize) -> bool {
-        let first = self.0.first().and_then(|(_, a)| a.get(index));
-        self.0.iter().all(|(_, array)| array.len() == len && array.get(index) == first)
+    fn held(&self, len: usize) -> Vec<bool> {
+        let Some((_, first)) = self.0.first().filter(|(_, a)| a.len() == len) else { return vec![false; len] };
+        let mut held = vec![true; len];
+        // Sample by sample, each array read in order.
+        for (_, array) in &self.0 {
+            if array.len() != len {
+                return vec![false; len];
+            }
+            held.iter_mut().zip(array.iter().zip(first)).for_each(|(h, (v, f))| *h &= v == f);
+        }
+        held
     }
 }
 

@@ -250,7 +250,7 @@ fn channel_tracks<T: KeyValue>(
     joints: usize,
 ) -> Result<Vec<Track<T>>, String> {
     let at = |code: f64| channel.and_then(|c| read(c, code)).filter(|v| v.len() == joints);
-    let held: Vec<bool> = (0..joints).map(|a| channel.is_none_or(|c| c.holds(a, joints))).collect();
+    let held = channel.map_or_else(|| vec![true; joints], |c| c.held(joints));
     let mut moving: Vec<Vec<T>> =
         held.iter().map(|&h| if h { Vec::new() } else { Vec::with_capacity(codes.len()) }).collect();
     if held.contains(&false) {
