@@ -23,7 +23,10 @@ const FILES: [&str; 3] = ["blender/stretchy_full.glb", "gltf-khronos/cesium_man.
 fn tools() -> PathBuf {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf-compressors");
     if !folder.join("node_modules/.bin/gltfpack").exists() {
-        let npm = Command::new("npm").args(["ci", "--no-audit", "--no-fund"]).current_dir(&folder).output();
+        let npm = Command::new("npm")
+            .args(["ci", "--no-audit", "--no-fund", "--ignore-scripts"])
+            .current_dir(&folder)
+            .output();
         let npm = npm.expect("npm (Node.js) runs gltfpack and glTF-Transform: install nodejs and npm");
         assert!(npm.status.success(), "npm ci failed: {}", String::from_utf8_lossy(&npm.stderr));
     }
