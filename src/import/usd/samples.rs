@@ -69,16 +69,13 @@ impl Channel {
         }
     }
 
-    /// The vectors at time code `code` (`None` for a rotation channel).
-    pub fn vectors(&self, code: f64) -> Option<Vec<Vec3>> {
+    /// The vectors at time code `code` of the elements `picked`, where its array there has `len` elements (`None`
+    /// otherwise, and for a rotation channel).
+    pub fn vectors(&self, code: f64, len: usize, picked: &[usize]) -> Option<Vec<Vec3>> {
         match self {
-            Channel::Half3(s) => {
-                Some(s.at(code).iter().map(|v| Vec3::new(v.x.into(), v.y.into(), v.z.into())).collect())
-            }
-            Channel::Float3(s) => Some(s.at(code).iter().map(|v| Vec3::new(v.x, v.y, v.z)).collect()),
-            Channel::Double3(s) => {
-                Some(s.at(code).iter().map(|v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)).collect())
-            }
+            Channel::Half3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x.into(), v.y.into(), v.z.into())),
+            Channel::Float3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x, v.y, v.z)),
+            Channel::Double3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)),
             _ => None,
         }
     }
@@ -91,19 +88,16 @@ impl Channel {
         }
     }
 
-    /// The rotations at time code `code`, as stored: not normalised, as UsdSkel makes a matrix of them (and as glTF's
-    /// keys are read). `None` for a vector channel.
-    pub fn rotations(&self, code: f64) -> Option<Vec<Quat>> {
+    /// The rotations at time code `code` of the elements `picked`, as stored: not normalised, as UsdSkel makes a
+    /// matrix of them (and as glTF's keys are read). `None` where its array there has not `len` elements, and for a
+    /// vector channel.
+    pub fn rotations(&self, code: f64, len: usize, picked: &[usize]) -> Option<Vec<Quat>> {
         let quat = |w: f64, x: f64, y: f64, z: f64| Quat::from_xyzw(x as f32, y as f32, z as f32, w as f32);
         let half = |h: f16| f64::from(h.to_f32());
         match self {
-            Channel::Quath(s) => {
-                Some(s.at(code).iter().map(|q| quat(half(q.w), half(q.x), half(q.y), half(q.z))).collect())
-            }
-            Channel::Quatf(s) => {
-                Some(s.at(code).iter().map(|q| quat(q.w.into(), q.x.into(), q.y.into(), q.z.into())).collect())
-            }
-            Channel::Quatd(s) => Some(s.at(code).iter().map(|q| quat(q.w, q.x, q.y, q.z)).collect()),
+            Channel::Quath(s) => s.picked(code, len, picked, |q| quat(half(q.w), half(q.x), half(q.y), half(q.z))),
+            Channel::Quatf(s) => s.picked(code, len, picked, |q| quat(q.w.into(), q.x.into(), q.y.into(), q.z.into())),
+            Channel::Quatd(s) => s.picked(code, len, picked, |q| quat(q.w, q.x, q.y, q.z)),
             _ => None,
         }
     }
@@ -152,6 +146,12 @@ impl<T: PartialEq> Samples<T> {
 }
 
 impl<T: Mix> Samples<T> {
+    /// The elements `picked` of the array at `code`, each made a `U`, where the array has `len` elements.
+    fn picked<U>(&self, code: f64, len: usize, picked: &[usize], into: impl Fn(&T) -> U) -> Option<Vec<U>> {
+        let array = self.at(code);
+        (array.len() == len).then(|| picked.iter().map(|&i| into(&array[i])).collect())
+    }
+
     /// The array at time code `code`: a sample's own (borrowed) at its time and outside the samples, else mixed.
     fn at(&self, code: f64) -> Cow<'_, [T]> {
         let samples = &self.0;

@@ -243,32 +243,36 @@ fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, S
 /// rounding may read a value a rounding step off; held, bonescope reads the value itself.)
 fn channel_tracks<T: KeyValue>(
     channel: Option<&Channel>,
-    read: impl Fn(&Channel, f64) -> Option<Vec<T>>,
+    read: impl Fn(&Channel, f64, usize, &[usize]) -> Option<Vec<T>>,
     identity: T,
     codes: &[f64],
     times: &Arc<[f64]>,
     joints: usize,
 ) -> Result<Vec<Track<T>>, String> {
-    let at = |code: f64| channel.and_then(|c| read(c, code)).filter(|v| v.len() == joints);
     let held = channel.map_or_else(|| vec![true; joints], |c| c.held(joints));
-    let mut moving: Vec<Vec<T>> =
-        held.iter().map(|&h| if h { Vec::new() } else { Vec::with_capacity(codes.len()) }).collect();
-    if held.contains(&false) {
+    let (still, moving): (Vec<usize>, Vec<usize>) = (0..joints).partition(|&a| held[a]);
+    // Read only the joints each pass needs: most channels move few of them.
+    let at = |code: f64, picked: &[usize]| {
+        let values = channel.and_then(|c| read(c, code, joints, picked));
+        values.unwrap_or_else(|| vec![identity; picked.len()])
+    };
+    let mut keys: Vec<Vec<T>> = moving.iter().map(|_| Vec::with_capacity(codes.len())).collect();
+    if !moving.is_empty() {
         for &code in codes {
-            let values = at(code);
-            for (a, track) in moving.iter_mut().enumerate().filter(|(a, _)| !held[*a]) {
-                track.push(values.as_ref().map_or(identity, |v| v[a]));
-            }
+            keys.iter_mut().zip(at(code, &moving)).for_each(|(track, value)| track.push(value));
         }
     }
-    let first = at(codes[0]);
     let once: Arc<[f64]> = Arc::from(&times[..1]);
-    let track = |(a, values): (usize, Vec<T>)| {
-        let value = || first.as_ref().map_or(identity, |v| v[a]);
-        let (times, values) = if held[a] { (once.clone(), vec![value()]) } else { (times.clone(), values) };
-        Track::new(times, values, Interpolation::Linear).map_err(|e| e.to_string())
-    };
-    moving.into_iter().enumerate().map(track).collect()
+    let mut tracks: Vec<Option<Track<T>>> = (0..joints).map(|_| None).collect();
+    let linear =
+        |times: Arc<[f64]>, values| Track::new(times, values, Interpolation::Linear).map_err(|e| e.to_string());
+    for (&a, value) in still.iter().zip(at(codes[0], &still)) {
+        tracks[a] = Some(linear(once.clone(), vec![value])?);
+    }
+    for (&a, values) in moving.iter().zip(keys) {
+        tracks[a] = Some(linear(times.clone(), values)?);
+    }
+    Ok(tracks.into_iter().flatten().collect())
 }
 
 /// The animation a skeleton plays: the target of the nearest `skel:animationSource` on it or an ancestor (a
