@@ -14,9 +14,9 @@ use std::ops::Range;
 use glam::{DMat4, Quat, Vec3};
 
 use super::buffers::Buffers;
+use super::draco;
 use super::schema::{self, Root, Uint};
 use super::{Failure, Result};
-use super::{draco, meshopt};
 
 /// The most bytes of elements an accessor may hold without a buffer view behind them.
 pub(super) const MAX_ZEROS: usize = 64 << 20;
@@ -118,7 +118,7 @@ impl<'a> Accessors<'a> {
     pub fn supply_draco(
         &self,
         primitive: &schema::Primitive,
-        compressed: &draco::Compressed,
+        compressed: &schema::DracoCompressed,
         place: &str,
     ) -> Result<()> {
         let place = format!("{place}.extensions.KHR_draco_mesh_compression");
@@ -332,7 +332,7 @@ impl<'a> Accessors<'a> {
     }
 
     /// The bytes `bufferViews[index]` decodes to under `EXT_meshopt_compression`, decoded on first use.
-    fn decoded(&self, index: Uint, compressed: &meshopt::Compressed, user: &str) -> Result<&[u8]> {
+    fn decoded(&self, index: Uint, compressed: &schema::MeshoptCompressed, user: &str) -> Result<&[u8]> {
         let place = format!("bufferViews[{}].extensions.EXT_meshopt_compression", index.0);
         let decoded = self.decoded[index.0].get_or_init(|| {
             let (offset, length) = (compressed.byte_offset.0, compressed.byte_length.0);

@@ -4,20 +4,8 @@
 //! `draco-core` crate (pure Rust, its output capped by the memory budget), each attribute and the triangles are laid
 //! out as their accessors describe and read through them, as if they lay in a buffer.
 
-use std::collections::BTreeMap;
-
+use super::schema::{Accessor, DracoCompressed, Primitive, Root, Uint};
 use draco_core::{DecodeLimits, DecoderBuffer, Mesh, MeshDecoder, PointIndex};
-use serde::Deserialize;
-
-use super::schema::{Accessor, Primitive, Root, Uint};
-
-/// A primitive's `KHR_draco_mesh_compression`.
-#[derive(Debug, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub(super) struct Compressed {
-    pub buffer_view: Uint,
-    pub attributes: BTreeMap<String, Uint>,
-}
 
 /// glTF's component type of floats.
 const FLOAT: usize = 5126;
@@ -36,7 +24,7 @@ fn component_size(component_type: Uint) -> Option<usize> {
 /// accessor's layout, its attributes' and its indices'. `limit` caps the decoded bytes.
 pub(super) fn decode(
     stream: &[u8],
-    compressed: &Compressed,
+    compressed: &DracoCompressed,
     primitive: &Primitive,
     root: &Root,
     limit: u64,

@@ -104,11 +104,6 @@ pub(super) fn read_meshes(
 ) -> Result<Vec<Mesh>> {
     let mut meshes = Vec::new();
     let mut tally = Tally::default();
-    // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
-    let mut unread_normals = Vec::new();
-    let mut unsupplied = Vec::new();
-    // Compressed geometry that does not decode leaves its primitive out, never the file.
-    let mut undecoded = Vec::new();
     for (bone, node_of_bone) in scene.skeleton.bones().iter().enumerate() {
         let node = &root.nodes[node_of_bone.node];
         let Some(mesh_index) = node.mesh else { continue };
@@ -123,50 +118,9 @@ pub(super) fn read_meshes(
         let node_place = format!("nodes[{}].extensions.EXT_mesh_gpu_instancing", node_of_bone.node);
         let instances =
             node.extensions.gpu_instancing.as_ref().map(|i| instances(i, accessors, &node_place)).transpose()?;
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            let mode = primitive.mode.map_or(TRIANGLES, |m| m.0);
-            if !matches!(mode, TRIANGLES | TRIANGLE_STRIP | TRIANGLE_FAN) {
-                tally.other_modes += 1;
-                continue;
-            }
-            let place = format!("meshes[{}].primitives[{p}]", mesh_index.0);
-            if let Some(buffer) = unsupplied_buffer(primitive, accessors) {
-                unsupplied.push(format!("{place} (buffers[{}])", buffer.0));
-                continue;
-            }
-            let base = mesh.name.as_deref().unwrap_or(&scene.skeleton.bone(bone).name);
-            let name = match mesh.primitives.len() {
-                1 => base.to_owned(),
-                _ => format!("{base}[{p}]"),
-            };
-            if let Err(failure) = decompress(primitive, accessors, &place) {
-                undecoded.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
-                continue;
-            }
-            let mut read = Mesh { name, bone, ..Mesh::default() };
-            read.positions = positions(primitive, accessors, &place)?;
-            if skin.is_some() && quantized_positions(root, primitive) {
-                dequantize_by_node(&mut read.positions, &scene.skeleton, bone);
-                tally.dequantized_by_node += 1;
-            }
-            read.normals = normals(primitive, accessors, read.positions.len(), &place).unwrap_or_else(|failure| {
-                unread_normals.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
-                Vec::new()
-            });
-            if let Some(skin) = skin {
-                if read_skinning(&mut read, primitive, accessors, &skins[skin], &place, &mut tally)? {
-                    read.skin = Some(skin);
-                } else {
-                    tally.unweighted += 1;
-                }
-            }
-            read.indices = triangle_indices(primitive, accessors, read.positions.len(), mode, &place, &mut tally)?;
-            read.morph_targets = morph_targets(primitive, accessors, read.positions.len(), &place)?;
-            tally.non_finite += read.remove_non_finite_vertices();
-            tally.unnormalized += read.normalize_weights();
-            let weights = node.weights.as_ref().unwrap_or(&mesh.weights);
-            read.morph_weights =
-                (0..read.morph_targets.len()).map(|k| weights.get(k).map_or(0.0, |&w| w as f32)).collect();
+        let shown = Shown { node, mesh, mesh_index: mesh_index.0, bone, skin };
+        for p in 0..mesh.primitives.len() {
+            let Some(read) = read_primitive(root, accessors, scene, skins, &shown, p, &mut tally)? else { continue };
             match &instances {
                 Some(instances) => meshes.extend(instances.iter().enumerate().map(|(k, m)| instance(&read, k, m))),
                 None => meshes.push(read),
@@ -174,19 +128,72 @@ pub(super) fn read_meshes(
         }
     }
     tally.notes(notes);
-    if !unread_normals.is_empty() {
-        notes.push(format!("normals left out: {}", unread_normals.join("; ")));
-    }
-    if !unsupplied.is_empty() {
-        notes.push(format!(
-            "not drawn, their data lies in buffers without a uri (to be supplied by an application): {}",
-            unsupplied.join(", ")
-        ));
-    }
-    if !undecoded.is_empty() {
-        notes.push(format!("not drawn, their compressed geometry does not decode: {}", undecoded.join("; ")));
-    }
     Ok(meshes)
+}
+
+/// A node's mesh, and where it hangs: its bone, its skin.
+struct Shown<'a> {
+    node: &'a schema::Node,
+    mesh: &'a schema::Mesh,
+    mesh_index: usize,
+    bone: usize,
+    skin: Option<usize>,
+}
+
+/// Primitive `p` of the mesh `shown` shows, read; `None` where it is left out (not triangles, its data not in the
+/// file, its compressed data not decoding), with the reason in `tally`.
+fn read_primitive(
+    root: &Root,
+    accessors: &Accessors,
+    scene: &SceneBones,
+    skins: &[Skin],
+    shown: &Shown,
+    p: usize,
+    tally: &mut Tally,
+) -> Result<Option<Mesh>> {
+    let (mesh, bone) = (shown.mesh, shown.bone);
+    let primitive = &mesh.primitives[p];
+    let mode = primitive.mode.map_or(TRIANGLES, |m| m.0);
+    if !matches!(mode, TRIANGLES | TRIANGLE_STRIP | TRIANGLE_FAN) {
+        tally.other_modes += 1;
+        return Ok(None);
+    }
+    let place = format!("meshes[{}].primitives[{p}]", shown.mesh_index);
+    if let Some(buffer) = unsupplied_buffer(primitive, accessors) {
+        tally.unsupplied.push(format!("{place} (buffers[{}])", buffer.0));
+        return Ok(None);
+    }
+    if let Err(failure) = decompress(primitive, accessors, &place) {
+        tally.undecoded.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
+        return Ok(None);
+    }
+    let base = mesh.name.as_deref().unwrap_or(&scene.skeleton.bone(bone).name);
+    let name = if mesh.primitives.len() == 1 { base.to_owned() } else { format!("{base}[{p}]") };
+    let mut read = Mesh { name, bone, ..Mesh::default() };
+    read.positions = positions(primitive, accessors, &place)?;
+    if shown.skin.is_some() && quantized_positions(root, primitive) {
+        dequantize_by_node(&mut read.positions, &scene.skeleton, bone);
+        tally.dequantized_by_node += 1;
+    }
+    // Normals only travel into a bake: a broken NORMAL leaves them out rather than the file.
+    read.normals = normals(primitive, accessors, read.positions.len(), &place).unwrap_or_else(|failure| {
+        tally.unread_normals.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
+        Vec::new()
+    });
+    if let Some(skin) = shown.skin {
+        if read_skinning(&mut read, primitive, accessors, &skins[skin], &place, tally)? {
+            read.skin = Some(skin);
+        } else {
+            tally.unweighted += 1;
+        }
+    }
+    read.indices = triangle_indices(primitive, accessors, read.positions.len(), mode, &place, tally)?;
+    read.morph_targets = morph_targets(primitive, accessors, read.positions.len(), &place)?;
+    tally.non_finite += read.remove_non_finite_vertices();
+    tally.unnormalized += read.normalize_weights();
+    let weights = shown.node.weights.as_ref().unwrap_or(&mesh.weights);
+    read.morph_weights = (0..read.morph_targets.len()).map(|k| weights.get(k).map_or(0.0, |&w| w as f32)).collect();
+    Ok(Some(read))
 }
 
 /// What the meshes of a document add up to, for the notes.
@@ -206,6 +213,12 @@ struct Tally {
     out_of_range: Vec<(String, usize)>,
     /// Skinned primitives whose quantized positions were put where their node is.
     dequantized_by_node: usize,
+    /// Primitives whose normals could not be read, and why.
+    unread_normals: Vec<String>,
+    /// Primitives whose data lies in buffers without a uri.
+    unsupplied: Vec<String>,
+    /// Primitives whose compressed data does not decode, and why.
+    undecoded: Vec<String>,
 }
 
 impl Tally {
@@ -251,6 +264,18 @@ impl Tally {
             let places: Vec<String> =
                 self.out_of_range.iter().map(|(place, dropped)| format!("{dropped} in {place}")).collect();
             notes.push(format!("triangles whose indices pass their vertices left out: {}", places.join(", ")));
+        }
+        if !self.unread_normals.is_empty() {
+            notes.push(format!("normals left out: {}", self.unread_normals.join("; ")));
+        }
+        if !self.unsupplied.is_empty() {
+            notes.push(format!(
+                "not drawn, their data lies in buffers without a uri (to be supplied by an application): {}",
+                self.unsupplied.join(", ")
+            ));
+        }
+        if !self.undecoded.is_empty() {
+            notes.push(format!("not drawn, their compressed geometry does not decode: {}", self.undecoded.join("; ")));
         }
     }
 }

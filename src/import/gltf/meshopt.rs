@@ -6,26 +6,9 @@
 //! decoded, the view reads as any other. Decoding is meshoptimizer's own (the `meshopt` crate), which is safe on
 //! untrusted input: a broken stream is an error, never a read outside it.
 
-use serde::Deserialize;
+use super::schema::MeshoptCompressed;
 
-use super::schema::Uint;
-
-/// A view's `EXT_meshopt_compression`.
-#[derive(Debug, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub(super) struct Compressed {
-    pub buffer: Uint,
-    #[serde(default)]
-    pub byte_offset: Uint,
-    pub byte_length: Uint,
-    pub byte_stride: Uint,
-    pub count: Uint,
-    pub mode: String,
-    #[serde(default)]
-    pub filter: Option<String>,
-}
-
-impl Compressed {
+impl MeshoptCompressed {
     /// The bytes it decodes to: `count × byteStride`.
     pub fn decoded_len(&self) -> Option<usize> {
         self.count.0.checked_mul(self.byte_stride.0)

@@ -158,7 +158,7 @@ pub(super) struct Primitive {
 #[derive(Debug, Default, Deserialize)]
 pub(super) struct PrimitiveExtensions {
     #[serde(rename = "KHR_draco_mesh_compression", default)]
-    pub draco: Option<super::draco::Compressed>,
+    pub draco: Option<DracoCompressed>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -273,7 +273,7 @@ pub(super) struct BufferView {
 #[derive(Debug, Default, Deserialize)]
 pub(super) struct ViewExtensions {
     #[serde(rename = "EXT_meshopt_compression", default)]
-    pub meshopt: Option<super::meshopt::Compressed>,
+    pub meshopt: Option<MeshoptCompressed>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -327,4 +327,27 @@ mod tests {
         assert_eq!(target.node, None);
         assert_eq!(target.extensions.animation_pointer.as_ref().unwrap().pointer, "/materials/0/alphaCutoff");
     }
+}
+
+/// A view's `EXT_meshopt_compression`.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct MeshoptCompressed {
+    pub buffer: Uint,
+    #[serde(default)]
+    pub byte_offset: Uint,
+    pub byte_length: Uint,
+    pub byte_stride: Uint,
+    pub count: Uint,
+    pub mode: String,
+    #[serde(default)]
+    pub filter: Option<String>,
+}
+
+/// A primitive's `KHR_draco_mesh_compression`.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub(super) struct DracoCompressed {
+    pub buffer_view: Uint,
+    pub attributes: Attributes,
 }
