@@ -39,11 +39,15 @@ fn run(tool: &str, args: &[&Path]) {
     assert!(output.status.success(), "{tool} {args:?}: {}", String::from_utf8_lossy(&output.stderr));
 }
 
+/// A `.glb`'s JSON, and where its binary chunk's data starts.
+fn glb_json(bytes: &[u8]) -> (serde_json::Value, usize) {
+    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    (serde_json::from_slice(&bytes[20..20 + length]).unwrap(), 20 + length + 8)
+}
+
 /// The extensions `file` (a `.glb`) requires.
 fn required(file: &Path) -> Vec<String> {
-    let bytes = std::fs::read(file).unwrap();
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    let (json, _) = glb_json(&std::fs::read(file).unwrap());
     json["extensionsRequired"].as_array().into_iter().flatten().map(|e| e.as_str().unwrap().to_owned()).collect()
 }
 
@@ -82,8 +86,7 @@ fn compressed_as_decoded(extension: &str, compress: impl Fn(&Path, &Path)) -> Ve
 /// meshopt-compressed view of `POSITION`) loads all the same: its animation whole, that mesh left out with a note.
 fn scrambled_streams_leave_the_mesh_out(packed: &Path, extension: &str) {
     let mut bytes = std::fs::read(packed).unwrap();
-    let length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).unwrap();
+    let (json, bin) = glb_json(&bytes);
     let primitive = &json["meshes"][0]["primitives"][0];
     let stream = match extension {
         "KHR_draco_mesh_compression" => {
@@ -94,7 +97,7 @@ fn scrambled_streams_leave_the_mesh_out(packed: &Path, extension: &str) {
             &json["bufferViews"][position["bufferView"].as_u64().unwrap() as usize]["extensions"][extension]
         }
     };
-    let start = 20 + length + 8 + stream["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let start = bin + stream["byteOffset"].as_u64().unwrap_or(0) as usize;
     let end = start + stream["byteLength"].as_u64().unwrap() as usize;
     for byte in &mut bytes[start + 8..end] {
         *byte = byte.wrapping_mul(7).wrapping_add(13);

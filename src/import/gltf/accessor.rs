@@ -15,47 +15,11 @@ use glam::{DMat4, Quat, Vec3};
 
 use super::buffers::Buffers;
 use super::draco;
-use super::schema::{self, Root, Uint};
+use super::schema::{self, DataType, Root, Uint};
 use super::{Failure, Result};
 
 /// The most bytes of elements an accessor may hold without a buffer view behind them.
 pub(super) const MAX_ZEROS: usize = 64 << 20;
-
-/// glTF's component types (`componentType`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum DataType {
-    I8 = 5120,
-    U8 = 5121,
-    I16 = 5122,
-    U16 = 5123,
-    U32 = 5125,
-    F32 = 5126,
-}
-
-impl DataType {
-    fn from_code(code: Uint) -> Option<Self> {
-        [Self::I8, Self::U8, Self::I16, Self::U16, Self::U32, Self::F32].into_iter().find(|t| *t as usize == code.0)
-    }
-
-    fn size(self) -> usize {
-        match self {
-            Self::I8 | Self::U8 => 1,
-            Self::I16 | Self::U16 => 2,
-            Self::U32 | Self::F32 => 4,
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Self::I8 => "BYTE",
-            Self::U8 => "UNSIGNED_BYTE",
-            Self::I16 => "SHORT",
-            Self::U16 => "UNSIGNED_SHORT",
-            Self::U32 => "UNSIGNED_INT",
-            Self::F32 => "FLOAT",
-        }
-    }
-}
 
 /// An allowed component type and whether it must be `normalized`.
 type Component = (DataType, bool);
@@ -144,6 +108,18 @@ impl<'a> Accessors<'a> {
     fn view(&self, index: Uint, user: &str) -> Result<Cow<'_, [u8]>> {
         let view = schema::item(&self.root.buffer_views, index, "bufferViews", user)?;
         let range = self.view_range(view, &format!("bufferViews[{}]", index.0), user)?;
+        self.view_bytes(index, view, range, user)
+    }
+
+    /// The bytes of `bufferViews[index]` (`view`) in `range` of its buffer, or of what it decodes to where meshopt
+    /// compresses it ([`Accessors::view_range`] says which), for `user`.
+    fn view_bytes(
+        &self,
+        index: Uint,
+        view: &schema::BufferView,
+        range: Range<usize>,
+        user: &str,
+    ) -> Result<Cow<'_, [u8]>> {
         match &view.extensions.meshopt {
             Some(compressed) => Ok(Cow::Borrowed(&self.decoded(index, compressed, user)?[range])),
             None => self.buffers.read(view.buffer, range, user),
@@ -324,10 +300,7 @@ impl<'a> Accessors<'a> {
             return Err(Failure::at(place, message));
         };
         let range = view_range.start + offset..view_range.start + end;
-        let bytes = match &view.extensions.meshopt {
-            Some(compressed) => Cow::Borrowed(&self.decoded(view_index, compressed, place)?[range]),
-            None => self.buffers.read(view.buffer, range, place)?,
-        };
+        let bytes = self.view_bytes(view_index, view, range, place)?;
         Ok(Elements { bytes, stride, layout })
     }
 

@@ -4,21 +4,9 @@
 //! `draco-core` crate (pure Rust, its output capped by the memory budget), each attribute and the triangles are laid
 //! out as their accessors describe and read through them, as if they lay in a buffer.
 
-use super::schema::{Accessor, DracoCompressed, Primitive, Root, Uint};
 use draco_core::{DecodeLimits, DecoderBuffer, Mesh, MeshDecoder, PointIndex};
 
-/// glTF's component type of floats.
-const FLOAT: usize = 5126;
-
-/// The bytes of a glTF component type (`componentType`), `None` for none.
-fn component_size(component_type: Uint) -> Option<usize> {
-    match component_type.0 {
-        5120 | 5121 => Some(1),
-        5122 | 5123 => Some(2),
-        5125 | 5126 => Some(4),
-        _ => None,
-    }
-}
+use super::schema::{Accessor, DataType, DracoCompressed, Primitive, Root, Uint};
 
 /// The bytes each accessor of `primitive` reads, decoded from `stream`: `(accessor, bytes)`, tightly packed in the
 /// accessor's layout, its attributes' and its indices'. `limit` caps the decoded bytes.
@@ -54,11 +42,12 @@ fn attribute(mesh: &Mesh, id: usize, accessor: &Accessor) -> Result<Vec<u8>, Str
     if points != accessor.count.0 {
         return Err(format!("{points} points decoded for an accessor of count {}", accessor.count.0));
     }
-    if accessor.component_type.0 == FLOAT {
+    let data_type = DataType::from_code(accessor.component_type);
+    if data_type == Some(DataType::F32) {
         return Ok(attribute.read_f32s(points, components).iter().flat_map(|v| v.to_le_bytes()).collect());
     }
     let width = attribute.data_type().byte_length();
-    if component_size(accessor.component_type) != Some(width) || attribute.num_components() as usize != components {
+    if data_type.map(DataType::size) != Some(width) || attribute.num_components() as usize != components {
         let decoded = format!("{:?} × {}", attribute.data_type(), attribute.num_components());
         return Err(format!("decoded as {decoded}, not as its accessor says"));
     }
@@ -76,8 +65,11 @@ fn indices(mesh: &Mesh, accessor: &Accessor) -> Result<Vec<u8>, String> {
     if mesh.num_faces() * 3 != accessor.count.0 {
         return Err(format!("{} triangles decoded for {} indices", mesh.num_faces(), accessor.count.0));
     }
-    let width = component_size(accessor.component_type).filter(|_| accessor.component_type.0 != FLOAT);
-    let width = width.ok_or(format!("componentType {} is no index type", accessor.component_type.0))?;
+    let index_type = DataType::from_code(accessor.component_type)
+        .filter(|t| [DataType::U8, DataType::U16, DataType::U32].contains(t));
+    let width = index_type
+        .map(DataType::size)
+        .ok_or(format!("componentType {} is no index type", accessor.component_type.0))?;
     let mut bytes = Vec::with_capacity(accessor.count.0 * width);
     for index in mesh.faces().iter().flatten().map(|p| p.0) {
         if width < 4 && index >> (8 * width) != 0 {

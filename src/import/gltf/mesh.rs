@@ -7,7 +7,7 @@ use glam::{DMat4, DVec4};
 
 use super::accessor::Accessors;
 use super::scene::SceneBones;
-use super::schema::{self, Root};
+use super::schema::{self, DataType, Root};
 use super::{Failure, Result};
 use crate::model::{Mesh, MorphTarget, Skeleton, Skin};
 
@@ -15,8 +15,6 @@ use crate::model::{Mesh, MorphTarget, Skeleton, Skin};
 const AFFINE_TOLERANCE: f64 = 1e-6;
 
 /// glTF's `mode`s of triangles: lists (the default), strips and fans.
-/// glTF's `componentType` of floats.
-const FLOAT: usize = 5126;
 const TRIANGLES: usize = 4;
 const TRIANGLE_STRIP: usize = 5;
 const TRIANGLE_FAN: usize = 6;
@@ -340,7 +338,7 @@ fn instance(mesh: &Mesh, k: usize, transform: &DMat4) -> Mesh {
 /// Whether the primitive's `POSITION` is integers (`KHR_mesh_quantization`), which need a transform to mean lengths.
 fn quantized_positions(root: &Root, primitive: &schema::Primitive) -> bool {
     let accessor = primitive.attributes.get("POSITION").and_then(|a| root.accessors.get(a.0));
-    accessor.is_some_and(|a| a.component_type.0 != FLOAT)
+    accessor.is_some_and(|a| DataType::from_code(a.component_type) != Some(DataType::F32))
 }
 
 /// Quantized positions of a skinned mesh, put where its node's transform at rest puts them. The specification has

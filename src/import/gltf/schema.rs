@@ -351,3 +351,39 @@ pub(super) struct DracoCompressed {
     pub buffer_view: Uint,
     pub attributes: Attributes,
 }
+
+/// glTF's component types (`componentType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum DataType {
+    I8 = 5120,
+    U8 = 5121,
+    I16 = 5122,
+    U16 = 5123,
+    U32 = 5125,
+    F32 = 5126,
+}
+
+impl DataType {
+    pub fn from_code(code: Uint) -> Option<Self> {
+        [Self::I8, Self::U8, Self::I16, Self::U16, Self::U32, Self::F32].into_iter().find(|t| *t as usize == code.0)
+    }
+
+    pub fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::U32 | Self::F32 => 4,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::I8 => "BYTE",
+            Self::U8 => "UNSIGNED_BYTE",
+            Self::I16 => "SHORT",
+            Self::U16 => "UNSIGNED_SHORT",
+            Self::U32 => "UNSIGNED_INT",
+            Self::F32 => "FLOAT",
+        }
+    }
+}
