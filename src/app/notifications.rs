@@ -142,7 +142,8 @@ impl Notification {
                             .map_or(topic.as_str(), |n| n.to_str().unwrap_or(topic));
                         let name = crate::import::text::printable(name).into_owned();
                         ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
-                            super::text::name_label(ui, &name, &name, ui.available_width(), None).on_hover_text(topic);
+                            super::text::name_label(ui, &name, || name.clone(), ui.available_width(), None)
+                                .on_hover_text(topic);
                         });
                     }
                 });

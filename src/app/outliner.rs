@@ -167,8 +167,8 @@ impl Outliner {
             let notes = Notes::of(shared, bone).fitted(ui, ui.available_width() - name_needs);
             let name_width = ui.available_width() - notes.width(ui);
             let selected = shared.selection.contains(&bone);
-            let path = shared.doc.rig.skeleton.path(bone);
-            let label = text::name_label(ui, &name, &path, name_width, Some(selected));
+            let path = || shared.doc.rig.skeleton.path(bone);
+            let label = text::name_label(ui, &name, path, name_width, Some(selected));
             if label.clicked() {
                 let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
                 shared.select(bone, extend);

@@ -60,10 +60,16 @@ fn elide(chars: &[char], keep: usize) -> String {
     chars[..head].iter().chain(['…'].iter()).chain(&chars[chars.len() - tail..]).collect()
 }
 
-/// A label of `name` no wider than `width` points, shortened in the middle when it has to be, with `full` (the full
-/// name, or more: a bone's path) on hover where it says more than the label; clickable and selectable like
-/// [`Ui::selectable_label`] when `selected` is given.
-pub fn name_label(ui: &mut Ui, name: &str, full: &str, width: f32, selected: Option<bool>) -> Response {
+/// A label of `name` no wider than `width` points, shortened in the middle when it has to be, with `full()` (the
+/// full name, or more: a bone's path; made only while hovered) on hover where it says more than the label;
+/// clickable and selectable like [`Ui::selectable_label`] when `selected` is given.
+pub fn name_label(
+    ui: &mut Ui,
+    name: &str,
+    full: impl FnOnce() -> String,
+    width: f32,
+    selected: Option<bool>,
+) -> Response {
     let font = TextStyle::Button.resolve(ui.style());
     let padding = if selected.is_some() { 2.0 * ui.spacing().button_padding.x } else { 0.0 };
     let shown = shorten_middle(name, |text| text_width(ui, text, &font) + padding <= width);
@@ -71,6 +77,10 @@ pub fn name_label(ui: &mut Ui, name: &str, full: &str, width: f32, selected: Opt
         Some(selected) => ui.add(egui::Button::selectable(selected, WidgetText::from(RichText::new(&shown)))),
         None => ui.add(egui::Label::new(&shown).sense(Sense::hover())),
     };
+    if !response.hovered() {
+        return response;
+    }
+    let full = full();
     if shown != full { response.on_hover_text(full) } else { response }
 }
 

@@ -173,7 +173,7 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
 fn link_row(ui: &mut Ui, shared: &mut Shared, link: &Link, shear: f64, main: bool, columns: &Columns) {
     ui.horizontal(|ui| {
         let selected = shared.selection.contains(&link.bone);
-        let name = name_label(ui, &link.name, &link.name, columns.name, Some(selected));
+        let name = name_label(ui, &link.name, || link.name.clone(), columns.name, Some(selected));
         let room = columns.name - name.rect.width();
         if name.clicked() {
             shared.select(link.bone, false);
