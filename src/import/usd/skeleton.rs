@@ -167,17 +167,27 @@ impl Xformable for Xformed {}
 /// outermost first, from the nearest one that resets the stack.
 pub(super) fn world_transform(stage: &Stage, path: &sdf::Path, time: f64) -> Result<DMat4, String> {
     let mut world = DMat4::IDENTITY;
+    for xformed in transform_stack(stage, path)? {
+        world = matrix(&xformed.local_to_parent_transform(TimeCode::new(time)).map_err(said)?) * world;
+    }
+    Ok(world)
+}
+
+/// The prims whose transforms place the prim at `path` in the world: it and its ancestors, innermost first, up to
+/// the nearest that resets the stack (`!resetXformStack!`).
+fn transform_stack(stage: &Stage, path: &sdf::Path) -> Result<Vec<Xformed>, String> {
+    let mut stack = Vec::new();
     let mut prim_path = Some(path.clone());
     while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {
         let xformed = Xformed(stage.prim(current.clone()));
-        let local = xformed.local_to_parent_transform(TimeCode::new(time)).map_err(said)?;
-        world = matrix(&local) * world;
-        if xformed.resets_xform_stack().map_err(said)? {
+        let resets = xformed.resets_xform_stack().map_err(said)?;
+        stack.push(xformed);
+        if resets {
             break;
         }
         prim_path = current.parent();
     }
-    Ok(world)
+    Ok(stack)
 }
 
 /// The tracks of the skeleton's bound animation (`skel:animationSource` on it or inherited), its joints' bones
@@ -351,23 +361,18 @@ pub(super) fn moving_node(
     Ok(Some(tracks))
 }
 
-/// The time codes of the transform ops of the prim at `path` and its ancestors, up to the nearest that resets the
-/// stack, sorted, once each.
+/// The time codes of the transform ops of the prims that place the prim at `path` ([`transform_stack`]), sorted,
+/// once each.
 fn xform_codes(stage: &Stage, path: &sdf::Path) -> Result<Vec<f64>, String> {
     let mut codes = Vec::new();
-    let mut prim_path = Some(path.clone());
-    while let Some(current) = prim_path.filter(|p| !p.is_abs_root()) {
-        let xformed = Xformed(stage.prim(current.clone()));
+    for xformed in transform_stack(stage, path)? {
+        let prim = xformed.0.path().clone();
         for op in xformed.xform_op_order().map_err(said)?.unwrap_or_default() {
             let op = op.strip_prefix("!invert!").unwrap_or(&op);
-            let Ok(attribute) = current.append_property(op) else { continue };
+            let Ok(attribute) = prim.append_property(op) else { continue };
             let samples = stage.time_samples(attribute).map_err(said)?.unwrap_or_default();
             codes.extend(samples.iter().map(|(code, _)| *code).filter(|c| c.is_finite()));
         }
-        if xformed.resets_xform_stack().map_err(said)? {
-            break;
-        }
-        prim_path = current.parent();
     }
     codes.sort_by(f64::total_cmp);
     codes.dedup();
