@@ -134,10 +134,13 @@ impl<T: PartialEq> Samples<T> {
     fn held(&self, len: usize) -> Vec<bool> {
         let Some((_, first)) = self.0.first().filter(|(_, a)| a.len() == len) else { return vec![false; len] };
         let mut held = vec![true; len];
-        // Sample by sample, each array read in order.
+        // Sample by sample, each array read in order, while some element may still be held.
         for (_, array) in &self.0 {
             if array.len() != len {
                 return vec![false; len];
+            }
+            if !held.contains(&true) {
+                continue;
             }
             held.iter_mut().zip(array.iter().zip(first)).for_each(|(h, (v, f))| *h &= v == f);
         }

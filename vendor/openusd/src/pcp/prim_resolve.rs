@@ -507,7 +507,7 @@ impl PrimIndex {
         prop_suffix: Option<&str>,
     ) -> Result<Option<sdf::TimeSampleMap>> {
         self.first_time_samples(stack, prop_suffix, None, |map, offset| {
-            retime_samples(map.clone(), offset)
+            retime_samples(map.into_owned(), offset)
         })
     }
 
@@ -540,7 +540,7 @@ impl PrimIndex {
         interp: &dyn Fn(&sdf::TimeSampleMap, f64) -> Option<Value>,
     ) -> Result<Option<Option<Value>>> {
         self.first_time_samples(stack, prop_suffix, local_layers, |map, offset| {
-            interp(map, offset.inverse().apply(time))
+            interp(&map, offset.inverse().apply(time))
         })
     }
 
@@ -557,7 +557,7 @@ impl PrimIndex {
         prop_suffix: Option<&str>,
         local_layers: Option<&HashSet<LayerId>>,
     ) -> Result<Option<(sdf::TimeSampleMap, LayerOffset)>> {
-        self.first_time_samples(stack, prop_suffix, local_layers, |map, offset| (map.clone(), offset))
+        self.first_time_samples(stack, prop_suffix, local_layers, |map, offset| (map.into_owned(), offset))
     }
 
     /// Resolves only the retimed sample times of the strongest authored
@@ -599,7 +599,8 @@ impl PrimIndex {
         stack: &LayerGraph,
         prop_suffix: Option<&str>,
         local_layers: Option<&HashSet<LayerId>>,
-        extract: impl FnOnce(&sdf::TimeSampleMap, LayerOffset) -> R,
+        // bonescope: the map as the layer gave it, so a map decoded for this read is handed on, not cloned.
+        extract: impl FnOnce(Cow<'_, sdf::TimeSampleMap>, LayerOffset) -> R,
     ) -> Result<Option<R>> {
         let field = FieldKey::TimeSamples.as_str();
         for opinion in self.opinions(field, stack, prop_suffix) {
@@ -609,9 +610,10 @@ impl PrimIndex {
             if local_layers.is_some_and(|local| !local.contains(&layer)) {
                 continue;
             }
-            match value.as_ref() {
-                Value::ValueBlock => return Ok(None),
-                Value::TimeSamples(map) => return Ok(Some(extract(map, offset))),
+            match value {
+                Cow::Borrowed(Value::ValueBlock) | Cow::Owned(Value::ValueBlock) => return Ok(None),
+                Cow::Borrowed(Value::TimeSamples(map)) => return Ok(Some(extract(Cow::Borrowed(map), offset))),
+                Cow::Owned(Value::TimeSamples(map)) => return Ok(Some(extract(Cow::Owned(map), offset))),
                 _ => continue,
             }
         }

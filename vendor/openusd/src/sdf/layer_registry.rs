@@ -94,6 +94,9 @@ pub(crate) enum Error {
 /// format registration.
 pub struct LayerRegistry {
     resolver: Box<dyn ar::Resolver>,
+    /// bonescope: the layer `own_expression_variables` last read, taken by the next `read` of the same asset, so
+    /// opening a stage parses its root layer once, not twice.
+    shallow: std::cell::RefCell<Option<(ar::ResolvedPath, sdf::LayerData)>>,
 }
 
 impl Default for LayerRegistry {
@@ -108,7 +111,10 @@ impl Default for LayerRegistry {
 impl LayerRegistry {
     /// A registry resolving asset paths through `resolver`.
     pub fn new(resolver: Box<dyn ar::Resolver>) -> Self {
-        Self { resolver }
+        Self {
+            resolver,
+            shallow: std::cell::RefCell::new(None),
+        }
     }
 
     /// Canonicalizes `asset_path` into a stable identifier, anchoring a relative
@@ -216,9 +222,7 @@ impl LayerRegistry {
     /// collected. An empty identifier yields an empty map; a resolve or read failure
     /// propagates.
     ///
-    /// TODO(perf): the layer read here is read again when its stack is collected;
-    /// the registry does not cache reads, so a root or session layer is parsed twice
-    /// at open.
+    /// bonescope: the layer read here is kept for the read of its stack that follows.
     pub(crate) fn own_expression_variables(
         &self,
         asset_path: &str,
@@ -232,7 +236,9 @@ impl LayerRegistry {
             .resolve_layer(&identifier)
             .with_context(|| format!("failed to resolve asset path: {asset_path}"))?;
         let data = self.read(&resolved)?;
-        Ok(expr::read_expression_variables(data.as_ref())?.into_owned())
+        let variables = expr::read_expression_variables(data.as_ref())?.into_owned();
+        *self.shallow.borrow_mut() = Some((resolved, data));
+        Ok(variables)
     }
 
     /// Opens `asset_path` (anchored against `anchor`) together with its sublayer
@@ -367,6 +373,10 @@ impl LayerRegistry {
     /// [`matches_content`](sdf::FileFormat::matches_content) (the crate magic),
     /// falling back to text. C++ `SdfFileFormat::FindByExtension` + `CanRead`.
     fn read(&self, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
+        let kept = self.shallow.borrow_mut().take_if(|(path, _)| path == resolved);
+        if let Some((_, data)) = kept {
+            return Ok(data);
+        }
         let ext = resolved.extension();
         let format = if ext.eq_ignore_ascii_case("usd") {
             // TODO(perf): the chosen format re-opens the asset in `read`; only
