@@ -1160,3 +1160,38 @@ fn a_reload_keeps_the_history_and_another_file_starts_a_new_one() {
     settle(&mut harness);
     assert_eq!((harness.state().session.undo_label(), harness.state().session.redo_label()), (None, None));
 }
+
+/// The worst shear, its time and the worst stretch the app's outliner shows (its analysis at the document's rate)
+/// are `scan`'s, bone for bone, on every animation of every shared file: the shear refined between samples to
+/// 0.001° whatever the rate, and both sampling where the other does.
+#[test]
+fn the_app_and_scan_report_one_worst_shear_stretch_and_time_on_every_shared_file() {
+    use bonescope::analysis::{ScanOptions, scan};
+    let folder = common::assets();
+    let output = common::bonescope(&["scan", "--format", "jsonl", folder.to_str().unwrap()]);
+    let mut compared = 0;
+    for line in String::from_utf8(output.stdout).unwrap().lines() {
+        let record: serde_json::Value = serde_json::from_str(line).unwrap();
+        let Some(animations) = record["animations"].as_array().filter(|a| !a.is_empty()) else { continue };
+        let path = std::path::PathBuf::from(record["file"].as_str().unwrap());
+        let mut doc = Document::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        for animation in animations {
+            doc.set_clip(animation["animation"]["index"].as_u64().map(|i| i as usize)).unwrap();
+            let options = ScanOptions { rate: doc.analysis_rate(), ..ScanOptions::default() };
+            let app = scan(&doc.evaluation(), &options, &|_, _| {});
+            let cli = animation["stretched"].as_array().unwrap();
+            let shown: Vec<_> = app.stretched_worst_first();
+            let place = format!("{} {}", path.display(), animation["animation"]);
+            assert_eq!(shown.len(), cli.len(), "{place}: the same bones are flagged");
+            for (bone, said) in shown.iter().zip(cli) {
+                let figure = |key: &str| said[key].as_f64().unwrap();
+                assert_eq!(said["index"].as_u64(), Some(bone.index as u64), "{place}");
+                assert!((bone.worst_shear_deg - figure("worst_shear_deg")).abs() < 1e-3, "{place}: {said}");
+                assert!((bone.worst_shear_time - figure("worst_shear_time")).abs() < 1e-4, "{place}: {said}");
+                assert!((bone.worst_stretch_deg - figure("worst_stretch_deg")).abs() < 1e-3, "{place}: {said}");
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 40, "the library has sheared bones to compare: {compared}");
+}

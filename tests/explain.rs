@@ -11,23 +11,57 @@ mod common;
 mod generated_gltf;
 
 use bonescope::analysis::{ClipScan, ScanOptions, scan};
-use bonescope::diff::{Pairs, compare_at_size, comparison_times};
+use bonescope::diff::{PROBE_FRACTION, Pairs, compare_at_size, comparison_times};
 use bonescope::eval::{Evaluation, LayerStack, Layers};
 use bonescope::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
 use bonescope::model::{InheritMode, Rig};
 use common::{asset, bonescope, json, load_asset};
+use glam::DVec3;
 
 /// The rule a fix's cost follows, applied to `diff`'s own comparison of `a` with `b`: the largest vertex distance
-/// of any mesh, and the largest probe distance of any bone of the figure that no mesh shows.
+/// of any mesh, and the largest probe distance of any bone of the figure.
 fn visible_distance(a: &Evaluation, b: &Evaluation, rate: f64) -> (f64, bool) {
     // Costs are measured against the rig as it is (the source's size sets the probe points' reach).
     let times = comparison_times(a, b, rate);
     let comparison = compare_at_size(a, b, &Pairs::by_name(a, b), &times, a.size(&times));
-    let (shown, figure) = (a.rig.shown_by_meshes(), a.rig.skeleton.figure());
+    let figure = a.rig.skeleton.figure();
     let skin = comparison.meshes.iter().map(|m| m.distance.max).fold(0.0, f64::max);
-    let unseen = comparison.bones.iter().filter(|d| figure[d.a] && !shown[d.a]).map(|d| d.probe.max);
-    let bones = unseen.fold(0.0, f64::max);
+    let of_figure = comparison.bones.iter().filter(|d| figure[d.a]).map(|d| d.probe.max);
+    let bones = of_figure.fold(0.0, f64::max);
     (skin.max(bones), comparison.meshes.is_empty() || bones > skin)
+}
+
+/// How far `fixed` moves anything of `source` at `times`, found here from the two evaluations' poses and skins
+/// alone: the origin of every bone of the figure and the points `probe` along each of its axes, and every vertex
+/// of every mesh (bones and meshes matched by name).
+fn moved_for_real(source: &Evaluation, fixed: &Evaluation, times: &[f64], probe: f64) -> f64 {
+    let (a, b) = (source.skeleton(), fixed.skeleton());
+    let figure = a.figure();
+    let bones: Vec<(usize, usize)> =
+        (0..a.len()).filter(|&i| figure[i]).filter_map(|i| Some((i, b.find(&a.bone(i).name)?))).collect();
+    let named = |name: &str| fixed.rig.meshes.iter().position(|m| m.name == name);
+    let meshes: Vec<(usize, usize)> =
+        source.rig.meshes.iter().enumerate().filter_map(|(i, m)| Some((i, named(&m.name)?))).collect();
+    let (mut on_a, mut on_b) = (source.evaluator(), fixed.evaluator());
+    let (mut skin_a, mut skin_b) = (Vec::new(), Vec::new());
+    let mut largest: f64 = 0.0;
+    for &time in times {
+        on_a.evaluate(time);
+        on_b.evaluate(time);
+        let (ma, mb) = (&on_a.pose.model.model, &on_b.pose.model.model);
+        for &(i, j) in &bones {
+            // The origin, and a point `probe` away along each of the source's axes, in the bone's own frame.
+            let along = |axis: usize| DVec3::AXES[axis] * probe / ma[i].col(axis).truncate().length();
+            let points = [DVec3::ZERO, along(0), along(1), along(2)].into_iter().filter(|p| p.is_finite());
+            points.for_each(|p| largest = largest.max(ma[i].transform_point3(p).distance(mb[j].transform_point3(p))));
+        }
+        for &(i, j) in &meshes {
+            source.skin(&on_a.pose, i, &mut skin_a);
+            fixed.skin(&on_b.pose, j, &mut skin_b);
+            skin_a.iter().zip(&skin_b).for_each(|(p, q)| largest = largest.max(p.distance(*q)));
+        }
+    }
+    largest
 }
 
 /// `fix` of `bone` checked against `fixed`, the same change made independently: the bone's worst shear and flag
@@ -46,6 +80,11 @@ fn check_fix(source: &Evaluation, fixed: &Evaluation, bone_in_fixed: usize, fix:
     let tolerance = 1e-12 * source.size(&[0.0]).max(1.0);
     assert!((distance - fix.cost.distance.max).abs() <= tolerance, "{}: {distance} against {:?}", fix.label, fix.cost);
     assert_eq!(on_bones, fix.cost.measured == Measured::Bones, "{}", fix.label);
+    // Never less than what the change moves, found without `diff`, at the times the cost is measured at.
+    let times = comparison_times(source, fixed, options.rate);
+    let probe = PROBE_FRACTION * source.size(&times);
+    let moved = moved_for_real(source, fixed, &times, probe);
+    assert!(fix.cost.distance.max >= moved - tolerance, "{}: moves {moved}, costed {:?}", fix.label, fix.cost);
 }
 
 /// What `fix` of `bone` says of the other bones, against scans of the rig before and with the change: every bone
@@ -146,6 +185,10 @@ fn on_the_blender_rig_every_fix_holds_and_the_bakes_hold_as_the_files_bake_write
     let from_fbx = check_fixes_in_memory(&Evaluation::declared(&fbx, fbx.clips.first()), &options);
     let names = |explained: &[Explanation]| explained.iter().map(|e| e.name.clone()).collect::<Vec<_>>();
     assert_eq!(names(&from_fbx), names(&explained), "the same bones shear, in the same order");
+    // And as Blender's USD export (UsdSkel: every joint inherits fully).
+    let usd = load_asset("blender/stretchy_full.usdc");
+    let from_usd = check_fixes_in_memory(&Evaluation::declared(&usd, usd.clips.first()), &options);
+    assert!(names(&from_usd).contains(&"forearm".to_owned()), "{:?}", names(&from_usd));
     check_bakes(&path, &source, forearm, &options);
     // The same through the command line: a mode given to one bone, a scale made uniform.
     let shear_with = |extra: &[&str]| {
@@ -297,4 +340,112 @@ fn costing_only_the_contenders_finds_the_same_best_fix() {
             assert!(brief.fixes.len() <= all.fixes.len());
         }
     }
+}
+
+/// A glTF rig with no skin: `upper` scaled (2, 1, 1), its child `fore` one unit along X turning about Z from 0° to
+/// 90° over a second, and a plain node `hand` one unit along X under `fore` (with `tip` one unit further where
+/// `with_tip`).
+fn turning_arm(with_tip: bool) -> Vec<u8> {
+    use base64::Engine as _;
+    let times = [0.0f32, 0.5, 1.0];
+    let turn = |degrees: f32| {
+        let half = degrees.to_radians() / 2.0;
+        [0.0, 0.0, half.sin(), half.cos()]
+    };
+    let rotations = [turn(0.0), turn(45.0), turn(90.0)];
+    let bin: Vec<u8> = times.iter().chain(rotations.as_flattened()).flat_map(|v| v.to_le_bytes()).collect();
+    let uri = format!("data:application/octet-stream;base64,{}", base64::prelude::BASE64_STANDARD.encode(&bin));
+    let hand_children = if with_tip { serde_json::json!([3]) } else { serde_json::json!([]) };
+    let document = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"name": "upper", "scale": [2.0, 1.0, 1.0], "children": [1]},
+            {"name": "fore", "translation": [1.0, 0.0, 0.0], "children": [2]},
+            {"name": "hand", "translation": [1.0, 0.0, 0.0], "children": hand_children},
+            {"name": "tip", "translation": [1.0, 0.0, 0.0]}
+        ],
+        "buffers": [{"byteLength": bin.len(), "uri": uri}],
+        "bufferViews": [{"buffer": 0, "byteLength": 12}, {"buffer": 0, "byteOffset": 12, "byteLength": 48}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0.0], "max": [1.0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC4"}
+        ],
+        "animations": [{"name": "turn", "samplers": [{"input": 0, "output": 1}],
+                        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]}]
+    });
+    document.to_string().into_bytes()
+}
+
+#[test]
+fn a_plain_node_under_a_turning_bone_is_of_the_figure_and_every_fix_pays_for_moving_it() {
+    for with_tip in [false, true] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("arm.gltf");
+        std::fs::write(&path, turning_arm(with_tip)).unwrap();
+        let rig = bonescope::import::load(&path).unwrap();
+        let figure = rig.skeleton.figure();
+        let tip = rig.skeleton.find("tip");
+        for bone in ["hand"].into_iter().chain(tip.map(|_| "tip")) {
+            assert!(figure[rig.skeleton.find(bone).unwrap()], "{bone} carries the chain on: of the figure");
+        }
+        let source = Evaluation::declared(&rig, rig.clips.first());
+        let explained = check_fixes_in_memory(&source, &ScanOptions::default());
+        let fore = explained.iter().find(|e| e.name == "fore").expect("the turn under the squash shears fore");
+        // Made by hand: at 0 s the hand is at x = 2·(1 + 1) = 4 under full inheritance, and at x = 2 + 1 = 3 when
+        // fore compensates its parent's scale; at 1 s, (2, 1) against (2, 1): the hand moves 1 m at worst.
+        let compensate = fore.fixes.iter().find(
+            |f| matches!(f.change, Change::Mode { bone, mode: InheritMode::SegmentCompensate } if bone == fore.bone),
+        );
+        let compensate = compensate.expect("segment-compensate is among fore's fixes");
+        let reach = if with_tip { 2.0 } else { 1.0 };
+        assert!(compensate.cost.distance.max >= reach - 1e-9, "the chain's end moves {reach}: {compensate:?}");
+    }
+}
+
+/// The table's fixes under two headings: the modes of the tool that wrote the file first (Blender's for Blender's
+/// FBX, Maya's segment-compensate and full for Maya's), the others under "other modes"; both answers said first;
+/// a fix that changes nothing left out unless `--all` asks for every one.
+#[test]
+fn explain_answers_both_questions_and_offers_the_files_own_modes_first() {
+    let table = |file: &str, extra: &[&str]| {
+        let path = asset(file);
+        let mut args = vec!["explain", path.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let output = bonescope(&args);
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        String::from_utf8(output.stdout).unwrap()
+    };
+    // The fix rows of the table headed `heading`, each row's label.
+    let rows = |text: &str, heading: &str| -> Vec<String> {
+        let lines = text.lines().skip_while(|l| !l.trim_start().starts_with(heading)).skip(1);
+        let rows = lines.take_while(|l| l.starts_with("    ") && !l.trim_start().starts_with("other modes"));
+        rows.map(|l| l.trim().split("  ").next().unwrap().to_owned()).collect()
+    };
+    let mode_of = |label: &str| label.split(" → ").nth(1).map(|m| m.parse::<InheritMode>().unwrap());
+
+    let blender = table("blender/stretchy_full.fbx", &["--bone", "forearm"]);
+    assert!(blender.contains("  to play it as authored in any engine: bake exact, no visible change\n"), "{blender}");
+    assert!(blender.contains("  to remove the shear: forearm → blender-aligned, moves the skin"), "{blender}");
+    assert!(blender.contains("— no fix under 1 % of the rig"), "{blender}");
+    let first = rows(&blender, "fixes, best first");
+    let blenders = |m: InheritMode| m == InheritMode::Full || m.is_blender();
+    assert!(first.iter().filter_map(|l| mode_of(l)).all(blenders), "{first:?}");
+    let other = rows(&blender, "other modes");
+    assert!(!other.is_empty() && other.iter().filter_map(|l| mode_of(l)).all(|m| !blenders(m)), "{other:?}");
+    // Fix Shear leaves the forearm's shear where it was and moves nothing visibly: listed only on asking.
+    assert!(!blender.contains("forearm → blender-fix-shear"), "{blender}");
+    assert!(
+        table("blender/stretchy_full.fbx", &["--bone", "forearm", "--all"]).contains("forearm → blender-fix-shear")
+    );
+
+    let maya = table("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", &["--bone", "Right_Tip"]);
+    let first = rows(&maya, "fixes, best first");
+    let maya_modes = [InheritMode::Full, InheritMode::SegmentCompensate];
+    assert!(first.iter().filter_map(|l| mode_of(l)).all(|m| maya_modes.contains(&m)), "{first:?}");
+    assert!(maya.contains("  to remove the shear: Mid → segment-compensate"), "{maya}");
+
+    // A glTF names no tool of its own: every mode is among the first.
+    let gltf = table("blender/stretchy_full.glb", &["--bone", "forearm"]);
+    assert!(!gltf.contains("other modes"), "{gltf}");
 }

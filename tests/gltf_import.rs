@@ -400,8 +400,8 @@ fn assert_fails(result: Result<Rig, ImportError>, place: &str, needle: &str) {
 }
 
 /// A node's role: Cesium Man's nodes (unnamed: node 0 the Z-up root, 21 the armature, 2 to 20 the skin's joints,
-/// 1 the skinned mesh); in a hand-written scene, a camera, a light, a node nothing refers to and one that an
-/// animation moves.
+/// 1 the skinned mesh); in a hand-written scene, a camera, a light, a node nothing refers to, one that an
+/// animation moves and the nodes below it.
 #[test]
 fn nodes_have_the_role_of_what_refers_to_them() {
     let cesium = load_asset("gltf-khronos/cesium_man.gltf");
@@ -424,7 +424,10 @@ fn nodes_have_the_role_of_what_refers_to_them() {
             {"name": "cam", "camera": 0},
             {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}},
             {"name": "empty"},
-            {"name": "moved"}
+            {"name": "moved", "children": [4, 6]},
+            {"name": "carried", "children": [5]},
+            {"name": "carried_on"},
+            {"name": "held_camera", "camera": 0}
         ],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
         "buffers": [{"byteLength": bin.len(), "uri": uri}],
@@ -439,7 +442,9 @@ fn nodes_have_the_role_of_what_refers_to_them() {
     let dir = tempfile::tempdir().unwrap();
     let rig = load_file(dir.path(), "roles.gltf", document.to_string().as_bytes()).unwrap_or_else(|e| panic!("{e}"));
     let expected = [("cam", NodeRole::Camera), ("lamp", NodeRole::Light), ("empty", NodeRole::Helper)];
-    for (name, expected) in expected.into_iter().chain([("moved", NodeRole::Joint)]) {
+    // A plain node below a joint carries the chain onward, however deep; a camera there stays a camera.
+    let below = [("carried", NodeRole::Joint), ("carried_on", NodeRole::Joint), ("held_camera", NodeRole::Camera)];
+    for (name, expected) in expected.into_iter().chain([("moved", NodeRole::Joint)]).chain(below) {
         assert_eq!(role(&rig, name), expected, "{name}");
     }
 }

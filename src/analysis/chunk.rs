@@ -326,7 +326,7 @@ impl<'a> Plotter<'a> {
 }
 
 /// `bones` and all their ancestors, sorted (so parents come first).
-fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
+pub(super) fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
     let mut wanted = vec![false; skeleton.len()];
     for &bone in bones.iter().filter(|&&b| b < skeleton.len()) {
         let mut next = Some(bone);

@@ -5,6 +5,7 @@ use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::findings::{Tolerances, Verdict, shear_cosine};
+use super::peak::Peaks;
 use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg_of_cosine};
 
 /// One bone over a whole clip. Times are in seconds.
@@ -23,11 +24,17 @@ pub struct BoneSummary {
     pub non_uniform_samples: usize,
     pub mirrored_samples: usize,
     pub degenerate_samples: usize,
-    /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end.
+    /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end, and when the
+    /// worst stretch happens.
     #[serde(skip)]
-    worst_shear_cosine_squared: f64,
+    pub(super) worst_shear_cosine_squared: f64,
     #[serde(skip)]
-    worst_stretch_half_cosine: f64,
+    pub(super) worst_stretch_half_cosine: f64,
+    #[serde(skip)]
+    pub(super) worst_stretch_time: f64,
+    /// The highest peaks of the sampled shear, where [`super::peak`] refines it.
+    #[serde(skip)]
+    pub(super) shear_peaks: Peaks,
 }
 
 impl BoneSummary {
@@ -44,18 +51,24 @@ impl BoneSummary {
             degenerate_samples: 0,
             worst_shear_cosine_squared: 0.0,
             worst_stretch_half_cosine: 1.0,
+            worst_stretch_time: 0.0,
+            shear_peaks: Peaks::default(),
         }
     }
 
     /// Adds one sample. The worst angles are kept as cosines until [`BoneSummary::finish`].
     pub(super) fn add(&mut self, time: f64, verdict: &Verdict) {
+        self.shear_peaks.add(time, verdict.shear_cosine_squared);
         if verdict.shear_cosine_squared > self.worst_shear_cosine_squared {
             self.worst_shear_cosine_squared = verdict.shear_cosine_squared;
             self.worst_shear_time = time;
         }
         let f = verdict.findings;
         if f.stretched {
-            self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(verdict.stretch_half_cosine);
+            if verdict.stretch_half_cosine < self.worst_stretch_half_cosine {
+                self.worst_stretch_half_cosine = verdict.stretch_half_cosine;
+                self.worst_stretch_time = time;
+            }
             self.flagged_samples += 1;
             self.first_flagged_time.get_or_insert(time);
         }
@@ -66,11 +79,15 @@ impl BoneSummary {
 
     /// Combines the summary of an earlier run of samples with that of a later one.
     pub(super) fn merge(&mut self, later: &BoneSummary) {
+        self.shear_peaks.merge(&later.shear_peaks);
         if later.worst_shear_cosine_squared > self.worst_shear_cosine_squared {
             self.worst_shear_cosine_squared = later.worst_shear_cosine_squared;
             self.worst_shear_time = later.worst_shear_time;
         }
-        self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(later.worst_stretch_half_cosine);
+        if later.worst_stretch_half_cosine < self.worst_stretch_half_cosine {
+            self.worst_stretch_half_cosine = later.worst_stretch_half_cosine;
+            self.worst_stretch_time = later.worst_stretch_time;
+        }
         self.flagged_samples += later.flagged_samples;
         self.first_flagged_time = self.first_flagged_time.or(later.first_flagged_time);
         self.non_uniform_samples += later.non_uniform_samples;

@@ -5,6 +5,7 @@ mod bind;
 mod chunk;
 mod clip_analysis;
 mod findings;
+mod peak;
 pub mod report;
 mod request;
 mod scan;

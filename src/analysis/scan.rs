@@ -1,5 +1,6 @@
 //! Whole-clip analysis: every key time plus a fixed rate, every bone, in parallel. Summarised per bone for the
-//! whole rig (cheap to keep for any rig); full component curves only for the bones asked for (plotted ones).
+//! whole rig (cheap to keep for any rig), each bone's worst values refined between samples (`peak`); full component
+//! curves only for the bones asked for (plotted ones).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -7,6 +8,8 @@ use rayon::prelude::*;
 
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
+use super::findings::Judge;
+use super::peak;
 use super::request::{CurveRequest, ScanOptions};
 use crate::eval::{Evaluation, run_length};
 
@@ -50,7 +53,9 @@ pub fn analyze(
         })
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
-    Some(assemble(skeleton.figure(), times, curves, chunks))
+    let mut analysis = assemble(skeleton.figure(), times, curves, chunks);
+    peak::refine(evaluation, &analysis.times, &mut analysis.scan.bones, &Judge::new(&options.tolerances));
+    Some(analysis)
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.

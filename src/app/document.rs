@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use super::compared::Compared;
 use super::identity::RigId;
+use crate::analysis::ScanOptions;
 use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};
 use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton};
@@ -165,10 +166,11 @@ impl Document {
         self.frame_rate_override.or_else(|| self.clip().map(Clip::frame_rate)).unwrap_or(DEFAULT_FRAME_RATE)
     }
 
-    /// Samples per second of the whole-clip analysis: the clip's own frames, and at least 30 a second, so that a
-    /// clip keyed sparsely is examined between its keys.
+    /// Samples per second of the whole-clip analysis: the clip's own frames, and at least `scan`'s default rate, so
+    /// that a clip keyed sparsely is examined between its keys and the app samples where `scan` does (the worst
+    /// shear is refined between samples whatever the rate; a stretch angle that spikes between two samples is not).
     pub fn analysis_rate(&self) -> f64 {
-        self.frame_rate().max(DEFAULT_FRAME_RATE)
+        self.frame_rate().max(ScanOptions::default().rate)
     }
 
     /// How long the timeline runs: the clip's duration, or what the layers make of it (a synced blend's cycle, a

@@ -101,6 +101,9 @@ fn explanation_ui(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     if explained.causes.stretched_samples == 0 {
         return;
     }
+    for answer in explained.answers(shared.doc.rig.unit) {
+        ui.label(RichText::new(drawable(&answer)).small());
+    }
     ui.add_space(4.0);
     chain(ui, shared, explained);
     ui.add_space(4.0);
@@ -143,7 +146,7 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
             go_to(shared, at.time);
         }
         let shear = RichText::new(format!("shear {}°", compact(at.shear_deg)));
-        ui.label(shear).on_hover_text(format!("{}°", at.shear_deg));
+        ui.label(shear).on_hover_text("the largest angle by which two of the bone's axes miss 90°");
     });
     let main = at.main_cause().map(|l| l.bone);
     let columns = Columns::of(ui);
@@ -208,18 +211,21 @@ fn bar(ui: &mut Ui, width: f32, contribution: f64, shear: f64, main: bool) -> eg
     response
 }
 
-/// A chain bone's numbers, exact.
+/// A chain bone's numbers, and what a negative contribution means: its scale counters the others'.
 fn link_hint(link: &Link, shear: f64) -> String {
     let k = link.scale;
+    let (x, y, z) = (compact(k.x), compact(k.y), compact(k.z));
     let mut text =
-        format!("{}'s local scale ({}, {}, {}), unequal by {} %", link.name, k.x, k.y, k.z, 100.0 * link.anisotropy);
+        format!("{}'s local scale ({x}, {y}, {z}), unequal by {} %", link.name, compact(100.0 * link.anisotropy));
     if let Some(turn) = link.turn_deg {
-        text.push_str(&format!("; its axes turned {turn}° from the bone's"));
+        text.push_str(&format!("; its axes turned {}° from the bone's", compact(turn)));
     }
-    text.push_str(&format!(
-        "\nmade uniform, {}° of the {shear}° shear is left: it causes {}°",
-        link.shear_left_deg, link.contribution_deg
-    ));
+    let (left, shear, causes) = (compact(link.shear_left_deg), compact(shear), compact(link.contribution_deg + 0.0));
+    text.push_str(&format!("\nmade uniform, {left}° of the {shear}° shear is left: it causes {causes}°"));
+    if link.contribution_deg < 0.0 {
+        text.push_str("\nnegative: its scale counters the others' (made uniform, the shear grows)");
+    }
+    text.push_str("\ncontributions need not add up: scales compound and cancel");
     text
 }
 
@@ -244,13 +250,15 @@ fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
 /// The fixes, best first: each with what it leaves and what it moves, in columns; a Try button on those that are
 /// settings of the document.
 fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
-    if explained.fixes.is_empty() {
+    // Those that change something: Blender's Fix Shear on a bone its parent does not shear is no fix.
+    let shown: Vec<Fix> = explained.shown_fixes(false, shared.settings.tolerances.min_shear_deg).cloned().collect();
+    if shown.is_empty() {
         return;
     }
     ui.label(RichText::new("Fixes, best first").strong());
     let unit = shared.doc.rig.unit;
-    let columns = FixColumns::of(ui, &explained.fixes, unit);
-    listed(ui, "why-more-fixes", &explained.fixes, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns));
+    let columns = FixColumns::of(ui, &shown, unit, explained.causes.at.time);
+    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns));
 }
 
 /// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
@@ -260,10 +268,12 @@ struct FixColumns {
     effect: f32,
     distance: f32,
     unit: Option<Unit>,
+    /// The explained bone's worst time, where Try goes.
+    worst: f64,
 }
 
 impl FixColumns {
-    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>) -> FixColumns {
+    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>, worst: f64) -> FixColumns {
         let body = TextStyle::Body.resolve(ui.style());
         let widest = |text: &dyn Fn(&Fix) -> String| {
             fixes.iter().map(|fix| text_width(ui, &text(fix), &body)).fold(0.0, f32::max)
@@ -273,6 +283,7 @@ impl FixColumns {
             effect: widest(&effect),
             distance: widest(&|fix| distance(fix, unit)),
             unit,
+            worst,
         }
     }
 }
@@ -283,7 +294,7 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
-            change => try_button(ui, shared, change, columns.button),
+            change => try_button(ui, shared, change, columns.button, columns.worst),
         }
         ui.vertical(|ui| {
             // Rows as tall as their text, so that the label and its numbers read as one entry.
@@ -312,7 +323,8 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
 }
 
 /// Tries a change on the document.
-fn try_button(ui: &mut Ui, shared: &mut Shared, change: Change, width: f32) {
+/// Try: the fix made, and the timeline at the bone's worst time `worst`, where the change shows.
+fn try_button(ui: &mut Ui, shared: &mut Shared, change: Change, width: f32, worst: f64) {
     let what = match change {
         Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
         _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
@@ -320,6 +332,7 @@ fn try_button(ui: &mut Ui, shared: &mut Shared, change: Change, width: f32) {
     let hint = format!("{what}; the ghost then shows the clip as it was");
     if ui.add(Button::new("Try").small().min_size(vec2(width, 0.0))).on_hover_text(hint).clicked() {
         try_fix(shared, change);
+        go_to(shared, worst);
     }
 }
 
@@ -369,14 +382,12 @@ fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
     };
     let distance = fix.cost.distance;
     let mut text = format!(
-        "{}: {}° of shear left over the clip ({flagged})\nmoves {what} at most {} in the rig's units ({}) at {} s, {} % \
-         of the rig's size",
+        "{}: {}° of shear left over the clip ({flagged})\nmoves {what} at most {} at {} s, {} % of the rig's size",
         drawable(&fix.label),
-        fix.shear_left_deg,
-        distance.max,
+        compact(fix.shear_left_deg),
         Unit::readable(unit, distance.max),
-        distance.time,
-        100.0 * fix.cost.fraction
+        compact(distance.time),
+        compact(100.0 * fix.cost.fraction)
     );
     if !fix.cleared().is_empty() {
         text.push_str(&format!("\nalso clears {}", fix.cleared().join(", ")));

@@ -13,7 +13,7 @@ use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
 use crate::eval::Layers;
-use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain};
+use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain, is_other_mode};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
 
@@ -32,6 +32,9 @@ pub struct ExplainArgs {
     /// Samples per second, on top of every key time.
     #[arg(long, value_name = "HZ", default_value_t = ScanOptions::default().rate, value_parser = parse_rate)]
     pub rate: f64,
+    /// List every fix measured, also those that change nothing (the JSON always lists every one).
+    #[arg(long)]
+    pub all: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: OutputFormat,
     #[command(flatten)]
@@ -76,12 +79,22 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     };
     match args.format {
         OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        OutputFormat::Table => print!("{}", render_table(&report, &rig, evaluation.modes())),
+        OutputFormat::Table => {
+            let shown = Shown { all: args.all, min_shear_deg: options.tolerances.min_shear_deg };
+            print!("{}", render_table(&report, &rig, evaluation.modes(), shown));
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode]) -> String {
+/// Which fixes the table lists: every one, or those that change something (a shear tolerance apart).
+#[derive(Clone, Copy)]
+struct Shown {
+    all: bool,
+    min_shear_deg: f64,
+}
+
+fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode], shown: Shown) -> String {
     let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {animation}  inherit: {}\n", report.file, report.inherit);
     let layers = report.layers.summary(rig, report.animation.as_ref().and_then(|a| rig.clips.get(a.index)));
@@ -93,18 +106,21 @@ fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode]) -> Str
     }
     for explained in report.bones {
         out.push('\n');
-        out.push_str(&render_bone(explained, rig, modes, report.unit));
+        out.push_str(&render_bone(explained, rig, modes, report.unit, shown));
     }
     out
 }
 
-/// One bone: the chain at the detailed time, the main causes over the clip, the fixes, and what the declared modes
-/// on the chain are worth.
-fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: Option<Unit>) -> String {
+/// One bone: both answers, the chain at the detailed time, the main causes over the clip, the fixes, and what the
+/// declared modes on the chain are worth.
+fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: Option<Unit>, shown: Shown) -> String {
     let (causes, at) = (&explained.causes, &explained.causes.at);
     let mut out = format!("{}\n", explained.headline(unit));
     if causes.stretched_samples == 0 {
         return out;
+    }
+    for answer in explained.answers(unit) {
+        out.push_str(&format!("  {answer}\n"));
     }
     out.push_str(&format!(
         "  shears {:.3}° at {:.4} s{}; flagged at {} of {} samples\n",
@@ -149,7 +165,18 @@ fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: 
             causes.spans.iter().map(|s| format!("{} {:.4}–{:.4} s", s.name, s.from, s.to)).collect();
         out.push_str(&format!("  main cause over the clip: {}\n", spans.join(", ")));
     }
-    out.push_str(&render_fixes(&explained.fixes, unit));
+    // The modes of the file's own tool first (every mode for a format without a tool of its own), the others apart.
+    let listed = explained.shown_fixes(shown.all, shown.min_shear_deg);
+    let (other, first): (Vec<&Fix>, Vec<&Fix>) = listed.partition(|fix| is_other_mode(fix.change, rig.tool));
+    out.push_str(&render_fixes("  fixes, best first", &first, unit));
+    if !other.is_empty() {
+        out.push_str(&render_fixes("  other modes", &other, unit));
+    }
+    match explained.fixes.len() - first.len() - other.len() {
+        0 => {}
+        1 => out.push_str("  1 fix that changes nothing is left out (--all lists it)\n"),
+        n => out.push_str(&format!("  {n} fixes that change nothing are left out (--all lists them)\n")),
+    }
     out.push_str(&render_modes(explained, rig, modes, unit));
     for note in &explained.notes {
         out.push_str(&format!("  note: {note}\n"));
@@ -157,9 +184,9 @@ fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: 
     out
 }
 
-fn render_fixes(fixes: &[Fix], unit: Option<Unit>) -> String {
+fn render_fixes(title: &'static str, fixes: &[&Fix], unit: Option<Unit>) -> String {
     let mut table = Table::new(&[
-        ("  fixes, best first", false),
+        (title, false),
         ("shear left°", true),
         ("removes", false),
         ("moves", true),

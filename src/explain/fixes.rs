@@ -9,7 +9,7 @@ use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, compare_each, comparison_times};
 use crate::eval::{Evaluation, Setup};
 use crate::import;
-use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Unit};
+use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
 
 /// A change to how the clip is evaluated that may take a bone's shear away.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -87,8 +87,8 @@ impl Change {
 pub enum Measured {
     /// At a skinned vertex (or a vertex of a mesh hanging from a bone).
     Skin,
-    /// At a bone no mesh shows (its origin or a probe point on its axes): a rig without a mesh, or a part of the
-    /// figure its meshes do not cover.
+    /// At a bone of the figure (its origin or a probe point on its axes): a rig without a mesh, a part of the figure
+    /// its meshes do not cover, or a bone's tip that moves further than the skin around it.
     Bones,
 }
 
@@ -110,7 +110,7 @@ const BATCH: usize = 16;
 const BOUND_TIMES: usize = 64;
 
 /// What every change is measured against, found once: the evaluation explained, its scan, its times and size (for
-/// `diff`'s comparison), which bones a mesh shows, and the options.
+/// `diff`'s comparison), and the options.
 pub(super) struct Baseline<'e, 'a> {
     pub source: &'e Evaluation<'a>,
     pub before: &'e ClipScan,
@@ -118,26 +118,23 @@ pub(super) struct Baseline<'e, 'a> {
     /// The source's own comparison times, and its size over them.
     times: Vec<f64>,
     size: f64,
-    /// Per bone, whether a mesh shows it ([`Rig::shown_by_meshes`]).
-    shown: Vec<bool>,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
     pub fn new(source: &'e Evaluation<'a>, before: &'e ClipScan, options: &'e ScanOptions) -> Self {
         let times = comparison_times(source, source, options.rate);
         let size = source.size(&times);
-        let shown = source.rig.shown_by_meshes();
-        Baseline { source, before, options, times, size, shown }
+        Baseline { source, before, options, times, size }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
-    /// vertices, and of the probe points of every bone of the figure that no mesh shows; a skin that stays put does
-    /// not hide a neck that moves.
+    /// vertices, and of the origin and probe points of every bone of the figure; a skin that stays put does not
+    /// hide a neck that moves, nor a bone's tip that swings further than the skin around it.
     fn visible(&self, comparison: &Comparison) -> Cost {
         let skin = comparison.meshes.iter().map(|m| m.distance).fold(Extreme::default(), Extreme::merge);
         let figure = self.source.skeleton().figure();
-        let unseen = comparison.bones.iter().filter(|b| figure[b.a] && !self.shown[b.a]).map(|b| b.probe);
-        let bones = unseen.fold(Extreme::default(), Extreme::merge);
+        let of_figure = comparison.bones.iter().filter(|b| figure[b.a]).map(|b| b.probe);
+        let bones = of_figure.fold(Extreme::default(), Extreme::merge);
         let (distance, measured) = if bones.max > skin.max || self.source.rig.meshes.is_empty() {
             (bones, Measured::Bones)
         } else {
@@ -258,10 +255,10 @@ pub(super) struct Applied {
 
 impl Applied {
     /// Where a fix by this change for `bone` ranks before its cost is known: fixes that leave the bone unflagged
-    /// first, then by the shear they leave ([`rank`]).
-    pub fn standing(&self, bone: usize) -> (bool, f64) {
+    /// first, the modes of the file's own tool before others, then by the shear they leave ([`rank`]).
+    pub fn standing(&self, bone: usize, other_mode: bool) -> (bool, bool, f64) {
         let (shear, flagged) = self.shear[bone];
-        (flagged, if flagged { shear } else { 0.0 })
+        (flagged, other_mode, if flagged { shear } else { 0.0 })
     }
 }
 
@@ -337,6 +334,18 @@ impl Fix {
         }
     }
 
+    /// Whether the fix changes nothing worth offering for a bone whose worst shear is `shear_deg`: a mode or scale
+    /// change that leaves the shear where it was (within `min_shear_deg`), moves nothing visibly
+    /// ([`super::INVISIBLE`]) and changes no other bone's shear (Blender's Fix Shear on a bone whose parent does
+    /// not shear it).
+    pub fn changes_nothing(&self, shear_deg: f64, min_shear_deg: f64) -> bool {
+        !matches!(self.change, Change::Bake { .. })
+            && !self.removes
+            && (self.shear_left_deg - shear_deg).abs() <= min_shear_deg
+            && self.cost.fraction < super::INVISIBLE
+            && self.elsewhere.is_empty()
+    }
+
     /// The other bones the change flags that were not flagged before.
     pub fn newly_flagged(&self) -> Vec<&str> {
         self.elsewhere.iter().filter(|e| e.flagged_after && !e.flagged_before).map(|e| e.name.as_str()).collect()
@@ -350,22 +359,37 @@ impl Fix {
     /// "forearm → segment-compensate, moves the skin 0.4 mm" (and the shear it leaves, where it leaves some),
     /// lengths in `unit` (the rig's).
     pub fn summary(&self, unit: Option<Unit>) -> String {
+        let left = if self.removes { String::new() } else { format!(", leaves {:.2}°", self.shear_left_deg) };
+        format!("{}, {}{left}", self.label, self.moves(unit))
+    }
+
+    /// "moves the skin 0.4 mm", in `unit` (the rig's).
+    pub fn moves(&self, unit: Option<Unit>) -> String {
         let moved = match self.cost.measured {
             Measured::Skin => "moves the skin",
             Measured::Bones => "moves the bones",
         };
-        let left = if self.removes { String::new() } else { format!(", leaves {:.2}°", self.shear_left_deg) };
-        format!("{}, {moved} {}{left}", self.label, Unit::readable(unit, self.cost.distance.max))
+        format!("{moved} {}", Unit::readable(unit, self.cost.distance.max))
     }
 }
 
-/// Ranks fixes: those that remove the shear first, by cost; then the others by the shear they leave, then cost.
-pub(super) fn rank(fixes: &mut [Fix]) {
-    let key = |f: &Fix| (!f.removes, if f.removes { 0.0 } else { f.shear_left_deg }, f.cost.distance.max);
+/// Ranks fixes: those that remove the shear first, the modes of `tool` (the file's own) before the others, by cost;
+/// then the others the same way by the shear they leave, then cost.
+pub(super) fn rank(fixes: &mut [Fix], tool: Option<Tool>) {
+    let key = |f: &Fix| {
+        let left = if f.removes { 0.0 } else { f.shear_left_deg };
+        (!f.removes, is_other_mode(f.change, tool), left, f.cost.distance.max)
+    };
     fixes.sort_by(|a, b| {
         let (ka, kb) = (key(a), key(b));
-        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(ka.2.total_cmp(&kb.2))
+        ka.0.cmp(&kb.0).then(ka.1.cmp(&kb.1)).then(ka.2.total_cmp(&kb.2)).then(ka.3.total_cmp(&kb.3))
     });
+}
+
+/// Whether `change` sets a mode that `tool` (the file's own) has no setting for: every mode is a glTF's, a BVH's
+/// or a USD file's.
+pub fn is_other_mode(change: Change, tool: Option<Tool>) -> bool {
+    matches!(change, Change::Mode { mode, .. } if tool.is_some_and(|tool| !tool.modes().contains(&mode)))
 }
 
 /// The changes worth trying for `bone`, whose chain holds the unequally scaled bones `scaled`: each bone of the

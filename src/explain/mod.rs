@@ -20,7 +20,7 @@ mod attribution;
 mod fixes;
 
 pub use attribution::{Attribution, CauseSpan, Causes, Link, attribute, causes};
-pub use fixes::{Change, Cost, Fix, Measured, ShearElsewhere};
+pub use fixes::{Change, Cost, Fix, Measured, ShearElsewhere, is_other_mode};
 
 use std::collections::HashMap;
 
@@ -28,8 +28,9 @@ use rayon::prelude::*;
 
 use crate::analysis::report::ExplainedBone;
 use crate::analysis::{ClipScan, ScanOptions};
+use crate::bake::Strategy;
 use crate::eval::Evaluation;
-use crate::model::{Unit, significant};
+use crate::model::{Tool, Unit, significant};
 use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.
@@ -37,6 +38,8 @@ use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 pub struct Explanation {
     pub bone: usize,
     pub name: String,
+    /// Its worst shear over the clip, in degrees, as the scan found it (refined between samples).
+    pub worst_shear_deg: f64,
     pub causes: Causes,
     /// Ranked: the best first. Empty when the bone is never flagged.
     pub fixes: Vec<Fix>,
@@ -49,6 +52,42 @@ impl Explanation {
     /// The best fix, if the bone needs one.
     pub fn best_fix(&self) -> Option<&Fix> {
         self.fixes.first()
+    }
+
+    /// The answer to "make it play as authored in my engine": the exact bake, where it was measured.
+    pub fn as_authored(&self) -> Option<&Fix> {
+        self.fixes.iter().find(|f| f.change == Change::Bake { strategy: Strategy::Exact })
+    }
+
+    /// The answer to "take the shear out of the rig": the cheapest fix that removes it, where one does.
+    pub fn removal(&self) -> Option<&Fix> {
+        self.fixes.iter().find(|f| f.removes)
+    }
+
+    /// Both answers, a line each, lengths in `unit` (the rig's): "to play it as authored in any engine: bake exact,
+    /// no visible change" and "to remove the shear: forearm → blender-aligned, moves the skin 11 cm — no fix under
+    /// 1 % of the rig". Empty when the bone is never flagged.
+    pub fn answers(&self, unit: Option<Unit>) -> Vec<String> {
+        if self.causes.stretched_samples == 0 {
+            return Vec::new();
+        }
+        let mut lines = Vec::new();
+        if let Some(bake) = self.as_authored() {
+            let change = if bake.cost.fraction < INVISIBLE { "no visible change".to_owned() } else { bake.moves(unit) };
+            lines.push(format!("to play it as authored in any engine: bake exact, {change}"));
+        }
+        let removal = match self.removal() {
+            Some(fix) if fix.cost.fraction >= SMALL => format!("{} — no fix under 1 % of the rig", fix.summary(unit)),
+            Some(fix) => fix.summary(unit),
+            None => "no single change removes it".to_owned(),
+        };
+        lines.push(format!("to remove the shear: {removal}"));
+        lines
+    }
+
+    /// The fixes to show: all of them where `all`, else those that change something (see [`Fix::changes_nothing`]).
+    pub fn shown_fixes(&self, all: bool, min_shear_deg: f64) -> impl Iterator<Item = &Fix> {
+        self.fixes.iter().filter(move |f| all || !f.changes_nothing(self.worst_shear_deg, min_shear_deg))
     }
 
     /// The explanation in brief, as `scan --explain` records it.
@@ -65,9 +104,9 @@ impl Explanation {
         }
     }
 
-    /// One line for a report: the main cause where the bone shears most, and the best fix, lengths in `unit` (the
-    /// rig's). "forearm: upper_arm's scale (1.3, 0.8, 1) under a 35° turn; fix: forearm → segment-compensate,
-    /// moves the skin 0.4 mm".
+    /// One line for a report: the main cause where the bone shears most, and the best fix (the cheapest that
+    /// removes the shear, where one does), lengths in `unit` (the rig's). "forearm: upper_arm's scale (1.3, 0.8, 1)
+    /// under a 35° turn; fix: forearm → segment-compensate, moves the skin 0.4 mm".
     pub fn headline(&self, unit: Option<Unit>) -> String {
         let name = &self.name;
         if self.causes.stretched_samples == 0 {
@@ -87,6 +126,12 @@ impl Explanation {
         }
     }
 }
+
+/// Below this fraction of the rig's size a change is not visible: the exact bake's rounding.
+pub const INVISIBLE: f64 = 1e-4;
+
+/// A fix that moves the character by this fraction of the rig's size or more is no small change.
+pub const SMALL: f64 = 0.01;
 
 /// Which fixes an explanation measures the cost of.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -124,8 +169,11 @@ pub fn explain(
     }
     let times = evaluation.times(options.rate);
     let tolerances = &options.tolerances;
-    let at = question.at;
-    let causes: Vec<Causes> = bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at, tolerances)).collect();
+    // Detailed at the time asked for, else where the scan found the bone's worst shear (refined between samples):
+    // one figure per bone, whatever the sampling.
+    let at = |bone: usize| question.at.or_else(|| before.bones.get(bone).map(|b| b.worst_shear_time));
+    let causes: Vec<Causes> =
+        bones.par_iter().map(|&bone| causes(evaluation, bone, &times, at(bone), tolerances)).collect();
     // A bake that reproduces the clip leaves every shear where it was: no candidate for the best fix.
     let bakes = question.costs == Costs::Every || !bakes_reproduce(evaluation);
     let changes: Vec<Vec<Change>> = bones
@@ -137,6 +185,7 @@ pub fn explain(
         })
         .collect();
     let baseline = Baseline::new(evaluation, before, options);
+    let tool = evaluation.rig.tool;
     let applied: HashMap<Change, Result<Applied, String>> = distinct(changes.iter().flatten().copied())
         .into_par_iter()
         .map(|change| (change, baseline.apply(change)))
@@ -150,7 +199,7 @@ pub fn explain(
         Costs::Best => {
             let mut costs = HashMap::new();
             for (&bone, changes) in bones.iter().zip(&changes) {
-                cheapest(&baseline, &contenders(bone, changes, &applied), &applied, &mut costs);
+                cheapest(&baseline, &contenders(bone, changes, &applied, tool), &applied, &mut costs);
             }
             costs
         }
@@ -167,8 +216,9 @@ pub fn explain(
                 (Ok(_), None) => {}
             }
         }
-        rank(&mut fixes);
-        Explanation { bone, name: skeleton.bone(bone).name.clone(), causes, fixes, notes }
+        rank(&mut fixes, tool);
+        let worst_shear_deg = before.bones.get(bone).map_or(0.0, |b| b.worst_shear_deg);
+        Explanation { bone, name: skeleton.bone(bone).name.clone(), worst_shear_deg, causes, fixes, notes }
     });
     explained.collect()
 }
@@ -210,13 +260,20 @@ fn distinct(changes: impl IntoIterator<Item = Change>) -> Vec<Change> {
 
 /// The changes of `bone`'s fixes that can rank first once their shear is known: those that stand best
 /// ([`Applied::standing`]), the shear left equal to within 1e-9°.
-fn contenders(bone: usize, changes: &[Change], applied: &HashMap<Change, Result<Applied, String>>) -> Vec<Change> {
-    let standing = |change: &Change| applied[change].as_ref().ok().map(|a| a.standing(bone));
-    let best = changes.iter().filter_map(standing).min_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    let Some((flagged, shear)) = best else {
+fn contenders(
+    bone: usize,
+    changes: &[Change],
+    applied: &HashMap<Change, Result<Applied, String>>,
+    tool: Option<Tool>,
+) -> Vec<Change> {
+    let standing =
+        |change: &Change| applied[change].as_ref().ok().map(|a| a.standing(bone, is_other_mode(*change, tool)));
+    let best =
+        changes.iter().filter_map(standing).min_by(|a, b| a.0.cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.total_cmp(&b.2)));
+    let Some((flagged, other, shear)) = best else {
         return Vec::new();
     };
-    let ties = |s: (bool, f64)| s.0 == flagged && (s.1 - shear).abs() <= 1e-9;
+    let ties = |s: (bool, bool, f64)| s.0 == flagged && s.1 == other && (s.2 - shear).abs() <= 1e-9;
     changes.iter().copied().filter(|c| standing(c).is_some_and(ties)).collect()
 }
 

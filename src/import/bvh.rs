@@ -189,7 +189,7 @@ fn read(bytes: &[u8]) -> Result<Rig> {
             vec![clip(&joints, &values, frames as usize, frame_time)?]
         }
     };
-    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), unit: None, notes })
+    Ok(Rig { skeleton, clips, skins: Vec::new(), meshes: Vec::new(), unit: None, notes, tool: None })
 }
 
 /// `HIERARCHY` up to and including `MOTION`.

@@ -38,6 +38,7 @@ pub fn demo_rig() -> Rig {
         ],
         unit: Some(Unit::METRE),
         skeleton,
+        tool: None,
     }
 }
 

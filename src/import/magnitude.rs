@@ -135,14 +135,7 @@ mod tests {
                 role: NodeRole::Joint,
             })
             .collect();
-        Rig {
-            skeleton: Skeleton::new(bones).unwrap(),
-            clips: vec![],
-            skins: vec![],
-            meshes: vec![],
-            unit: None,
-            notes: vec![],
-        }
+        Rig { skeleton: Skeleton::new(bones).unwrap(), ..Rig::default() }
     }
 
     #[test]

@@ -6,6 +6,7 @@ mod inherit;
 mod skeleton;
 mod skin;
 mod timeline;
+mod tool;
 mod transform;
 mod unit;
 
@@ -19,6 +20,7 @@ pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, NodeRole, ParentOrderError, Placement, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
 pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
+pub use tool::Tool;
 pub use transform::{Transform, affine};
 pub(crate) use unit::significant;
 pub use unit::{Unit, UnknownUnit};
@@ -35,6 +37,8 @@ pub struct Rig {
     pub unit: Option<Unit>,
     /// Facts about the import a user should know (units, axes, what was listed but not evaluated).
     pub notes: Vec<String>,
+    /// The tool that wrote the file, where the file says and the tool has scale-inheritance settings of its own.
+    pub tool: Option<Tool>,
 }
 
 impl Rig {

@@ -42,7 +42,7 @@ pub enum NodeRole {
     Camera,
     Light,
     /// Any other node: an FBX null or marker (a camera's target, an IK effector), a glTF node with no part in a
-    /// skin or the animation.
+    /// skin or the animation and none below a joint.
     Helper,
 }
 

@@ -30,7 +30,7 @@ use std::path::Path;
 
 use super::failure::{Failure, Result};
 use super::{ImportError, Options, Space};
-use crate::model::{Rig, Unit};
+use crate::model::{Rig, Tool, Unit};
 
 /// Reads an FBX file whose bytes are in memory.
 pub fn load(path: &Path, bytes: &[u8], options: &Options) -> std::result::Result<Rig, ImportError> {
@@ -150,7 +150,8 @@ fn read(scene: &ufbx::SceneRoot, file_size: usize, options: &Options) -> Result<
     let (skins, meshes) = mesh::read(scene, &bones, file_size, &mut notes)?;
     let clips = anim::read_clips(scene, &bones.bone_of_node, file_size, &mut notes)?;
     let unit = unit(scene, options.space);
-    Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, unit, notes })
+    let tool = Tool::named(&scene.metadata.original_application.name);
+    Ok(Rig { skeleton: bones.skeleton, clips, skins, meshes, unit, notes, tool })
 }
 
 /// The unit the file states (ufbx keeps the file's own settings in `scene.settings` even when it converts).

@@ -55,5 +55,5 @@ fn read(path: &Path, source: Source<'_>) -> Result<Rig> {
     let skins = mesh::read_skins(root, &accessors, &scene.bone_of_node, &mut notes)?;
     let meshes = mesh::read_meshes(root, &accessors, &scene, &skins, &mut notes)?;
     let clips = animation::read_clips(root, &accessors, &scene.bone_of_node, &mut notes)?;
-    Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, unit: Some(Unit::METRE), notes })
+    Ok(Rig { skeleton: scene.skeleton, clips, skins, meshes, unit: Some(Unit::METRE), notes, tool: None })
 }

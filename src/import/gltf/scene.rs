@@ -26,20 +26,26 @@ pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
     let roots = scene_roots(root, &parents, notes)?;
     let moved = joints_and_animated(root);
     let mut bone_of_node = vec![None; root.nodes.len()];
-    let mut bones = Vec::new();
+    let mut bones: Vec<Bone> = Vec::new();
     // Depth-first: (node, parent bone), children pushed in reverse so they come out in file order.
     let mut stack: Vec<(usize, Option<usize>)> = roots.iter().rev().map(|&r| (r, None)).collect();
     while let Some((index, parent)) = stack.pop() {
         let node = &root.nodes[index];
         let bone = bones.len();
         bone_of_node[index] = Some(bone);
+        let role = match role(node, moved[index]) {
+            // A plain node below a joint carries the chain onward (a static node under an animated one): it moves
+            // with the chain, so it is of the figure.
+            NodeRole::Helper if parent.is_some_and(|p: usize| bones[p].role == NodeRole::Joint) => NodeRole::Joint,
+            role => role,
+        };
         bones.push(Bone {
             name: node.name.clone().unwrap_or_else(|| format!("node{index}")),
             node: index,
             parent,
             rest: rest_transform(node, index)?,
             inherit: InheritMode::Full,
-            role: role(node, moved[index]),
+            role,
         });
         stack.extend(node.children.iter().rev().map(|c| (c.0, Some(bone))));
     }

@@ -88,7 +88,7 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         Space::YUpMetres => (skeleton.placed(conversion.placement()), Some(Unit::METRE)),
         Space::File => (skeleton, Unit::metres(conversion.meters_per_unit)),
     };
-    Ok(Rig { skeleton, clips, skins, meshes, unit, notes })
+    Ok(Rig { skeleton, clips, skins, meshes, unit, notes, tool: None })
 }
 
 /// The skeletons' animations (and the tracks of moving nodes), and the blend-shape weights they animate, as one
