@@ -115,7 +115,11 @@ fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64,
 /// The timeline's frame rate: the clip's own (from its file), or one the user types; "file's rate" goes back.
 fn frame_rate_field(ui: &mut egui::Ui, shared: &mut Shared, rate: f64) {
     let mut chosen = rate;
-    let response = ui.add(egui::DragValue::new(&mut chosen).range(1.0..=1000.0).max_decimals(3).suffix(" fps"));
+    // At most three decimals, none that are zeros: a BVH's 0.0083333 s frames read "120 fps", as 30 fps does.
+    let field = egui::DragValue::new(&mut chosen).range(1.0..=1000.0).suffix(" fps");
+    let field =
+        field.custom_formatter(|fps, _| format!("{fps:.3}").trim_end_matches('0').trim_end_matches('.').to_owned());
+    let response = ui.add(field);
     let source = if shared.doc.frame_rate_override.is_some() { "chosen here" } else { "the clip's own" };
     let response = response.on_hover_text(format!("frames per second of stepping and frame numbers ({source})"));
     if response.changed() {

@@ -33,9 +33,10 @@ pub enum SetupError {
 }
 
 impl Setup {
-    /// The file as it declares itself: its first clip (the rest pose without one), its declared modes, no layers.
+    /// The file as it declares itself: the clip it opens on ([`Rig::opening_clip`]; the rest pose without one), its
+    /// declared modes, no layers.
     pub fn declared(rig: &Rig) -> Self {
-        Setup { clip: (!rig.clips.is_empty()).then_some(0), ..Setup::default() }
+        Setup { clip: rig.opening_clip(), ..Setup::default() }
     }
 
     /// Checks every index against `rig` and prepares the layers (what does not change with time).

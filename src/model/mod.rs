@@ -42,6 +42,19 @@ pub struct Rig {
 }
 
 impl Rig {
+    /// The clip a viewer opens on: the first where it moves something, else the longest that does (a Mixamo FBX's
+    /// first take, `Take 001`, is empty beside its `mixamo.com`); `None` without clips.
+    pub fn opening_clip(&self) -> Option<usize> {
+        let moving = |c: &&Clip| !c.tracks().is_empty();
+        let first = self.clips.first().filter(moving).map(|_| 0);
+        let longest = || {
+            // The first of equally long clips.
+            let keyed = self.clips.iter().enumerate().rev().filter(|(_, c)| moving(c));
+            keyed.max_by(|(_, a), (_, b)| a.duration().total_cmp(&b.duration())).map(|(i, _)| i)
+        };
+        first.or_else(longest).or((!self.clips.is_empty()).then_some(0))
+    }
+
     /// The clip named `name`, or with index `name` when it parses as a number.
     pub fn find_clip(&self, name: &str) -> Option<&Clip> {
         self.clips
@@ -182,5 +195,20 @@ mod tests {
             .map(|(_, b)| b.name.as_str())
             .collect();
         assert_eq!(conversion, ["Armature", "Scene", "skin", "keyed", "units"]);
+    }
+
+    #[test]
+    fn a_viewer_opens_on_the_first_clip_that_moves_something_else_the_longest() {
+        let moving = |index: usize, end: f64| {
+            let times: Arc<[f64]> = vec![0.0, end].into();
+            let track = Track::new(times, vec![Vec3::ZERO, Vec3::X], Interpolation::Linear).unwrap();
+            Clip::new(index, None, vec![BoneTracks { translation: Some(track), ..BoneTracks::new(0) }], vec![])
+        };
+        let empty = |index: usize| Clip::new(index, Some("Take 001".into()), vec![], vec![]);
+        let rig = |clips: Vec<Clip>| Rig { clips, ..Rig::default() };
+        assert_eq!(rig(vec![]).opening_clip(), None);
+        assert_eq!(rig(vec![moving(0, 1.0), moving(1, 5.0)]).opening_clip(), Some(0), "the first, where it moves");
+        assert_eq!(rig(vec![empty(0), moving(1, 1.0), moving(2, 19.8), moving(3, 19.8)]).opening_clip(), Some(2));
+        assert_eq!(rig(vec![empty(0), empty(1)]).opening_clip(), Some(0), "nothing moves: the first");
     }
 }
