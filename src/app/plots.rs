@@ -307,7 +307,7 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
     let (time, stretched) = (*shared.time, shared.stretched);
     let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
     let range = group.range;
-    let response = frame(shared, &place).show(ui, |plot_ui| {
+    let response = frame(shared, &place, range).show(ui, |plot_ui| {
         let scroll = plot_ui.ctx().input(|i| i.smooth_scroll_delta.y);
         if plot_ui.response().hovered() && scroll != 0.0 {
             plot_ui.zoom_bounds_around_hovered(egui::Vec2::new((scroll * 0.0026).exp(), 1.0));
@@ -327,14 +327,17 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
 }
 
 /// The plot at `place`: the whole clip's time axis in the chosen unit, linked to the other plots' (the wheel zooms
-/// here, not egui_plot), reset when asked.
-fn frame<'a>(shared: &Shared, place: &PlotPlace) -> Plot<'a> {
+/// here, not egui_plot), reset when asked, and at least the curves' value range `(y_min, y_max)` tall.
+fn frame<'a>(shared: &Shared, place: &PlotPlace, (y_min, y_max): (f64, f64)) -> Plot<'a> {
     let mut plot = Plot::new(("components", place.index))
         .id(plot_id(place.index))
         .height(place.height)
         // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
         .include_x(0.0)
         .include_x(shared.doc.duration())
+        // Never narrower than the value range (at least `MIN_SPAN`): rounding noise on a flat curve reads as flat.
+        .include_y(y_min)
+        .include_y(y_max)
         .link_axis(place.link, egui::Vec2b::new(true, false))
         .link_cursor(place.link, egui::Vec2b::new(true, false))
         .allow_scroll(false)
@@ -403,14 +406,19 @@ fn stretched_bands(plot_ui: &mut egui_plot::PlotUi, stretched: &[(f64, f64)], (y
     }
 }
 
-/// The smallest and largest value of all curves, padded by a tenth (±1 when there are none).
+/// The smallest value range a plot spans: a fix's 5e-6° of shear left is drawn as the 0 it is, not stretched to the
+/// plot's height.
+const MIN_SPAN: f64 = 0.02;
+
+/// The smallest and largest value of all curves, padded by a tenth and at least [`MIN_SPAN`] apart (±1 when there
+/// are none).
 fn value_range(series: &[Series]) -> (f64, f64) {
     let values = series.iter().flat_map(|s| s.values.iter().copied()).filter(|v| v.is_finite());
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if lo > hi {
         return (-1.0, 1.0);
     }
-    let pad = ((hi - lo) * 0.1).max(1e-3);
+    let pad = ((hi - lo) * 0.1).max(0.5 * MIN_SPAN - 0.5 * (hi - lo)).max(0.0);
     (lo - pad, hi + pad)
 }
 
@@ -501,5 +509,14 @@ mod tests {
         // One unit: one plot.
         assert_eq!(Group::split(["hand x", "hand y"].map(series).into()).len(), 1);
         assert_eq!(Group::split(["hand X°", "hand Y°"].map(series).into()).len(), 1);
+    }
+
+    #[test]
+    fn a_flat_curve_with_rounding_noise_spans_the_smallest_range_and_reads_flat() {
+        let noise = Series { values: vec![0.0, 5e-6, 0.0], ..series("forearm shear°") };
+        let (lo, hi) = value_range(std::slice::from_ref(&noise));
+        assert!((hi - lo - MIN_SPAN).abs() < 1e-12 && lo < 0.0 && hi > 5e-6, "({lo}, {hi})");
+        // A curve that moves keeps a tenth of its span either side.
+        assert_eq!(value_range(&[series("forearm shear°")]), (-9.0, 99.0));
     }
 }
