@@ -993,7 +993,26 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     assert!(!app.analysis().unwrap().scan.bones[forearm].stretched(), "the analysis no longer flags the forearm");
     // The ghost shows the declared modes, as the clip was before.
     assert_eq!(app.session.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));
-    harness.get_by_label("not sheared: nothing to explain");
+    harness.get_by_label("not sheared now");
+}
+
+#[test]
+fn what_was_tried_stays_in_its_place_at_the_worst_time_and_undo_takes_it_back() {
+    let mut harness = why_forearm();
+    let forearm = bone(&harness, "forearm");
+    let before = state_of(&harness);
+    let summary = harness.state().analysis().unwrap().scan.bones[forearm].clone();
+    in_inspector(&harness, "Try").click();
+    settle(&mut harness);
+    // Try goes to the bone's worst time, where the change shows, and says what it did in the section's place.
+    assert!((harness.state().window.time - summary.worst_shear_time).abs() < 1e-12);
+    let mode = harness.state().session.doc.modes()[forearm];
+    let said = format!("Tried: forearm to {mode}: shear {:.3}° before, 0° after; skin moved ", summary.worst_shear_deg);
+    harness.get_by_label_contains(&said);
+    in_inspector(&harness, "Undo").click();
+    settle(&mut harness);
+    assert_eq!(state_of(&harness), before, "Undo is the history's");
+    assert!(harness.query_by_label_contains("Tried: ").is_none(), "undone, the line goes");
 }
 
 #[test]

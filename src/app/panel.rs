@@ -5,6 +5,7 @@ use super::document::Document;
 use super::frame::CurrentPose;
 use super::pane::{Pane, Place, Visibility};
 use super::settings::Settings;
+use super::why::Tried;
 use super::work::{Results, Work};
 
 /// At most this many bones are plotted at once (the most recently selected).
@@ -26,6 +27,10 @@ pub struct Shared<'a> {
     pub stretched: &'a [(f64, f64)],
     /// Where panels ask for more (an explanation, a bind check, a storage report).
     pub work: &'a mut Work,
+    /// The fix last tried from the Why? section, said in its place while it stands.
+    pub tried: &'a mut Option<Tried>,
+    /// Set by a panel that asks for the history's Undo (as Edit → Undo does).
+    pub undo_asked: &'a mut bool,
 }
 
 impl Shared<'_> {

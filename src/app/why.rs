@@ -17,6 +17,7 @@ use super::panel::Shared;
 use super::text::{compact, drawable, name_label, text_width};
 use super::work::WhyRequest;
 use crate::analysis::ScanOptions;
+use crate::eval::Setup;
 use crate::explain::{Change, Explanation, Fix, Link, Measured};
 use crate::model::{Choice, ModeChoice, Unit};
 use crate::view::Badge;
@@ -32,12 +33,23 @@ const COUNTERS: Color32 = Color32::from_rgb(60, 175, 160);
 /// Below this a shear left by a fix is floating-point noise, not a measurement.
 const NOISE_DEG: f64 = 1e-9;
 
+/// A fix tried on a bone from this section: what was evaluated after it (while the document still evaluates that,
+/// it stands) and the line that says what it did.
+pub struct Tried {
+    bone: usize,
+    setup: Setup,
+    line: String,
+}
+
 /// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a toggle
 /// when the whole-clip analysis flags the bone, a note otherwise.
 pub fn header(ui: &mut Ui, shared: &Shared, bone: usize) {
     match flagged(shared, bone) {
         None => {
             ui.label(RichText::new("Why? once the clip is analysed").weak());
+        }
+        Some(false) if standing(shared, bone).is_some() => {
+            ui.label(RichText::new("not sheared now").weak());
         }
         Some(false) => {
             ui.label(RichText::new("not sheared: nothing to explain").weak());
@@ -57,8 +69,17 @@ pub fn header(ui: &mut Ui, shared: &Shared, bone: usize) {
     }
 }
 
-/// The section's body, while its header is open: the explanation, computed off the UI thread.
+/// The section's body, while its header is open: the explanation, computed off the UI thread; first, the fix tried
+/// on the bone while it stands, with Undo.
 pub fn ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+    if let Some(line) = standing(shared, bone) {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new(line).strong());
+            if ui.link("Undo").on_hover_text("take the fix back (Edit → Undo)").clicked() {
+                *shared.undo_asked = true;
+            }
+        });
+    }
     if flagged(shared, bone) != Some(true) {
         return;
     }
@@ -77,6 +98,12 @@ fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
         Some(explained) => explanation_ui(ui, shared, &explained),
         None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
     }
+}
+
+/// The line of the fix tried on `bone`, while the document evaluates what it made.
+fn standing(shared: &Shared, bone: usize) -> Option<String> {
+    let tried = shared.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
+    Some(tried.line.clone())
 }
 
 /// Whether the whole-clip analysis flags `bone` anywhere in the clip; `None` before the first analysis.
@@ -257,8 +284,10 @@ fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     }
     ui.label(RichText::new("Fixes, best first").strong());
     let unit = shared.doc.rig.unit;
-    let columns = FixColumns::of(ui, &shown, unit, explained.causes.at.time);
-    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns));
+    let columns = FixColumns::of(ui, &shown, unit);
+    let worst =
+        Explained { bone: explained.bone, shear_deg: explained.worst_shear_deg, time: explained.causes.at.time };
+    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns, worst));
 }
 
 /// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
@@ -268,12 +297,18 @@ struct FixColumns {
     effect: f32,
     distance: f32,
     unit: Option<Unit>,
-    /// The explained bone's worst time, where Try goes.
-    worst: f64,
+}
+
+/// The explained bone, its worst shear and when: where Try goes, and what a tried fix says it changed.
+#[derive(Clone, Copy)]
+struct Explained {
+    bone: usize,
+    shear_deg: f64,
+    time: f64,
 }
 
 impl FixColumns {
-    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>, worst: f64) -> FixColumns {
+    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>) -> FixColumns {
         let body = TextStyle::Body.resolve(ui.style());
         let widest = |text: &dyn Fn(&Fix) -> String| {
             fixes.iter().map(|fix| text_width(ui, &text(fix), &body)).fold(0.0, f32::max)
@@ -283,18 +318,17 @@ impl FixColumns {
             effect: widest(&effect),
             distance: widest(&|fix| distance(fix, unit)),
             unit,
-            worst,
         }
     }
 }
 
 /// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
-fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
+fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, worst: Explained) {
     let hint = fix_hint(fix, columns.unit);
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
-            change => try_button(ui, shared, change, columns.button, columns.worst),
+            _ => try_button(ui, shared, fix, columns, worst),
         }
         ui.vertical(|ui| {
             // Rows as tall as their text, so that the label and its numbers read as one entry.
@@ -323,17 +357,36 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns) {
 }
 
 /// Tries a change on the document.
-/// Try: the fix made, and the timeline at the bone's worst time `worst`, where the change shows.
-fn try_button(ui: &mut Ui, shared: &mut Shared, change: Change, width: f32, worst: f64) {
-    let what = match change {
+/// Try: the fix made, said in the section's place, and the timeline at the bone's worst time, where it shows.
+fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, worst: Explained) {
+    let what = match fix.change {
         Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
         _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
     };
     let hint = format!("{what}; the ghost then shows the clip as it was");
-    if ui.add(Button::new("Try").small().min_size(vec2(width, 0.0))).on_hover_text(hint).clicked() {
-        try_fix(shared, change);
-        go_to(shared, worst);
+    if ui.add(Button::new("Try").small().min_size(vec2(columns.button, 0.0))).on_hover_text(hint).clicked() {
+        try_fix(shared, fix.change);
+        go_to(shared, worst.time);
+        let setup = shared.doc.setup().clone();
+        *shared.tried = Some(Tried { bone: worst.bone, setup, line: tried_line(fix, worst, columns.unit) });
     }
+}
+
+/// "Tried: forearm to blender-aligned: shear 18.666° before, 0° after; skin moved 11 cm at 0.567 s".
+fn tried_line(fix: &Fix, worst: Explained, unit: Option<Unit>) -> String {
+    let moved = match fix.cost.measured {
+        Measured::Skin => "skin",
+        Measured::Bones => "bones",
+    };
+    let distance = fix.cost.distance;
+    format!(
+        "Tried: {}: shear {}° before, {}° after; {moved} moved {} at {} s",
+        drawable(&fix.label),
+        compact(worst.shear_deg),
+        compact(if fix.removes { 0.0 } else { fix.shear_left_deg }),
+        Unit::readable(unit, distance.max),
+        compact(distance.time)
+    )
 }
 
 /// A bake is a new file, not a setting of the document: where the Try button would be, the command that makes it.

@@ -17,6 +17,7 @@ use super::settings::Settings;
 use super::timeline::{self, PlayClock};
 use super::toolbar::{self, Actions, Menus};
 use super::viewport::{CanvasFill, Viewport};
+use super::why::Tried;
 use super::work::{Wanted, Work};
 use super::{inspector, layers, outliner, plots};
 use crate::analysis::ClipAnalysis;
@@ -65,6 +66,8 @@ pub struct Window {
     size: egui::Vec2,
     pub notifications: Notifications,
     pub dialogs: Dialogs,
+    /// The fix last tried from the Why? section.
+    tried: Option<Tried>,
 }
 
 impl Window {
@@ -82,6 +85,7 @@ impl Window {
             size: egui::Vec2::ZERO,
             notifications: Notifications::default(),
             dialogs: Dialogs::default(),
+            tried: None,
         };
         window.replaced(Replaced::Opened, doc);
         window
@@ -157,6 +161,7 @@ impl Window {
         let frame = CurrentPose::evaluate(doc, self.time, settings.scene.skinning, &settings.tolerances);
         let results = work.results(doc);
         let stretched = self.spans.get(results.analysis.as_ref(), self.selection.last().copied());
+        let mut undo_asked = false;
         let mut shared = Shared {
             doc,
             settings,
@@ -167,6 +172,8 @@ impl Window {
             results: &results,
             stretched,
             work,
+            tried: &mut self.tried,
+            undo_asked: &mut undo_asked,
         };
         if self.chrome == Chrome::ViewportOnly {
             egui::CentralPanel::default()
@@ -189,6 +196,7 @@ impl Window {
                 shared.settings.layout = Some(layout);
             });
         }
+        actions.undo |= undo_asked;
         self.notifications.ui(&ctx, self.viewport.rect().unwrap_or_else(|| ctx.content_rect()));
         let folder = browsing_folder(&session.doc, settings);
         if let Some((path, purpose)) = self.dialogs.ui(&ctx, &folder, &mut self.notifications) {
