@@ -68,9 +68,10 @@ impl Panel for Outliner {
                 );
             }
         }
+        let badge_width = badge_column(shared, &rows);
         list.show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
             for &bone in &rows[range] {
-                self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 });
+                self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 }, badge_width);
             }
         });
         // A bone picked in the list itself is in view already: the list stays where it is.
@@ -125,6 +126,7 @@ impl Outliner {
         let header = egui::CollapsingHeader::new(format!("Cameras, lights and helpers ({})", others.len()))
             .id_salt("outliner-others")
             .default_open(false);
+        let badge_width = badge_column(shared, &others.iter().map(|(_, b)| *b).collect::<Vec<_>>());
         header.show(ui, |ui| {
             let list = egui::ScrollArea::vertical().id_salt("outliner-others-list").max_height(ROW_HEIGHT * 8.0);
             list.show(ui, |ui| {
@@ -134,14 +136,14 @@ impl Outliner {
                         ui.label(RichText::new(format!("{}s", role.label())).weak().small());
                     }
                     for bone in bones {
-                        self.row(ui, shared, bone, 0);
+                        self.row(ui, shared, bone, 0, badge_width);
                     }
                 }
             });
         });
     }
 
-    fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, depth: usize) {
+    fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, depth: usize, badge_width: f32) {
         let skeleton = &shared.doc.rig.skeleton;
         let has_children = (bone + 1..skeleton.len()).any(|c| skeleton.parent(c) == Some(bone));
         let name = skeleton.bone(bone).name.clone();
@@ -149,8 +151,7 @@ impl Outliner {
         let row_width = ui.available_width();
         ui.horizontal(|ui| {
             ui.set_height(ROW_HEIGHT);
-            // Deep chains (a hand's fingers under a HumanIK rig) stop indenting before the names lose their room.
-            ui.add_space((depth as f32 * INDENT).min(MAX_INDENT_SHARE * row_width));
+            ui.add_space(indent(depth, row_width));
             if has_children {
                 let collapsed = self.collapsed.contains(&bone);
                 let toggle = ui.add(egui::Button::new(if collapsed { "+" } else { "−" }).small().frame(false));
@@ -161,7 +162,7 @@ impl Outliner {
             } else {
                 ui.add_space(14.0);
             }
-            badges(ui, &findings);
+            badges(ui, &findings, badge_width);
             let font = egui::TextStyle::Button.resolve(ui.style());
             let name_needs = text::text_width(ui, &name, &font) + 2.0 * ui.spacing().button_padding.x;
             let notes = Notes::of(shared, bone).fitted(ui, ui.available_width() - name_needs);
@@ -184,7 +185,20 @@ impl Outliner {
 }
 
 /// Deep rows indent by at most this share of the list's width.
-const MAX_INDENT_SHARE: f32 = 0.15;
+const MAX_INDENT_SHARE: f32 = 0.25;
+
+/// Each level's indent is this share of the one above's: every level still steps in, and a hand's fingers under a
+/// HumanIK rig keep room for their names.
+const INDENT_DECAY: f32 = 0.85;
+
+/// How far a row `depth` levels down indents in a list `width` wide: [`INDENT`] for the first level, a step smaller
+/// by [`INDENT_DECAY`] for each one below, the whole scaled down where the deepest would pass [`MAX_INDENT_SHARE`]
+/// of the width.
+fn indent(depth: usize, width: f32) -> f32 {
+    let deepest = INDENT / (1.0 - INDENT_DECAY);
+    let scale = (MAX_INDENT_SHARE * width / deepest).min(1.0);
+    scale * INDENT * (1.0 - INDENT_DECAY.powi(depth as i32)) / (1.0 - INDENT_DECAY)
+}
 
 /// What a row says after the name: the difference from a compared file, the mode, the worst shear. Measured before
 /// the name is laid out, so that the name gets the rest of the row (shortened in the middle when it must).
@@ -305,19 +319,29 @@ fn converts(shared: &Shared, bone: usize) -> bool {
 }
 
 /// The icons of a bone's findings, painted in a fixed-width slot so names line up.
-fn badges(ui: &mut egui::Ui, findings: &Findings) {
-    let (rect, response) = ui.allocate_exact_size(vec2(34.0, ROW_HEIGHT), Sense::hover());
+fn badges(ui: &mut egui::Ui, findings: &Findings, width: f32) {
+    let (rect, response) = ui.allocate_exact_size(vec2(width, ROW_HEIGHT), Sense::hover());
     let mut x = rect.left() + 6.0;
     let mut names = Vec::new();
     for badge in Badge::of(findings) {
         badge.paint_icon(ui.painter(), egui::pos2(x, rect.center().y), 4.5);
         names.push(badge.label());
-        x += 11.0;
+        x += BADGE_STEP;
     }
     if !names.is_empty() {
         response.on_hover_text(names.join(", "));
     }
 }
+
+/// The width of the badges' column for the rows of `bones`: as wide as the most badges a row has, so that names
+/// line up and keep the room where nothing is found.
+fn badge_column(shared: &Shared, bones: &[usize]) -> f32 {
+    let most = bones.iter().map(|&b| Badge::of(&shared.frame.primary.findings[b]).count()).max().unwrap_or(0);
+    if most == 0 { 0.0 } else { 12.0 + BADGE_STEP * (most - 1) as f32 }
+}
+
+/// From one badge's centre to the next's.
+const BADGE_STEP: f32 = 11.0;
 
 /// The room an icon takes before its name in the legend.
 const ICON_WIDTH: f32 = 14.0;
@@ -357,5 +381,23 @@ fn mode_menu(ui: &mut egui::Ui, shared: &mut Shared, bone: usize) {
                 }
             }
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_level_indents_further_in_smaller_steps_within_a_share_of_the_list() {
+        for width in [180.0, 270.0, 600.0] {
+            let indents: Vec<f32> = (0..12).map(|d| indent(d, width)).collect();
+            let steps: Vec<f32> = indents.windows(2).map(|w| w[1] - w[0]).collect();
+            assert_eq!(indents[0], 0.0);
+            assert!(steps.iter().all(|&s| s > 0.5), "{width}: every level steps in: {steps:?}");
+            assert!(steps.windows(2).all(|w| w[1] < w[0]), "{width}: smaller steps as depth grows: {steps:?}");
+            assert!(indents[11] <= MAX_INDENT_SHARE * width, "{width}: {indents:?}");
+        }
+        assert_eq!(indent(1, 600.0), INDENT, "room enough: the first step is whole");
     }
 }
