@@ -24,14 +24,11 @@ pub struct BoneSummary {
     pub non_uniform_samples: usize,
     pub mirrored_samples: usize,
     pub degenerate_samples: usize,
-    /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end, and when the
-    /// worst stretch happens.
+    /// The worst shear and stretch as the cosines of [`Verdict`], turned into angles once at the end.
     #[serde(skip)]
     pub(super) worst_shear_cosine_squared: f64,
     #[serde(skip)]
-    pub(super) worst_stretch_half_cosine: f64,
-    #[serde(skip)]
-    pub(super) worst_stretch_time: f64,
+    worst_stretch_half_cosine: f64,
     /// The highest peaks of the sampled shear, where [`super::peak`] refines it.
     #[serde(skip)]
     pub(super) shear_peaks: Peaks,
@@ -51,7 +48,6 @@ impl BoneSummary {
             degenerate_samples: 0,
             worst_shear_cosine_squared: 0.0,
             worst_stretch_half_cosine: 1.0,
-            worst_stretch_time: 0.0,
             shear_peaks: Peaks::default(),
         }
     }
@@ -65,10 +61,7 @@ impl BoneSummary {
         }
         let f = verdict.findings;
         if f.stretched {
-            if verdict.stretch_half_cosine < self.worst_stretch_half_cosine {
-                self.worst_stretch_half_cosine = verdict.stretch_half_cosine;
-                self.worst_stretch_time = time;
-            }
+            self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(verdict.stretch_half_cosine);
             self.flagged_samples += 1;
             self.first_flagged_time.get_or_insert(time);
         }
@@ -84,10 +77,7 @@ impl BoneSummary {
             self.worst_shear_cosine_squared = later.worst_shear_cosine_squared;
             self.worst_shear_time = later.worst_shear_time;
         }
-        if later.worst_stretch_half_cosine < self.worst_stretch_half_cosine {
-            self.worst_stretch_half_cosine = later.worst_stretch_half_cosine;
-            self.worst_stretch_time = later.worst_stretch_time;
-        }
+        self.worst_stretch_half_cosine = self.worst_stretch_half_cosine.min(later.worst_stretch_half_cosine);
         self.flagged_samples += later.flagged_samples;
         self.first_flagged_time = self.first_flagged_time.or(later.first_flagged_time);
         self.non_uniform_samples += later.non_uniform_samples;

@@ -126,6 +126,12 @@ impl Judge {
         Judge { tolerances: *tolerances, stretch_half_cosine, shear_cosine_squared, uniform_spread_squared }
     }
 
+    /// Whether a shear whose largest column cosine is the square root of `shear_cosine_squared` passes the shear
+    /// tolerance.
+    pub fn sees_shear(&self, shear_cosine_squared: f64) -> bool {
+        shear_cosine_squared > self.shear_cosine_squared
+    }
+
     /// Whether a matrix with the Gram matrix `gram` (`MᵀM`) certainly has scale factors within half the anisotropy
     /// tolerance of each other: every eigenvalue of `MᵀM` lies within `‖MᵀM − g·I‖_F` of `g`, its mean. Its
     /// verdicts are then [`Judge::uniform_verdict`]'s, whatever its stretch frame.

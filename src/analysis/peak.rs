@@ -1,20 +1,19 @@
-//! A bone's worst shear and stretch between samples. Between keys a bone's curves are smooth, so the largest sampled
-//! value lies beside the clip's true maximum: a golden-section search over the two sample intervals around it finds
-//! that maximum to well under 0.001°, and every sampling rate (the app's 30 fps, `scan`'s 60, `--rate 240`) reports
-//! one figure and one time.
+//! A bone's worst shear between samples. Between keys a bone's curves are smooth, so the highest sampled peaks lie
+//! beside the clip's true maximum: a search over the two sample intervals around each finds that maximum to well
+//! under 0.001°, and every sampling rate (`scan --rate 30`, 60, 240, the app) reports one figure and one time.
 
 use glam::DQuat;
 use rayon::prelude::*;
 
 use super::chunk::with_ancestors;
 use super::clip_analysis::BoneSummary;
-use super::findings::{Judge, Verdict};
+use super::findings::Judge;
 use super::stretch::Stretch;
 use crate::eval::{BonesEvaluator, Evaluation};
 
-/// Golden-section steps: each keeps 0.618 of the interval, so two sample intervals shrink below 10⁻¹⁰ of their
-/// length.
-const STEPS: usize = 48;
+/// Golden-section steps: each keeps 0.618 of the interval, so two sample intervals shrink below 10⁻⁶ of their
+/// length (7 ns at 60 samples a second).
+const STEPS: usize = 32;
 
 /// A refined value replaces the sampled one only when it is larger by more than this fraction: rounding noise
 /// between samples of a shear that holds still does not move its time.
@@ -27,11 +26,22 @@ const CANDIDATES: usize = 4;
 /// A bone's highest local maxima of the sampled shear (as its cosine squared), found sample by sample.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(super) struct Peaks {
-    /// `(time, value)`, the highest first, at most [`CANDIDATES`].
-    highest: Vec<(f64, f64)>,
-    /// The previous sample, and whether the value rose to it.
+    /// The highest first, at most [`CANDIDATES`].
+    highest: Vec<Peak>,
+    /// The sample before the previous one, the previous sample, and whether the value rose to the latter.
+    before: Option<f64>,
     last: Option<(f64, f64)>,
     rising: bool,
+}
+
+/// A sample higher than its neighbours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Peak {
+    pub time: f64,
+    pub value: f64,
+    /// How high the parabola through it and its neighbours reaches (its own value where one is unknown): a peak
+    /// that reaches no higher than another's sample is not searched.
+    pub reach: f64,
 }
 
 impl Peaks {
@@ -40,7 +50,8 @@ impl Peaks {
         match self.last {
             Some((t, v)) => {
                 if self.rising && value < v {
-                    self.offer(t, v);
+                    let reach = self.before.map_or(v, |p| v + vertex_gain(p, v, value));
+                    self.offer(Peak { time: t, value: v, reach });
                 }
                 // A plateau keeps the way the values went.
                 if value != v {
@@ -50,6 +61,7 @@ impl Peaks {
             // A run's first sample may be a peak whose rise lies in the run before.
             None => self.rising = true,
         }
+        self.before = self.last.map(|(_, v)| v);
         self.last = Some((time, value));
     }
 
@@ -59,58 +71,60 @@ impl Peaks {
         self.close();
         let mut later = later.clone();
         later.close();
-        later.highest.iter().for_each(|&(t, v)| self.offer(t, v));
-        (self.last, self.rising) = (None, false);
+        later.highest.iter().for_each(|&peak| self.offer(peak));
+        (self.before, self.last, self.rising) = (None, None, false);
     }
 
     /// The peaks, the highest first, the run's end included where the value rose to it.
-    pub fn highest(&self) -> Vec<(f64, f64)> {
+    pub fn highest(&self) -> Vec<Peak> {
         let mut closed = self.clone();
         closed.close();
         closed.highest
     }
 
     fn close(&mut self) {
-        if let Some((t, v)) = self.last.take().filter(|_| self.rising) {
-            self.offer(t, v);
+        if let Some((time, value)) = self.last.take().filter(|_| self.rising) {
+            self.offer(Peak { time, value, reach: value });
         }
     }
 
-    fn offer(&mut self, time: f64, value: f64) {
-        let at = self.highest.partition_point(|&(_, v)| v >= value);
+    fn offer(&mut self, peak: Peak) {
+        let at = self.highest.partition_point(|p| p.value >= peak.value);
         if at < CANDIDATES {
-            self.highest.insert(at, (time, value));
+            self.highest.insert(at, peak);
             self.highest.truncate(CANDIDATES);
         }
     }
 }
 
-/// Refines each judged bone's worst shear (around each of its highest sampled peaks) and worst stretch (around its
-/// highest sample) in `summaries` (sampled at `times`, sorted) to the largest value between the samples beside it.
+/// How far above `v` the parabola through three evenly spaced samples `p`, `v`, `n` (`v` the highest) peaks.
+fn vertex_gain(p: f64, v: f64, n: f64) -> f64 {
+    let curvature = 2.0 * v - p - n;
+    if curvature > 0.0 { (n - p) * (n - p) / (8.0 * curvature) } else { 0.0 }
+}
+
+/// Refines each judged bone's worst shear in `summaries` (sampled at `times`, sorted) to the largest value between
+/// the samples beside each of its highest sampled peaks: those whose sampled shear passes the tolerance (a shear of
+/// rounding noise is left as sampled). The worst stretch angle stays the sampled one: an angle of the stretch
+/// rotation jumps where two scale factors cross, so no search between samples is sure to find its maximum.
 pub(super) fn refine(evaluation: &Evaluation, times: &[f64], summaries: &mut [BoneSummary], judge: &Judge) {
-    summaries.par_iter_mut().filter(|s| s.worst_shear_cosine_squared > 0.0 || s.stretched()).for_each(|summary| {
+    let seen = |s: &&mut BoneSummary| judge.sees_shear(s.worst_shear_cosine_squared);
+    summaries.par_iter_mut().filter(seen).for_each(|summary| {
         let chain = with_ancestors(evaluation.skeleton(), &[summary.index]);
         let mut evaluator = BonesEvaluator::new(evaluation, &chain);
         let mut verdict = |time: f64| {
             let model = &evaluator.evaluate(time).model.model[summary.index];
             Stretch::of_matrix(model, DQuat::IDENTITY).verdict(judge)
         };
-        // The shear as its cosine squared (larger is worse); the stretch as its half-angle cosine where the bone is
-        // stretched (smaller is worse), so both are maximised as a number that grows with the angle.
+        // The shear as its cosine squared: larger is worse.
         let peaks = if summary.worst_shear_cosine_squared > 0.0 { summary.shear_peaks.highest() } else { Vec::new() };
-        for (sampled, _) in peaks {
+        let highest = peaks.first().map_or(0.0, |p| p.value);
+        // The highest peak, and those whose parabola reaches past it.
+        for sampled in peaks.iter().enumerate().filter(|(i, p)| *i == 0 || p.reach >= highest).map(|(_, p)| p.time) {
             let (lo, hi) = around(times, sampled);
-            let (time, value) = largest(lo, hi, |t| verdict(t).shear_cosine_squared);
+            let (time, value) = largest(lo, sampled, hi, |t| verdict(t).shear_cosine_squared);
             if value > summary.worst_shear_cosine_squared * (1.0 + GAIN) {
                 (summary.worst_shear_cosine_squared, summary.worst_shear_time) = (value, time);
-            }
-        }
-        if summary.stretched() {
-            let (lo, hi) = around(times, summary.worst_stretch_time);
-            let turn = |v: Verdict| if v.findings.stretched { 1.0 - v.stretch_half_cosine } else { 0.0 };
-            let (time, value) = largest(lo, hi, |t| turn(verdict(t)));
-            if value > (1.0 - summary.worst_stretch_half_cosine) * (1.0 + GAIN) {
-                (summary.worst_stretch_half_cosine, summary.worst_stretch_time) = (1.0 - value, time);
             }
         }
         summary.finish();
@@ -125,20 +139,48 @@ fn around(times: &[f64], time: f64) -> (f64, f64) {
     (before, after)
 }
 
-/// The largest value of `f` over `[lo, hi]` and where it is: the best of [`PROBES`] evenly spread times, then a
-/// golden-section search between its neighbours (a stretch angle may rise to more than one peak between samples).
-fn largest(lo: f64, hi: f64, mut f: impl FnMut(f64) -> f64) -> (f64, f64) {
-    let step = (hi - lo) / PROBES as f64;
-    let probe = |k: usize| lo + step * k as f64;
-    let best =
-        (0..=PROBES).map(|k| (k, f(probe(k)))).fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
-    let (near_lo, near_hi) = (probe(best.0.saturating_sub(1)), probe((best.0 + 1).min(PROBES)));
-    let found = golden(near_lo, near_hi, f);
-    if found.1 >= best.1 { found } else { (probe(best.0), best.1) }
+/// The largest value of `f` over `[lo, hi]` and where it is, from the sample at `mid` (the highest of the three):
+/// successive parabolas through the best three points, each bracketing the peak (a peak between keys is smooth: a
+/// few steps reach it), and a golden-section search where a parabola does not help (a kink on a key).
+fn largest(lo: f64, mid: f64, hi: f64, mut f: impl FnMut(f64) -> f64) -> (f64, f64) {
+    let [mut a, mut b, mut c] = [lo, mid, hi].map(|t| (t, f(t)));
+    if !(a.0 < b.0 && b.0 < c.0 && b.1 >= a.1 && b.1 >= c.1) {
+        let found = golden(lo, hi, f);
+        return if found.1 > b.1 { found } else { b };
+    }
+    for _ in 0..PARABOLA_STEPS {
+        let x = parabola_peak(a, b, c);
+        if !x.is_finite() {
+            // Three equal values: a shear that holds still.
+            return b;
+        }
+        if !(x > a.0 && x < c.0) {
+            break;
+        }
+        if (x - b.0).abs() <= 1e-9 * (hi - lo) {
+            return b;
+        }
+        let at = (x, f(x));
+        (a, b, c) = match (x < b.0, at.1 > b.1) {
+            (true, true) => (a, at, b),
+            (true, false) => (at, b, c),
+            (false, true) => (b, at, c),
+            (false, false) => (a, b, at),
+        };
+    }
+    let found = golden(a.0, c.0, f);
+    if found.1 > b.1 { found } else { b }
 }
 
-/// Evenly spread times [`largest`] first compares.
-const PROBES: usize = 16;
+/// Parabola steps before the golden-section search takes over.
+const PARABOLA_STEPS: usize = 12;
+
+/// Where the parabola through three points peaks (not finite where they lie on a line).
+fn parabola_peak((x0, y0): (f64, f64), (x1, y1): (f64, f64), (x2, y2): (f64, f64)) -> f64 {
+    let (d0, d2) = (x1 - x0, x1 - x2);
+    let (e0, e2) = ((y1 - y2) * d0, (y1 - y0) * d2);
+    x1 - 0.5 * (d0 * e0 - d2 * e2) / (e0 - e2)
+}
 
 /// The largest value of `f` over `[lo, hi]` and where it is, by golden-section search: for a function that rises
 /// to one peak and falls, the peak.
@@ -167,12 +209,14 @@ mod tests {
     #[test]
     fn the_search_finds_a_peak_between_samples() {
         // A parabola peaking at 0.3: sampled at 0.25 and 0.5, the search over (0, 0.5) finds 0.3.
-        let (time, value) = largest(0.0, 0.5, |t| 2.0 - (t - 0.3) * (t - 0.3));
+        let (time, value) = largest(0.0, 0.25, 0.5, |t| 2.0 - (t - 0.3) * (t - 0.3));
         assert!((time - 0.3).abs() < 1e-7, "{time}");
         assert!((value - 2.0).abs() < 1e-14, "{value}");
-        // A kink (the peak of |·| on a key) is found as well.
-        let (time, _) = largest(0.0, 1.0, |t| -(t - 0.75).abs());
-        assert!((time - 0.75).abs() < 1e-9, "{time}");
+        // A smooth peak that is no parabola, and a kink (the peak of |·| on a key), are found as well.
+        let (time, _) = largest(0.0, 0.5, 1.0, |t| (3.0 * t).sin());
+        assert!((time - std::f64::consts::FRAC_PI_6).abs() < 1e-6, "{time}");
+        let (time, _) = largest(0.0, 0.5, 1.0, |t| -(t - 0.75).abs());
+        assert!((time - 0.75).abs() < 1e-6, "{time}");
     }
 
     #[test]
@@ -182,11 +226,14 @@ mod tests {
         [1.0, 3.0, 2.0].into_iter().enumerate().for_each(|(t, v)| early.add(t as f64, v));
         [2.0, 5.0, 4.0, 6.0].into_iter().enumerate().for_each(|(t, v)| late.add(3.0 + t as f64, v));
         early.merge(&late);
-        assert_eq!(early.highest(), [(6.0, 6.0), (4.0, 5.0), (1.0, 3.0)]);
+        let found: Vec<(f64, f64)> = early.highest().iter().map(|p| (p.time, p.value)).collect();
+        assert_eq!(found, [(6.0, 6.0), (4.0, 5.0), (1.0, 3.0)]);
+        // 2 5 4: the parabola through them, 2 + 4.5·x − 1.5·x² over x = 0, 1, 2, peaks at x = 1.5, 1/8 above 5.
+        assert_eq!(early.highest()[1].reach, 5.125);
         // A run that only falls peaks at its start.
         let mut falling = Peaks::default();
         [4.0, 3.0, 1.0].into_iter().enumerate().for_each(|(t, v)| falling.add(t as f64, v));
-        assert_eq!(falling.highest(), [(0.0, 4.0)]);
+        assert_eq!(falling.highest(), [Peak { time: 0.0, value: 4.0, reach: 4.0 }]);
     }
 
     #[test]
