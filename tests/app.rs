@@ -69,6 +69,20 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
 }
 
 #[test]
+fn every_inherit_scale_choice_is_in_view_at_a_laptops_size() {
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    settle(&mut harness);
+    harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
+    harness.run();
+    // The last choice is clicked where it is drawn, no scrolling first.
+    harness.get_by_role_and_label(Role::Button, "blender-none-legacy").click();
+    settle(&mut harness);
+    assert!(harness.state().session.doc.modes().iter().all(|&m| m == InheritMode::BlenderNoneLegacy));
+}
+
+#[test]
 fn arrow_keys_step_one_frame_and_space_plays() {
     let mut harness = demo_app();
     harness.key_press(egui::Key::ArrowRight);

@@ -239,6 +239,8 @@ fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     egui::ComboBox::from_id_salt("inherit-all")
         .selected_text(current.map_or("mixed", ModeChoice::id))
         .width(170.0)
+        // Every choice in view (ten: egui's default height shows eight).
+        .height(f32::INFINITY)
         .show_ui(ui, |ui| {
             for &choice in ModeChoice::ALL {
                 if ui
