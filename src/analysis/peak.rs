@@ -117,7 +117,7 @@ pub(super) fn refine(evaluation: &Evaluation, times: &[f64], summaries: &mut [Bo
             Stretch::of_matrix(model, DQuat::IDENTITY).verdict(judge)
         };
         // The shear as its cosine squared: larger is worse.
-        let peaks = if summary.worst_shear_cosine_squared > 0.0 { summary.shear_peaks.highest() } else { Vec::new() };
+        let peaks = summary.shear_peaks.highest();
         let highest = peaks.first().map_or(0.0, |p| p.value);
         // The highest peak, and those whose parabola reaches past it.
         for sampled in peaks.iter().enumerate().filter(|(i, p)| *i == 0 || p.reach >= highest).map(|(_, p)| p.time) {

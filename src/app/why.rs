@@ -278,16 +278,14 @@ fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
 /// settings of the document.
 fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     // Those that change something: Blender's Fix Shear on a bone its parent does not shear is no fix.
-    let shown: Vec<Fix> = explained.shown_fixes(false, shared.settings.tolerances.min_shear_deg).cloned().collect();
+    let shown: Vec<&Fix> = explained.shown_fixes(false, shared.settings.tolerances.min_shear_deg).collect();
     if shown.is_empty() {
         return;
     }
     ui.label(RichText::new("Fixes, best first").strong());
     let unit = shared.doc.rig.unit;
     let columns = FixColumns::of(ui, &shown, unit);
-    let worst =
-        Explained { bone: explained.bone, shear_deg: explained.worst_shear_deg, time: explained.causes.at.time };
-    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns, worst));
+    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns, explained));
 }
 
 /// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
@@ -299,16 +297,8 @@ struct FixColumns {
     unit: Option<Unit>,
 }
 
-/// The explained bone, its worst shear and when: where Try goes, and what a tried fix says it changed.
-#[derive(Clone, Copy)]
-struct Explained {
-    bone: usize,
-    shear_deg: f64,
-    time: f64,
-}
-
 impl FixColumns {
-    fn of(ui: &Ui, fixes: &[Fix], unit: Option<Unit>) -> FixColumns {
+    fn of(ui: &Ui, fixes: &[&Fix], unit: Option<Unit>) -> FixColumns {
         let body = TextStyle::Body.resolve(ui.style());
         let widest = |text: &dyn Fn(&Fix) -> String| {
             fixes.iter().map(|fix| text_width(ui, &text(fix), &body)).fold(0.0, f32::max)
@@ -323,12 +313,12 @@ impl FixColumns {
 }
 
 /// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
-fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, worst: Explained) {
+fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, explained: &Explanation) {
     let hint = fix_hint(fix, columns.unit);
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
-            _ => try_button(ui, shared, fix, columns, worst),
+            _ => try_button(ui, shared, fix, columns, explained),
         }
         ui.vertical(|ui| {
             // Rows as tall as their text, so that the label and its numbers read as one entry.
@@ -356,9 +346,8 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, wo
     });
 }
 
-/// Tries a change on the document.
 /// Try: the fix made, said in the section's place, and the timeline at the bone's worst time, where it shows.
-fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, worst: Explained) {
+fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, explained: &Explanation) {
     let what = match fix.change {
         Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
         _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
@@ -366,14 +355,14 @@ fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns,
     let hint = format!("{what}; the ghost then shows the clip as it was");
     if ui.add(Button::new("Try").small().min_size(vec2(columns.button, 0.0))).on_hover_text(hint).clicked() {
         try_fix(shared, fix.change);
-        go_to(shared, worst.time);
+        go_to(shared, explained.causes.at.time);
         let setup = shared.doc.setup().clone();
-        *shared.tried = Some(Tried { bone: worst.bone, setup, line: tried_line(fix, worst, columns.unit) });
+        *shared.tried = Some(Tried { bone: explained.bone, setup, line: tried_line(fix, explained, columns.unit) });
     }
 }
 
 /// "Tried: forearm to blender-aligned: shear 18.666° before, 0° after; skin moved 11 cm at 0.567 s".
-fn tried_line(fix: &Fix, worst: Explained, unit: Option<Unit>) -> String {
+fn tried_line(fix: &Fix, explained: &Explanation, unit: Option<Unit>) -> String {
     let moved = match fix.cost.measured {
         Measured::Skin => "skin",
         Measured::Bones => "bones",
@@ -382,7 +371,7 @@ fn tried_line(fix: &Fix, worst: Explained, unit: Option<Unit>) -> String {
     format!(
         "Tried: {}: shear {}° before, {}° after; {moved} moved {} at {} s",
         drawable(&fix.label),
-        compact(worst.shear_deg),
+        compact(explained.worst_shear_deg),
         compact(if fix.removes { 0.0 } else { fix.shear_left_deg }),
         Unit::readable(unit, distance.max),
         compact(distance.time)

@@ -80,25 +80,6 @@ impl Rig {
         weighted
     }
 
-    /// For each bone, whether a mesh shows where it goes: some skinned vertex is weighted to it
-    /// ([`Rig::weighted_joints`]), or an unskinned mesh hangs from it.
-    pub fn shown_by_meshes(&self) -> Vec<bool> {
-        let mut shown = vec![false; self.skeleton.len()];
-        let mut show = |bone: usize| {
-            if let Some(slot) = shown.get_mut(bone) {
-                *slot = true;
-            }
-        };
-        for mesh in self.meshes.iter().filter(|m| m.skin.is_none_or(|s| s >= self.skins.len())) {
-            show(mesh.bone);
-        }
-        for (s, skin) in self.skins.iter().enumerate() {
-            let weighted = self.weighted_joints(s);
-            skin.joints.iter().zip(weighted).filter(|(_, w)| *w).for_each(|(&bone, _)| show(bone));
-        }
-        shown
-    }
-
     /// For each bone, whether it is a conversion node: one at the top of the hierarchy (a root, or below conversion
     /// nodes only) that only changes axes or units ([`Transform::only_converts`]: a ratio of units, quarter turns)
     /// at rest and in every clip (which may key it, but only to hold one value), that carries bones or a mesh, that
