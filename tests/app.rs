@@ -68,18 +68,86 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
     assert!(app.analysis().unwrap().scan.bones.iter().all(|b| !b.stretched()));
 }
 
-#[test]
-fn every_inherit_scale_choice_is_in_view_at_a_laptops_size() {
+/// The demo in a laptop's window, 1280×800.
+fn laptop_demo() -> Harness<'static, BonescopeApp> {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
         .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
     settle(&mut harness);
+    harness
+}
+
+#[test]
+fn every_inherit_scale_choice_is_in_view_at_a_laptops_size() {
+    let mut harness = laptop_demo();
     harness.get_by_role_and_label(Role::ComboBox, "Inherit scale").click();
     harness.run();
     // The last choice is clicked where it is drawn, no scrolling first.
     harness.get_by_role_and_label(Role::Button, "blender-none-legacy").click();
     settle(&mut harness);
     assert!(harness.state().session.doc.modes().iter().all(|&m| m == InheritMode::BlenderNoneLegacy));
+}
+
+#[test]
+fn the_plot_controls_and_the_top_bar_hold_still_whatever_is_chosen() {
+    use bonescope::app::Ghost;
+    use bonescope::model::ModeChoice;
+    let mut rig = bonescope::import::demo_rig();
+    rig.clips[1].name = Some("a take named after its studio's whole folder path, as exporters do".into());
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    settle(&mut harness);
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    let places = |harness: &Harness<'static, BonescopeApp>| {
+        let combo = |label| harness.get_by_role_and_label(Role::ComboBox, label).rect();
+        [harness.get_by_label("Reset view").rect(), harness.get_by_label("ghost").rect(), combo("Inherit scale")]
+    };
+    let before = places(&harness);
+    harness.get_by_role_and_label(Role::Button, "shear°").click();
+    settle(&mut harness);
+    assert_eq!(places(&harness), before, "a component with no rotation format");
+    harness.state_mut().session.doc.ghost = Some(Ghost::Modes(ModeChoice::Mode(InheritMode::SegmentCompensate)));
+    settle(&mut harness);
+    assert_eq!(places(&harness), before, "a ghost to show");
+    for clip in [Some(1), None] {
+        harness.state_mut().session.doc.set_clip(clip).unwrap();
+        settle(&mut harness);
+        assert_eq!(places(&harness), before, "clip {clip:?}, a name of another length");
+    }
+}
+
+#[test]
+fn several_components_stack_and_the_column_says_it_scrolls() {
+    let mut harness = laptop_demo();
+    harness.state_mut().window.time = 0.5;
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    harness.get_by_role_and_label(Role::Button, "scale k").click();
+    harness.step();
+    for added in ["shear°", "translation"] {
+        harness.get_by_role_and_label(Role::Button, added).click_modifiers(egui::Modifiers::COMMAND);
+        harness.step();
+    }
+    settle(&mut harness);
+    // Each curve says whose component it is; three plots do not fit 1280×800's plot panel, and it says so.
+    for curve in ["forearm translation x", "forearm scale k z", "forearm shear°"] {
+        harness.get_by_label(curve);
+    }
+    harness.get_by_label("3 plots: the bar at the right scrolls to the rest");
+    // Ctrl-click takes one away again; a plain click shows that one alone.
+    harness.get_by_role_and_label(Role::Button, "translation").click_modifiers(egui::Modifiers::COMMAND);
+    settle(&mut harness);
+    assert!(harness.query_by_label("forearm translation x").is_none());
+    harness.get_by_role_and_label(Role::Button, "shear°").click();
+    settle(&mut harness);
+    harness.get_by_label("forearm shear°");
+    assert!(harness.query_by_label("forearm scale k z").is_none());
+    // The rest pose has no time to plot over: the panel says where its values are instead of a −0.4…0.4 s axis.
+    harness.state_mut().session.doc.set_clip(None).unwrap();
+    settle(&mut harness);
+    harness.get_by_label("One pose, no time to plot it over: the Inspector lists its values.");
 }
 
 #[test]
@@ -842,7 +910,7 @@ fn frames_are_frames_everywhere_once_chosen() {
 }
 
 #[test]
-fn messages_stack_in_the_viewport_wrap_and_cover_no_control() {
+fn messages_stack_in_the_viewport_wrap_and_cover_no_control_nor_the_caption() {
     use bonescope::app::Pane;
     let mut harness = demo_app();
     let dir = tempfile::tempdir().unwrap();
@@ -856,6 +924,8 @@ fn messages_stack_in_the_viewport_wrap_and_cover_no_control() {
     let viewport = harness.state().pane_rect(&Pane::VIEWPORT).unwrap();
     let messages = harness.state().notifications_rect().unwrap();
     assert!(viewport.contains_rect(messages), "{messages:?} within {viewport:?}");
+    let caption_side = viewport.right() - viewport.width() * bonescope::app::CAPTION_SIDE;
+    assert!(messages.right() <= caption_side, "{messages:?} clear of the caption (right of x = {caption_side})");
     // Both whole: each error's text wraps within the stack, and each has its Dismiss.
     assert_eq!(harness.query_all_by_label("Dismiss").count(), 2);
     let texts: Vec<_> =

@@ -69,7 +69,7 @@ fn bind_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
         weight_slider(ui, &mut layers.bind_weight, "clip weight").on_hover_text("0: the bind pose, 1: the clip");
         ui.checkbox(&mut shared.settings.scene.bind_pose, "Show the bind pose");
         if shared.doc.rig.skins.is_empty() {
-            ui.label(RichText::new("no skin: the bind pose is the rest pose").weak());
+            ui.label(RichText::new("no skinned mesh in the file: the bind pose is the rest pose").weak());
             return;
         }
         match shared.work.bind_check(shared.doc) {

@@ -40,6 +40,7 @@ pub use compared::Compared;
 pub use document::{Document, Ghost, ModeScope};
 pub use file_browser::NativeDialog;
 pub use identity::RigId;
+pub use notifications::CAPTION_SIDE;
 pub use pane::{Layout, Pane};
 pub use panel::MAX_PLOTTED;
 pub use plots::plot_id;

@@ -1,8 +1,8 @@
 //! Short messages in the corner: errors stay until dismissed (or until what they were about is fixed), information
 //! fades after a few seconds.
 //!
-//! They are built not to get in the way: they stack in the viewport's lower right corner (never over a control),
-//! each as wide as the stack, its file's name first and its text wrapped (never cut); nothing fades or moves while
+//! They are built not to get in the way: they stack in the viewport's lower left corner (never over a control, and
+//! clear of the caption the viewport draws at its lower right), each as wide as the stack, its file's name first and its text wrapped (never cut); nothing fades or moves while
 //! the pointer is over them (so a click meant for Dismiss never lands on the viewport behind), a message repeated
 //! collapses into one with a count, and at most a few are shown, the rest counted.
 
@@ -72,7 +72,7 @@ impl Notifications {
         self.items.push(Notification { text, error, topic, count, shown_at: None });
     }
 
-    /// Shows the messages in the lower right corner of `within` (the viewport).
+    /// Shows the messages in the lower left corner of `within` (the viewport).
     pub fn ui(&mut self, ctx: &egui::Context, within: Rect) {
         let now = ctx.input(|i| i.time);
         let hovered =
@@ -86,12 +86,12 @@ impl Notifications {
             self.area = None;
             return;
         }
-        let width = (within.width() - 2.0 * MARGIN).clamp(MIN_WIDTH, MAX_WIDTH);
+        let width = (within.width() * (1.0 - CAPTION_SIDE) - 2.0 * MARGIN).clamp(MIN_WIDTH, MAX_WIDTH);
         let mut dismissed = None;
         let hidden = self.items.len().saturating_sub(MAX_SHOWN);
         let response = egui::Area::new(egui::Id::unique("notifications"))
-            .pivot(Align2::RIGHT_BOTTOM)
-            .fixed_pos(within.right_bottom() - egui::vec2(MARGIN, MARGIN))
+            .pivot(Align2::LEFT_BOTTOM)
+            .fixed_pos(within.left_bottom() + egui::vec2(MARGIN, -MARGIN))
             .show(ctx, |ui| {
                 ui.set_width(width);
                 if hidden > 0 {
@@ -116,7 +116,9 @@ impl Notifications {
 
 /// Points between the messages and the viewport's edges.
 const MARGIN: f32 = 10.0;
-/// The width of the stack: as wide as the viewport allows, up to a readable line.
+/// The share of the viewport's width, at its right, left to the caption (file, clip, time, modes).
+pub const CAPTION_SIDE: f32 = 0.4;
+/// The width of the stack: as wide as the viewport allows beside the caption, up to a readable line.
 const MIN_WIDTH: f32 = 220.0;
 const MAX_WIDTH: f32 = 480.0;
 

@@ -1,5 +1,6 @@
 //! Each decomposed component of the selected bones over the whole clip, in local or model space, under the
-//! current modes and optionally the ghost mode. A cursor marks the current time; a click seeks.
+//! current modes and optionally the ghost mode. A cursor marks the current time; a click seeks. Several components
+//! stack, one plot per unit, in a column that scrolls (and says so) when they outgrow the panel.
 //!
 //! Long clips stay smooth: curves are reduced to the minimum and maximum of each pixel column of the visible
 //! range (see `reduce`) and drawn as a filled envelope at least a pixel thick; zoomed in far enough that every
@@ -110,15 +111,24 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
     (f64::from(angle.to_degrees()), axis.as_dvec3().to_array())
 }
 
-#[derive(Default)]
 pub struct Plots {
-    pub component: Component,
+    /// The components plotted, in [`Component::ALL`]'s order: a click shows one, Ctrl- or Shift-click adds or removes.
+    components: Vec<Component>,
     pub show_ghost: bool,
     /// The curves, split into plots of one unit each (an angle in degrees and a unit axis never share an axis).
     cache: Option<(SeriesKey, Vec<Group>)>,
     /// Set by "Reset view": the next frame fits the plots to the whole clip again.
     reset: bool,
 }
+
+impl Default for Plots {
+    fn default() -> Self {
+        Plots { components: vec![Component::default()], show_ghost: false, cache: None, reset: false }
+    }
+}
+
+/// The shortest a plot is drawn, in points: below it the stack scrolls rather than squeezing every plot.
+const MIN_PLOT_HEIGHT: f32 = 120.0;
 
 /// The curves of one plot: all in one unit, with their value range and their reduction to the visible range.
 struct Group {
@@ -160,7 +170,7 @@ struct SeriesKey {
     /// Held so its address identifies the analysis for as long as the cache lives.
     analysis: Arc<ClipAnalysis>,
     bones: Vec<usize>,
-    component: Component,
+    components: Vec<Component>,
     format: RotationFormat,
     model_space: bool,
     ghost: bool,
@@ -177,8 +187,8 @@ impl PartialEq for SeriesKey {
         };
         Arc::ptr_eq(&self.analysis, &other.analysis)
             && same_compared
-            && (&self.bones, self.component, self.format, self.model_space, self.ghost)
-                == (&other.bones, other.component, other.format, other.model_space, other.ghost)
+            && (&self.bones, &self.components, self.format, self.model_space, self.ghost)
+                == (&other.bones, &other.components, other.format, other.model_space, other.ghost)
     }
 }
 
@@ -204,7 +214,7 @@ impl Panel for Plots {
     }
 
     fn place(&self) -> Place {
-        Place::Centre(0.3)
+        Place::Centre(0.36)
     }
 
     fn plots_curves(&self) -> bool {
@@ -212,32 +222,14 @@ impl Panel for Plots {
     }
 
     fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        ui.horizontal_wrapped(|ui| {
-            for c in Component::ALL {
-                ui.selectable_value(&mut self.component, c, c.label());
-            }
-            ui.separator();
-            ui.selectable_value(&mut shared.settings.plot_model_space, true, "model");
-            ui.selectable_value(&mut shared.settings.plot_model_space, false, "local");
-            if self.component == Component::Rotation {
-                ui.separator();
-                let f = &mut shared.settings.rotation_format;
-                ui.selectable_value(f, RotationFormat::Quaternion, "quaternion");
-                ui.selectable_value(f, RotationFormat::Euler, "Euler XYZ");
-                ui.selectable_value(f, RotationFormat::AxisAngle, "axis-angle");
-            }
-            if shared.doc.ghost.is_some() {
-                ui.separator();
-                ui.checkbox(&mut self.show_ghost, "ghost");
-            }
-            ui.separator();
-            if ui.button("Reset view").on_hover_text("the whole clip again (or double-click a plot)").clicked() {
-                self.reset = true;
-            }
-        });
+        self.toolbar(ui, shared);
         let plotted = shared.plotted();
         if plotted.is_empty() {
             ui.label(RichText::new("Select bones to plot their components over the clip.").weak());
+            return;
+        }
+        if shared.doc.duration() <= 0.0 {
+            ui.label(RichText::new("One pose, no time to plot it over: the Inspector lists its values.").weak());
             return;
         }
         let Some(analysis) =
@@ -249,7 +241,7 @@ impl Panel for Plots {
         let key = SeriesKey {
             analysis: analysis.clone(),
             bones: plotted,
-            component: self.component,
+            components: self.components.clone(),
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
             ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
@@ -261,18 +253,93 @@ impl Panel for Plots {
                 .cloned(),
         };
         if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
-            let groups = Group::split(build_series(&key, &shared.doc.rig.skeleton));
+            let groups = key
+                .components
+                .iter()
+                .flat_map(|&component| Group::split(build_series(&key, component, &shared.doc.rig.skeleton)))
+                .collect();
             self.cache = Some((key, groups));
         }
         let reset = std::mem::take(&mut self.reset);
         let Some((key, groups)) = &mut self.cache else { return };
         legend(ui, groups);
-        let height = (ui.available_height() / groups.len() as f32).max(100.0);
-        let (count, link) = (groups.len(), ui.scope_id().with("component-plots"));
-        for (index, group) in groups.iter_mut().enumerate() {
-            plot(ui, shared, key, group, PlotPlace { index, last: index + 1 == count, height, reset, link });
-        }
+        stack(ui, shared, key, groups, reset);
     }
+}
+
+impl Plots {
+    /// The plot's controls, each in its place whatever is chosen (a control that does not apply is disabled, not
+    /// hidden), so nothing moves under the pointer.
+    fn toolbar(&mut self, ui: &mut Ui, shared: &mut Shared) {
+        ui.horizontal_wrapped(|ui| {
+            for c in Component::ALL {
+                let shown = self.components.contains(&c);
+                let response = ui
+                    .selectable_label(shown, c.label())
+                    .on_hover_text("Ctrl- or Shift-click to plot it with the others");
+                if response.clicked() {
+                    let adding = ui.input(|i| i.modifiers.command || i.modifiers.shift);
+                    self.components = choose(&self.components, c, adding);
+                }
+            }
+            ui.separator();
+            ui.selectable_value(&mut shared.settings.plot_model_space, true, "model");
+            ui.selectable_value(&mut shared.settings.plot_model_space, false, "local");
+            ui.separator();
+            let rotation = self.components.contains(&Component::Rotation);
+            let format = &mut shared.settings.rotation_format;
+            for (choice, label) in [
+                (RotationFormat::Quaternion, "quaternion"),
+                (RotationFormat::Euler, "Euler XYZ"),
+                (RotationFormat::AxisAngle, "axis-angle"),
+            ] {
+                if ui.add_enabled(rotation, egui::Button::selectable(*format == choice, label)).clicked() {
+                    *format = choice;
+                }
+            }
+            ui.separator();
+            ui.add_enabled(shared.doc.ghost.is_some(), egui::Checkbox::new(&mut self.show_ghost, "ghost"))
+                .on_disabled_hover_text("no ghost: choose one in the top bar");
+            ui.separator();
+            if ui.button("Reset view").on_hover_text("the whole clip again (or double-click a plot)").clicked() {
+                self.reset = true;
+            }
+        });
+    }
+}
+
+/// The components after a click on `clicked`: only it, or (`adding`) it added or removed, never none.
+fn choose(shown: &[Component], clicked: Component, adding: bool) -> Vec<Component> {
+    if !adding {
+        return vec![clicked];
+    }
+    let toggled = |c: &Component| (*c == clicked) != shown.contains(c);
+    let chosen: Vec<Component> = Component::ALL.into_iter().filter(toggled).collect();
+    if chosen.is_empty() { vec![clicked] } else { chosen }
+}
+
+/// The plots one above the other, sharing the panel's height down to [`MIN_PLOT_HEIGHT`] each, in a column that
+/// scrolls past that, its scroll bar drawn (not only on hover) and a line saying how many plots the column holds.
+fn stack(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, groups: &mut [Group], reset: bool) {
+    let count = groups.len();
+    let spacing = ui.spacing().item_spacing.y;
+    let fitting = (ui.available_height() + spacing) / count as f32 - spacing;
+    // One plot takes whatever there is: scrolling it alone would show less of it, not more.
+    let height = if count == 1 { fitting.max(MIN_PLOT_HEIGHT / 2.0) } else { fitting.max(MIN_PLOT_HEIGHT) };
+    if count > 1 && fitting < MIN_PLOT_HEIGHT {
+        ui.label(RichText::new(format!("{count} plots: the bar at the right scrolls to the rest")).weak());
+    }
+    let link = ui.scope_id().with("component-plots");
+    // A solid bar where the column scrolls, drawn whether or not the pointer is near (egui's floating one hides
+    // until hovered).
+    ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            for (index, group) in groups.iter_mut().enumerate() {
+                plot(ui, shared, key, group, PlotPlace { index, last: index + 1 == count, height, reset, link });
+            }
+        });
 }
 
 /// The egui id of the `index`-th plot of the stack (its `egui_plot::PlotMemory` holds the visible range).
@@ -312,6 +379,8 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
         if plot_ui.response().hovered() && scroll != 0.0 {
             plot_ui.zoom_bounds_around_hovered(egui::Vec2::new((scroll * 0.0026).exp(), 1.0));
             plot_ui.set_auto_bounds(egui::Vec2b::new(false, true));
+            // Taken: the column of plots around would scroll by it too.
+            plot_ui.ctx().input_mut(|i| i.smooth_scroll_delta = egui::Vec2::ZERO);
         }
         curves(plot_ui, &key.analysis.times, group);
         stretched_bands(plot_ui, stretched, range);
@@ -349,7 +418,12 @@ fn frame<'a>(shared: &Shared, place: &PlotPlace, (y_min, y_max): (f64, f64)) -> 
         .x_grid_spacer(move |input| ticks::time_marks(input, unit, rate))
         .y_grid_spacer(ticks::value_marks)
         .x_axis_formatter(move |mark, _| ticks::time_label(mark.value, mark.step_size, unit, rate))
-        .y_axis_formatter(|mark, _| ticks::value_label(mark.value, mark.step_size));
+        .custom_y_axes(vec![
+            egui_plot::AxisHints::new_y()
+                .formatter(|mark, _| ticks::value_label(mark.value, mark.step_size))
+                // Every label the marks make is drawn, at full strength (egui_plot fades them below 30 points).
+                .label_spacing((ticks::CLOSEST_VALUE_LABELS - 1.0) as f32..=ticks::CLOSEST_VALUE_LABELS as f32),
+        ]);
     if place.last {
         plot = plot.x_axis_label(format!("time ({})", unit.label()));
     }
@@ -422,9 +496,9 @@ fn value_range(series: &[Series]) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// Every curve's values at every sample, computed once per analysis and choice of component.
-fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Series> {
-    let channels = key.component.channels(key.format);
+/// Every curve of `component` at every sample, computed once per analysis and choice of components.
+fn build_series(key: &SeriesKey, component: Component, skeleton: &crate::model::Skeleton) -> Vec<Series> {
+    let channels = component.channels(key.format);
     let mut out = Vec::new();
     for (slot, &bone) in key.bones.iter().enumerate() {
         let Some(curves) = key.analysis.curves_of(bone) else { continue };
@@ -438,6 +512,12 @@ fn build_series(key: &SeriesKey, skeleton: &crate::model::Skeleton) -> Vec<Serie
         let ghost = if key.ghost && ghost.len() == primary.len() { continuous(ghost) } else { Vec::new() };
         for (c, (channel, read)) in channels.iter().enumerate() {
             let color = channel_color(slot * channels.len() + c);
+            // With other components beside it, a channel says whose it is ("hand scale k x", "hand shear°").
+            let channel = match (key.components.len(), channels.len()) {
+                (1, _) => (*channel).to_owned(),
+                (_, 1) => component.label().to_owned(),
+                _ => format!("{} {channel}", component.label()),
+            };
             out.push(Series {
                 name: format!("{name} {channel}"),
                 color,

@@ -44,6 +44,9 @@ fn marks(bounds: (f64, f64), major: f64) -> Vec<GridMark> {
 /// (values).
 pub const TIME_LABEL_POINTS: f64 = 70.0;
 pub const VALUE_LABEL_POINTS: f64 = 26.0;
+/// The closest value labels are drawn, in points: a line of text and a little air (the value axis draws every
+/// label from here on at full strength).
+pub const CLOSEST_VALUE_LABELS: f64 = 18.0;
 
 /// The points per value unit of a plot axis, from egui_plot's base step (the value span of its minimum grid
 /// spacing, which is 8 points unless set otherwise).
@@ -52,9 +55,25 @@ fn points_per_value(input: &GridInput) -> f64 {
     GRID_SPACING_MIN / input.base_step_size.max(f64::MIN_POSITIVE)
 }
 
-/// The marks of a value axis: 1-2-5 steps at least [`VALUE_LABEL_POINTS`] apart.
+/// The next smaller step of the form {1, 2, 5} × 10ⁿ below `step` (one of that form).
+fn smaller_125(step: f64) -> f64 {
+    let mantissa = step / 10f64.powf(step.log10().floor());
+    // 1 → 0.5, 2 → 1, 5 → 2.
+    step * if (mantissa - 5.0).abs() < 1e-9 { 0.4 } else { 0.5 }
+}
+
+/// The marks of a value axis: 1-2-5 steps at least [`VALUE_LABEL_POINTS`] apart, closer (down to
+/// [`CLOSEST_VALUE_LABELS`]) where that labels fewer than three values: a short plot spanning −0.75…1.05 reads
+/// −0.5, 0, 0.5, 1, not a lone 0 (the 1 at its top edge hidden).
 pub fn value_marks(input: GridInput) -> Vec<GridMark> {
-    let major = step_125(VALUE_LABEL_POINTS / points_per_value(&input));
+    let per_value = points_per_value(&input);
+    let (lo, hi) = input.bounds;
+    let labelled = |step: f64| (hi / step).floor() - (lo / step).ceil() + 1.0;
+    let closest = step_125(CLOSEST_VALUE_LABELS / per_value);
+    let mut major = step_125(VALUE_LABEL_POINTS / per_value);
+    while labelled(major) < 3.0 && smaller_125(major) >= closest * (1.0 - 1e-12) {
+        major = smaller_125(major);
+    }
     marks(input.bounds, major)
 }
 
@@ -133,6 +152,19 @@ mod tests {
         assert_eq!(majors, [0.0, 0.5, 1.0]);
         assert_eq!(marks.len(), 11, "minor marks every 0.1");
         assert!(super::marks((0.0, 1e9), 1e-6).is_empty(), "too many marks: none");
+    }
+
+    #[test]
+    fn a_short_plot_labels_several_values_not_a_lone_zero() {
+        // A quaternion plot 80 points high spanning −0.75…1.05 (−0.6…0.9 padded): 26 points would be a step of 1
+        // (0 and 1 only); steps of 0.5 label four values, still 22 points apart.
+        let input = GridInput { bounds: (-0.75, 1.05), base_step_size: 1.8 / 80.0 * 8.0 };
+        let labelled: Vec<f64> = value_marks(input).iter().filter(|m| m.step_size == 0.5).map(|m| m.value).collect();
+        assert_eq!(labelled, [-0.5, 0.0, 0.5, 1.0]);
+        // Never closer than a line of text: 40 points for the same span keep steps of 1.
+        let input = GridInput { bounds: (-0.75, 1.05), base_step_size: 1.8 / 40.0 * 8.0 };
+        assert!(value_marks(input).iter().all(|m| m.step_size >= 1.0 || m.step_size < 0.5));
+        assert_eq!([1.0, 2.0, 5.0, 0.1].map(smaller_125), [0.5, 1.0, 2.0, 0.05]);
     }
 
     #[test]

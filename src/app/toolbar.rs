@@ -200,8 +200,9 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mu
     }
 }
 
-/// The widest the animation's name is shown in the toolbar, in points.
-const CLIP_NAME_WIDTH: f32 = 160.0;
+/// The width of the top bar's lists, in points: the animation's too, whatever its name's length (shortened to fit),
+/// so the controls after it never move.
+const PICKER_WIDTH: f32 = 170.0;
 
 fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     let label = ui.label("Animation");
@@ -209,10 +210,13 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
     let current = shared.doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
     // A take's name can be a path long: shortened in the middle, whole on hover and in the list.
     let font = egui::TextStyle::Button.resolve(ui.style());
-    let shown = text::shorten_middle(&current, |t| text::text_width(ui, t, &font) <= CLIP_NAME_WIDTH);
+    let spacing = ui.spacing();
+    let room = PICKER_WIDTH - spacing.icon_width - spacing.item_spacing.x - 2.0 * spacing.button_padding.x;
+    let shown = text::shorten_middle(&current, |t| text::text_width(ui, t, &font) <= room);
     let mut chosen = shared.doc.setup().clip;
     egui::ComboBox::from_id_salt("animation")
         .selected_text(shown)
+        .width(PICKER_WIDTH)
         .show_ui(ui, |ui| {
             for clip in clips {
                 ui.selectable_value(
@@ -238,7 +242,7 @@ fn mode_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let mut chosen = None;
     egui::ComboBox::from_id_salt("inherit-all")
         .selected_text(current.map_or("mixed", ModeChoice::id))
-        .width(170.0)
+        .width(PICKER_WIDTH)
         // Every choice in view (ten: egui's default height shows eight).
         .height(f32::INFINITY)
         .show_ui(ui, |ui| {
@@ -279,7 +283,7 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let text = shared.doc.ghost.as_ref().map_or("off", Ghost::label);
     egui::ComboBox::from_id_salt("ghost")
         .selected_text(text)
-        .width(170.0)
+        .width(PICKER_WIDTH)
         .show_ui(ui, |ui| {
             ui.selectable_value(&mut shared.doc.ghost, None, "off");
             if let Some(compared) = &shared.doc.compared {

@@ -180,7 +180,7 @@ impl Panel for Viewport {
     }
 
     fn place(&self) -> Place {
-        Place::Centre(0.7)
+        Place::Centre(0.64)
     }
 
     fn visibility(&self) -> Visibility {

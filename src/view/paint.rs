@@ -6,7 +6,7 @@
 
 use egui::epaint::Mesh as EguiMesh;
 use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Shape, Stroke};
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DMat4, DVec2, DVec3};
 
 use super::camera::{Camera, Projection};
 use super::scene::{DrawnPose, Scene};
@@ -289,6 +289,10 @@ fn box_color(drawn: &DrawnPose, bone: usize, palette: &Palette) -> Color32 {
 /// manipulators they stay readable however far the view is zoomed out.
 const MIN_GIZMO: f64 = 16.0;
 
+/// The longest a gizmo's axis is drawn, in gizmo lengths of the rig's typical scale: a bone scaled 100× (an
+/// unconverted centimetre node, a bad export) keeps its triad beside its joint instead of across the view.
+const MAX_GIZMO_STRETCH: f64 = 4.0;
+
 /// The gizmo unit ([`Scene::gizmo_unit`]) for a joint at `at`: enlarged where a gizmo of the rig's typical scale
 /// would be drawn shorter than [`MIN_GIZMO`], so a bone's own scale and shear still show in proportion.
 fn gizmo_unit(scene: &Scene, projection: &Projection, at: DVec3) -> f64 {
@@ -297,8 +301,19 @@ fn gizmo_unit(scene: &Scene, projection: &Projection, at: DVec3) -> f64 {
     scene.gizmo_unit * enlarge
 }
 
-/// Each shown bone's matrix applied to a cube of side [`gizmo_unit`] (in the bone's own units) centred on the
-/// joint: shear slants it, non-uniform scale stretches it.
+/// A bone's gizmo axes in model space: its model matrix columns times [`gizmo_unit`], so their lengths show scale
+/// and their angles shear, shrunk as a whole (angles and proportions kept) where the longest would pass
+/// [`MAX_GIZMO_STRETCH`] typical lengths.
+fn gizmo_axes(scene: &Scene, projection: &Projection, model: &DMat4) -> DMat3 {
+    let unit = gizmo_unit(scene, projection, model.w_axis.truncate());
+    let axes = DMat3::from_mat4(*model) * unit;
+    let longest = [axes.x_axis, axes.y_axis, axes.z_axis].iter().map(|a| a.length()).fold(0.0, f64::max);
+    let limit = MAX_GIZMO_STRETCH * unit * scene.gizmo_size / scene.gizmo_unit;
+    if longest > limit && longest.is_finite() { axes * (limit / longest) } else { axes }
+}
+
+/// Each shown bone's gizmo axes ([`gizmo_axes`]) applied to a unit cube centred on the joint: shear slants it,
+/// non-uniform scale stretches it.
 fn paint_boxes(
     painter: &Painter,
     projection: &Projection,
@@ -307,10 +322,11 @@ fn paint_boxes(
     color_of: impl Fn(usize) -> Color32,
 ) {
     for (bone, model) in drawn.model.iter().enumerate().filter(|(b, _)| scene.shows(*b)) {
-        let h = gizmo_unit(scene, projection, model.w_axis.truncate()) * 0.5;
+        let axes = gizmo_axes(scene, projection, model);
+        let origin = model.w_axis.truncate();
         let corner = |i: usize| {
-            let pick = |bit: usize| if i & bit == 0 { -h } else { h };
-            model.transform_point3(DVec3::new(pick(1), pick(2), pick(4)))
+            let pick = |bit: usize| if i & bit == 0 { -0.5 } else { 0.5 };
+            origin + axes * DVec3::new(pick(1), pick(2), pick(4))
         };
         let color = color_of(bone);
         for (a, b) in [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)] {
@@ -319,8 +335,7 @@ fn paint_boxes(
     }
 }
 
-/// Axis triads of the shown bones `which` picks, from their model matrix columns times [`gizmo_unit`]: their
-/// lengths show scale, their angles show shear.
+/// Axis triads of the shown bones `which` picks, from their gizmo axes ([`gizmo_axes`]).
 fn paint_axes(
     painter: &Painter,
     projection: &Projection,
@@ -332,9 +347,9 @@ fn paint_axes(
     let palette_axes = Palette::new(true).axes;
     for (_, model) in drawn.model.iter().enumerate().filter(|&(b, _)| scene.shows(b) && which(b)) {
         let origin = model.w_axis.truncate();
-        let unit = gizmo_unit(scene, projection, origin);
-        for (axis, color) in [model.x_axis, model.y_axis, model.z_axis].iter().zip(palette_axes) {
-            line(painter, projection, origin, origin + axis.truncate() * unit, Stroke::new(2.0, tint(color)));
+        let axes = gizmo_axes(scene, projection, model);
+        for (axis, color) in [axes.x_axis, axes.y_axis, axes.z_axis].iter().zip(palette_axes) {
+            line(painter, projection, origin, origin + *axis, Stroke::new(2.0, tint(color)));
         }
     }
 }
@@ -405,6 +420,26 @@ mod tests {
                 Some(points) => assert!((length - points).abs() < 1e-9, "far away, {length} points"),
             }
         }
+    }
+
+    #[test]
+    fn a_triad_shows_scale_in_proportion_but_never_leaves_its_joint() {
+        let rig = demo_rig();
+        let scene = Scene::new(&rig, DrawnPose::default(), SceneOptions::default());
+        let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
+        let at = DVec3::new(0.0, 1.5, 0.0);
+        let camera = Camera { distance: 2.0, target: at, ..Camera::default() };
+        let projection = projection(&camera, rect);
+        let typical = gizmo_unit(&scene, &projection, at);
+        let longest = |scale: DVec3| {
+            let axes =
+                gizmo_axes(&scene, &projection, &DMat4::from_scale_rotation_translation(scale, Default::default(), at));
+            [axes.x_axis, axes.y_axis, axes.z_axis].map(|a| a.length() / typical)
+        };
+        assert_eq!(longest(DVec3::new(2.0, 1.0, 0.5)), [2.0, 1.0, 0.5], "scale shown as it is");
+        let far = longest(DVec3::new(100.0, 50.0, 1.0));
+        assert!((far[0] - MAX_GIZMO_STRETCH).abs() < 1e-12, "the longest axis capped: {far:?}");
+        assert!((far[1] / far[0] - 0.5).abs() < 1e-12 && (far[2] / far[0] - 0.01).abs() < 1e-12, "proportions kept");
     }
 
     #[test]
