@@ -1020,9 +1020,18 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
 
 /// The node labelled `label` inside the Inspector (the skeleton's rows name the same bones).
 fn in_inspector<'h>(harness: &'h Harness<'static, BonescopeApp>, label: &'h str) -> egui_kittest::Node<'h> {
-    let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
+    in_pane(harness, "Inspector", label)
+}
+
+/// The node labelled `label` inside the panel titled `pane`.
+fn in_pane<'h>(
+    harness: &'h Harness<'static, BonescopeApp>,
+    pane: &'static str,
+    label: &'h str,
+) -> egui_kittest::Node<'h> {
+    let rect = harness.state().pane_rect(&bonescope::app::Pane::named(pane)).unwrap();
     let mut nodes = harness.get_all_by_label(label);
-    nodes.find(|n| inspector.contains(n.rect().center())).unwrap_or_else(|| panic!("no {label} in the Inspector"))
+    nodes.find(|n| rect.contains(n.rect().center())).unwrap_or_else(|| panic!("no {label} in the {pane}"))
 }
 
 /// The demo with the forearm inspected and its Why? section open, explained.
@@ -1056,10 +1065,22 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     // The upper arm's squash under the elbow's turn shears the forearm.
     harness.get_by_label_contains("forearm: upper_arm's scale (");
     harness.get_by_label("main");
-    // A bone of the chain is a click away: it is selected as the skeleton's row selects it.
+    // A bone of the chain is a click away: it is selected (highlighted in the viewport, its axes drawn, its curves
+    // plotted) while the Inspector stays with the forearm's explanation, with the way back.
     in_inspector(&harness, "upper_arm").click();
     settle(&mut harness);
     assert_eq!(harness.state().window.selection, vec![upper_arm]);
+    harness.get_by_label("Fixes, best first");
+    harness.get_by_label("upper_arm selected: its scale shows in the viewport");
+    harness.get_by_label("back to forearm").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().window.selection, vec![forearm]);
+    // Another bone selected elsewhere lets the explanation go.
+    in_inspector(&harness, "upper_arm").click();
+    settle(&mut harness);
+    in_pane(&harness, "Skeleton", "shoulder").click();
+    settle(&mut harness);
+    assert!(harness.query_by_label("back to forearm").is_none());
     harness.get_by_label("not sheared: nothing to explain");
     harness.get_by_label("forearm").click();
     settle(&mut harness);

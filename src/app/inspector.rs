@@ -28,10 +28,11 @@ impl Panel for Inspector {
     }
 
     fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        let Some(bone) = shared.inspected() else {
+        let Some(bone) = why::shown(shared) else {
             ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
             return;
         };
+        why::pinned_line(ui, shared, bone);
         bone_ui(ui, shared, bone);
     }
 }

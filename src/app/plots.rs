@@ -333,13 +333,11 @@ fn stack(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, groups: &mut [Group]
     // A solid bar where the column scrolls, drawn whether or not the pointer is near (egui's floating one hides
     // until hovered).
     ui.spacing_mut().scroll = egui::style::ScrollStyle::solid();
-    egui::ScrollArea::vertical()
-        .auto_shrink([false, false])
-        .show(ui, |ui| {
-            for (index, group) in groups.iter_mut().enumerate() {
-                plot(ui, shared, key, group, PlotPlace { index, last: index + 1 == count, height, reset, link });
-            }
-        });
+    egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+        for (index, group) in groups.iter_mut().enumerate() {
+            plot(ui, shared, key, group, PlotPlace { index, last: index + 1 == count, height, reset, link });
+        }
+    });
 }
 
 /// The egui id of the `index`-th plot of the stack (its `egui_plot::PlotMemory` holds the visible range).

@@ -1,6 +1,7 @@
 //! The Inspector's Why? section, for a bone the whole-clip analysis flags: whose scale shears it (its chain at the
 //! worst time, each bone's contribution), when (the main cause's time spans), and the fixes ranked
-//! ([`crate::explain`]). The explanation is computed off the UI thread, one at a time (it cannot stop half way).
+//! ([`crate::explain`]). A bone of the chain clicked is selected (shown in the viewport) while the Inspector stays
+//! with the explained bone, a link away from it. The explanation is computed off the UI thread, one at a time (it cannot stop half way).
 //!
 //! A fix that is a setting of the document can be tried on it (one step of the history: Edit → Undo takes it back,
 //! the ghost with it): a mode goes to the bone's own mode, a uniform scale to the layers.
@@ -33,12 +34,43 @@ const COUNTERS: Color32 = Color32::from_rgb(60, 175, 160);
 /// Below this a shear left by a fix is floating-point noise, not a measurement.
 const NOISE_DEG: f64 = 1e-9;
 
+/// What the section keeps between frames.
+#[derive(Default)]
+pub struct Memory {
+    /// The fix last tried, said in its place while it stands.
+    tried: Option<Tried>,
+    /// The bone whose section stays in the Inspector, and the bone of its chain clicked there, while that bone alone
+    /// is selected.
+    pinned: Option<(usize, usize)>,
+}
+
 /// A fix tried on a bone from this section: what was evaluated after it (while the document still evaluates that,
 /// it stands) and the line that says what it did.
-pub struct Tried {
+struct Tried {
     bone: usize,
     setup: Setup,
     line: String,
+}
+
+/// The bone the Inspector shows: the selected one, or the bone in whose chain (in this section) the selected one was
+/// clicked, for as long as that one alone is selected (any other selection lets the section go).
+pub fn shown(shared: &mut Shared) -> Option<usize> {
+    let selected = shared.inspected()?;
+    let (selection, pinned) = (&shared.selection, &mut shared.why.pinned);
+    *pinned = pinned.filter(|&(_, clicked)| selection.as_slice() == [clicked]);
+    Some(pinned.map_or(selected, |(explained, _)| explained))
+}
+
+/// The line above a bone shown pinned ([`shown`]): which bone of its chain is selected (highlighted in the viewport,
+/// its axes drawn, its curves plotted), and the way back to the bone itself.
+pub fn pinned_line(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+    let Some(selected) = shared.inspected().filter(|&s| s != bone) else { return };
+    let skeleton = &shared.doc.rig.skeleton;
+    let (name, selected_name) = (skeleton.bone(bone).name.clone(), skeleton.bone(selected).name.clone());
+    ui.label(RichText::new(drawable(&format!("{selected_name} selected: its scale shows in the viewport"))).weak());
+    if ui.link(drawable(&format!("back to {name}"))).on_hover_text("select the explained bone again").clicked() {
+        shared.select(bone, false);
+    }
 }
 
 /// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a toggle
@@ -102,7 +134,7 @@ fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
 
 /// The line of the fix tried on `bone`, while the document evaluates what it made.
 fn standing(shared: &Shared, bone: usize) -> Option<String> {
-    let tried = shared.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
+    let tried = shared.why.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
     Some(tried.line.clone())
 }
 
@@ -160,7 +192,7 @@ impl Columns {
     }
 }
 
-/// The chain at the worst time, root first: each bone's name (a click selects it), a bar as long as the share of
+/// The chain at the worst time, root first: each bone's name (a click selects it, the section staying), a bar as long as the share of
 /// the shear its squash causes, the contribution in degrees, and the scale where it is unequal.
 fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     let at = &explained.causes.at;
@@ -179,7 +211,7 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     let columns = Columns::of(ui);
     let tolerance = shared.settings.tolerances.min_anisotropy;
     for link in &at.chain {
-        link_row(ui, shared, link, at.shear_deg, Some(link.bone) == main, &columns);
+        link_row(ui, shared, explained.bone, link, at.shear_deg, Some(link.bone) == main, &columns);
         if link.anisotropy > tolerance {
             ui.horizontal(|ui| {
                 ui.add_space(ui.spacing().indent);
@@ -200,13 +232,23 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     }
 }
 
-fn link_row(ui: &mut Ui, shared: &mut Shared, link: &Link, shear: f64, main: bool, columns: &Columns) {
+/// One bone of `explained`'s chain; a click on its name selects it, the section staying with `explained`.
+fn link_row(
+    ui: &mut Ui,
+    shared: &mut Shared,
+    explained: usize,
+    link: &Link,
+    shear: f64,
+    main: bool,
+    columns: &Columns,
+) {
     ui.horizontal(|ui| {
         let selected = shared.selection.contains(&link.bone);
         let name = name_label(ui, &link.name, || link.name.clone(), columns.name, Some(selected));
         let room = columns.name - name.rect.width();
         if name.clicked() {
             shared.select(link.bone, false);
+            shared.why.pinned = Some((explained, link.bone)).filter(|_| link.bone != explained);
         }
         ui.add_space(room.max(0.0));
         let hint = link_hint(link, shear);
@@ -357,7 +399,7 @@ fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns,
         try_fix(shared, fix.change);
         go_to(shared, explained.causes.at.time);
         let setup = shared.doc.setup().clone();
-        *shared.tried = Some(Tried { bone: explained.bone, setup, line: tried_line(fix, explained, columns.unit) });
+        shared.why.tried = Some(Tried { bone: explained.bone, setup, line: tried_line(fix, explained, columns.unit) });
     }
 }
 

@@ -17,7 +17,7 @@ use super::settings::Settings;
 use super::timeline::{self, PlayClock};
 use super::toolbar::{self, Actions, Menus};
 use super::viewport::{CanvasFill, Viewport};
-use super::why::Tried;
+use super::why;
 use super::work::{Wanted, Work};
 use super::{inspector, layers, outliner, plots};
 use crate::analysis::ClipAnalysis;
@@ -66,8 +66,8 @@ pub struct Window {
     size: egui::Vec2,
     pub notifications: Notifications,
     pub dialogs: Dialogs,
-    /// The fix last tried from the Why? section.
-    tried: Option<Tried>,
+    /// What the Why? section keeps between frames.
+    why: why::Memory,
 }
 
 impl Window {
@@ -85,7 +85,7 @@ impl Window {
             size: egui::Vec2::ZERO,
             notifications: Notifications::default(),
             dialogs: Dialogs::default(),
-            tried: None,
+            why: why::Memory::default(),
         };
         window.replaced(Replaced::Opened, doc);
         window
@@ -172,7 +172,7 @@ impl Window {
             results: &results,
             stretched,
             work,
-            tried: &mut self.tried,
+            why: &mut self.why,
             undo_asked: &mut undo_asked,
         };
         if self.chrome == Chrome::ViewportOnly {
