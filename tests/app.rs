@@ -1018,6 +1018,34 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
     harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh");
 }
 
+#[test]
+fn a_z_up_bvh_compared_says_it_lies_down_and_stands_up_on_the_axis_picked() {
+    // Blender's BVH of the stretchy rig is in Blender's Z-up space: beside the rig's glTF it lies on the floor.
+    let mut harness = asset_app("blender/stretchy_full.glb");
+    harness.state_mut().compare(&asset("blender/stretchy_full.bvh"));
+    settle(&mut harness);
+    harness.get_by_role_and_label(Role::ComboBox, "unit of stretchy_full.bvh").click();
+    harness.run();
+    harness.get_by_label("metres").click();
+    settle(&mut harness);
+    harness.get_by_label("lies along Z: stretchy_full.glb stands along Y");
+    let worst = |harness: &Harness<'static, BonescopeApp>| {
+        let differences = harness.state().differences().expect("differences");
+        differences.bones.iter().flatten().copied().fold(0.0, f64::max)
+    };
+    let lying = worst(&harness);
+    harness.get_by_role_and_label(Role::ComboBox, "up of stretchy_full.bvh").click();
+    harness.run();
+    harness.get_by_label("Z").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().session.doc.compared.as_ref().unwrap().up, bonescope::model::UpAxis::Z);
+    assert!(harness.query_by_label_contains("lies along").is_none(), "standing, nothing to say");
+    // Standing, the ghost stands where the figure does: what is left is what a BVH cannot store (its scale).
+    let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
+    assert!((ghost / figure - 1.0).abs() < 0.05, "{figure} against {ghost}");
+    assert!(worst(&harness) < lying / 2.0, "{lying} then {}", worst(&harness));
+}
+
 /// The node labelled `label` inside the Inspector (the skeleton's rows name the same bones).
 fn in_inspector<'h>(harness: &'h Harness<'static, BonescopeApp>, label: &'h str) -> egui_kittest::Node<'h> {
     in_pane(harness, "Inspector", label)

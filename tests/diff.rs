@@ -389,3 +389,43 @@ fn swapping_the_files_changes_nothing() {
         }
     }
 }
+
+#[test]
+fn a_z_up_bvh_stands_up_when_given_its_axis() {
+    use bonescope::model::{InheritMode, UpAxis};
+    // Blender writes its BVH in its own Z-up space: beside the same rig's glTF it lies on the floor.
+    let (glb, bvh) = (asset("blender/stretchy_full.glb"), asset("blender/stretchy_full.bvh"));
+    let (glb, bvh) = (glb.to_str().unwrap(), bvh.to_str().unwrap());
+    let diff = |extra: &[&str]| {
+        let args = [&["diff", glb, bvh, "--anim-a", "0", "--anim-b", "0", "--unit-b", "m", "--format", "json"], extra];
+        bonescope(&args.concat())
+    };
+    let hips = |output: &std::process::Output| {
+        let bones = json(output)["animations"][0]["bones"].as_array().unwrap().clone();
+        let hips = bones.iter().find(|b| b["name"] == "hips").unwrap().clone();
+        hips["position"]["max"].as_f64().unwrap()
+    };
+    let lying = diff(&[]);
+    let note = String::from_utf8_lossy(&lying.stderr).into_owned();
+    assert!(note.contains("A's skeleton stands along Y, B's along Z") && note.contains("give --up-b z"), "{note}");
+    let standing = diff(&["--up-b", "z"]);
+    assert!(String::from_utf8_lossy(&standing.stderr).is_empty(), "stood up, nothing to suggest");
+    // The hips travel the same path in both files once B is turned (within the BVH's 4 decimals, 1 cm); lying down,
+    // they are over a metre apart.
+    assert!(hips(&lying) > 1.0 && hips(&standing) < 0.01, "{} {}", hips(&lying), hips(&standing));
+    // The turn is the exporters': every joint of the stood-up rig at (x, z, −y) of where the file puts it.
+    let rig = bonescope::import::load(&asset("blender/stretchy_full.bvh")).unwrap();
+    let stood = rig.clone().stood_up(UpAxis::Z);
+    assert!(stood.notes.iter().any(|n| n == "axes: given as up along Z, turned to Y up"), "{:?}", stood.notes);
+    let pose = |rig: &Rig| {
+        let modes = vec![InheritMode::Full; rig.skeleton.len()];
+        let evaluation = bonescope::eval::Evaluation::new(rig, rig.clips.first(), &modes).unwrap();
+        evaluation.pose_at(0.55).model.model
+    };
+    for (before, after) in pose(&rig).iter().zip(pose(&stood)) {
+        let (p, q) = (before.w_axis, after.w_axis);
+        assert!((q.truncate() - glam::DVec3::new(p.x, p.z, -p.y)).length() < 1e-9, "{p} → {q}");
+    }
+    // Turned back, it is the file's again.
+    assert_eq!(stood.restood(UpAxis::Z, UpAxis::Y).skeleton.placement().conversion, glam::DMat4::IDENTITY);
+}

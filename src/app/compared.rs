@@ -3,7 +3,7 @@
 //! plotted dashed beside the document's, and each bone's largest difference over the clip, which the outliner badges
 //! above a threshold; conversion nodes, which only state a file's axes and unit, are left out as `diff` leaves them.
 //! The compared file is measured in the document's unit; where a file states none (BVH), the user gives it one
-//! (the toolbar's unit pickers). The file is watched and reloaded like the document.
+//! (the toolbar's unit pickers), and the axis it stands along where it lies down beside the document. The file is watched and reloaded like the document.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -14,7 +14,7 @@ use crate::diff::{match_bones, match_clips, match_meshes};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup, SkinningMethod};
 use crate::import::{self, ImportError};
-use crate::model::{Clip, Rig, Unit};
+use crate::model::{Clip, Rig, Unit, UpAxis};
 use crate::view::DrawnPose;
 
 /// The compared file and how its bones and meshes stand for the document's.
@@ -27,6 +27,8 @@ pub struct Compared {
     pub rig_id: RigId,
     /// Whether the file states its unit.
     states_unit: bool,
+    /// The axis the file is read as standing along (Y: as it says).
+    pub up: UpAxis,
     /// The unit the file is measured in: the document's, or the one the user gave the document where its file
     /// states none.
     document_unit: Option<Unit>,
@@ -71,7 +73,8 @@ impl Compared {
         }
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
         let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
-        Compared { path, rig, rig_id, states_unit, document_unit, bones, conversion, meshes, clips, played }
+        let up = UpAxis::Y;
+        Compared { path, rig, rig_id, states_unit, up, document_unit, bones, conversion, meshes, clips, played }
     }
 
     /// The same file paired with another document rig (the document was reloaded), keeping the units given and
@@ -79,18 +82,18 @@ impl Compared {
     pub fn repaired(&self, document: &Rig) -> Self {
         let repaired = Compared::pair(self.path.clone(), (*self.rig).clone(), document);
         let document_unit = document.unit.or(self.document_unit);
-        Compared { states_unit: self.states_unit, document_unit, played: self.played, ..repaired }
+        Compared { states_unit: self.states_unit, up: self.up, document_unit, played: self.played, ..repaired }
     }
 
-    /// The file read again after it changed on disk, paired with `document`, keeping the units the user gave and
-    /// how it is played.
+    /// The file read again after it changed on disk, paired with `document`, keeping the units and the up axis the
+    /// user gave and how it is played.
     pub fn reloaded(&self, document: &Rig) -> Result<Self, ImportError> {
-        let mut rig = import::load(&self.path)?;
+        let mut rig = import::load(&self.path)?.stood_up(self.up);
         if rig.unit.is_none() && !self.states_unit {
             rig.unit = self.rig.unit;
         }
         let fresh = Compared::pair(self.path.clone(), rig, document);
-        Ok(Compared { document_unit: self.document_unit, played: self.played, ..fresh })
+        Ok(Compared { document_unit: self.document_unit, played: self.played, up: self.up, ..fresh })
     }
 
     /// Whether the file states its unit (else the user gives it one).
@@ -103,6 +106,12 @@ impl Compared {
         let mut rig = (*self.rig).clone();
         rig.unit = Some(unit);
         Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), ..self.clone() }
+    }
+
+    /// The same file read as standing along `up`: another rig to compare.
+    pub fn given_up(&self, up: UpAxis) -> Self {
+        let rig = (*self.rig).clone().restood(self.up, up);
+        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), up, ..self.clone() }
     }
 
     /// The same measured in `unit`, the document's where its file states none.

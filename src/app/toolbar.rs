@@ -12,9 +12,11 @@ use super::pane::{Pane, Visibility};
 use super::panel::Shared;
 use super::text;
 use crate::analysis::Tolerances;
+use crate::diff::standing_apart;
 use crate::eval::SkinningMethod;
 use crate::eval::layers::RotationInterpolation;
-use crate::model::{Choice, ModeChoice, Unit};
+use crate::model::{Choice, ModeChoice, Unit, UpAxis};
+use crate::view::Badge;
 
 /// What the menus and keys ask of the session after the frame (things that replace or step the document).
 #[derive(Debug, Default)]
@@ -304,14 +306,21 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .labelled_by(label.id);
 }
 
-/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in: the
-/// ghost, the dashed curves and the differences follow it.
+/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in, and for
+/// the compared file the axis it stands along where it states none or lies down beside the document: the ghost, the
+/// dashed curves and the differences follow them.
 fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     let Some(compared) = doc.compared.clone() else { return };
     if !compared.states_unit()
         && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
     {
         replace(doc, compared.given_unit(unit));
+    }
+    let apart = standing_apart(&doc.rig, &compared.rig);
+    if (!compared.states_unit() || apart.is_some() || compared.up != UpAxis::Y)
+        && let Some(up) = up_picker(ui, &compared, apart, &doc.title())
+    {
+        replace(doc, compared.given_up(up));
     }
     if doc.rig.unit.is_none()
         && let Some(unit) = unit_picker(ui, &doc.title(), compared.units()[0], &compared.title())
@@ -350,6 +359,31 @@ fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -
         .labelled_by(label.id)
         .on_hover_text(format!("{file} states no unit: the one it is in, to compare it with {other} in one unit"));
     picked.filter(|_| picked != unit)
+}
+
+/// A picker of the axis `compared` stands along, saying where it lies down beside the document (`apart`: the axes
+/// `[the document's, the compared file's]`); the axis picked, if another.
+fn up_picker(ui: &mut egui::Ui, compared: &Compared, apart: Option<[UpAxis; 2]>, document: &str) -> Option<UpAxis> {
+    let file = compared.title();
+    let label = ui.label(format!("up of {file}"));
+    let mut picked = compared.up;
+    egui::ComboBox::from_id_salt(("up", &file))
+        .selected_text(compared.up.id().to_uppercase())
+        .show_ui(ui, |ui| {
+            for &up in UpAxis::ALL {
+                ui.selectable_value(&mut picked, up, up.id().to_uppercase()).on_hover_text(up.description());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text(format!("the axis {file}'s skeleton stands along, where the file does not say (BVH)"));
+    if let Some([ours, theirs]) = apart {
+        let text =
+            format!("lies along {}: {document} stands along {}", theirs.id().to_uppercase(), ours.id().to_uppercase());
+        ui.label(RichText::new(text).color(Badge::NonUniform.color()))
+            .on_hover_text("every difference would measure the turn: pick the axis the file stands along");
+    }
+    (picked != compared.up).then_some(picked)
 }
 
 /// The document compared with `compared` instead.

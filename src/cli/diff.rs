@@ -9,11 +9,11 @@ use clap::Args;
 use super::OutputFormat;
 use super::options::{Distance, choice, clip_index, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
-use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
+use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, diff_files, standing_apart};
 use crate::eval::Setup;
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
-use crate::model::{Choice, ModeChoice, Modes, Rig, Unit};
+use crate::model::{Choice, ModeChoice, Modes, Rig, Unit, UpAxis};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -45,6 +45,13 @@ pub struct DiffArgs {
     /// The second file's unit where the file states none; the second file's lengths are brought into the first's.
     #[arg(long, value_name = "UNIT")]
     pub unit_b: Option<Unit>,
+    /// The axis the first file's skeleton stands along, where the file does not say (BVH) or says wrongly: `z` turns
+    /// a Z-up file (Blender's, 3ds Max's) into bonescope's Y-up space.
+    #[arg(long, value_name = "AXIS", value_parser = choice::<UpAxis>())]
+    pub up_a: Option<UpAxis>,
+    /// The axis the second file's skeleton stands along.
+    #[arg(long, value_name = "AXIS", value_parser = choice::<UpAxis>())]
+    pub up_b: Option<UpAxis>,
     /// How the second file's linear rotation keys are played: `slerp` as glTF says, `nlerp` as a runtime that
     /// keys each quaternion component as a curve of its own (Blender, Unity, Unreal) plays a bake.
     #[arg(long, value_parser = choice::<RotationInterpolation>(), value_name = "MODE", default_value = RotationInterpolation::default().id())]
@@ -61,8 +68,15 @@ pub struct DiffArgs {
 }
 
 pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
-    let rig_a = stated_unit(import::load(&args.a)?, args.unit_a, "--unit-a")?;
-    let rig_b = stated_unit(import::load(&args.b)?, args.unit_b, "--unit-b")?;
+    let stood = |rig: Rig, up: Option<UpAxis>| match up {
+        Some(up) => rig.stood_up(up),
+        None => rig,
+    };
+    let rig_a = stated_unit(stood(import::load(&args.a)?, args.up_a), args.unit_a, "--unit-a")?;
+    let rig_b = stated_unit(stood(import::load(&args.b)?, args.up_b), args.unit_b, "--unit-b")?;
+    if let Some(note) = lying_down(&rig_a, &rig_b) {
+        eprintln!("note: {note}");
+    }
     let chosen = chosen_clips(args, &rig_a, &rig_b)?;
     let [clip_a, clip_b] = chosen.map_or([None, None], |[a, b]| [Some(a), Some(b)]);
     let a = side(&args.a, &rig_a, args.inherit_a, clip_a);
@@ -112,6 +126,20 @@ fn stated_unit(mut rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result
 /// `rig` (read from `path`) under `modes`, its clip `clip` (where chosen), as authored.
 pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, clip: Option<usize>) -> FileSide<'a> {
     FileSide { file: shown(path), rig, setup: Setup { clip, modes: Modes::all(modes), ..Setup::default() } }
+}
+
+/// What to give where one file's skeleton lies down beside the other's.
+fn lying_down(a: &Rig, b: &Rig) -> Option<String> {
+    let [up_a, up_b] = standing_apart(a, b)?;
+    let (side, option, up) = if up_a == UpAxis::Y { ("B", "--up-b", up_b) } else { ("A", "--up-a", up_a) };
+    Some(format!(
+        "A's skeleton stands along {}, B's along {}: every distance measures the turn; if {side} is {}-up, give \
+         {option} {}",
+        up_a.id().to_uppercase(),
+        up_b.id().to_uppercase(),
+        up.id().to_uppercase(),
+        up.id()
+    ))
 }
 
 /// The table of `diff`, saying which units were `given` (`--unit-a`, `--unit-b`).

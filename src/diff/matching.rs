@@ -10,7 +10,7 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use super::DiffError;
-use crate::model::{Clip, Mesh, Rig, Skeleton};
+use crate::model::{Clip, Mesh, Rig, Skeleton, UpAxis};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
 pub const HELPER_SUFFIX: &str = ".stretch";
@@ -202,6 +202,19 @@ pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, 
     let only_a = (0..a.len()).filter(|&i| partner[i].is_none()).collect();
     let only_b = (0..b.len()).filter(|&j| !taken[j]).collect();
     (pairs, only_a, only_b)
+}
+
+/// The axes two rigs stand along at rest, `[A's, B's]`, where they differ: one file's skeleton lies down beside
+/// the other's (a Z-up BVH beside its Y-up glTF), and every distance between them would measure the turn, not the
+/// motion. `None` where they agree or either figure stands along neither Y nor Z clearly.
+pub fn standing_apart(a: &Rig, b: &Rig) -> Option<[UpAxis; 2]> {
+    let standing = |rig: &Rig| {
+        let figure = rig.skeleton.figure();
+        let heads = rig.skeleton.rest_model_matrices().into_iter().enumerate().filter(|&(i, _)| figure[i]);
+        UpAxis::standing(heads.map(|(_, m)| m.w_axis.truncate()))
+    };
+    let (a, b) = (standing(a)?, standing(b)?);
+    (a != b).then_some([a, b])
 }
 
 #[cfg(test)]

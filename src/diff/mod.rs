@@ -23,6 +23,7 @@ mod report;
 
 pub use matching::{
     BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
+    standing_apart,
 };
 pub use report::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
 

@@ -1,5 +1,6 @@
 //! The loaded document: skeleton, clips, skins and meshes, independent of the file format they came from.
 
+mod axes;
 mod choice;
 mod clip;
 mod inherit;
@@ -10,6 +11,7 @@ mod tool;
 mod transform;
 mod unit;
 
+pub use axes::UpAxis;
 pub use choice::Choice;
 pub use clip::{
     BoneTracks, Clip, DEFAULT_FRAME_RATE, Interpolation, KEY_TIME_RESOLUTION, KeyValue, MorphWeights, Track, TrackError,
@@ -24,6 +26,9 @@ pub use tool::Tool;
 pub use transform::{Transform, affine};
 pub(crate) use unit::significant;
 pub use unit::{Unit, UnknownUnit};
+
+/// How a rig's notes say the up axis it was given.
+const UP_NOTE: &str = "axes: given as up along ";
 
 /// Everything bonescope knows about one file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -109,6 +114,29 @@ impl Rig {
             conversion[i] = on_top && outside && self.only_converts(i, &bone.rest);
         }
         conversion
+    }
+
+    /// The rig read as standing along `up` (a file whose axes are not stated, or stated wrongly), turned into
+    /// bonescope's Y-up space above its roots with the file's own placement: every mode is still evaluated in the
+    /// file's space, meshes and skins follow their bones.
+    pub fn stood_up(self, up: UpAxis) -> Rig {
+        self.turned(up.to_y_up(), up)
+    }
+
+    /// The rig, read as standing along `from`, read as standing along `to` instead.
+    pub fn restood(self, from: UpAxis, to: UpAxis) -> Rig {
+        self.turned(to.to_y_up() * from.to_y_up().inverse(), to)
+    }
+
+    fn turned(mut self, turn: glam::DMat4, up: UpAxis) -> Rig {
+        let placement = self.skeleton.placement().clone();
+        let conversion = turn * placement.conversion;
+        self.skeleton = self.skeleton.placed(crate::model::Placement { conversion, ..placement });
+        self.notes.retain(|n| !n.starts_with(UP_NOTE));
+        if up != UpAxis::Y {
+            self.notes.push(format!("{UP_NOTE}{}, turned to Y up", up.id().to_uppercase()));
+        }
+        self
     }
 
     /// Whether `bone` (at `rest`) only converts axes or units, at rest and throughout every clip.
