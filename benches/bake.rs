@@ -65,7 +65,7 @@ fn baking(c: &mut Criterion) {
     benches(c, "locomotions.fbx", &rig, &locomotions, None);
     let folder = tempfile::tempdir().unwrap();
     let file: PathBuf = folder.path().join("generated_200x6000.glb");
-    std::fs::write(&file, generated_gltf::glb()).unwrap();
+    std::fs::write(&file, generated_gltf::glb(generated_gltf::Squashes::Sparse)).unwrap();
     let generated = import::load(&file).unwrap();
     benches(c, "generated_200x6000", &generated, &file, None);
     benches(c, "generated_200x6000_compensate", &generated, &file, Some(InheritMode::SegmentCompensate));

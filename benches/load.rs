@@ -9,6 +9,8 @@
 //! do: glTF and FBX are read from the file as they are parsed, the rest read whole first). The whole-process
 //! comparison with assimp is `benches/compare_assimp.sh`.
 
+// The rig whose every chain squashes is for the benchmarks of `explain`.
+#[allow(dead_code)]
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
 // The repeated mocap walk is for the benchmarks of long clips.
@@ -50,7 +52,10 @@ fn shared_files(c: &mut Criterion) {
 
 fn generated(c: &mut Criterion) {
     let folder = tempfile::tempdir().expect("a temporary folder");
-    for (extension, bytes) in [("glb", generated_gltf::glb()), ("gltf", generated_gltf::gltf_embedded())] {
+    for (extension, bytes) in [
+        ("glb", generated_gltf::glb(generated_gltf::Squashes::Sparse)),
+        ("gltf", generated_gltf::gltf_embedded(generated_gltf::Squashes::Sparse)),
+    ] {
         let path = folder.path().join(format!("generated_200x6000.{extension}"));
         std::fs::write(&path, bytes).expect("the temporary folder is writable");
         load_file(c, &format!("generated_200x6000.{extension}"), &path);
@@ -65,7 +70,8 @@ fn generated_usd(c: &mut Criterion) {
     };
     let folder = tempfile::tempdir().expect("a temporary folder");
     let [glb, data, usdc] = ["glb", "data", "usdc"].map(|e| folder.path().join(format!("generated_200x6000.{e}")));
-    std::fs::write(&glb, generated_gltf::glb()).expect("the temporary folder is writable");
+    std::fs::write(&glb, generated_gltf::glb(generated_gltf::Squashes::Sparse))
+        .expect("the temporary folder is writable");
     write_poses(&import::load(&glb).expect("the generated glTF loads"), &data);
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/support/generated_usd.py");
     let written = Command::new(&python).arg(&script).arg(&usdc).arg(&data).status().expect("python runs");

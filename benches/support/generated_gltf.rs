@@ -6,7 +6,8 @@
 //!
 //! As exporters write them: key times are single precision (`k / 60` rounded to `f32`, which misses the 60 Hz grid
 //! by up to a few microseconds), every sampler shares one time accessor, and each accessor has its own buffer view.
-//! The root walks, and every 25th bone squashes and stretches, so bones below it shear and an analysis has work.
+//! The root walks, and some bones squash and stretch ([`Squashes`]), so bones below them shear and an analysis has
+//! work.
 //! The root also carries a skinned mesh, a small square plate at every joint (loaders such as assimp refuse a file
 //! without one).
 //! Two containers of the same document: [`glb`] (binary, what large files are shipped as) and [`gltf_embedded`]
@@ -30,12 +31,36 @@ pub const FRAME_RATE: f64 = 60.0;
 
 /// Bones per chain: the spine is one, and 19 more hang off the spine's bones in turn.
 const CHAIN: usize = 10;
-/// Every this many bones one squashes and stretches.
-const STRETCHY_EVERY: usize = 25;
+/// Which bones squash and stretch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Squashes {
+    /// Every 25th bone (8 of them): the loading benchmarks' rig, 20 bones flagged.
+    Sparse,
+    /// The fifth bone of every limb (the 19 chains off the spine): a production clip of squash-and-stretch limbs,
+    /// the five bones below each squash flagged (95 in all).
+    EveryLimb,
+}
+
+impl Squashes {
+    fn squashes(self, bone: usize) -> bool {
+        match self {
+            Squashes::Sparse => bone % 25 == 24,
+            Squashes::EveryLimb => bone >= CHAIN && bone % CHAIN == 4,
+        }
+    }
+
+    /// The name the file is written under by `write_generated_gltf`.
+    pub fn file_stem(self) -> &'static str {
+        match self {
+            Squashes::Sparse => "generated_200x6000",
+            Squashes::EveryLimb => "generated_limbs_200x6000",
+        }
+    }
+}
 
 /// The document as binary glTF (`.glb`).
-pub fn glb() -> Vec<u8> {
-    let (root, bin) = document(None);
+pub fn glb(squashes: Squashes) -> Vec<u8> {
+    let (root, bin) = document(None, squashes);
     let json = root.to_vec().expect("the document serializes");
     let glb = Glb {
         header: Header { magic: *b"glTF", version: 2, length: 0 },
@@ -46,19 +71,19 @@ pub fn glb() -> Vec<u8> {
 }
 
 /// The document as JSON glTF (`.gltf`) with its buffer embedded as a base64 `data:` URI.
-pub fn gltf_embedded() -> Vec<u8> {
-    let (_, bin) = document(None);
+pub fn gltf_embedded(squashes: Squashes) -> Vec<u8> {
+    let (_, bin) = document(None, squashes);
     let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(bin));
-    document(Some(uri)).0.to_vec().expect("the document serializes")
+    document(Some(uri), squashes).0.to_vec().expect("the document serializes")
 }
 
 /// The JSON document and its binary buffer; `uri` is the buffer's URI (`None`: the GLB `BIN` chunk).
-fn document(uri: Option<String>) -> (json::Root, Vec<u8>) {
+fn document(uri: Option<String>, squashes: Squashes) -> (json::Root, Vec<u8>) {
     let mut doc = Document { root: json::Root::default(), bin: Vec::new() };
     doc.root.asset.generator = Some("bonescope benches/support/generated_gltf.rs".to_owned());
     let nodes = doc.skeleton();
     doc.skinned_plates(&nodes);
-    doc.animation(&nodes);
+    doc.animation(&nodes, squashes);
     let byte_length = USize64::from(doc.bin.len());
     doc.root.push(json::Buffer { byte_length, name: None, uri, extensions: None, extras: Default::default() });
     (doc.root, doc.bin)
@@ -149,9 +174,9 @@ impl Document {
         root.skin = Some(skin);
     }
 
-    /// One clip: a rotation on every bone, the root's translation, and scale on every [`STRETCHY_EVERY`]th bone,
-    /// all keyed at every frame.
-    fn animation(&mut self, nodes: &[Index<json::Node>]) {
+    /// One clip: a rotation on every bone, the root's translation, and scale on the bones that `squashes`, all keyed
+    /// at every frame.
+    fn animation(&mut self, nodes: &[Index<json::Node>], squashes: Squashes) {
         let times: Vec<f32> = (0..FRAMES).map(|k| time(k) as f32).collect();
         let (first, last) = (times[0], times[FRAMES - 1]);
         let input = self.accessor(&times, Type::Scalar, Some((Value::from(vec![first]), Value::from(vec![last]))));
@@ -181,7 +206,7 @@ impl Document {
         for (bone, &node) in nodes.iter().enumerate() {
             let rotations: Vec<f32> = (0..FRAMES).flat_map(|k| rotation(bone, time(k))).collect();
             channel(node, Property::Rotation, self.accessor(&rotations, Type::Vec4, None));
-            if bone % STRETCHY_EVERY == STRETCHY_EVERY - 1 {
+            if squashes.squashes(bone) {
                 let scales: Vec<f32> = (0..FRAMES).flat_map(|k| squash(bone, time(k))).collect();
                 channel(node, Property::Scale, self.accessor(&scales, Type::Vec3, None));
             }

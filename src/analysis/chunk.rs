@@ -15,7 +15,7 @@ use super::request::{CurveRequest, Judged, ScanOptions};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, BonesEvaluator, Chains, Evaluation, Hierarchy};
 use crate::math::{decompose_near, decompose_with_stretch};
-use crate::model::{BoneTracks, Clip, InheritMode, Skeleton, Transform};
+use crate::model::{BoneTracks, Clip, InheritMode, Transform};
 
 /// What the workers need to know about the evaluation, found once per analysis.
 pub(super) struct Plan<'a> {
@@ -65,11 +65,11 @@ impl<'a> Plan<'a> {
             length_scales: skeleton.length_scales().to_vec(),
             varying_scale: varying(|t| t.scale.as_ref().is_some_and(|s| !s.is_constant())),
             varying_rotation: varying(|t| t.rotation.as_ref().is_some_and(|r| !r.is_constant())),
-            modelled: with_ancestors(skeleton, plotted),
+            modelled: skeleton.with_ancestors(plotted),
             judged: match judged {
                 Judged::Every => (0..skeleton.len()).collect(),
-                Judged::CurveChains => with_ancestors(skeleton, plotted),
-                Judged::Subtree(top) => with_ancestors(skeleton, &skeleton.subtree(top)),
+                Judged::CurveChains => skeleton.with_ancestors(plotted),
+                Judged::Subtree(top) => skeleton.with_ancestors(&skeleton.subtree(top)),
             },
         }
     }
@@ -323,17 +323,4 @@ impl<'a> Plotter<'a> {
             local_curve[sample] = Components::of_matrix(&local[bone].matrix(), DQuat::IDENTITY);
         }
     }
-}
-
-/// `bones` and all their ancestors, sorted (so parents come first).
-pub(super) fn with_ancestors(skeleton: &Skeleton, bones: &[usize]) -> Vec<usize> {
-    let mut wanted = vec![false; skeleton.len()];
-    for &bone in bones.iter().filter(|&&b| b < skeleton.len()) {
-        let mut next = Some(bone);
-        while let Some(b) = next.filter(|&b| !wanted[b]) {
-            wanted[b] = true;
-            next = skeleton.parent(b);
-        }
-    }
-    (0..skeleton.len()).filter(|&b| wanted[b]).collect()
 }

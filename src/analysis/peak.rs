@@ -5,7 +5,6 @@
 use glam::DQuat;
 use rayon::prelude::*;
 
-use super::chunk::with_ancestors;
 use super::clip_analysis::BoneSummary;
 use super::findings::Judge;
 use super::stretch::Stretch;
@@ -110,7 +109,7 @@ fn vertex_gain(p: f64, v: f64, n: f64) -> f64 {
 pub(super) fn refine(evaluation: &Evaluation, times: &[f64], summaries: &mut [BoneSummary], judge: &Judge) {
     let seen = |s: &&mut BoneSummary| judge.sees_shear(s.worst_shear_cosine_squared);
     summaries.par_iter_mut().filter(seen).for_each(|summary| {
-        let chain = with_ancestors(evaluation.skeleton(), &[summary.index]);
+        let chain = evaluation.skeleton().with_ancestors(&[summary.index]);
         let mut evaluator = BonesEvaluator::new(evaluation, &chain);
         let mut verdict = |time: f64| {
             let model = &evaluator.evaluate(time).model.model[summary.index];

@@ -30,9 +30,9 @@ pub use report::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
-use crate::eval::{Evaluation, Evaluator, over_runs};
+use crate::eval::{BonesEvaluator, Evaluation, over_runs, skin_vertices_with};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
-use crate::model::{MAX_FRAMES, sample_times};
+use crate::model::{MAX_FRAMES, Rig, sample_times};
 
 /// How many times a second two evaluations are compared between their keys, unless a user says otherwise.
 pub const DEFAULT_RATE: f64 = 60.0;
@@ -142,7 +142,23 @@ impl MeshDifference {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Pairs {
     pub bones: BoneMatching,
-    pub meshes: Vec<(usize, usize)>,
+    pub meshes: Vec<MeshPair>,
+}
+
+/// A mesh of A and its partner in B (the same vertex count), and the vertices compared: every one (`None`), or
+/// those a comparison knows may differ (`explain`'s of a change below one bone: the vertices weighted to its
+/// subtree), the only ones skinned.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshPair {
+    pub a: usize,
+    pub b: usize,
+    pub vertices: Option<Vec<u32>>,
+}
+
+impl MeshPair {
+    fn whole((a, b): (usize, usize)) -> Self {
+        MeshPair { a, b, vertices: None }
+    }
 }
 
 impl Pairs {
@@ -158,20 +174,23 @@ impl Pairs {
             shown_a[i] = shown;
             shown_b[j] = shown;
         }
-        let (meshes_a, meshes_b): (Vec<usize>, Vec<usize>) = self.meshes.iter().copied().unzip();
+        let (meshes_a, meshes_b): (Vec<usize>, Vec<usize>) = self.meshes.iter().map(|m| (m.a, m.b)).unzip();
         a.size_of(times, &shown_a, &meshes_a).max(b.size_of(times, &shown_b, &meshes_b))
     }
 
     /// Bones by name and meshes by name and vertex count.
     pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
         let bones = match_bones(a.rig, b.rig);
-        Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) }
+        Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect() }
     }
 
     /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones.
     pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
         let bones = match_bones_mapped(a.rig, b.rig, map)?;
-        Ok(Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes) })
+        Ok(Pairs {
+            bones,
+            meshes: match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect(),
+        })
     }
 }
 
@@ -246,14 +265,21 @@ pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f
 pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f64], rig_size: f64) -> Vec<Comparison> {
     let probe_length = rig_size * PROBE_FRACTION;
     let fresh = || sides.iter().map(|&(b, pairs)| Differences::new(a, b, pairs)).collect::<Vec<_>>();
+    let plan_a = Plan::new(
+        a,
+        sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0)),
+        sides.iter().flat_map(|(_, pairs)| pairs.meshes.iter().map(|m| (m.a, m.vertices.as_deref()))),
+    );
+    let plans: Vec<Plan> = sides
+        .iter()
+        .map(|&(b, pairs)| {
+            let meshes = pairs.meshes.iter().map(|m| (m.b, m.vertices.as_deref()));
+            Plan::new(b, pairs.bones.pairs.iter().map(|p| p.1), meshes)
+        })
+        .collect();
     let runs = over_runs(times, |run| {
-        let bones_a = sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0));
-        let meshes_a = sides.iter().flat_map(|(_, pairs)| pairs.meshes.iter().map(|p| p.0));
-        let mut side_a = Side::new(a, bones_a, meshes_a);
-        let mut others: Vec<Side> = sides
-            .iter()
-            .map(|&(b, pairs)| Side::new(b, pairs.bones.pairs.iter().map(|p| p.1), pairs.meshes.iter().map(|p| p.1)))
-            .collect();
+        let mut side_a = Side::new(a, &plan_a);
+        let mut others: Vec<Side> = sides.iter().zip(&plans).map(|(&(b, _), plan)| Side::new(b, plan)).collect();
         let mut differences = fresh();
         for &time in run {
             side_a.evaluate(time);
@@ -279,6 +305,8 @@ pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f6
 struct Differences {
     bones: Vec<BoneDifference>,
     meshes: Vec<MeshDifference>,
+    /// Per mesh pair, the vertices compared (every one for `None`).
+    compared: Vec<Option<Vec<u32>>>,
 }
 
 impl Differences {
@@ -286,30 +314,24 @@ impl Differences {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
         let bones =
             pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
-        let meshes = pairs.meshes.iter().map(|&(i, j)| {
-            let mesh = &a.rig.meshes[i];
+        let meshes = pairs.meshes.iter().map(|pair| {
+            let mesh = &a.rig.meshes[pair.a];
             let (distance, sum) = (Extreme::default(), 0.0);
-            MeshDifference {
-                a: i,
-                b: j,
-                name: mesh.name.clone(),
-                vertices: mesh.positions.len(),
-                distance,
-                mean: 0.0,
-                sum,
-            }
+            let vertices = pair.vertices.as_ref().map_or(mesh.positions.len(), Vec::len);
+            MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
-        Differences { bones: bones.collect(), meshes: meshes.collect() }
+        let compared = pairs.meshes.iter().map(|pair| pair.vertices.clone()).collect();
+        Differences { bones: bones.collect(), meshes: meshes.collect(), compared }
     }
 
     fn merge(self, later: Differences) -> Self {
         let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
         let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
-        Differences { bones, meshes }
+        Differences { bones, meshes, compared: self.compared }
     }
 
     fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
-        let (model_a, model_b) = (&a.evaluator.pose.model.model, &b.evaluator.pose.model.model);
+        let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
@@ -320,59 +342,132 @@ impl Differences {
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
         }
-        for difference in &mut self.meshes {
+        for (difference, compared) in self.meshes.iter_mut().zip(&self.compared) {
             let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
             let mut largest: f64 = 0.0;
-            for (p, q) in va.iter().zip(vb) {
+            let mut add = |p: &DVec3, q: &DVec3| {
                 let d = p.distance(*q);
                 largest = largest.max(d);
                 difference.sum += d;
+            };
+            match compared {
+                Some(vertices) => vertices.iter().map(|&v| v as usize).for_each(|v| add(&va[v], &vb[v])),
+                None => va.iter().zip(vb).for_each(|(p, q)| add(p, q)),
             }
             difference.distance.add(largest, time);
         }
     }
 }
 
-/// One side of a comparison as one thread evaluates it, one time after another: its pose, the polar parts of the
-/// bones compared (the identity's elsewhere) and the meshes compared, skinned (by mesh index; empty elsewhere).
-struct Side<'e, 'a> {
-    evaluator: Evaluator<'e, 'a>,
-    /// Sorted, each once.
+/// What one side of a comparison evaluates at each time, found once: the bones compared (sorted, each once), the
+/// meshes compared with the vertices to skin (every one for `None`), and the bones that takes: those bones, the
+/// bones the meshes hang from and the joints of those vertices, with every ancestor; every bone where a compared
+/// mesh has morph targets, whose weights only whole poses carry.
+struct Plan<'p> {
     bones: Vec<usize>,
-    meshes: Vec<usize>,
-    /// The bones' parts, their scale factors the authored ones ([`Evaluation::length_scales`]): a change of units
-    /// moves positions, not scale factors.
+    meshes: Vec<(usize, Option<Vec<u32>>)>,
+    needed: Vec<usize>,
+    evaluation: &'p Evaluation<'p>,
+}
+
+impl<'p> Plan<'p> {
+    fn new<'v>(
+        evaluation: &'p Evaluation<'p>,
+        bones: impl Iterator<Item = usize>,
+        meshes: impl Iterator<Item = (usize, Option<&'v [u32]>)>,
+    ) -> Self {
+        let mut bones: Vec<usize> = bones.collect();
+        bones.sort_unstable();
+        bones.dedup();
+        let meshes = union_of_vertices(meshes);
+        let rig = evaluation.rig;
+        let morphs = meshes.iter().any(|(m, _)| !rig.meshes[*m].morph_targets.is_empty());
+        let needed = if morphs {
+            (0..rig.skeleton.len()).collect()
+        } else {
+            let joints = meshes.iter().flat_map(|(m, vertices)| mesh_bones(rig, *m, vertices.as_deref()));
+            rig.skeleton.with_ancestors(&bones.iter().copied().chain(joints).collect::<Vec<_>>())
+        };
+        Plan { bones, meshes, needed, evaluation }
+    }
+}
+
+/// Each mesh once, with the union of the vertices asked for (every one where any asks for every one).
+fn union_of_vertices<'v>(meshes: impl Iterator<Item = (usize, Option<&'v [u32]>)>) -> Vec<(usize, Option<Vec<u32>>)> {
+    let mut union: Vec<(usize, Option<Vec<u32>>)> = Vec::new();
+    for (mesh, vertices) in meshes {
+        match union.iter_mut().find(|(m, _)| *m == mesh) {
+            Some((_, slot)) => match (slot.as_mut(), vertices) {
+                (Some(all), Some(more)) => all.extend_from_slice(more),
+                _ => *slot = None,
+            },
+            None => union.push((mesh, vertices.map(<[u32]>::to_vec))),
+        }
+    }
+    for (_, vertices) in &mut union {
+        if let Some(list) = vertices {
+            list.sort_unstable();
+            list.dedup();
+        }
+    }
+    union
+}
+
+/// The bones mesh `mesh` of `rig` moves with at `vertices` (every vertex for `None`): the bone it hangs from and the
+/// joints those vertices are weighted to.
+fn mesh_bones<'r>(rig: &'r Rig, mesh: usize, vertices: Option<&'r [u32]>) -> impl Iterator<Item = usize> + 'r {
+    let mesh = &rig.meshes[mesh];
+    let joints = mesh.skin.and_then(|s| rig.skins.get(s)).map_or(&[][..], |skin| &skin.joints[..]);
+    let all = 0..mesh.joints.len() as u32;
+    let chosen: Box<dyn Iterator<Item = u32> + 'r> = match vertices {
+        Some(list) => Box::new(list.iter().copied()),
+        None => Box::new(all),
+    };
+    let weighted =
+        chosen.filter_map(move |v| Some(mesh.joints.get(v as usize)?.iter().zip(mesh.weights.get(v as usize)?)));
+    let bones =
+        weighted.flatten().filter(|(_, w)| **w > 0.0).filter_map(move |(&j, _)| joints.get(usize::from(j)).copied());
+    std::iter::once(mesh.bone).chain(bones)
+}
+
+/// One side of a comparison as one thread evaluates it, one time after another: the bones its [`Plan`] needs, the
+/// polar parts of the bones compared (the identity's elsewhere) and the meshes compared, skinned where asked (by
+/// mesh index; empty elsewhere).
+struct Side<'e, 'a> {
+    evaluator: BonesEvaluator<'e, 'a>,
+    plan: &'e Plan<'a>,
     parts: Vec<AffineParts>,
     length_scales: Vec<f64>,
     skinned: Vec<Vec<DVec3>>,
 }
 
 impl<'e, 'a> Side<'e, 'a> {
-    fn new(
-        evaluation: &'e Evaluation<'a>,
-        bones: impl Iterator<Item = usize>,
-        meshes: impl Iterator<Item = usize>,
-    ) -> Self {
-        let distinct = |items: &mut Vec<usize>| {
-            items.sort_unstable();
-            items.dedup();
-        };
-        let (mut bones, mut meshes): (Vec<usize>, Vec<usize>) = (bones.collect(), meshes.collect());
-        distinct(&mut bones);
-        distinct(&mut meshes);
+    fn new(evaluation: &'e Evaluation<'a>, plan: &'e Plan<'a>) -> Self {
         let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
         let length_scales = evaluation.length_scales();
-        Side { evaluator: evaluation.evaluator(), bones, meshes, parts: Vec::new(), length_scales, skinned }
+        let evaluator = BonesEvaluator::new(evaluation, &plan.needed);
+        Side { evaluator, plan, parts: Vec::new(), length_scales, skinned }
     }
 
     /// Evaluates the side at `time`.
     fn evaluate(&mut self, time: f64) {
-        self.parts = decompose_bones(&self.evaluator.evaluate(time).model.model, &self.bones);
-        for &bone in &self.bones {
+        let pose = self.evaluator.evaluate(time);
+        self.parts = decompose_bones(&pose.model.model, &self.plan.bones);
+        for &bone in &self.plan.bones {
             self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
         }
-        for &mesh in &self.meshes {
-            self.evaluator.evaluation().skin(&self.evaluator.pose, mesh, &mut self.skinned[mesh]);
+        let evaluation = self.plan.evaluation;
+        let (rig, method) = (evaluation.rig, evaluation.skinning);
+        for (mesh, vertices) in &self.plan.meshes {
+            let posed = (&pose.model.model[..], &pose.morph);
+            skin_vertices_with(
+                &rig.meshes[*mesh],
+                &rig.skins,
+                posed,
+                method,
+                vertices.as_deref(),
+                &mut self.skinned[*mesh],
+            );
         }
     }
 }

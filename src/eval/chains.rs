@@ -57,4 +57,12 @@ impl<'e, 'a> BonesEvaluator<'e, 'a> {
             BonesEvaluator::Whole(evaluator) => evaluator.evaluate(time),
         }
     }
+
+    /// The pose last evaluated.
+    pub fn pose(&self) -> &Pose {
+        match self {
+            BonesEvaluator::Chains(chains, _) => &chains.pose,
+            BonesEvaluator::Whole(evaluator) => &evaluator.pose,
+        }
+    }
 }

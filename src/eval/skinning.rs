@@ -103,29 +103,53 @@ pub fn skin_positions_with(
     out: &mut Vec<DVec3>,
 ) {
     out.clear();
+    skin_vertices_with(mesh, skins, (model, morph), method, None, out);
+}
+
+/// [`skin_positions_with`] of the vertices `vertices` only (every one for `None`): `out` holds a position per
+/// vertex, those not asked for left as they were (a comparison that knows they cannot move skins only the others).
+/// `model` need only be meaningful at the joints of the vertices asked for.
+pub fn skin_vertices_with(
+    mesh: &Mesh,
+    skins: &[Skin],
+    (model, morph): (&[DMat4], &MorphPose),
+    method: Method,
+    vertices: Option<&[u32]>,
+    out: &mut Vec<DVec3>,
+) {
     let positions = morph.positions(mesh);
+    out.resize(positions.len(), DVec3::ZERO);
+    let each = |visit: &mut dyn FnMut(usize)| match vertices {
+        Some(list) => list.iter().map(|&v| v as usize).filter(|&v| v < positions.len()).for_each(visit),
+        None => (0..positions.len()).for_each(visit),
+    };
     let skin = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == positions.len());
     let Some(skin) = skin else {
         let placement = model[mesh.bone];
-        out.extend(positions.iter().map(|p| placement.transform_point3(p.as_dvec3())));
+        each(&mut |v| out[v] = placement.transform_point3(positions[v].as_dvec3()));
         return;
     };
     let mut joints = Vec::with_capacity(skin.joints.len());
     joint_matrices(skin, model, &mut joints);
     let any_dq = (0..positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
     let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
-    for (v, ((position, indices), weights)) in positions.iter().zip(&mesh.joints).zip(&mesh.weights).enumerate() {
-        let p = position.as_dvec3();
-        let influences =
-            indices.iter().zip(weights).filter(|(_, w)| **w != 0.0).map(|(&j, &w)| (usize::from(j), f64::from(w)));
+    each(&mut |v| {
+        // Weights as long as the joints (importers check): a shorter list skins the vertices it covers.
+        let Some(weights) = mesh.weights.get(v) else { return };
+        let p = positions[v].as_dvec3();
+        let influences = mesh.joints[v]
+            .iter()
+            .zip(weights)
+            .filter(|(_, w)| **w != 0.0)
+            .map(|(&j, &w)| (usize::from(j), f64::from(w)));
         let dq = method.dq_weight(mesh, v);
         let linear = || influences.clone().map(|(j, w)| joints[j].transform_point3(p) * w).sum::<DVec3>();
-        out.push(match dq {
+        out[v] = match dq {
             0.0 => linear(),
             1.0 => dual_quaternion(&rigid, influences, p),
             d => linear() * (1.0 - d) + dual_quaternion(&rigid, influences, p) * d,
-        });
-    }
+        };
+    });
 }
 
 /// A joint matrix split for dual-quaternion blending: rotation `R`, the dual part `½·t·R`, and the stretch `Rᵀ·A`.

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Request, Strategy};
-use crate::diff::{Comparison, Extreme, Pairs, compare_at_size, compare_each, comparison_times};
+use crate::diff::{Comparison, Extreme, MeshPair, Pairs, compare_at_size, compare_each, comparison_times};
 use crate::eval::{Evaluation, Setup};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
@@ -216,12 +216,14 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones that change and the
-    /// meshes that follow them (nothing else differs).
+    /// vertices that follow them (nothing else differs).
     fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
         let changed = self.changed(change);
         let mut pairs = Pairs::by_name(self.source, fixed);
         pairs.bones.pairs.retain(|&(a, _)| changed(a));
-        pairs.meshes.retain(|&(a, _)| follows(self.source.rig, a).any(&changed));
+        let moving =
+            |pair: MeshPair| Some(MeshPair { vertices: following(self.source.rig, pair.a, &changed)?, ..pair });
+        pairs.meshes = pairs.meshes.into_iter().filter_map(moving).collect();
         pairs
     }
 
@@ -262,13 +264,19 @@ impl Applied {
     }
 }
 
-/// The bones mesh `mesh` of `rig` may move with: the bone it hangs from, and every joint a vertex is weighted to.
-fn follows(rig: &Rig, mesh: usize) -> impl Iterator<Item = usize> + '_ {
+/// The vertices of mesh `mesh` of `rig` that move where the bones `changed` says do: `None` for none, `Some(None)`
+/// for every one (a mesh that hangs from a changed bone, unskinned), else those weighted to a changed joint.
+fn following(rig: &Rig, mesh: usize, changed: impl Fn(usize) -> bool) -> Option<Option<Vec<u32>>> {
     let mesh = &rig.meshes[mesh];
-    let joints = mesh.skin.and_then(|s| rig.skins.get(s)).map_or(&[][..], |skin| &skin.joints[..]);
-    let weighted = mesh.joints.iter().zip(&mesh.weights).flat_map(|(js, ws)| js.iter().zip(ws));
-    let bones = weighted.filter(|(_, w)| **w > 0.0).filter_map(|(&j, _)| joints.get(usize::from(j)).copied());
-    std::iter::once(mesh.bone).chain(bones)
+    let skin = mesh.skin.and_then(|s| rig.skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len());
+    let Some(skin) = skin else {
+        return changed(mesh.bone).then_some(None);
+    };
+    let moves = |(&j, &w): (&u16, &f32)| w > 0.0 && skin.joints.get(usize::from(j)).is_some_and(|&b| changed(b));
+    let weighted = mesh.joints.iter().zip(&mesh.weights).enumerate();
+    let vertices: Vec<u32> =
+        weighted.filter(|(_, (js, ws))| js.iter().zip(ws.iter()).any(moves)).map(|(v, _)| v as u32).collect();
+    (!vertices.is_empty()).then_some(Some(vertices))
 }
 
 /// One fix for one bone.

@@ -309,6 +309,19 @@ impl Skeleton {
         chain
     }
 
+    /// `bones` (those in range) and every ancestor of each, once each, parents first.
+    pub fn with_ancestors(&self, bones: &[usize]) -> Vec<usize> {
+        let mut wanted = vec![false; self.len()];
+        for &bone in bones.iter().filter(|&&b| b < self.len()) {
+            let mut next = Some(bone);
+            while let Some(b) = next.filter(|&b| !wanted[b]) {
+                wanted[b] = true;
+                next = self.parent(b);
+            }
+        }
+        (0..self.len()).filter(|&b| wanted[b]).collect()
+    }
+
     /// `top` and every bone below it, in bone order.
     pub fn subtree(&self, top: usize) -> Vec<usize> {
         // Parents come first, so one pass in order finds them all.
