@@ -143,6 +143,18 @@ impl MeshDifference {
 pub struct Pairs {
     pub bones: BoneMatching,
     pub meshes: Vec<MeshPair>,
+    pub measure: Measure,
+}
+
+/// What a comparison measures of each pair of bones.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Measure {
+    /// Distances (positions and probes) and the polar parts' differences (orientation, scale, stretch).
+    #[default]
+    Everything,
+    /// Distances alone (what a change costs, [`crate::explain`]): no polar decomposition, the parts' differences
+    /// left at none.
+    Distances,
 }
 
 /// A mesh of A and its partner in B (the same vertex count), and the vertices compared: every one (`None`), or
@@ -181,16 +193,15 @@ impl Pairs {
     /// Bones by name and meshes by name and vertex count.
     pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
         let bones = match_bones(a.rig, b.rig);
-        Pairs { bones, meshes: match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect() }
+        let meshes = match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect();
+        Pairs { bones, meshes, measure: Measure::Everything }
     }
 
     /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones.
     pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
         let bones = match_bones_mapped(a.rig, b.rig, map)?;
-        Ok(Pairs {
-            bones,
-            meshes: match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect(),
-        })
+        let meshes = match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect();
+        Ok(Pairs { bones, meshes, measure: Measure::Everything })
     }
 }
 
@@ -269,12 +280,13 @@ pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f6
         a,
         sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0)),
         sides.iter().flat_map(|(_, pairs)| pairs.meshes.iter().map(|m| (m.a, m.vertices.as_deref()))),
+        sides.iter().any(|(_, pairs)| pairs.measure == Measure::Everything),
     );
     let plans: Vec<Plan> = sides
         .iter()
         .map(|&(b, pairs)| {
             let meshes = pairs.meshes.iter().map(|m| (m.b, m.vertices.as_deref()));
-            Plan::new(b, pairs.bones.pairs.iter().map(|p| p.1), meshes)
+            Plan::new(b, pairs.bones.pairs.iter().map(|p| p.1), meshes, pairs.measure == Measure::Everything)
         })
         .collect();
     let runs = over_runs(times, |run| {
@@ -307,6 +319,7 @@ struct Differences {
     meshes: Vec<MeshDifference>,
     /// Per mesh pair, the vertices compared (every one for `None`).
     compared: Vec<Option<Vec<u32>>>,
+    measure: Measure,
 }
 
 impl Differences {
@@ -321,23 +334,26 @@ impl Differences {
             MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
         let compared = pairs.meshes.iter().map(|pair| pair.vertices.clone()).collect();
-        Differences { bones: bones.collect(), meshes: meshes.collect(), compared }
+        Differences { bones: bones.collect(), meshes: meshes.collect(), compared, measure: pairs.measure }
     }
 
     fn merge(self, later: Differences) -> Self {
         let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
         let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
-        Differences { bones, meshes, compared: self.compared }
+        Differences { bones, meshes, compared: self.compared, measure: self.measure }
     }
 
     fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
         let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
-            let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
             let probe = probe_distance(wa, wb, probe_length).max(probe_distance(wb, wa, probe_length));
             difference.probe.add(probe, time);
+            if self.measure == Measure::Distances {
+                continue;
+            }
+            let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
             difference.orientation_deg.add(angle_between(pa.rotation, pb.rotation).to_degrees(), time);
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
@@ -362,9 +378,10 @@ impl Differences {
 /// What one side of a comparison evaluates at each time, found once: the bones compared (sorted, each once), the
 /// meshes compared with the vertices to skin (every one for `None`), and the bones that takes: those bones, the
 /// bones the meshes hang from and the joints of those vertices, with every ancestor; every bone where a compared
-/// mesh has morph targets, whose weights only whole poses carry.
+/// mesh has morph targets, whose weights only whole poses carry; and whether the bones' polar parts are wanted.
 struct Plan<'p> {
     bones: Vec<usize>,
+    decompose: bool,
     meshes: Vec<(usize, Option<Vec<u32>>)>,
     needed: Vec<usize>,
     evaluation: &'p Evaluation<'p>,
@@ -375,6 +392,7 @@ impl<'p> Plan<'p> {
         evaluation: &'p Evaluation<'p>,
         bones: impl Iterator<Item = usize>,
         meshes: impl Iterator<Item = (usize, Option<&'v [u32]>)>,
+        decompose: bool,
     ) -> Self {
         let mut bones: Vec<usize> = bones.collect();
         bones.sort_unstable();
@@ -388,7 +406,7 @@ impl<'p> Plan<'p> {
             let joints = meshes.iter().flat_map(|(m, vertices)| mesh_bones(rig, *m, vertices.as_deref()));
             rig.skeleton.with_ancestors(&bones.iter().copied().chain(joints).collect::<Vec<_>>())
         };
-        Plan { bones, meshes, needed, evaluation }
+        Plan { bones, decompose, meshes, needed, evaluation }
     }
 }
 
@@ -413,11 +431,13 @@ fn union_of_vertices<'v>(meshes: impl Iterator<Item = (usize, Option<&'v [u32]>)
     union
 }
 
-/// The bones mesh `mesh` of `rig` moves with at `vertices` (every vertex for `None`): the bone it hangs from and the
-/// joints those vertices are weighted to.
+/// The bones mesh `mesh` of `rig` moves with at `vertices` (every vertex for `None`): the bone it hangs from, the
+/// node its skin follows, and the joints those vertices are weighted to.
 fn mesh_bones<'r>(rig: &'r Rig, mesh: usize, vertices: Option<&'r [u32]>) -> impl Iterator<Item = usize> + 'r {
     let mesh = &rig.meshes[mesh];
-    let joints = mesh.skin.and_then(|s| rig.skins.get(s)).map_or(&[][..], |skin| &skin.joints[..]);
+    let skin = mesh.skin.and_then(|s| rig.skins.get(s));
+    let joints = skin.map_or(&[][..], |skin| &skin.joints[..]);
+    let node = skin.and_then(|skin| skin.node_bind).map(|node| node.bone);
     let all = 0..mesh.joints.len() as u32;
     let chosen: Box<dyn Iterator<Item = u32> + 'r> = match vertices {
         Some(list) => Box::new(list.iter().copied()),
@@ -427,7 +447,7 @@ fn mesh_bones<'r>(rig: &'r Rig, mesh: usize, vertices: Option<&'r [u32]>) -> imp
         chosen.filter_map(move |v| Some(mesh.joints.get(v as usize)?.iter().zip(mesh.weights.get(v as usize)?)));
     let bones =
         weighted.flatten().filter(|(_, w)| **w > 0.0).filter_map(move |(&j, _)| joints.get(usize::from(j)).copied());
-    std::iter::once(mesh.bone).chain(bones)
+    std::iter::once(mesh.bone).chain(node).chain(bones)
 }
 
 /// One side of a comparison as one thread evaluates it, one time after another: the bones its [`Plan`] needs, the
@@ -452,9 +472,11 @@ impl<'e, 'a> Side<'e, 'a> {
     /// Evaluates the side at `time`.
     fn evaluate(&mut self, time: f64) {
         let pose = self.evaluator.evaluate(time);
-        self.parts = decompose_bones(&pose.model.model, &self.plan.bones);
-        for &bone in &self.plan.bones {
-            self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
+        if self.plan.decompose {
+            self.parts = decompose_bones(&pose.model.model, &self.plan.bones);
+            for &bone in &self.plan.bones {
+                self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
+            }
         }
         let evaluation = self.plan.evaluation;
         let (rig, method) = (evaluation.rig, evaluation.skinning);

@@ -74,15 +74,21 @@ impl Method {
 /// `W_j · IBM_j` for every joint of `skin`, from the model matrices of all bones; premultiplied by the mesh node's
 /// motion since the bind where the skin follows its node ([`crate::model::NodeBind`]).
 pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
+    joint_matrices_of(skin, model, None, out);
+}
+
+/// [`joint_matrices`] of the joints `used` marks (every one for `None`; the identity elsewhere).
+fn joint_matrices_of(skin: &Skin, model: &[DMat4], used: Option<&[bool]>, out: &mut Vec<DMat4>) {
     out.clear();
-    let joints = skin.joints.iter().zip(&skin.inverse_bind).map(|(&bone, ibm)| model[bone] * *ibm);
-    match skin.node_bind {
-        Some(node) => {
-            let moved = model[node.bone] * node.inverse_bind;
-            out.extend(joints.map(|joint| moved * joint));
+    let moved = skin.node_bind.map(|node| model[node.bone] * node.inverse_bind);
+    let joints = skin.joints.iter().zip(&skin.inverse_bind).enumerate().map(|(j, (&bone, ibm))| {
+        if used.is_some_and(|used| !used.get(j).copied().unwrap_or(false)) {
+            return DMat4::IDENTITY;
         }
-        None => out.extend(joints),
-    }
+        let joint = model[bone] * *ibm;
+        moved.map_or(joint, |moved| moved * joint)
+    });
+    out.extend(joints);
 }
 
 /// The positions of `mesh` in model space, given the model matrices of all bones (`out` is reused), skinned as the
@@ -129,8 +135,21 @@ pub fn skin_vertices_with(
         each(&mut |v| out[v] = placement.transform_point3(positions[v].as_dvec3()));
         return;
     };
+    // Only the joints of the vertices asked for: a few vertices of a big skin need a few of its joints.
+    let used = vertices.map(|list| {
+        let mut used = vec![false; skin.joints.len()];
+        for v in list.iter().map(|&v| v as usize).filter(|&v| v < positions.len()) {
+            let weighted = mesh.joints[v].iter().zip(mesh.weights.get(v).into_iter().flatten());
+            for (&j, _) in weighted.filter(|(_, w)| **w != 0.0) {
+                if let Some(slot) = used.get_mut(usize::from(j)) {
+                    *slot = true;
+                }
+            }
+        }
+        used
+    });
     let mut joints = Vec::with_capacity(skin.joints.len());
-    joint_matrices(skin, model, &mut joints);
+    joint_matrices_of(skin, model, used.as_deref(), &mut joints);
     let any_dq = (0..positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
     let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
     each(&mut |v| {

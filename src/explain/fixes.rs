@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Request, Strategy};
-use crate::diff::{Comparison, Extreme, MeshPair, Pairs, compare_at_size, compare_each, comparison_times};
+use crate::diff::{Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, comparison_times};
 use crate::eval::{Evaluation, Setup};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
@@ -170,7 +170,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the
     /// changed bones and the meshes that follow them (nothing else differs).
     pub fn cost(&self, change: Change, applied: &Applied) -> Result<Cost, String> {
-        self.cost_at(change, applied, 1)
+        self.cost_at(change, applied.baked.as_ref(), 1)
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
@@ -199,18 +199,24 @@ impl<'e, 'a> Baseline<'e, 'a> {
 
     /// A lower bound of [`Baseline::cost`] for a fraction of the work: the same comparison at every
     /// of about [`BOUND_TIMES`] evenly spread times only (a largest distance over fewer times is never larger).
-    pub fn cost_bound(&self, change: Change, applied: &Applied) -> Result<f64, String> {
+    /// Needs the change made only for a bake (`baked`: the rig it writes); any other change is evaluated from its
+    /// setup alone, before it is scanned.
+    pub fn cost_bound(&self, change: Change, baked: Option<&Rig>) -> Result<f64, String> {
         let stride = (self.times.len() / BOUND_TIMES).max(1);
-        Ok(self.cost_at(change, applied, stride)?.distance.max)
+        Ok(self.cost_at(change, baked, stride)?.distance.max)
     }
 
-    /// The cost of `change` compared at every `stride`th time.
-    fn cost_at(&self, change: Change, applied: &Applied, stride: usize) -> Result<Cost, String> {
-        let fixed = self.fixed(change, applied.baked.as_ref())?;
+    /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time.
+    fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize) -> Result<Cost, String> {
+        let fixed = self.fixed(change, baked)?;
         let pairs = self.pairs(change, &fixed);
-        let times = comparison_times(self.source, &fixed, self.options.rate);
-        // A change that keeps the clip's times (any but a bake) keeps the size found once.
-        let size = if times == self.times { self.size } else { self.source.size(&times) };
+        // A mode keeps the clip and its layers, so their times and size, found once; a layer or a bake may not.
+        let own_times = match change {
+            Change::Mode { .. } => None,
+            _ => Some(comparison_times(self.source, &fixed, self.options.rate)),
+        };
+        let times = own_times.as_deref().unwrap_or(&self.times);
+        let size = if times == self.times { self.size } else { self.source.size(times) };
         let compared: Vec<f64> = times.iter().copied().step_by(stride).collect();
         Ok(self.visible(&compare_at_size(self.source, &fixed, &pairs, &compared, size)))
     }
@@ -219,7 +225,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// vertices that follow them (nothing else differs).
     fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
         let changed = self.changed(change);
-        let mut pairs = Pairs::by_name(self.source, fixed);
+        let mut pairs = Pairs { measure: Measure::Distances, ..Pairs::by_name(self.source, fixed) };
         pairs.bones.pairs.retain(|&(a, _)| changed(a));
         let moving =
             |pair: MeshPair| Some(MeshPair { vertices: following(self.source.rig, pair.a, &changed)?, ..pair });
@@ -251,7 +257,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
 /// A change made and scanned: for a bake, the baked rig read back; and by the source's bone index, each bone's worst
 /// shear in degrees and whether it is flagged anywhere (a bone the changed rig lacks counts as neither).
 pub(super) struct Applied {
-    baked: Option<Rig>,
+    pub baked: Option<Rig>,
     pub shear: Vec<(f64, bool)>,
 }
 

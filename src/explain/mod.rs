@@ -186,34 +186,39 @@ pub fn explain(
         .collect();
     let baseline = Baseline::new(evaluation, before, options);
     let tool = evaluation.rig.tool;
-    let applied: HashMap<Change, Result<Applied, String>> = distinct(changes.iter().flatten().copied())
-        .into_par_iter()
-        .map(|change| (change, baseline.apply(change)))
-        .collect();
-    let costs: HashMap<Change, Result<Cost, String>> = match question.costs {
+    let (mut applied, mut costs) = (HashMap::new(), HashMap::new());
+    match question.costs {
         Costs::Every => {
-            let made = distinct(changes.iter().flatten().copied()).into_iter();
+            let every: Vec<Change> = changes.iter().flatten().copied().collect();
+            apply_all(&baseline, &every, &mut applied);
+            let made = distinct(every).into_iter();
             let made: Vec<_> = made.filter_map(|change| Some((change, applied[&change].as_ref().ok()?))).collect();
-            baseline.costs(&made).into_iter().collect()
+            costs = baseline.costs(&made).into_iter().collect();
         }
         Costs::Best => {
-            let mut costs = HashMap::new();
             for (&bone, changes) in bones.iter().zip(&changes) {
-                cheapest(&baseline, &contenders(bone, changes, &applied, tool), &applied, &mut costs);
+                if cheapest_removal(&baseline, bone, changes, tool, &mut applied, &mut costs).is_none() {
+                    apply_all(&baseline, changes, &mut applied);
+                    cheapest(&baseline, &contenders(bone, changes, &applied, tool), &applied, &mut costs);
+                }
             }
-            costs
         }
-    };
+    }
     let skeleton = evaluation.skeleton();
     let scanned = (before, tolerances.min_shear_deg);
     let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
         let mut fixes = Vec::new();
         let mut notes = Vec::new();
         for change in changes {
-            match (&applied[&change], costs.get(&change)) {
-                (Ok(made), Some(Ok(cost))) => fixes.push(Fix::new(skeleton, bone, change, made, *cost, scanned)),
-                (Err(why), _) | (_, Some(Err(why))) => notes.push(format!("{}: {why}", change.describe(skeleton))),
-                (Ok(_), None) => {}
+            match (applied.get(&change), costs.get(&change)) {
+                (Some(Ok(made)), Some(Ok(cost))) => {
+                    fixes.push(Fix::new(skeleton, bone, change, made, *cost, scanned));
+                }
+                (Some(Err(why)), _) | (_, Some(Err(why))) => {
+                    notes.push(format!("{}: {why}", change.describe(skeleton)));
+                }
+                // Not made or not costed: not needed for the best fix.
+                (None, _) | (Some(Ok(_)), None) => {}
             }
         }
         rank(&mut fixes, tool);
@@ -221,6 +226,60 @@ pub fn explain(
         Explanation { bone, name: skeleton.bone(bone).name.clone(), worst_shear_deg, causes, fixes, notes }
     });
     explained.collect()
+}
+
+/// Makes each of `changes` not yet made, in parallel.
+fn apply_all(baseline: &Baseline, changes: &[Change], applied: &mut HashMap<Change, Result<Applied, String>>) {
+    let missing = distinct(changes.iter().copied().filter(|change| !applied.contains_key(change)));
+    applied.extend(missing.into_par_iter().map(|change| (change, baseline.apply(change))).collect::<Vec<_>>());
+}
+
+/// The best fix of `bone` where a change of `changes` that sets no mode foreign to `tool` leaves it unflagged: the
+/// cheapest such change (ties: the first in `changes`), found making and costing (into `applied` and `costs`) as few
+/// changes as it takes. Changes are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]:
+/// a bake's once it is made, any other's from its setup), until the next bound exceeds the cheapest cost found (a
+/// bound never exceeds its cost). `None` where no such change removes the shear: then the best is among every
+/// change made ([`contenders`]).
+fn cheapest_removal(
+    baseline: &Baseline,
+    bone: usize,
+    changes: &[Change],
+    tool: Option<Tool>,
+    applied: &mut HashMap<Change, Result<Applied, String>>,
+    costs: &mut HashMap<Change, Result<Cost, String>>,
+) -> Option<Change> {
+    let bakes: Vec<Change> = changes.iter().copied().filter(|c| matches!(c, Change::Bake { .. })).collect();
+    apply_all(baseline, &bakes, applied);
+    let made: &HashMap<Change, Result<Applied, String>> = applied;
+    let own = changes.iter().copied().enumerate().filter(|&(_, change)| !is_other_mode(change, tool));
+    let mut bounded: Vec<(f64, usize, Change)> = own
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .filter_map(|(index, change)| {
+            let baked = match change {
+                Change::Bake { .. } => Some(made.get(&change)?.as_ref().ok()?.baked.as_ref()?),
+                _ => None,
+            };
+            Some((baseline.cost_bound(change, baked).ok()?, index, change))
+        })
+        .collect();
+    bounded.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut best: Option<(f64, usize, Change)> = None;
+    for (bound, index, change) in bounded {
+        if best.is_some_and(|(cost, ..)| bound > cost) {
+            break;
+        }
+        let Ok(made) = applied.entry(change).or_insert_with(|| baseline.apply(change)) else { continue };
+        if made.standing(bone, false).0 {
+            continue;
+        }
+        let Ok(cost) = costs.entry(change).or_insert_with(|| baseline.cost(change, made)) else { continue };
+        let cost = cost.distance.max;
+        if best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && index < first)) {
+            best = Some((cost, index, change));
+        }
+    }
+    best.map(|(.., change)| change)
 }
 
 /// Costs enough of `contenders` into `costs` for the cheapest to be among them, exactly: lower bounds of every cost
@@ -235,7 +294,7 @@ fn cheapest(
     let made = |change: &Change| applied[change].as_ref().ok();
     let mut bounds: Vec<(f64, Change)> = contenders
         .par_iter()
-        .filter_map(|&change| Some((baseline.cost_bound(change, made(&change)?).ok()?, change)))
+        .filter_map(|&change| Some((baseline.cost_bound(change, made(&change)?.baked.as_ref()).ok()?, change)))
         .collect();
     bounds.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut cheapest = f64::INFINITY;
