@@ -3,19 +3,28 @@
 //! shears under it. Measured after the rig-wide analysis, as the app and `scan --explain` run it: the hand's
 //! causes over the whole clip (the chain at its worst time, the main causes' time spans; target ≤ 50 ms), and the
 //! whole explanation with every fix measured (no target).
+//!
+//! And on a production clip, the generated 200-bone rig whose every limb squashes (`support/generated_gltf.rs`,
+//! 6,000 frames, 95 bones flagged): one bone's explanation, its best fix alone (what `scan --explain` does per
+//! bone) and every fix (the app's Why?, `explain`); and the bind check of the same rig with every joint's rest turned
+//! off its bind, so that it searches the clip for the frame that is the bind pose (what `inspect` pays for).
 
 use std::hint::black_box;
 use std::sync::Arc;
 
-use bonescope::analysis::{ScanOptions, scan};
+use bonescope::analysis::{BindTolerance, ScanOptions, check_bind, scan};
 use bonescope::eval::Evaluation;
-use bonescope::explain::{Question, causes, explain};
-use bonescope::model::{BoneTracks, Interpolation, Rig, Track};
+use bonescope::explain::{Costs, Question, causes, explain};
+use bonescope::model::{BoneTracks, Interpolation, Rig, Skeleton, Track};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 
 #[path = "support/shared_assets.rs"]
 mod shared_assets;
+// The loading benchmarks' variants of the generated rig are theirs.
+#[allow(dead_code)]
+#[path = "support/generated_gltf.rs"]
+mod generated_gltf;
 
 /// The repeated walk with a squash on the hand's third ancestor; the rig and the hand.
 fn squashed_walk() -> (Rig, usize) {
@@ -60,5 +69,53 @@ fn explain_on_mocap(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, explain_on_mocap);
+/// The generated rig whose every limb squashes.
+fn squashing_limbs() -> Rig {
+    let glb = generated_gltf::glb(generated_gltf::Squashes::EveryLimb);
+    bonescope::import::load_bytes(std::path::Path::new("limbs.glb"), &glb).expect("the generated glTF loads")
+}
+
+fn explain_on_a_production_clip(c: &mut Criterion) {
+    let rig = squashing_limbs();
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let options = ScanOptions::default();
+    let before = scan(&evaluation, &options, &|_, _| {});
+    let flagged = before.stretched_worst_first();
+    let bone = flagged.last().expect("the limbs shear").index;
+    eprintln!("generated limbs: {} bones flagged; explained: {}", flagged.len(), rig.skeleton.bone(bone).name);
+    let mut group = c.benchmark_group("explain a production clip");
+    group.sample_size(10);
+    for (name, costs) in [("one bone, its best fix", Costs::Best), ("one bone, every fix", Costs::Every)] {
+        let question = Question { bones: Some(&[bone]), costs, ..Question::default() };
+        group.bench_function(name, |b| b.iter(|| black_box(explain(&evaluation, &before, question, &options))));
+    }
+    group.finish();
+}
+
+fn bind_frame_search(c: &mut Criterion) {
+    let rig = squashing_limbs();
+    // Every joint rests a little turned from its bind, as exporters that store the first frame as the rest do.
+    let turned: Vec<_> = rig
+        .skeleton
+        .bones()
+        .iter()
+        .map(|bone| {
+            let mut bone = bone.clone();
+            bone.rest.rotation *= glam::DQuat::from_rotation_z(0.05);
+            bone
+        })
+        .collect();
+    let rig = Rig { skeleton: Skeleton::new(turned).expect("the same hierarchy"), ..rig };
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let check = check_bind(&evaluation, &BindTolerance::default());
+    assert!(!check.posed.is_empty(), "the rest is off the bind: the clip is searched");
+    let mut group = c.benchmark_group("bind check");
+    group.sample_size(10);
+    group.bench_function("the generated rig posed off its bind, 6,000 frames searched", |b| {
+        b.iter(|| black_box(check_bind(&evaluation, &BindTolerance::default())))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, explain_on_mocap, explain_on_a_production_clip, bind_frame_search);
 criterion_main!(benches);

@@ -26,7 +26,7 @@
 use glam::DMat4;
 use serde::Serialize;
 
-use crate::eval::{Evaluation, invert, median};
+use crate::eval::{BonesEvaluator, Evaluation, invert, median, over_runs};
 use crate::math::decompose;
 use crate::model::{MAX_FRAMES, Rig, sample_times};
 
@@ -316,6 +316,9 @@ fn checked_skins(rig: &Rig) -> Vec<CheckedSkin> {
 
 /// The frame of `authored`'s clip (at its frame rate, thinned past [`MAX_FRAMES`] as every whole-clip pass is)
 /// whose pose is closest to the bind pose of the skins' joints but their broken ones, if it is within the tolerance.
+/// Only the checked joints and their ancestors are evaluated (bone by bone where the clip allows), over runs of
+/// frames on every thread, and a frame is left as soon as one joint shows it further than the closest frame of its
+/// run; of equally close frames, the first.
 fn bind_frame(
     skins: &[(CheckedSkin, Vec<usize>)],
     authored: &Evaluation,
@@ -323,21 +326,38 @@ fn bind_frame(
 ) -> Option<ClipFrame> {
     let clip = authored.clip?;
     let rate = clip.frame_rate();
-    let mut evaluator = authored.evaluator();
-    let mut best: Option<(f64, f64)> = None;
-    for time in sample_times([], 0.0, clip.duration(), rate, MAX_FRAMES).times {
-        let model = &evaluator.evaluate(time).model.model;
-        let excess = skins
-            .iter()
-            .flat_map(|(skin, broken)| skin.gaps(model).into_iter().enumerate().filter(|(j, _)| !broken.contains(j)))
-            .map(|(_, gap)| gap.excess(tolerance))
-            .fold(0.0, f64::max);
-        if best.is_none_or(|(least, _)| excess < least) {
-            best = Some((excess, time));
+    let joints: Vec<usize> = skins.iter().flat_map(|(skin, _)| skin.joints.iter().map(|j| j.bone)).collect();
+    let bones = authored.skeleton().with_ancestors(&joints);
+    let times = sample_times([], 0.0, clip.duration(), rate, MAX_FRAMES).times;
+    let closest = |a: (f64, f64), b: (f64, f64)| if b.0 < a.0 { b } else { a };
+    let runs = over_runs(&times, |run| {
+        let mut evaluator = BonesEvaluator::new(authored, &bones);
+        let mut best: Option<(f64, f64)> = None;
+        for &time in run {
+            let beaten = best.map_or(f64::INFINITY, |(excess, _)| excess);
+            let excess = frame_excess(skins, &evaluator.evaluate(time).model.model, tolerance, beaten);
+            best = Some(best.map_or((excess, time), |best| closest(best, (excess, time))));
+        }
+        best
+    });
+    let (excess, time) = runs.into_iter().flatten().reduce(closest)?;
+    (excess <= 1.0).then(|| ClipFrame { frame: (time * rate).round(), time })
+}
+
+/// The largest excess over `tolerance` of the gaps of `skins`' joints (their broken ones aside) at `model`, or a
+/// value past `beaten` as soon as one joint's passes it (the frame cannot be the closest).
+fn frame_excess(skins: &[(CheckedSkin, Vec<usize>)], model: &[DMat4], tolerance: &BindTolerance, beaten: f64) -> f64 {
+    let mut largest: f64 = 0.0;
+    for (skin, broken) in skins {
+        let roots = skin.root_space(model);
+        for j in (0..skin.joints.len()).filter(|j| !broken.contains(j)) {
+            largest = largest.max(skin.gap(j, skin.joints[j].anchor, model, &roots).excess(tolerance));
+            if largest > beaten {
+                return largest;
+            }
         }
     }
-    let (excess, time) = best?;
-    (excess <= 1.0).then(|| ClipFrame { frame: (time * rate).round(), time })
+    largest
 }
 
 /// How much a scale factor changes from `pose` to `bind`, relative to `pose`; a zero (degenerate) factor in the pose
