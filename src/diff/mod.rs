@@ -274,6 +274,31 @@ pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f
 /// `rig_size`: [`compare_at_size`] of each, in one pass over time that evaluates, decomposes and skins A once per
 /// time for all of them (one evaluation weighed against many changes of it).
 pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f64], rig_size: f64) -> Vec<Comparison> {
+    let compared = compare_each_within(a, sides, times, rig_size, f64::INFINITY);
+    compared.into_iter().map(|c| c.expect("no distance passes an infinite limit")).collect()
+}
+
+/// [`compare_at_size`], given up (`None`) as soon as a probe point or a vertex lies further apart than `limit`:
+/// what a search for the cheapest of several changes needs of all but the cheapest.
+pub fn compare_within(
+    a: &Evaluation,
+    b: &Evaluation,
+    pairs: &Pairs,
+    times: &[f64],
+    rig_size: f64,
+    limit: f64,
+) -> Option<Comparison> {
+    compare_each_within(a, &[(b, pairs)], times, rig_size, limit).pop().flatten()
+}
+
+/// [`compare_each`], each side given up (`None`) once a probe point or a vertex lies further apart than `limit`.
+fn compare_each_within(
+    a: &Evaluation,
+    sides: &[(&Evaluation, &Pairs)],
+    times: &[f64],
+    rig_size: f64,
+    limit: f64,
+) -> Vec<Option<Comparison>> {
     let probe_length = rig_size * PROBE_FRACTION;
     let fresh = || sides.iter().map(|&(b, pairs)| Differences::new(a, b, pairs)).collect::<Vec<_>>();
     let plan_a = Plan::new(
@@ -294,8 +319,11 @@ pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f6
         let mut others: Vec<Side> = sides.iter().zip(&plans).map(|(&(b, _), plan)| Side::new(b, plan)).collect();
         let mut differences = fresh();
         for &time in run {
+            if differences.iter().all(|found| found.largest > limit) {
+                break;
+            }
             side_a.evaluate(time);
-            for (side_b, found) in others.iter_mut().zip(&mut differences) {
+            for (side_b, found) in others.iter_mut().zip(&mut differences).filter(|(_, f)| f.largest <= limit) {
                 side_b.evaluate(time);
                 found.add(&side_a, side_b, probe_length, time);
             }
@@ -306,9 +334,12 @@ pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f6
         runs.into_iter().reduce(|earlier, later| earlier.into_iter().zip(later).map(|(x, y)| x.merge(y)).collect());
     let count = times.len().max(1) as f64;
     let finish = |found: Differences| {
+        if found.largest > limit {
+            return None;
+        }
         let mean = |m: MeshDifference| MeshDifference { mean: m.sum / (count * m.vertices.max(1) as f64), ..m };
         let meshes = found.meshes.into_iter().map(mean).collect();
-        Comparison { samples: times.len(), rig_size, bones: found.bones, meshes }
+        Some(Comparison { samples: times.len(), rig_size, bones: found.bones, meshes })
     };
     totals.unwrap_or_else(fresh).into_iter().map(finish).collect()
 }
@@ -320,6 +351,8 @@ struct Differences {
     /// Per mesh pair, the vertices compared (every one for `None`).
     compared: Vec<Option<Vec<u32>>>,
     measure: Measure,
+    /// The largest probe or vertex distance found.
+    largest: f64,
 }
 
 impl Differences {
@@ -334,13 +367,15 @@ impl Differences {
             MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
         let compared = pairs.meshes.iter().map(|pair| pair.vertices.clone()).collect();
-        Differences { bones: bones.collect(), meshes: meshes.collect(), compared, measure: pairs.measure }
+        let (bones, meshes, measure) = (bones.collect(), meshes.collect(), pairs.measure);
+        Differences { bones, meshes, compared, measure, largest: 0.0 }
     }
 
     fn merge(self, later: Differences) -> Self {
         let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
         let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
-        Differences { bones, meshes, compared: self.compared, measure: self.measure }
+        let largest = self.largest.max(later.largest);
+        Differences { bones, meshes, compared: self.compared, measure: self.measure, largest }
     }
 
     fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
@@ -350,6 +385,7 @@ impl Differences {
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
             let probe = probe_distance(wa, wb, probe_length).max(probe_distance(wb, wa, probe_length));
             difference.probe.add(probe, time);
+            self.largest = self.largest.max(probe);
             if self.measure == Measure::Distances {
                 continue;
             }
@@ -371,6 +407,7 @@ impl Differences {
                 None => va.iter().zip(vb).for_each(|(p, q)| add(p, q)),
             }
             difference.distance.add(largest, time);
+            self.largest = self.largest.max(largest);
         }
     }
 }

@@ -150,7 +150,8 @@ pub fn skin_vertices_with(
     });
     let mut joints = Vec::with_capacity(skin.joints.len());
     joint_matrices_of(skin, model, used.as_deref(), &mut joints);
-    let any_dq = (0..positions.len()).any(|v| method.dq_weight(mesh, v) > 0.0);
+    let mut any_dq = false;
+    each(&mut |v| any_dq |= method.dq_weight(mesh, v) > 0.0);
     let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
     each(&mut |v| {
         // Weights as long as the joints (importers check): a shorter list skins the vertices it covers.

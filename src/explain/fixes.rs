@@ -6,7 +6,9 @@ use std::sync::atomic::AtomicBool;
 
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
 use crate::bake::{self, ClipToBake, Request, Strategy};
-use crate::diff::{Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, comparison_times};
+use crate::diff::{
+    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_within, comparison_times,
+};
 use crate::eval::{Evaluation, Setup};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
@@ -170,7 +172,14 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the
     /// changed bones and the meshes that follow them (nothing else differs).
     pub fn cost(&self, change: Change, applied: &Applied) -> Result<Cost, String> {
-        self.cost_at(change, applied.baked.as_ref(), 1)
+        self.cost_at(change, applied.baked.as_ref(), 1, true)
+    }
+
+    /// [`Baseline::cost`] where it is at most `limit`; `None` once something moves further (the comparison given
+    /// up there).
+    pub fn cost_within(&self, change: Change, applied: &Applied, limit: f64) -> Result<Option<Cost>, String> {
+        let (fixed, pairs, times, size) = self.compared(change, applied.baked.as_ref())?;
+        Ok(compare_within(self.source, &fixed, &pairs, &times, size, limit).map(|c| self.visible(&c)))
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
@@ -197,36 +206,54 @@ impl<'e, 'a> Baseline<'e, 'a> {
         costs
     }
 
-    /// A lower bound of [`Baseline::cost`] for a fraction of the work: the same comparison at every
-    /// of about [`BOUND_TIMES`] evenly spread times only (a largest distance over fewer times is never larger).
+    /// A lower bound of [`Baseline::cost`] for a fraction of the work: the bones alone, no skin, at about
+    /// [`BOUND_TIMES`] evenly spread times (a largest distance over fewer points and times is never larger).
     /// Needs the change made only for a bake (`baked`: the rig it writes); any other change is evaluated from its
     /// setup alone, before it is scanned.
     pub fn cost_bound(&self, change: Change, baked: Option<&Rig>) -> Result<f64, String> {
         let stride = (self.times.len() / BOUND_TIMES).max(1);
-        Ok(self.cost_at(change, baked, stride)?.distance.max)
+        Ok(self.cost_at(change, baked, stride, false)?.distance.max)
     }
 
-    /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time.
-    fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize) -> Result<Cost, String> {
-        let fixed = self.fixed(change, baked)?;
-        let pairs = self.pairs(change, &fixed);
-        // A mode keeps the clip and its layers, so their times and size, found once; a layer or a bake may not.
-        let own_times = match change {
-            Change::Mode { .. } => None,
-            _ => Some(comparison_times(self.source, &fixed, self.options.rate)),
-        };
-        let times = own_times.as_deref().unwrap_or(&self.times);
-        let size = if times == self.times { self.size } else { self.source.size(times) };
+    /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time, with the
+    /// skin where `skin` says (else on the bones alone).
+    fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize, skin: bool) -> Result<Cost, String> {
+        let (fixed, mut pairs, times, size) = self.compared(change, baked)?;
+        if !skin {
+            pairs.meshes.clear();
+        }
         let compared: Vec<f64> = times.iter().copied().step_by(stride).collect();
         Ok(self.visible(&compare_at_size(self.source, &fixed, &pairs, &compared, size)))
     }
 
-    /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones that change and the
-    /// vertices that follow them (nothing else differs).
+    /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on: its evaluation, the
+    /// pairs, the times and the size there.
+    fn compared<'r>(
+        &self,
+        change: Change,
+        baked: Option<&'r Rig>,
+    ) -> Result<(Evaluation<'r>, Pairs, Vec<f64>, f64), String>
+    where
+        'a: 'r,
+    {
+        let fixed = self.fixed(change, baked)?;
+        let pairs = self.pairs(change, &fixed);
+        // A mode keeps the clip and its layers, so their times and size, found once; a layer or a bake may not.
+        let times = match change {
+            Change::Mode { .. } => self.times.clone(),
+            _ => comparison_times(self.source, &fixed, self.options.rate),
+        };
+        let size = if times == self.times { self.size } else { self.source.size(&times) };
+        Ok((fixed, pairs, times, size))
+    }
+
+    /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones of the figure that
+    /// change (the cost reads no others) and the vertices that follow them (nothing else differs).
     fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
         let changed = self.changed(change);
+        let figure = self.source.skeleton().figure();
         let mut pairs = Pairs { measure: Measure::Distances, ..Pairs::by_name(self.source, fixed) };
-        pairs.bones.pairs.retain(|&(a, _)| changed(a));
+        pairs.bones.pairs.retain(|&(a, _)| changed(a) && figure[a]);
         let moving =
             |pair: MeshPair| Some(MeshPair { vertices: following(self.source.rig, pair.a, &changed)?, ..pair });
         pairs.meshes = pairs.meshes.into_iter().filter_map(moving).collect();

@@ -273,7 +273,16 @@ fn cheapest_removal(
         if made.standing(bone, false).0 {
             continue;
         }
-        let Ok(cost) = costs.entry(change).or_insert_with(|| baseline.cost(change, made)) else { continue };
+        let cost = match (costs.get(&change), best) {
+            (Some(known), _) => known.clone(),
+            // Only a cost at most the cheapest's matters: the comparison is given up past it.
+            (None, Some((cheapest, ..))) => match baseline.cost_within(change, made, cheapest) {
+                Ok(None) => continue,
+                within => within.map(|c| c.expect("within the limit")),
+            },
+            (None, None) => baseline.cost(change, made),
+        };
+        let Ok(cost) = costs.entry(change).or_insert(cost) else { continue };
         let cost = cost.distance.max;
         if best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && index < first)) {
             best = Some((cost, index, change));
