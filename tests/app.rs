@@ -1020,8 +1020,13 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
 
 #[test]
 fn a_z_up_bvh_compared_says_it_lies_down_and_stands_up_on_the_axis_picked() {
-    // Blender's BVH of the stretchy rig is in Blender's Z-up space: beside the rig's glTF it lies on the floor.
-    let mut harness = asset_app("blender/stretchy_full.glb");
+    // Blender's BVH of the stretchy rig is in Blender's Z-up space: beside the rig's glTF it lies on the floor. In a
+    // laptop's window, where the top bar's pickers wrap.
+    let doc = Document::load(&asset("blender/stretchy_full.glb")).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+    settle(&mut harness);
     harness.state_mut().compare(&asset("blender/stretchy_full.bvh"));
     settle(&mut harness);
     harness.get_by_role_and_label(Role::ComboBox, "unit of stretchy_full.bvh").click();
@@ -1062,9 +1067,9 @@ fn in_pane<'h>(
     nodes.find(|n| rect.contains(n.rect().center())).unwrap_or_else(|| panic!("no {label} in the {pane}"))
 }
 
-/// The demo with the forearm inspected and its Why? section open, explained.
+/// The demo in a laptop's window with the forearm inspected and its Why? section open, explained.
 fn why_forearm() -> Harness<'static, BonescopeApp> {
-    let mut harness = demo_app();
+    let mut harness = laptop_demo();
     harness.get_by_label("forearm").click();
     settle(&mut harness);
     harness.get_by_label("Why?").click();
