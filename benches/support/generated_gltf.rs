@@ -60,7 +60,17 @@ impl Squashes {
 
 /// The document as binary glTF (`.glb`).
 pub fn glb(squashes: Squashes) -> Vec<u8> {
-    let (root, bin) = document(None, squashes);
+    glb_of(document(None, squashes, false))
+}
+
+/// The same with every node resting at the clip's first frame, off its bind (the skin's inverse bind matrices stay
+/// the unturned pose's), as exporters that store the first frame as the rest write it: a bind check then searches
+/// the clip for the frame that is the bind pose.
+pub fn glb_posed(squashes: Squashes) -> Vec<u8> {
+    glb_of(document(None, squashes, true))
+}
+
+fn glb_of((root, bin): (json::Root, Vec<u8>)) -> Vec<u8> {
     let json = root.to_vec().expect("the document serializes");
     let glb = Glb {
         header: Header { magic: *b"glTF", version: 2, length: 0 },
@@ -72,16 +82,17 @@ pub fn glb(squashes: Squashes) -> Vec<u8> {
 
 /// The document as JSON glTF (`.gltf`) with its buffer embedded as a base64 `data:` URI.
 pub fn gltf_embedded(squashes: Squashes) -> Vec<u8> {
-    let (_, bin) = document(None, squashes);
+    let (_, bin) = document(None, squashes, false);
     let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(bin));
-    document(Some(uri), squashes).0.to_vec().expect("the document serializes")
+    document(Some(uri), squashes, false).0.to_vec().expect("the document serializes")
 }
 
-/// The JSON document and its binary buffer; `uri` is the buffer's URI (`None`: the GLB `BIN` chunk).
-fn document(uri: Option<String>, squashes: Squashes) -> (json::Root, Vec<u8>) {
+/// The JSON document and its binary buffer; `uri` is the buffer's URI (`None`: the GLB `BIN` chunk); `posed`: the
+/// nodes rest at the first frame.
+fn document(uri: Option<String>, squashes: Squashes, posed: bool) -> (json::Root, Vec<u8>) {
     let mut doc = Document { root: json::Root::default(), bin: Vec::new() };
     doc.root.asset.generator = Some("bonescope benches/support/generated_gltf.rs".to_owned());
-    let nodes = doc.skeleton();
+    let nodes = doc.skeleton(posed);
     doc.skinned_plates(&nodes);
     doc.animation(&nodes, squashes);
     let byte_length = USize64::from(doc.bin.len());
@@ -96,8 +107,8 @@ struct Document {
 
 impl Document {
     /// The bones as nodes of the scene, parents first: the spine from the root up, then the other chains, each
-    /// hanging off a spine bone (so the spine branches nine ways).
-    fn skeleton(&mut self) -> Vec<Index<json::Node>> {
+    /// hanging off a spine bone (so the spine branches nine ways); resting at the first frame where `posed`.
+    fn skeleton(&mut self, posed: bool) -> Vec<Index<json::Node>> {
         let parents: Vec<Option<usize>> = (0..BONES).map(parent).collect();
         let nodes: Vec<Index<json::Node>> = (0..BONES)
             .map(|bone| {
@@ -105,9 +116,11 @@ impl Document {
                     .filter(|&child| parents[child] == Some(bone))
                     .map(|child| Index::new(child as u32))
                     .collect();
+                let rotation = posed.then(|| json::scene::UnitQuaternion(rotation(bone, 0.0)));
                 self.root.push(json::Node {
                     name: Some(bone_name(bone)),
                     translation: Some(rest_offset(bone)),
+                    rotation,
                     children: (!children.is_empty()).then_some(children),
                     ..Default::default()
                 })

@@ -1,7 +1,7 @@
 //! Writes the generated glTF of the benchmarks (`generated_gltf.rs`) into a folder, as `generated_200x6000.glb` and
 //! `generated_200x6000.gltf` (the same document with its buffer in base64; the loading benchmarks' rig) and
-//! `generated_limbs_200x6000.glb` (every limb squashing: `explain`'s production clip), for tools outside this
-//! crate to load (`benches/compare_assimp.sh` times `assimp info` on them) and the CLI's figures.
+//! `generated_limbs_200x6000.glb` (every limb squashing: `explain`'s production clip; `generated_limbs_posed_…` the
+//! same resting at its first frame, off its bind), for tools outside this crate to load (`benches/compare_assimp.sh` times `assimp info` on them) and the CLI's figures.
 //!
 //! `cargo run --release --locked --example write_generated_gltf -- FOLDER`
 
@@ -11,16 +11,19 @@ mod generated_gltf;
 use std::path::PathBuf;
 
 fn main() -> std::io::Result<()> {
+    use generated_gltf::Squashes;
     let folder = PathBuf::from(std::env::args_os().nth(1).unwrap_or_else(|| "target".into()));
     std::fs::create_dir_all(&folder)?;
-    use generated_gltf::Squashes;
+    let stem = Squashes::file_stem;
     let files = [
-        (Squashes::Sparse, "glb", generated_gltf::glb(Squashes::Sparse)),
-        (Squashes::Sparse, "gltf", generated_gltf::gltf_embedded(Squashes::Sparse)),
-        (Squashes::EveryLimb, "glb", generated_gltf::glb(Squashes::EveryLimb)),
+        (format!("{}.glb", stem(Squashes::Sparse)), generated_gltf::glb(Squashes::Sparse)),
+        (format!("{}.gltf", stem(Squashes::Sparse)), generated_gltf::gltf_embedded(Squashes::Sparse)),
+        (format!("{}.glb", stem(Squashes::EveryLimb)), generated_gltf::glb(Squashes::EveryLimb)),
+        // Resting at the first frame, off its bind: `inspect`'s bind check searches the clip.
+        ("generated_limbs_posed_200x6000.glb".to_owned(), generated_gltf::glb_posed(Squashes::EveryLimb)),
     ];
-    for (squashes, extension, bytes) in files {
-        let path = folder.join(format!("{}.{extension}", squashes.file_stem()));
+    for (name, bytes) in files {
+        let path = folder.join(name);
         std::fs::write(&path, bytes)?;
         println!("{}", path.display());
     }
