@@ -322,13 +322,19 @@ fn the_command_line_explains_in_a_table_in_json_and_in_a_scan() {
 
 #[test]
 fn costing_only_the_contenders_finds_the_same_best_fix() {
-    // `scan --explain` costs only the fixes that can rank first; the best fix is the one the whole ranking finds.
-    for file in [
+    // `scan --explain` makes and costs only the fixes that can rank first (in the order of their cost's lower
+    // bound, each compared only until it passes the cheapest found); the best fix is the one the whole ranking
+    // finds: on shared files and on a generated rig of long chains that shear below every tenth bone.
+    let rigs = [
         "blender/stretchy_full.glb",
         "blender/stretchy_noinherit.fbx",
+        "blender/stretchy_full.usdc",
         "fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx",
-    ] {
-        let rig = load_asset(file);
+    ]
+    .map(|file| (file.to_owned(), load_asset(file)))
+    .into_iter()
+    .chain([("stress_rig(40, 120, 5)".to_owned(), bonescope::import::stress_rig(40, 120, 5))]);
+    for (file, rig) in rigs {
         let options = ScanOptions::default();
         let source = Evaluation::declared(&rig, rig.clips.first());
         let before = scan(&source, &options, &|_, _| {});

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use super::identity::RigId;
 use crate::analysis::{Assessment, Tolerances};
-use crate::diff::{match_bones, match_clips, match_meshes};
+use crate::diff::{match_bones, match_clips, match_meshes, standing_apart};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup, SkinningMethod};
 use crate::import::{self, ImportError};
@@ -29,6 +29,8 @@ pub struct Compared {
     states_unit: bool,
     /// The axis the file is read as standing along (Y: as it says).
     pub up: UpAxis,
+    /// The axes the document and this file stand along at rest, where they differ ([`standing_apart`]).
+    pub apart: Option<[UpAxis; 2]>,
     /// The unit the file is measured in: the document's, or the one the user gave the document where its file
     /// states none.
     document_unit: Option<Unit>,
@@ -73,8 +75,8 @@ impl Compared {
         }
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
         let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
-        let up = UpAxis::Y;
-        Compared { path, rig, rig_id, states_unit, up, document_unit, bones, conversion, meshes, clips, played }
+        let (up, apart) = (UpAxis::Y, standing_apart(document, &rig));
+        Compared { path, rig, rig_id, states_unit, up, apart, document_unit, bones, conversion, meshes, clips, played }
     }
 
     /// The same file paired with another document rig (the document was reloaded), keeping the units given and
@@ -108,10 +110,11 @@ impl Compared {
         Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), ..self.clone() }
     }
 
-    /// The same file read as standing along `up`: another rig to compare.
-    pub fn given_up(&self, up: UpAxis) -> Self {
+    /// The same file read as standing along `up` beside `document`: another rig to compare.
+    pub fn given_up(&self, up: UpAxis, document: &Rig) -> Self {
         let rig = (*self.rig).clone().restood(self.up, up);
-        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), up, ..self.clone() }
+        let apart = standing_apart(document, &rig);
+        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), up, apart, ..self.clone() }
     }
 
     /// The same measured in `unit`, the document's where its file states none.

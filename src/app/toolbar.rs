@@ -12,7 +12,6 @@ use super::pane::{Pane, Visibility};
 use super::panel::Shared;
 use super::text;
 use crate::analysis::Tolerances;
-use crate::diff::standing_apart;
 use crate::eval::SkinningMethod;
 use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, ModeChoice, Unit, UpAxis};
@@ -316,11 +315,10 @@ fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     {
         replace(doc, compared.given_unit(unit));
     }
-    let apart = standing_apart(&doc.rig, &compared.rig);
-    if (!compared.states_unit() || apart.is_some() || compared.up != UpAxis::Y)
-        && let Some(up) = up_picker(ui, &compared, apart, &doc.title())
+    if (!compared.states_unit() || compared.apart.is_some() || compared.up != UpAxis::Y)
+        && let Some(up) = up_picker(ui, &compared, &doc.title())
     {
-        replace(doc, compared.given_up(up));
+        replace(doc, compared.given_up(up, &doc.rig));
     }
     if doc.rig.unit.is_none()
         && let Some(unit) = unit_picker(ui, &doc.title(), compared.units()[0], &compared.title())
@@ -361,9 +359,9 @@ fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -
     picked.filter(|_| picked != unit)
 }
 
-/// A picker of the axis `compared` stands along, saying where it lies down beside the document (`apart`: the axes
-/// `[the document's, the compared file's]`); the axis picked, if another.
-fn up_picker(ui: &mut egui::Ui, compared: &Compared, apart: Option<[UpAxis; 2]>, document: &str) -> Option<UpAxis> {
+/// A picker of the axis `compared` stands along, saying where it lies down beside the document; the axis picked, if
+/// another.
+fn up_picker(ui: &mut egui::Ui, compared: &Compared, document: &str) -> Option<UpAxis> {
     let file = compared.title();
     let label = ui.label(format!("up of {file}"));
     let mut picked = compared.up;
@@ -377,7 +375,7 @@ fn up_picker(ui: &mut egui::Ui, compared: &Compared, apart: Option<[UpAxis; 2]>,
         .response
         .labelled_by(label.id)
         .on_hover_text(format!("the axis {file}'s skeleton stands along, where the file does not say (BVH)"));
-    if let Some([ours, theirs]) = apart {
+    if let Some([ours, theirs]) = compared.apart {
         let text =
             format!("lies along {}: {document} stands along {}", theirs.id().to_uppercase(), ours.id().to_uppercase());
         ui.label(RichText::new(text).color(Badge::NonUniform.color()))

@@ -315,8 +315,8 @@ fn compare_each_within(
         })
         .collect();
     let runs = over_runs(times, |run| {
-        let mut side_a = Side::new(a, &plan_a);
-        let mut others: Vec<Side> = sides.iter().zip(&plans).map(|(&(b, _), plan)| Side::new(b, plan)).collect();
+        let mut side_a = Side::new(&plan_a);
+        let mut others: Vec<Side> = plans.iter().map(Side::new).collect();
         let mut differences = fresh();
         for &time in run {
             if differences.iter().all(|found| found.largest > limit) {
@@ -345,18 +345,18 @@ fn compare_each_within(
 }
 
 /// The differences found over some of the times.
-struct Differences {
+struct Differences<'p> {
     bones: Vec<BoneDifference>,
     meshes: Vec<MeshDifference>,
-    /// Per mesh pair, the vertices compared (every one for `None`).
-    compared: Vec<Option<Vec<u32>>>,
+    /// The mesh pairs, with the vertices compared.
+    pairs: &'p [MeshPair],
     measure: Measure,
     /// The largest probe or vertex distance found.
     largest: f64,
 }
 
-impl Differences {
-    fn new(a: &Evaluation, b: &Evaluation, pairs: &Pairs) -> Self {
+impl<'p> Differences<'p> {
+    fn new(a: &Evaluation, b: &Evaluation, pairs: &'p Pairs) -> Self {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
         let bones =
             pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
@@ -366,16 +366,15 @@ impl Differences {
             let vertices = pair.vertices.as_ref().map_or(mesh.positions.len(), Vec::len);
             MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
-        let compared = pairs.meshes.iter().map(|pair| pair.vertices.clone()).collect();
         let (bones, meshes, measure) = (bones.collect(), meshes.collect(), pairs.measure);
-        Differences { bones, meshes, compared, measure, largest: 0.0 }
+        Differences { bones, meshes, pairs: &pairs.meshes, measure, largest: 0.0 }
     }
 
     fn merge(self, later: Differences) -> Self {
         let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
         let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
         let largest = self.largest.max(later.largest);
-        Differences { bones, meshes, compared: self.compared, measure: self.measure, largest }
+        Differences { bones, meshes, pairs: self.pairs, measure: self.measure, largest }
     }
 
     fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
@@ -394,7 +393,7 @@ impl Differences {
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
         }
-        for (difference, compared) in self.meshes.iter_mut().zip(&self.compared) {
+        for (difference, pair) in self.meshes.iter_mut().zip(self.pairs) {
             let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
             let mut largest: f64 = 0.0;
             let mut add = |p: &DVec3, q: &DVec3| {
@@ -402,7 +401,7 @@ impl Differences {
                 largest = largest.max(d);
                 difference.sum += d;
             };
-            match compared {
+            match &pair.vertices {
                 Some(vertices) => vertices.iter().map(|&v| v as usize).for_each(|v| add(&va[v], &vb[v])),
                 None => va.iter().zip(vb).for_each(|(p, q)| add(p, q)),
             }
@@ -499,7 +498,8 @@ struct Side<'e, 'a> {
 }
 
 impl<'e, 'a> Side<'e, 'a> {
-    fn new(evaluation: &'e Evaluation<'a>, plan: &'e Plan<'a>) -> Self {
+    fn new(plan: &'e Plan<'a>) -> Self {
+        let evaluation = plan.evaluation;
         let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
         let length_scales = evaluation.length_scales();
         let evaluator = BonesEvaluator::new(evaluation, &plan.needed);

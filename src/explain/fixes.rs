@@ -1,6 +1,7 @@
 //! The fixes for a sheared bone, each another evaluation of the same clip, analysed as `scan` analyses a clip and
 //! compared with the declared evaluation as `diff` compares two.
 
+use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
@@ -178,8 +179,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// [`Baseline::cost`] where it is at most `limit`; `None` once something moves further (the comparison given
     /// up there).
     pub fn cost_within(&self, change: Change, applied: &Applied, limit: f64) -> Result<Option<Cost>, String> {
-        let (fixed, pairs, times, size) = self.compared(change, applied.baked.as_ref())?;
-        Ok(compare_within(self.source, &fixed, &pairs, &times, size, limit).map(|c| self.visible(&c)))
+        let on = self.compared_on(change, applied.baked.as_ref())?;
+        Ok(compare_within(self.source, &on.fixed, &on.pairs, &on.times, on.size, limit).map(|c| self.visible(&c)))
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
@@ -218,33 +219,31 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time, with the
     /// skin where `skin` says (else on the bones alone).
     fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize, skin: bool) -> Result<Cost, String> {
-        let (fixed, mut pairs, times, size) = self.compared(change, baked)?;
+        let mut on = self.compared_on(change, baked)?;
         if !skin {
-            pairs.meshes.clear();
+            on.pairs.meshes.clear();
         }
-        let compared: Vec<f64> = times.iter().copied().step_by(stride).collect();
-        Ok(self.visible(&compare_at_size(self.source, &fixed, &pairs, &compared, size)))
+        let compared: Vec<f64> = on.times.iter().copied().step_by(stride).collect();
+        Ok(self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &compared, on.size)))
     }
 
-    /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on: its evaluation, the
-    /// pairs, the times and the size there.
-    fn compared<'r>(
-        &self,
-        change: Change,
-        baked: Option<&'r Rig>,
-    ) -> Result<(Evaluation<'r>, Pairs, Vec<f64>, f64), String>
+    /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on.
+    fn compared_on<'r>(&self, change: Change, baked: Option<&'r Rig>) -> Result<ComparedOn<'r, '_>, String>
     where
         'a: 'r,
     {
         let fixed = self.fixed(change, baked)?;
         let pairs = self.pairs(change, &fixed);
-        // A mode keeps the clip and its layers, so their times and size, found once; a layer or a bake may not.
-        let times = match change {
-            Change::Mode { .. } => self.times.clone(),
-            _ => comparison_times(self.source, &fixed, self.options.rate),
+        // A change that keeps the clip's times (any but a bake) keeps the times and size found once.
+        let (times, size) = match baked {
+            None => (Cow::Borrowed(&self.times[..]), self.size),
+            Some(_) => {
+                let times = comparison_times(self.source, &fixed, self.options.rate);
+                let size = self.source.size(&times);
+                (Cow::Owned(times), size)
+            }
         };
-        let size = if times == self.times { self.size } else { self.source.size(&times) };
-        Ok((fixed, pairs, times, size))
+        Ok(ComparedOn { fixed, pairs, times, size })
     }
 
     /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones of the figure that
@@ -279,6 +278,15 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let below = change.changed_below().map(|top| self.source.skeleton().subtree(top));
         move |b: usize| below.as_ref().is_none_or(|bones| bones.binary_search(&b).is_ok())
     }
+}
+
+/// What a change is compared with the source on: the evaluation it gives, the pairs, the times and the rig's size
+/// there.
+struct ComparedOn<'r, 't> {
+    fixed: Evaluation<'r>,
+    pairs: Pairs,
+    times: Cow<'t, [f64]>,
+    size: f64,
 }
 
 /// A change made and scanned: for a bake, the baked rig read back; and by the source's bone index, each bone's worst
