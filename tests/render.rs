@@ -174,17 +174,18 @@ fn bad_requests_fail_with_a_message_that_names_the_problem() {
     assert!(!out.exists());
 }
 
-/// The README's pictures are made by the `bonescope render … --out assets/readme/…` commands it shows: each is run
-/// again against the committed picture, so neither the pictures nor the commands go stale.
+/// The pictures of the README and `docs/app.md` are made by the `bonescope render … --out assets/readme/…` commands
+/// `docs/app.md` shows: each is run again against the committed picture, so neither the pictures nor the commands go
+/// stale.
 #[test]
 fn the_readme_pictures_are_what_their_commands_render() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let commands: Vec<&str> = readme
+    let page = std::fs::read_to_string(root.join("docs/app.md")).unwrap();
+    let commands: Vec<&str> = page
         .lines()
         .filter(|line| line.starts_with("bonescope render ") && line.contains("--out assets/readme/"))
         .collect();
-    assert_eq!(commands.len(), 4, "the README shows four pictures' commands");
+    assert_eq!(commands.len(), 4, "docs/app.md shows four pictures' commands");
     let out = Path::new(env!("CARGO_TARGET_TMPDIR"));
     for command in commands {
         let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_owned).collect();
