@@ -70,6 +70,7 @@ impl<'a> Plan<'a> {
                 Judged::Every => (0..skeleton.len()).collect(),
                 Judged::CurveChains => skeleton.with_ancestors(plotted),
                 Judged::Subtree(top) => skeleton.with_ancestors(&skeleton.subtree(top)),
+                Judged::Chain(bone) => skeleton.with_ancestors(&[bone]),
             },
         }
     }
@@ -87,6 +88,11 @@ impl ChunkResult {
     fn new(bones: usize, samples: usize) -> Self {
         let words = samples.div_ceil(64);
         ChunkResult { summaries: (0..bones).map(BoneSummary::new).collect(), bits: vec![0; bones * words], words }
+    }
+
+    /// Whether `bone` is flagged at any of the chunk's samples.
+    pub fn flagged(&self, bone: usize) -> bool {
+        self.bits[bone * self.words..][..self.words].iter().any(|&word| word != 0)
     }
 
     fn add(&mut self, bone: usize, sample: usize, time: f64, verdict: &Verdict) {

@@ -16,4 +16,4 @@ pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
-pub use scan::{analyze, scan};
+pub use scan::{analyze, flagged_in_run, scan};

@@ -41,4 +41,6 @@ pub enum Judged {
     /// Only this bone, the bones below it and its ancestors: what a change to that bone alone can change (the
     /// other bones' summaries stay empty).
     Subtree(usize),
+    /// Only this bone and its ancestors: what its own verdicts need.
+    Chain(usize),
 }

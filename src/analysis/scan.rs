@@ -10,7 +10,7 @@ use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 use super::findings::Judge;
 use super::peak;
-use super::request::{CurveRequest, ScanOptions};
+use super::request::{CurveRequest, Judged, ScanOptions};
 use crate::eval::{Evaluation, run_length};
 
 /// Scans `evaluation` over its whole clip. `progress(done, total)` is called from worker threads as samples
@@ -56,6 +56,22 @@ pub fn analyze(
     let mut analysis = assemble(skeleton.figure(), times, curves, chunks);
     peak::refine(evaluation, &analysis.times, &mut analysis.scan.bones, &Judge::new(&options.tolerances));
     Some(analysis)
+}
+
+/// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time` (else the last
+/// run): exactly what the whole-clip analysis finds in that run, which is judged on its own, here for the bone's
+/// chain alone. A cheap first look where a change is expected to leave a bone flagged where it was worst.
+pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, options: &ScanOptions) -> bool {
+    let times = evaluation.times(options.rate);
+    let Some(last) = times.len().checked_sub(1) else {
+        return false;
+    };
+    let run_length = run_length(times.len());
+    let run = times.partition_point(|&t| t < time).min(last) / run_length;
+    let run = &times[run * run_length..times.len().min((run + 1) * run_length)];
+    let request = CurveRequest { judged: Judged::Chain(bone), ..CurveRequest::default() };
+    let plan = Plan::new(evaluation, request.bones, request.judged);
+    analyze_chunk(evaluation, &plan, request, options, run, CurveSlices::default()).flagged(bone)
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.
@@ -107,5 +123,42 @@ fn assemble(figure: &[bool], times: Vec<f64>, curves: Vec<(usize, Curves)>, chun
         words_per_bone,
         any_stretched_bits,
         curves,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::demo_rig;
+    use crate::model::InheritMode;
+
+    #[test]
+    fn a_run_is_judged_as_the_whole_clip_judges_it() {
+        // The demo's arm judged bone by bone (full inheritance) and sample by sample (the forearm compensating):
+        // every bone's verdict over every run, looked up from any time in it, equals the whole analysis's there.
+        let rig = demo_rig();
+        let declared = Evaluation::declared(&rig, rig.clips.first());
+        let mut modes = declared.modes().to_vec();
+        modes[rig.skeleton.find("forearm").unwrap()] = InheritMode::SegmentCompensate;
+        let compensating = declared.with_modes(&modes).unwrap();
+        let options = ScanOptions { rate: 240.0, ..ScanOptions::default() };
+        let never = AtomicBool::new(false);
+        let mut flagged_runs = 0;
+        for evaluation in [&declared, &compensating] {
+            let whole = analyze(evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
+            let length = run_length(whole.times.len());
+            for bone in 0..rig.skeleton.len() {
+                for (run, samples) in whole.times.chunks(length).enumerate() {
+                    let first = run * length;
+                    let expected = (first..first + samples.len()).any(|s| whole.stretched_at(bone, s));
+                    for time in [samples[0], samples[samples.len() / 2], samples[samples.len() - 1]] {
+                        let found = flagged_in_run(evaluation, bone, time, &options);
+                        assert_eq!(found, expected, "bone {bone}, run {run}, {time} s");
+                    }
+                    flagged_runs += usize::from(expected);
+                }
+            }
+        }
+        assert!(flagged_runs > 0, "the demo's forearm shears somewhere");
     }
 }

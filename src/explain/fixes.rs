@@ -5,7 +5,7 @@ use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze};
+use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run};
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
     Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_within, comparison_times,
@@ -168,6 +168,18 @@ impl<'e, 'a> Baseline<'e, 'a> {
             })
             .collect();
         Ok(Applied { baked, shear })
+    }
+
+    /// Whether `change` certainly leaves `bone` flagged: it is flagged in the run of samples that holds the bone's
+    /// worst shear in the source, judged exactly as [`Baseline::apply`]'s scan judges that run. A change that does
+    /// not remove a shear most often leaves it there, so this settles most of them for a run's work; `false` says
+    /// nothing (the change must be made to know). A bake is its own rig: never settled here.
+    pub fn leaves_flagged(&self, change: Change, bone: usize) -> bool {
+        let worst = self.before.bones.get(bone).map(|b| b.worst_shear_time);
+        match (change.changed_below(), worst, self.fixed(change, None)) {
+            (Some(_), Some(worst), Ok(fixed)) => flagged_in_run(&fixed, bone, worst, self.options),
+            _ => false,
+        }
     }
 
     /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the

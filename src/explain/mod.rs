@@ -269,6 +269,9 @@ fn cheapest_removal(
         if best.is_some_and(|(cost, ..)| bound > cost) {
             break;
         }
+        if !applied.contains_key(&change) && baseline.leaves_flagged(change, bone) {
+            continue;
+        }
         let Ok(made) = applied.entry(change).or_insert_with(|| baseline.apply(change)) else { continue };
         if made.standing(bone, false).0 {
             continue;
