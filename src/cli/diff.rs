@@ -63,7 +63,7 @@ pub struct DiffArgs {
     pub format: OutputFormat,
     /// Exit with status 1 when a bone's origin or axis probe, or a vertex, differs by more than this: a distance in
     /// the first file's unit, or a percentage (`0.01%`) of the larger rig's size.
-    #[arg(long, value_name = "DIST", value_parser = parse_distance)]
+    #[arg(long, value_name = "DIST", value_parser = parse_distance, alias = "max-error")]
     pub fail_above: Option<Distance>,
 }
 

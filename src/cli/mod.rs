@@ -79,8 +79,8 @@ pub enum Command {
 
 /// What a build without the `gui` feature says of what needs it.
 #[cfg(not(feature = "gui"))]
-const NEEDS_GUI: &str = "needs the `gui` feature: install bonescope with its default features \
-    (cargo install --locked bonescope), not --no-default-features";
+const NEEDS_GUI: &str = "needs the `gui` feature: install bonescope with its default features, from a checkout \
+    `cargo install --path . --locked` (not --no-default-features)";
 
 /// Parses the process arguments and runs the command.
 pub fn main() -> ExitCode {

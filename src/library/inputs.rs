@@ -68,6 +68,9 @@ pub struct InputProblem {
 pub struct Found {
     pub path: PathBuf,
     pub key: String,
+    /// A path named that cannot be opened (missing, say): in every shard, so that each fails on it as the whole scan
+    /// does, rather than all but one passing (the merged report keeps it once).
+    pub every_shard: bool,
 }
 
 /// The files to scan, sorted by path and distinct, and what could not be read on the way.
@@ -84,9 +87,10 @@ impl Inputs {
     }
 
     /// The paths of the `part`-th of `parts` (1-based) stable parts: a file belongs to part `1 + crc32(key) mod
-    /// parts`, so machines scanning the same library agree without talking, and the parts partition it.
+    /// parts`, so machines scanning the same library agree without talking, and the parts partition it; a path
+    /// named that cannot be opened belongs to every part.
     pub fn shard(&self, part: usize, parts: usize) -> Vec<PathBuf> {
-        let of = |f: &&Found| (crc32fast::hash(f.key.as_bytes()) as usize % parts.max(1)) + 1 == part;
+        let of = |f: &&Found| f.every_shard || (crc32fast::hash(f.key.as_bytes()) as usize % parts.max(1)) + 1 == part;
         self.files.iter().filter(of).map(|f| f.path.clone()).collect()
     }
 }
@@ -115,7 +119,7 @@ pub fn collect(names: &[PathBuf], filter: &Filter, stdin: &mut dyn Read) -> Inpu
 impl Inputs {
     /// A file named (or listed, or matched by a glob): its key is the path as given.
     fn push_named(&mut self, path: &Path) {
-        self.files.push(Found { path: path.to_owned(), key: key_of(path) });
+        self.files.push(Found { path: path.to_owned(), key: key_of(path), every_shard: !opens(path) });
     }
 
     fn problem(&mut self, path: &Path, message: String) {
@@ -174,7 +178,7 @@ impl Inputs {
                         || (entry.file_type().is_file() && recognised(entry.path()));
                     if filter.admits(relative) && animation {
                         let key = key_of(relative);
-                        self.files.push(Found { path: entry.into_path(), key });
+                        self.files.push(Found { path: entry.into_path(), key, every_shard: false });
                     }
                 }
                 Ok(_) => {}
@@ -188,13 +192,23 @@ fn key_of(path: &Path) -> String {
     path.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/")
 }
 
+/// Whether `path` can be opened for reading: a regular file is opened (and closed); anything else that exists counts
+/// as openable, since opening a pipe would wait for its writer.
+fn opens(path: &Path) -> bool {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_file() => std::fs::File::open(path).is_ok(),
+        Ok(_) => true,
+        Err(_) => false,
+    }
+}
+
 /// Whether `path` has glob characters.
 fn is_glob(path: &Path) -> bool {
     path.to_string_lossy().contains(['*', '?', '['])
 }
 
-/// The extensions of the formats bonescope reads.
-const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
+/// The extensions of the formats bonescope reads (lower case).
+pub const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
 
 /// Whether `path` is named as an animation file.
 fn has_animation_extension(path: &Path) -> bool {
@@ -269,6 +283,17 @@ mod tests {
         let file_names =
             |paths: Vec<PathBuf>| paths.iter().map(|p| p.file_name().unwrap().to_owned()).collect::<Vec<_>>();
         assert_eq!(file_names(there.shard(2, 3)), file_names(inputs.shard(2, 3)));
+    }
+
+    #[test]
+    fn a_named_path_that_cannot_be_opened_is_in_every_shard() {
+        let dir = library();
+        let missing = dir.path().join("missing");
+        let inputs = collect(&[dir.path().to_owned(), missing.clone()], &Filter::default(), &mut std::io::empty());
+        let parts: Vec<Vec<PathBuf>> = (1..=8).map(|k| inputs.shard(k, 8)).collect();
+        assert!(parts.iter().all(|p| p.contains(&missing)), "{parts:?}");
+        let found: usize = parts.iter().map(|p| p.iter().filter(|&path| path != &missing).count()).sum();
+        assert_eq!(found, inputs.files.len() - 1, "the folder's files still in one part each");
     }
 
     #[test]
