@@ -8,6 +8,7 @@ mod findings;
 mod peak;
 pub mod report;
 mod request;
+mod sampled;
 mod scan;
 pub mod storage;
 mod stretch;
@@ -16,4 +17,5 @@ pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
+pub use sampled::{Sampled, sample};
 pub use scan::{analyze, flagged_in_run, scan};

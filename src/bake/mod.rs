@@ -160,6 +160,20 @@ impl<'a> Request<'a> {
         Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
 
+    /// What a bake of `source` writes: every clip evaluated as `source` is (or the one `only` names), or, where
+    /// `source` plays layers, their result as one new clip named after its main clip and what was layered on it.
+    pub fn of(source: &Evaluation<'a>, only: Option<&'a Clip>, strategy: Strategy, tolerance: f64) -> Self {
+        let layers = source.setup().layers;
+        if layers.is_empty() {
+            return Request::every_clip(source, only, strategy, tolerance);
+        }
+        let main = source.clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
+        let name = format!("{main} + {}", layers.summary(source.rig, source.clip));
+        let rest = source.at_rest();
+        let clips = vec![ClipToBake { name, source: source.clone() }];
+        Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
+    }
+
     /// The same for `engine`.
     pub fn for_engine(self, engine: Engine) -> Self {
         Request { engine, ..self }

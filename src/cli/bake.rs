@@ -10,7 +10,7 @@ use super::options::{Distance, choice, parse_distance};
 use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, OutputFormat};
-use crate::bake::{self, BakeReport, ClipToBake, Engine, Request, Strategy};
+use crate::bake::{self, BakeReport, Engine, Request, Strategy};
 use crate::eval::Setup;
 use crate::import;
 use crate::model::Choice;
@@ -57,17 +57,8 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     let setup = args.eval.setup(&rig)?;
     let source = evaluation(&rig, &setup)?;
     let (strategy, tolerance) = (args.strategy.unwrap_or(args.engine.strategy()), args.tolerance);
-    let request = if setup.layers.is_empty() {
-        let only = args.eval.anim.is_some().then_some(source.clip).flatten();
-        Request::every_clip(&source, only, strategy, tolerance)
-    } else {
-        // A layered result is one new clip, named after its main clip and what was layered on it.
-        let main = source.clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
-        let name = format!("{main} + {}", setup.layers.summary(&rig, source.clip));
-        let rest = source.at_rest();
-        Request::new(rest, vec![ClipToBake { name, source }], strategy, tolerance)?
-    }
-    .for_engine(args.engine);
+    let only = args.eval.anim.is_some().then_some(source.clip).flatten();
+    let request = Request::of(&source, only, strategy, tolerance).for_engine(args.engine);
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
     let report = bake::report(&request, &baked, &baked_rig);

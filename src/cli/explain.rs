@@ -12,8 +12,7 @@ use super::table::{Table, shown};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan};
-use crate::eval::Layers;
-use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, explain, is_other_mode};
+use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, Report, explain, is_other_mode};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
 
@@ -41,20 +40,6 @@ pub struct ExplainArgs {
     pub tolerances: ToleranceArgs,
 }
 
-/// `bonescope explain --format json`.
-#[derive(serde::Serialize)]
-struct ExplainReport<'a> {
-    file: String,
-    animation: Option<AnimationInfo>,
-    inherit: String,
-    rate: f64,
-    /// The layers the clip plays through (the default for none).
-    layers: Layers,
-    /// The rig's unit, where its file states one: every length (the fixes' costs) is in it.
-    unit: Option<Unit>,
-    bones: &'a [Explanation],
-}
-
 pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let rig = import::load(&args.file)?;
     let setup = args.eval.setup(&rig)?;
@@ -68,15 +53,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
     let question = Question { bones: asked, at: args.time, costs: Costs::Every };
     let explained = explain(&evaluation, &before, question, &options);
-    let report = ExplainReport {
-        file: shown(&args.file),
-        animation: evaluation.clip.map(AnimationInfo::of),
-        inherit: setup.modes.label().to_owned(),
-        rate: args.rate,
-        layers: setup.layers.clone(),
-        unit: rig.unit,
-        bones: &explained,
-    };
+    let report = Report::new(shown(&args.file), &evaluation, args.rate, &explained);
     match args.format {
         OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
         OutputFormat::Table => {
@@ -94,7 +71,7 @@ struct Shown {
     min_shear_deg: f64,
 }
 
-fn render_table(report: &ExplainReport, rig: &Rig, modes: &[InheritMode], shown: Shown) -> String {
+fn render_table(report: &Report, rig: &Rig, modes: &[InheritMode], shown: Shown) -> String {
     let animation = AnimationInfo::describe(report.animation.as_ref());
     let mut out = format!("{}  {animation}  inherit: {}\n", report.file, report.inherit);
     let layers = report.layers.summary(rig, report.animation.as_ref().and_then(|a| rig.clips.get(a.index)));

@@ -13,12 +13,12 @@ use super::options::{clip_index, parse_angle, parse_comparison, parse_rate};
 use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, ToleranceArgs};
+use crate::analysis::ScanOptions;
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
-use crate::analysis::{ScanOptions, scan};
 use crate::diff::{AnimationDiff, Clips, diff_files};
 use crate::eval::{Evaluation, Setup};
-use crate::explain::{Costs, Question, explain};
+use crate::explain::scan_clip;
 use crate::import;
 use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
@@ -305,20 +305,8 @@ fn loaded_code(all_loaded: bool) -> ExitCode {
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = shown(path);
-    let scanned = Loaded::read(path, &args.eval).and_then(|loaded| {
-        let inherit = loaded.setup.modes.label();
-        loaded.each_clip(|evaluation| {
-            let result = scan(evaluation, options, &|_, _| {});
-            let explained = match args.explain {
-                true => explain(evaluation, &result, Question { costs: Costs::Best, ..Question::default() }, options),
-                false => Vec::new(),
-            };
-            let (skeleton, clip) = (evaluation.skeleton(), evaluation.clip);
-            let scanned = AnimationScan::new(skeleton, clip, inherit.to_owned(), options.rate, result);
-            let explained = explained.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
-            AnimationScan { explained, ..scanned }
-        })
-    });
+    let scanned = Loaded::read(path, &args.eval)
+        .and_then(|loaded| loaded.each_clip(|evaluation| scan_clip(evaluation, options, args.explain)));
     FileReport::new(file, scanned)
 }
 

@@ -26,10 +26,10 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use crate::analysis::report::ExplainedBone;
-use crate::analysis::{ClipScan, ScanOptions};
+use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
+use crate::analysis::{ClipScan, ScanOptions, scan};
 use crate::bake::Strategy;
-use crate::eval::Evaluation;
+use crate::eval::{Evaluation, Layers};
 use crate::model::{Tool, Unit, significant};
 use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 
@@ -125,6 +125,51 @@ impl Explanation {
             None => format!("{name}: {cause}"),
         }
     }
+}
+
+/// `explain`'s report of a file: the bones explained over one clip, as `explain --format json` prints it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Report<'a> {
+    pub file: String,
+    pub animation: Option<AnimationInfo>,
+    /// The mode given for every bone, or `declared`.
+    pub inherit: String,
+    pub rate: f64,
+    /// The layers the clip plays through (the default for none).
+    pub layers: Layers,
+    /// The rig's unit, where its file states one: every length (the fixes' costs) is in it.
+    pub unit: Option<Unit>,
+    pub bones: &'a [Explanation],
+}
+
+impl<'a> Report<'a> {
+    /// `bones`, explained over `evaluation`'s clip sampled at `rate` per second, of the file shown as `file`.
+    pub fn new(file: String, evaluation: &Evaluation, rate: f64, bones: &'a [Explanation]) -> Self {
+        let setup = evaluation.setup();
+        Report {
+            file,
+            animation: evaluation.clip.map(AnimationInfo::of),
+            inherit: setup.modes.label().to_owned(),
+            rate,
+            layers: setup.layers,
+            unit: evaluation.rig.unit,
+            bones,
+        }
+    }
+}
+
+/// `evaluation`'s clip scanned as `scan` reports it, each stretched bone explained in brief (its main cause and
+/// best fix) where `explained` asks: one clip of `scan [--explain]`.
+pub fn scan_clip(evaluation: &Evaluation, options: &ScanOptions, explained: bool) -> AnimationScan {
+    let result = scan(evaluation, options, &|_, _| {});
+    let briefs = match explained {
+        true => explain(evaluation, &result, Question { costs: Costs::Best, ..Question::default() }, options),
+        false => Vec::new(),
+    };
+    let inherit = evaluation.setup().modes.label().to_owned();
+    let scanned = AnimationScan::new(evaluation.skeleton(), evaluation.clip, inherit, options.rate, result);
+    let explained = briefs.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
+    AnimationScan { explained, ..scanned }
 }
 
 /// Below this fraction of the rig's size a change is not visible: the exact bake's rounding.
