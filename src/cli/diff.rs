@@ -3,13 +3,12 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Args;
 
 use super::OutputFormat;
-use super::options::{Distance, choice, clip_index, parse_assignment, parse_distance, parse_rate};
+use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
-use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, diff_files, standing_apart};
+use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
 use crate::eval::Setup;
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
@@ -77,7 +76,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     if let Some(note) = lying_down(&rig_a, &rig_b) {
         eprintln!("note: {note}");
     }
-    let chosen = chosen_clips(args, &rig_a, &rig_b)?;
+    let chosen = chosen(args, &rig_a, &rig_b)?;
     let [clip_a, clip_b] = chosen.map_or([None, None], |[a, b]| [Some(a), Some(b)]);
     let a = side(&args.a, &rig_a, args.inherit_a, clip_a);
     let mut b = side(&args.b, &rig_b, args.inherit_b, clip_b);
@@ -92,35 +91,19 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
-/// The clips `--anim-a` and `--anim-b` choose, `[in A, in B]`: a name given for one side only is looked up on both
-/// (the other file's clip named as the chosen clip is). `None`: every clip, paired by name.
-fn chosen_clips(args: &DiffArgs, a: &Rig, b: &Rig) -> anyhow::Result<Option<[usize; 2]>> {
-    let find = |path: &Path, rig: &Rig, option: &str, name: &str| clip_index(rig, option, name).context(shown(path));
-    let named_alike = |rig: &Rig, clip: usize, given: &str| rig.clips[clip].name.clone().unwrap_or(given.to_owned());
-    Ok(Some(match (&args.anim_a, &args.anim_b) {
-        (None, None) => return Ok(None),
-        (Some(x), Some(y)) => [find(&args.a, a, "--anim-a", x)?, find(&args.b, b, "--anim-b", y)?],
-        (Some(x), None) => {
-            let i = find(&args.a, a, "--anim-a", x)?;
-            [i, find(&args.b, b, "--anim-a", &named_alike(a, i, x))?]
-        }
-        (None, Some(y)) => {
-            let j = find(&args.b, b, "--anim-b", y)?;
-            [find(&args.a, a, "--anim-b", &named_alike(b, j, y))?, j]
-        }
-    }))
+/// The clips `--anim-a` and `--anim-b` choose ([`chosen_clips`]), a clip a file lacks named with the file and the
+/// option that asked for it.
+fn chosen(args: &DiffArgs, a: &Rig, b: &Rig) -> anyhow::Result<Option<[usize; 2]>> {
+    let names = [args.anim_a.as_deref(), args.anim_b.as_deref()];
+    chosen_clips([a, b], names).map_err(|missing| {
+        let file = shown(if missing.searched == 0 { &args.a } else { &args.b });
+        anyhow::anyhow!("{file}: {}: {}", ["--anim-a", "--anim-b"][missing.named_by], missing.why)
+    })
 }
 
 /// `rig` in `unit` (given as `option`), which only a rig whose file states no unit may be given.
-fn stated_unit(mut rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result<Rig> {
-    match (rig.unit, unit) {
-        (Some(stated), Some(_)) => {
-            anyhow::bail!("{option}: the file states its unit ({stated}); give one only to a file that does not (BVH)")
-        }
-        (None, given) => rig.unit = given,
-        (Some(_), None) => {}
-    }
-    Ok(rig)
+fn stated_unit(rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result<Rig> {
+    rig.given_unit(unit).map_err(|why| anyhow::anyhow!("{option}: {why}"))
 }
 
 /// `rig` (read from `path`) under `modes`, its clip `clip` (where chosen), as authored.

@@ -25,11 +25,7 @@ pub fn choice<T: Choice>() -> impl TypedValueParser<Value = T> {
 
 /// The clip named `name`, or with index `name`; the error lists the available ones.
 pub fn find_clip<'a>(rig: &'a Rig, name: &str) -> anyhow::Result<&'a Clip> {
-    rig.find_clip(name).ok_or_else(|| {
-        let available: Vec<String> = rig.clips.iter().map(|c| format!("{} ({})", c.index, c.label())).collect();
-        let available = if available.is_empty() { "none".to_owned() } else { available.join(", ") };
-        anyhow!("no animation `{name}` (available: {available})")
-    })
+    rig.clip_named(name).map_err(|why| anyhow!(why))
 }
 
 pub fn parse_bone_mode(s: &str) -> Result<(String, InheritMode), String> {

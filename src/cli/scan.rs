@@ -305,8 +305,12 @@ fn loaded_code(all_loaded: bool) -> ExitCode {
 
 fn scan_file(path: &std::path::Path, args: &ScanArgs, options: &ScanOptions) -> FileScan {
     let file = shown(path);
-    let scanned = Loaded::read(path, &args.eval)
-        .and_then(|loaded| loaded.each_clip(|evaluation| scan_clip(evaluation, options, args.explain)));
+    // Ctrl+C stops the library between files (`pool`): a file begun is scanned whole.
+    let never = AtomicBool::new(false);
+    let scanned = Loaded::read(path, &args.eval).and_then(|loaded| {
+        let scanned = |evaluation: &Evaluation| scan_clip(evaluation, options, args.explain, &never);
+        loaded.each_clip(|evaluation| scanned(evaluation).expect("never cancelled"))
+    });
     FileReport::new(file, scanned)
 }
 

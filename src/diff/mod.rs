@@ -25,7 +25,7 @@ pub use matching::{
     BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
     standing_apart,
 };
-pub use report::{AnimationDiff, Clips, FileDiff, FileSide, diff_files};
+pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_clips, diff_files};
 
 use glam::{DMat4, DQuat, DVec3};
 

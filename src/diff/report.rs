@@ -6,6 +6,40 @@ use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup};
 use crate::model::{Rig, Unit};
 
+/// The clips `names` choose, `[in A, in B]`, each a name or an index: a name given for one side only is looked up on
+/// both (the other file's clip named as the chosen clip is). `None`: every clip, paired by name. The error is a clip
+/// one file lacks: [`MissingClip`].
+pub fn chosen_clips(rigs: [&Rig; 2], names: [Option<&str>; 2]) -> Result<Option<[usize; 2]>, MissingClip> {
+    let find = |searched: usize, named_by: usize, name: &str| {
+        let rig = rigs[searched];
+        let clip = rig.clip_named(name).map_err(|why| MissingClip { searched, named_by, why })?;
+        Ok(rig.clips.iter().position(|c| std::ptr::eq(c, clip)).expect("a clip of the rig"))
+    };
+    let named_alike =
+        |side: usize, clip: usize, given: &str| rigs[side].clips[clip].name.clone().unwrap_or(given.into());
+    Ok(Some(match names {
+        [None, None] => return Ok(None),
+        [Some(x), Some(y)] => [find(0, 0, x)?, find(1, 1, y)?],
+        [Some(x), None] => {
+            let i = find(0, 0, x)?;
+            [i, find(1, 0, &named_alike(0, i, x))?]
+        }
+        [None, Some(y)] => {
+            let j = find(1, 1, y)?;
+            [find(0, 1, &named_alike(1, j, y))?, j]
+        }
+    }))
+}
+
+/// A clip name one file of a comparison lacks: the file searched (0 for A, 1 for B), the side whose choice named
+/// it, and what the file has.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MissingClip {
+    pub searched: usize,
+    pub named_by: usize,
+    pub why: String,
+}
+
 /// One side of a file comparison: a file's rig and what is evaluated of it (its modes, how its keys are played; its
 /// clip where the clips are [`Clips::Chosen`]). Its lengths are measured in the first side's unit.
 #[derive(Clone, Debug)]

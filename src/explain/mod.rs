@@ -23,11 +23,12 @@ pub use attribution::{Attribution, CauseSpan, Causes, Link, attribute, causes};
 pub use fixes::{Change, Cost, Fix, Measured, ShearElsewhere, is_other_mode};
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
 use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
-use crate::analysis::{ClipScan, ScanOptions, scan};
+use crate::analysis::{ClipScan, CurveRequest, ScanOptions, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
 use crate::model::{Tool, Unit, significant};
@@ -159,17 +160,24 @@ impl<'a> Report<'a> {
 }
 
 /// `evaluation`'s clip scanned as `scan` reports it, each stretched bone explained in brief (its main cause and
-/// best fix) where `explained` asks: one clip of `scan [--explain]`.
-pub fn scan_clip(evaluation: &Evaluation, options: &ScanOptions, explained: bool) -> AnimationScan {
-    let result = scan(evaluation, options, &|_, _| {});
+/// best fix) where `explained` asks: one clip of `scan [--explain]`. `None` once `cancel` is set (checked between
+/// runs of samples and before the explanations).
+pub fn scan_clip(
+    evaluation: &Evaluation,
+    options: &ScanOptions,
+    explained: bool,
+    cancel: &AtomicBool,
+) -> Option<AnimationScan> {
+    let result = analyze(evaluation, CurveRequest::default(), options, &|_, _| {}, cancel)?.scan;
     let briefs = match explained {
+        _ if cancel.load(Ordering::Relaxed) => return None,
         true => explain(evaluation, &result, Question { costs: Costs::Best, ..Question::default() }, options),
         false => Vec::new(),
     };
     let inherit = evaluation.setup().modes.label().to_owned();
     let scanned = AnimationScan::new(evaluation.skeleton(), evaluation.clip, inherit, options.rate, result);
     let explained = briefs.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
-    AnimationScan { explained, ..scanned }
+    Some(AnimationScan { explained, ..scanned })
 }
 
 /// Below this fraction of the rig's size a change is not visible: the exact bake's rounding.

@@ -68,6 +68,29 @@ impl Rig {
             .or_else(|| name.parse::<usize>().ok().and_then(|i| self.clips.get(i)))
     }
 
+    /// The rig measured in `unit` where its file states none (BVH): a stated unit cannot be given another.
+    pub fn given_unit(mut self, unit: Option<Unit>) -> Result<Rig, String> {
+        match (self.unit, unit) {
+            (Some(stated), Some(_)) => {
+                return Err(format!(
+                    "the file states its unit ({stated}); give one only to a file that does not (BVH)"
+                ));
+            }
+            (None, given) => self.unit = given,
+            (Some(_), None) => {}
+        }
+        Ok(self)
+    }
+
+    /// [`Rig::find_clip`]'s clip, or why there is none: "no animation `run` (available: 0 (walk), 1 (jog))".
+    pub fn clip_named(&self, name: &str) -> Result<&Clip, String> {
+        self.find_clip(name).ok_or_else(|| {
+            let available: Vec<String> = self.clips.iter().map(|c| format!("{} ({})", c.index, c.label())).collect();
+            let available = if available.is_empty() { "none".to_owned() } else { available.join(", ") };
+            format!("no animation `{name}` (available: {available})")
+        })
+    }
+
     /// Per joint of skin `skin` (in the skin's joint order), whether some vertex of a mesh it deforms has a positive
     /// weight on it.
     pub fn weighted_joints(&self, skin: usize) -> Vec<bool> {
