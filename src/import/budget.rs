@@ -24,6 +24,11 @@ pub fn set_limit(bytes: Option<u64>) {
     LIMIT.store(bytes.unwrap_or(0), Ordering::Relaxed);
 }
 
+/// The budget set, if one was (`None`: the machine's default).
+pub fn explicit_limit() -> Option<u64> {
+    Some(LIMIT.load(Ordering::Relaxed)).filter(|&set| set != 0)
+}
+
 /// The budget, in bytes.
 pub fn limit() -> u64 {
     match LIMIT.load(Ordering::Relaxed) {
