@@ -9,6 +9,8 @@ use bonescope::analysis::{Tolerances, sample};
 use bonescope::eval::Evaluation;
 use criterion::{Criterion, criterion_group, criterion_main};
 
+// Only the sparse rig and its binary form are sampled here.
+#[allow(dead_code)]
 #[path = "support/generated_gltf.rs"]
 mod generated_gltf;
 
