@@ -75,3 +75,42 @@ fn options(command: &str) -> Vec<String> {
     options.dedup();
     options
 }
+
+/// Every crate the package and the Python module depend on (normal and dev) has a row in the README's table of
+/// dependencies, which says why it is there.
+#[test]
+fn every_dependency_says_why_in_the_readme() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let rows: Vec<&str> = readme.lines().filter(|line| line.starts_with("| ")).collect();
+    let mut missing = Vec::new();
+    for manifest in ["Cargo.toml", "python/Cargo.toml"] {
+        let text = std::fs::read_to_string(root.join(manifest)).unwrap();
+        let names = dependencies(&text);
+        assert!(names.iter().any(|n| n == "serde_json"), "{manifest}'s dependencies are read: {names:?}");
+        for name in names {
+            let named = format!("`{name}`");
+            if !rows.iter().any(|row| row.split('|').nth(1).is_some_and(|cell| cell.contains(&named))) {
+                missing.push(format!("{manifest}: {name}"));
+            }
+        }
+    }
+    assert!(missing.is_empty(), "dependencies without a row in the README's table: {missing:?}");
+}
+
+/// The names in a manifest's `[dependencies]` and `[dev-dependencies]` tables (renamed ones by their package name).
+fn dependencies(manifest: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut listing = false;
+    for line in manifest.lines() {
+        if line.starts_with('[') {
+            listing = matches!(line.trim(), "[dependencies]" | "[dev-dependencies]");
+            continue;
+        }
+        let Some((name, spec)) = line.split_once('=').filter(|_| listing && !line.starts_with('#')) else { continue };
+        let package = spec.split("package = \"").nth(1).and_then(|rest| rest.split('"').next());
+        names.push(package.unwrap_or(name.trim()).to_owned());
+    }
+    names.retain(|name| !name.is_empty() && name != "bonescope");
+    names
+}

@@ -3,6 +3,8 @@ non-uniformly under a turned child, exports it with Blender's own glTF exporter 
 bonescope's shear of each bone, read back from that file, equals the shear of Blender's evaluated pose matrices
 (`pose.bones[...].matrix`) at every frame. Prints "sheared bones agree" and exits 0, else raises."""
 
+import contextlib
+import io
 import math
 import sys
 from pathlib import Path
@@ -72,3 +74,14 @@ assert {bone["name"] for bone in explained} >= {"arm"}, said
 assert all(bone["best_fix"] for bone in explained), explained
 assert any(level == "WARNING" and "arm shears" in text for level, text in said), said
 print("the example add-on reports:", *[text for _, text in said], sep="\n  ")
+
+# The README's Blender snippet, on the same armature selected.
+readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+snippet = readme.split("```python\n")[2].split("```", 1)[0]
+rig.select_set(True)
+printed = io.StringIO()
+with contextlib.redirect_stdout(printed):
+    exec(compile(snippet, "README.md", "exec"), {})
+lines = printed.getvalue().splitlines()
+assert any(line.startswith("arm: root's scale (1.8, 1, 0.7) under a 40° turn; fix: arm → ") for line in lines), lines
+print("the README's snippet prints:", *lines, sep="\n  ")

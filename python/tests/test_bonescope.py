@@ -209,7 +209,7 @@ def test_blender_reads_the_shear_bonescope_reads(tmp_path):
 
 def test_the_readme_example_prints_what_the_readme_says(capsys, monkeypatch):
     readme = Path(os.environ["BONESCOPE_README"])
-    block = readme.read_text().split("```python\n", 1)[1].split("```", 1)[0]
+    block = readme.read_text().split("```python\n", 1)[1].split("```", 1)[0]  # the first: the Blender one needs bpy
     monkeypatch.chdir(readme.parent)
     exec(compile(block, str(readme), "exec"), {})
     printed = capsys.readouterr().out.splitlines()
