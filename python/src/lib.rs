@@ -230,8 +230,7 @@ impl Rig {
         min_shear_deg: Option<f64>,
     ) -> PyResult<EvaluationArrays> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let tolerances = tolerances(min_anisotropy, min_stretch_deg, min_shear_deg)?;
-        let rate = positive_rate(rate)?;
+        let ScanOptions { rate, tolerances } = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
         if let Some(bad) = times.iter().flatten().find(|t| !t.is_finite()) {
             return Err(error(format!("times must be finite numbers of seconds, got {bad}")));
         }
@@ -264,10 +263,7 @@ impl Rig {
         min_shear_deg: Option<f64>,
     ) -> PyResult<Py<PyAny>> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let options = ScanOptions {
-            rate: positive_rate(rate)?,
-            tolerances: tolerances(min_anisotropy, min_stretch_deg, min_shear_deg)?,
-        };
+        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
         let clips: Vec<Option<usize>> = match (clip, self.rig.clips.len()) {
             (Some(_), _) => vec![setup.clip],
             (None, 0) => vec![None],
@@ -304,10 +300,7 @@ impl Rig {
         min_shear_deg: Option<f64>,
     ) -> PyResult<Py<PyAny>> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let options = ScanOptions {
-            rate: positive_rate(rate)?,
-            tolerances: tolerances(min_anisotropy, min_stretch_deg, min_shear_deg)?,
-        };
+        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
         if let Some(time) = time.filter(|t| !t.is_finite()) {
             return Err(error(format!("time must be a finite number of seconds, got {time}")));
         }
@@ -388,24 +381,23 @@ fn mode_choice(id: &str) -> PyResult<ModeChoice> {
     id.parse::<ModeChoice>().map_err(error)
 }
 
-/// The verdicts' tolerances, each a finite number ≥ 0 (the defaults for `None`).
-fn tolerances(
-    min_anisotropy: Option<f64>,
-    min_stretch_deg: Option<f64>,
-    min_shear_deg: Option<f64>,
-) -> PyResult<Tolerances> {
+/// How clips are sampled and judged: `rate` samples per second (finite, > 0) on top of the key times, and the
+/// verdicts' tolerances `[min_anisotropy, min_stretch_deg, min_shear_deg]`, each a finite number ≥ 0 (the defaults
+/// for `None`).
+fn scan_options(rate: f64, [anisotropy, stretch, shear]: [Option<f64>; 3]) -> PyResult<ScanOptions> {
     let defaults = Tolerances::default();
     let value = |name: &str, given: Option<f64>, default: f64| match given {
         None => Ok(default),
         Some(v) if v.is_finite() && v >= 0.0 => Ok(v),
         Some(v) => Err(error(format!("{name} must be a finite number ≥ 0, got {v}"))),
     };
-    Ok(Tolerances {
-        min_anisotropy: value("min_anisotropy", min_anisotropy, defaults.min_anisotropy)?,
-        min_stretch_deg: value("min_stretch_deg", min_stretch_deg, defaults.min_stretch_deg)?,
-        min_shear_deg: value("min_shear_deg", min_shear_deg, defaults.min_shear_deg)?,
+    let tolerances = Tolerances {
+        min_anisotropy: value("min_anisotropy", anisotropy, defaults.min_anisotropy)?,
+        min_stretch_deg: value("min_stretch_deg", stretch, defaults.min_stretch_deg)?,
+        min_shear_deg: value("min_shear_deg", shear, defaults.min_shear_deg)?,
         ..defaults
-    })
+    };
+    Ok(ScanOptions { rate: positive_rate(rate)?, tolerances })
 }
 
 /// Samples per second: a finite number > 0.

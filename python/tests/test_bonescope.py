@@ -165,6 +165,8 @@ def test_what_the_rig_holds():
         (lambda: bonescope.load(STRETCHY).evaluate(modes="bogus"), None),
         (lambda: bonescope.load(STRETCHY, max_memory="1KiB"), ["inspect", "--max-memory", "1KiB", STRETCHY]),
         (lambda: bonescope.diff(STRETCHY, STRETCHY, anim_a="nope"), None),
+        (lambda: bonescope.load(STRETCHY).scan(min_shear_deg=-1.0), None),
+        (lambda: bonescope.load(STRETCHY).evaluate(rate=0.0), None),
     ],
 )
 def test_bad_input_raises_bonescope_error_with_the_command_lines_message(call, cli_args):
