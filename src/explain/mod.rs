@@ -239,24 +239,26 @@ pub fn explain(
         .collect();
     let baseline = Baseline::new(evaluation, before, options);
     let tool = evaluation.rig.tool;
-    let (mut applied, mut costs) = (HashMap::new(), HashMap::new());
+    let mut known = Known::default();
     match question.costs {
         Costs::Every => {
             let every: Vec<Change> = changes.iter().flatten().copied().collect();
-            apply_all(&baseline, &every, &mut applied);
+            known.make(&baseline, &every);
             let made = distinct(every).into_iter();
-            let made: Vec<_> = made.filter_map(|change| Some((change, applied[&change].as_ref().ok()?))).collect();
-            costs = baseline.costs(&made).into_iter().collect();
+            let made: Vec<_> =
+                made.filter_map(|change| Some((change, known.applied[&change].as_ref().ok()?))).collect();
+            known.costs = baseline.costs(&made).into_iter().collect();
         }
         Costs::Best => {
             for (&bone, changes) in bones.iter().zip(&changes) {
-                if cheapest_removal(&baseline, bone, changes, tool, &mut applied, &mut costs).is_none() {
-                    apply_all(&baseline, changes, &mut applied);
-                    cheapest(&baseline, &contenders(bone, changes, &applied, tool), &applied, &mut costs);
+                if cheapest_removal(&baseline, bone, changes, tool, &mut known).is_none() {
+                    known.make(&baseline, changes);
+                    cheapest(&baseline, &contenders(bone, changes, &known.applied, tool), &mut known);
                 }
             }
         }
     }
+    let Known { applied, costs, .. } = known;
     let skeleton = evaluation.skeleton();
     let scanned = (before, tolerances.min_shear_deg);
     let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
@@ -281,55 +283,81 @@ pub fn explain(
     explained.collect()
 }
 
-/// Makes each of `changes` not yet made, in parallel.
-fn apply_all(baseline: &Baseline, changes: &[Change], applied: &mut HashMap<Change, Result<Applied, String>>) {
-    let missing = distinct(changes.iter().copied().filter(|change| !applied.contains_key(change)));
-    applied.extend(missing.into_par_iter().map(|change| (change, baseline.apply(change))).collect::<Vec<_>>());
+/// What is known of the changes looked at so far, each found once for every bone whose fixes include it: made
+/// and scanned, costed, and the lower bound of its cost.
+#[derive(Default)]
+struct Known {
+    applied: HashMap<Change, Result<Applied, String>>,
+    costs: HashMap<Change, Result<Cost, String>>,
+    /// [`Baseline::cost_bound`]; `None` where it could not be found (the change is then not a contender).
+    bounds: HashMap<Change, Option<f64>>,
+}
+
+impl Known {
+    /// Makes each of `changes` not yet made, in parallel.
+    fn make(&mut self, baseline: &Baseline, changes: &[Change]) {
+        let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
+        let made: Vec<_> = missing.into_par_iter().map(|change| (change, baseline.apply(change))).collect();
+        self.applied.extend(made);
+    }
+
+    /// The lower bound of the cost of each of `changes`, those not known yet found in parallel (a bake's needs it
+    /// made: one that is not has none).
+    fn bound(&mut self, baseline: &Baseline, changes: &[Change]) -> Vec<Option<f64>> {
+        let missing = distinct(changes.iter().copied().filter(|change| !self.bounds.contains_key(change)));
+        let applied = &self.applied;
+        let found: Vec<_> = missing
+            .into_par_iter()
+            .map(|change| {
+                let baked = match change {
+                    Change::Bake { .. } => match applied.get(&change) {
+                        Some(Ok(Applied { baked: Some(rig), .. })) => Some(rig),
+                        _ => return (change, None),
+                    },
+                    _ => None,
+                };
+                (change, baseline.cost_bound(change, baked).ok())
+            })
+            .collect();
+        self.bounds.extend(found);
+        changes.iter().map(|change| self.bounds[change]).collect()
+    }
 }
 
 /// The best fix of `bone` where a change of `changes` that sets no mode foreign to `tool` leaves it unflagged: the
-/// cheapest such change (ties: the first in `changes`), found making and costing (into `applied` and `costs`) as few
-/// changes as it takes. Changes are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]:
-/// a bake's once it is made, any other's from its setup), until the next bound exceeds the cheapest cost found (a
-/// bound never exceeds its cost). `None` where no such change removes the shear: then the best is among every
-/// change made ([`contenders`]).
+/// cheapest such change (ties: the first in `changes`), found making and costing (into `known`) as few changes as it
+/// takes. Changes are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]: a bake's once it is
+/// made, any other's from its setup), until the next bound exceeds the cheapest cost found (a bound never exceeds
+/// its cost). `None` where no such change removes the shear: then the best is among every change made
+/// ([`contenders`]).
 fn cheapest_removal(
     baseline: &Baseline,
     bone: usize,
     changes: &[Change],
     tool: Option<Tool>,
-    applied: &mut HashMap<Change, Result<Applied, String>>,
-    costs: &mut HashMap<Change, Result<Cost, String>>,
+    known: &mut Known,
 ) -> Option<Change> {
     let bakes: Vec<Change> = changes.iter().copied().filter(|c| matches!(c, Change::Bake { .. })).collect();
-    apply_all(baseline, &bakes, applied);
-    let made: &HashMap<Change, Result<Applied, String>> = applied;
-    let own = changes.iter().copied().enumerate().filter(|&(_, change)| !is_other_mode(change, tool));
-    let mut bounded: Vec<(f64, usize, Change)> = own
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .filter_map(|(index, change)| {
-            let baked = match change {
-                Change::Bake { .. } => Some(made.get(&change)?.as_ref().ok()?.baked.as_ref()?),
-                _ => None,
-            };
-            Some((baseline.cost_bound(change, baked).ok()?, index, change))
-        })
-        .collect();
+    known.make(baseline, &bakes);
+    let own: Vec<(usize, Change)> =
+        changes.iter().copied().enumerate().filter(|&(_, change)| !is_other_mode(change, tool)).collect();
+    let bounds = known.bound(baseline, &own.iter().map(|&(_, change)| change).collect::<Vec<_>>());
+    let mut bounded: Vec<(f64, usize, Change)> =
+        own.into_iter().zip(bounds).filter_map(|((index, change), bound)| Some((bound?, index, change))).collect();
     bounded.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut best: Option<(f64, usize, Change)> = None;
     for (bound, index, change) in bounded {
         if best.is_some_and(|(cost, ..)| bound > cost) {
             break;
         }
-        if !applied.contains_key(&change) && baseline.leaves_flagged(change, bone) {
+        if !known.applied.contains_key(&change) && baseline.leaves_flagged(change, bone) {
             continue;
         }
-        let Ok(made) = applied.entry(change).or_insert_with(|| baseline.apply(change)) else { continue };
+        let Ok(made) = known.applied.entry(change).or_insert_with(|| baseline.apply(change)) else { continue };
         if made.standing(bone, false).0 {
             continue;
         }
-        let cost = match (costs.get(&change), best) {
+        let cost = match (known.costs.get(&change), best) {
             (Some(known), _) => known.clone(),
             // Only a cost at most the cheapest's matters: the comparison is given up past it.
             (None, Some((cheapest, ..))) => match baseline.cost_within(change, made, cheapest) {
@@ -338,7 +366,7 @@ fn cheapest_removal(
             },
             (None, None) => baseline.cost(change, made),
         };
-        let Ok(cost) = costs.entry(change).or_insert(cost) else { continue };
+        let Ok(cost) = known.costs.entry(change).or_insert(cost) else { continue };
         let cost = cost.distance.max;
         if best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && index < first)) {
             best = Some((cost, index, change));
@@ -347,27 +375,23 @@ fn cheapest_removal(
     best.map(|(.., change)| change)
 }
 
-/// Costs enough of `contenders` into `costs` for the cheapest to be among them, exactly: lower bounds of every cost
-/// first ([`Baseline::cost_bound`]), then exact costs in the order of their bounds until the next bound exceeds the
-/// cheapest exact cost found (ties included, so the ranking's order among equal costs is kept).
-fn cheapest(
-    baseline: &Baseline,
-    contenders: &[Change],
-    applied: &HashMap<Change, Result<Applied, String>>,
-    costs: &mut HashMap<Change, Result<Cost, String>>,
-) {
-    let made = |change: &Change| applied[change].as_ref().ok();
-    let mut bounds: Vec<(f64, Change)> = contenders
-        .par_iter()
-        .filter_map(|&change| Some((baseline.cost_bound(change, made(&change)?.baked.as_ref()).ok()?, change)))
-        .collect();
+/// Costs enough of `contenders` (made) into `known` for the cheapest to be among them, exactly: lower bounds of every
+/// cost first ([`Baseline::cost_bound`]), then exact costs in the order of their bounds until the next bound exceeds
+/// the cheapest exact cost found (ties included, so the ranking's order among equal costs is kept).
+fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
+    let made: Vec<Change> =
+        contenders.iter().copied().filter(|change| matches!(known.applied.get(change), Some(Ok(_)))).collect();
+    let bounds = known.bound(baseline, &made);
+    let mut bounds: Vec<(f64, Change)> =
+        made.into_iter().zip(bounds).filter_map(|(change, bound)| Some((bound?, change))).collect();
     bounds.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut cheapest = f64::INFINITY;
     for (bound, change) in bounds {
         if bound > cheapest {
             break;
         }
-        let cost = costs.entry(change).or_insert_with(|| baseline.cost(change, made(&change).expect("bounded")));
+        let Some(Ok(made)) = known.applied.get(&change) else { continue };
+        let cost = known.costs.entry(change).or_insert_with(|| baseline.cost(change, made));
         if let Ok(cost) = cost {
             cheapest = cheapest.min(cost.distance.max);
         }
