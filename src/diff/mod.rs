@@ -30,7 +30,7 @@ pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_c
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
-use crate::eval::{BonesEvaluator, Evaluation, over_runs, skin_vertices_with};
+use crate::eval::{BonesEvaluator, Evaluation, Reach, over_runs, skin_vertices_with};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, Rig, sample_times};
 
@@ -152,8 +152,9 @@ pub enum Measure {
     /// Distances (positions and probes) and the polar parts' differences (orientation, scale, stretch).
     #[default]
     Everything,
-    /// Distances alone (what a change costs, [`crate::explain`]): no polar decomposition, the parts' differences
-    /// left at none.
+    /// The largest distances alone (what a change costs, [`crate::explain`]): no polar decomposition, the parts'
+    /// differences and the meshes' means left at none. Between two evaluations of one rig, a time at which a mesh's
+    /// vertices provably lie no further apart than the largest distance already found ([`Reach`]) is not skinned.
     Distances,
 }
 
@@ -300,7 +301,11 @@ fn compare_each_within(
     limit: f64,
 ) -> Vec<Option<Comparison>> {
     let probe_length = rig_size * PROBE_FRACTION;
-    let fresh = || sides.iter().map(|&(b, pairs)| Differences::new(a, b, pairs)).collect::<Vec<_>>();
+    let reaches: Vec<Vec<Option<Reach>>> = sides.iter().map(|&(b, pairs)| reaches(a, b, pairs)).collect();
+    let fresh = || {
+        let sides = sides.iter().zip(&reaches);
+        sides.map(|(&(b, pairs), reaches)| Differences::new(a, b, pairs, reaches, rig_size)).collect::<Vec<_>>()
+    };
     let plan_a = Plan::new(
         a,
         sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0)),
@@ -325,7 +330,7 @@ fn compare_each_within(
             side_a.evaluate(time);
             for (side_b, found) in others.iter_mut().zip(&mut differences).filter(|(_, f)| f.largest <= limit) {
                 side_b.evaluate(time);
-                found.add(&side_a, side_b, probe_length, time);
+                found.add(&mut side_a, side_b, probe_length, time);
             }
         }
         differences
@@ -348,15 +353,19 @@ fn compare_each_within(
 struct Differences<'p> {
     bones: Vec<BoneDifference>,
     meshes: Vec<MeshDifference>,
-    /// The mesh pairs, with the vertices compared.
+    /// The mesh pairs, with the vertices compared, and how far each pair's vertices can lie apart where that is
+    /// known from the joints alone ([`reaches`]).
     pairs: &'p [MeshPair],
+    reaches: &'p [Option<Reach>],
     measure: Measure,
     /// The largest probe or vertex distance found.
     largest: f64,
+    /// What a bound must stay under the largest distance by to skip skinning: rounding, at the rig's size.
+    margin: f64,
 }
 
 impl<'p> Differences<'p> {
-    fn new(a: &Evaluation, b: &Evaluation, pairs: &'p Pairs) -> Self {
+    fn new(a: &Evaluation, b: &Evaluation, pairs: &'p Pairs, reaches: &'p [Option<Reach>], rig_size: f64) -> Self {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
         let bones =
             pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
@@ -367,17 +376,18 @@ impl<'p> Differences<'p> {
             MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
         let (bones, meshes, measure) = (bones.collect(), meshes.collect(), pairs.measure);
-        Differences { bones, meshes, pairs: &pairs.meshes, measure, largest: 0.0 }
+        let margin = 1e-12 * rig_size;
+        Differences { bones, meshes, pairs: &pairs.meshes, reaches, measure, largest: 0.0, margin }
     }
 
     fn merge(self, later: Differences) -> Self {
         let bones = self.bones.into_iter().zip(later.bones).map(|(x, y)| x.merge(y)).collect();
         let meshes = self.meshes.into_iter().zip(later.meshes).map(|(x, y)| x.merge(y)).collect();
         let largest = self.largest.max(later.largest);
-        Differences { bones, meshes, pairs: self.pairs, measure: self.measure, largest }
+        Differences { bones, meshes, largest, ..self }
     }
 
-    fn add(&mut self, a: &Side, b: &Side, probe_length: f64, time: f64) {
+    fn add(&mut self, a: &mut Side, b: &mut Side, probe_length: f64, time: f64) {
         let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
@@ -393,13 +403,24 @@ impl<'p> Differences<'p> {
             difference.scale_ratio.add(scale_ratio(pa.scale, pb.scale), time);
             difference.stretch_deg.add(stretch_difference_deg(pa, pb), time);
         }
-        for (difference, pair) in self.meshes.iter_mut().zip(self.pairs) {
+        let skins = &a.plan.evaluation.rig.skins;
+        for ((difference, pair), reach) in self.meshes.iter_mut().zip(self.pairs).zip(self.reaches) {
+            let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
+            let bound = reach.as_ref().map(|reach| reach.bound(skins, model_a, model_b));
+            if bound.is_some_and(|bound| bound * (1.0 + 1e-9) + self.margin < difference.distance.max) {
+                continue;
+            }
+            a.skin(difference.a);
+            b.skin(difference.b);
             let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
             let mut largest: f64 = 0.0;
+            let everything = self.measure == Measure::Everything;
             let mut add = |p: &DVec3, q: &DVec3| {
                 let d = p.distance(*q);
                 largest = largest.max(d);
-                difference.sum += d;
+                if everything {
+                    difference.sum += d;
+                }
             };
             match &pair.vertices {
                 Some(vertices) => vertices.iter().map(|&v| v as usize).for_each(|v| add(&va[v], &vb[v])),
@@ -409,6 +430,19 @@ impl<'p> Differences<'p> {
             self.largest = self.largest.max(largest);
         }
     }
+}
+
+/// Per mesh pair of `pairs`, how far its vertices can lie apart, known from the joints alone where both sides are
+/// evaluations of one rig skinning alike and only the largest distances are measured ([`Measure::Distances`]: the
+/// means need every vertex at every time).
+fn reaches(a: &Evaluation, b: &Evaluation, pairs: &Pairs) -> Vec<Option<Reach>> {
+    let alike = pairs.measure == Measure::Distances && std::ptr::eq(a.rig, b.rig) && a.skinning == b.skinning;
+    let reach = |pair: &MeshPair| {
+        let rig = a.rig;
+        let mesh = rig.meshes.get(pair.a).filter(|_| alike && pair.a == pair.b)?;
+        Reach::of(mesh, &rig.skins, a.skinning, pair.vertices.as_deref())
+    };
+    pairs.meshes.iter().map(reach).collect()
 }
 
 /// What one side of a comparison evaluates at each time, found once: the bones compared (sorted, each once), the
@@ -495,18 +529,21 @@ struct Side<'e, 'a> {
     parts: Vec<AffineParts>,
     length_scales: Vec<f64>,
     skinned: Vec<Vec<DVec3>>,
+    /// Per mesh, whether `skinned` holds it at the time evaluated.
+    fresh: Vec<bool>,
 }
 
 impl<'e, 'a> Side<'e, 'a> {
     fn new(plan: &'e Plan<'a>) -> Self {
         let evaluation = plan.evaluation;
         let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
+        let fresh = vec![false; skinned.len()];
         let length_scales = evaluation.length_scales();
         let evaluator = BonesEvaluator::new(evaluation, &plan.needed);
-        Side { evaluator, plan, parts: Vec::new(), length_scales, skinned }
+        Side { evaluator, plan, parts: Vec::new(), length_scales, skinned, fresh }
     }
 
-    /// Evaluates the side at `time`.
+    /// Evaluates the side's bones at `time` (its meshes are skinned when asked: [`Side::skin`]).
     fn evaluate(&mut self, time: f64) {
         let pose = self.evaluator.evaluate(time);
         if self.plan.decompose {
@@ -515,19 +552,20 @@ impl<'e, 'a> Side<'e, 'a> {
                 self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
             }
         }
-        let evaluation = self.plan.evaluation;
-        let (rig, method) = (evaluation.rig, evaluation.skinning);
-        for (mesh, vertices) in &self.plan.meshes {
-            let posed = (&pose.model.model[..], &pose.morph);
-            skin_vertices_with(
-                &rig.meshes[*mesh],
-                &rig.skins,
-                posed,
-                method,
-                vertices.as_deref(),
-                &mut self.skinned[*mesh],
-            );
+        self.fresh.fill(false);
+    }
+
+    /// Skins mesh `mesh` (its vertices the plan compares) at the time evaluated, once.
+    fn skin(&mut self, mesh: usize) {
+        if std::mem::replace(&mut self.fresh[mesh], true) {
+            return;
         }
+        let Some((_, vertices)) = self.plan.meshes.iter().find(|(m, _)| *m == mesh) else { return };
+        let evaluation = self.plan.evaluation;
+        let pose = self.evaluator.pose();
+        let posed = (&pose.model.model[..], &pose.morph);
+        let (rig, method) = (evaluation.rig, evaluation.skinning);
+        skin_vertices_with(&rig.meshes[mesh], &rig.skins, posed, method, vertices.as_deref(), &mut self.skinned[mesh]);
     }
 }
 

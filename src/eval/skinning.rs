@@ -80,15 +80,110 @@ pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
 /// [`joint_matrices`] of the joints `used` marks (every one for `None`; the identity elsewhere).
 fn joint_matrices_of(skin: &Skin, model: &[DMat4], used: Option<&[bool]>, out: &mut Vec<DMat4>) {
     out.clear();
-    let moved = skin.node_bind.map(|node| model[node.bone] * node.inverse_bind);
-    let joints = skin.joints.iter().zip(&skin.inverse_bind).enumerate().map(|(j, (&bone, ibm))| {
+    let moved = moved_since_bind(skin, model);
+    let joints = (0..skin.joints.len()).map(|j| {
         if used.is_some_and(|used| !used.get(j).copied().unwrap_or(false)) {
             return DMat4::IDENTITY;
         }
-        let joint = model[bone] * *ibm;
-        moved.map_or(joint, |moved| moved * joint)
+        joint_matrix(skin, model, moved, j)
     });
     out.extend(joints);
+}
+
+/// The mesh node's motion since the bind, where the skin follows its node.
+fn moved_since_bind(skin: &Skin, model: &[DMat4]) -> Option<DMat4> {
+    skin.node_bind.map(|node| model[node.bone] * node.inverse_bind)
+}
+
+/// The joint matrix of joint `j` of `skin`, given [`moved_since_bind`].
+fn joint_matrix(skin: &Skin, model: &[DMat4], moved: Option<DMat4>, j: usize) -> DMat4 {
+    let joint = model[skin.joints[j]] * skin.inverse_bind[j];
+    moved.map_or(joint, |moved| moved * joint)
+}
+
+/// How far the vertices of a linearly skinned mesh can lie apart under two poses, bounded from their joints alone.
+/// A vertex bound at `p` lands at `Σ w_j·J_j·p`, so two poses put it at most `Σ|w_j| · max_j |(J_j − J′_j)·p|` apart,
+/// and `|(J − J′)·p|` is convex in `p`: over the box of the vertices weighted to a joint it is largest at a corner.
+/// Lets a comparison skip skinning where the bound says nothing can move further than what it has already seen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reach {
+    /// Per joint some vertex is weighted to (a skin's joint index, or the mesh's bone for an unskinned mesh), the
+    /// corners of those vertices' box.
+    joints: Vec<(usize, [DVec3; 8])>,
+    /// The largest `Σ|w_j|` of a vertex (1 unskinned).
+    weight: f64,
+    skin: Option<usize>,
+}
+
+impl Reach {
+    /// The reach of `vertices` of `mesh` (every one for `None`) skinned by `method`; `None` where the bound does
+    /// not hold: morph targets (the bind positions move), a dual-quaternion blend, vertices that are not finite.
+    pub fn of(mesh: &Mesh, skins: &[Skin], method: Method, vertices: Option<&[u32]>) -> Option<Reach> {
+        if !mesh.morph_targets.is_empty() {
+            return None;
+        }
+        let chosen: Vec<usize> = match vertices {
+            Some(list) => list.iter().map(|&v| v as usize).filter(|&v| v < mesh.positions.len()).collect(),
+            None => (0..mesh.positions.len()).collect(),
+        };
+        let position = |v: usize| Some(mesh.positions[v].as_dvec3()).filter(|p| p.is_finite());
+        let skin = mesh.skin.filter(|&s| s < skins.len() && mesh.joints.len() == mesh.positions.len());
+        let Some(skin) = skin else {
+            let points: Option<Vec<DVec3>> = chosen.iter().map(|&v| position(v)).collect();
+            return Some(Reach { joints: vec![(mesh.bone, corners(&points?)?)], weight: 1.0, skin: None });
+        };
+        let mut boxes: Vec<Option<(DVec3, DVec3)>> = vec![None; skins[skin].joints.len()];
+        let mut weight: f64 = 0.0;
+        for v in chosen {
+            if method.dq_weight(mesh, v) != 0.0 {
+                return None;
+            }
+            let (p, weights) = (position(v)?, mesh.weights.get(v)?);
+            let influences = mesh.joints[v].iter().zip(weights).filter(|(_, w)| **w != 0.0);
+            let mut sum = 0.0;
+            for (&j, &w) in influences {
+                let slot = boxes.get_mut(usize::from(j))?;
+                *slot = Some(slot.map_or((p, p), |(low, high)| (low.min(p), high.max(p))));
+                sum += f64::from(w).abs();
+            }
+            weight = weight.max(sum);
+        }
+        let joints = boxes.iter().enumerate().filter_map(|(j, b)| Some((j, box_corners((*b)?))));
+        Some(Reach { joints: joints.collect(), weight, skin: Some(skin) })
+    }
+
+    /// The most any of the vertices lies apart under the poses whose model matrices (of every bone) are `a` and `b`.
+    pub fn bound(&self, skins: &[Skin], a: &[DMat4], b: &[DMat4]) -> f64 {
+        let apart = |d: DMat4, corners: &[DVec3; 8]| {
+            corners.iter().map(|&c| (d * c.extend(1.0)).truncate().length()).fold(0.0, f64::max)
+        };
+        let joints = self.joints.iter().map(|(joint, corners)| {
+            let difference = match self.skin.map(|s| &skins[s]) {
+                Some(skin) => {
+                    let (moved_a, moved_b) = (moved_since_bind(skin, a), moved_since_bind(skin, b));
+                    joint_matrix(skin, a, moved_a, *joint) - joint_matrix(skin, b, moved_b, *joint)
+                }
+                None => a[*joint] - b[*joint],
+            };
+            apart(difference, corners)
+        });
+        self.weight * joints.fold(0.0, f64::max)
+    }
+}
+
+/// The corners of the box of `points`; `None` for no points.
+fn corners(points: &[DVec3]) -> Option<[DVec3; 8]> {
+    let first = *points.first()?;
+    let (low, high) = points.iter().fold((first, first), |(low, high), &p| (low.min(p), high.max(p)));
+    Some(box_corners((low, high)))
+}
+
+/// The eight corners of the box from `low` to `high`.
+fn box_corners((low, high): (DVec3, DVec3)) -> [DVec3; 8] {
+    std::array::from_fn(|k| {
+        let pick = |bit: usize, l: f64, h: f64| if k & bit == 0 { l } else { h };
+        DVec3::new(pick(1, low.x, high.x), pick(2, low.y, high.y), pick(4, low.z, high.z))
+    })
 }
 
 /// The positions of `mesh` in model space, given the model matrices of all bones (`out` is reused), skinned as the
@@ -288,6 +383,50 @@ mod tests {
             ..Mesh::default()
         };
         (skin, mesh)
+    }
+
+    #[test]
+    fn a_reach_bounds_how_far_every_vertex_lies_apart() {
+        // Random skins of 40 vertices over 5 joints (a node bind on every other one) under random sheared poses:
+        // the bound is never below the largest vertex distance, and for one joint moved by a translation alone it
+        // is that translation.
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_xorshift::XorShiftRng::seed_from_u64(11);
+        let mut noise = |scale: f64| DVec3::from_array(std::array::from_fn(|_| (rng.random::<f64>() - 0.5) * scale));
+        for case in 0..200 {
+            let joints = 5;
+            let matrix = |n: &mut dyn FnMut(f64) -> DVec3| {
+                DMat4::from_cols(n(2.0).extend(0.0), n(2.0).extend(0.0), n(2.0).extend(0.0), n(10.0).extend(1.0))
+            };
+            let inverse_bind = (0..joints).map(|_| matrix(&mut noise)).collect();
+            let node_bind =
+                (case % 2 == 0).then(|| crate::model::NodeBind { bone: 0, inverse_bind: matrix(&mut noise) });
+            let skin = Skin { joints: (0..joints).collect(), inverse_bind, node_bind, ..Skin::default() };
+            let mut mesh = Mesh { skin: Some(0), ..Mesh::default() };
+            for _ in 0..40 {
+                mesh.positions.push(noise(4.0).as_vec3());
+                let picked: [u16; 4] = std::array::from_fn(|_| (noise(1.0).x.abs() * 9.9) as u16 % joints as u16);
+                let weights = noise(1.0).abs();
+                mesh.joints.push(picked);
+                mesh.weights.push([weights.x as f32, weights.y as f32, weights.z as f32, 0.25]);
+            }
+            let (a, b): (Vec<DMat4>, Vec<DMat4>) =
+                (0..joints).map(|_| (matrix(&mut noise), matrix(&mut noise))).unzip();
+            let skins = [skin];
+            let reach = Reach::of(&mesh, &skins, Method::Linear, None).expect("a linear skin has a reach");
+            let (mut at_a, mut at_b) = (Vec::new(), Vec::new());
+            skin_positions_with(&mesh, &skins, &a, &MorphPose::default(), Method::Linear, &mut at_a);
+            skin_positions_with(&mesh, &skins, &b, &MorphPose::default(), Method::Linear, &mut at_b);
+            let largest = at_a.iter().zip(&at_b).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max);
+            let bound = reach.bound(&skins, &a, &b);
+            assert!(bound >= largest * (1.0 - 1e-12), "case {case}: bound {bound} under {largest}");
+        }
+        let (skin, mesh) = two_joints(DVec3::new(0.3, -1.0, 2.0), 1.0, 0.0, vec![]);
+        let moved = [DMat4::from_translation(DVec3::new(0.0, 3.0, 4.0)), DMat4::IDENTITY];
+        let reach = Reach::of(&mesh, std::slice::from_ref(&skin), Method::Linear, None).unwrap();
+        assert!((reach.bound(&[skin], &moved, &[DMat4::IDENTITY; 2]) - 5.0).abs() < 1e-12);
+        let (skin, mesh) = two_joints(DVec3::X, 0.5, 0.5, vec![0.5]);
+        assert_eq!(Reach::of(&mesh, &[skin], Method::AsFile, None), None, "no bound through dual quaternions");
     }
 
     fn skinned(skin: Skin, mesh: &Mesh, model: &[DMat4], method: Method) -> DVec3 {
