@@ -60,9 +60,10 @@ pub fn analyze(
 
 /// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time` (else the last
 /// run): exactly what the whole-clip analysis finds in that run, which is judged on its own, here for the bone's
-/// chain alone. A cheap first look where a change is expected to leave a bone flagged where it was worst.
-pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, options: &ScanOptions) -> bool {
-    let times = evaluation.times(options.rate);
+/// chain alone. `times` are the analysis's, `evaluation.times(options.rate)` (found once by a caller asking many
+/// times). A cheap first look where a change is expected to leave a bone flagged where it was worst.
+pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[f64], options: &ScanOptions) -> bool {
+    debug_assert_eq!(times, evaluation.times(options.rate), "the analysis's times");
     let Some(last) = times.len().checked_sub(1) else {
         return false;
     };
@@ -152,7 +153,7 @@ mod tests {
                     let first = run * length;
                     let expected = (first..first + samples.len()).any(|s| whole.stretched_at(bone, s));
                     for time in [samples[0], samples[samples.len() / 2], samples[samples.len() - 1]] {
-                        let found = flagged_in_run(evaluation, bone, time, &options);
+                        let found = flagged_in_run(evaluation, bone, time, &whole.times, &options);
                         assert_eq!(found, expected, "bone {bone}, run {run}, {time} s");
                     }
                     flagged_runs += usize::from(expected);

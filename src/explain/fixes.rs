@@ -121,13 +121,17 @@ pub(super) struct Baseline<'e, 'a> {
     /// The source's own comparison times, and its size over them.
     times: Vec<f64>,
     size: f64,
+    /// The times a scan of the source samples, which a change of modes or a uniform scale keeps (they follow the
+    /// clip, and layers only where they retime it).
+    analysis_times: Vec<f64>,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
     pub fn new(source: &'e Evaluation<'a>, before: &'e ClipScan, options: &'e ScanOptions) -> Self {
         let times = comparison_times(source, source, options.rate);
         let size = source.size(&times);
-        Baseline { source, before, options, times, size }
+        let analysis_times = source.times(options.rate);
+        Baseline { source, before, options, times, size, analysis_times }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -177,7 +181,9 @@ impl<'e, 'a> Baseline<'e, 'a> {
     pub fn leaves_flagged(&self, change: Change, bone: usize) -> bool {
         let worst = self.before.bones.get(bone).map(|b| b.worst_shear_time);
         match (change.changed_below(), worst, self.fixed(change, None)) {
-            (Some(_), Some(worst), Ok(fixed)) => flagged_in_run(&fixed, bone, worst, self.options),
+            (Some(_), Some(worst), Ok(fixed)) => {
+                flagged_in_run(&fixed, bone, worst, &self.analysis_times, self.options)
+            }
             _ => false,
         }
     }
