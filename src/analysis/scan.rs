@@ -58,8 +58,9 @@ pub fn analyze(
     Some(analysis)
 }
 
-/// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time` (else the last
-/// run): exactly what the whole-clip analysis finds in that run, which is judged on its own, here for the bone's
+/// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time`, from the run's
+/// first sample to the one at `time` (or the first after it; the last sample for a later time): exactly what the
+/// whole-clip analysis finds there, since a run is judged on its own from its first sample on, here for the bone's
 /// chain alone. `times` are the analysis's, `evaluation.times(options.rate)` (found once by a caller asking many
 /// times). A cheap first look where a change is expected to leave a bone flagged where it was worst.
 pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[f64], options: &ScanOptions) -> bool {
@@ -67,12 +68,11 @@ pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[
     let Some(last) = times.len().checked_sub(1) else {
         return false;
     };
-    let run_length = run_length(times.len());
-    let run = times.partition_point(|&t| t < time).min(last) / run_length;
-    let run = &times[run * run_length..times.len().min((run + 1) * run_length)];
+    let at = times.partition_point(|&t| t < time).min(last);
+    let first = at - at % run_length(times.len());
     let request = CurveRequest { judged: Judged::Chain(bone), ..CurveRequest::default() };
     let plan = Plan::new(evaluation, request.bones, request.judged);
-    analyze_chunk(evaluation, &plan, request, options, run, CurveSlices::default()).flagged(bone)
+    analyze_chunk(evaluation, &plan, request, options, &times[first..=at], CurveSlices::default()).flagged(bone)
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.
@@ -136,7 +136,8 @@ mod tests {
     #[test]
     fn a_run_is_judged_as_the_whole_clip_judges_it() {
         // The demo's arm judged bone by bone (full inheritance) and sample by sample (the forearm compensating):
-        // every bone's verdict over every run, looked up from any time in it, equals the whole analysis's there.
+        // every bone's verdict from the start of a run to a sample, looked up from that sample's time or from just
+        // before it, equals the whole analysis's over those samples.
         let rig = demo_rig();
         let declared = Evaluation::declared(&rig, rig.clips.first());
         let mut modes = declared.modes().to_vec();
@@ -147,16 +148,19 @@ mod tests {
         let mut flagged_runs = 0;
         for evaluation in [&declared, &compensating] {
             let whole = analyze(evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
-            let length = run_length(whole.times.len());
+            let times = &whole.times;
+            let length = run_length(times.len());
             for bone in 0..rig.skeleton.len() {
-                for (run, samples) in whole.times.chunks(length).enumerate() {
+                for (run, samples) in times.chunks(length).enumerate() {
                     let first = run * length;
-                    let expected = (first..first + samples.len()).any(|s| whole.stretched_at(bone, s));
-                    for time in [samples[0], samples[samples.len() / 2], samples[samples.len() - 1]] {
-                        let found = flagged_in_run(evaluation, bone, time, &whole.times, &options);
-                        assert_eq!(found, expected, "bone {bone}, run {run}, {time} s");
+                    for at in [0, samples.len() / 2, samples.len() - 1] {
+                        let expected = (first..=first + at).any(|s| whole.stretched_at(bone, s));
+                        for time in [samples[at], samples[at] - 1e-9] {
+                            let found = flagged_in_run(evaluation, bone, time, times, &options);
+                            assert_eq!(found, expected, "bone {bone}, run {run}, sample {at}, {time} s");
+                        }
+                        flagged_runs += usize::from(expected);
                     }
-                    flagged_runs += usize::from(expected);
                 }
             }
         }
