@@ -16,7 +16,6 @@ use egui::{pos2, vec2};
 use super::document::{Ghost, ModeScope};
 use super::panel::Shared;
 use super::text::{compact, drawable, name_label, text_width};
-use super::work::WhyRequest;
 use crate::analysis::ScanOptions;
 use crate::eval::Setup;
 use crate::explain::{Change, Explanation, Fix, Link, Measured};
@@ -125,9 +124,9 @@ fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
         return;
     }
     let options = ScanOptions { rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
-    let request = WhyRequest { bone, options };
-    match shared.work.explanation(shared.doc, request).cloned() {
-        Some(explained) => explanation_ui(ui, shared, &explained),
+    match shared.work.explanation(shared.doc, bone, options) {
+        Some((explained, true)) => explanation_ui(ui, shared, &explained),
+        Some((first, false)) => first_answer_ui(ui, shared, &first),
         None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
     }
 }
@@ -153,6 +152,21 @@ fn spinner(ui: &mut Ui, text: &str) {
         ui.spinner();
         ui.label(RichText::new(text).weak());
     });
+}
+
+/// The explanation with its best fix alone, while every fix is ranked: the headline (the cause and that fix), the
+/// chain and the causes over the clip.
+fn first_answer_ui(ui: &mut Ui, shared: &mut Shared, first: &Explanation) {
+    ui.label(drawable(&first.headline(shared.doc.rig.unit)));
+    if first.causes.stretched_samples == 0 {
+        return;
+    }
+    ui.add_space(4.0);
+    chain(ui, shared, first);
+    ui.add_space(4.0);
+    spans(ui, shared, first);
+    ui.add_space(4.0);
+    spinner(ui, "ranking every fix…");
 }
 
 fn explanation_ui(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {

@@ -16,7 +16,7 @@ use crate::analysis::{
 };
 use crate::diff::{Pairs, compare, comparison_times, model_curves};
 use crate::eval::{Evaluation, Setup};
-use crate::explain::{Explanation, Question, explain};
+use crate::explain::{Costs, Explanation, Question, explain};
 use crate::model::Rig;
 
 /// What a whole-clip analysis is asked.
@@ -31,12 +31,20 @@ pub struct AnalysisRequest {
     pub judged: Judged,
 }
 
-/// What an explanation is asked: the bone, and how the clip is sampled and judged (as the whole-clip analysis
-/// samples and judges it, so that both flag the same samples).
+/// What an explanation is asked: the bone, how the clip is sampled and judged (as the whole-clip analysis samples
+/// and judges it, so that both flag the same samples), and which fixes are costed.
 #[derive(Clone, Debug, PartialEq)]
-pub struct WhyRequest {
-    pub bone: usize,
-    pub options: ScanOptions,
+struct WhyRequest {
+    bone: usize,
+    options: ScanOptions,
+    costs: Costs,
+}
+
+/// Which of the two explanation jobs.
+#[derive(Clone, Copy)]
+enum Which {
+    Best,
+    Every,
 }
 
 /// What a comparison with the compared file is asked: that file (this pairing of it) as evaluated, and how often
@@ -100,7 +108,11 @@ pub struct Work {
     compared_curves: Job<Key<CurvesRequest>, ComparedCurves>,
     bind: Job<Key<()>, BindCheck>,
     storage: Job<Key<()>, StorageReport>,
+    /// The explained bone's best fix first (`explain::Costs::Best`, a fraction of the time), then every fix ranked.
+    best_fix: Job<Key<WhyRequest>, Explanation>,
     explanation: Job<Key<WhyRequest>, Explanation>,
+    /// The ranking last asked for, started once its best fix is known (by the UI's next frame, or by [`Work::settle`]).
+    ranking_asked: Option<(Key<WhyRequest>, Arc<Rig>)>,
     /// Woken when a job finishes, so that the UI shows its result.
     waker: Option<egui::Context>,
 }
@@ -201,16 +213,39 @@ impl Work {
         (self.storage.for_key(&Key::of(doc, ())), running)
     }
 
-    /// The explanation `request` asks of what `doc` evaluates: started when asked anew (one at a time: it cannot
-    /// stop half way, so a newer one waits for the one under way to finish), `None` until done.
-    pub fn explanation(&mut self, doc: &Document, request: WhyRequest) -> Option<&Arc<Explanation>> {
-        let key = Key::of(doc, request);
-        if !self.explanation.busy_with_other(&key) {
-            let (rig, explained) = (doc.rig.clone(), key.clone());
+    /// `bone` of what `doc` evaluates explained (the clip sampled and judged with `options`), as far as it is known: its best fix first
+    /// ([`Costs::Best`]), then every fix ranked ([`Costs::Every`], started once the first is done, so that it takes
+    /// no core from it). Each is started when asked anew (one at a time: it cannot stop half way, so a newer one
+    /// waits for the one under way to finish); the flag says whether the ranking is complete.
+    pub fn explanation(
+        &mut self,
+        doc: &Document,
+        bone: usize,
+        options: ScanOptions,
+    ) -> Option<(Arc<Explanation>, bool)> {
+        let best = Key::of(doc, WhyRequest { bone, options, costs: Costs::Best });
+        let every = Key { request: WhyRequest { costs: Costs::Every, ..best.request.clone() }, ..best.clone() };
+        self.explain(Which::Best, best.clone(), doc.rig.clone());
+        self.ranking_asked = Some((every.clone(), doc.rig.clone()));
+        let first = self.best_fix.for_key(&best)?.clone();
+        self.explain(Which::Every, every.clone(), doc.rig.clone());
+        Some(match self.explanation.for_key(&every) {
+            Some(ranked) => (ranked.clone(), true),
+            None => (first, false),
+        })
+    }
+
+    /// Starts the explanation `key` asks of `rig` in its job, unless that job is busy with another.
+    fn explain(&mut self, which: Which, key: Key<WhyRequest>, rig: Arc<Rig>) {
+        let job = match which {
+            Which::Best => &mut self.best_fix,
+            Which::Every => &mut self.explanation,
+        };
+        if !job.busy_with_other(&key) {
+            let explained = key.clone();
             let work = || move |progress: &Progress| explanation(&rig, &explained, progress);
-            Work::start(&self.waker, &mut self.explanation, key.clone(), work);
+            Work::start(&self.waker, job, key, work);
         }
-        self.explanation.for_key(&key)
     }
 
     /// Whether the analyses of the window's state are still being computed.
@@ -231,6 +266,10 @@ impl Work {
         self.compared_curves.wait();
         self.bind.wait();
         self.storage.wait();
+        self.best_fix.wait();
+        if let Some((key, rig)) = self.ranking_asked.clone() {
+            self.explain(Which::Every, key, rig);
+        }
         self.explanation.wait();
     }
 }
@@ -281,7 +320,7 @@ fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<
     let (bone, options) = (key.request.bone, &key.request.options);
     let report = |done: usize, total: usize| progress.report(done, total);
     let before = analyze(&evaluation, CurveRequest::default(), options, &report, progress.cancelled())?.scan;
-    let question = Question { bones: Some(&[bone]), ..Question::default() };
+    let question = Question { bones: Some(&[bone]), costs: key.request.costs, ..Question::default() };
     explain(&evaluation, &before, question, options).pop()
 }
 
@@ -318,5 +357,30 @@ fn compared_curves(
         let partners: Vec<usize> = paired.iter().map(|&(_, p)| p).collect();
         let curves = model_curves(&key.evaluation(&compared.rig)?, &partners, &request.times);
         Some(paired.into_iter().map(|(b, _)| b).zip(curves).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_best_fix_comes_first_then_every_fix_ranked() {
+        // The demo's forearm: nothing known at first; once its best-fix job is done the explanation has that fix
+        // (and only the fixes it took to find it); the ranking that follows has every fix, the same one first.
+        let doc = Document::demo();
+        let forearm = doc.rig.skeleton.find("forearm").unwrap();
+        let options = ScanOptions::default();
+        let mut work = Work::default();
+        assert!(work.explanation(&doc, forearm, options).is_none(), "nothing is known before the first job ends");
+        work.best_fix.wait();
+        let (first, _) = work.explanation(&doc, forearm, options).expect("the best fix is known");
+        work.explanation.wait();
+        let (ranked, ranked_complete) = work.explanation(&doc, forearm, options).expect("the ranking is known");
+        assert!(ranked_complete, "the ranking is complete once its job ends");
+        let change = |e: &Explanation| e.best_fix().map(|fix| fix.change);
+        assert_eq!(change(&first), change(&ranked), "the first answer is the ranking's best");
+        assert!(first.best_fix().is_some() && first.fixes.len() < ranked.fixes.len(), "{}", first.fixes.len());
+        assert_eq!(first.headline(doc.rig.unit), ranked.headline(doc.rig.unit), "the same line heads both");
     }
 }
