@@ -11,8 +11,8 @@ use super::identity::RigId;
 use super::job::{Job, Key, Progress};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{
-    BindCheck, BindTolerance, ClipAnalysis, Components, CurveRequest, Judged, ScanOptions, Tolerances, analyze,
-    check_bind,
+    BindCheck, BindTolerance, ClipAnalysis, ClipScan, Components, CurveRequest, Judged, ScanOptions, Tolerances,
+    analyze, check_bind,
 };
 use crate::diff::{Pairs, compare, comparison_times, model_curves};
 use crate::eval::{Evaluation, Setup};
@@ -111,8 +111,8 @@ pub struct Work {
     /// The explained bone's best fix first (`explain::Costs::Best`, a fraction of the time), then every fix ranked.
     best_fix: Job<Key<WhyRequest>, Explanation>,
     explanation: Job<Key<WhyRequest>, Explanation>,
-    /// The ranking last asked for, started once its best fix is known (by the UI's next frame, or by [`Work::settle`]).
-    ranking_asked: Option<(Key<WhyRequest>, Arc<Rig>)>,
+    /// The bone last explained and its options: what [`Work::settle`] explains to the end.
+    why_asked: Option<(usize, ScanOptions)>,
     /// Woken when a job finishes, so that the UI shows its result.
     waker: Option<egui::Context>,
 }
@@ -213,37 +213,43 @@ impl Work {
         (self.storage.for_key(&Key::of(doc, ())), running)
     }
 
-    /// `bone` of what `doc` evaluates explained (the clip sampled and judged with `options`), as far as it is known: its best fix first
-    /// ([`Costs::Best`]), then every fix ranked ([`Costs::Every`], started once the first is done, so that it takes
-    /// no core from it). Each is started when asked anew (one at a time: it cannot stop half way, so a newer one
-    /// waits for the one under way to finish); the flag says whether the ranking is complete.
+    /// `bone` of what `doc` evaluates explained (the clip sampled and judged with `options`), as far as it is known,
+    /// from the window's whole-clip analysis of it (`None` until that is done): its best fix first ([`Costs::Best`]),
+    /// then every fix ranked ([`Costs::Every`], started once the first is done, so that it takes no core from it).
+    /// Each is started when asked anew (one at a time: it cannot stop half way, so a newer one waits for the one
+    /// under way to finish); the flag says whether the ranking is complete.
     pub fn explanation(
         &mut self,
         doc: &Document,
         bone: usize,
         options: ScanOptions,
     ) -> Option<(Arc<Explanation>, bool)> {
+        self.why_asked = Some((bone, options));
+        let analysed =
+            Key::of(doc, AnalysisRequest { ghost: None, plotted: Vec::new(), options, judged: Judged::Every });
+        self.analysis.collect();
+        let before = self.analysis.for_key(&analysed)?.clone();
         let best = Key::of(doc, WhyRequest { bone, options, costs: Costs::Best });
         let every = Key { request: WhyRequest { costs: Costs::Every, ..best.request.clone() }, ..best.clone() };
-        self.explain(Which::Best, best.clone(), doc.rig.clone());
-        self.ranking_asked = Some((every.clone(), doc.rig.clone()));
+        self.explain(Which::Best, best.clone(), doc.rig.clone(), before.clone());
         let first = self.best_fix.for_key(&best)?.clone();
-        self.explain(Which::Every, every.clone(), doc.rig.clone());
+        self.explain(Which::Every, every.clone(), doc.rig.clone(), before);
         Some(match self.explanation.for_key(&every) {
             Some(ranked) => (ranked.clone(), true),
             None => (first, false),
         })
     }
 
-    /// Starts the explanation `key` asks of `rig` in its job, unless that job is busy with another.
-    fn explain(&mut self, which: Which, key: Key<WhyRequest>, rig: Arc<Rig>) {
+    /// Starts the explanation `key` asks of `rig` in its job, given the clip's analysis `before`, unless that job is
+    /// busy with another.
+    fn explain(&mut self, which: Which, key: Key<WhyRequest>, rig: Arc<Rig>, before: Arc<ClipAnalysis>) {
         let job = match which {
             Which::Best => &mut self.best_fix,
             Which::Every => &mut self.explanation,
         };
         if !job.busy_with_other(&key) {
             let explained = key.clone();
-            let work = || move |progress: &Progress| explanation(&rig, &explained, progress);
+            let work = || move |_: &Progress| explanation(&rig, &explained, &before.scan);
             Work::start(&self.waker, job, key, work);
         }
     }
@@ -266,11 +272,12 @@ impl Work {
         self.compared_curves.wait();
         self.bind.wait();
         self.storage.wait();
-        self.best_fix.wait();
-        if let Some((key, rig)) = self.ranking_asked.clone() {
-            self.explain(Which::Every, key, rig);
+        if let Some((bone, options)) = self.why_asked {
+            self.explanation(wanted.doc, bone, options);
+            self.best_fix.wait();
+            self.explanation(wanted.doc, bone, options);
+            self.explanation.wait();
         }
-        self.explanation.wait();
     }
 }
 
@@ -313,15 +320,13 @@ fn analysis(
     }
 }
 
-/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it; `None` when cancelled while the clip was
-/// scanned.
-fn explanation(rig: &Rig, key: &Key<WhyRequest>, progress: &Progress) -> Option<Explanation> {
+/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it, given the clip's scan `before` (the
+/// window's: the same setup and options).
+fn explanation(rig: &Rig, key: &Key<WhyRequest>, before: &ClipScan) -> Option<Explanation> {
     let evaluation = key.evaluation(rig)?;
     let (bone, options) = (key.request.bone, &key.request.options);
-    let report = |done: usize, total: usize| progress.report(done, total);
-    let before = analyze(&evaluation, CurveRequest::default(), options, &report, progress.cancelled())?.scan;
     let question = Question { bones: Some(&[bone]), costs: key.request.costs, ..Question::default() };
-    explain(&evaluation, &before, question, options).pop()
+    explain(&evaluation, before, question, options).pop()
 }
 
 /// The differences `key` asks for, as work for a [`Job`]: the document's rig (the one `key` was made of) against
@@ -372,6 +377,10 @@ mod tests {
         let forearm = doc.rig.skeleton.find("forearm").unwrap();
         let options = ScanOptions::default();
         let mut work = Work::default();
+        let wanted = Wanted { doc: &doc, tolerances: options.tolerances, plotted: Vec::new() };
+        assert!(work.explanation(&doc, forearm, options).is_none(), "nothing is known before the analysis");
+        work.analyse(&wanted);
+        work.analysis.wait();
         assert!(work.explanation(&doc, forearm, options).is_none(), "nothing is known before the first job ends");
         work.best_fix.wait();
         let (first, _) = work.explanation(&doc, forearm, options).expect("the best fix is known");
