@@ -30,7 +30,7 @@ pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_c
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
-use crate::eval::{BonesEvaluator, Evaluation, Reach, over_runs, skin_vertices_with};
+use crate::eval::{BonesEvaluator, Evaluation, Reach, over_runs};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, Rig, sample_times};
 
@@ -516,7 +516,7 @@ fn mesh_bones<'r>(rig: &'r Rig, mesh: usize, vertices: Option<&'r [u32]>) -> imp
     let weighted =
         chosen.filter_map(move |v| Some(mesh.joints.get(v as usize)?.iter().zip(mesh.weights.get(v as usize)?)));
     let bones =
-        weighted.flatten().filter(|(_, w)| **w > 0.0).filter_map(move |(&j, _)| joints.get(usize::from(j)).copied());
+        weighted.flatten().filter(|(_, w)| **w != 0.0).filter_map(move |(&j, _)| joints.get(usize::from(j)).copied());
     std::iter::once(mesh.bone).chain(node).chain(bones)
 }
 
@@ -561,11 +561,8 @@ impl<'e, 'a> Side<'e, 'a> {
             return;
         }
         let Some((_, vertices)) = self.plan.meshes.iter().find(|(m, _)| *m == mesh) else { return };
-        let evaluation = self.plan.evaluation;
         let pose = self.evaluator.pose();
-        let posed = (&pose.model.model[..], &pose.morph);
-        let (rig, method) = (evaluation.rig, evaluation.skinning);
-        skin_vertices_with(&rig.meshes[mesh], &rig.skins, posed, method, vertices.as_deref(), &mut self.skinned[mesh]);
+        self.plan.evaluation.skin_vertices(pose, mesh, vertices.as_deref(), &mut self.skinned[mesh]);
     }
 }
 

@@ -28,4 +28,4 @@ pub use pose::Pose;
 pub use runs::{over_runs, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use setup::{Setup, SetupError};
-pub use skinning::{Method as SkinningMethod, Reach, skin_meshes, skin_vertices_with};
+pub use skinning::{Method as SkinningMethod, Reach, skin_meshes};

@@ -157,13 +157,14 @@ impl Reach {
         let apart = |d: DMat4, corners: &[DVec3; 8]| {
             corners.iter().map(|&c| (d * c.extend(1.0)).truncate().length()).fold(0.0, f64::max)
         };
+        let skin = self.skin.map(|s| &skins[s]);
+        let moved = skin.map(|skin| (moved_since_bind(skin, a), moved_since_bind(skin, b)));
         let joints = self.joints.iter().map(|(joint, corners)| {
-            let difference = match self.skin.map(|s| &skins[s]) {
-                Some(skin) => {
-                    let (moved_a, moved_b) = (moved_since_bind(skin, a), moved_since_bind(skin, b));
+            let difference = match (skin, moved) {
+                (Some(skin), Some((moved_a, moved_b))) => {
                     joint_matrix(skin, a, moved_a, *joint) - joint_matrix(skin, b, moved_b, *joint)
                 }
-                None => a[*joint] - b[*joint],
+                _ => a[*joint] - b[*joint],
             };
             apart(difference, corners)
         });

@@ -324,14 +324,18 @@ impl Applied {
 }
 
 /// The vertices of mesh `mesh` of `rig` that move where the bones `changed` says do: `None` for none, `Some(None)`
-/// for every one (a mesh that hangs from a changed bone, unskinned), else those weighted to a changed joint.
+/// for every one (a mesh that hangs from a changed bone, unskinned, or a skin that follows a changed node), else
+/// those weighted to a changed joint (any weight but zero, as skinning reads them).
 fn following(rig: &Rig, mesh: usize, changed: impl Fn(usize) -> bool) -> Option<Option<Vec<u32>>> {
     let mesh = &rig.meshes[mesh];
     let skin = mesh.skin.and_then(|s| rig.skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len());
     let Some(skin) = skin else {
         return changed(mesh.bone).then_some(None);
     };
-    let moves = |(&j, &w): (&u16, &f32)| w > 0.0 && skin.joints.get(usize::from(j)).is_some_and(|&b| changed(b));
+    if skin.node_bind.is_some_and(|node| changed(node.bone)) {
+        return Some(None);
+    }
+    let moves = |(&j, &w): (&u16, &f32)| w != 0.0 && skin.joints.get(usize::from(j)).is_some_and(|&b| changed(b));
     let weighted = mesh.joints.iter().zip(&mesh.weights).enumerate();
     let vertices: Vec<u32> =
         weighted.filter(|(_, (js, ws))| js.iter().zip(ws.iter()).any(moves)).map(|(v, _)| v as u32).collect();
@@ -482,4 +486,41 @@ pub(super) fn bakes_reproduce(evaluation: &Evaluation) -> bool {
     let skeleton = evaluation.skeleton();
     let full = |b: usize| skeleton.parent(b).is_none() || evaluation.modes()[b] == InheritMode::Full;
     evaluation.layers().is_none() && (0..skeleton.len()).all(full)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DMat4, Vec3};
+
+    use super::*;
+    use crate::model::{Bone, Mesh, NodeBind, Skin, Transform};
+
+    #[test]
+    fn the_vertices_a_change_moves_are_those_skinning_moves() {
+        // Two joints under a root, the mesh's node beside them: vertex 0 on the first joint, vertex 1 on the second
+        // with a negative weight, vertex 2 on the root. A skin that follows its node moves wholly with it.
+        let bones = vec![
+            Bone::joint("root", None, Transform::IDENTITY),
+            Bone::joint("a", Some(0), Transform::IDENTITY),
+            Bone::joint("b", Some(0), Transform::IDENTITY),
+            Bone::joint("node", Some(0), Transform::IDENTITY),
+        ];
+        let skin = Skin { joints: vec![0, 1, 2], inverse_bind: vec![DMat4::IDENTITY; 3], ..Skin::default() };
+        let mesh = Mesh {
+            skin: Some(0),
+            bone: 3,
+            positions: vec![Vec3::X; 3],
+            joints: vec![[1, 0, 0, 0], [2, 0, 0, 0], [0, 0, 0, 0]],
+            weights: vec![[1.0, 0.0, 0.0, 0.0], [-0.2, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]],
+            ..Mesh::default()
+        };
+        let mut rig =
+            Rig { skeleton: Skeleton::new(bones).unwrap(), skins: vec![skin], meshes: vec![mesh], ..Rig::default() };
+        let only = |bone: usize| move |b: usize| b == bone;
+        assert_eq!(following(&rig, 0, only(1)), Some(Some(vec![0])));
+        assert_eq!(following(&rig, 0, only(2)), Some(Some(vec![1])), "a negative weight moves its vertex too");
+        assert_eq!(following(&rig, 0, only(3)), None, "the mesh's node moves no glTF skin");
+        rig.skins[0].node_bind = Some(NodeBind { bone: 3, inverse_bind: DMat4::IDENTITY });
+        assert_eq!(following(&rig, 0, only(3)), Some(None), "a skin that follows its node moves with it");
+    }
 }
