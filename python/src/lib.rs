@@ -521,11 +521,7 @@ fn diff(
             let file = paths[missing.searched].display();
             format!("{file}: anim_{}: {}", ["a", "b"][missing.named_by], missing.why)
         })?;
-        let side = |s: usize| FileSide {
-            file: paths[s].display().to_string(),
-            rig: &rigs[s],
-            setup: Setup { clip: chosen.map(|c| c[s]), modes: Modes::all(modes[s]), ..Setup::default() },
-        };
+        let side = |s: usize| FileSide::new(paths[s].display().to_string(), &rigs[s], modes[s], chosen.map(|c| c[s]));
         let (side_a, mut side_b) = (side(0), side(1));
         if let Some(interp) = interp {
             side_b.setup.layers.interpolation.rotation = interp;

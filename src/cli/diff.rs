@@ -1,6 +1,6 @@
 //! `bonescope diff`: two evaluations compared over time, bone by bone and vertex by vertex.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
@@ -9,10 +9,9 @@ use super::OutputFormat;
 use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
 use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
-use crate::eval::Setup;
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
-use crate::model::{Choice, ModeChoice, Modes, Rig, Unit, UpAxis};
+use crate::model::{Choice, ModeChoice, Rig, Unit, UpAxis};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -78,8 +77,8 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     }
     let chosen = chosen(args, &rig_a, &rig_b)?;
     let [clip_a, clip_b] = chosen.map_or([None, None], |[a, b]| [Some(a), Some(b)]);
-    let a = side(&args.a, &rig_a, args.inherit_a, clip_a);
-    let mut b = side(&args.b, &rig_b, args.inherit_b, clip_b);
+    let a = FileSide::new(shown(&args.a), &rig_a, args.inherit_a, clip_a);
+    let mut b = FileSide::new(shown(&args.b), &rig_b, args.inherit_b, clip_b);
     b.setup.layers.interpolation.rotation = args.interp;
     let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
     let diff = diff_files(&a, &b, clips, &args.map, args.rate)?;
@@ -104,11 +103,6 @@ fn chosen(args: &DiffArgs, a: &Rig, b: &Rig) -> anyhow::Result<Option<[usize; 2]
 /// `rig` in `unit` (given as `option`), which only a rig whose file states no unit may be given.
 fn stated_unit(rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result<Rig> {
     rig.given_unit(unit).map_err(|why| anyhow::anyhow!("{option}: {why}"))
-}
-
-/// `rig` (read from `path`) under `modes`, its clip `clip` (where chosen), as authored.
-pub(super) fn side<'a>(path: &Path, rig: &'a Rig, modes: ModeChoice, clip: Option<usize>) -> FileSide<'a> {
-    FileSide { file: shown(path), rig, setup: Setup { clip, modes: Modes::all(modes), ..Setup::default() } }
 }
 
 /// What to give where one file's skeleton lies down beside the other's.

@@ -16,7 +16,7 @@ use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::ScanOptions;
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
-use crate::diff::{AnimationDiff, Clips, diff_files};
+use crate::diff::{AnimationDiff, Clips, FileSide, diff_files};
 use crate::eval::{Evaluation, Setup};
 use crate::explain::scan_clip;
 use crate::import;
@@ -414,7 +414,7 @@ fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Exi
 fn compare_animations(path: &Path, args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<Vec<AnimationDiff>> {
     let rig = import::load(path)?;
     let clip = args.eval.anim.as_ref().map(|name| clip_index(&rig, "--anim", name)).transpose()?;
-    let [a, b] = sides.map(|modes| super::diff::side(path, &rig, modes, clip));
+    let [a, b] = sides.map(|modes| FileSide::new(shown(path), &rig, modes, clip));
     let clips = if clip.is_some() { Clips::Chosen } else { Clips::ByName };
     Ok(diff_files(&a, &b, clips, &[], args.rate)?.animations)
 }

@@ -4,7 +4,7 @@
 use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup};
-use crate::model::{Rig, Unit};
+use crate::model::{ModeChoice, Modes, Rig, Unit};
 
 /// The clips `names` choose, `[in A, in B]`, each a name or an index: a name given for one side only is looked up on
 /// both (the other file's clip named as the chosen clip is). `None`: every clip, paired by name. The error is a clip
@@ -48,6 +48,13 @@ pub struct FileSide<'a> {
     pub file: String,
     pub rig: &'a Rig,
     pub setup: Setup,
+}
+
+impl<'a> FileSide<'a> {
+    /// `rig` (its file shown as `file`) under `modes`, its clip `clip` (where clips are chosen), as authored.
+    pub fn new(file: String, rig: &'a Rig, modes: ModeChoice, clip: Option<usize>) -> Self {
+        FileSide { file, rig, setup: Setup { clip, modes: Modes::all(modes), ..Setup::default() } }
+    }
 }
 
 /// Which clips a file comparison compares.
