@@ -84,6 +84,8 @@ fn load(py: Python<'_>, path: &Bound<'_, PyAny>, max_memory: Option<&Bound<'_, P
         Some(size) => Some(size.extract::<u64>()?),
     };
     let loaded = py.detach(|| {
+        // The budget is the process's: loads from several Python threads take turns, so none reads another's.
+        let _turn = LOADING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let before = import::budget::explicit_limit();
         import::budget::set_limit(limit.or(before));
         let loaded = import::load(&path);
@@ -93,6 +95,9 @@ fn load(py: Python<'_>, path: &Bound<'_, PyAny>, max_memory: Option<&Bound<'_, P
     let rig = loaded.map_err(error)?;
     Ok(Rig { rig, file: path.display().to_string() })
 }
+
+/// Held while a file loads under its own memory budget ([`load`]).
+static LOADING: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// A loaded file: its skeleton, clips and meshes, and what can be asked of it.
 #[pyclass(frozen, module = "bonescope")]
