@@ -316,9 +316,9 @@ fn checked_skins(rig: &Rig) -> Vec<CheckedSkin> {
 
 /// The frame of `authored`'s clip (at its frame rate, thinned past [`MAX_FRAMES`] as every whole-clip pass is)
 /// whose pose is closest to the bind pose of the skins' joints but their broken ones, if it is within the tolerance.
-/// Only the checked joints and their ancestors are evaluated (bone by bone where the clip allows), over runs of
-/// frames on every thread, and a frame is left as soon as one joint shows it further than the closest frame of its
-/// run; of equally close frames, the first.
+/// Only the checked joints and their ancestors are evaluated (bone by bone where the clip allows, and in a frame
+/// only as far as it is looked at), over runs of frames on every thread, and a frame is left as soon as one joint
+/// shows it further than the closest frame of its run or than the tolerance; of equally close frames, the first.
 fn bind_frame(
     skins: &[(CheckedSkin, Vec<usize>)],
     authored: &Evaluation,
@@ -331,11 +331,13 @@ fn bind_frame(
     let times = sample_times([], 0.0, clip.duration(), rate, MAX_FRAMES).times;
     let closest = |a: (f64, f64), b: (f64, f64)| if b.0 < a.0 { b } else { a };
     let runs = over_runs(&times, |run| {
-        let mut evaluator = BonesEvaluator::new(authored, &bones);
+        let mut frame = FramePose::new(authored, &bones);
         let mut best: Option<(f64, f64)> = None;
         for &time in run {
-            let beaten = best.map_or(f64::INFINITY, |(excess, _)| excess);
-            let excess = frame_excess(skins, &evaluator.evaluate(time).model.model, tolerance, beaten);
+            // A frame further than the tolerance is no bind pose, however close.
+            let beaten = best.map_or(1.0, |(excess, _)| excess.min(1.0));
+            frame.start(time);
+            let excess = frame_excess(skins, &mut frame, tolerance, beaten);
             best = Some(best.map_or((excess, time), |best| closest(best, (excess, time))));
         }
         best
@@ -344,13 +346,23 @@ fn bind_frame(
     (excess <= 1.0).then(|| ClipFrame { frame: (time * rate).round(), time })
 }
 
-/// The largest excess over `tolerance` of the gaps of `skins`' joints (their broken ones aside) at `model`, or a
+/// The largest excess over `tolerance` of the gaps of `skins`' joints (their broken ones aside) at `frame`, or a
 /// value past `beaten` as soon as one joint's passes it (the frame cannot be the closest).
-fn frame_excess(skins: &[(CheckedSkin, Vec<usize>)], model: &[DMat4], tolerance: &BindTolerance, beaten: f64) -> f64 {
+fn frame_excess(
+    skins: &[(CheckedSkin, Vec<usize>)],
+    frame: &mut FramePose,
+    tolerance: &BindTolerance,
+    beaten: f64,
+) -> f64 {
     let mut largest: f64 = 0.0;
     for (skin, broken) in skins {
-        let roots = skin.root_space(model);
+        // Bones are evaluated parents first, so the last root's bone brings every root.
+        let Some(last_root) = skin.joints.iter().filter(|j| j.anchor.is_none()).map(|j| j.bone).max() else {
+            continue;
+        };
+        let roots = skin.root_space(frame.model_with(last_root));
         for j in (0..skin.joints.len()).filter(|j| !broken.contains(j)) {
+            let model = frame.model_with(skin.joints[j].bone);
             largest = largest.max(skin.gap(j, skin.joints[j].anchor, model, &roots).excess(tolerance));
             if largest > beaten {
                 return largest;
@@ -358,6 +370,42 @@ fn frame_excess(skins: &[(CheckedSkin, Vec<usize>)], model: &[DMat4], tolerance:
         }
     }
     largest
+}
+
+/// One frame's pose of some bones (each with its ancestors, parents first), evaluated only as far as it is looked
+/// at: a frame left after its first joints costs those joints' chains, not the rig.
+struct FramePose<'e, 'a> {
+    evaluator: BonesEvaluator<'e, 'a>,
+    /// Each bone's place among the bones, plus one (how many bones bring it).
+    through: Vec<usize>,
+    time: f64,
+    evaluated: usize,
+}
+
+impl<'e, 'a> FramePose<'e, 'a> {
+    fn new(evaluation: &'e Evaluation<'a>, bones: &'e [usize]) -> Self {
+        let mut through = vec![0; evaluation.skeleton().len()];
+        for (place, &bone) in bones.iter().enumerate() {
+            through[bone] = place + 1;
+        }
+        FramePose { evaluator: BonesEvaluator::for_prefixes(evaluation, bones), through, time: 0.0, evaluated: 0 }
+    }
+
+    /// Looks at the frame at `time`: nothing of it evaluated yet.
+    fn start(&mut self, time: f64) {
+        self.time = time;
+        self.evaluated = 0;
+    }
+
+    /// The model matrices, with `bone` and its ancestors evaluated. The evaluated prefix at least doubles each time
+    /// it grows, so a frame looked at whole costs at most two evaluations of it.
+    fn model_with(&mut self, bone: usize) -> &[DMat4] {
+        let needed = self.through[bone];
+        if needed > self.evaluated {
+            self.evaluated = self.evaluator.evaluate_first(self.time, needed.max(2 * self.evaluated)).1;
+        }
+        &self.evaluator.pose().model.model
+    }
 }
 
 /// How much a scale factor changes from `pose` to `bind`, relative to `pose`; a zero (degenerate) factor in the pose
@@ -449,6 +497,32 @@ mod tests {
         assert_eq!(check.bind_frame, Some(ClipFrame { frame: 15.0, time: 0.5 }));
         let note = check.note().unwrap();
         assert!(note.contains("1 joint (forearm) is posed") && note.contains("frame 15 (0.500 s)"), "{note}");
+    }
+
+    #[test]
+    fn the_bind_frame_is_the_closest_a_search_of_every_whole_pose_finds() {
+        // Bound between frames 15 and 16 (0.51 s), with a tolerance several frames pass: the search, which leaves a
+        // frame early and evaluates it only as far as it looks, picks the frame that judging every joint of every
+        // frame's whole pose picks (the least excess, the first of equals).
+        let mut rig = demo_rig();
+        let frame = Evaluation::declared(&rig, rig.clips.first()).pose_at(0.51).model.model;
+        rig.skins[0].inverse_bind = rig.skins[0].joints.iter().map(|&bone| frame[bone].inverse()).collect();
+        let tolerance = BindTolerance { distance: 0.05, angle_deg: 4.0, scale: 0.05 };
+        let evaluation = Evaluation::declared(&rig, rig.clips.first());
+        let skins = checked_skins(&rig);
+        let excess = |time: f64| {
+            let model = evaluation.pose_at(time).model.model;
+            let gaps = skins.iter().flat_map(|skin| skin.gaps(&model));
+            gaps.map(|gap| gap.excess(&tolerance)).fold(0.0, f64::max)
+        };
+        let clip = &rig.clips[0];
+        let times = sample_times([], 0.0, clip.duration(), clip.frame_rate(), MAX_FRAMES).times;
+        let excesses: Vec<(f64, f64)> = times.iter().map(|&time| (excess(time), time)).collect();
+        assert!(excesses.iter().filter(|(e, _)| *e <= 1.0).count() >= 3, "several frames pass: {excesses:?}");
+        let closest = excesses.into_iter().reduce(|a, b| if b.0 < a.0 { b } else { a }).unwrap();
+        let check = check_bind(&evaluation, &tolerance);
+        assert_eq!(check.bind_frame.map(|f| f.time), Some(closest.1));
+        assert_eq!(check_bind(&evaluation, &BindTolerance::default()).bind_frame, None, "0.51 s is no frame");
     }
 
     #[test]

@@ -23,10 +23,16 @@ impl<'a> Chains<'a> {
     }
 
     pub fn evaluate(&mut self, time: f64, hierarchy: &Hierarchy) -> &Pose {
-        for (&bone, cursor) in self.bones.iter().zip(&mut self.cursors) {
+        self.evaluate_first(time, self.bones.len(), hierarchy)
+    }
+
+    /// [`Chains::evaluate`] of the first `count` bones alone: parents coming first, a prefix holds its ancestors.
+    pub fn evaluate_first(&mut self, time: f64, count: usize, hierarchy: &Hierarchy) -> &Pose {
+        let bones = &self.bones[..count.min(self.bones.len())];
+        for (&bone, cursor) in bones.iter().zip(&mut self.cursors) {
             self.pose.local[bone] = cursor.local(time);
         }
-        hierarchy.evaluate_bones(&self.pose.local, self.bones, &mut self.pose.model);
+        hierarchy.evaluate_bones(&self.pose.local, bones, &mut self.pose.model);
         &self.pose
     }
 }
@@ -43,7 +49,17 @@ impl<'e, 'a> BonesEvaluator<'e, 'a> {
     /// `bones` (sorted, with every ancestor of each) of `evaluation`; all of them read whole poses.
     pub fn new(evaluation: &'e Evaluation<'a>, bones: &'e [usize]) -> Self {
         let every = bones.len() == evaluation.skeleton().len();
-        match evaluation.clip.filter(|_| !every && evaluation.reads_bone_by_bone()) {
+        Self::reading(evaluation, bones, !every)
+    }
+
+    /// `bones` of `evaluation` to be evaluated a few at a time ([`BonesEvaluator::evaluate_first`]): bone by bone
+    /// wherever the clip allows, even all of them.
+    pub fn for_prefixes(evaluation: &'e Evaluation<'a>, bones: &'e [usize]) -> Self {
+        Self::reading(evaluation, bones, true)
+    }
+
+    fn reading(evaluation: &'e Evaluation<'a>, bones: &'e [usize], bone_by_bone: bool) -> Self {
+        match evaluation.clip.filter(|_| bone_by_bone && evaluation.reads_bone_by_bone()) {
             Some(clip) => {
                 BonesEvaluator::Chains(Box::new(Chains::new(evaluation.skeleton(), clip, bones)), &evaluation.hierarchy)
             }
@@ -55,6 +71,18 @@ impl<'e, 'a> BonesEvaluator<'e, 'a> {
         match self {
             BonesEvaluator::Chains(chains, hierarchy) => chains.evaluate(time, hierarchy),
             BonesEvaluator::Whole(evaluator) => evaluator.evaluate(time),
+        }
+    }
+
+    /// The first `count` bones at `time`, and how many of the bones the pose holds: `count` or more (whole poses
+    /// hold all).
+    pub fn evaluate_first(&mut self, time: f64, count: usize) -> (&Pose, usize) {
+        match self {
+            BonesEvaluator::Chains(chains, hierarchy) => {
+                let count = count.min(chains.bones.len());
+                (chains.evaluate_first(time, count, hierarchy), count)
+            }
+            BonesEvaluator::Whole(evaluator) => (evaluator.evaluate(time), usize::MAX),
         }
     }
 
