@@ -3,6 +3,7 @@
 
 mod common;
 
+use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -13,6 +14,7 @@ use bonescope::import::{Options, Space, load_with};
 use bonescope::model::Rig;
 use common::{assets, usd_python};
 use glam::DMat4;
+use openusd::usdc::blocks::Blocks;
 use serde_json::Value;
 
 /// Every USD file of the shared assets, sorted.
@@ -345,4 +347,37 @@ fn a_hostile_stage_reads_nothing_outside_its_folder_and_fails_in_one_line() {
         .unwrap();
     let error = refused(&nan);
     assert!(error.contains("is not finite") && !error.contains('\x1b'), "{error}");
+}
+
+/// The `.usdc` reader reads through blocks of the file it keeps (`openusd::usdc::blocks`): reads of every size, near
+/// the last (a kept block) and anywhere in a file of twice as many blocks as are kept, after seeks of each kind,
+/// read what the file holds there, and nothing past its end.
+#[test]
+fn the_crate_readers_blocks_read_what_the_file_holds() {
+    let file: Vec<u8> = (0..((1 << 16) * 64 + 123)).map(|i| (i * 7 % 251) as u8).collect();
+    let mut blocks = Blocks::new(std::io::Cursor::new(file.clone())).unwrap();
+    let mut state = 12345u64;
+    for _ in 0..2000 {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let anywhere = (state >> 33) as usize % (file.len() + 10);
+        let here = blocks.stream_position().unwrap() as usize;
+        let start = if state % 4 == 0 { anywhere } else { (here + anywhere % 100_000).saturating_sub(50_000) };
+        let size = [1, 8, 100, (1 << 16) - 1, 1 << 16, 3 << 16][(state >> 20) as usize % 6];
+        match (state >> 8) % 3 {
+            0 => blocks.seek(SeekFrom::Start(start as u64)).unwrap(),
+            1 => blocks.seek(SeekFrom::End(start as i64 - file.len() as i64)).unwrap(),
+            _ => blocks.seek(SeekFrom::Current(start as i64 - here as i64)).unwrap(),
+        };
+        let mut got = vec![0; size];
+        let mut filled = 0;
+        while filled < size {
+            match blocks.read(&mut got[filled..]).unwrap() {
+                0 => break,
+                read => filled += read,
+            }
+        }
+        let end = (start + size).min(file.len()).max(start.min(file.len()));
+        assert_eq!(&got[..filled], &file[start.min(file.len())..end], "{size} bytes at {start}");
+    }
+    assert!(blocks.seek(SeekFrom::Current(-(file.len() as i64) - 1)).is_err());
 }

@@ -9,6 +9,7 @@ pub mod budget;
 mod coding;
 mod layout;
 mod reader;
+pub mod blocks;
 mod writer;
 
 pub use layout::{version, Version};
@@ -275,8 +276,10 @@ impl sdf::FileFormat for UsdcFileFormat {
     }
 
     fn read(&self, resolver: &dyn ar::Resolver, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
-        let bytes = resolver.open_asset(resolved)?.read_all()?;
-        let data = CrateData::open(io::Cursor::new(bytes), true).context("failed to parse USDC layer")?;
+        // bonescope: read through blocks of the file kept in memory, not whole into memory first (half a large
+        // layer's load was that copy and its fresh pages).
+        let asset = blocks::Blocks::new(resolver.open_asset(resolved)?)?;
+        let data = CrateData::open(asset, true).context("failed to parse USDC layer")?;
         Ok(Box::new(data))
     }
 
