@@ -361,7 +361,7 @@ fn the_crate_readers_blocks_read_what_the_file_holds() {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         let anywhere = (state >> 33) as usize % (file.len() + 10);
         let here = blocks.stream_position().unwrap() as usize;
-        let start = if state % 4 == 0 { anywhere } else { (here + anywhere % 100_000).saturating_sub(50_000) };
+        let start = if state.is_multiple_of(4) { anywhere } else { (here + anywhere % 100_000).saturating_sub(50_000) };
         let size = [1, 8, 100, (1 << 16) - 1, 1 << 16, 3 << 16][(state >> 20) as usize % 6];
         match (state >> 8) % 3 {
             0 => blocks.seek(SeekFrom::Start(start as u64)).unwrap(),
