@@ -330,6 +330,9 @@ fn bind_frame(
     let bones = authored.skeleton().with_ancestors(&joints);
     let times = sample_times([], 0.0, clip.duration(), rate, MAX_FRAMES).times;
     let closest = |a: (f64, f64), b: (f64, f64)| if b.0 < a.0 { b } else { a };
+    // Bones are evaluated parents first, so each skin's last root's bone brings every root of it.
+    let last_roots: Vec<Option<usize>> =
+        skins.iter().map(|(skin, _)| skin.joints.iter().filter(|j| j.anchor.is_none()).map(|j| j.bone).max()).collect();
     let runs = over_runs(&times, |run| {
         let mut frame = FramePose::new(authored, &bones);
         let mut best: Option<(f64, f64)> = None;
@@ -337,7 +340,7 @@ fn bind_frame(
             // A frame further than the tolerance is no bind pose, however close.
             let beaten = best.map_or(1.0, |(excess, _)| excess.min(1.0));
             frame.start(time);
-            let excess = frame_excess(skins, &mut frame, tolerance, beaten);
+            let excess = frame_excess(skins, &last_roots, &mut frame, tolerance, beaten);
             best = Some(best.map_or((excess, time), |best| closest(best, (excess, time))));
         }
         best
@@ -347,19 +350,18 @@ fn bind_frame(
 }
 
 /// The largest excess over `tolerance` of the gaps of `skins`' joints (their broken ones aside) at `frame`, or a
-/// value past `beaten` as soon as one joint's passes it (the frame cannot be the closest).
+/// value past `beaten` as soon as one joint's passes it (the frame cannot be the closest). `last_roots` is each
+/// skin's root joint of the highest bone index (`None` for a skin without joints).
 fn frame_excess(
     skins: &[(CheckedSkin, Vec<usize>)],
+    last_roots: &[Option<usize>],
     frame: &mut FramePose,
     tolerance: &BindTolerance,
     beaten: f64,
 ) -> f64 {
     let mut largest: f64 = 0.0;
-    for (skin, broken) in skins {
-        // Bones are evaluated parents first, so the last root's bone brings every root.
-        let Some(last_root) = skin.joints.iter().filter(|j| j.anchor.is_none()).map(|j| j.bone).max() else {
-            continue;
-        };
+    for ((skin, broken), &last_root) in skins.iter().zip(last_roots) {
+        let Some(last_root) = last_root else { continue };
         let roots = skin.root_space(frame.model_with(last_root));
         for j in (0..skin.joints.len()).filter(|j| !broken.contains(j)) {
             let model = frame.model_with(skin.joints[j].bone);

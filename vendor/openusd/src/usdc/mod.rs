@@ -276,7 +276,7 @@ impl sdf::FileFormat for UsdcFileFormat {
     }
 
     fn read(&self, resolver: &dyn ar::Resolver, resolved: &ar::ResolvedPath) -> Result<sdf::LayerData> {
-        // bonescope: read through blocks of the file kept in memory, not whole into memory first (half a large
+        // bonescope: read through blocks of the file kept in memory, not whole into memory first (a fifth of a large
         // layer's load was that copy and its fresh pages).
         let asset = blocks::Blocks::new(resolver.open_asset(resolved)?)?;
         let data = CrateData::open(asset, true).context("failed to parse USDC layer")?;
