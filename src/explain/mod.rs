@@ -250,12 +250,20 @@ pub fn explain(
             known.costs = baseline.costs(&made).into_iter().collect();
         }
         Costs::Best => {
-            for (&bone, changes) in bones.iter().zip(&changes) {
-                if cheapest_removal(&baseline, bone, changes, tool, &mut known).is_none() {
-                    known.make(&baseline, changes);
-                    cheapest(&baseline, &contenders(bone, changes, &known.applied, tool), &mut known);
+            // Bones that share no change share nothing a search learns: their searches run side by side, each
+            // group's bones in the order asked (what one learns is the same whichever runs first).
+            let searched = sharing(&changes).into_par_iter().map(|group| {
+                let mut known = Known::default();
+                for i in group {
+                    let (bone, changes) = (bones[i], &changes[i]);
+                    if cheapest_removal(&baseline, bone, changes, tool, &mut known).is_none() {
+                        known.make(&baseline, changes);
+                        cheapest(&baseline, &contenders(bone, changes, &known.applied, tool), &mut known);
+                    }
                 }
-            }
+                known
+            });
+            known = searched.reduce(Known::default, Known::merge);
         }
     }
     let Known { applied, costs, .. } = known;
@@ -294,6 +302,14 @@ struct Known {
 }
 
 impl Known {
+    /// What two searches learnt of changes neither shares with the other.
+    fn merge(mut self, other: Known) -> Known {
+        self.applied.extend(other.applied);
+        self.costs.extend(other.costs);
+        self.bounds.extend(other.bounds);
+        self
+    }
+
     /// Makes each of `changes` not yet made, in parallel.
     fn make(&mut self, baseline: &Baseline, changes: &[Change]) {
         let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
@@ -396,6 +412,39 @@ fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
             cheapest = cheapest.min(cost.distance.max);
         }
     }
+}
+
+/// The bones (indices of `changes`, each bone's candidate changes) in groups that share no change, each group in
+/// the order given, the groups in the order of their first bone: bones are in one group where a chain of shared
+/// changes links them.
+fn sharing(changes: &[Vec<Change>]) -> Vec<Vec<usize>> {
+    // Union-find over the bones, a bone linked to the first bone that had each of its changes.
+    let mut leader: Vec<usize> = (0..changes.len()).collect();
+    fn root(leader: &mut [usize], mut i: usize) -> usize {
+        while leader[i] != i {
+            leader[i] = leader[leader[i]];
+            i = leader[i];
+        }
+        i
+    }
+    let mut first: HashMap<Change, usize> = HashMap::new();
+    for (i, changes) in changes.iter().enumerate() {
+        for &change in changes {
+            let other = *first.entry(change).or_insert(i);
+            let (a, b) = (root(&mut leader, i), root(&mut leader, other));
+            leader[a.max(b)] = a.min(b);
+        }
+    }
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut group_of: HashMap<usize, usize> = HashMap::new();
+    for i in 0..changes.len() {
+        let at = *group_of.entry(root(&mut leader, i)).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[at].push(i);
+    }
+    groups
 }
 
 /// Each change once, in a stable order.
@@ -531,6 +580,21 @@ mod tests {
         assert_eq!((spans[1].0, spans[1].2), ("m", 3.0));
         assert!(spans[1].1 > 1.5 && spans[1].1 < 1.7, "{spans:?}");
         assert!(causes.at.time >= 2.0, "the worst shear is under m's full squash: {:?}", causes.at);
+    }
+
+    #[test]
+    fn bones_that_share_a_change_are_searched_together_in_the_order_given() {
+        let mode = |bone| Change::Mode { bone, mode: InheritMode::SegmentCompensate };
+        let uniform = |bone| Change::UniformScale { bone };
+        // 0 and 2 share bone 5's mode, 2 and 3 bone 6's scale: one group through 2; 1 and 4 stand alone.
+        let changes =
+            vec![vec![mode(5), uniform(1)], vec![mode(7)], vec![uniform(6), mode(5)], vec![uniform(6)], vec![]];
+        assert_eq!(sharing(&changes), vec![vec![0, 2, 3], vec![1], vec![4]]);
+        // A link found late still joins the groups formed before it: 3 links 2 (bone 3's mode) to 0 (bone 1's).
+        let changes = vec![vec![mode(1)], vec![mode(2)], vec![mode(3)], vec![mode(3), mode(1)]];
+        assert_eq!(sharing(&changes), vec![vec![0, 2, 3], vec![1]]);
+        let changes = vec![vec![mode(1)], vec![mode(2)], vec![mode(2), mode(1)]];
+        assert_eq!(sharing(&changes), vec![vec![0, 1, 2]]);
     }
 
     #[test]
