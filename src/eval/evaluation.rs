@@ -7,7 +7,7 @@ use glam::{DMat4, DVec3, DVec4};
 use super::hierarchy::HierarchyError;
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with, skin_vertices_with};
-use super::{Hierarchy, LayerStack, Pose};
+use super::{Hierarchy, LayerStack, Pose, over_runs};
 use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Unit, sample_times};
 
 /// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
@@ -217,22 +217,23 @@ impl<'a> Evaluation<'a> {
 
     /// [`Evaluation::size`] of some of the character: the bones flagged in `bones` and the meshes `meshes`.
     pub fn size_of(&self, times: &[f64], bones: &[bool], meshes: &[usize]) -> f64 {
+        let Some((&first, later)) = times.split_first() else { return 1.0 };
         let mut evaluator = self.evaluator();
+        let pose = evaluator.evaluate(first);
         let mut vertices = Vec::new();
-        let mut size: f64 = 0.0;
-        for (i, &time) in times.iter().enumerate() {
-            let pose = evaluator.evaluate(time);
-            let origins = pose.model.model.iter().zip(bones).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate());
-            vertices.clear();
-            if i == 0 {
-                for &mesh in meshes {
-                    let mut skinned = Vec::new();
-                    self.skin(pose, mesh, &mut skinned);
-                    vertices.extend(skinned);
-                }
-            }
-            size = size.max(diagonal(origins.chain(vertices.iter().copied())));
+        for &mesh in meshes {
+            let mut skinned = Vec::new();
+            self.skin(pose, mesh, &mut skinned);
+            vertices.extend(skinned);
         }
+        let at_first = diagonal(origins(pose, bones).chain(vertices));
+        // A whole pose at every time: the later times in runs on every core (a largest value is the same whichever
+        // order it is found in).
+        let runs = over_runs(later, |run| {
+            let mut evaluator = self.evaluator();
+            run.iter().map(|&time| diagonal(origins(evaluator.evaluate(time), bones))).fold(0.0, f64::max)
+        });
+        let size = runs.into_iter().fold(at_first, f64::max);
         if size > 0.0 && size.is_finite() { size } else { 1.0 }
     }
 }
@@ -274,6 +275,11 @@ fn scale_lengths(model: &mut [DMat4], scale: f64) {
             *axis *= columns;
         }
     }
+}
+
+/// The origins of the bones flagged in `bones` at `pose`.
+fn origins<'p>(pose: &'p Pose, bones: &'p [bool]) -> impl Iterator<Item = DVec3> + 'p {
+    pose.model.model.iter().zip(bones).filter(|(_, c)| **c).map(|(m, _)| m.w_axis.truncate())
 }
 
 /// The diagonal of the bounding box of `points` (0 for none).
