@@ -319,7 +319,7 @@ impl Rig {
         let evaluation = Evaluation::of(&self.rig, &setup).map_err(error)?;
         let explained = py.detach(|| {
             let before = bonescope_core::analysis::scan(&evaluation, &options, &|_, _| {});
-            let question = Question { bones: bones.as_deref(), at: time, costs: Costs::Every };
+            let question = Question { bones: bones.as_deref(), at: time, costs: Costs::Every, scale: None };
             explain(&evaluation, &before, question, &options)
         });
         json_value(py, &Report::new(self.file.clone(), &evaluation, options.rate, &explained))

@@ -152,6 +152,11 @@ impl<R> Key<R> {
         Key { setup: Setup { layers: Layers::default(), ..doc.setup().clone() }, ..Key::of(doc, request) }
     }
 
+    /// Another request of what this key evaluates.
+    pub fn asking<S>(&self, request: S) -> Key<S> {
+        Key { rig: self.rig, setup: self.setup.clone(), request }
+    }
+
     /// The evaluation the key's setup makes of `rig` (the rig the key was made of); `None` if it does not fit.
     pub fn evaluation<'a>(&self, rig: &'a Rig) -> Option<Evaluation<'a>> {
         Evaluation::of(rig, &self.setup).ok()

@@ -16,7 +16,7 @@ use crate::analysis::{
 };
 use crate::diff::{Pairs, compare, comparison_times, model_curves};
 use crate::eval::{Evaluation, Setup};
-use crate::explain::{Costs, Explanation, Question, explain};
+use crate::explain::{Costs, Explanation, Question, Scale, explain};
 use crate::model::Rig;
 
 /// What a whole-clip analysis is asked.
@@ -108,6 +108,9 @@ pub struct Work {
     compared_curves: Job<Key<CurvesRequest>, ComparedCurves>,
     bind: Job<Key<()>, BindCheck>,
     storage: Job<Key<()>, StorageReport>,
+    /// The size of what the window analyses over its clip, which every Why? of it compares changes at: measured
+    /// once the analysis flags a bone, before one is asked about.
+    scale: Job<Key<ScanOptions>, Scale>,
     /// The explained bone's best fix first (`explain::Costs::Best`, a fraction of the time), then every fix ranked.
     best_fix: Job<Key<WhyRequest>, Explanation>,
     explanation: Job<Key<WhyRequest>, Explanation>,
@@ -138,7 +141,8 @@ impl Work {
     pub fn analyse(&mut self, wanted: &Wanted) {
         let rig = &wanted.doc.rig;
         let key = analysis_key(wanted);
-        Work::start(&self.waker, &mut self.analysis, key.clone(), || analysis(key, rig.clone()));
+        Work::start(&self.waker, &mut self.analysis, key.clone(), || analysis(key.clone(), rig.clone()));
+        self.measure_scale(&key, rig);
         if let Some(key) = curves_key(wanted) {
             Work::start(&self.waker, &mut self.curves, key.clone(), || analysis(key, rig.clone()));
         }
@@ -149,6 +153,19 @@ impl Work {
         });
         if let Some(key) = self.compared_curves_key(wanted) {
             Work::start(&self.waker, &mut self.compared_curves, key.clone(), || compared_curves(key, compared));
+        }
+    }
+
+    /// Measures the scale of what the analysis `analysed` evaluates once it is done and flags a bone: what the Why? of
+    /// any bone would otherwise measure first.
+    fn measure_scale(&mut self, analysed: &Key<AnalysisRequest>, rig: &Arc<Rig>) {
+        self.analysis.collect();
+        let flagged = self.analysis.for_key(analysed).is_some_and(|a| a.scan.bones.iter().any(|b| b.stretched()));
+        if flagged {
+            let key = analysed.asking(analysed.request.options);
+            let (rig, measured) = (rig.clone(), key.clone());
+            let work = || move |_: &Progress| Some(Scale::of(&measured.evaluation(&rig)?, measured.request.rate));
+            Work::start(&self.waker, &mut self.scale, key, work);
         }
     }
 
@@ -229,27 +246,36 @@ impl Work {
             Key::of(doc, AnalysisRequest { ghost: None, plotted: Vec::new(), options, judged: Judged::Every });
         self.analysis.collect();
         let before = self.analysis.for_key(&analysed)?.clone();
+        self.scale.collect();
+        let scale = self.scale.for_key(&analysed.asking(options)).cloned();
         let best = Key::of(doc, WhyRequest { bone, options, costs: Costs::Best });
         let every = Key { request: WhyRequest { costs: Costs::Every, ..best.request.clone() }, ..best.clone() };
-        self.explain(Which::Best, best.clone(), doc.rig.clone(), before.clone());
+        self.explain(Which::Best, best.clone(), doc.rig.clone(), before.clone(), scale.clone());
         let first = self.best_fix.for_key(&best)?.clone();
-        self.explain(Which::Every, every.clone(), doc.rig.clone(), before);
+        self.explain(Which::Every, every.clone(), doc.rig.clone(), before, scale);
         Some(match self.explanation.for_key(&every) {
             Some(ranked) => (ranked.clone(), true),
             None => (first, false),
         })
     }
 
-    /// Starts the explanation `key` asks of `rig` in its job, given the clip's analysis `before`, unless that job is
-    /// busy with another.
-    fn explain(&mut self, which: Which, key: Key<WhyRequest>, rig: Arc<Rig>, before: Arc<ClipAnalysis>) {
+    /// Starts the explanation `key` asks of `rig` in its job, given the clip's analysis `before` and its scale where
+    /// measured, unless that job is busy with another.
+    fn explain(
+        &mut self,
+        which: Which,
+        key: Key<WhyRequest>,
+        rig: Arc<Rig>,
+        before: Arc<ClipAnalysis>,
+        scale: Option<Arc<Scale>>,
+    ) {
         let job = match which {
             Which::Best => &mut self.best_fix,
             Which::Every => &mut self.explanation,
         };
         if !job.busy_with_other(&key) {
             let explained = key.clone();
-            let work = || move |_: &Progress| explanation(&rig, &explained, &before.scan);
+            let work = || move |_: &Progress| explanation(&rig, &explained, &before.scan, scale.as_deref());
             Work::start(&self.waker, job, key, work);
         }
     }
@@ -262,13 +288,14 @@ impl Work {
     }
 
     /// Waits for every job under way, starting what `wanted` needs first (the compared curves wait for the
-    /// document's).
+    /// document's, the scale for the analysis).
     pub fn settle(&mut self, wanted: &Wanted) {
         self.analyse(wanted);
         self.analysis.wait();
         self.curves.wait();
         self.differences.wait();
         self.analyse(wanted);
+        self.scale.wait();
         self.compared_curves.wait();
         self.bind.wait();
         self.storage.wait();
@@ -321,11 +348,11 @@ fn analysis(
 }
 
 /// The bone `key` asks of `rig` explained, as `bonescope explain` explains it, given the clip's scan `before` (the
-/// window's: the same setup and options).
-fn explanation(rig: &Rig, key: &Key<WhyRequest>, before: &ClipScan) -> Option<Explanation> {
+/// window's: the same setup and options) and its scale where measured.
+fn explanation(rig: &Rig, key: &Key<WhyRequest>, before: &ClipScan, scale: Option<&Scale>) -> Option<Explanation> {
     let evaluation = key.evaluation(rig)?;
     let (bone, options) = (key.request.bone, &key.request.options);
-    let question = Question { bones: Some(&[bone]), costs: key.request.costs, ..Question::default() };
+    let question = Question { bones: Some(&[bone]), costs: key.request.costs, scale, ..Question::default() };
     explain(&evaluation, before, question, options).pop()
 }
 

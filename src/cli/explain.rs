@@ -51,7 +51,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let evaluation = evaluation(&rig, &setup)?;
     let before = scan(&evaluation, &options, &|_, _| {});
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
-    let question = Question { bones: asked, at: args.time, costs: Costs::Every };
+    let question = Question { bones: asked, at: args.time, costs: Costs::Every, scale: None };
     let explained = explain(&evaluation, &before, question, &options);
     let report = Report::new(shown(&args.file), &evaluation, args.rate, &explained);
     match args.format {

@@ -112,26 +112,49 @@ const BATCH: usize = 16;
 /// About how many times a lower bound of a cost compares ([`Baseline::cost_bound`]).
 const BOUND_TIMES: usize = 64;
 
-/// What every change is measured against, found once: the evaluation explained, its scan, its times and size (for
-/// `diff`'s comparison), and the options.
+/// How large the character is over a clip: the times an evaluation and its changes are compared at (its own
+/// comparison times, [`comparison_times`]), and its size over them ([`Evaluation::size`]). Measuring it is a whole
+/// evaluation of the clip, so one measured for an evaluation serves every explanation of it ([`super::Question`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scale {
+    pub times: Vec<f64>,
+    pub size: f64,
+}
+
+impl Scale {
+    /// `source`'s, its clip sampled `rate` times a second.
+    pub fn of(source: &Evaluation, rate: f64) -> Self {
+        let times = comparison_times(source, source, rate);
+        let size = source.size(&times);
+        Scale { times, size }
+    }
+}
+
+/// What every change is measured against, found once: the evaluation explained, its scan, its scale (for `diff`'s
+/// comparison), and the options.
 pub(super) struct Baseline<'e, 'a> {
     pub source: &'e Evaluation<'a>,
     pub before: &'e ClipScan,
     pub options: &'e ScanOptions,
     /// The source's own comparison times, and its size over them.
-    times: Vec<f64>,
-    size: f64,
+    scale: Cow<'e, Scale>,
     /// The times a scan of the source samples, which a change of modes or a uniform scale keeps (they follow the
     /// clip, and layers only where they retime it).
     analysis_times: Vec<f64>,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
-    pub fn new(source: &'e Evaluation<'a>, before: &'e ClipScan, options: &'e ScanOptions) -> Self {
-        let times = comparison_times(source, source, options.rate);
-        let size = source.size(&times);
+    /// `scale` is the source's at the options' rate where already measured ([`Scale::of`]).
+    pub fn new(
+        source: &'e Evaluation<'a>,
+        before: &'e ClipScan,
+        options: &'e ScanOptions,
+        scale: Option<&'e Scale>,
+    ) -> Self {
+        let scale = scale.map_or_else(|| Cow::Owned(Scale::of(source, options.rate)), Cow::Borrowed);
+        debug_assert_eq!(scale.times, comparison_times(source, source, options.rate), "the source's scale");
         let analysis_times = source.times(options.rate);
-        Baseline { source, before, options, times, size, analysis_times }
+        Baseline { source, before, options, scale, analysis_times }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -219,7 +242,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
                 }
             }
             let sides: Vec<(&Evaluation, &Pairs)> = fixed.iter().map(|(_, e, p)| (e, p)).collect();
-            let compared = compare_each(self.source, &sides, &self.times, self.size);
+            let compared = compare_each(self.source, &sides, &self.scale.times, self.scale.size);
             costs.extend(fixed.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c)))));
         }
         costs
@@ -230,7 +253,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// Needs the change made only for a bake (`baked`: the rig it writes); any other change is evaluated from its
     /// setup alone, before it is scanned.
     pub fn cost_bound(&self, change: Change, baked: Option<&Rig>) -> Result<f64, String> {
-        let stride = (self.times.len() / BOUND_TIMES).max(1);
+        let stride = (self.scale.times.len() / BOUND_TIMES).max(1);
         Ok(self.cost_at(change, baked, stride, false)?.distance.max)
     }
 
@@ -254,7 +277,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let pairs = self.pairs(change, &fixed);
         // A change that keeps the clip's times (any but a bake) keeps the times and size found once.
         let (times, size) = match baked {
-            None => (Cow::Borrowed(&self.times[..]), self.size),
+            None => (Cow::Borrowed(&self.scale.times[..]), self.scale.size),
             Some(_) => {
                 let times = comparison_times(self.source, &fixed, self.options.rate);
                 let size = self.source.size(&times);

@@ -20,7 +20,7 @@ mod attribution;
 mod fixes;
 
 pub use attribution::{Attribution, CauseSpan, Causes, Link, attribute, causes};
-pub use fixes::{Change, Cost, Fix, Measured, ShearElsewhere, is_other_mode};
+pub use fixes::{Change, Cost, Fix, Measured, Scale, ShearElsewhere, is_other_mode};
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -198,12 +198,14 @@ pub enum Costs {
 }
 
 /// What to explain: which bones (every flagged bone, the worst first, for `None`), the time to detail (each bone's
-/// worst for `None`), and which fixes to cost.
+/// worst for `None`), and which fixes to cost; and the evaluation's [`Scale`] at the options' rate where it is
+/// already measured (else it is measured, where there is something to explain).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Question<'q> {
     pub bones: Option<&'q [usize]>,
     pub at: Option<f64>,
     pub costs: Costs,
+    pub scale: Option<&'q Scale>,
 }
 
 /// Explains the bones `question` asks about over `evaluation`'s clip. `before` is the clip's scan with `options`
@@ -237,7 +239,7 @@ pub fn explain(
             _ => candidates(evaluation, bone, &scaled(causes, tolerances.min_anisotropy), bakes),
         })
         .collect();
-    let baseline = Baseline::new(evaluation, before, options);
+    let baseline = Baseline::new(evaluation, before, options, question.scale);
     let tool = evaluation.rig.tool;
     let mut known = Known::default();
     match question.costs {
