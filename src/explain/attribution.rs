@@ -116,7 +116,7 @@ pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f6
             .map(|&time| {
                 let pose = source.evaluate(time);
                 chain.iter().for_each(|&b| local[b] = pose.local[b]);
-                probe.sample(&mut local, &mut start, tolerances)
+                probe.sample(&pose.model.model[bone], &mut local, &mut start, tolerances)
             })
             .collect::<Vec<_>>()
     })
@@ -190,9 +190,10 @@ impl<'a> Probe<'a> {
 
     /// The bone's shear and verdict at one time, and the main cause where it is flagged: the chain bone, among those
     /// scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix, without a
-    /// decomposition). `start` is where the verdict's decomposition starts, updated for the next sample.
-    fn sample(&mut self, local: &mut [Transform], start: &mut DQuat, tolerances: &Tolerances) -> Sample {
-        let m = self.matrix(local, &[]);
+    /// decomposition). `m` is the bone's model matrix as `local` evaluates (what [`Probe::matrix`] gives with no
+    /// scale made uniform); `start` is where the verdict's decomposition starts, updated for the next sample.
+    fn sample(&mut self, m: &DMat4, local: &mut [Transform], start: &mut DQuat, tolerances: &Tolerances) -> Sample {
+        let m = *m;
         let assessment = Assessment::near(&m, tolerances, *start);
         *start = assessment.parts.stretch;
         let shear = column_shear(&m);
