@@ -124,7 +124,12 @@ pub struct Scale {
 impl Scale {
     /// `source`'s, its clip sampled `rate` times a second.
     pub fn of(source: &Evaluation, rate: f64) -> Self {
-        let times = comparison_times(source, source, rate);
+        Scale::against(source, source, rate)
+    }
+
+    /// `source`'s at the times it is compared with `other` at (both clips' keys and `rate` a second).
+    fn against(source: &Evaluation, other: &Evaluation, rate: f64) -> Self {
+        let times = comparison_times(source, other, rate);
         let size = source.size(&times);
         Scale { times, size }
     }
@@ -221,7 +226,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// up there).
     pub fn cost_within(&self, change: Change, applied: &Applied, limit: f64) -> Result<Option<Cost>, String> {
         let on = self.compared_on(change, applied.baked.as_ref())?;
-        Ok(compare_within(self.source, &on.fixed, &on.pairs, &on.times, on.size, limit).map(|c| self.visible(&c)))
+        let Scale { times, size } = &*on.scale;
+        Ok(compare_within(self.source, &on.fixed, &on.pairs, times, *size, limit).map(|c| self.visible(&c)))
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
@@ -264,8 +270,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
         if !skin {
             on.pairs.meshes.clear();
         }
-        let compared: Vec<f64> = on.times.iter().copied().step_by(stride).collect();
-        Ok(self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &compared, on.size)))
+        let compared: Vec<f64> = on.scale.times.iter().copied().step_by(stride).collect();
+        Ok(self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &compared, on.scale.size)))
     }
 
     /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on.
@@ -275,16 +281,12 @@ impl<'e, 'a> Baseline<'e, 'a> {
     {
         let fixed = self.fixed(change, baked)?;
         let pairs = self.pairs(change, &fixed);
-        // A change that keeps the clip's times (any but a bake) keeps the times and size found once.
-        let (times, size) = match baked {
-            None => (Cow::Borrowed(&self.scale.times[..]), self.scale.size),
-            Some(_) => {
-                let times = comparison_times(self.source, &fixed, self.options.rate);
-                let size = self.source.size(&times);
-                (Cow::Owned(times), size)
-            }
+        // A change that keeps the clip's times (any but a bake) keeps the scale found once.
+        let scale = match baked {
+            None => Cow::Borrowed(&*self.scale),
+            Some(_) => Cow::Owned(Scale::against(self.source, &fixed, self.options.rate)),
         };
-        Ok(ComparedOn { fixed, pairs, times, size })
+        Ok(ComparedOn { fixed, pairs, scale })
     }
 
     /// What the source and `fixed` (the evaluation `change` gives) are compared on: the bones of the figure that
@@ -321,13 +323,12 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 }
 
-/// What a change is compared with the source on: the evaluation it gives, the pairs, the times and the rig's size
-/// there.
+/// What a change is compared with the source on: the evaluation it gives, the pairs, and the source's scale at the
+/// times the two are compared at.
 struct ComparedOn<'r, 't> {
     fixed: Evaluation<'r>,
     pairs: Pairs,
-    times: Cow<'t, [f64]>,
-    size: f64,
+    scale: Cow<'t, Scale>,
 }
 
 /// A change made and scanned: for a bake, the baked rig read back; and by the source's bone index, each bone's worst
