@@ -422,13 +422,6 @@ fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
 fn sharing(changes: &[Vec<Change>]) -> Vec<Vec<usize>> {
     // Union-find over the bones, a bone linked to the first bone that had each of its changes.
     let mut leader: Vec<usize> = (0..changes.len()).collect();
-    fn root(leader: &mut [usize], mut i: usize) -> usize {
-        while leader[i] != i {
-            leader[i] = leader[leader[i]];
-            i = leader[i];
-        }
-        i
-    }
     let mut first: HashMap<Change, usize> = HashMap::new();
     for (i, changes) in changes.iter().enumerate() {
         for &change in changes {
@@ -447,6 +440,16 @@ fn sharing(changes: &[Vec<Change>]) -> Vec<Vec<usize>> {
         groups[at].push(i);
     }
     groups
+}
+
+/// The bone that leads `i`'s group in the union-find `leader` (each bone's link towards it), the links on the way
+/// halved.
+fn root(leader: &mut [usize], mut i: usize) -> usize {
+    while leader[i] != i {
+        leader[i] = leader[leader[i]];
+        i = leader[i];
+    }
+    i
 }
 
 /// Each change once, in a stable order.
