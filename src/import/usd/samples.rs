@@ -1,219 +1,487 @@
-//! A SkelAnimation's translations, rotations, scales or blend-shape weights as USD reads them at any time code: held before the first
-//! sample and after the last, a sample's own at its time, and between two samples of the same length interpolated
-//! with the arithmetic of Pixar's `Gf` types, which rounds every step to the attribute's precision: `GfLerp` is
-//! `(1 − t)·a + t·b` with both products and their sum rounded (a `half3` held between two equal samples reads a
-//! half step off), `GfSlerp` turns by `θ = acos(cos θ)` where `1 − cos θ > 10⁻⁵` and mixes linearly below, neither
-//! normalised. The `openusd` crate rounds once and normalises a near-linear slerp: the same within the
+//! A SkelAnimation's translations, rotations, scales or blend-shape weights as USD reads them at any time code: held
+//! before the first sample and after the last, a sample's own at its time, and between two samples of the same length
+//! interpolated with the arithmetic of Pixar's `Gf` types, which rounds every step to the attribute's precision:
+//! `GfLerp` is `(1 − t)·a + t·b` with both products and their sum rounded (a `half3` held between two equal samples
+//! reads a half step off), `GfSlerp` turns by `θ = acos(cos θ)` where `1 − cos θ > 10⁻⁵` and mixes linearly below,
+//! neither normalised. The `openusd` crate rounds once and normalises a near-linear slerp: the same within the
 //! precision of a `float`, not to the bit UsdSkel computes.
+//!
+//! A channel is read sample by sample as the layer decodes it and kept by element (joint or blend shape): an element
+//! whose value never changes is kept once, one that moves as its column of values, one per sample. So a clip's
+//! samples are never all in memory at once, and a moving joint's column is its track.
 
-use std::borrow::Cow;
+use std::sync::Arc;
 
-use glam::{Quat, Vec3};
-use openusd::gf::{self, f16};
-use openusd::sdf::Value;
+use glam::{DQuat, DVec3, Quat, Vec3};
+use half::slice::HalfFloatSliceExt;
+use openusd::gf::f16;
+use openusd::sdf::{TimeSample, Value};
 use openusd::usd::{Attribute, Stage};
 
 use super::said;
 
-/// One channel's samples, by time code, in the type the file stores them in.
+/// One channel's samples, sorted by time code, in the precision the file stores them in.
 pub enum Channel {
-    Half3(Samples<gf::Vec3h>),
-    Float3(Samples<gf::Vec3f>),
-    Double3(Samples<gf::Vec3d>),
-    Quath(Samples<gf::Quath>),
-    Quatf(Samples<gf::Quatf>),
-    Quatd(Samples<gf::Quatd>),
-    Float(Samples<f32>),
+    Vectors(Columns<Vec3>),
+    DoubleVectors(Columns<DVec3>),
+    Rotations(Columns<Quat>),
+    DoubleRotations(Columns<DQuat>),
+    Numbers(Columns<f32>),
 }
 
-/// Time codes and the array at each, sorted by time code.
-pub struct Samples<T>(Vec<(f64, Vec<T>)>);
+/// Per element, its values at the clip's time codes.
+#[derive(Debug, PartialEq)]
+pub enum Keys<T> {
+    /// The same at every sample: the value read at the first time code.
+    Held(T),
+    /// One value per time code.
+    Moving(Arc<[T]>),
+}
 
 impl Channel {
-    /// The attribute's time samples, else its default value (held throughout); `None` where it has neither or
-    /// holds another type.
-    pub fn read(stage: &Stage, attribute: &Attribute) -> Result<Option<Channel>, String> {
-        let mut samples = stage.time_samples(attribute.path().clone()).map_err(said)?.unwrap_or_default();
-        samples.retain(|(code, _)| code.is_finite());
-        if samples.is_empty() {
-            let Some(default) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
-            samples.push((0.0, default));
+    /// The attribute's time samples, else its default value (held throughout), for arrays of `len` elements;
+    /// `None` where it has neither or its samples are not all one array type.
+    pub fn read(stage: &Stage, attribute: &Attribute, len: usize) -> Result<Option<Channel>, String> {
+        let mut reading = Reading { channel: None, mixed: false, len, widened: Vec::new() };
+        stage.visit_time_samples(attribute.path().clone(), |sample| reading.add(sample)).map_err(said)?;
+        if reading.channel.is_none() && !reading.mixed {
+            let Some(value) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
+            reading.add(TimeSample { index: 0, time: 0.0, value, count: 1 });
         }
-        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
-        Ok(Channel::of(samples))
-    }
-
-    /// The channel of `samples`, all of one array type.
-    fn of(samples: Vec<(f64, Value)>) -> Option<Channel> {
-        macro_rules! typed {
-            ($variant:ident, $channel:ident) => {
-                samples
-                    .into_iter()
-                    .map(|(code, value)| match value {
-                        Value::$variant(array) => Some((code, array)),
-                        _ => None,
-                    })
-                    .collect::<Option<Vec<_>>>()
-                    .map(|s| Channel::$channel(Samples(s)))
-            };
-        }
-        match samples.first()?.1 {
-            Value::Vec3hVec(_) => typed!(Vec3hVec, Half3),
-            Value::Vec3fVec(_) => typed!(Vec3fVec, Float3),
-            Value::Vec3dVec(_) => typed!(Vec3dVec, Double3),
-            Value::QuathVec(_) => typed!(QuathVec, Quath),
-            Value::QuatfVec(_) => typed!(QuatfVec, Quatf),
-            Value::QuatdVec(_) => typed!(QuatdVec, Quatd),
-            Value::FloatVec(_) => typed!(FloatVec, Float),
-            _ => None,
-        }
-    }
-
-    /// The vectors at time code `code` of the elements `picked`, where its array there has `len` elements (`None`
-    /// otherwise, and for a rotation channel).
-    pub fn vectors(&self, code: f64, len: usize, picked: &[usize]) -> Option<Vec<Vec3>> {
-        match self {
-            Channel::Half3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x.into(), v.y.into(), v.z.into())),
-            Channel::Float3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x, v.y, v.z)),
-            Channel::Double3(s) => s.picked(code, len, picked, |v| Vec3::new(v.x as f32, v.y as f32, v.z as f32)),
-            _ => None,
-        }
-    }
-
-    /// The numbers at time code `code` (`None` for a vector or rotation channel).
-    pub fn numbers(&self, code: f64) -> Option<Vec<f32>> {
-        match self {
-            Channel::Float(s) => Some(s.at(code).into_owned()),
-            _ => None,
-        }
-    }
-
-    /// The rotations at time code `code` of the elements `picked`, as stored: not normalised, as UsdSkel makes a
-    /// matrix of them (and as glTF's keys are read). `None` where its array there has not `len` elements, and for a
-    /// vector channel.
-    pub fn rotations(&self, code: f64, len: usize, picked: &[usize]) -> Option<Vec<Quat>> {
-        let quat = |w: f64, x: f64, y: f64, z: f64| Quat::from_xyzw(x as f32, y as f32, z as f32, w as f32);
-        let half = |h: f16| f64::from(h.to_f32());
-        match self {
-            Channel::Quath(s) => s.picked(code, len, picked, |q| quat(half(q.w), half(q.x), half(q.y), half(q.z))),
-            Channel::Quatf(s) => s.picked(code, len, picked, |q| quat(q.w.into(), q.x.into(), q.y.into(), q.z.into())),
-            Channel::Quatd(s) => s.picked(code, len, picked, |q| quat(q.w, q.x, q.y, q.z)),
-            _ => None,
-        }
+        Ok(reading.finish())
     }
 
     /// The time codes of its samples.
-    pub fn codes(&self) -> Vec<f64> {
-        each!(self, s => s.0.iter().map(|(c, _)| *c).collect())
+    pub fn codes(&self) -> &[f64] {
+        each!(self, c => &c.codes)
     }
 
-    /// Per element of arrays of length `len`, whether every sample's array has that length and holds the same
-    /// value there: held throughout.
-    pub fn held(&self, len: usize) -> Vec<bool> {
-        each!(self, s => s.held(len))
+    /// Each element's vectors at `codes`, `identity` where a sample there is not an array of the channel's length
+    /// and throughout a channel of rotations or numbers.
+    pub fn vectors(self, codes: &[f64], identity: Vec3) -> Vec<Keys<Vec3>> {
+        match self {
+            Channel::Vectors(c) => c.keys(codes, identity, |v| v, |column| column),
+            Channel::DoubleVectors(c) => {
+                c.keys(codes, identity, DVec3::as_vec3, |c| c.iter().map(|v| v.as_vec3()).collect())
+            }
+            other => each!(other, c => c.keys(codes, identity, |_| identity, |c| c.iter().map(|_| identity).collect())),
+        }
+    }
+
+    /// Each element's rotations at `codes`, as stored: not normalised, as UsdSkel makes a matrix of them (and as
+    /// glTF's keys are read); `identity` where a sample there is not an array of the channel's length and throughout
+    /// a channel of vectors or numbers.
+    pub fn rotations(self, codes: &[f64], identity: Quat) -> Vec<Keys<Quat>> {
+        let single = |q: DQuat| Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32);
+        match self {
+            Channel::Rotations(c) => c.keys(codes, identity, |q| q, |column| column),
+            Channel::DoubleRotations(c) => c.keys(codes, identity, single, |c| c.iter().map(|q| single(*q)).collect()),
+            other => each!(other, c => c.keys(codes, identity, |_| identity, |c| c.iter().map(|_| identity).collect())),
+        }
+    }
+
+    /// The numbers at each of `codes`, one per element; `None` at a code where the sample is not an array of the
+    /// channel's length, and for a channel of vectors or rotations.
+    pub fn numbers(&self, codes: &[f64]) -> Option<Vec<Option<Vec<f32>>>> {
+        let Channel::Numbers(c) = self else { return None };
+        let reads = c.reads(codes);
+        Some(reads.iter().map(|&read| (0..c.len).map(|e| c.read(e, read)).collect()).collect())
     }
 }
 
-/// `$body` with `$s` bound to the samples of whichever type `$channel` holds.
+/// `$body` with `$c` bound to the columns of whichever type `$channel` holds.
 macro_rules! each {
-    ($channel:expr, $s:ident => $body:expr) => {
+    ($channel:expr, $c:ident => $body:expr) => {
         match $channel {
-            Channel::Half3($s) => $body,
-            Channel::Float3($s) => $body,
-            Channel::Double3($s) => $body,
-            Channel::Quath($s) => $body,
-            Channel::Quatf($s) => $body,
-            Channel::Quatd($s) => $body,
-            Channel::Float($s) => $body,
+            Channel::Vectors($c) => $body,
+            Channel::DoubleVectors($c) => $body,
+            Channel::Rotations($c) => $body,
+            Channel::DoubleRotations($c) => $body,
+            Channel::Numbers($c) => $body,
         }
     };
 }
 use each;
 
-impl<T: PartialEq> Samples<T> {
-    fn held(&self, len: usize) -> Vec<bool> {
-        let Some((_, first)) = self.0.first().filter(|(_, a)| a.len() == len) else { return vec![false; len] };
-        let mut held = vec![true; len];
-        // Sample by sample, each array read in order, while some element may still be held.
-        for (_, array) in &self.0 {
-            if array.len() != len {
-                return vec![false; len];
-            }
-            if !held.contains(&true) {
-                continue;
-            }
-            held.iter_mut().zip(array.iter().zip(first)).for_each(|(h, (v, f))| *h &= v == f);
+/// A channel as its samples arrive.
+struct Reading {
+    channel: Option<Channel>,
+    /// A sample was of another type than the first, or of none a channel holds: the attribute is no channel.
+    mixed: bool,
+    len: usize,
+    /// A half-precision sample's numbers, widened.
+    widened: Vec<f32>,
+}
+
+impl Reading {
+    /// Takes a sample (none at a time code that is not finite).
+    fn add(&mut self, sample: TimeSample) {
+        let TimeSample { index, time: code, value, count: of } = sample;
+        if !code.is_finite() || self.mixed {
+            return;
         }
-        held
+        let len = Length { len: self.len, of };
+        let at = Place { index, code };
+        let added = match value {
+            Value::Vec3hVec(a) => {
+                let values = widen(&mut self.widened, bytemuck::cast_slice(&a))
+                    .chunks_exact(3)
+                    .map(|v| Vec3::new(v[0], v[1], v[2]));
+                push(&mut self.channel, Channel::Vectors, Precision::Half, len, at, a.len(), values)
+            }
+            Value::Vec3fVec(a) => {
+                let values = a.iter().map(|v| Vec3::new(v.x, v.y, v.z));
+                push(&mut self.channel, Channel::Vectors, Precision::Float, len, at, a.len(), values)
+            }
+            Value::Vec3dVec(a) => {
+                let values = a.iter().map(|v| DVec3::new(v.x, v.y, v.z));
+                push(&mut self.channel, Channel::DoubleVectors, Precision::Double, len, at, a.len(), values)
+            }
+            Value::QuathVec(a) => {
+                // Stored (w, x, y, z).
+                let values = widen(&mut self.widened, bytemuck::cast_slice(&a))
+                    .chunks_exact(4)
+                    .map(|q| Quat::from_xyzw(q[1], q[2], q[3], q[0]));
+                push(&mut self.channel, Channel::Rotations, Precision::Half, len, at, a.len(), values)
+            }
+            Value::QuatfVec(a) => {
+                let values = a.iter().map(|q| Quat::from_xyzw(q.x, q.y, q.z, q.w));
+                push(&mut self.channel, Channel::Rotations, Precision::Float, len, at, a.len(), values)
+            }
+            Value::QuatdVec(a) => {
+                let values = a.iter().map(|q| DQuat::from_xyzw(q.x, q.y, q.z, q.w));
+                push(&mut self.channel, Channel::DoubleRotations, Precision::Double, len, at, a.len(), values)
+            }
+            Value::FloatVec(a) => {
+                let values = a.iter().copied();
+                push(&mut self.channel, Channel::Numbers, Precision::Float, len, at, a.len(), values)
+            }
+            _ => false,
+        };
+        self.mixed = !added;
+    }
+
+    fn finish(self) -> Option<Channel> {
+        let mut channel = self.channel.filter(|_| !self.mixed)?;
+        each!(&mut channel, c => c.finish());
+        Some(channel)
     }
 }
 
-impl<T: Mix> Samples<T> {
-    /// The elements `picked` of the array at `code`, each made a `U`, where the array has `len` elements.
-    fn picked<U>(&self, code: f64, len: usize, picked: &[usize], into: impl Fn(&T) -> U) -> Option<Vec<U>> {
-        let array = self.at(code);
-        (array.len() == len).then(|| picked.iter().map(|&i| into(&array[i])).collect())
-    }
+/// The length of the arrays a channel reads, and how many samples it has.
+#[derive(Clone, Copy)]
+struct Length {
+    len: usize,
+    of: usize,
+}
 
-    /// The array at time code `code`: a sample's own (borrowed) at its time and outside the samples, else mixed.
-    fn at(&self, code: f64) -> Cow<'_, [T]> {
-        let samples = &self.0;
-        let next = samples.partition_point(|(c, _)| *c <= code);
-        match (next.checked_sub(1).map(|i| &samples[i]), samples.get(next)) {
-            (Some((c0, a)), Some((c1, b))) if *c0 != code && a.len() == b.len() => {
-                let t = (code - c0) / (c1 - c0);
-                Cow::Owned(a.iter().zip(b).map(|(a, b)| T::mix(a, b, t)).collect())
-            }
-            (Some((_, a)), _) | (None, Some((_, a))) => Cow::Borrowed(a),
-            (None, None) => Cow::Borrowed(&[]),
+/// `halves` widened into `into`, a slice at a time (one instruction for several, where the processor has it).
+fn widen<'a>(into: &'a mut Vec<f32>, halves: &[f16]) -> &'a [f32] {
+    into.resize(halves.len(), 0.0);
+    halves.convert_to_f32_slice(into);
+    into
+}
+
+/// Where a sample is: its index among the channel's samples, and its time code.
+#[derive(Clone, Copy)]
+struct Place {
+    index: usize,
+    code: f64,
+}
+
+/// Adds a sample of `count` `values` at `at` to `channel`, which it starts as `variant` where it is `None`; `false`
+/// where the channel holds another type or precision.
+fn push<V: Stored>(
+    channel: &mut Option<Channel>,
+    variant: fn(Columns<V>) -> Channel,
+    precision: Precision,
+    length: Length,
+    at: Place,
+    count: usize,
+    values: impl Iterator<Item = V>,
+) -> bool {
+    let columns = channel.get_or_insert_with(|| variant(Columns::new(precision, length)));
+    match V::columns(columns) {
+        Some(c) if c.precision == precision => {
+            c.push(at, count, values);
+            true
+        }
+        _ => false,
+    }
+}
+
+/// How a file stores a channel's numbers, which decides the rounding of a value read between two samples.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Precision {
+    Half,
+    Float,
+    Double,
+}
+
+/// How many samples are staged before they are written into the columns.
+const STAGED: usize = 256;
+
+/// A channel's samples by element, sorted by time code.
+pub struct Columns<V> {
+    precision: Precision,
+    /// The length an array must have to be read.
+    len: usize,
+    /// How many samples the channel has, as its layer says.
+    of: usize,
+    /// Per sample, its time code (NaN for one not read: at no finite time code, dropped once all are read).
+    codes: Vec<f64>,
+    /// Per sample, whether its array has `len` elements.
+    fits: Vec<bool>,
+    /// The first fitting sample's values; an element without a column has this value in every fitting sample.
+    first: Option<Vec<V>>,
+    /// Per element, its value at each sample, from the first sample that differs from `first` on (`first`'s value
+    /// stands in for it at a sample that does not fit, and at those not written yet). Made as large as the layer
+    /// says at once: a moving joint's column becomes its track as it is.
+    columns: Vec<Option<Arc<[V]>>>,
+    /// Fitting samples not yet written into the columns: their values, sample after sample, and their indices.
+    staged: Vec<V>,
+    staged_samples: Vec<usize>,
+}
+
+/// How a value at one time code is read from the samples.
+#[derive(Clone, Copy)]
+enum Read {
+    /// A sample's own.
+    Sample(usize),
+    /// Between two fitting samples, at `t` from the first to the second.
+    Mix(usize, usize, f64),
+    /// From no sample, or from one whose array does not fit: the identity.
+    Nothing,
+}
+
+impl<V: Stored> Columns<V> {
+    fn new(precision: Precision, Length { len, of }: Length) -> Self {
+        let columns = (0..len).map(|_| None).collect();
+        let (codes, fits) = (vec![f64::NAN; of], vec![false; of]);
+        Columns {
+            precision,
+            len,
+            of,
+            codes,
+            fits,
+            first: None,
+            columns,
+            staged: Vec::new(),
+            staged_samples: Vec::new(),
         }
     }
+
+    /// A column holding `value` at every sample but `v` at `sample`.
+    fn column(&self, value: V, sample: usize, v: V) -> Arc<[V]> {
+        let mut column: Arc<[V]> = std::iter::repeat_n(value, self.of).collect();
+        Arc::make_mut(&mut column)[sample] = v;
+        column
+    }
+
+    /// Adds the `count` `values` of the sample at `at` (samples come in any order, once each).
+    fn push(&mut self, at: Place, count: usize, values: impl Iterator<Item = V>) {
+        let sample = at.index;
+        if sample >= self.of {
+            return;
+        }
+        self.codes[sample] = at.code;
+        self.fits[sample] = count == self.len;
+        if count != self.len {
+            return;
+        }
+        if self.first.is_none() {
+            let first: Vec<V> = values.collect();
+            // A value unequal to itself (NaN) is never held.
+            for (e, v) in first.iter().enumerate().filter(|(_, v)| v.is_nan()) {
+                self.columns[e] = Some(self.column(*v, sample, *v));
+            }
+            self.first = Some(first);
+            return;
+        }
+        self.staged.extend(values);
+        self.staged_samples.push(sample);
+        if self.staged_samples.len() == STAGED {
+            self.flush();
+        }
+    }
+
+    /// Writes the staged samples into the columns, starting the column of an element where one differs from the
+    /// first.
+    fn flush(&mut self) {
+        let Some(first) = &self.first else { return };
+        let mut columns = std::mem::take(&mut self.columns);
+        let rows = self.staged_samples.iter().copied().zip(self.staged.chunks_exact(self.len));
+        // The elements that start to move, found row by row: a row is contiguous, and most rows of a channel that
+        // mostly holds are the first sample's.
+        for (sample, row) in rows.clone().filter(|(_, row)| *row != first.as_slice()) {
+            for ((column, v), held) in columns.iter_mut().zip(row).zip(first) {
+                if column.is_none() && v != held {
+                    *column = Some(self.column(*held, sample, *v));
+                }
+            }
+        }
+        // The moving elements' values, a column at a time: each is reached for writing once per flush.
+        for (e, column) in columns.iter_mut().enumerate().filter_map(|(e, c)| Some((e, c.as_mut()?))) {
+            let column = Arc::make_mut(column);
+            rows.clone().for_each(|(sample, row)| column[sample] = row[e]);
+        }
+        self.columns = columns;
+        self.staged.clear();
+        self.staged_samples.clear();
+    }
+
+    /// Writes what is staged, drops the samples not read and puts the others in order of time code, the stored
+    /// order among equal ones.
+    fn finish(&mut self) {
+        self.flush();
+        if self.codes.iter().all(|c| c.is_finite()) && self.codes.is_sorted_by(|a, b| a.total_cmp(b).is_le()) {
+            return;
+        }
+        let mut order: Vec<usize> = (0..self.of).filter(|&i| self.codes[i].is_finite()).collect();
+        order.sort_by(|&a, &b| self.codes[a].total_cmp(&self.codes[b]));
+        self.codes = order.iter().map(|&i| self.codes[i]).collect();
+        self.fits = order.iter().map(|&i| self.fits[i]).collect();
+        for column in self.columns.iter_mut().flatten() {
+            *column = order.iter().map(|&i| column[i]).collect();
+        }
+    }
+
+    /// How the value at each of `codes` is read.
+    fn reads(&self, codes: &[f64]) -> Vec<Read> {
+        let read = |code: f64| {
+            let next = self.codes.partition_point(|c| *c <= code);
+            match (next.checked_sub(1), (next < self.codes.len()).then_some(next)) {
+                (Some(a), Some(b)) if self.codes[a] != code && self.fits[a] && self.fits[b] => {
+                    Read::Mix(a, b, (code - self.codes[a]) / (self.codes[b] - self.codes[a]))
+                }
+                (Some(a), _) | (None, Some(a)) if self.fits[a] => Read::Sample(a),
+                _ => Read::Nothing,
+            }
+        };
+        codes.iter().map(|&code| read(code)).collect()
+    }
+
+    /// Element `e`'s value as `read` reads it; `None` for the identity.
+    fn read(&self, e: usize, read: Read) -> Option<V> {
+        let at = |sample: usize| {
+            self.columns[e].as_ref().map_or_else(|| self.first.as_ref().map(|f| f[e]), |c| Some(c[sample]))
+        };
+        match read {
+            Read::Sample(sample) => at(sample),
+            Read::Mix(a, b, t) => Some(V::mix(at(a)?, at(b)?, t, self.precision)),
+            Read::Nothing => None,
+        }
+    }
+
+    /// Each element's keys at `codes`, made `T`s (`whole` makes a whole column): held where every sample fits and
+    /// holds its value, else one per code (`identity` where nothing fits there). A column whose samples are `codes`
+    /// is its keys.
+    fn keys<T: Copy>(
+        mut self,
+        codes: &[f64],
+        identity: T,
+        into: impl Fn(V) -> T,
+        whole: impl Fn(Arc<[V]>) -> Arc<[T]>,
+    ) -> Vec<Keys<T>> {
+        let reads = self.reads(codes);
+        let all_fit = self.fits.iter().all(|f| *f);
+        let own = all_fit && codes == self.codes;
+        let value = |columns: &Self, e: usize, read: Read| columns.read(e, read).map_or(identity, &into);
+        (0..self.len)
+            .map(|e| match self.columns[e].take() {
+                None if all_fit => Keys::Held(value(&self, e, reads[0])),
+                Some(column) if own => Keys::Moving(whole(column)),
+                column => {
+                    self.columns[e] = column;
+                    let keys = reads.iter().map(|&read| value(&self, e, read)).collect();
+                    self.columns[e] = None;
+                    Keys::Moving(keys)
+                }
+            })
+            .collect()
+    }
 }
 
-/// A value between two samples at `t`, as Pixar's `Gf` computes it.
-pub trait Mix: Clone {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self;
+/// A value as a channel keeps it: the numbers stored, exactly (half and float widen to `f32` without loss).
+pub trait Stored: Copy + PartialEq {
+    /// Its columns, where `channel` holds values of its type.
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>>;
+
+    /// The value between `a` and `b` at `t`, as Pixar's `Gf` computes it in `precision`.
+    fn mix(a: Self, b: Self, t: f64, precision: Precision) -> Self;
+
+    /// Whether a number of it is NaN: it is unequal to itself.
+    fn is_nan(self) -> bool;
 }
 
-/// `half(half(a·(1 − t)) + half(b·t))`: `GfVec3h`'s scaling and sum, each rounded to half precision.
-fn lerp_half(a: f16, b: f16, t: f64) -> f16 {
-    let scaled = |h: f16, s: f64| f16::from_f32(h.to_f32() * s as f32);
-    f16::from_f32(scaled(a, 1.0 - t).to_f32() + scaled(b, t).to_f32())
+/// `half(half(a·(1 − t)) + half(b·t))` with weights `(1 − t, t)` = `(w0, w1)`: `GfVec3h`'s scaling and sum, each
+/// rounded to half precision.
+fn mix_half(a: f32, b: f32, w0: f64, w1: f64) -> f32 {
+    let scaled = |x: f32, s: f64| f16::from_f32(x * s as f32).to_f32();
+    f16::from_f32(scaled(a, w0) + scaled(b, w1)).to_f32()
 }
 
-/// `float(float(a·(1 − t)) + float(b·t))`: `GfVec3f`'s scaling and sum, each rounded to single precision.
-fn lerp_float(a: f32, b: f32, t: f64) -> f32 {
-    (f64::from(a) * (1.0 - t)) as f32 + (f64::from(b) * t) as f32
+/// `float(float(a·w0) + float(b·w1))`: `GfVec3f`'s scaling and sum, each rounded to single precision.
+fn mix_float(a: f32, b: f32, w0: f64, w1: f64) -> f32 {
+    (f64::from(a) * w0) as f32 + (f64::from(b) * w1) as f32
+}
+
+impl Stored for Vec3 {
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+        match channel {
+            Channel::Vectors(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    fn mix(a: Self, b: Self, t: f64, precision: Precision) -> Self {
+        let mix = if precision == Precision::Half { mix_half } else { mix_float };
+        Vec3::new(mix(a.x, b.x, 1.0 - t, t), mix(a.y, b.y, 1.0 - t, t), mix(a.z, b.z, 1.0 - t, t))
+    }
+
+    fn is_nan(self) -> bool {
+        Vec3::is_nan(self)
+    }
+}
+
+impl Stored for DVec3 {
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+        match channel {
+            Channel::DoubleVectors(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
+        let lerp = |a: f64, b: f64| (1.0 - t) * a + t * b;
+        DVec3::new(lerp(a.x, b.x), lerp(a.y, b.y), lerp(a.z, b.z))
+    }
+
+    fn is_nan(self) -> bool {
+        DVec3::is_nan(self)
+    }
 }
 
 /// `GfLerp` of two `float`s: computed in double precision, rounded once.
-impl Mix for f32 {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        ((1.0 - t) * f64::from(*a) + t * f64::from(*b)) as f32
+impl Stored for f32 {
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+        match channel {
+            Channel::Numbers(c) => Some(c),
+            _ => None,
+        }
     }
-}
 
-impl Mix for gf::Vec3h {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        gf::vec3h(lerp_half(a.x, b.x, t), lerp_half(a.y, b.y, t), lerp_half(a.z, b.z, t))
+    fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
+        ((1.0 - t) * f64::from(a) + t * f64::from(b)) as f32
     }
-}
 
-impl Mix for gf::Vec3f {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        gf::vec3f(lerp_float(a.x, b.x, t), lerp_float(a.y, b.y, t), lerp_float(a.z, b.z, t))
-    }
-}
-
-impl Mix for gf::Vec3d {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        let lerp = |a: f64, b: f64| (1.0 - t) * a + t * b;
-        gf::Vec3d { x: lerp(a.x, b.x), y: lerp(a.y, b.y), z: lerp(a.z, b.z) }
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
     }
 }
 
 /// `GfSlerp`'s weights of the two quaternions `(w, x, y, z)` at `t`: the angle between them found in `f32` (as for
-/// `GfQuatf`), the shorter way round.
+/// `GfQuatf` and `GfQuath`) or in `f64`, the shorter way round.
 fn slerp_weights(a: [f64; 4], b: [f64; 4], t: f64, single: bool) -> (f64, f64) {
     let dot = if single {
         // The imaginary parts' dot product and the real parts' product, in single precision.
@@ -237,31 +505,111 @@ fn slerp_weights(a: [f64; 4], b: [f64; 4], t: f64, single: bool) -> (f64, f64) {
     (w0, if flip { -w1 } else { w1 })
 }
 
-impl Mix for gf::Quatf {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        let (pa, pb) = ([a.w, a.x, a.y, a.z].map(f64::from), [b.w, b.x, b.y, b.z].map(f64::from));
-        let (w0, w1) = slerp_weights(pa, pb, t, true);
-        let c = |x: f32, y: f32| (f64::from(x) * w0) as f32 + (f64::from(y) * w1) as f32;
-        gf::quatf(c(a.w, b.w), c(a.x, b.x), c(a.y, b.y), c(a.z, b.z))
+impl Stored for Quat {
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+        match channel {
+            Channel::Rotations(c) => Some(c),
+            _ => None,
+        }
     }
-}
 
-impl Mix for gf::Quath {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
-        let wide = |q: &gf::Quath| [q.w, q.x, q.y, q.z].map(|h| f64::from(h.to_f32()));
+    fn mix(a: Self, b: Self, t: f64, precision: Precision) -> Self {
+        let wide = |q: Quat| [q.w, q.x, q.y, q.z].map(f64::from);
         let (w0, w1) = slerp_weights(wide(a), wide(b), t, true);
-        let c = |x: f16, y: f16| {
-            let scaled = |h: f16, s: f64| f16::from_f32(h.to_f32() * s as f32);
-            f16::from_f32(scaled(x, w0).to_f32() + scaled(y, w1).to_f32())
-        };
-        gf::Quath { w: c(a.w, b.w), x: c(a.x, b.x), y: c(a.y, b.y), z: c(a.z, b.z) }
+        let mix = if precision == Precision::Half { mix_half } else { mix_float };
+        let c = |x: f32, y: f32| mix(x, y, w0, w1);
+        Quat::from_xyzw(c(a.x, b.x), c(a.y, b.y), c(a.z, b.z), c(a.w, b.w))
+    }
+
+    fn is_nan(self) -> bool {
+        Quat::is_nan(self)
     }
 }
 
-impl Mix for gf::Quatd {
-    fn mix(a: &Self, b: &Self, t: f64) -> Self {
+impl Stored for DQuat {
+    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+        match channel {
+            Channel::DoubleRotations(c) => Some(c),
+            _ => None,
+        }
+    }
+
+    fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
         let (w0, w1) = slerp_weights([a.w, a.x, a.y, a.z], [b.w, b.x, b.y, b.z], t, false);
         let c = |x: f64, y: f64| x * w0 + y * w1;
-        gf::Quatd { w: c(a.w, b.w), x: c(a.x, b.x), y: c(a.y, b.y), z: c(a.z, b.z) }
+        DQuat::from_xyzw(c(a.x, b.x), c(a.y, b.y), c(a.z, b.z), c(a.w, b.w))
+    }
+
+    fn is_nan(self) -> bool {
+        DQuat::is_nan(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use openusd::gf;
+
+    use super::*;
+
+    /// The samples (index, time code, x of the second element) of a channel of two vectors: the first element
+    /// holds (1, 1, 1), the second is at (x, 0, 0); an `x` of `None` is an array of one element, which does not fit.
+    fn channel(samples: &[(usize, f64, Option<f32>)]) -> Channel {
+        let mut reading = Reading { channel: None, mixed: false, len: 2, widened: Vec::new() };
+        for &(index, time, x) in samples {
+            let moving = x.map(|x| gf::vec3f(x, 0.0, 0.0));
+            let array = [Some(gf::vec3f(1.0, 1.0, 1.0)), moving].into_iter().flatten().collect();
+            reading.add(TimeSample { index, time, value: Value::Vec3fVec(array), count: samples.len() });
+        }
+        reading.finish().expect("one type throughout")
+    }
+
+    fn x(x: f32) -> Vec3 {
+        Vec3::new(x, 0.0, 0.0)
+    }
+
+    #[test]
+    fn samples_in_any_order_are_read_as_in_time_order() {
+        let samples = [(0, 0.0, Some(0.0)), (1, 1.0, Some(1.0)), (2, 2.0, Some(3.0))];
+        let codes = [0.0, 0.5, 1.0, 2.0, 3.0];
+        let in_order = channel(&samples).vectors(&codes, Vec3::ZERO);
+        let [a, b, c] = samples;
+        assert_eq!(channel(&[c, a, b]).vectors(&codes, Vec3::ZERO), in_order);
+        // Held before the first sample and after the last, mixed between (exact in `float` at these values).
+        let moving: Arc<[Vec3]> = [x(0.0), x(0.5), x(1.0), x(3.0), x(3.0)].into();
+        assert_eq!(in_order, vec![Keys::Held(Vec3::ONE), Keys::Moving(moving)]);
+    }
+
+    #[test]
+    fn a_sample_at_no_finite_time_is_dropped_and_one_that_does_not_fit_reads_as_the_identity() {
+        // Stored unsorted: index 1 is the last in time.
+        let samples = [(0, 0.0, Some(0.0)), (1, 3.0, None), (2, f64::NAN, Some(9.0)), (3, 2.0, Some(2.0))];
+        let channel = channel(&samples);
+        assert_eq!(channel.codes(), [0.0, 2.0, 3.0]);
+        let keys = channel.vectors(&[0.0, 1.0, 2.5, 3.0], Vec3::ZERO);
+        // Between a fitting sample and one that does not, the earlier is held; at the one that does not fit, nothing
+        // is read; every element then moves.
+        let held: Arc<[Vec3]> = [Vec3::ONE, Vec3::ONE, Vec3::ONE, Vec3::ZERO].into();
+        let moving: Arc<[Vec3]> = [x(0.0), x(1.0), x(2.0), Vec3::ZERO].into();
+        assert_eq!(keys, vec![Keys::Moving(held), Keys::Moving(moving)]);
+    }
+
+    #[test]
+    fn a_half_precision_sample_is_widened_exactly_and_a_second_type_is_no_channel() {
+        let half = |x: f32| gf::Vec3h { x: f16::from_f32(x), y: f16::ZERO, z: f16::from_f32(-x) };
+        let mut reading = Reading { channel: None, mixed: false, len: 1, widened: Vec::new() };
+        reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 1 });
+        let widened = f16::from_f32(0.1).to_f32();
+        let keys = reading.finish().expect("a channel").vectors(&[0.0], Vec3::ZERO);
+        assert_eq!(keys, vec![Keys::Held(Vec3::new(widened, 0.0, -widened))]);
+
+        let mut reading = Reading { channel: None, mixed: false, len: 1, widened: Vec::new() };
+        reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 2 });
+        reading.add(TimeSample {
+            index: 1,
+            time: 1.0,
+            value: Value::Vec3fVec(vec![gf::vec3f(0.1, 0.0, 0.0)]),
+            count: 2,
+        });
+        assert!(reading.finish().is_none());
     }
 }

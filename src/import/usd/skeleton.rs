@@ -13,7 +13,7 @@ use openusd::schemas::skel::{SkelAnimation, SkelBindingAPI, Skeleton};
 use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
-use super::samples::Channel;
+use super::samples::{Channel, Keys};
 use super::{Timing, said, within_budget};
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
@@ -205,23 +205,24 @@ fn animation(
     let anim = SkelAnimation::get(stage, source.clone()).map_err(said)?.ok_or("not a SkelAnimation")?;
     let anim_joints = anim.joints().map_err(said)?;
     let mapped = skeleton.map_anim_joints(&anim_joints).map_err(said)?;
-    let read = |attribute: Attribute| Channel::read(stage, &attribute);
-    let channels = [read(anim.translations_attr())?, read(anim.rotations_attr())?, read(anim.scales_attr())?];
+    let n = mapped.len();
     let shape_names = anim.blend_shapes().map_err(said)?;
-    let shape_weights = read(anim.blend_shape_weights_attr())?;
+    let read = |attribute: Attribute, len: usize| Channel::read(stage, &attribute, len);
+    let (translated, rotated) = (read(anim.translations_attr(), n)?, read(anim.rotations_attr(), n)?);
+    let scaled = read(anim.scales_attr(), n)?;
+    let shape_weights = read(anim.blend_shape_weights_attr(), shape_names.len())?;
     // Samples before the start time code shape what is read from it on, but are not played.
-    let mut codes = sample_codes(channels.iter().chain([&shape_weights]).flatten(), timing.start)?;
+    let channels = [&translated, &rotated, &scaled, &shape_weights];
+    let mut codes = sample_codes(channels.into_iter().flatten(), timing.start)?;
     codes.retain(|&code| code >= timing.start);
     if codes.is_empty() {
         codes.push(timing.start);
     }
-    check_budget(codes.len(), mapped.len() + shape_names.len().div_ceil(10))?;
+    check_budget(codes.len(), n + shape_names.len().div_ceil(10))?;
     let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
-    let n = mapped.len();
-    let [translated, rotated, scaled] = &channels;
-    let translations = channel_tracks(translated.as_ref(), Channel::vectors, Vec3::ZERO, &codes, &times, n)?;
-    let rotations = channel_tracks(rotated.as_ref(), Channel::rotations, Quat::IDENTITY, &codes, &times, n)?;
-    let scales = channel_tracks(scaled.as_ref(), Channel::vectors, Vec3::ONE, &codes, &times, n)?;
+    let translations = tracks(joint_keys(translated, Channel::vectors, &codes, Vec3::ZERO, n), &times)?;
+    let rotations = tracks(joint_keys(rotated, Channel::rotations, &codes, Quat::IDENTITY, n), &times)?;
+    let scales = tracks(joint_keys(scaled, Channel::vectors, &codes, Vec3::ONE, n), &times)?;
     let mut tracks = Vec::new();
     let joint_tracks = translations.into_iter().zip(rotations).zip(scales);
     for (joint, ((translation, rotation), scale)) in mapped.iter().zip(joint_tracks) {
@@ -233,56 +234,40 @@ fn animation(
     }
     let weights = (!shape_names.is_empty()).then(|| {
         let count = shape_names.len();
-        let values = codes.iter().map(|&code| {
-            let read = shape_weights.as_ref().and_then(|c| c.numbers(code));
-            read.filter(|w| w.len() == count).unwrap_or_else(|| vec![0.0; count])
-        });
-        ShapeWeights { names: shape_names, times: times.clone(), values: values.collect() }
+        let read = shape_weights.as_ref().and_then(|c| c.numbers(&codes));
+        let rows = read.unwrap_or_else(|| vec![None; codes.len()]);
+        let values = rows.into_iter().map(|row| row.unwrap_or_else(|| vec![0.0; count])).collect();
+        ShapeWeights { names: shape_names, times: times.clone(), values }
     });
     Ok(Some((Animation { name: source.name().map(str::to_owned), tracks }, weights)))
 }
 
 /// A track of `values` at `times`, linear between them (slerp for rotations), as UsdSkel reads them.
-fn linear<T: KeyValue>(times: &Arc<[f64]>, values: Vec<T>) -> Result<Track<T>, String> {
+fn linear<T: KeyValue>(times: &Arc<[f64]>, values: impl Into<Arc<[T]>>) -> Result<Track<T>, String> {
     Track::new(times.clone(), values, Interpolation::Linear).map_err(|e| e.to_string())
 }
 
-/// One channel's track for each of the animation's `joints` at `codes` (`times` their seconds): the value `read`
-/// gives there, `identity` where the channel has none or an array of another length. A joint whose samples all hold
-/// one value (an offset, most scales) is one key: a clip the size of its motion. (Between two equal samples USD's
-/// rounding may read a value a rounding step off; held, bonescope reads the value itself.)
-fn channel_tracks<T: KeyValue>(
-    channel: Option<&Channel>,
-    read: impl Fn(&Channel, f64, usize, &[usize]) -> Option<Vec<T>>,
-    identity: T,
+/// Each of the `joints`' keys in `channel` at `codes` (`read` reads them), held at `identity` where there is none.
+fn joint_keys<T: Copy>(
+    channel: Option<Channel>,
+    read: fn(Channel, &[f64], T) -> Vec<Keys<T>>,
     codes: &[f64],
-    times: &Arc<[f64]>,
+    identity: T,
     joints: usize,
-) -> Result<Vec<Track<T>>, String> {
-    let held = channel.map_or_else(|| vec![true; joints], |c| c.held(joints));
-    let (still, moving): (Vec<usize>, Vec<usize>) = (0..joints).partition(|&a| held[a]);
-    // Read only the joints each pass needs: most channels move few of them.
-    let at = |code: f64, picked: &[usize]| {
-        let values = channel.and_then(|c| read(c, code, joints, picked));
-        values.unwrap_or_else(|| vec![identity; picked.len()])
-    };
-    let mut keys: Vec<Vec<T>> = moving.iter().map(|_| Vec::with_capacity(codes.len())).collect();
-    if !moving.is_empty() {
-        for &code in codes {
-            keys.iter_mut().zip(at(code, &moving)).for_each(|(track, value)| track.push(value));
-        }
-    }
+) -> Vec<Keys<T>> {
+    channel.map_or_else(|| (0..joints).map(|_| Keys::Held(identity)).collect(), |c| read(c, codes, identity))
+}
+
+/// A track per element of `keys` at `times`: one key where it holds (an offset, most scales: a clip the size of its
+/// motion; between two equal samples USD's rounding may read a value a rounding step off, held, bonescope reads the
+/// value itself), else one per time.
+fn tracks<T: KeyValue>(keys: Vec<Keys<T>>, times: &Arc<[f64]>) -> Result<Vec<Track<T>>, String> {
     let once: Arc<[f64]> = Arc::from(&times[..1]);
-    let mut tracks: Vec<Option<Track<T>>> = (0..joints).map(|_| None).collect();
-    let linear =
-        |times: Arc<[f64]>, values| Track::new(times, values, Interpolation::Linear).map_err(|e| e.to_string());
-    for (&a, value) in still.iter().zip(at(codes[0], &still)) {
-        tracks[a] = Some(linear(once.clone(), vec![value])?);
-    }
-    for (&a, values) in moving.iter().zip(keys) {
-        tracks[a] = Some(linear(times.clone(), values)?);
-    }
-    Ok(tracks.into_iter().flatten().collect())
+    let track = |keys| match keys {
+        Keys::Held(value) => linear(&once, vec![value]),
+        Keys::Moving(values) => linear(times, values),
+    };
+    keys.into_iter().map(track).collect()
 }
 
 /// The animation a skeleton plays: the target of the nearest `skel:animationSource` on it or an ancestor (a
@@ -304,7 +289,7 @@ fn animation_source(stage: &Stage, skeleton: &sdf::Path) -> Result<Option<sdf::P
 /// The time codes an animation is sampled at: every time code of its translations, rotations, scales and blend-shape
 /// weights, and every whole time code between the first and the last ([`every_frame`]).
 fn sample_codes<'a>(channels: impl Iterator<Item = &'a Channel>, start: f64) -> Result<Vec<f64>, String> {
-    every_frame(channels.flat_map(Channel::codes).collect(), start)
+    every_frame(channels.flat_map(Channel::codes).copied().collect(), start)
 }
 
 /// `codes` and every whole time code between the first and the last (USD reads between samples in the precision of

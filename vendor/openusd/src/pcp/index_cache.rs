@@ -1038,6 +1038,27 @@ impl IndexCache {
         }))
     }
 
+    /// bonescope: composes the prim of the property at `path` (which may demand layers not open yet), so that
+    /// [`visit_time_samples`](Self::visit_time_samples) then reads without composing.
+    pub(crate) fn compose_property(&mut self, graph: &LayerGraph, path: &Path) -> Result<()> {
+        let path = self.effective_path(graph, path)?;
+        self.ensure_index(graph, &path.prim_path())
+    }
+
+    /// bonescope: the property at `path`'s composed `timeSamples` handed to `visit` sample by sample, in stage
+    /// time (`resolve_field` of `timeSamples` without the map); `true` where it has samples.
+    pub(crate) fn visit_time_samples(
+        &mut self,
+        graph: &LayerGraph,
+        path: &Path,
+        visit: &mut dyn FnMut(crate::sdf::TimeSample),
+    ) -> Result<bool> {
+        let path = self.effective_path(graph, path)?;
+        let prim_path = path.prim_path();
+        self.ensure_index(graph, &prim_path)?;
+        self.cached(&prim_path).visit_time_samples(graph, Some(path.property_suffix()), visit)
+    }
+
     /// Resolves a field value from the strongest opinion across all composition nodes.
     ///
     /// Layer metadata authored on the pseudo-root is resolved directly from

@@ -511,6 +511,27 @@ impl PrimIndex {
         })
     }
 
+    /// bonescope: the strongest authored `timeSamples`, retimed to stage time, handed to `visit` sample by sample
+    /// as its layer decodes them ([`resolve_time_samples`](Self::resolve_time_samples) without the map). `true`
+    /// where a layer had samples; `false` where none has or one blocks them.
+    pub(crate) fn visit_time_samples(
+        &self,
+        stack: &LayerGraph,
+        prop_suffix: Option<&str>,
+        visit: &mut dyn FnMut(sdf::TimeSample),
+    ) -> Result<bool> {
+        for site in self.contributing_sites(prop_suffix) {
+            let ContributingSite { layer, offset, query_path, .. } = site?;
+            let mut retimed = |sample: sdf::TimeSample| visit(sdf::TimeSample { time: offset.apply(sample.time), ..sample });
+            match stack.layer(layer).data().visit_time_samples(&query_path, &mut retimed)? {
+                None | Some(sdf::TimeSamplesField::NotSamples) => continue,
+                Some(sdf::TimeSamplesField::Blocked) => return Ok(false),
+                Some(sdf::TimeSamplesField::Visited) => return Ok(true),
+            }
+        }
+        Ok(false)
+    }
+
     /// Interpolates the strongest authored `timeSamples` at stage `time`
     /// without cloning the sample map. The matched map is borrowed and
     /// interpolated in its own layer-time frame: `time` is mapped back through

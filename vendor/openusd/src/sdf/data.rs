@@ -10,7 +10,48 @@ use std::{
 
 use anyhow::Result;
 
-use crate::sdf::{Path, SpecData, SpecType, Value};
+use crate::sdf::{FieldKey, Path, SpecData, SpecType, Value};
+
+/// bonescope: what an authored `timeSamples` field held, once [`AbstractData::visit_time_samples`] read it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeSamplesField {
+    /// Samples, every one handed on.
+    Visited,
+    /// A value block: weaker opinions are blocked.
+    Blocked,
+    /// A value of another type, which is no opinion on the samples.
+    NotSamples,
+}
+
+/// bonescope: one of a field's time samples, as [`AbstractData::visit_time_samples`] hands it on.
+#[derive(Clone, Debug)]
+pub struct TimeSample {
+    /// Where it is among the field's samples, in their order.
+    pub index: usize,
+    pub time: f64,
+    pub value: Value,
+    /// How many samples the field holds.
+    pub count: usize,
+}
+
+/// bonescope: a `timeSamples` field already decoded, its samples handed to `visit`.
+pub fn visit_decoded(field: Cow<'_, Value>, visit: &mut dyn FnMut(TimeSample)) -> TimeSamplesField {
+    match field {
+        Cow::Owned(Value::TimeSamples(samples)) => {
+            let count = samples.len();
+            let samples = samples.into_iter().enumerate();
+            samples.for_each(|(index, (time, value))| visit(TimeSample { index, time, value, count }))
+        }
+        Cow::Borrowed(Value::TimeSamples(samples)) => {
+            let count = samples.len();
+            let samples = samples.iter().enumerate().map(|(index, (time, value))| (index, *time, value.clone()));
+            samples.for_each(|(index, time, value)| visit(TimeSample { index, time, value, count }))
+        }
+        Cow::Borrowed(Value::ValueBlock) | Cow::Owned(Value::ValueBlock) => return TimeSamplesField::Blocked,
+        _ => return TimeSamplesField::NotSamples,
+    }
+    TimeSamplesField::Visited
+}
 
 /// The scene-description storage interface, mirroring C++ `SdfAbstractData`.
 ///
@@ -53,6 +94,17 @@ pub trait AbstractData {
             path: path.clone(),
             field: field.to_owned(),
         })
+    }
+
+    /// bonescope: the `timeSamples` field at `path`, its samples handed to `visit` one by one, in any order, each
+    /// with its place among them (a binary layer decodes each value as it hands it on, in the order they lie in the
+    /// file, so the caller never holds all of them at once); `Ok(None)` where it is not authored.
+    fn visit_time_samples(
+        &self,
+        path: &Path,
+        visit: &mut dyn FnMut(TimeSample),
+    ) -> Result<Option<TimeSamplesField>, DataError> {
+        Ok(self.try_field(path, FieldKey::TimeSamples.as_str())?.map(|field| visit_decoded(field, visit)))
     }
 
     /// Returns the field names for a given path in authored order.
@@ -271,6 +323,14 @@ impl<T: AbstractData + ?Sized> AbstractData for Box<T> {
 
     fn try_field(&self, path: &Path, field: &str) -> Result<Option<Cow<'_, Value>>, DataError> {
         (**self).try_field(path, field)
+    }
+
+    fn visit_time_samples(
+        &self,
+        path: &Path,
+        visit: &mut dyn FnMut(TimeSample),
+    ) -> Result<Option<TimeSamplesField>, DataError> {
+        (**self).visit_time_samples(path, visit)
     }
 
     fn list_fields(&self, path: &Path) -> Option<Vec<String>> {
@@ -492,6 +552,17 @@ impl<T: AbstractData> AbstractData for CowData<T> {
                 }
             }
             None => self.base.try_field(path, field),
+        }
+    }
+
+    fn visit_time_samples(
+        &self,
+        path: &Path,
+        visit: &mut dyn FnMut(TimeSample),
+    ) -> Result<Option<TimeSamplesField>, DataError> {
+        match self.staged(path) {
+            None => self.base.visit_time_samples(path, visit),
+            Some(_) => Ok(self.try_field(path, FieldKey::TimeSamples.as_str())?.map(|field| visit_decoded(field, visit))),
         }
     }
 

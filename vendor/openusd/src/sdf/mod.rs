@@ -34,7 +34,7 @@ pub use copy::{
     copy_spec, copy_spec_with, copy_spec_within, should_copy_children, should_copy_value, CopyChildren,
     CopyChildrenArgs, CopyValue, CopyValueArgs,
 };
-pub use data::{AbstractData, CowData, Data, DataError, Patch};
+pub use data::{visit_decoded, AbstractData, CowData, Data, DataError, Patch, TimeSample, TimeSamplesField};
 pub use expr::{Evaluation, EvaluationValue, Expr, StringEvaluation, StringSegment};
 pub use file_format::{FileFormat, FileFormatCaps, WriteSeek};
 pub(crate) use layer::{dry_run_layers, edit_layers};

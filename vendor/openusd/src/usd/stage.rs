@@ -2352,6 +2352,26 @@ impl Stage {
         })
     }
 
+    /// bonescope: the composed `timeSamples` of an attribute handed to `visit` one by one, each with its place among
+    /// them, in any order, retimed as [`Self::time_samples`] retimes them: a binary layer decodes each value as it
+    /// hands it on, so a reader building arrays of its own never holds every sample at once. `false` where the attribute has
+    /// none. `visit` must not read the stage. Asset-path values are handed on unanchored.
+    pub fn visit_time_samples(
+        &self,
+        attr_path: impl Into<sdf::Path>,
+        mut visit: impl FnMut(sdf::TimeSample),
+    ) -> Result<bool> {
+        let attr_path = attr_path.into();
+        if !self.mask_includes(&attr_path.prim_path()) {
+            return Ok(false);
+        }
+        // Composed first, opening any layer that demands (and composing again): the visit then runs once.
+        self.with_cache(|graph, cache| cache.compose_property(graph, &attr_path))?;
+        let graph = self.layers.borrow();
+        let mut cache = self.cache.borrow_mut();
+        cache.visit_time_samples(&graph, &attr_path, &mut visit)
+    }
+
     /// Returns the composed `timeSamples` sample times for an attribute, or
     /// `None` when none are authored. Resolves the times without cloning the
     /// sample values, retimed by the contributing layer offsets to match

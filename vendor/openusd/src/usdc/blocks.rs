@@ -15,7 +15,7 @@ pub struct Blocks<R> {
     inner: R,
     len: u64,
     position: u64,
-    /// Each kept block's index, bytes (fewer at the end of the file) and when it was last used.
+    /// Each kept block's index (`u64::MAX` for none), buffer and when it was last used.
     kept: Vec<(u64, Box<[u8]>, u64)>,
     clock: u64,
 }
@@ -26,28 +26,37 @@ impl<R: Read + Seek> Blocks<R> {
         Ok(Blocks { inner, len, position: 0, kept: Vec::new(), clock: 0 })
     }
 
-    /// Block `index`, read from the file unless it is kept (in place of the one used longest ago).
+    /// Block `index`, read from the file unless it is kept (into the buffer of the one used longest ago: a fresh
+    /// buffer per read cost more than the read).
     fn block(&mut self, index: u64) -> io::Result<&[u8]> {
         self.clock += 1;
         let slot = match self.kept.iter().position(|(i, ..)| *i == index) {
             Some(slot) => slot,
             None => {
-                let start = index * BLOCK as u64;
-                let mut bytes = vec![0; (self.len - start).min(BLOCK as u64) as usize].into_boxed_slice();
-                self.inner.seek(SeekFrom::Start(start))?;
-                self.inner.read_exact(&mut bytes)?;
-                if self.kept.len() < KEPT {
-                    self.kept.push((index, bytes, 0));
+                let slot = if self.kept.len() < KEPT {
+                    self.kept.push((index, vec![0; BLOCK].into_boxed_slice(), 0));
                     self.kept.len() - 1
                 } else {
-                    let oldest = (0..KEPT).min_by_key(|&slot| self.kept[slot].2).expect("blocks are kept");
-                    self.kept[oldest] = (index, bytes, 0);
-                    oldest
-                }
+                    (0..KEPT).min_by_key(|&slot| self.kept[slot].2).expect("blocks are kept")
+                };
+                let (start, len) = self.extent(index);
+                // Marked unread until the read succeeds: a failed read leaves no block that seems to hold it.
+                self.kept[slot].0 = u64::MAX;
+                self.inner.seek(SeekFrom::Start(start))?;
+                self.inner.read_exact(&mut self.kept[slot].1[..len])?;
+                self.kept[slot].0 = index;
+                slot
             }
         };
         self.kept[slot].2 = self.clock;
-        Ok(&self.kept[slot].1)
+        let (_, len) = self.extent(index);
+        Ok(&self.kept[slot].1[..len])
+    }
+
+    /// Where block `index` starts in the file, and its length (shorter at the end of the file).
+    fn extent(&self, index: u64) -> (u64, usize) {
+        let start = index * BLOCK as u64;
+        (start, (self.len - start).min(BLOCK as u64) as usize)
     }
 }
 

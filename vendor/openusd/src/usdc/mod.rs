@@ -135,29 +135,30 @@ where
     }
 
     fn try_field(&self, path: &sdf::Path, field: &str) -> Result<Option<Cow<'_, sdf::Value>>, sdf::DataError> {
-        let Some(spec) = self.data.get(path) else {
-            return Ok(None);
-        };
-        if let Some(authored) = spec.authored(field) {
-            return Ok(authored.as_ref().map(Cow::Borrowed));
+        match self.field_source(path, field) {
+            None => Ok(None),
+            Some(Source::Authored(value)) => Ok(value.map(Cow::Borrowed)),
+            Some(Source::Crate(rep)) => {
+                let value = self.file.borrow_mut().value(rep).map_err(|e| decode_error(path, field, e))?;
+                Ok(Some(Cow::Owned(value)))
+            }
         }
-        let Some(start) = spec.fieldset else {
-            return Ok(None);
-        };
-        let rep = crate_fields(&self.file.borrow(), start)
-            .find(|(name, _)| *name == field)
-            .map(|(_, rep)| rep);
-        let Some(rep) = rep else {
-            return Ok(None);
-        };
-        // The crate value decoder still reports failures as `anyhow`; box it as
-        // the typed `DataError`'s source at this trait boundary.
-        let value = self.file.borrow_mut().value(rep).map_err(|e| sdf::DataError::Decode {
-            path: path.clone(),
-            field: field.to_owned(),
-            source: e.into(),
-        })?;
-        Ok(Some(Cow::Owned(value)))
+    }
+
+    fn visit_time_samples(
+        &self,
+        path: &sdf::Path,
+        visit: &mut dyn FnMut(sdf::TimeSample),
+    ) -> Result<Option<sdf::TimeSamplesField>, sdf::DataError> {
+        let field = sdf::FieldKey::TimeSamples.as_str();
+        match self.field_source(path, field) {
+            Some(Source::Crate(rep)) if rep.ty().ok() == Some(layout::Type::TimeSamples) => {
+                let mut file = self.file.borrow_mut();
+                file.visit_time_samples(rep, visit).map_err(|e| decode_error(path, field, e))?;
+                Ok(Some(sdf::TimeSamplesField::Visited))
+            }
+            _ => Ok(self.try_field(path, field)?.map(|value| sdf::visit_decoded(value, visit))),
+        }
     }
 
     fn list_fields(&self, path: &sdf::Path) -> Option<Vec<String>> {
@@ -239,6 +240,29 @@ fn crate_fields<R>(file: &CrateFile<R>, start: usize) -> impl Iterator<Item = (&
             let field = &file.fields[index];
             (field_name(file, field.token_index), field.value_rep)
         })
+}
+
+/// Where a spec's field is: authored in memory over the crate (`None` for one erased there), or in the crate.
+enum Source<'a> {
+    Authored(Option<&'a sdf::Value>),
+    Crate(ValueRep),
+}
+
+impl<R> CrateData<R> {
+    /// Where the field `field` of the spec at `path` is; `None` where it has none.
+    fn field_source(&self, path: &sdf::Path, field: &str) -> Option<Source<'_>> {
+        let spec = self.data.get(path)?;
+        if let Some(authored) = spec.authored(field) {
+            return Some(Source::Authored(authored.as_ref()));
+        }
+        let rep = crate_fields(&self.file.borrow(), spec.fieldset?).find(|(name, _)| *name == field)?.1;
+        Some(Source::Crate(rep))
+    }
+}
+
+/// A failure of the crate's value decoder (still reported as `anyhow`) as the typed `DataError`.
+fn decode_error(path: &sdf::Path, field: &str, error: anyhow::Error) -> sdf::DataError {
+    sdf::DataError::Decode { path: path.clone(), field: field.to_owned(), source: error.into() }
 }
 
 /// Resolves a crate token index to a field name, translating the crate's

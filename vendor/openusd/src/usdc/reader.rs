@@ -931,6 +931,59 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         Ok(result)
     }
 
+    /// bonescope: the time samples at `value` (a `TimeSamples` rep) handed to `visit` one by one as each value is
+    /// decoded: a reader making arrays of its own holds one sample's value at a time, not all. They come in the order
+    /// their values lie in the file, each deduplicated value decoded once (taken in time order, values shared by
+    /// samples far apart sent the reader back and forth across the file); each says where it is in time order.
+    pub fn visit_time_samples(&mut self, value: ValueRep, visit: &mut dyn FnMut(sdf::TimeSample)) -> Result<()> {
+        ensure!(value.ty()? == Type::TimeSamples, "Not time samples");
+        ensure!(!value.is_inlined());
+        ensure!(!value.is_compressed());
+
+        self.set_position(value.payload())?;
+
+        self.apply_recursive_offset()?;
+
+        let times_rep = self.reader.read_pod::<ValueRep>()?;
+
+        let ty = times_rep.ty()?;
+        ensure!(
+            ty == Type::DoubleVector || (ty == Type::Double && times_rep.is_array()),
+            "Invalid time samples type: expected either double vector or double array"
+        );
+
+        // Save current position.
+        let saved_position = self.reader.stream_position()?;
+
+        let times = self
+            .value(times_rep)?
+            .try_as_double_vec()
+            .context("Failed to read time samples")?;
+
+        // Restore position
+        self.set_position(saved_position)?;
+
+        self.apply_recursive_offset()?;
+
+        let count = self.reader.read_count()?;
+        ensure!(count == times.len(), "Invalid time samples count");
+
+        let value_reps = self.reader.read_vec::<ValueRep>(count)?;
+        debug_assert_eq!(value_reps.len(), count);
+
+        let mut order: Vec<usize> = (0..count).collect();
+        order.sort_by_key(|&i| (value_reps[i].payload(), value_reps[i].0));
+        for shared in order.chunk_by(|&a, &b| value_reps[a].0 == value_reps[b].0) {
+            let value = self.value(value_reps[shared[0]])?;
+            let (&last, others) = shared.split_last().expect("a chunk is never empty");
+            for &index in others {
+                visit(sdf::TimeSample { index, time: times[index], value: value.clone(), count });
+            }
+            visit(sdf::TimeSample { index: last, time: times[last], value, count });
+        }
+        Ok(())
+    }
+
     pub fn value(&mut self, value: ValueRep) -> Result<sdf::Value> {
         let ty = value.ty()?;
         ensure!(ty != Type::Invalid, "Invalid value type");
@@ -1359,48 +1412,10 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             }
 
             Type::TimeSamples => {
-                ensure!(!value.is_inlined());
-                ensure!(!value.is_compressed());
-
-                self.set_position(value.payload())?;
-
-                self.apply_recursive_offset()?;
-
-                let times_rep = self.reader.read_pod::<ValueRep>()?;
-
-                let ty = times_rep.ty()?;
-                ensure!(
-                    ty == Type::DoubleVector || (ty == Type::Double && times_rep.is_array()),
-                    "Invalid time samples type: expected either double vector or double array"
-                );
-
-                // Save current position.
-                let saved_position = self.reader.stream_position()?;
-
-                let times = self
-                    .value(times_rep)?
-                    .try_as_double_vec()
-                    .context("Failed to read time samples")?;
-
-                // Restore position
-                self.set_position(saved_position)?;
-
-                self.apply_recursive_offset()?;
-
-                let count = self.reader.read_count()?;
-                ensure!(count == times.len(), "Invalid time samples count");
-
-                let value_reps = self.reader.read_vec::<ValueRep>(count)?;
-                debug_assert_eq!(value_reps.len(), count);
-
-                let values = value_reps
-                    .into_iter()
-                    .map(|value| self.value(value))
-                    .collect::<Result<Vec<_>>>()?;
-
-                let samples = times.into_iter().zip(values).collect();
-
-                sdf::Value::TimeSamples(samples)
+                let mut samples = Vec::new();
+                self.visit_time_samples(value, &mut |sample| samples.push(sample))?;
+                samples.sort_by_key(|sample| sample.index);
+                sdf::Value::TimeSamples(samples.into_iter().map(|sample| (sample.time, sample.value)).collect())
             }
 
             // Empty dictionary.
