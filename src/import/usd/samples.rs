@@ -42,8 +42,11 @@ impl Channel {
     /// The attribute's time samples, else its default value (held throughout), for arrays of `len` elements;
     /// `None` where it has neither or its samples are not all one array type.
     pub fn read(stage: &Stage, attribute: &Attribute, len: usize) -> Result<Option<Channel>, String> {
-        let mut reading = Reading { channel: None, mixed: false, len, widened: Vec::new() };
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len, widened: Vec::new() };
         stage.visit_time_samples(attribute.path().clone(), |sample| reading.add(sample)).map_err(said)?;
+        if let Some(refused) = reading.refused {
+            return Err(refused);
+        }
         if reading.channel.is_none() && !reading.mixed {
             let Some(value) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
             reading.add(TimeSample { index: 0, time: 0.0, value, count: 1 });
@@ -108,6 +111,8 @@ struct Reading {
     channel: Option<Channel>,
     /// A sample was of another type than the first, or of none a channel holds: the attribute is no channel.
     mixed: bool,
+    /// Why the channel cannot be read: its columns would take more memory than the reading may use.
+    refused: Option<String>,
     len: usize,
     /// A half-precision sample's numbers, widened.
     widened: Vec<f32>,
@@ -117,7 +122,7 @@ impl Reading {
     /// Takes a sample (none at a time code that is not finite).
     fn add(&mut self, sample: TimeSample) {
         let TimeSample { index, time: code, value, count: of } = sample;
-        if !code.is_finite() || self.mixed {
+        if !code.is_finite() || self.mixed || self.refused.is_some() {
             return;
         }
         let len = Length { len: self.len, of };
@@ -156,9 +161,12 @@ impl Reading {
                 let values = a.iter().copied();
                 push(&mut self.channel, Channel::Numbers, Precision::Float, len, at, a.len(), values)
             }
-            _ => false,
+            _ => Ok(false),
         };
-        self.mixed = !added;
+        match added {
+            Ok(added) => self.mixed = !added,
+            Err(refused) => self.refused = Some(refused),
+        }
     }
 
     fn finish(self) -> Option<Channel> {
@@ -190,7 +198,8 @@ struct Place {
 }
 
 /// Adds a sample of `count` `values` at `at` to `channel`, which it starts as `variant` where it is `None`; `false`
-/// where the channel holds another type or precision.
+/// where the channel holds another type or precision. Starting it charges the reading's budget for a column of every
+/// element (samples that share a value are decoded, and charged, once: the columns may take far more).
 fn push<V: Stored>(
     channel: &mut Option<Channel>,
     variant: fn(Columns<V>) -> Channel,
@@ -199,14 +208,18 @@ fn push<V: Stored>(
     at: Place,
     count: usize,
     values: impl Iterator<Item = V>,
-) -> bool {
-    let columns = channel.get_or_insert_with(|| variant(Columns::new(precision, length)));
-    match V::columns(columns) {
+) -> Result<bool, String> {
+    if channel.is_none() {
+        let elements = length.len.saturating_mul(length.of);
+        openusd::usdc::budget::charge(elements, size_of::<V>()).map_err(said)?;
+        *channel = Some(variant(Columns::new(precision, length)));
+    }
+    match channel.as_mut().and_then(V::columns) {
         Some(c) if c.precision == precision => {
             c.push(at, count, values);
-            true
+            Ok(true)
         }
-        _ => false,
+        _ => Ok(false),
     }
 }
 
@@ -554,7 +567,7 @@ mod tests {
     /// The samples (index, time code, x of the second element) of a channel of two vectors: the first element
     /// holds (1, 1, 1), the second is at (x, 0, 0); an `x` of `None` is an array of one element, which does not fit.
     fn channel(samples: &[(usize, f64, Option<f32>)]) -> Channel {
-        let mut reading = Reading { channel: None, mixed: false, len: 2, widened: Vec::new() };
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 2, widened: Vec::new() };
         for &(index, time, x) in samples {
             let moving = x.map(|x| gf::vec3f(x, 0.0, 0.0));
             let array = [Some(gf::vec3f(1.0, 1.0, 1.0)), moving].into_iter().flatten().collect();
@@ -596,13 +609,13 @@ mod tests {
     #[test]
     fn a_half_precision_sample_is_widened_exactly_and_a_second_type_is_no_channel() {
         let half = |x: f32| gf::Vec3h { x: f16::from_f32(x), y: f16::ZERO, z: f16::from_f32(-x) };
-        let mut reading = Reading { channel: None, mixed: false, len: 1, widened: Vec::new() };
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
         reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 1 });
         let widened = f16::from_f32(0.1).to_f32();
         let keys = reading.finish().expect("a channel").vectors(&[0.0], Vec3::ZERO);
         assert_eq!(keys, vec![Keys::Held(Vec3::new(widened, 0.0, -widened))]);
 
-        let mut reading = Reading { channel: None, mixed: false, len: 1, widened: Vec::new() };
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
         reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 2 });
         reading.add(TimeSample {
             index: 1,
@@ -611,5 +624,22 @@ mod tests {
             count: 2,
         });
         assert!(reading.finish().is_none());
+    }
+
+    #[test]
+    fn a_channel_whose_columns_would_pass_the_budget_is_refused_before_they_are_made() {
+        // A million samples of a thousand joints, say, sharing two values: the layer decodes two arrays, the columns
+        // would take 12 GB.
+        let sample =
+            TimeSample { index: 0, time: 0.0, value: Value::Vec3fVec(vec![gf::vec3f(0.0, 0.0, 0.0)]), count: 1 << 20 };
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1000, widened: Vec::new() };
+        openusd::usdc::budget::within(1 << 30, || reading.add(sample.clone()));
+        let refused = reading.refused.expect("refused");
+        assert!(refused.contains("over the reader's budget of 1073741824"), "{refused}");
+        assert!(reading.channel.is_none());
+
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1000, widened: Vec::new() };
+        openusd::usdc::budget::within(1 << 35, || reading.add(sample));
+        assert!(reading.refused.is_none() && reading.channel.is_some());
     }
 }

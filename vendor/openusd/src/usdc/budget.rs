@@ -20,8 +20,9 @@ pub fn within<R>(limit: u64, read: impl FnOnce() -> R) -> (R, u64) {
     (result, charged)
 }
 
-/// Charges `count` elements of `size` bytes to the budget, where one is set.
-pub(crate) fn charge(count: usize, size: usize) -> Result<()> {
+/// Charges `count` elements of `size` bytes to the budget, where one is set (public: a reader that builds arrays of
+/// its own from what a visit hands it charges them too).
+pub fn charge(count: usize, size: usize) -> Result<()> {
     let Some((limit, charged)) = BUDGET.get() else { return Ok(()) };
     let charged = charged.saturating_add((count as u64).saturating_mul(size as u64));
     BUDGET.set(Some((limit, charged)));
