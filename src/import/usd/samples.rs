@@ -427,6 +427,22 @@ pub trait Stored: Copy + PartialEq {
     fn is_nan(self) -> bool;
 }
 
+/// The part of [`Stored`] alike for every type: the channel variant that holds `$type`, and NaN as `$type` finds it.
+macro_rules! of_channel {
+    ($type:ty, $variant:ident) => {
+        fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
+            match channel {
+                Channel::$variant(c) => Some(c),
+                _ => None,
+            }
+        }
+
+        fn is_nan(self) -> bool {
+            <$type>::is_nan(self)
+        }
+    };
+}
+
 /// `half(half(a·(1 − t)) + half(b·t))` with weights `(1 − t, t)` = `(w0, w1)`: `GfVec3h`'s scaling and sum, each
 /// rounded to half precision.
 fn mix_half(a: f32, b: f32, w0: f64, w1: f64) -> f32 {
@@ -440,56 +456,29 @@ fn mix_float(a: f32, b: f32, w0: f64, w1: f64) -> f32 {
 }
 
 impl Stored for Vec3 {
-    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
-        match channel {
-            Channel::Vectors(c) => Some(c),
-            _ => None,
-        }
-    }
+    of_channel!(Vec3, Vectors);
 
     fn mix(a: Self, b: Self, t: f64, precision: Precision) -> Self {
         let mix = if precision == Precision::Half { mix_half } else { mix_float };
         Vec3::new(mix(a.x, b.x, 1.0 - t, t), mix(a.y, b.y, 1.0 - t, t), mix(a.z, b.z, 1.0 - t, t))
     }
-
-    fn is_nan(self) -> bool {
-        Vec3::is_nan(self)
-    }
 }
 
 impl Stored for DVec3 {
-    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
-        match channel {
-            Channel::DoubleVectors(c) => Some(c),
-            _ => None,
-        }
-    }
+    of_channel!(DVec3, DoubleVectors);
 
     fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
         let lerp = |a: f64, b: f64| (1.0 - t) * a + t * b;
         DVec3::new(lerp(a.x, b.x), lerp(a.y, b.y), lerp(a.z, b.z))
     }
-
-    fn is_nan(self) -> bool {
-        DVec3::is_nan(self)
-    }
 }
 
 /// `GfLerp` of two `float`s: computed in double precision, rounded once.
 impl Stored for f32 {
-    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
-        match channel {
-            Channel::Numbers(c) => Some(c),
-            _ => None,
-        }
-    }
+    of_channel!(f32, Numbers);
 
     fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
         ((1.0 - t) * f64::from(a) + t * f64::from(b)) as f32
-    }
-
-    fn is_nan(self) -> bool {
-        f32::is_nan(self)
     }
 }
 
@@ -519,12 +508,7 @@ fn slerp_weights(a: [f64; 4], b: [f64; 4], t: f64, single: bool) -> (f64, f64) {
 }
 
 impl Stored for Quat {
-    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
-        match channel {
-            Channel::Rotations(c) => Some(c),
-            _ => None,
-        }
-    }
+    of_channel!(Quat, Rotations);
 
     fn mix(a: Self, b: Self, t: f64, precision: Precision) -> Self {
         let wide = |q: Quat| [q.w, q.x, q.y, q.z].map(f64::from);
@@ -533,28 +517,15 @@ impl Stored for Quat {
         let c = |x: f32, y: f32| mix(x, y, w0, w1);
         Quat::from_xyzw(c(a.x, b.x), c(a.y, b.y), c(a.z, b.z), c(a.w, b.w))
     }
-
-    fn is_nan(self) -> bool {
-        Quat::is_nan(self)
-    }
 }
 
 impl Stored for DQuat {
-    fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>> {
-        match channel {
-            Channel::DoubleRotations(c) => Some(c),
-            _ => None,
-        }
-    }
+    of_channel!(DQuat, DoubleRotations);
 
     fn mix(a: Self, b: Self, t: f64, _: Precision) -> Self {
         let (w0, w1) = slerp_weights([a.w, a.x, a.y, a.z], [b.w, b.x, b.y, b.z], t, false);
         let c = |x: f64, y: f64| x * w0 + y * w1;
         DQuat::from_xyzw(c(a.x, b.x), c(a.y, b.y), c(a.z, b.z), c(a.w, b.w))
-    }
-
-    fn is_nan(self) -> bool {
-        DQuat::is_nan(self)
     }
 }
 
