@@ -325,6 +325,7 @@ impl<T: AbstractData + ?Sized> AbstractData for Box<T> {
         (**self).try_field(path, field)
     }
 
+    // bonescope: forwarded, so that a boxed crate layer still decodes sample by sample.
     fn visit_time_samples(
         &self,
         path: &Path,
@@ -555,6 +556,7 @@ impl<T: AbstractData> AbstractData for CowData<T> {
         }
     }
 
+    // bonescope: the base's own visit where nothing is staged at `path`.
     fn visit_time_samples(
         &self,
         path: &Path,

@@ -135,6 +135,7 @@ where
     }
 
     fn try_field(&self, path: &sdf::Path, field: &str) -> Result<Option<Cow<'_, sdf::Value>>, sdf::DataError> {
+        // bonescope: where the field is found, shared with `visit_time_samples`.
         match self.field_source(path, field) {
             None => Ok(None),
             Some(Source::Authored(value)) => Ok(value.map(Cow::Borrowed)),
@@ -145,6 +146,7 @@ where
         }
     }
 
+    /// bonescope: a crate's time samples decoded one by one as they are handed on.
     fn visit_time_samples(
         &self,
         path: &sdf::Path,
@@ -242,7 +244,7 @@ fn crate_fields<R>(file: &CrateFile<R>, start: usize) -> impl Iterator<Item = (&
         })
 }
 
-/// Where a spec's field is: authored in memory over the crate (`None` for one erased there), or in the crate.
+/// bonescope: where a spec's field is: authored in memory over the crate (`None` for one erased there), or in the crate.
 enum Source<'a> {
     Authored(Option<&'a sdf::Value>),
     Crate(ValueRep),
@@ -260,7 +262,7 @@ impl<R> CrateData<R> {
     }
 }
 
-/// A failure of the crate's value decoder (still reported as `anyhow`) as the typed `DataError`.
+/// bonescope: a failure of the crate's value decoder (still reported as `anyhow`) as the typed `DataError`.
 fn decode_error(path: &sdf::Path, field: &str, error: anyhow::Error) -> sdf::DataError {
     sdf::DataError::Decode { path: path.clone(), field: field.to_owned(), source: error.into() }
 }

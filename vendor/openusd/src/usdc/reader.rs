@@ -1411,6 +1411,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 sdf::Value::VariantSelectionMap(map)
             }
 
+            // bonescope: decoded by the visit, in the order the values lie in the file, then put in time order.
             Type::TimeSamples => {
                 let mut samples = Vec::new();
                 self.visit_time_samples(value, &mut |sample| samples.push(sample))?;
