@@ -239,9 +239,8 @@ pub struct Columns<V> {
     precision: Precision,
     /// The length an array must have to be read.
     len: usize,
-    /// How many samples the channel has, as its layer says.
-    of: usize,
-    /// Per sample, its time code (NaN for one not read: at no finite time code, dropped once all are read).
+    /// Per sample (as many as its layer says it has), its time code (NaN for one not read: at no finite time code,
+    /// dropped once all are read).
     codes: Vec<f64>,
     /// Per sample, whether its array has `len` elements.
     fits: Vec<bool>,
@@ -271,22 +270,12 @@ impl<V: Stored> Columns<V> {
     fn new(precision: Precision, Length { len, of }: Length) -> Self {
         let columns = (0..len).map(|_| None).collect();
         let (codes, fits) = (vec![f64::NAN; of], vec![false; of]);
-        Columns {
-            precision,
-            len,
-            of,
-            codes,
-            fits,
-            first: None,
-            columns,
-            staged: Vec::new(),
-            staged_samples: Vec::new(),
-        }
+        Columns { precision, len, codes, fits, first: None, columns, staged: Vec::new(), staged_samples: Vec::new() }
     }
 
     /// A column holding `value` at every sample but `v` at `sample`.
     fn column(&self, value: V, sample: usize, v: V) -> Arc<[V]> {
-        let mut column: Arc<[V]> = std::iter::repeat_n(value, self.of).collect();
+        let mut column: Arc<[V]> = std::iter::repeat_n(value, self.codes.len()).collect();
         Arc::make_mut(&mut column)[sample] = v;
         column
     }
@@ -294,7 +283,7 @@ impl<V: Stored> Columns<V> {
     /// Adds the `count` `values` of the sample at `at` (samples come in any order, once each).
     fn push(&mut self, at: Place, count: usize, values: impl Iterator<Item = V>) {
         let sample = at.index;
-        if sample >= self.of {
+        if sample >= self.codes.len() {
             return;
         }
         self.codes[sample] = at.code;
@@ -350,7 +339,7 @@ impl<V: Stored> Columns<V> {
         if self.codes.iter().all(|c| c.is_finite()) && self.codes.is_sorted_by(|a, b| a.total_cmp(b).is_le()) {
             return;
         }
-        let mut order: Vec<usize> = (0..self.of).filter(|&i| self.codes[i].is_finite()).collect();
+        let mut order: Vec<usize> = (0..self.codes.len()).filter(|&i| self.codes[i].is_finite()).collect();
         order.sort_by(|&a, &b| self.codes[a].total_cmp(&self.codes[b]));
         self.codes = order.iter().map(|&i| self.codes[i]).collect();
         self.fits = order.iter().map(|&i| self.fits[i]).collect();
@@ -399,17 +388,13 @@ impl<V: Stored> Columns<V> {
         let reads = self.reads(codes);
         let all_fit = self.fits.iter().all(|f| *f);
         let own = all_fit && codes == self.codes;
-        let value = |columns: &Self, e: usize, read: Read| columns.read(e, read).map_or(identity, &into);
         (0..self.len)
-            .map(|e| match self.columns[e].take() {
-                None if all_fit => Keys::Held(value(&self, e, reads[0])),
-                Some(column) if own => Keys::Moving(whole(column)),
-                column => {
-                    self.columns[e] = column;
-                    let keys = reads.iter().map(|&read| value(&self, e, read)).collect();
-                    self.columns[e] = None;
-                    Keys::Moving(keys)
+            .map(|e| match self.columns[e].take_if(|_| own) {
+                Some(column) => Keys::Moving(whole(column)),
+                None if all_fit && self.columns[e].is_none() => {
+                    Keys::Held(self.read(e, reads[0]).map_or(identity, &into))
                 }
+                None => Keys::Moving(reads.iter().map(|&read| self.read(e, read).map_or(identity, &into)).collect()),
             })
             .collect()
     }
