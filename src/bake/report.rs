@@ -4,7 +4,9 @@
 //! file that was written, as that runtime plays it, not the intentions behind it.
 
 use super::{Baked, BakedAnimation, Engine, Request, Strategy};
-use crate::diff::{Comparison, DEFAULT_RATE, Extreme, MeshDifference, Pairs, compare_each, comparison_times};
+use crate::diff::{
+    Comparison, DEFAULT_RATE, Extreme, Measure, MeshDifference, Pairs, compare_each, comparison_times,
+};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Rig};
@@ -101,7 +103,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
         .map(|(k, animation)| {
             let source = &request.clips()[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
-            let pairs = Pairs::by_name(source, &result);
+            // The report prints distances alone: the polar parts are not decomposed.
+            let pairs = Pairs { measure: Measure::Distances, ..Pairs::by_name(source, &result) };
             let comparison =
                 played(request.engine, source, &result, &pairs, &checked_times(source, &result, animation));
             let nodes = |bone: usize| match (request.strategy, baked.helpers[bone]) {

@@ -152,10 +152,13 @@ pub enum Measure {
     /// Distances (positions and probes) and the polar parts' differences (orientation, scale, stretch).
     #[default]
     Everything,
+    /// The distances alone, the meshes' means among them (what a bake's report prints): no polar decomposition, the
+    /// parts' differences left at none.
+    Distances,
     /// The largest distances alone (what a change costs, [`crate::explain`]): no polar decomposition, the parts'
     /// differences and the meshes' means left at none. Between two evaluations of one rig, a time at which a mesh's
     /// vertices provably lie no further apart than the largest distance already found ([`Reach`]) is not skinned.
-    Distances,
+    Largest,
 }
 
 /// A mesh of A and its partner in B (the same vertex count), and the vertices compared: every one (`None`), or
@@ -395,7 +398,7 @@ impl<'p> Differences<'p> {
             let probe = probe_distance(wa, wb, probe_length).max(probe_distance(wb, wa, probe_length));
             difference.probe.add(probe, time);
             self.largest = self.largest.max(probe);
-            if self.measure == Measure::Distances {
+            if self.measure != Measure::Everything {
                 continue;
             }
             let (pa, pb) = (&a.parts[difference.a], &b.parts[difference.b]);
@@ -414,11 +417,11 @@ impl<'p> Differences<'p> {
             b.skin(difference.b);
             let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
             let mut largest: f64 = 0.0;
-            let everything = self.measure == Measure::Everything;
+            let means = self.measure != Measure::Largest;
             let mut add = |p: &DVec3, q: &DVec3| {
                 let d = p.distance(*q);
                 largest = largest.max(d);
-                if everything {
+                if means {
                     difference.sum += d;
                 }
             };
@@ -433,10 +436,10 @@ impl<'p> Differences<'p> {
 }
 
 /// Per mesh pair of `pairs`, how far its vertices can lie apart, known from the joints alone where both sides are
-/// evaluations of one rig skinning alike and only the largest distances are measured ([`Measure::Distances`]: the
+/// evaluations of one rig skinning alike and only the largest distances are measured ([`Measure::Largest`]: the
 /// means need every vertex at every time).
 fn reaches(a: &Evaluation, b: &Evaluation, pairs: &Pairs) -> Vec<Option<Reach>> {
-    let alike = pairs.measure == Measure::Distances && std::ptr::eq(a.rig, b.rig) && a.skinning == b.skinning;
+    let alike = pairs.measure == Measure::Largest && std::ptr::eq(a.rig, b.rig) && a.skinning == b.skinning;
     let reach = |pair: &MeshPair| {
         let rig = a.rig;
         let mesh = rig.meshes.get(pair.a).filter(|_| alike && pair.a == pair.b)?;

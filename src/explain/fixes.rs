@@ -294,7 +294,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
         let changed = self.changed(change);
         let figure = self.source.skeleton().figure();
-        let mut pairs = Pairs { measure: Measure::Distances, ..Pairs::by_name(self.source, fixed) };
+        let mut pairs = Pairs { measure: Measure::Largest, ..Pairs::by_name(self.source, fixed) };
         pairs.bones.pairs.retain(|&(a, _)| changed(a) && figure[a]);
         let moving =
             |pair: MeshPair| Some(MeshPair { vertices: following(self.source.rig, pair.a, &changed)?, ..pair });
