@@ -908,33 +908,20 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
     fn read_vec_array<T: Default + NoUninit + AnyBitPattern, const N: usize>(
         &mut self,
         value: ValueRep,
-    ) -> Result<Vec<[T; N]>> {
+    ) -> Result<Vec<[T; N]>>
+    where
+        [T; N]: Default + NoUninit + AnyBitPattern,
+    {
         debug_assert!(value.is_array());
         debug_assert!(!value.is_compressed());
 
         let (count, _) = self.unpack_array_len(value, ArrayKind::Other)?;
 
-        // Array allowed to be empty.
-        if count == 0 {
-            return Ok(Vec::default());
-        }
-
-        let flat: Vec<T> = self.reader.read_vec(count * N)?;
-
-        // Reinterpret the flat vec as a vec of fixed-size arrays. `chunks_exact(N)`
-        // always yields slices of exactly N elements, so `try_into` cannot fail.
-        let result = flat
-            .chunks_exact(N)
-            .map(|chunk| chunk.try_into().expect("chunks_exact yields N elements"))
-            .collect();
-
-        Ok(result)
+        // bonescope: read as the arrays themselves (an array of plain numbers is plain numbers), not as a flat vector
+        // copied into them.
+        self.reader.read_vec(count)
     }
 
-    /// bonescope: the time samples at `value` (a `TimeSamples` rep) handed to `visit` one by one as each value is
-    /// decoded: a reader making arrays of its own holds one sample's value at a time, not all. They come in the order
-    /// their values lie in the file, each deduplicated value decoded once (taken in time order, values shared by
-    /// samples far apart sent the reader back and forth across the file); each says where it is in time order.
     pub fn visit_time_samples(&mut self, value: ValueRep, visit: &mut dyn FnMut(sdf::TimeSample)) -> Result<()> {
         ensure!(value.ty()? == Type::TimeSamples, "Not time samples");
         ensure!(!value.is_inlined());
