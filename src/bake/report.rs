@@ -4,9 +4,7 @@
 //! file that was written, as that runtime plays it, not the intentions behind it.
 
 use super::{Baked, BakedAnimation, Engine, Request, Strategy};
-use crate::diff::{
-    Comparison, DEFAULT_RATE, Extreme, Measure, MeshDifference, Pairs, compare_each, comparison_times,
-};
+use crate::diff::{Comparison, DEFAULT_RATE, Extreme, Measure, MeshDifference, Pairs, compare_each, comparison_times};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
 use crate::model::{Choice, Rig};
