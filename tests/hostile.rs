@@ -409,7 +409,7 @@ fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
     let usdc = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.usdc");
     let run = bonescope(&["inspect", usdc.to_str().unwrap(), "--max-memory", "20K"]);
     check_run(&run).unwrap();
-    check_refusal(&run, &usdc, "for the arrays of its binary layers; the limit is 20 KiB (--max-memory)").unwrap();
+    check_refusal(&run, &usdc, "for the arrays read from its layers; the limit is 20 KiB (--max-memory)").unwrap();
     let run = bonescope(&["inspect", usdc.to_str().unwrap(), "--max-memory", "1M"]);
     assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));
 }

@@ -381,3 +381,25 @@ fn the_crate_readers_blocks_read_what_the_file_holds() {
     }
     assert!(blocks.seek(SeekFrom::Current(-(file.len() as i64) - 1)).is_err());
 }
+
+#[test]
+fn the_budget_bounds_what_a_binary_layer_s_samples_hold_at_once_not_their_sum() {
+    // 2,000 time codes of 20 joints' translations, each an array of its own (480 kB decoded in all), of which the
+    // reading keeps one moving joint's column (24 kB): streamed, a sample is given back to the budget once read, so
+    // the file loads within 400 KiB, less than its samples take together, and is refused in one line below what it
+    // holds at once.
+    let Some(python) = usd_python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("long.usdc");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/long_clip.py");
+    let status = Command::new(python).arg(script).arg(&file).status().expect("python runs");
+    assert!(status.success());
+    let file = file.to_str().unwrap();
+    let loaded = common::bonescope(&["inspect", file, "--time", "0.5", "--max-memory", "400K"]);
+    assert!(loaded.status.success(), "{}", String::from_utf8_lossy(&loaded.stderr));
+    let refused = common::bonescope(&["inspect", file, "--time", "0.5", "--max-memory", "64K"]);
+    let said = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{said}");
+    assert_eq!(said.lines().count(), 1, "{said}");
+    assert!(said.contains("long.usdc") && said.contains("the limit is 64 KiB (--max-memory)"), "{said}");
+}

@@ -36,15 +36,16 @@ const DEFAULT_METERS_PER_UNIT: f64 = 0.01;
 /// Reads the USD file at `path` (any of its three encodings) into a rig. A panic inside the `openusd` crate (a bug
 /// there, which a hostile file may find) is that file's error, not the end of the process.
 ///
-/// Every array the binary layers decode is charged to the memory budget before it is allocated (the counts in their
-/// headers say how large): a file that would need more is refused with the budget's figures.
+/// Every array the binary layers decode, and every array of samples and keys made of what the layers hold, is
+/// charged to the memory budget before it is allocated (the counts in their headers say how large; a value dropped
+/// once read is given back): a file that would need more at once is refused with the budget's figures.
 pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     let (read, needed) =
         openusd::usdc::budget::within(super::budget::limit(), || guard::caught(|| read(path, options)));
     let read = read.unwrap_or_else(|bug| {
         Err(ImportError::new(path, None, format!("the USD reader failed (a bug in openusd): {bug}")))
     });
-    read.map_err(|error| match within_budget(needed, || "the arrays of its binary layers".to_owned()) {
+    read.map_err(|error| match within_budget(needed, || "the arrays read from its layers".to_owned()) {
         Err(message) => ImportError::new(path, None, message),
         Ok(()) => error,
     })

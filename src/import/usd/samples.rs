@@ -44,14 +44,11 @@ impl Channel {
     pub fn read(stage: &Stage, attribute: &Attribute, len: usize) -> Result<Option<Channel>, String> {
         let mut reading = Reading { channel: None, mixed: false, refused: None, len, widened: Vec::new() };
         stage.visit_time_samples(attribute.path().clone(), |sample| reading.add(sample)).map_err(said)?;
-        if let Some(refused) = reading.refused {
-            return Err(refused);
-        }
-        if reading.channel.is_none() && !reading.mixed {
+        if reading.channel.is_none() && !reading.mixed && reading.refused.is_none() {
             let Some(value) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
             reading.add(TimeSample { index: 0, time: 0.0, value, count: 1 });
         }
-        Ok(reading.finish())
+        reading.finish()
     }
 
     /// The time codes of its samples.
@@ -60,35 +57,36 @@ impl Channel {
     }
 
     /// Each element's vectors at `codes`, `identity` where a sample there is not an array of the channel's length
-    /// and throughout a channel of rotations or numbers.
-    pub fn vectors(self, codes: &[f64], identity: Vec3) -> Vec<Keys<Vec3>> {
+    /// and throughout a channel of rotations or numbers; an error where the keys made anew would pass the reading's
+    /// budget.
+    pub fn vectors(self, codes: &[f64], identity: Vec3) -> Result<Vec<Keys<Vec3>>, String> {
         match self {
-            Channel::Vectors(c) => c.keys(codes, identity, |v| v, |column| column),
-            Channel::DoubleVectors(c) => {
-                c.keys(codes, identity, DVec3::as_vec3, |c| c.iter().map(|v| v.as_vec3()).collect())
-            }
-            other => each!(other, c => c.keys(codes, identity, |_| identity, |c| c.iter().map(|_| identity).collect())),
+            Channel::Vectors(c) => c.keys(codes, identity, |v| v, Ok),
+            Channel::DoubleVectors(c) => c.keys(codes, identity, DVec3::as_vec3, Err),
+            other => each!(other, c => c.keys(codes, identity, |_| identity, Err)),
         }
     }
 
     /// Each element's rotations at `codes`, as stored: not normalised, as UsdSkel makes a matrix of them (and as
     /// glTF's keys are read); `identity` where a sample there is not an array of the channel's length and throughout
-    /// a channel of vectors or numbers.
-    pub fn rotations(self, codes: &[f64], identity: Quat) -> Vec<Keys<Quat>> {
+    /// a channel of vectors or numbers; an error where the keys made anew would pass the reading's budget.
+    pub fn rotations(self, codes: &[f64], identity: Quat) -> Result<Vec<Keys<Quat>>, String> {
         let single = |q: DQuat| Quat::from_xyzw(q.x as f32, q.y as f32, q.z as f32, q.w as f32);
         match self {
-            Channel::Rotations(c) => c.keys(codes, identity, |q| q, |column| column),
-            Channel::DoubleRotations(c) => c.keys(codes, identity, single, |c| c.iter().map(|q| single(*q)).collect()),
-            other => each!(other, c => c.keys(codes, identity, |_| identity, |c| c.iter().map(|_| identity).collect())),
+            Channel::Rotations(c) => c.keys(codes, identity, |q| q, Ok),
+            Channel::DoubleRotations(c) => c.keys(codes, identity, single, Err),
+            other => each!(other, c => c.keys(codes, identity, |_| identity, Err)),
         }
     }
 
     /// The numbers at each of `codes`, one per element; `None` at a code where the sample is not an array of the
-    /// channel's length, and for a channel of vectors or rotations.
-    pub fn numbers(&self, codes: &[f64]) -> Option<Vec<Option<Vec<f32>>>> {
-        let Channel::Numbers(c) = self else { return None };
+    /// channel's length, and for a channel of vectors or rotations. Charged to the reading's budget before they are
+    /// made.
+    pub fn numbers(&self, codes: &[f64]) -> Result<Option<Vec<Option<Vec<f32>>>>, String> {
+        let Channel::Numbers(c) = self else { return Ok(None) };
+        openusd::usdc::budget::charge(codes.len().saturating_mul(c.len), size_of::<f32>()).map_err(said)?;
         let reads = c.reads(codes);
-        Some(reads.iter().map(|&read| (0..c.len).map(|e| c.read(e, read)).collect()).collect())
+        Ok(Some(reads.iter().map(|&read| (0..c.len).map(|e| c.read(e, read)).collect()).collect()))
     }
 }
 
@@ -169,10 +167,14 @@ impl Reading {
         }
     }
 
-    fn finish(self) -> Option<Channel> {
-        let mut channel = self.channel.filter(|_| !self.mixed)?;
-        each!(&mut channel, c => c.finish());
-        Some(channel)
+    /// The channel read; `None` where the attribute is no channel, an error where it could not be read.
+    fn finish(self) -> Result<Option<Channel>, String> {
+        if let Some(refused) = self.refused {
+            return Err(refused);
+        }
+        let Some(mut channel) = self.channel.filter(|_| !self.mixed) else { return Ok(None) };
+        each!(&mut channel, c => c.finish())?;
+        Ok(Some(channel))
     }
 }
 
@@ -198,8 +200,9 @@ struct Place {
 }
 
 /// Adds a sample of `count` `values` at `at` to `channel`, which it starts as `variant` where it is `None`; `false`
-/// where the channel holds another type or precision. Starting it charges the reading's budget for a column of every
-/// element (samples that share a value are decoded, and charged, once: the columns may take far more).
+/// where the channel holds another type or precision. Starting it charges the reading's budget for what it keeps
+/// besides the columns (which are charged as they are made): a time code per sample, the first sample's values and
+/// the samples staged.
 fn push<V: Stored>(
     channel: &mut Option<Channel>,
     variant: fn(Columns<V>) -> Channel,
@@ -210,15 +213,12 @@ fn push<V: Stored>(
     values: impl Iterator<Item = V>,
 ) -> Result<bool, String> {
     if channel.is_none() {
-        let elements = length.len.saturating_mul(length.of);
-        openusd::usdc::budget::charge(elements, size_of::<V>()).map_err(said)?;
+        openusd::usdc::budget::charge(length.of, size_of::<f64>() + size_of::<bool>()).map_err(said)?;
+        openusd::usdc::budget::charge(length.len.saturating_mul(STAGED + 1), size_of::<V>()).map_err(said)?;
         *channel = Some(variant(Columns::new(precision, length)));
     }
     match channel.as_mut().and_then(V::columns) {
-        Some(c) if c.precision == precision => {
-            c.push(at, count, values);
-            Ok(true)
-        }
+        Some(c) if c.precision == precision => c.push(at, count, values).map(|()| true),
         _ => Ok(false),
     }
 }
@@ -273,44 +273,48 @@ impl<V: Stored> Columns<V> {
         Columns { precision, len, codes, fits, first: None, columns, staged: Vec::new(), staged_samples: Vec::new() }
     }
 
-    /// A column holding `value` at every sample but `v` at `sample`.
-    fn column(&self, value: V, sample: usize, v: V) -> Arc<[V]> {
+    /// A column holding `value` at every sample but `v` at `sample`, charged to the reading's budget before it is
+    /// made.
+    fn column(&self, value: V, sample: usize, v: V) -> Result<Arc<[V]>, String> {
+        openusd::usdc::budget::charge(self.codes.len(), size_of::<V>()).map_err(said)?;
         let mut column: Arc<[V]> = std::iter::repeat_n(value, self.codes.len()).collect();
         Arc::make_mut(&mut column)[sample] = v;
-        column
+        Ok(column)
     }
 
-    /// Adds the `count` `values` of the sample at `at` (samples come in any order, once each).
-    fn push(&mut self, at: Place, count: usize, values: impl Iterator<Item = V>) {
+    /// Adds the `count` `values` of the sample at `at` (samples come in any order, once each); an error where a
+    /// column it starts would pass the reading's budget.
+    fn push(&mut self, at: Place, count: usize, values: impl Iterator<Item = V>) -> Result<(), String> {
         let sample = at.index;
         if sample >= self.codes.len() {
-            return;
+            return Ok(());
         }
         self.codes[sample] = at.code;
         self.fits[sample] = count == self.len;
         if count != self.len {
-            return;
+            return Ok(());
         }
         if self.first.is_none() {
             let first: Vec<V> = values.collect();
             // A value unequal to itself (NaN) is never held.
             for (e, v) in first.iter().enumerate().filter(|(_, v)| v.is_nan()) {
-                self.columns[e] = Some(self.column(*v, sample, *v));
+                self.columns[e] = Some(self.column(*v, sample, *v)?);
             }
             self.first = Some(first);
-            return;
+            return Ok(());
         }
         self.staged.extend(values);
         self.staged_samples.push(sample);
         if self.staged_samples.len() == STAGED {
-            self.flush();
+            self.flush()?;
         }
+        Ok(())
     }
 
     /// Writes the staged samples into the columns, starting the column of an element where one differs from the
     /// first.
-    fn flush(&mut self) {
-        let Some(first) = &self.first else { return };
+    fn flush(&mut self) -> Result<(), String> {
+        let Some(first) = &self.first else { return Ok(()) };
         let mut columns = std::mem::take(&mut self.columns);
         let rows = self.staged_samples.iter().copied().zip(self.staged.chunks_exact(self.len));
         // The elements that start to move, found row by row: a row is contiguous, and most rows of a channel that
@@ -318,7 +322,7 @@ impl<V: Stored> Columns<V> {
         for (sample, row) in rows.clone().filter(|(_, row)| *row != first.as_slice()) {
             for ((column, v), held) in columns.iter_mut().zip(row).zip(first) {
                 if column.is_none() && v != held {
-                    *column = Some(self.column(*held, sample, *v));
+                    *column = Some(self.column(*held, sample, *v)?);
                 }
             }
         }
@@ -330,14 +334,15 @@ impl<V: Stored> Columns<V> {
         self.columns = columns;
         self.staged.clear();
         self.staged_samples.clear();
+        Ok(())
     }
 
     /// Writes what is staged, drops the samples not read and puts the others in order of time code, the stored
     /// order among equal ones.
-    fn finish(&mut self) {
-        self.flush();
+    fn finish(&mut self) -> Result<(), String> {
+        self.flush()?;
         if self.codes.iter().all(|c| c.is_finite()) && self.codes.is_sorted_by(|a, b| a.total_cmp(b).is_le()) {
-            return;
+            return Ok(());
         }
         let mut order: Vec<usize> = (0..self.codes.len()).filter(|&i| self.codes[i].is_finite()).collect();
         order.sort_by(|&a, &b| self.codes[a].total_cmp(&self.codes[b]));
@@ -346,6 +351,7 @@ impl<V: Stored> Columns<V> {
         for column in self.columns.iter_mut().flatten() {
             *column = order.iter().map(|&i| column[i]).collect();
         }
+        Ok(())
     }
 
     /// How the value at each of `codes` is read.
@@ -375,26 +381,33 @@ impl<V: Stored> Columns<V> {
         }
     }
 
-    /// Each element's keys at `codes`, made `T`s (`whole` makes a whole column): held where every sample fits and
-    /// holds its value, else one per code (`identity` where nothing fits there). A column whose samples are `codes`
-    /// is its keys.
+    /// Each element's keys at `codes`, made `T`s: held where every sample fits and holds its value, else one per
+    /// code (`identity` where nothing fits there). A column whose samples are `codes` is its keys where it already
+    /// holds `T`s (`same` gives it back as such, else back as it is); any other is made anew, charged to the reading's budget first.
     fn keys<T: Copy>(
         mut self,
         codes: &[f64],
         identity: T,
         into: impl Fn(V) -> T,
-        whole: impl Fn(Arc<[V]>) -> Arc<[T]>,
-    ) -> Vec<Keys<T>> {
+        same: impl Fn(Arc<[V]>) -> Result<Arc<[T]>, Arc<[V]>>,
+    ) -> Result<Vec<Keys<T>>, String> {
         let reads = self.reads(codes);
         let all_fit = self.fits.iter().all(|f| *f);
         let own = all_fit && codes == self.codes;
+        let made = |values: &mut dyn Iterator<Item = T>| -> Result<Keys<T>, String> {
+            openusd::usdc::budget::charge(codes.len(), size_of::<T>()).map_err(said)?;
+            Ok(Keys::Moving(values.collect()))
+        };
         (0..self.len)
             .map(|e| match self.columns[e].take_if(|_| own) {
-                Some(column) => Keys::Moving(whole(column)),
+                Some(column) => match same(column) {
+                    Ok(keys) => Ok(Keys::Moving(keys)),
+                    Err(column) => made(&mut column.iter().map(|v| into(*v))),
+                },
                 None if all_fit && self.columns[e].is_none() => {
-                    Keys::Held(self.read(e, reads[0]).map_or(identity, &into))
+                    Ok(Keys::Held(self.read(e, reads[0]).map_or(identity, &into)))
                 }
-                None => Keys::Moving(reads.iter().map(|&read| self.read(e, read).map_or(identity, &into)).collect()),
+                None => made(&mut reads.iter().map(|&read| self.read(e, read).map_or(identity, &into))),
             })
             .collect()
     }
@@ -529,7 +542,7 @@ mod tests {
             let array = [Some(gf::vec3f(1.0, 1.0, 1.0)), moving].into_iter().flatten().collect();
             reading.add(TimeSample { index, time, value: Value::Vec3fVec(array), count: samples.len() });
         }
-        reading.finish().expect("one type throughout")
+        reading.finish().expect("within the budget").expect("one type throughout")
     }
 
     fn x(x: f32) -> Vec3 {
@@ -540,9 +553,9 @@ mod tests {
     fn samples_in_any_order_are_read_as_in_time_order() {
         let samples = [(0, 0.0, Some(0.0)), (1, 1.0, Some(1.0)), (2, 2.0, Some(3.0))];
         let codes = [0.0, 0.5, 1.0, 2.0, 3.0];
-        let in_order = channel(&samples).vectors(&codes, Vec3::ZERO);
+        let in_order = channel(&samples).vectors(&codes, Vec3::ZERO).unwrap();
         let [a, b, c] = samples;
-        assert_eq!(channel(&[c, a, b]).vectors(&codes, Vec3::ZERO), in_order);
+        assert_eq!(channel(&[c, a, b]).vectors(&codes, Vec3::ZERO).unwrap(), in_order);
         // Held before the first sample and after the last, mixed between (exact in `float` at these values).
         let moving: Arc<[Vec3]> = [x(0.0), x(0.5), x(1.0), x(3.0), x(3.0)].into();
         assert_eq!(in_order, vec![Keys::Held(Vec3::ONE), Keys::Moving(moving)]);
@@ -554,7 +567,7 @@ mod tests {
         let samples = [(0, 0.0, Some(0.0)), (1, 3.0, None), (2, f64::NAN, Some(9.0)), (3, 2.0, Some(2.0))];
         let channel = channel(&samples);
         assert_eq!(channel.codes(), [0.0, 2.0, 3.0]);
-        let keys = channel.vectors(&[0.0, 1.0, 2.5, 3.0], Vec3::ZERO);
+        let keys = channel.vectors(&[0.0, 1.0, 2.5, 3.0], Vec3::ZERO).unwrap();
         // Between a fitting sample and one that does not, the earlier is held; at the one that does not fit, nothing
         // is read; every element then moves.
         let held: Arc<[Vec3]> = [Vec3::ONE, Vec3::ONE, Vec3::ONE, Vec3::ZERO].into();
@@ -568,7 +581,7 @@ mod tests {
         let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
         reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 1 });
         let widened = f16::from_f32(0.1).to_f32();
-        let keys = reading.finish().expect("a channel").vectors(&[0.0], Vec3::ZERO);
+        let keys = reading.finish().unwrap().expect("a channel").vectors(&[0.0], Vec3::ZERO).unwrap();
         assert_eq!(keys, vec![Keys::Held(Vec3::new(widened, 0.0, -widened))]);
 
         let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
@@ -579,23 +592,36 @@ mod tests {
             value: Value::Vec3fVec(vec![gf::vec3f(0.1, 0.0, 0.0)]),
             count: 2,
         });
-        assert!(reading.finish().is_none());
+        assert!(matches!(reading.finish(), Ok(None)));
     }
 
     #[test]
-    fn a_channel_whose_columns_would_pass_the_budget_is_refused_before_they_are_made() {
-        // A million samples of a thousand joints, say, sharing two values: the layer decodes two arrays, the columns
-        // would take 12 GB.
-        let sample =
-            TimeSample { index: 0, time: 0.0, value: Value::Vec3fVec(vec![gf::vec3f(0.0, 0.0, 0.0)]), count: 1 << 20 };
-        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1000, widened: Vec::new() };
-        openusd::usdc::budget::within(1 << 30, || reading.add(sample.clone()));
-        let refused = reading.refused.expect("refused");
-        assert!(refused.contains("over the reader's budget of 1073741824"), "{refused}");
-        assert!(reading.channel.is_none());
-
-        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1000, widened: Vec::new() };
-        openusd::usdc::budget::within(1 << 35, || reading.add(sample));
-        assert!(reading.refused.is_none() && reading.channel.is_some());
+    fn a_channel_is_refused_once_the_columns_made_would_pass_the_budget() {
+        // Two samples of a hundred joints, every joint moving between them, in a layer that says it has 65,536
+        // samples (sharing those two values, say): the layer decodes two arrays, each column takes 786 kB.
+        let (samples, joints) = (1 << 16, 100);
+        let sample = |index: usize, x: f32| {
+            let value = Value::Vec3fVec(vec![gf::vec3f(x, 0.0, 0.0); joints]);
+            TimeSample { index, time: index as f64, value, count: samples }
+        };
+        let column = samples * size_of::<Vec3>();
+        let read = |budget: usize| {
+            let mut reading = Reading { channel: None, mixed: false, refused: None, len: joints, widened: Vec::new() };
+            let (finished, peak) = openusd::usdc::budget::within(budget as u64, || {
+                reading.add(sample(0, 0.0));
+                reading.add(sample(1, 1.0));
+                reading.finish()
+            });
+            (finished.map(|channel| channel.is_some()), peak as usize)
+        };
+        // Room for 8 columns: refused at the one that does not fit, having made no more than fit.
+        let (refused, peak) = read(8 * column);
+        let refused = refused.expect_err("refused");
+        assert!(refused.contains(&format!("over the reader's budget of {}", 8 * column)), "{refused}");
+        assert!(peak <= 9 * column, "{peak} bytes charged");
+        // Room for every column and what the reading keeps besides: read.
+        let (read, peak) = read(joints * column + (1 << 24));
+        assert_eq!(read, Ok(true));
+        assert!(peak >= joints * column, "every column charged: {peak} bytes");
     }
 }

@@ -14,7 +14,7 @@ use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
 use super::samples::{Channel, Keys};
-use super::{Timing, said, within_budget};
+use super::{Timing, said};
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
 
@@ -218,11 +218,12 @@ fn animation(
     if codes.is_empty() {
         codes.push(timing.start);
     }
-    check_budget(codes.len(), n + shape_names.len().div_ceil(10))?;
+    // The tracks' keys are charged as they are made (a moving joint's column of samples is its track as it is).
+    openusd::usdc::budget::charge(codes.len(), size_of::<f64>()).map_err(said)?;
     let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
-    let translations = tracks(joint_keys(translated, Channel::vectors, &codes, Vec3::ZERO, n), &times)?;
-    let rotations = tracks(joint_keys(rotated, Channel::rotations, &codes, Quat::IDENTITY, n), &times)?;
-    let scales = tracks(joint_keys(scaled, Channel::vectors, &codes, Vec3::ONE, n), &times)?;
+    let translations = tracks(joint_keys(translated, Channel::vectors, &codes, Vec3::ZERO, n)?, &times)?;
+    let rotations = tracks(joint_keys(rotated, Channel::rotations, &codes, Quat::IDENTITY, n)?, &times)?;
+    let scales = tracks(joint_keys(scaled, Channel::vectors, &codes, Vec3::ONE, n)?, &times)?;
     let mut tracks = Vec::new();
     let joint_tracks = translations.into_iter().zip(rotations).zip(scales);
     for (joint, ((translation, rotation), scale)) in mapped.iter().zip(joint_tracks) {
@@ -232,13 +233,21 @@ fn animation(
         bone.stretch = Some(DQuat::IDENTITY);
         tracks.push(bone);
     }
-    let weights = (!shape_names.is_empty()).then(|| {
-        let count = shape_names.len();
-        let read = shape_weights.as_ref().and_then(|c| c.numbers(&codes));
-        let rows = read.unwrap_or_else(|| vec![None; codes.len()]);
-        let values = rows.into_iter().map(|row| row.unwrap_or_else(|| vec![0.0; count])).collect();
-        ShapeWeights { names: shape_names, times: times.clone(), values }
-    });
+    let weights = match shape_names.len() {
+        0 => None,
+        count => {
+            let read = shape_weights.as_ref().map(|c| c.numbers(&codes)).transpose()?.flatten();
+            let rows = match read {
+                Some(rows) => rows,
+                None => {
+                    openusd::usdc::budget::charge(codes.len().saturating_mul(count), size_of::<f32>()).map_err(said)?;
+                    vec![None; codes.len()]
+                }
+            };
+            let values = rows.into_iter().map(|row| row.unwrap_or_else(|| vec![0.0; count])).collect();
+            Some(ShapeWeights { names: shape_names, times: times.clone(), values })
+        }
+    };
     Ok(Some((Animation { name: source.name().map(str::to_owned), tracks }, weights)))
 }
 
@@ -250,12 +259,12 @@ fn linear<T: KeyValue>(times: &Arc<[f64]>, values: impl Into<Arc<[T]>>) -> Resul
 /// Each of the `joints`' keys in `channel` at `codes` (`read` reads them), held at `identity` where there is none.
 fn joint_keys<T: Copy>(
     channel: Option<Channel>,
-    read: fn(Channel, &[f64], T) -> Vec<Keys<T>>,
+    read: impl FnOnce(Channel, &[f64], T) -> Result<Vec<Keys<T>>, String>,
     codes: &[f64],
     identity: T,
     joints: usize,
-) -> Vec<Keys<T>> {
-    channel.map_or_else(|| (0..joints).map(|_| Keys::Held(identity)).collect(), |c| read(c, codes, identity))
+) -> Result<Vec<Keys<T>>, String> {
+    channel.map_or_else(|| Ok((0..joints).map(|_| Keys::Held(identity)).collect()), |c| read(c, codes, identity))
 }
 
 /// A track per element of `keys` at `times`: one key where it holds (an offset, most scales: a clip the size of its
@@ -301,7 +310,8 @@ fn every_frame(mut codes: Vec<f64>, start: f64) -> Result<Vec<f64>, String> {
         return Ok(vec![start]);
     };
     let frames = (last.floor() - first.ceil()).max(0.0);
-    check_budget(frames as usize + codes.len(), 1)?;
+    // Charged before they are made: two samples far apart in time are a great many frames.
+    openusd::usdc::budget::charge((frames as usize).saturating_add(1), size_of::<f64>()).map_err(said)?;
     codes.extend((0..=frames as u64).map(|k| first.ceil() + k as f64));
     codes.sort_by(f64::total_cmp);
     codes.dedup();
@@ -362,12 +372,4 @@ fn xform_codes(stage: &Stage, path: &sdf::Path) -> Result<Vec<f64>, String> {
     codes.sort_by(f64::total_cmp);
     codes.dedup();
     Ok(codes)
-}
-
-/// Refuses an animation whose tracks would take more memory than one file may use (`joints` counts ten
-/// blend-shape weights as one joint).
-fn check_budget(codes: usize, joints: usize) -> Result<(), String> {
-    // A translation, a rotation and a scale per joint and time, and the time itself.
-    let bytes = (codes as u64).saturating_mul(joints as u64).saturating_mul(40).saturating_add(codes as u64 * 8);
-    within_budget(bytes, || format!("an animation of {joints} joints at {codes} time codes"))
 }

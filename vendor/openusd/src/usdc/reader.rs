@@ -922,7 +922,16 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         self.reader.read_vec(count)
     }
 
+    /// bonescope: hands the time samples `value` holds to `visit` one by one, decoding each value as it goes, in
+    /// the order the values lie in the file (a value several samples share decoded once, and handed on once per
+    /// sample). `visit` drops each: what a value was charged to the budget is released once it is handed on (a
+    /// visitor that keeps what it is handed charges that itself).
     pub fn visit_time_samples(&mut self, value: ValueRep, visit: &mut dyn FnMut(sdf::TimeSample)) -> Result<()> {
+        self.visit_samples(value, Held::Dropped, visit)
+    }
+
+    /// [`Self::visit_time_samples`], the values `held` as it says.
+    fn visit_samples(&mut self, value: ValueRep, held: Held, visit: &mut dyn FnMut(sdf::TimeSample)) -> Result<()> {
         ensure!(value.ty()? == Type::TimeSamples, "Not time samples");
         ensure!(!value.is_inlined());
         ensure!(!value.is_compressed());
@@ -961,12 +970,21 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         let mut order: Vec<usize> = (0..count).collect();
         order.sort_by_key(|&i| (value_reps[i].payload(), value_reps[i].0));
         for shared in order.chunk_by(|&a, &b| value_reps[a].0 == value_reps[b].0) {
+            let before = super::budget::held();
             let value = self.value(value_reps[shared[0]])?;
+            let charged = super::budget::held().saturating_sub(before);
+            if held == Held::Kept {
+                // Each sample keeps a copy of its own.
+                super::budget::charge_bytes(charged.saturating_mul(shared.len() as u64 - 1))?;
+            }
             let (&last, others) = shared.split_last().expect("a chunk is never empty");
             for &index in others {
                 visit(sdf::TimeSample { index, time: times[index], value: value.clone(), count });
             }
             visit(sdf::TimeSample { index: last, time: times[last], value, count });
+            if held == Held::Dropped {
+                super::budget::release(charged);
+            }
         }
         Ok(())
     }
@@ -1401,7 +1419,7 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             // bonescope: decoded by the visit, in the order the values lie in the file, then put in time order.
             Type::TimeSamples => {
                 let mut samples = Vec::new();
-                self.visit_time_samples(value, &mut |sample| samples.push(sample))?;
+                self.visit_samples(value, Held::Kept, &mut |sample| samples.push(sample))?;
                 samples.sort_by_key(|sample| sample.index);
                 sdf::Value::TimeSamples(samples.into_iter().map(|sample| (sample.time, sample.value)).collect())
             }
@@ -1524,6 +1542,15 @@ fn decompress_lz4(mut input: &[u8], output: &mut [u8]) -> Result<usize> {
 
         todo!("Support lz4 chunked decompression")
     }
+}
+
+/// bonescope: what becomes of the time-sample values a visit hands on.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Held {
+    /// Each sample's value is kept (a `TimeSamples` value decoded whole): charged once per sample.
+    Kept,
+    /// Each is dropped once handed on (a streamed visit): released after it.
+    Dropped,
 }
 
 pub trait ReadExt {
