@@ -231,6 +231,14 @@ impl<'e, 'a> NodeSolver<'e, 'a> {
         }
     }
 
+    /// Starts the next times' searches from `nodes` (each bone's, at a time solved before): what is solved then
+    /// depends on those alone, not on whatever this solver solved last.
+    pub fn start_near<'n>(&mut self, nodes: impl Iterator<Item = &'n NodeSample>) {
+        for (previous, node) in self.previous.iter_mut().zip(nodes) {
+            *previous = node.stretch;
+        }
+    }
+
     /// Every bone's nodes at `time`.
     pub fn solve_at(&mut self, time: f64) -> &[NodeSample] {
         self.source.evaluate(time);
