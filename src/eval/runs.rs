@@ -18,7 +18,13 @@ pub fn run_length(count: usize) -> usize {
 
 /// `work` of each run of consecutive `times` (of [`run_length`]), in parallel; the results in time order.
 pub fn over_runs<R: Send>(times: &[f64], work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
-    times.par_chunks(run_length(times.len())).map(work).collect()
+    over_runs_of(times, run_length(times.len()), work)
+}
+
+/// [`over_runs`] in runs of `length` times whatever the number of cores: for work whose result depends on where a
+/// run starts (a search started anew at each run's first time), so that it is the same on every machine.
+pub fn over_runs_of<R: Send>(times: &[f64], length: usize, work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
+    times.par_chunks(length.max(1)).map(work).collect()
 }
 
 #[cfg(test)]
