@@ -143,6 +143,12 @@ fn within_budget(bytes: u64, what: impl FnOnce() -> String) -> Result<(), String
     super::budget::check(bytes, None, what).map_err(|failure| failure.message)
 }
 
+/// Charges `count` values of `T` to the reading's memory budget before they are made (the binary layers' arrays are
+/// charged to the same budget by the crate itself).
+fn charge<T>(count: usize) -> Result<(), String> {
+    openusd::usdc::budget::charge(count, size_of::<T>()).map_err(said)
+}
+
 /// An error of the `openusd` crate in one line, its causes after its message.
 fn said(error: impl std::fmt::Display) -> String {
     format!("{error:#}")

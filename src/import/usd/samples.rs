@@ -18,7 +18,7 @@ use openusd::gf::f16;
 use openusd::sdf::{TimeSample, Value};
 use openusd::usd::{Attribute, Stage};
 
-use super::said;
+use super::{charge, said};
 
 /// One channel's samples, sorted by time code, in the precision the file stores them in.
 pub enum Channel {
@@ -80,13 +80,11 @@ impl Channel {
     }
 
     /// The numbers at each of `codes`, one per element; `None` at a code where the sample is not an array of the
-    /// channel's length, and for a channel of vectors or rotations. Charged to the reading's budget before they are
-    /// made.
-    pub fn numbers(&self, codes: &[f64]) -> Result<Option<Vec<Option<Vec<f32>>>>, String> {
-        let Channel::Numbers(c) = self else { return Ok(None) };
-        openusd::usdc::budget::charge(codes.len().saturating_mul(c.len), size_of::<f32>()).map_err(said)?;
+    /// channel's length, and for a channel of vectors or rotations (the caller charges them to the reading's budget).
+    pub fn numbers(&self, codes: &[f64]) -> Option<Vec<Option<Vec<f32>>>> {
+        let Channel::Numbers(c) = self else { return None };
         let reads = c.reads(codes);
-        Ok(Some(reads.iter().map(|&read| (0..c.len).map(|e| c.read(e, read)).collect()).collect()))
+        Some(reads.iter().map(|&read| (0..c.len).map(|e| c.read(e, read)).collect()).collect())
     }
 }
 
@@ -213,8 +211,9 @@ fn push<V: Stored>(
     values: impl Iterator<Item = V>,
 ) -> Result<bool, String> {
     if channel.is_none() {
-        openusd::usdc::budget::charge(length.of, size_of::<f64>() + size_of::<bool>()).map_err(said)?;
-        openusd::usdc::budget::charge(length.len.saturating_mul(STAGED + 1), size_of::<V>()).map_err(said)?;
+        charge::<f64>(length.of)?;
+        charge::<bool>(length.of)?;
+        charge::<V>(length.len.saturating_mul(STAGED + 1))?;
         *channel = Some(variant(Columns::new(precision, length)));
     }
     match channel.as_mut().and_then(V::columns) {
@@ -276,7 +275,7 @@ impl<V: Stored> Columns<V> {
     /// A column holding `value` at every sample but `v` at `sample`, charged to the reading's budget before it is
     /// made.
     fn column(&self, value: V, sample: usize, v: V) -> Result<Arc<[V]>, String> {
-        openusd::usdc::budget::charge(self.codes.len(), size_of::<V>()).map_err(said)?;
+        charge::<V>(self.codes.len())?;
         let mut column: Arc<[V]> = std::iter::repeat_n(value, self.codes.len()).collect();
         Arc::make_mut(&mut column)[sample] = v;
         Ok(column)
@@ -395,7 +394,7 @@ impl<V: Stored> Columns<V> {
         let all_fit = self.fits.iter().all(|f| *f);
         let own = all_fit && codes == self.codes;
         let made = |values: &mut dyn Iterator<Item = T>| -> Result<Keys<T>, String> {
-            openusd::usdc::budget::charge(codes.len(), size_of::<T>()).map_err(said)?;
+            charge::<T>(codes.len())?;
             Ok(Keys::Moving(values.collect()))
         };
         (0..self.len)

@@ -14,7 +14,7 @@ use openusd::sdf;
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
 use super::samples::{Channel, Keys};
-use super::{Timing, said};
+use super::{Timing, charge, said};
 use crate::math::decompose;
 use crate::model::{Bone, BoneTracks, InheritMode, Interpolation, KeyValue, NodeRole, Track, Transform};
 
@@ -219,7 +219,7 @@ fn animation(
         codes.push(timing.start);
     }
     // The tracks' keys are charged as they are made (a moving joint's column of samples is its track as it is).
-    openusd::usdc::budget::charge(codes.len(), size_of::<f64>()).map_err(said)?;
+    charge::<f64>(codes.len())?;
     let times: Arc<[f64]> = codes.iter().map(|&c| timing.seconds(c)).collect();
     let translations = tracks(joint_keys(translated, Channel::vectors, &codes, Vec3::ZERO, n)?, &times)?;
     let rotations = tracks(joint_keys(rotated, Channel::rotations, &codes, Quat::IDENTITY, n)?, &times)?;
@@ -236,14 +236,10 @@ fn animation(
     let weights = match shape_names.len() {
         0 => None,
         count => {
-            let read = shape_weights.as_ref().map(|c| c.numbers(&codes)).transpose()?.flatten();
-            let rows = match read {
-                Some(rows) => rows,
-                None => {
-                    openusd::usdc::budget::charge(codes.len().saturating_mul(count), size_of::<f32>()).map_err(said)?;
-                    vec![None; codes.len()]
-                }
-            };
+            // A weight per shape and time code, read or zero.
+            charge::<f32>(codes.len().saturating_mul(count))?;
+            let read = shape_weights.as_ref().and_then(|c| c.numbers(&codes));
+            let rows = read.unwrap_or_else(|| vec![None; codes.len()]);
             let values = rows.into_iter().map(|row| row.unwrap_or_else(|| vec![0.0; count])).collect();
             Some(ShapeWeights { names: shape_names, times: times.clone(), values })
         }
@@ -311,7 +307,7 @@ fn every_frame(mut codes: Vec<f64>, start: f64) -> Result<Vec<f64>, String> {
     };
     let frames = (last.floor() - first.ceil()).max(0.0);
     // Charged before they are made: two samples far apart in time are a great many frames.
-    openusd::usdc::budget::charge((frames as usize).saturating_add(1), size_of::<f64>()).map_err(said)?;
+    charge::<f64>((frames as usize).saturating_add(1))?;
     codes.extend((0..=frames as u64).map(|k| first.ceil() + k as f64));
     codes.sort_by(f64::total_cmp);
     codes.dedup();
