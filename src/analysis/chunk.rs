@@ -45,10 +45,7 @@ impl<'a> Plan<'a> {
     pub fn new(evaluation: &'a Evaluation, plotted: &[usize], judged: Judged) -> Self {
         let (skeleton, hierarchy) = (evaluation.skeleton(), &evaluation.hierarchy);
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
-        // A root's mode changes nothing (it has no parent to inherit from): FBX files declare cameras and other
-        // top-level nodes componentwise, and that must not take the whole rig off the bone-by-bone path.
-        let inherits: Vec<bool> =
-            parents.iter().zip(hierarchy.modes()).map(|(p, &m)| p.is_none() || m == InheritMode::Full).collect();
+        let inherits: Vec<bool> = (0..skeleton.len()).map(|b| inherits_stretch(evaluation, b)).collect();
         let by_bone = evaluation.clip.filter(|_| evaluation.layers().is_none() && inherits.iter().all(|&full| full));
         let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
             (0..skeleton.len()).map(|b| by_bone.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
@@ -76,6 +73,13 @@ impl<'a> Plan<'a> {
     }
 }
 
+/// Whether `bone`'s stretch passes down from its parent's under `evaluation` ([`Stretch::child`]): full
+/// inheritance, or a root. A root's mode changes nothing (it has no parent to inherit from): FBX files declare
+/// cameras and other top-level nodes componentwise, and that must not take the whole rig off the bone-by-bone path.
+pub(super) fn inherits_stretch(evaluation: &Evaluation, bone: usize) -> bool {
+    evaluation.skeleton().parent(bone).is_none() || evaluation.modes()[bone] == InheritMode::Full
+}
+
 /// What one chunk of samples produced.
 pub(super) struct ChunkResult {
     pub summaries: Vec<BoneSummary>,
@@ -85,7 +89,7 @@ pub(super) struct ChunkResult {
 }
 
 impl ChunkResult {
-    fn new(bones: usize, samples: usize) -> Self {
+    pub fn new(bones: usize, samples: usize) -> Self {
         let words = samples.div_ceil(64);
         ChunkResult { summaries: (0..bones).map(BoneSummary::new).collect(), bits: vec![0; bones * words], words }
     }
@@ -95,7 +99,7 @@ impl ChunkResult {
         self.bits[bone * self.words..][..self.words].iter().any(|&word| word != 0)
     }
 
-    fn add(&mut self, bone: usize, sample: usize, time: f64, verdict: &Verdict) {
+    pub fn add(&mut self, bone: usize, sample: usize, time: f64, verdict: &Verdict) {
         self.summaries[bone].add(time, verdict);
         self.bits[bone * self.words + sample / 64] |= u64::from(verdict.findings.stretched) << (sample % 64);
     }

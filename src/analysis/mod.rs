@@ -12,6 +12,7 @@ mod sampled;
 mod scan;
 pub mod storage;
 mod stretch;
+mod variants;
 
 pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check_bind};
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
@@ -19,3 +20,4 @@ pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};
 pub use scan::{analyze, flagged_in_run, scan};
+pub use variants::scan_variants;

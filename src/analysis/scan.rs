@@ -96,7 +96,12 @@ fn pieces(samples: &mut [Components], len: usize) -> impl Iterator<Item = Option
 }
 
 /// The chunks' results as one analysis; `figure` (one flag per bone) says which bones count for "any bone".
-fn assemble(figure: &[bool], times: Vec<f64>, curves: Vec<(usize, Curves)>, chunks: Vec<ChunkResult>) -> ClipAnalysis {
+pub(super) fn assemble(
+    figure: &[bool],
+    times: Vec<f64>,
+    curves: Vec<(usize, Curves)>,
+    chunks: Vec<ChunkResult>,
+) -> ClipAnalysis {
     let bones = figure.len();
     let words_per_bone = times.len().div_ceil(64);
     let mut summaries: Vec<BoneSummary> = (0..bones).map(BoneSummary::new).collect();

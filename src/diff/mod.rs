@@ -30,7 +30,8 @@ pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_c
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
-use crate::eval::{BonesEvaluator, Evaluation, Reach, over_runs};
+use crate::eval::skinning::Skinner;
+use crate::eval::{BonesEvaluator, Evaluation, Pose, Reach, Reference, Variant, over_runs};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, Rig, sample_times};
 
@@ -322,9 +323,30 @@ fn compare_each_within(
             Plan::new(b, pairs.bones.pairs.iter().map(|p| p.1), meshes, pairs.measure == Measure::Everything)
         })
         .collect();
+    // A side that differs from A only below one bone is evaluated from A's pose: A then evaluates what it needs,
+    // and every variant's bones with what they hang from.
+    let variants: Vec<Option<Variant>> =
+        plans.iter().map(|plan| Variant::of(a, plan.evaluation).filter(|_| !plan.morphs && !plan_a.morphs)).collect();
+    let reference = variants.iter().any(Option::is_some).then(|| {
+        let held = variants.iter().zip(&plans).filter(|(v, _)| v.is_some()).map(|(_, plan)| &plan.needed);
+        let bones: Vec<usize> = plan_a.needed.iter().chain(held.flatten()).copied().collect();
+        a.skeleton().with_ancestors(&bones)
+    });
     let runs = over_runs(times, |run| {
-        let mut side_a = Side::new(&plan_a);
-        let mut others: Vec<Side> = plans.iter().map(Side::new).collect();
+        let mut side_a = match (&reference, a.clip) {
+            (Some(bones), Some(clip)) => {
+                Side::new(&plan_a, Posing::Reference(Box::new(Reference::new(a, clip, bones))))
+            }
+            _ => Side::alone(&plan_a),
+        };
+        let mut others: Vec<Side> = plans
+            .iter()
+            .zip(&variants)
+            .map(|(plan, variant)| match variant {
+                Some(variant) => Side::new(plan, Posing::variant(variant.clone(), plan)),
+                None => Side::alone(plan),
+            })
+            .collect();
         let mut differences = fresh();
         for &time in run {
             if differences.iter().all(|found| found.largest > limit) {
@@ -332,7 +354,7 @@ fn compare_each_within(
             }
             side_a.evaluate(time);
             for (side_b, found) in others.iter_mut().zip(&mut differences).filter(|(_, f)| f.largest <= limit) {
-                side_b.evaluate(time);
+                side_b.evaluate_beside(time, &side_a);
                 found.add(&mut side_a, side_b, probe_length, time);
             }
         }
@@ -391,7 +413,7 @@ impl<'p> Differences<'p> {
     }
 
     fn add(&mut self, a: &mut Side, b: &mut Side, probe_length: f64, time: f64) {
-        let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
+        let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
@@ -408,7 +430,7 @@ impl<'p> Differences<'p> {
         }
         let skins = &a.plan.evaluation.rig.skins;
         for ((difference, pair), reach) in self.meshes.iter_mut().zip(self.pairs).zip(self.reaches) {
-            let (model_a, model_b) = (&a.evaluator.pose().model.model, &b.evaluator.pose().model.model);
+            let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
             let bound = reach.as_ref().map(|reach| reach.bound(skins, model_a, model_b));
             if bound.is_some_and(|bound| bound * (1.0 + 1e-9) + self.margin < difference.distance.max) {
                 continue;
@@ -455,6 +477,8 @@ fn reaches(a: &Evaluation, b: &Evaluation, pairs: &Pairs) -> Vec<Option<Reach>> 
 struct Plan<'p> {
     bones: Vec<usize>,
     decompose: bool,
+    /// Whether a compared mesh has morph targets: their weights come with whole poses.
+    morphs: bool,
     meshes: Vec<(usize, Option<Vec<u32>>)>,
     needed: Vec<usize>,
     evaluation: &'p Evaluation<'p>,
@@ -479,7 +503,7 @@ impl<'p> Plan<'p> {
             let joints = meshes.iter().flat_map(|(m, vertices)| mesh_bones(rig, *m, vertices.as_deref()));
             rig.skeleton.with_ancestors(&bones.iter().copied().chain(joints).collect::<Vec<_>>())
         };
-        Plan { bones, decompose, meshes, needed, evaluation }
+        Plan { bones, decompose, morphs, meshes, needed, evaluation }
     }
 }
 
@@ -527,28 +551,100 @@ fn mesh_bones<'r>(rig: &'r Rig, mesh: usize, vertices: Option<&'r [u32]>) -> imp
 /// polar parts of the bones compared (the identity's elsewhere) and the meshes compared, skinned where asked (by
 /// mesh index; empty elsewhere).
 struct Side<'e, 'a> {
-    evaluator: BonesEvaluator<'e, 'a>,
+    posing: Posing<'e, 'a>,
     plan: &'e Plan<'a>,
     parts: Vec<AffineParts>,
     length_scales: Vec<f64>,
+    /// Per mesh, what skins the vertices the plan compares (`None` for a mesh not compared), where they are, and
+    /// whether they are skinned at the time evaluated.
+    skinners: Vec<Option<Skinner>>,
     skinned: Vec<Vec<DVec3>>,
-    /// Per mesh, whether `skinned` holds it at the time evaluated.
     fresh: Vec<bool>,
 }
 
-impl<'e, 'a> Side<'e, 'a> {
-    fn new(plan: &'e Plan<'a>) -> Self {
-        let evaluation = plan.evaluation;
-        let skinned = vec![Vec::new(); evaluation.rig.meshes.len()];
-        let fresh = vec![false; skinned.len()];
-        let length_scales = evaluation.length_scales();
-        let evaluator = BonesEvaluator::new(evaluation, &plan.needed);
-        Side { evaluator, plan, parts: Vec::new(), length_scales, skinned, fresh }
+/// How a side's poses are found.
+enum Posing<'e, 'a> {
+    /// Evaluated on its own.
+    Alone(BonesEvaluator<'e, 'a>),
+    /// A's, as the reference its variants are evaluated from.
+    Reference(Box<Reference<'e>>),
+    /// A variant of A, evaluated from A's pose.
+    Variant(Box<FromA<'e, 'a>>),
+}
+
+/// A variant of A and its pose: its own bones, and the others it needs (`borrowed`) as A has them.
+struct FromA<'e, 'a> {
+    variant: Variant<'e, 'a>,
+    pose: Pose,
+    borrowed: Vec<usize>,
+}
+
+impl<'e, 'a> Posing<'e, 'a> {
+    /// `variant` (of A), needing the bones of `plan`.
+    fn variant(variant: Variant<'e, 'a>, plan: &Plan) -> Self {
+        let borrowed = plan.needed.iter().copied().filter(|b| variant.bones.binary_search(b).is_err()).collect();
+        Posing::Variant(Box::new(FromA { variant, pose: Pose::default(), borrowed }))
     }
 
-    /// Evaluates the side's bones at `time` (its meshes are skinned when asked: [`Side::skin`]).
+    fn pose(&self) -> &Pose {
+        match self {
+            Posing::Alone(evaluator) => evaluator.pose(),
+            Posing::Reference(reference) => reference.pose(),
+            Posing::Variant(from_a) => &from_a.pose,
+        }
+    }
+}
+
+impl<'e, 'a> Side<'e, 'a> {
+    /// The side of `plan`, evaluated on its own.
+    fn alone(plan: &'e Plan<'a>) -> Self {
+        Side::new(plan, Posing::Alone(BonesEvaluator::new(plan.evaluation, &plan.needed)))
+    }
+
+    fn new(plan: &'e Plan<'a>, posing: Posing<'e, 'a>) -> Self {
+        let rig = plan.evaluation.rig;
+        let mut skinners = vec![None; rig.meshes.len()];
+        for (mesh, vertices) in &plan.meshes {
+            skinners[*mesh] = Some(Skinner::new(&rig.meshes[*mesh], &rig.skins, vertices.clone()));
+        }
+        let skinned = vec![Vec::new(); skinners.len()];
+        let fresh = vec![false; skinners.len()];
+        let length_scales = plan.evaluation.length_scales();
+        Side { posing, plan, parts: Vec::new(), length_scales, skinners, skinned, fresh }
+    }
+
+    /// Evaluates the side's bones at `time` (its meshes are skinned when asked: [`Side::skin`]); a variant is
+    /// evaluated beside A ([`Side::evaluate_beside`]).
     fn evaluate(&mut self, time: f64) {
-        let pose = self.evaluator.evaluate(time);
+        match &mut self.posing {
+            Posing::Alone(evaluator) => _ = evaluator.evaluate(time),
+            Posing::Reference(reference) => _ = reference.evaluate(time),
+            Posing::Variant(_) => unreachable!("a variant is evaluated beside A"),
+        }
+        self.evaluated();
+    }
+
+    /// [`Side::evaluate`] of side B, `a` (side A) evaluated at `time`: a variant of A from A's pose.
+    fn evaluate_beside(&mut self, time: f64, a: &Side) {
+        let Posing::Variant(from_a) = &mut self.posing else {
+            return self.evaluate(time);
+        };
+        let FromA { variant, pose, borrowed } = &mut **from_a;
+        let Posing::Reference(reference) = &a.posing else {
+            unreachable!("A is the reference of its variants");
+        };
+        let held = &reference.pose().model.model;
+        pose.model.model.resize(held.len(), DMat4::IDENTITY);
+        for &bone in borrowed.iter() {
+            pose.model.model[bone] = held[bone];
+        }
+        reference.evaluate_variant(variant, &mut pose.model);
+        self.evaluated();
+    }
+
+    /// What follows an evaluation: the compared bones' polar parts where asked for, no mesh skinned yet.
+    fn evaluated(&mut self) {
+        let pose = self.posing.pose();
         if self.plan.decompose {
             self.parts = decompose_bones(&pose.model.model, &self.plan.bones);
             for &bone in &self.plan.bones {
@@ -563,9 +659,10 @@ impl<'e, 'a> Side<'e, 'a> {
         if std::mem::replace(&mut self.fresh[mesh], true) {
             return;
         }
-        let Some((_, vertices)) = self.plan.meshes.iter().find(|(m, _)| *m == mesh) else { return };
-        let pose = self.evaluator.pose();
-        self.plan.evaluation.skin_vertices(pose, mesh, vertices.as_deref(), &mut self.skinned[mesh]);
+        let Some(skinner) = &mut self.skinners[mesh] else { return };
+        let (evaluation, pose) = (self.plan.evaluation, self.posing.pose());
+        let (rig, posed) = (evaluation.rig, (&pose.model.model[..], &pose.morph));
+        skinner.skin(&rig.meshes[mesh], &rig.skins, posed, evaluation.skinning, &mut self.skinned[mesh]);
     }
 }
 

@@ -22,6 +22,11 @@ impl<'a> Chains<'a> {
         Chains { bones, cursors, pose }
     }
 
+    /// The pose last evaluated: only the bones' entries are meaningful.
+    pub fn pose(&self) -> &Pose {
+        &self.pose
+    }
+
     pub fn evaluate(&mut self, time: f64, hierarchy: &Hierarchy) -> &Pose {
         self.evaluate_first(time, self.bones.len(), hierarchy)
     }

@@ -6,7 +6,7 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::hierarchy::HierarchyError;
 use super::layers::{Resampling, RotationInterpolation};
-use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with, skin_vertices_with};
+use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose, over_runs};
 use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Unit, sample_times};
 
@@ -193,13 +193,6 @@ impl<'a> Evaluation<'a> {
     pub fn skin(&self, pose: &Pose, mesh: usize, out: &mut Vec<DVec3>) {
         let (rig, model) = (self.rig, &pose.model.model);
         skin_positions_with(&rig.meshes[mesh], &rig.skins, model, &pose.morph, self.skinning, out);
-    }
-
-    /// [`Evaluation::skin`] of the vertices `vertices` only (every one for `None`), the others left as they were in
-    /// `out`: `pose` need only hold the bones those vertices move with.
-    pub fn skin_vertices(&self, pose: &Pose, mesh: usize, vertices: Option<&[u32]>, out: &mut Vec<DVec3>) {
-        let (rig, posed) = (self.rig, (&pose.model.model[..], &pose.morph));
-        skin_vertices_with(&rig.meshes[mesh], &rig.skins, posed, self.skinning, vertices, out);
     }
 
     /// Every mesh at `pose`, morphed and skinned.

@@ -21,6 +21,9 @@ use crate::model::{InheritMode, Placement, Rig, Skeleton, Transform};
 pub struct ModelPose {
     /// `W`, one per bone.
     pub model: Vec<DMat4>,
+    /// Where the hierarchy places its bones: `W_file`, the model matrices in the file's space that children are
+    /// evaluated from (empty where nothing is placed: `model` is in the file's space).
+    file: Vec<DMat4>,
     unscaled: Vec<DMat4>,
     rigid: Vec<DMat4>,
     /// ufbx's `inherit_scale`: the scale a componentwise or compensating child multiplies its offset by.
@@ -47,6 +50,8 @@ pub struct Hierarchy {
     /// Per bone, the conversion node whose placed matrix places it (itself for a conversion node), or `None` for
     /// the skeleton's conversion; empty where nothing is placed.
     placed_by: Vec<Option<usize>>,
+    /// Whether any bone is placed: children are then evaluated from their parents' matrices in the file's space.
+    places: bool,
 }
 
 /// Modes or rest transforms that are not one per bone.
@@ -126,7 +131,15 @@ impl Hierarchy {
         let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
         let placement = skeleton.placement().clone();
         let placed_by = skeleton.placed_by().to_vec();
-        Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid, placement, placed_by }
+        let places = !placed_by.is_empty() || placement.conversion != DMat4::IDENTITY;
+        Hierarchy { parents, modes: modes.to_vec(), offsets, needs_unscaled, needs_rigid, placement, placed_by, places }
+    }
+
+    /// The same hierarchy evaluating, besides every model matrix, the matrices a child under any mode reads of its
+    /// parent: a reference that changes of mode below any bone are evaluated from ([`Hierarchy::evaluate_below`]).
+    /// Its model matrices are this hierarchy's.
+    pub fn reference(&self) -> Hierarchy {
+        Hierarchy { needs_unscaled: vec![true; self.parents.len()], needs_rigid: true, ..self.clone() }
     }
 
     pub fn modes(&self) -> &[InheritMode] {
@@ -146,6 +159,25 @@ impl Hierarchy {
     /// rig; only their entries of `local` are read, and the other bones' entries of `out` are not written.
     pub fn evaluate_bones(&self, local: &[Transform], bones: &[usize], out: &mut ModelPose) {
         self.size(local, out);
+        for &i in bones {
+            self.evaluate_bone(i, &local[i], out);
+        }
+        self.place(bones.iter().copied(), out);
+    }
+
+    /// Model matrices of `bones` (a subtree, its top first, parents first) under the matrices its top's parent has
+    /// in `reference`: a pose of a hierarchy that agrees with this one outside the subtree (the same skeleton, the
+    /// same modes) and evaluates every matrix a child may read ([`Hierarchy::reference`]), at the same time. What a
+    /// change below one bone gives, without evaluating its ancestors again; only the subtree's entries of `local`
+    /// are read, and of `out` only the subtree's and its top's parent's are written.
+    pub fn evaluate_below(&self, local: &[Transform], bones: &[usize], reference: &ModelPose, out: &mut ModelPose) {
+        self.size(local, out);
+        if let Some(parent) = bones.first().and_then(|&top| self.parents[top]) {
+            out.copy_bone(reference, parent);
+            if let Some(&Some(node)) = self.placed_by.get(parent) {
+                out.copy_conversion(reference, node);
+            }
+        }
         for &i in bones {
             self.evaluate_bone(i, &local[i], out);
         }
@@ -176,6 +208,9 @@ impl Hierarchy {
         }
         out.inherit_scale.resize(n, DVec3::ONE);
         out.carried_scale.resize(n, DVec3::ONE);
+        if self.places {
+            out.file.resize(n, DMat4::IDENTITY);
+        }
         if !self.placed_by.is_empty() {
             out.conversions.resize(n, DMat4::IDENTITY);
             out.identity_conversions.resize(n, true);
@@ -189,6 +224,7 @@ impl Hierarchy {
             out.conversions[i] = above * local.matrix();
             out.identity_conversions[i] = out.conversions[i] == DMat4::IDENTITY;
             out.model[i] = DMat4::IDENTITY;
+            out.file[i] = DMat4::IDENTITY;
             out.unscaled[i] = DMat4::IDENTITY;
             out.rigid[i] = DMat4::IDENTITY;
             out.inherit_scale[i] = DVec3::ONE;
@@ -201,17 +237,19 @@ impl Hierarchy {
             out.rigid[i] = out.unscaled[i];
             out.inherit_scale[i] = local.scale;
             out.carried_scale[i] = DVec3::ONE;
+            self.keep_file_space(i, out);
             return;
         };
+        let parent = if self.places { out.file[p] } else { out.model[p] };
         if self.needs_rigid {
             out.rigid[i] = out.rigid[p] * local.rigid_matrix();
         }
         let (mut inherit_scale, mut carried_scale) = (local.scale, DVec3::ONE);
         match self.modes[i] {
             InheritMode::Full => {
-                out.model[i] = out.model[p] * local.matrix();
+                out.model[i] = parent * local.matrix();
                 if self.needs_unscaled[i] {
-                    out.unscaled[i] = out.model[p] * local.rigid_matrix();
+                    out.unscaled[i] = parent * local.rigid_matrix();
                 }
             }
             InheritMode::UnscaledParent => {
@@ -236,7 +274,6 @@ impl Hierarchy {
             mode => {
                 let (offset, offset_inverse) = self.offsets[i].expect("offsets are prepared for Blender modes");
                 let mode = blender::BlenderInherit::from_mode(mode).expect("a Blender mode");
-                let parent = out.model[p];
                 out.model[i] = blender::child_pose(mode, &parent, &offset, &(offset_inverse * local.matrix()));
                 if self.needs_unscaled[i] {
                     let channel = offset_inverse * local.rigid_matrix();
@@ -246,5 +283,36 @@ impl Hierarchy {
         }
         out.inherit_scale[i] = inherit_scale;
         out.carried_scale[i] = carried_scale;
+        self.keep_file_space(i, out);
+    }
+
+    /// Keeps bone `i`'s model matrix in the file's space, where it is to be placed.
+    fn keep_file_space(&self, i: usize, out: &mut ModelPose) {
+        if self.places {
+            out.file[i] = out.model[i];
+        }
+    }
+}
+
+impl ModelPose {
+    /// Every matrix and scale `bone` has in `from`, the pose of the same skeleton at the same time.
+    fn copy_bone(&mut self, from: &ModelPose, bone: usize) {
+        self.model[bone] = from.model[bone];
+        if let (Some(to), Some(&file)) = (self.file.get_mut(bone), from.file.get(bone)) {
+            *to = file;
+        }
+        self.unscaled[bone] = from.unscaled[bone];
+        self.rigid[bone] = from.rigid[bone];
+        self.inherit_scale[bone] = from.inherit_scale[bone];
+        self.carried_scale[bone] = from.carried_scale[bone];
+        self.copy_conversion(from, bone);
+    }
+
+    /// Conversion node `node`'s placed matrix in `from`, where the poses place bones by conversion nodes.
+    fn copy_conversion(&mut self, from: &ModelPose, node: usize) {
+        if let (Some(to), Some(&conversion)) = (self.conversions.get_mut(node), from.conversions.get(node)) {
+            *to = conversion;
+            self.identity_conversions[node] = from.identity_conversions[node];
+        }
     }
 }

@@ -15,6 +15,7 @@ mod runs;
 mod sample;
 mod setup;
 pub mod skinning;
+mod variant;
 
 pub use bind::{bind_model_matrices, bind_pose, skin_bind_spaces};
 pub(crate) use bind::{invert, median};
@@ -29,3 +30,4 @@ pub use runs::{over_runs, over_runs_of, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use setup::{Setup, SetupError};
 pub use skinning::{Method as SkinningMethod, Reach, skin_meshes};
+pub use variant::{Reference, Variant};

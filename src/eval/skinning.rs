@@ -74,20 +74,9 @@ impl Method {
 /// `W_j · IBM_j` for every joint of `skin`, from the model matrices of all bones; premultiplied by the mesh node's
 /// motion since the bind where the skin follows its node ([`crate::model::NodeBind`]).
 pub fn joint_matrices(skin: &Skin, model: &[DMat4], out: &mut Vec<DMat4>) {
-    joint_matrices_of(skin, model, None, out);
-}
-
-/// [`joint_matrices`] of the joints `used` marks (every one for `None`; the identity elsewhere).
-fn joint_matrices_of(skin: &Skin, model: &[DMat4], used: Option<&[bool]>, out: &mut Vec<DMat4>) {
     out.clear();
     let moved = moved_since_bind(skin, model);
-    let joints = (0..skin.joints.len()).map(|j| {
-        if used.is_some_and(|used| !used.get(j).copied().unwrap_or(false)) {
-            return DMat4::IDENTITY;
-        }
-        joint_matrix(skin, model, moved, j)
-    });
-    out.extend(joints);
+    out.extend((0..skin.joints.len()).map(|j| joint_matrix(skin, model, moved, j)));
 }
 
 /// The mesh node's motion since the bind, where the skin follows its node.
@@ -205,67 +194,99 @@ pub fn skin_positions_with(
     out: &mut Vec<DVec3>,
 ) {
     out.clear();
-    skin_vertices_with(mesh, skins, (model, morph), method, None, out);
+    Skinner::new(mesh, skins, None).skin(mesh, skins, (model, morph), method, out);
 }
 
-/// [`skin_positions_with`] of the vertices `vertices` only (every one for `None`): `out` holds a position per
-/// vertex, those not asked for left as they were (a comparison that knows they cannot move skins only the others).
-/// `model` need only be meaningful at the joints of the vertices asked for.
-pub fn skin_vertices_with(
-    mesh: &Mesh,
-    skins: &[Skin],
-    (model, morph): (&[DMat4], &MorphPose),
-    method: Method,
-    vertices: Option<&[u32]>,
-    out: &mut Vec<DVec3>,
-) {
-    let positions = morph.positions(mesh);
-    out.resize(positions.len(), DVec3::ZERO);
-    let each = |visit: &mut dyn FnMut(usize)| match vertices {
-        Some(list) => list.iter().map(|&v| v as usize).filter(|&v| v < positions.len()).for_each(visit),
-        None => (0..positions.len()).for_each(visit),
-    };
-    let skin = mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == positions.len());
-    let Some(skin) = skin else {
-        let placement = model[mesh.bone];
-        each(&mut |v| out[v] = placement.transform_point3(positions[v].as_dvec3()));
-        return;
-    };
-    // Only the joints of the vertices asked for: a few vertices of a big skin need a few of its joints.
-    let used = vertices.map(|list| {
-        let mut used = vec![false; skin.joints.len()];
-        for v in list.iter().map(|&v| v as usize).filter(|&v| v < positions.len()) {
-            let weighted = mesh.joints[v].iter().zip(mesh.weights.get(v).into_iter().flatten());
-            for (&j, _) in weighted.filter(|(_, w)| **w != 0.0) {
-                if let Some(slot) = used.get_mut(usize::from(j)) {
-                    *slot = true;
+/// Skins some vertices of one mesh time after time (every vertex for `None`), as [`skin_positions_with`] skins them
+/// all: the joints they are weighted to found once, and only those joints' matrices computed at each time. A
+/// comparison that knows the other vertices cannot move skins only these.
+#[derive(Clone, Debug)]
+pub struct Skinner {
+    /// The vertices skinned, those in range; every one for `None`.
+    vertices: Option<Vec<u32>>,
+    /// The joints of the mesh's skin those vertices are weighted to (any weight but zero), each once; every joint
+    /// for `None`.
+    used: Option<Vec<usize>>,
+    /// The joint matrices at the time skinned, indexed as the skin's joints (those not used are not kept up).
+    joints: Vec<DMat4>,
+}
+
+impl Skinner {
+    /// For `vertices` of `mesh` (skinned by one of `skins`, where it is).
+    pub fn new(mesh: &Mesh, skins: &[Skin], vertices: Option<Vec<u32>>) -> Self {
+        let count = mesh.positions.len();
+        let vertices = vertices.map(|list| list.into_iter().filter(|&v| (v as usize) < count).collect::<Vec<_>>());
+        let joints = skin_of(mesh, skins).map_or(0, |skin| skin.joints.len());
+        let used = vertices.as_ref().filter(|_| joints > 0).map(|list| {
+            let mut used = vec![false; joints];
+            for &v in list {
+                let weighted = mesh.joints[v as usize].iter().zip(mesh.weights.get(v as usize).into_iter().flatten());
+                for (&j, _) in weighted.filter(|(_, w)| **w != 0.0) {
+                    if let Some(slot) = used.get_mut(usize::from(j)) {
+                        *slot = true;
+                    }
                 }
             }
-        }
-        used
-    });
-    let mut joints = Vec::with_capacity(skin.joints.len());
-    joint_matrices_of(skin, model, used.as_deref(), &mut joints);
-    let mut any_dq = false;
-    each(&mut |v| any_dq |= method.dq_weight(mesh, v) > 0.0);
-    let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
-    each(&mut |v| {
-        // Weights as long as the joints (importers check): a shorter list skins the vertices it covers.
-        let Some(weights) = mesh.weights.get(v) else { return };
-        let p = positions[v].as_dvec3();
-        let influences = mesh.joints[v]
-            .iter()
-            .zip(weights)
-            .filter(|(_, w)| **w != 0.0)
-            .map(|(&j, &w)| (usize::from(j), f64::from(w)));
-        let dq = method.dq_weight(mesh, v);
-        let linear = || influences.clone().map(|(j, w)| joints[j].transform_point3(p) * w).sum::<DVec3>();
-        out[v] = match dq {
-            0.0 => linear(),
-            1.0 => dual_quaternion(&rigid, influences, p),
-            d => linear() * (1.0 - d) + dual_quaternion(&rigid, influences, p) * d,
+            (0..joints).filter(|&j| used[j]).collect()
+        });
+        let joints = if used.is_some() { vec![DMat4::IDENTITY; joints] } else { Vec::new() };
+        Skinner { vertices, used, joints }
+    }
+
+    /// The vertices at `posed` (the model matrices, meaningful at least at the joints of the vertices, and the morph
+    /// weights) skinned by `method`, into `out` (one position per vertex of the mesh; the others left as they were).
+    pub fn skin(
+        &mut self,
+        mesh: &Mesh,
+        skins: &[Skin],
+        (model, morph): (&[DMat4], &MorphPose),
+        method: Method,
+        out: &mut Vec<DVec3>,
+    ) {
+        let positions = morph.positions(mesh);
+        out.resize(positions.len(), DVec3::ZERO);
+        let vertices = self.vertices.as_deref();
+        let each = |visit: &mut dyn FnMut(usize)| match vertices {
+            Some(list) => list.iter().map(|&v| v as usize).for_each(visit),
+            None => (0..positions.len()).for_each(visit),
         };
-    });
+        let Some(skin) = skin_of(mesh, skins) else {
+            let placement = model[mesh.bone];
+            each(&mut |v| out[v] = placement.transform_point3(positions[v].as_dvec3()));
+            return;
+        };
+        let moved = moved_since_bind(skin, model);
+        match &self.used {
+            Some(used) => used.iter().for_each(|&j| self.joints[j] = joint_matrix(skin, model, moved, j)),
+            None => joint_matrices(skin, model, &mut self.joints),
+        }
+        let joints = &self.joints;
+        let mut any_dq = false;
+        each(&mut |v| any_dq |= method.dq_weight(mesh, v) > 0.0);
+        let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
+        each(&mut |v| {
+            // Weights as long as the joints (importers check): a shorter list skins the vertices it covers.
+            let Some(weights) = mesh.weights.get(v) else { return };
+            let p = positions[v].as_dvec3();
+            let influences = mesh.joints[v]
+                .iter()
+                .zip(weights)
+                .filter(|(_, w)| **w != 0.0)
+                .map(|(&j, &w)| (usize::from(j), f64::from(w)));
+            let dq = method.dq_weight(mesh, v);
+            let linear = || influences.clone().map(|(j, w)| joints[j].transform_point3(p) * w).sum::<DVec3>();
+            out[v] = match dq {
+                0.0 => linear(),
+                1.0 => dual_quaternion(&rigid, influences, p),
+                d => linear() * (1.0 - d) + dual_quaternion(&rigid, influences, p) * d,
+            };
+        });
+    }
+}
+
+/// The skin of `mesh` among `skins`, where it has one with a joint list per vertex.
+fn skin_of<'s>(mesh: &Mesh, skins: &'s [Skin]) -> Option<&'s Skin> {
+    mesh.skin.and_then(|s| skins.get(s)).filter(|_| mesh.joints.len() == mesh.positions.len())
 }
 
 /// A joint matrix split for dual-quaternion blending: rotation `R`, the dual part `½·t·R`, and the stretch `Rᵀ·A`.

@@ -5,12 +5,14 @@ use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run};
+use rayon::prelude::*;
+
+use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run, scan_variants};
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
     Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_within, comparison_times,
 };
-use crate::eval::{Evaluation, Setup};
+use crate::eval::{Evaluation, Setup, Variant};
 use crate::import;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
 
@@ -109,6 +111,10 @@ pub struct Cost {
 /// skinned meshes while the pass runs.
 const BATCH: usize = 16;
 
+/// How many variants of the source one pass over the clip scans ([`Baseline::apply_each`]): each holds a summary of
+/// every bone per run of samples while the pass runs.
+const VARIANTS: usize = 32;
+
 /// About how many times a lower bound of a cost compares ([`Baseline::cost_bound`]).
 const BOUND_TIMES: usize = 64;
 
@@ -186,7 +192,40 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let judged = change.changed_below().map_or(Judged::Every, Judged::Subtree);
         let request = CurveRequest { judged, ..CurveRequest::default() };
         let never = AtomicBool::new(false);
-        let summary = analyze(&fixed, request, self.options, &|_, _| {}, &never).expect("never cancelled").scan;
+        let scan = analyze(&fixed, request, self.options, &|_, _| {}, &never).expect("never cancelled").scan;
+        Ok(self.applied(change, baked, &scan))
+    }
+
+    /// Each of `changes` made and scanned as [`Baseline::apply`] does, in parallel: those that are variants of the
+    /// source (another mode at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
+    /// ([`scan_variants`]); the others one by one.
+    pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
+        let mut variants = Vec::new();
+        let mut others = Vec::new();
+        for &change in changes {
+            match (change, self.fixed(change, None)) {
+                (Change::Mode { bone, .. }, Ok(fixed)) if Variant::of(self.source, &fixed).is_some() => {
+                    variants.push((bone, change, fixed));
+                }
+                _ => others.push(change),
+            }
+        }
+        let mut applied: Vec<_> = others.into_par_iter().map(|change| (change, self.apply(change))).collect();
+        variants.sort_by_key(|&(bone, ..)| bone);
+        for batch in variants.chunks(VARIANTS) {
+            let variant = batch.iter().map(|(_, _, fixed)| Variant::of(self.source, fixed));
+            let each: Vec<Variant> = variant.map(|v| v.expect("a variant, as sorted")).collect();
+            let scans = scan_variants(self.source, &each, self.options);
+            applied.extend(
+                batch.iter().zip(&scans).map(|((_, change, _), scan)| (*change, Ok(self.applied(*change, None, scan)))),
+            );
+        }
+        applied
+    }
+
+    /// `change` made (`baked`: the rig a bake writes) as `scan` found it: the changed bones' worst shear and
+    /// verdicts from the change's scan, the others' from the source's.
+    fn applied(&self, change: Change, baked: Option<Rig>, scan: &ClipScan) -> Applied {
         let (skeleton, changed) = (self.source.skeleton(), self.changed(change));
         let bone_of = |b: usize| match &baked {
             Some(rig) => rig.skeleton.find(&skeleton.bone(b).name),
@@ -194,12 +233,12 @@ impl<'e, 'a> Baseline<'e, 'a> {
         };
         let shear = (0..skeleton.len())
             .map(|b| match bone_of(b) {
-                Some(f) if changed(b) => (summary.bones[f].worst_shear_deg, summary.bones[f].stretched()),
+                Some(f) if changed(b) => (scan.bones[f].worst_shear_deg, scan.bones[f].stretched()),
                 Some(_) => (self.before.bones[b].worst_shear_deg, self.before.bones[b].stretched()),
                 None => (0.0, false),
             })
             .collect();
-        Ok(Applied { baked, shear })
+        Applied { baked, shear }
     }
 
     /// Whether `change` certainly leaves `bone` flagged: it is flagged in the run of samples that holds the bone's

@@ -315,8 +315,7 @@ impl Known {
     /// Makes each of `changes` not yet made, in parallel.
     fn make(&mut self, baseline: &Baseline, changes: &[Change]) {
         let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
-        let made: Vec<_> = missing.into_par_iter().map(|change| (change, baseline.apply(change))).collect();
-        self.applied.extend(made);
+        self.applied.extend(baseline.apply_each(&missing));
     }
 
     /// The lower bound of the cost of each of `changes`, those not known yet found in parallel (a bake's needs it

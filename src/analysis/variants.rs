@@ -1,0 +1,180 @@
+//! Scans of many variants of one evaluation (each another mode at one bone, [`Variant`]) in one pass over the clip:
+//! the bones above the variants are sampled, evaluated and judged once per time for all of them, and each variant
+//! evaluates and judges its own subtree under them. Explaining a shear weighs every mode of every bone below a
+//! squash; scanned one by one, each would evaluate its chain from the root again.
+
+use rayon::prelude::*;
+
+use glam::{DMat4, DQuat};
+
+use super::chunk::{ChunkResult, inherits_stretch};
+use super::clip_analysis::ClipScan;
+use super::findings::Judge;
+use super::peak;
+use super::request::ScanOptions;
+use super::scan::assemble;
+use super::stretch::Stretch;
+use crate::eval::{Evaluation, ModelPose, Reference, Variant, run_length};
+use crate::model::Transform;
+
+/// Each variant of `source` scanned as [`super::analyze`] scans it judging its top's subtree
+/// ([`super::Judged::Subtree`]): the same summaries, bit for bit, for the bones of the subtree; the other bones'
+/// stay empty. One pass over the clip for all of them: `variants` of one part of the rig share the most.
+pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOptions) -> Vec<ClipScan> {
+    let Some(clip) = source.clip.filter(|_| !variants.is_empty()) else {
+        return variants.iter().map(|_| ClipScan { samples: 0, bones: Vec::new() }).collect();
+    };
+    let skeleton = source.skeleton();
+    let times = source.times(options.rate);
+    let judge = Judge::new(&options.tolerances);
+    let own: Vec<Judging> = variants.iter().map(|v| Judging::of_variant(v)).collect();
+    let tops: Vec<usize> = variants.iter().filter_map(|v| skeleton.parent(v.top)).collect();
+    let above = Judging::of_bones(source, &skeleton.with_ancestors(&tops));
+    let every: Vec<usize> = variants.iter().flat_map(|v| v.bones.iter().copied()).collect();
+    let evaluated = skeleton.with_ancestors(&every);
+    let root = Stretch::uniform(skeleton.placement().conversion_scale());
+    let runs: Vec<Vec<ChunkResult>> = times
+        .par_chunks(run_length(times.len()))
+        .map(|run| {
+            let mut reference = Reference::new(source, clip, &evaluated);
+            let mut out = ModelPose::default();
+            let mut stretches = vec![Stretch::NONE; skeleton.len()];
+            let mut variant_stretches: Vec<Vec<Stretch>> =
+                variants.iter().map(|v| vec![Stretch::NONE; v.bones.len()]).collect();
+            let mut results: Vec<ChunkResult> =
+                variants.iter().map(|_| ChunkResult::new(skeleton.len(), run.len())).collect();
+            for (sample, &time) in run.iter().enumerate() {
+                reference.evaluate(time);
+                let pose = reference.pose();
+                for &(bone, inherits, parent) in &above.bones {
+                    let over = parent.map_or(root, |p| p.stretch(&[], &stretches));
+                    let start = stretches[bone].frame();
+                    stretches[bone] = judged(inherits, over, &pose.local[bone], &pose.model.model[bone], start, &judge);
+                }
+                for ((variant, judging), (own, result)) in
+                    variants.iter().zip(&own).zip(variant_stretches.iter_mut().zip(&mut results))
+                {
+                    reference.evaluate_variant(variant, &mut out);
+                    for (k, &(bone, inherits, parent)) in judging.bones.iter().enumerate() {
+                        let over = parent.map_or(root, |p| p.stretch(own, &stretches));
+                        own[k] = judged(inherits, over, &pose.local[bone], &out.model[bone], own[k].frame(), &judge);
+                        result.add(bone, sample, time, &own[k].verdict(&judge));
+                    }
+                }
+            }
+            results
+        })
+        .collect();
+    let mut per_variant: Vec<Vec<ChunkResult>> = variants.iter().map(|_| Vec::new()).collect();
+    for run in runs {
+        per_variant.iter_mut().zip(run).for_each(|(chunks, chunk)| chunks.push(chunk));
+    }
+    per_variant
+        .into_par_iter()
+        .zip(variants)
+        .map(|(chunks, variant)| {
+            let mut analysis = assemble(skeleton.figure(), times.clone(), Vec::new(), chunks);
+            peak::refine(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &judge);
+            analysis.scan
+        })
+        .collect()
+}
+
+/// A bone's stretch (`start`: where a decomposition starts its search) under `over`, its parent's (or what a root
+/// inherits): passed down through its local transform `local` where it `inherits` it, else decomposed from its model
+/// matrix `model`.
+fn judged(inherits: bool, over: Stretch, local: &Transform, model: &DMat4, start: DQuat, judge: &Judge) -> Stretch {
+    match inherits {
+        true => over.child(&mut &*local, start, judge),
+        false => Stretch::of_matrix(model, start),
+    }
+}
+
+/// Where a bone's parent is judged: among the variant's own bones (its position there), or above the variants.
+#[derive(Clone, Copy)]
+enum Parent {
+    Own(usize),
+    Above(usize),
+}
+
+impl Parent {
+    /// Its stretch, given the variant's own bones' and the bones' above.
+    fn stretch(self, own: &[Stretch], above: &[Stretch]) -> Stretch {
+        match self {
+            Parent::Own(k) => own[k],
+            Parent::Above(bone) => above[bone],
+        }
+    }
+}
+
+/// The bones a pass judges, parents first: each with whether it inherits its parent's stretch
+/// ([`inherits_stretch`]), and where its parent is judged (`None` for a root).
+struct Judging {
+    bones: Vec<(usize, bool, Option<Parent>)>,
+}
+
+impl Judging {
+    /// `bones` (parents first) of `evaluation`, judged above the variants.
+    fn of_bones(evaluation: &Evaluation, bones: &[usize]) -> Self {
+        let skeleton = evaluation.skeleton();
+        let judged = bones.iter().map(|&b| (b, inherits_stretch(evaluation, b), skeleton.parent(b).map(Parent::Above)));
+        Judging { bones: judged.collect() }
+    }
+
+    /// The bones of `variant`.
+    fn of_variant(variant: &Variant) -> Self {
+        let skeleton = variant.evaluation.skeleton();
+        let parent = |b: usize| {
+            let p = skeleton.parent(b)?;
+            Some(variant.bones.binary_search(&p).map_or(Parent::Above(p), Parent::Own))
+        };
+        let judged = variant.bones.iter().map(|&b| (b, inherits_stretch(variant.evaluation, b), parent(b)));
+        Judging { bones: judged.collect() }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicBool;
+
+    use super::*;
+    use crate::analysis::{CurveRequest, Judged, analyze};
+    use crate::import::stress_rig;
+    use crate::model::{Choice, InheritMode};
+
+    #[test]
+    fn a_variant_scanned_with_the_others_is_its_subtree_scanned_alone() {
+        // Every other mode of every bone of the stress rig's spine and first chain (a squash on its fifth bone),
+        // the squash itself compensated or not, over several runs of samples: every summary of the subtree equals
+        // the whole analysis's of that subtree, bit for bit.
+        let rig = stress_rig(12, 300, 3);
+        let options = ScanOptions::default();
+        let never = AtomicBool::new(false);
+        for squash in [InheritMode::Full, InheritMode::SegmentCompensate] {
+            let mut modes = vec![InheritMode::Full; rig.skeleton.len()];
+            modes[5] = squash;
+            let source = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
+            let mut changed = Vec::new();
+            for top in 1..rig.skeleton.len() {
+                for &mode in InheritMode::ALL.iter().filter(|&&m| m != modes[top]) {
+                    let mut with = modes.clone();
+                    with[top] = mode;
+                    changed.push(source.with_modes(&with).unwrap());
+                }
+            }
+            let variants: Vec<Variant> = changed.iter().map(|e| Variant::of(&source, e).unwrap()).collect();
+            let scans = scan_variants(&source, &variants, &options);
+            let mut flagged = 0;
+            for (variant, scan) in variants.iter().zip(&scans) {
+                let request = CurveRequest { judged: Judged::Subtree(variant.top), ..CurveRequest::default() };
+                let alone = analyze(variant.evaluation, request, &options, &|_, _| {}, &never).unwrap().scan;
+                assert_eq!(scan.samples, alone.samples);
+                for &b in &variant.bones {
+                    assert_eq!(scan.bones[b], alone.bones[b], "bone {b} below {}", variant.top);
+                    flagged += usize::from(alone.bones[b].stretched());
+                }
+            }
+            assert!(flagged > 0, "some variants shear");
+        }
+    }
+}
