@@ -1,4 +1,5 @@
-//! Scans of many variants of one evaluation (each another mode at one bone, [`Variant`]) in one pass over the clip:
+//! Scans of many variants of one evaluation (each another mode or a uniform scale at one bone, [`Variant`]) in one
+//! pass over the clip:
 //! the bones above the variants are sampled, evaluated and judged once per time for all of them, and each variant
 //! evaluates and judges its own subtree under them. Explaining a shear weighs every mode of every bone below a
 //! squash; scanned one by one, each would evaluate its chain from the root again.
@@ -57,7 +58,8 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
                     reference.evaluate_variant(variant, &mut out);
                     for (k, &(bone, inherits, parent)) in judging.bones.iter().enumerate() {
                         let over = parent.map_or(root, |p| p.stretch(own, &stretches));
-                        own[k] = judged(inherits, over, &pose.local[bone], &out.model[bone], own[k].frame(), &judge);
+                        let local = variant.local(&pose.local, bone);
+                        own[k] = judged(inherits, over, &local, &out.model[bone], own[k].frame(), &judge);
                         result.add(bone, sample, time, &own[k].verdict(&judge));
                     }
                 }
@@ -140,11 +142,13 @@ mod tests {
     use super::*;
     use crate::analysis::{CurveRequest, Judged, analyze};
     use crate::import::stress_rig;
-    use crate::model::{Choice, InheritMode};
+    use crate::eval::variant_changes_of as changes_of;
+    use crate::model::InheritMode;
 
     #[test]
     fn a_variant_scanned_with_the_others_is_its_subtree_scanned_alone() {
-        // Every other mode of every bone of the stress rig's spine and first chain (a squash on its fifth bone),
+        // Every other mode of every bone of the stress rig's spine and first chain (a squash on its fifth bone), and
+        // each bone's scale made uniform,
         // the squash itself compensated or not, over several runs of samples: every summary of the subtree equals
         // the whole analysis's of that subtree, bit for bit.
         let rig = stress_rig(12, 300, 3);
@@ -154,14 +158,7 @@ mod tests {
             let mut modes = vec![InheritMode::Full; rig.skeleton.len()];
             modes[5] = squash;
             let source = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
-            let mut changed = Vec::new();
-            for top in 1..rig.skeleton.len() {
-                for &mode in InheritMode::ALL.iter().filter(|&&m| m != modes[top]) {
-                    let mut with = modes.clone();
-                    with[top] = mode;
-                    changed.push(source.with_modes(&with).unwrap());
-                }
-            }
+            let changed: Vec<Evaluation> = (1..rig.skeleton.len()).flat_map(|top| changes_of(&source, top)).collect();
             let variants: Vec<Variant> = changed.iter().map(|e| Variant::of(&source, e).unwrap()).collect();
             let scans = scan_variants(&source, &variants, &options);
             let mut flagged = 0;

@@ -174,7 +174,12 @@ impl<'a> Evaluation<'a> {
     /// Whether a pose's bones can be read from the clip one at a time ([`super::Chains`]): no layers (which read
     /// whole poses) and lengths in the rig's own unit.
     pub fn reads_bone_by_bone(&self) -> bool {
-        self.layers.is_none() && self.length_scale == 1.0
+        self.layers.is_none() && self.in_rig_unit()
+    }
+
+    /// Whether lengths are in the rig's own unit (no [`Evaluation::measured_in`] that scales them).
+    pub fn in_rig_unit(&self) -> bool {
+        self.length_scale == 1.0
     }
 
     /// A worker's state for evaluating poses one time after another (its own pose buffers and copy of the layers).

@@ -148,7 +148,7 @@ impl Hierarchy {
 
     /// Model matrices of the local pose `local` (one transform per bone, parents first).
     pub fn evaluate(&self, local: &[Transform], out: &mut ModelPose) {
-        self.size(local, out);
+        self.size(local.len(), out);
         for (i, bone_local) in local.iter().enumerate() {
             self.evaluate_bone(i, bone_local, out);
         }
@@ -158,7 +158,7 @@ impl Hierarchy {
     /// Model matrices of `bones` only (in increasing order, with every ancestor of each), for a few bones of a big
     /// rig; only their entries of `local` are read, and the other bones' entries of `out` are not written.
     pub fn evaluate_bones(&self, local: &[Transform], bones: &[usize], out: &mut ModelPose) {
-        self.size(local, out);
+        self.size(local.len(), out);
         for &i in bones {
             self.evaluate_bone(i, &local[i], out);
         }
@@ -168,10 +168,16 @@ impl Hierarchy {
     /// Model matrices of `bones` (a subtree, its top first, parents first) under the matrices its top's parent has
     /// in `reference`: a pose of a hierarchy that agrees with this one outside the subtree (the same skeleton, the
     /// same modes) and evaluates every matrix a child may read ([`Hierarchy::reference`]), at the same time. What a
-    /// change below one bone gives, without evaluating its ancestors again; only the subtree's entries of `local`
-    /// are read, and of `out` only the subtree's and its top's parent's are written.
-    pub fn evaluate_below(&self, local: &[Transform], bones: &[usize], reference: &ModelPose, out: &mut ModelPose) {
-        self.size(local, out);
+    /// change below one bone gives, without evaluating its ancestors again; `local` gives the subtree's local
+    /// transforms, and of `out` only the subtree's entries and its top's parent's are written.
+    pub fn evaluate_below(
+        &self,
+        local: impl Fn(usize) -> Transform,
+        bones: &[usize],
+        reference: &ModelPose,
+        out: &mut ModelPose,
+    ) {
+        self.size(self.parents.len(), out);
         if let Some(parent) = bones.first().and_then(|&top| self.parents[top]) {
             out.copy_bone(reference, parent);
             if let Some(&Some(node)) = self.placed_by.get(parent) {
@@ -179,7 +185,7 @@ impl Hierarchy {
             }
         }
         for &i in bones {
-            self.evaluate_bone(i, &local[i], out);
+            self.evaluate_bone(i, &local(i), out);
         }
         self.place(bones.iter().copied(), out);
     }
@@ -200,9 +206,10 @@ impl Hierarchy {
         }
     }
 
-    fn size(&self, local: &[Transform], out: &mut ModelPose) {
+    /// Sizes `out` for this hierarchy, given `bones` local transforms: one per bone.
+    fn size(&self, bones: usize, out: &mut ModelPose) {
         let n = self.parents.len();
-        assert_eq!(local.len(), n, "one local transform per bone");
+        assert_eq!(bones, n, "one local transform per bone");
         for v in [&mut out.model, &mut out.unscaled, &mut out.rigid] {
             v.resize(n, DMat4::IDENTITY);
         }

@@ -1,9 +1,10 @@
-//! An evaluation that differs from another only at one bone and below it (another mode there): evaluated from the
-//! other's pose at the same time, its own subtree alone. Explaining a shear weighs hundreds of such changes against
+//! An evaluation that differs from another only at one bone and below it (another mode there, a scale made
+//! uniform): evaluated from the other's pose at the same time, its own subtree alone. Explaining a shear weighs hundreds of such changes against
 //! one clip; each shares the ancestors of the bone it changes with the clip as it is.
 
-use super::{Chains, Evaluation, Hierarchy, ModelPose};
-use crate::model::Clip;
+use super::layers::{Layers, uniform_scale};
+use super::{Chains, Evaluation, Hierarchy, ModelPose, Pose};
+use crate::model::{Clip, Transform};
 
 /// `evaluation`, which differs from a reference only at `top` and below it.
 #[derive(Clone, Debug)]
@@ -12,30 +13,53 @@ pub struct Variant<'e, 'a> {
     pub top: usize,
     /// `top` and every bone below it, parents first.
     pub bones: Vec<usize>,
+    /// The bones whose local scale it makes uniform (a layer of nothing else).
+    uniform: Vec<usize>,
 }
 
 impl<'e, 'a> Variant<'e, 'a> {
-    /// `evaluation` as a variant of `reference`, where it is one: the same rig, clip and skinning, both read from the
-    /// clip bone by bone ([`Evaluation::reads_bone_by_bone`]), and the modes differing only at and below one bone
-    /// (the top: the lowest bone above all that differ).
+    /// `evaluation` as a variant of `reference`, where it is one: the same rig, clip and skinning, lengths in the
+    /// rig's unit, the reference read from the clip bone by bone ([`Evaluation::reads_bone_by_bone`]) and
+    /// `evaluation` too but for scales it makes uniform; the modes and those scales differing only at and below one
+    /// bone (the top: the lowest bone above all that differ).
     pub fn of(reference: &Evaluation, evaluation: &'e Evaluation<'a>) -> Option<Self> {
+        let uniform = only_uniform_scales(evaluation)?;
         let alike = std::ptr::eq(reference.rig, evaluation.rig)
             && reference.clip.is_some()
             && reference.clip.map(std::ptr::from_ref) == evaluation.clip.map(std::ptr::from_ref)
             && reference.skinning == evaluation.skinning
             && reference.reads_bone_by_bone()
-            && evaluation.reads_bone_by_bone();
+            && evaluation.in_rig_unit();
         let skeleton = evaluation.skeleton();
         let modes = reference.modes().iter().zip(evaluation.modes());
-        let mut differing = modes.enumerate().filter(|(_, (a, b))| a != b).map(|(bone, _)| bone);
+        let other_modes = modes.enumerate().filter(|(_, (a, b))| a != b).map(|(bone, _)| bone);
+        let mut differing = other_modes.chain(uniform.iter().copied());
         let mut top = differing.next().filter(|_| alike)?;
         for bone in differing {
             while !skeleton.chain(bone).contains(&top) {
                 top = skeleton.parent(top)?;
             }
         }
-        Some(Variant { evaluation, top, bones: skeleton.subtree(top) })
+        Some(Variant { evaluation, top, bones: skeleton.subtree(top), uniform })
     }
+
+    /// `bone`'s local transform, the reference's being `reference` (one per bone).
+    pub fn local(&self, reference: &[Transform], bone: usize) -> Transform {
+        let mut local = reference[bone];
+        if self.uniform.contains(&bone) {
+            uniform_scale(&mut local);
+        }
+        local
+    }
+}
+
+/// The bones whose scale `evaluation`'s layers make uniform, where they do nothing else (none without layers).
+fn only_uniform_scales(evaluation: &Evaluation) -> Option<Vec<usize>> {
+    let Some(stack) = evaluation.layers() else {
+        return Some(Vec::new());
+    };
+    let uniform = &stack.layers().uniform_scale;
+    (*stack.layers() == Layers { uniform_scale: uniform.clone(), ..Layers::default() }).then(|| uniform.clone())
 }
 
 /// A reference evaluated for its variants, time after time: the bones they hang from and their own bones, read bone
@@ -54,29 +78,31 @@ impl<'e> Reference<'e> {
     }
 
     /// The reference at `time`.
-    pub fn evaluate(&mut self, time: f64) -> &super::Pose {
+    pub fn evaluate(&mut self, time: f64) -> &Pose {
         self.chains.evaluate(time, &self.hierarchy)
     }
 
     /// The pose last evaluated.
-    pub fn pose(&self) -> &super::Pose {
+    pub fn pose(&self) -> &Pose {
         self.chains.pose()
     }
 
-    /// `variant` at the time last evaluated: its bones' model matrices into `out` (its bones' local transforms are
-    /// the reference's).
+    /// `variant` at the time last evaluated: its bones' model matrices into `out` (their local transforms are the
+    /// reference's, as the variant changes them: [`Variant::local`]).
     pub fn evaluate_variant(&self, variant: &Variant, out: &mut ModelPose) {
         let pose = self.chains.pose();
-        variant.evaluation.hierarchy.evaluate_below(&pose.local, &variant.bones, &pose.model, out);
+        let local = |bone: usize| variant.local(&pose.local, bone);
+        variant.evaluation.hierarchy.evaluate_below(local, &variant.bones, &pose.model, out);
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use glam::{DMat4, DQuat, DVec3};
 
     use super::*;
     use crate::import::stress_rig;
+    use crate::eval::LayerStack;
     use crate::model::{Choice, InheritMode, Placement, Rig};
 
     /// The stress rig's spine and first chain, with a squash on the chain's fifth bone; placed where `placed` says
@@ -96,10 +122,23 @@ mod tests {
         rig
     }
 
+    /// Every change of one bone `explain` weighs on `source`: each other mode, and its scale made uniform.
+    pub(crate) fn changes_of<'a>(source: &Evaluation<'a>, top: usize) -> Vec<Evaluation<'a>> {
+        let modes = source.modes();
+        let other = InheritMode::ALL.iter().filter(|&&m| m != modes[top]).map(|&mode| {
+            let mut changed = modes.to_vec();
+            changed[top] = mode;
+            source.with_modes(&changed).unwrap()
+        });
+        let layers = Layers { uniform_scale: vec![top], ..Layers::default() };
+        let uniform = source.clone().with_layers(LayerStack::new(source.rig, &layers).unwrap());
+        other.chain([uniform]).collect()
+    }
+
     #[test]
     fn a_variant_evaluated_below_its_top_is_the_change_evaluated_whole() {
-        // Every bone under every mode, with its squashed ancestor under segment compensate or not: the subtree's
-        // model matrices equal the whole change's, bit for bit, placed or not.
+        // Every bone under every mode or with its scale made uniform, its squashed ancestor under segment
+        // compensate or not: the subtree's model matrices equal the whole change's, bit for bit, placed or not.
         for placed in [false, true] {
             let rig = rig(placed);
             let (skeleton, clip) = (&rig.skeleton, &rig.clips[0]);
@@ -111,18 +150,15 @@ mod tests {
                 let mut reference = Reference::new(&source, clip, &every);
                 let mut out = ModelPose::default();
                 for top in 1..skeleton.len() {
-                    for &mode in InheritMode::ALL.iter().filter(|&&m| m != modes[top]) {
-                        let mut changed_modes = modes.clone();
-                        changed_modes[top] = mode;
-                        let changed = source.with_modes(&changed_modes).unwrap();
-                        let variant = Variant::of(&source, &changed).expect("a change of one mode is a variant");
+                    for changed in changes_of(&source, top) {
+                        let variant = Variant::of(&source, &changed).expect("a change of one bone is a variant");
                         assert_eq!(variant.top, top);
                         for time in [0.0, 0.37, 1.1] {
                             reference.evaluate(time);
                             reference.evaluate_variant(&variant, &mut out);
                             let whole = changed.pose_at(time).model.model;
                             for &b in &variant.bones {
-                                assert_eq!(out.model[b], whole[b], "bone {b}, {top} → {mode}, {time} s, {placed}");
+                                assert_eq!(out.model[b], whole[b], "bone {b} below {top}, {time} s, {placed}");
                             }
                         }
                     }
@@ -150,5 +186,9 @@ mod tests {
         assert!(Variant::of(&source, &changed(&[6]).at_rest()).is_none(), "another clip");
         let layered = changed(&[6]).played_with(crate::eval::layers::RotationInterpolation::Nlerp);
         assert!(Variant::of(&source, &layered).is_none(), "layers read whole poses");
+        let uniform = Layers { uniform_scale: vec![8], ..Layers::default() };
+        let uniform = changed(&[6]).with_layers(LayerStack::new(&rig, &uniform).unwrap());
+        assert_eq!(Variant::of(&source, &uniform).map(|v| v.top), Some(6), "a scale made uniform below the mode");
+        assert!(Variant::of(&uniform, &source).is_none(), "a layered reference reads whole poses");
     }
 }

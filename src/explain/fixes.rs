@@ -197,14 +197,14 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// Each of `changes` made and scanned as [`Baseline::apply`] does, in parallel: those that are variants of the
-    /// source (another mode at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
+    /// source (another mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
     /// ([`scan_variants`]); the others one by one.
     pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
         let mut variants = Vec::new();
         let mut others = Vec::new();
         for &change in changes {
-            match (change, self.fixed(change, None)) {
-                (Change::Mode { bone, .. }, Ok(fixed)) if Variant::of(self.source, &fixed).is_some() => {
+            match (change.changed_below(), self.fixed(change, None)) {
+                (Some(bone), Ok(fixed)) if Variant::of(self.source, &fixed).is_some() => {
                     variants.push((bone, change, fixed));
                 }
                 _ => others.push(change),
