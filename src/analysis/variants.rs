@@ -141,8 +141,8 @@ mod tests {
 
     use super::*;
     use crate::analysis::{CurveRequest, Judged, analyze};
-    use crate::import::stress_rig;
     use crate::eval::variant_changes_of as changes_of;
+    use crate::import::stress_rig;
     use crate::model::InheritMode;
 
     #[test]

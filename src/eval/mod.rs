@@ -30,6 +30,6 @@ pub use runs::{over_runs, over_runs_of, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use setup::{Setup, SetupError};
 pub use skinning::{Method as SkinningMethod, Reach, skin_meshes};
-pub use variant::{Reference, Variant};
 #[cfg(test)]
 pub(crate) use variant::tests::changes_of as variant_changes_of;
+pub use variant::{Reference, Variant};

@@ -101,8 +101,8 @@ pub(crate) mod tests {
     use glam::{DMat4, DQuat, DVec3};
 
     use super::*;
-    use crate::import::stress_rig;
     use crate::eval::LayerStack;
+    use crate::import::stress_rig;
     use crate::model::{Choice, InheritMode, Placement, Rig};
 
     /// The stress rig's spine and first chain, with a squash on the chain's fifth bone; placed where `placed` says

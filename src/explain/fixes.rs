@@ -5,8 +5,6 @@ use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use rayon::prelude::*;
-
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run, scan_variants};
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
@@ -196,8 +194,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
         Ok(self.applied(change, baked, &scan))
     }
 
-    /// Each of `changes` made and scanned as [`Baseline::apply`] does, in parallel: those that are variants of the
-    /// source (another mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
+    /// Each of `changes` made and scanned as [`Baseline::apply`] does: those that are variants of the source (another
+    /// mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
     /// ([`scan_variants`]); the others one by one.
     pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
         let mut variants = Vec::new();
@@ -210,7 +208,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
                 _ => others.push(change),
             }
         }
-        let mut applied: Vec<_> = others.into_par_iter().map(|change| (change, self.apply(change))).collect();
+        // One at a time: each is parallel within, and a bake holds every sample of every bone while it runs.
+        let mut applied: Vec<_> = others.into_iter().map(|change| (change, self.apply(change))).collect();
         variants.sort_by_key(|&(bone, ..)| bone);
         for batch in variants.chunks(VARIANTS) {
             let variant = batch.iter().map(|(_, _, fixed)| Variant::of(self.source, fixed));
