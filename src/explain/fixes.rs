@@ -198,27 +198,29 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
     /// ([`scan_variants`]); the others one by one.
     pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
-        let mut variants = Vec::new();
-        let mut others = Vec::new();
-        for &change in changes {
-            match (change.changed_below(), self.fixed(change, None)) {
-                (Some(bone), Ok(fixed)) if Variant::of(self.source, &fixed).is_some() => {
-                    variants.push((bone, change, fixed));
-                }
-                _ => others.push(change),
-            }
-        }
-        // One at a time: each is parallel within, and a bake holds every sample of every bone while it runs.
-        let mut applied: Vec<_> = others.into_iter().map(|change| (change, self.apply(change))).collect();
-        variants.sort_by_key(|&(bone, ..)| bone);
+        // A change below one bone of a source read bone by bone is a variant of it.
+        let varies = |change: &&Change| change.changed_below().is_some() && self.source.reads_bone_by_bone();
+        let (mut variants, others): (Vec<Change>, Vec<Change>) = changes.iter().partition(varies);
+        let mut applied = Vec::new();
+        // Changes of one part of the rig together, each batch's evaluations made for it alone.
+        variants.sort_by_key(|change| change.changed_below());
         for batch in variants.chunks(VARIANTS) {
-            let variant = batch.iter().map(|(_, _, fixed)| Variant::of(self.source, fixed));
-            let each: Vec<Variant> = variant.map(|v| v.expect("a variant, as sorted")).collect();
+            let mut made = Vec::new();
+            for &change in batch {
+                match self.fixed(change, None) {
+                    Ok(fixed) => made.push((change, fixed)),
+                    Err(why) => applied.push((change, Err(why))),
+                }
+            }
+            let each: Vec<Variant> =
+                made.iter().map(|(_, f)| Variant::of(self.source, f).expect("a variant")).collect();
             let scans = scan_variants(self.source, &each, self.options);
             applied.extend(
-                batch.iter().zip(&scans).map(|((_, change, _), scan)| (*change, Ok(self.applied(*change, None, scan)))),
+                made.iter().zip(&scans).map(|((change, _), scan)| (*change, Ok(self.applied(*change, None, scan)))),
             );
         }
+        // One at a time: each is parallel within, and a bake holds every sample of every bone while it runs.
+        applied.extend(others.into_iter().map(|change| (change, self.apply(change))));
         applied
     }
 
