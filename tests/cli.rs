@@ -765,3 +765,23 @@ fn inspect_warns_of_broken_skins_and_notes_stored_poses() {
     let table = String::from_utf8(bonescope(&["inspect", &moved]).stdout).unwrap();
     assert!(table.contains(&format!("warning: `{}` is bound 0.05", name.as_str().unwrap())), "{table}");
 }
+
+#[test]
+fn a_reader_that_stops_early_ends_the_command_quietly() {
+    // `bonescope explain … | head -c 1`: the reader goes before the report is written. The command stops as a
+    // program stopped by the closed pipe does (status 141), with nothing on stderr: no panic, no error line.
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    for args in [["explain", "--format", "json"], ["inspect", "--format", "table"]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_bonescope"))
+            .args([args[0], &stretchy(), args[1], args[2]])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("bonescope runs");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(141), "{args:?}: {:?}", out.status.signal());
+        assert_eq!(String::from_utf8_lossy(&out.stderr), "", "{args:?}");
+    }
+}

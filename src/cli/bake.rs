@@ -64,8 +64,8 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     let report = bake::report(&request, &baked, &baked_rig);
     bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
     match args.format {
-        OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
-        OutputFormat::Table => print!("{}", render_table(args, &setup, &report, baked.glb.len())),
+        OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&report)?))?,
+        OutputFormat::Table => super::print_out(render_table(args, &setup, &report, baked.glb.len()))?,
     }
     let worst = report.worst();
     let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));

@@ -83,8 +83,8 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
     let diff = diff_files(&a, &b, clips, &args.map, args.rate)?;
     match args.format {
-        OutputFormat::Json => println!("{}", serde_json::to_string_pretty(&diff)?),
-        OutputFormat::Table => print!("{}", render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()])),
+        OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&diff)?))?,
+        OutputFormat::Table => super::print_out(render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()]))?,
     }
     let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })

@@ -84,6 +84,6 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     .and_then(|()| out.flush())
     .with_context(|| format!("cannot write {}", args.out.display()))?;
     let vertices: usize = positions.iter().map(Vec::len).sum();
-    println!("wrote {} meshes ({vertices} vertices) to {}", meshes.len(), args.out.display());
+    super::print_out(format_args!("wrote {} meshes ({vertices} vertices) to {}\n", meshes.len(), args.out.display()))?;
     Ok(ExitCode::SUCCESS)
 }

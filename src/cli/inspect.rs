@@ -56,7 +56,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
             writeln!(out)?;
             out.flush()?;
         }
-        OutputFormat::Table => print!("{}", render_table(&report, &summary)),
+        OutputFormat::Table => super::print_out(render_table(&report, &summary))?,
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -106,6 +106,9 @@ pub fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader closed the pipe (`bonescope … | head`): nothing more is wanted, and nothing went wrong here. The
+        // status a program stopped by the closed pipe has.
+        Err(error) if closed_pipe(&error) => ExitCode::from(128 + 13),
         Err(error) => {
             // One line, whatever a file put into the message (its names are escaped on import; paths and
             // options are escaped here).
@@ -113,4 +116,17 @@ pub fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Writes `text` to standard output: an error (a closed pipe among them) is returned, not a panic.
+fn print_out(text: impl std::fmt::Display) -> anyhow::Result<()> {
+    use std::io::Write;
+    write!(std::io::stdout().lock(), "{text}")?;
+    Ok(())
+}
+
+/// Whether `error` is standard output's reader gone.
+fn closed_pipe(error: &anyhow::Error) -> bool {
+    let kind = |e: &(dyn std::error::Error + 'static)| e.downcast_ref::<std::io::Error>().map(std::io::Error::kind);
+    error.chain().any(|e| kind(e) == Some(std::io::ErrorKind::BrokenPipe))
 }

@@ -205,7 +205,7 @@ fn finish(args: &RenderArgs, shot: &Shot, image: &image::RgbaImage) -> anyhow::R
     if let Some(out) = &args.out {
         let path = shot.path(out);
         image.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
-        println!("wrote {}", path.display());
+        super::print_out(format_args!("wrote {}\n", path.display()))?;
     }
     match &args.reference {
         Some(reference) => check(args, shot, image, &shot.path(reference)),
@@ -276,11 +276,11 @@ fn check(args: &RenderArgs, shot: &Shot, image: &image::RgbaImage, reference: &P
         .to_rgba8();
     let difference = pixel_difference(&expected, image);
     let within = difference.percent() <= args.threshold;
-    println!("{}", summary(reference, &difference, args.threshold, within));
+    super::print_out(format_args!("{}\n", summary(reference, &difference, args.threshold, within)))?;
     if !within && let Some(diff) = &difference.image {
         let path = diff_path(args.out.as_ref().map_or(reference.to_owned(), |out| shot.path(out)).as_path());
         diff.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
-        println!("wrote {}", path.display());
+        super::print_out(format_args!("wrote {}\n", path.display()))?;
     }
     Ok(within)
 }

@@ -43,9 +43,9 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
     }
     let files = merge(files);
     match args.format {
-        ReportFormat::Table => print!("{}", render_files(&files, &render_animation)),
-        ReportFormat::Json => println!("{}", serde_json::to_string_pretty(&files)?),
-        ReportFormat::Junit => println!("{}", junit(&files)),
+        ReportFormat::Table => super::print_out(render_files(&files, &render_animation))?,
+        ReportFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&files)?))?,
+        ReportFormat::Junit => super::print_out(format_args!("{}\n", junit(&files)))?,
     }
     for error in files.iter().filter_map(|f| f.error.as_deref()) {
         eprintln!("error: {}", crate::import::text::printable(error));
