@@ -5,6 +5,8 @@ use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
+use rayon::prelude::*;
+
 use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run, scan_variants};
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
@@ -198,13 +200,13 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
     /// ([`scan_variants`]); the others one by one.
     pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
-        // A change below one bone of a source read bone by bone is a variant of it.
-        let varies = |change: &&Change| change.changed_below().is_some() && self.source.reads_bone_by_bone();
-        let (mut variants, others): (Vec<Change>, Vec<Change>) = changes.iter().partition(varies);
+        // Only a change below one bone may be a variant; a bake is a rig of its own.
+        let (mut below, mut others): (Vec<Change>, Vec<Change>) =
+            changes.iter().partition(|change| change.changed_below().is_some());
         let mut applied = Vec::new();
         // Changes of one part of the rig together, each batch's evaluations made for it alone.
-        variants.sort_by_key(|change| change.changed_below());
-        for batch in variants.chunks(VARIANTS) {
+        below.sort_by_key(|change| change.changed_below());
+        for batch in below.chunks(VARIANTS) {
             let mut made = Vec::new();
             for &change in batch {
                 match self.fixed(change, None) {
@@ -212,15 +214,25 @@ impl<'e, 'a> Baseline<'e, 'a> {
                     Err(why) => applied.push((change, Err(why))),
                 }
             }
-            let each: Vec<Variant> =
-                made.iter().map(|(_, f)| Variant::of(self.source, f).expect("a variant")).collect();
-            let scans = scan_variants(self.source, &each, self.options);
+            let (mut scanned, mut variants) = (Vec::new(), Vec::new());
+            for (change, fixed) in &made {
+                if let Some(variant) = Variant::of(self.source, fixed) {
+                    scanned.push(*change);
+                    variants.push(variant);
+                } else {
+                    // Not read bone by bone (layers, another unit, no clip): made and scanned on its own.
+                    others.push(*change);
+                }
+            }
+            let scans = scan_variants(self.source, &variants, self.options);
             applied.extend(
-                made.iter().zip(&scans).map(|((change, _), scan)| (*change, Ok(self.applied(*change, None, scan)))),
+                scanned.into_iter().zip(&scans).map(|(change, scan)| (change, Ok(self.applied(change, None, scan)))),
             );
         }
+        let (bakes, alone): (Vec<Change>, Vec<Change>) = others.into_iter().partition(|c| c.changed_below().is_none());
+        applied.par_extend(alone.into_par_iter().map(|change| (change, self.apply(change))));
         // One at a time: each is parallel within, and a bake holds every sample of every bone while it runs.
-        applied.extend(others.into_iter().map(|change| (change, self.apply(change))));
+        applied.extend(bakes.into_iter().map(|change| (change, self.apply(change))));
         applied
     }
 
