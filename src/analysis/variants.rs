@@ -22,9 +22,9 @@ use crate::model::Transform;
 /// ([`super::Judged::Subtree`]): the same summaries, bit for bit, for the bones of the subtree; the other bones'
 /// stay empty. One pass over the clip for all of them: `variants` of one part of the rig share the most.
 pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOptions) -> Vec<ClipScan> {
-    let Some(clip) = source.clip.filter(|_| !variants.is_empty()) else {
-        return variants.iter().map(|_| ClipScan { samples: 0, bones: Vec::new() }).collect();
-    };
+    if variants.is_empty() {
+        return Vec::new();
+    }
     let skeleton = source.skeleton();
     let times = source.times(options.rate);
     let judge = Judge::new(&options.tolerances);
@@ -37,7 +37,7 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
     let runs: Vec<Vec<ChunkResult>> = times
         .par_chunks(run_length(times.len()))
         .map(|run| {
-            let mut reference = Reference::new(source, clip, &evaluated);
+            let mut reference = Reference::new(source, &evaluated).expect("variants have a clip");
             let mut out = ModelPose::default();
             let mut stretches = vec![Stretch::NONE; skeleton.len()];
             let mut variant_stretches: Vec<Vec<Stretch>> =

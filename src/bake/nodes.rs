@@ -375,42 +375,48 @@ mod tests {
     use crate::import::demo_rig;
     use crate::model::InheritMode;
 
+    /// The demo rig with every bone compensating its parent's scale, and `count + 1` times evenly over its clip.
+    fn compensated_demo(count: u32, test: impl FnOnce(&Evaluation, &[f64])) {
+        let rig = demo_rig();
+        let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
+        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
+        let times: Vec<f64> = (0..=count).map(|k| f64::from(k) * side.duration() / f64::from(count)).collect();
+        test(&side, &times);
+    }
+
     #[test]
     fn the_samples_are_the_same_whatever_the_number_of_cores() {
         // A solver's searches start near the time it solved before, so where runs start shows in the nodes (the demo
         // rig's compensated bones turn their stretch where two factors are nearly equal): runs of a fixed length.
-        let rig = demo_rig();
-        let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
-        let times: Vec<f64> = (0..=1000).map(|k| f64::from(k) * side.duration() / 1000.0).collect();
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| sample(&side, &times, Strategy::Exact).series)
-        };
-        let one = on(1);
-        assert_eq!(on(3), one);
-        assert_eq!(on(16), one);
+        compensated_demo(1000, |side, times| {
+            let on = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| sample(side, times, Strategy::Exact).series)
+            };
+            let one = on(1);
+            assert_eq!(on(3), one);
+            assert_eq!(on(16), one);
+        });
     }
 
     #[test]
     fn exact_samples_give_back_every_model_matrix() {
-        let rig = demo_rig();
-        let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
-        let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
-        let times: Vec<f64> = (0..=20).map(|k| f64::from(k) * side.duration() / 20.0).collect();
-        let mut sampled = sample(&side, &times, Strategy::Exact);
-        let helper = sampled.stats.stretched.clone();
-        assert!(helper.contains(&true), "the demo's compensated forearm is stretched in its local matrix");
-        sampled.series.iter_mut().for_each(follow_frames);
-        for (s, &time) in times.iter().enumerate() {
-            let pose = side.pose_at(time);
-            let mut baked: Vec<DMat4> = Vec::new();
-            for (bone, b) in rig.skeleton.bones().iter().enumerate() {
-                let local = sampled.series[bone].nodes[s].as_baked(helper[bone]).matrix();
-                baked.push(b.parent.map_or(local, |p| baked[p] * local));
-                assert!(baked[bone].abs_diff_eq(pose.model.model[bone], 1e-12), "{} at {time}", b.name);
+        compensated_demo(20, |side, times| {
+            let rig = side.rig;
+            let mut sampled = sample(side, times, Strategy::Exact);
+            let helper = sampled.stats.stretched.clone();
+            assert!(helper.contains(&true), "the demo's compensated forearm is stretched in its local matrix");
+            sampled.series.iter_mut().for_each(follow_frames);
+            for (s, &time) in times.iter().enumerate() {
+                let pose = side.pose_at(time);
+                let mut baked: Vec<DMat4> = Vec::new();
+                for (bone, b) in rig.skeleton.bones().iter().enumerate() {
+                    let local = sampled.series[bone].nodes[s].as_baked(helper[bone]).matrix();
+                    baked.push(b.parent.map_or(local, |p| baked[p] * local));
+                    assert!(baked[bone].abs_diff_eq(pose.model.model[bone], 1e-12), "{} at {time}", b.name);
+                }
             }
-        }
+        });
     }
 
     #[test]

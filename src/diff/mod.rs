@@ -333,11 +333,9 @@ fn compare_each_within(
         a.skeleton().with_ancestors(&bones)
     });
     let runs = over_runs(times, |run| {
-        let mut side_a = match (&reference, a.clip) {
-            (Some(bones), Some(clip)) => {
-                Side::new(&plan_a, Posing::Reference(Box::new(Reference::new(a, clip, bones))))
-            }
-            _ => Side::alone(&plan_a),
+        let mut side_a = match reference.as_ref().and_then(|bones| Reference::new(a, bones)) {
+            Some(reference) => Side::new(&plan_a, Posing::Reference(Box::new(reference))),
+            None => Side::alone(&plan_a),
         };
         let mut others: Vec<Side> = plans
             .iter()

@@ -4,7 +4,7 @@
 
 use super::layers::{Layers, uniform_scale};
 use super::{Chains, Evaluation, Hierarchy, ModelPose, Pose};
-use crate::model::{Clip, Transform};
+use crate::model::Transform;
 
 /// `evaluation`, which differs from a reference only at `top` and below it.
 #[derive(Clone, Debug)]
@@ -71,10 +71,10 @@ pub struct Reference<'e> {
 
 impl<'e> Reference<'e> {
     /// `reference` (read bone by bone, as its variants are) evaluated on `bones`: sorted, with every ancestor of each,
-    /// holding each variant's bones.
-    pub fn new(reference: &'e Evaluation, clip: &'e Clip, bones: &'e [usize]) -> Self {
-        let chains = Chains::new(reference.skeleton(), clip, bones);
-        Reference { hierarchy: reference.hierarchy.reference(), chains }
+    /// holding each variant's bones. `None` without a clip: a rest pose has no variants.
+    pub fn new(reference: &'e Evaluation, bones: &'e [usize]) -> Option<Self> {
+        let chains = Chains::new(reference.skeleton(), reference.clip?, bones);
+        Some(Reference { hierarchy: reference.hierarchy.reference(), chains })
     }
 
     /// The reference at `time`.
@@ -147,7 +147,7 @@ pub(crate) mod tests {
                 let mut modes = vec![InheritMode::Full; skeleton.len()];
                 modes[5] = squash_mode;
                 let source = Evaluation::new(&rig, Some(clip), &modes).unwrap();
-                let mut reference = Reference::new(&source, clip, &every);
+                let mut reference = Reference::new(&source, &every).unwrap();
                 let mut out = ModelPose::default();
                 for top in 1..skeleton.len() {
                     for changed in changes_of(&source, top) {
