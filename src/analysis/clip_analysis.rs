@@ -105,6 +105,11 @@ impl BoneSummary {
     }
 }
 
+/// Shears within this many degrees of each other are the same shear, apart by rounding alone (two bones whose
+/// matrices differ by a translation; one bone's shear evaluated along another path): orders of bones and fixes by
+/// shear treat them as equal, so that a last bit does not decide.
+pub const SAME_SHEAR_DEG: f64 = 1e-9;
+
 /// The result of scanning one clip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClipScan {
@@ -114,10 +119,11 @@ pub struct ClipScan {
 }
 
 impl ClipScan {
-    /// The bones stretched somewhere in the clip, the worst shear first (ties in bone order).
+    /// The bones stretched somewhere in the clip, the worst shear first (to [`SAME_SHEAR_DEG`]; ties in bone order).
     pub fn stretched_worst_first(&self) -> Vec<&BoneSummary> {
         let mut bones: Vec<&BoneSummary> = self.bones.iter().filter(|b| b.stretched()).collect();
-        bones.sort_by(|a, b| b.worst_shear_deg.total_cmp(&a.worst_shear_deg));
+        let shear = |b: &BoneSummary| (b.worst_shear_deg / SAME_SHEAR_DEG).round();
+        bones.sort_by(|a, b| shear(b).total_cmp(&shear(a)));
         bones
     }
 }
@@ -246,5 +252,25 @@ impl ClipAnalysis {
 
     pub fn curves_of(&self, bone: usize) -> Option<&Curves> {
         self.curves.iter().find(|(b, _)| *b == bone).map(|(_, c)| c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bones_whose_worst_shears_differ_by_rounding_alone_stay_in_bone_order() {
+        // Maya's mixed-inheritance test file: a bone and its tip shear the same 20.556°, one ulp apart.
+        let shear: f64 = 20.556044824203433;
+        let bone = |index: usize, worst_shear_deg: f64| BoneSummary {
+            worst_shear_deg,
+            flagged_samples: 1,
+            ..BoneSummary::new(index)
+        };
+        let scan =
+            ClipScan { samples: 1, bones: vec![bone(0, 3.0), bone(1, shear), bone(2, shear.next_up()), bone(3, 30.0)] };
+        let order: Vec<usize> = scan.stretched_worst_first().iter().map(|b| b.index).collect();
+        assert_eq!(order, [3, 1, 2, 0]);
     }
 }

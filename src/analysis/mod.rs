@@ -15,7 +15,7 @@ mod stretch;
 mod variants;
 
 pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check_bind};
-pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
+pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves, SAME_SHEAR_DEG};
 pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};

@@ -4,16 +4,22 @@
 
 use rayon::prelude::*;
 
-/// Runs per thread, at least: enough for the threads to even out uneven runs.
-const RUNS_PER_THREAD: usize = 4;
+/// How many runs a long pass is cut into, at most: enough for the threads of a large machine to even out uneven
+/// runs.
+const RUNS: usize = 16;
+
+/// The fewest times in a run (but the last): shorter runs spend more on setting a worker up than they share out.
+const MIN_RUN: usize = 256;
 
 /// The most times in a run: past it a longer run saves nothing on setting a worker up.
 const MAX_RUN: usize = 1024;
 
 /// How many consecutive times of `count` one run takes: a multiple of 64 (an analysis keeps one flag per time in
-/// 64-bit words, which runs must not share), and short enough for every thread to get several runs.
+/// 64-bit words, which runs must not share), short enough for every thread to get several runs, and the same on
+/// every machine: work whose result depends on where a run starts (a decomposition's search started anew at each
+/// run's first time) then gives the same figures, to the last bit, whatever the number of cores.
 pub fn run_length(count: usize) -> usize {
-    64 * (count.div_ceil(64) / (RUNS_PER_THREAD * rayon::current_num_threads())).clamp(1, MAX_RUN / 64)
+    64 * (count.div_ceil(64) / RUNS).clamp(MIN_RUN / 64, MAX_RUN / 64)
 }
 
 /// `work` of each run of consecutive `times` (of [`run_length`]), in parallel; the results in time order.
@@ -21,8 +27,7 @@ pub fn over_runs<R: Send>(times: &[f64], work: impl Fn(&[f64]) -> R + Sync + Sen
     over_runs_of(times, run_length(times.len()), work)
 }
 
-/// [`over_runs`] in runs of `length` times whatever the number of cores: for work whose result depends on where a
-/// run starts (a search started anew at each run's first time), so that it is the same on every machine.
+/// [`over_runs`] in runs of `length` times: for work that needs runs of its own length.
 pub fn over_runs_of<R: Send>(times: &[f64], length: usize, work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
     times.par_chunks(length.max(1)).map(work).collect()
 }

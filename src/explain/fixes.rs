@@ -7,7 +7,9 @@ use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
-use crate::analysis::{ClipScan, CurveRequest, Judged, ScanOptions, analyze, flagged_in_run, scan_variants};
+use crate::analysis::{
+    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, analyze, flagged_in_run, scan_variants,
+};
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
     Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_within, comparison_times,
@@ -521,10 +523,10 @@ impl Fix {
 }
 
 /// Ranks fixes: those that remove the shear first, the modes of `tool` (the file's own) before the others, by cost;
-/// then the others the same way by the shear they leave, then cost.
+/// then the others the same way by the shear they leave (to [`SAME_SHEAR_DEG`]), then cost.
 pub(super) fn rank(fixes: &mut [Fix], tool: Option<Tool>) {
     let key = |f: &Fix| {
-        let left = if f.removes { 0.0 } else { f.shear_left_deg };
+        let left = if f.removes { 0.0 } else { (f.shear_left_deg / SAME_SHEAR_DEG).round() };
         (!f.removes, is_other_mode(f.change, tool), left, f.cost.distance.max)
     };
     fixes.sort_by(|a, b| {
@@ -570,6 +572,26 @@ mod tests {
 
     use super::*;
     use crate::model::{Bone, Mesh, NodeBind, Skin, Transform};
+
+    #[test]
+    fn fixes_that_leave_the_same_shear_but_for_rounding_rank_by_cost() {
+        // Three fixes of other bones leave the bone's 29.07° as it was, one ulp apart where they are evaluated along
+        // other paths; the one that moves nothing comes first, whichever shear rounds lower.
+        let fix = |bone: usize, shear_left_deg: f64, moved: f64| Fix {
+            change: Change::Mode { bone, mode: InheritMode::SegmentCompensate },
+            label: String::new(),
+            shear_left_deg,
+            removes: false,
+            elsewhere: Vec::new(),
+            cost: Cost { distance: Extreme { max: moved, time: 0.0 }, fraction: moved, measured: Measured::Bones },
+        };
+        let shear: f64 = 29.069865920889978;
+        let (below, above) = (shear.next_down(), shear.next_up());
+        let mut fixes = vec![fix(1, below, 3e-6), fix(2, above, 0.0), fix(3, shear, 3e-14), fix(4, 20.0, 0.5)];
+        rank(&mut fixes, None);
+        let order: Vec<usize> = fixes.iter().map(|f| f.change.changed_below().unwrap()).collect();
+        assert_eq!(order, [4, 2, 3, 1], "less shear left first, then the same shear by cost");
+    }
 
     #[test]
     fn the_vertices_a_change_moves_are_those_skinning_moves() {
