@@ -1,6 +1,7 @@
 //! Whose scale shears a bone: every bone of its chain asked how much shear is left without its squash.
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
+use rayon::prelude::*;
 
 use crate::analysis::{Assessment, Tolerances};
 use crate::eval::layers::uniform_scale;
@@ -81,8 +82,9 @@ pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &T
     let skeleton = evaluation.skeleton();
     let chain = skeleton.chain(bone);
     let mut local = evaluation.pose_at(time).local;
-    let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
-    let assessment = Assessment::of(&probe.matrix(&mut local, &[]), tolerances);
+    let mut probe = Probe::new(&evaluation.hierarchy);
+    let mut matrix = |local: &mut [Transform], uniform: &[usize]| probe.models(local, &chain, uniform)[bone];
+    let assessment = Assessment::of(&matrix(&mut local, &[]), tolerances);
     let shear = assessment.shear_deg;
     // The turn from each bone of the chain down to the explained bone: the local rotations below it, in order.
     let mut below = vec![DQuat::IDENTITY; chain.len()];
@@ -93,34 +95,62 @@ pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &T
         .iter()
         .zip(&below)
         .map(|(&b, &turn)| {
-            let shear_left = Assessment::of(&probe.matrix(&mut local, &[b]), tolerances).shear_deg;
+            let shear_left = Assessment::of(&matrix(&mut local, &[b]), tolerances).shear_deg;
             let turn = (b != bone).then_some(turn);
             link(skeleton, b, &local[b], turn, shear, shear_left, tolerances)
         })
         .collect();
     let stretched = assessment.findings.stretched;
-    let sufficient = if stretched { sufficient(&mut probe, &mut local, &links, tolerances) } else { Vec::new() };
+    let sufficient = if stretched { sufficient(&mut matrix, &mut local, &links, tolerances) } else { Vec::new() };
     Attribution { bone, time, shear_deg: shear, stretched, chain: links, sufficient }
 }
 
 /// Why `bone` shears over `times` (sorted) of `evaluation`, with the detail at `at` (the worst time for `None`).
 pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f64>, tolerances: &Tolerances) -> Causes {
-    let skeleton = evaluation.skeleton();
-    let chain = skeleton.chain(bone);
-    let samples: Vec<Sample> = over_runs(times, |run| {
-        let mut source = BonesEvaluator::new(evaluation, &chain);
-        let mut probe = Probe::new(&evaluation.hierarchy, &chain, bone);
-        let mut local = vec![Transform::IDENTITY; skeleton.len()];
-        let mut start = DQuat::IDENTITY;
-        run.iter()
-            .map(|&time| {
-                let pose = source.evaluate(time);
-                chain.iter().for_each(|&b| local[b] = pose.local[b]);
-                probe.sample(&pose.model.model[bone], &mut local, &mut start, tolerances)
-            })
-            .collect::<Vec<_>>()
-    })
-    .concat();
+    causes_each(evaluation, &[(bone, at)], times, tolerances).pop().expect("one bone asked")
+}
+
+/// How many bones' causes one pass over the clip finds ([`causes_each`]): each holds a sample per time while the
+/// pass runs.
+const TOGETHER: usize = 8;
+
+/// [`causes`] of each of `bones` (each with the time to detail), in the order asked: [`TOGETHER`] at a time in bone
+/// order (the bones of one chain lie together), the groups in parallel. A group's chains are evaluated once per time
+/// for all its bones, and each squash on them made uniform once for every flagged bone below it.
+pub fn causes_each(
+    evaluation: &Evaluation,
+    bones: &[(usize, Option<f64>)],
+    times: &[f64],
+    tolerances: &Tolerances,
+) -> Vec<Causes> {
+    let mut order: Vec<usize> = (0..bones.len()).collect();
+    order.sort_by_key(|&i| bones[i].0);
+    let groups: Vec<Vec<(usize, Causes)>> = order
+        .par_chunks(TOGETHER)
+        .map(|group| {
+            let asked: Vec<usize> = group.iter().map(|&i| bones[i].0).collect();
+            let samples = samples_of(evaluation, &asked, times, tolerances);
+            let summarised = group.iter().zip(samples).map(|(&i, samples)| {
+                let (bone, at) = bones[i];
+                (i, summarised(evaluation, bone, &samples, times, at, tolerances))
+            });
+            summarised.collect()
+        })
+        .collect();
+    let mut causes: Vec<(usize, Causes)> = groups.into_iter().flatten().collect();
+    causes.sort_by_key(|(i, _)| *i);
+    causes.into_iter().map(|(_, causes)| causes).collect()
+}
+
+/// `bone`'s causes from its `samples` at `times`, with the detail at `at` (the worst time for `None`).
+fn summarised(
+    evaluation: &Evaluation,
+    bone: usize,
+    samples: &[Sample],
+    times: &[f64],
+    at: Option<f64>,
+    tolerances: &Tolerances,
+) -> Causes {
     // The first flagged sample with the largest shear (the largest shear where none is flagged).
     let key = |s: &Sample| (s.stretched, s.shear_deg);
     let worst = (0..samples.len()).reduce(|w, s| if key(&samples[s]) > key(&samples[w]) { s } else { w });
@@ -130,8 +160,70 @@ pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f6
         samples: samples.len(),
         stretched_samples: samples.iter().filter(|s| s.stretched).count(),
         at: attribute(evaluation, bone, time, tolerances),
-        spans: spans(skeleton, &samples, times),
+        spans: spans(evaluation.skeleton(), samples, times),
     }
+}
+
+/// Each of `bones`' samples at `times`: its shear and verdict, and where it is flagged its main cause, the bone of its
+/// chain, among those scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix,
+/// without a decomposition).
+fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerances: &Tolerances) -> Vec<Vec<Sample>> {
+    let skeleton = evaluation.skeleton();
+    let evaluated = skeleton.with_ancestors(bones);
+    // Per bone of the chains, the asked bones below it (itself included), and those and their ancestors: what its
+    // squash made uniform changes and needs evaluated.
+    let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
+    for (k, &bone) in bones.iter().enumerate() {
+        skeleton.chain(bone).into_iter().for_each(|b| below[b].push(k));
+    }
+    let reach: Vec<Vec<usize>> = below
+        .iter()
+        .map(|asked| skeleton.with_ancestors(&asked.iter().map(|&k| bones[k]).collect::<Vec<_>>()))
+        .collect();
+    let runs = over_runs(times, |run| {
+        let mut source = BonesEvaluator::new(evaluation, &evaluated);
+        let mut probe = Probe::new(&evaluation.hierarchy);
+        let mut local = vec![Transform::IDENTITY; skeleton.len()];
+        let mut starts = vec![DQuat::IDENTITY; bones.len()];
+        let mut samples: Vec<Vec<Sample>> = vec![Vec::with_capacity(run.len()); bones.len()];
+        // Per asked bone at the time: its shear on the matrix, and the largest contribution found yet.
+        let mut shears = vec![(0.0, 0.0); bones.len()];
+        for &time in run {
+            let pose = source.evaluate(time);
+            evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
+            for (k, &bone) in bones.iter().enumerate() {
+                let m = &pose.model.model[bone];
+                let assessment = Assessment::near(m, tolerances, starts[k]);
+                starts[k] = assessment.parts.stretch;
+                shears[k] = (column_shear(m), 0.0);
+                let (shear_deg, stretched) = (assessment.shear_deg, assessment.findings.stretched);
+                samples[k].push(Sample { shear_deg, stretched, main_cause: None });
+            }
+            // Parents first: each flagged bone meets the squashes of its chain in the chain's order.
+            for &squash in &evaluated {
+                let flagged = || below[squash].iter().copied().filter(|&k| samples[k].last().unwrap().stretched);
+                if anisotropy(local[squash].scale) <= tolerances.min_anisotropy || flagged().next().is_none() {
+                    continue;
+                }
+                let flagged: Vec<usize> = flagged().collect();
+                let models = probe.models(&mut local, &reach[squash], &[squash]);
+                for k in flagged {
+                    let (shear, largest) = &mut shears[k];
+                    let contribution = *shear - column_shear(&models[bones[k]]);
+                    if contribution > *largest {
+                        *largest = contribution;
+                        samples[k].last_mut().unwrap().main_cause = Some(squash);
+                    }
+                }
+            }
+        }
+        samples
+    });
+    let mut each: Vec<Vec<Sample>> = vec![Vec::with_capacity(times.len()); bones.len()];
+    for run in runs {
+        each.iter_mut().zip(run).for_each(|(samples, run)| samples.extend(run));
+    }
+    each
 }
 
 /// One sample of the explained bone over a clip.
@@ -163,53 +255,28 @@ fn spans(skeleton: &Skeleton, samples: &[Sample], times: &[f64]) -> Vec<CauseSpa
     spans
 }
 
-/// The explained bone's model matrix with some scales of its chain made uniform.
+/// Model matrices with some bones' scales made uniform.
 struct Probe<'a> {
     hierarchy: &'a Hierarchy,
-    chain: &'a [usize],
-    bone: usize,
     model: ModelPose,
     /// The local transforms a call replaces, put back after it (kept: the call is made per sample and bone).
     saved: Vec<Transform>,
 }
 
 impl<'a> Probe<'a> {
-    fn new(hierarchy: &'a Hierarchy, chain: &'a [usize], bone: usize) -> Self {
-        Probe { hierarchy, chain, bone, model: ModelPose::default(), saved: Vec::new() }
+    fn new(hierarchy: &'a Hierarchy) -> Self {
+        Probe { hierarchy, model: ModelPose::default(), saved: Vec::new() }
     }
 
-    /// The bone's model matrix with the scales of `uniform` made uniform in `local` (which is left as it was).
-    fn matrix(&mut self, local: &mut [Transform], uniform: &[usize]) -> DMat4 {
+    /// The model matrices of `bones` (parents first, each with its ancestors; the other bones' entries mean nothing)
+    /// with the scales of `uniform` made uniform in `local` (which is left as it was).
+    fn models(&mut self, local: &mut [Transform], bones: &[usize], uniform: &[usize]) -> &[DMat4] {
         self.saved.clear();
         self.saved.extend(uniform.iter().map(|&b| local[b]));
         uniform.iter().for_each(|&b| uniform_scale(&mut local[b]));
-        self.hierarchy.evaluate_bones(local, self.chain, &mut self.model);
+        self.hierarchy.evaluate_bones(local, bones, &mut self.model);
         uniform.iter().zip(&self.saved).for_each(|(&b, t)| local[b] = *t);
-        self.model.model[self.bone]
-    }
-
-    /// The bone's shear and verdict at one time, and the main cause where it is flagged: the chain bone, among those
-    /// scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix, without a
-    /// decomposition). `m` is the bone's model matrix as `local` evaluates (what [`Probe::matrix`] gives with no
-    /// scale made uniform); `start` is where the verdict's decomposition starts, updated for the next sample.
-    fn sample(&mut self, m: &DMat4, local: &mut [Transform], start: &mut DQuat, tolerances: &Tolerances) -> Sample {
-        let m = *m;
-        let assessment = Assessment::near(&m, tolerances, *start);
-        *start = assessment.parts.stretch;
-        let shear = column_shear(&m);
-        let mut main_cause = None;
-        if assessment.findings.stretched {
-            let mut largest = 0.0;
-            for &bone in self.chain {
-                if anisotropy(local[bone].scale) > tolerances.min_anisotropy {
-                    let contribution = shear - column_shear(&self.matrix(local, &[bone]));
-                    if contribution > largest {
-                        (largest, main_cause) = (contribution, Some(bone));
-                    }
-                }
-            }
-        }
-        Sample { shear_deg: assessment.shear_deg, stretched: assessment.findings.stretched, main_cause }
+        &self.model.model
     }
 }
 
@@ -262,11 +329,17 @@ fn link(
 const EXHAUSTIVE_CANDIDATES: usize = 12;
 
 /// The fewest bones of `links` (among those scaled unequally) whose uniform scales together leave the bone
-/// unflagged: every subset by size, or greedily by contribution for a long chain of squashes.
-fn sufficient(probe: &mut Probe, local: &mut [Transform], links: &[Link], tolerances: &Tolerances) -> Vec<usize> {
+/// unflagged: every subset by size, or greedily by contribution for a long chain of squashes. `matrix` is the bone's
+/// model matrix with some scales of `local` made uniform.
+fn sufficient(
+    matrix: &mut impl FnMut(&mut [Transform], &[usize]) -> DMat4,
+    local: &mut [Transform],
+    links: &[Link],
+    tolerances: &Tolerances,
+) -> Vec<usize> {
     let mut candidates: Vec<&Link> = links.iter().filter(|l| l.anisotropy > tolerances.min_anisotropy).collect();
     candidates.sort_by(|a, b| b.contribution_deg.total_cmp(&a.contribution_deg));
-    let mut clears = |bones: &[usize]| !Assessment::of(&probe.matrix(local, bones), tolerances).findings.stretched;
+    let mut clears = |bones: &[usize]| !Assessment::of(&matrix(local, bones), tolerances).findings.stretched;
     let found = if candidates.len() <= EXHAUSTIVE_CANDIDATES {
         let mut masks: Vec<u32> = (1..1u32 << candidates.len()).collect();
         masks.sort_by_key(|m| m.count_ones());
