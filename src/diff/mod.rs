@@ -27,6 +27,8 @@ pub use matching::{
 };
 pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_clips, diff_files};
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
@@ -332,6 +334,8 @@ fn compare_each_within(
         let bones: Vec<usize> = plan_a.needed.iter().chain(held.flatten()).copied().collect();
         a.skeleton().with_ancestors(&bones)
     });
+    // A side given up in one run is given up: its comparison is `None` whatever the other runs find, so they stop it.
+    let given_up: Vec<AtomicBool> = sides.iter().map(|_| AtomicBool::new(false)).collect();
     let runs = over_runs(times, |run| {
         let mut side_a = match reference.as_ref().and_then(|bones| Reference::new(a, bones)) {
             Some(reference) => Side::new(&plan_a, Posing::Reference(Box::new(reference))),
@@ -347,13 +351,17 @@ fn compare_each_within(
             .collect();
         let mut differences = fresh();
         for &time in run {
-            if differences.iter().all(|found| found.largest > limit) {
+            if given_up.iter().all(|given_up| given_up.load(Ordering::Relaxed)) {
                 break;
             }
             side_a.evaluate(time);
-            for (side_b, found) in others.iter_mut().zip(&mut differences).filter(|(_, f)| f.largest <= limit) {
+            let compared = others.iter_mut().zip(&mut differences).zip(&given_up);
+            for ((side_b, found), given_up) in compared.filter(|(_, given_up)| !given_up.load(Ordering::Relaxed)) {
                 side_b.evaluate_beside(time, &side_a);
                 found.add(&mut side_a, side_b, probe_length, time);
+                if found.largest > limit {
+                    given_up.store(true, Ordering::Relaxed);
+                }
             }
         }
         differences
@@ -784,6 +792,29 @@ mod tests {
         let forearm = comparison.bones.iter().find(|b| b.name == "forearm").unwrap();
         assert!(forearm.stretch_deg.max > 1.0 && forearm.scale_ratio.max > 1.01, "{forearm:?}");
         assert!(comparison.meshes[0].distance.max > 0.0 && comparison.meshes[0].mean > 0.0);
+    }
+
+    #[test]
+    fn a_comparison_within_a_limit_is_the_whole_comparison_or_given_up() {
+        // The demo under two modes at 600 samples a second, in runs on three threads: a limit at the largest
+        // distance keeps the whole comparison; one just under it gives it up, whichever run finds the distance.
+        let rig = demo_rig();
+        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]).unwrap();
+        let compensated =
+            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()])
+                .unwrap();
+        let pairs = Pairs { measure: Measure::Largest, ..Pairs::by_name(&full, &compensated) };
+        let times = comparison_times(&full, &compensated, 600.0);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
+        pool.install(|| {
+            let whole = compare_at_size(&full, &compensated, &pairs, &times, 1.0);
+            let largest =
+                whole.worst_distance().max.max(whole.meshes.iter().map(|m| m.distance.max).fold(0.0, f64::max));
+            assert!(largest > 0.0 && times.len() > 2 * crate::eval::run_length(times.len()), "several runs");
+            let within = compare_within(&full, &compensated, &pairs, &times, 1.0, largest);
+            assert!(within.as_ref() == Some(&whole), "within its own largest distance, the whole comparison");
+            assert!(compare_within(&full, &compensated, &pairs, &times, 1.0, largest * (1.0 - 1e-9)).is_none());
+        });
     }
 
     #[test]
