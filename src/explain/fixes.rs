@@ -200,12 +200,23 @@ impl<'e, 'a> Baseline<'e, 'a> {
 
     /// Each of `changes` made and scanned as [`Baseline::apply`] does: those that are variants of the source (another
     /// mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
-    /// ([`scan_variants`]); the others one by one.
+    /// ([`scan_variants`]); the others one by one, and the bakes beside them all, one after the other (each is
+    /// parallel within, with a part that is not, and holds every sample of every bone while it runs).
     pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
         // Only a change below one bone may be a variant; a bake is a rig of its own.
-        let (mut below, mut others): (Vec<Change>, Vec<Change>) =
+        let (below, bakes): (Vec<Change>, Vec<Change>) =
             changes.iter().partition(|change| change.changed_below().is_some());
-        let mut applied = Vec::new();
+        let (mut applied, baked) = rayon::join(
+            || self.apply_below(below),
+            || bakes.into_iter().map(|change| (change, self.apply(change))).collect::<Vec<_>>(),
+        );
+        applied.extend(baked);
+        applied
+    }
+
+    /// [`Baseline::apply_each`] of changes below one bone each.
+    fn apply_below(&self, mut below: Vec<Change>) -> Vec<(Change, Result<Applied, String>)> {
+        let (mut applied, mut alone) = (Vec::new(), Vec::new());
         // Changes of one part of the rig together, each batch's evaluations made for it alone.
         below.sort_by_key(|change| change.changed_below());
         for batch in below.chunks(VARIANTS) {
@@ -223,7 +234,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
                     variants.push(variant);
                 } else {
                     // Not read bone by bone (layers, another unit, no clip): made and scanned on its own.
-                    others.push(*change);
+                    alone.push(*change);
                 }
             }
             let scans = scan_variants(self.source, &variants, self.options);
@@ -231,10 +242,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
                 scanned.into_iter().zip(&scans).map(|(change, scan)| (change, Ok(self.applied(change, None, scan)))),
             );
         }
-        let (bakes, alone): (Vec<Change>, Vec<Change>) = others.into_iter().partition(|c| c.changed_below().is_none());
         applied.par_extend(alone.into_par_iter().map(|change| (change, self.apply(change))));
-        // One at a time: each is parallel within, and a bake holds every sample of every bone while it runs.
-        applied.extend(bakes.into_iter().map(|change| (change, self.apply(change))));
         applied
     }
 
@@ -286,10 +294,18 @@ impl<'e, 'a> Baseline<'e, 'a> {
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
     /// bakes) compared [`BATCH`] at a time in one pass that evaluates and skins the source once per time for the
-    /// batch, a bake on its own.
+    /// batch, the bakes each on its own beside them.
     pub fn costs(&self, changes: &[(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
         let (bakes, kept): (Vec<_>, Vec<_>) = changes.iter().partition(|(c, _)| c.changed_below().is_none());
-        let mut costs: Vec<_> = bakes.into_iter().map(|&(change, made)| (change, self.cost(change, made))).collect();
+        let bake_costs = || bakes.into_iter().map(|&(change, made)| (change, self.cost(change, made))).collect();
+        let (mut costs, baked): (Vec<_>, Vec<_>) = rayon::join(|| self.costs_kept(&kept), bake_costs);
+        costs.extend(baked);
+        costs
+    }
+
+    /// [`Baseline::costs`] of changes that keep the clip's times, [`BATCH`] at a time.
+    fn costs_kept(&self, kept: &[&(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
+        let mut costs = Vec::new();
         for batch in kept.chunks(BATCH) {
             let mut fixed = Vec::new();
             for &&(change, made) in batch {
