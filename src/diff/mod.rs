@@ -777,14 +777,17 @@ mod tests {
         assert_eq!(comparison.meshes.len(), rig.meshes.len());
     }
 
+    /// The demo's clip with every bone under `mode`.
+    fn every_bone(rig: &Rig, mode: InheritMode) -> Evaluation<'_> {
+        Evaluation::new(rig, rig.clips.first(), &vec![mode; rig.skeleton.len()]).unwrap()
+    }
+
     #[test]
     fn two_modes_differ_where_the_shear_goes() {
         // The demo's forearm shears under full inheritance and not under segment scale compensate.
         let rig = demo_rig();
-        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]).unwrap();
-        let compensated =
-            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()])
-                .unwrap();
+        let [full, compensated] =
+            [InheritMode::Full, InheritMode::SegmentCompensate].map(|mode| every_bone(&rig, mode));
         let pairs = Pairs::by_name(&full, &compensated);
         let comparison = compare(&full, &compensated, &pairs, &comparison_times(&full, &compensated, 30.0));
         let root = &comparison.bones[0];
@@ -799,10 +802,8 @@ mod tests {
         // The demo under two modes at 600 samples a second, in runs on three threads: a limit at the largest
         // distance keeps the whole comparison; one just under it gives it up, whichever run finds the distance.
         let rig = demo_rig();
-        let full = Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::Full; rig.skeleton.len()]).unwrap();
-        let compensated =
-            Evaluation::new(&rig, rig.clips.first(), &vec![InheritMode::SegmentCompensate; rig.skeleton.len()])
-                .unwrap();
+        let [full, compensated] =
+            [InheritMode::Full, InheritMode::SegmentCompensate].map(|mode| every_bone(&rig, mode));
         let pairs = Pairs { measure: Measure::Largest, ..Pairs::by_name(&full, &compensated) };
         let times = comparison_times(&full, &compensated, 600.0);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap();
