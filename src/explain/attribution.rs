@@ -114,7 +114,7 @@ pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f6
 /// pass runs.
 const TOGETHER: usize = 8;
 
-/// [`causes`] of each of `bones` (each with the time to detail), in the order asked: [`TOGETHER`] at a time in bone
+/// [`causes`] of each of `bones` (each with the time to detail), in the order asked: a few at a time in bone
 /// order (the bones of one chain lie together), the groups in parallel. A group's chains are evaluated once per time
 /// for all its bones, and each squash on them made uniform once for every flagged bone below it.
 pub fn causes_each(
