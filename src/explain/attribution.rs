@@ -168,53 +168,29 @@ fn summarised(
 /// chain, among those scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix,
 /// without a decomposition).
 fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerances: &Tolerances) -> Vec<Vec<Sample>> {
-    let skeleton = evaluation.skeleton();
-    let evaluated = skeleton.with_ancestors(bones);
-    // Per bone of the chains, the asked bones below it (itself included), and those and their ancestors: what its
-    // squash made uniform changes and needs evaluated.
-    let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
-    for (k, &bone) in bones.iter().enumerate() {
-        skeleton.chain(bone).into_iter().for_each(|b| below[b].push(k));
-    }
-    let reach: Vec<Vec<usize>> = below
-        .iter()
-        .map(|asked| skeleton.with_ancestors(&asked.iter().map(|&k| bones[k]).collect::<Vec<_>>()))
-        .collect();
+    let group = Group::new(evaluation.skeleton(), bones);
     let runs = over_runs(times, |run| {
-        let mut source = BonesEvaluator::new(evaluation, &evaluated);
+        let mut source = BonesEvaluator::new(evaluation, &group.evaluated);
         let mut probe = Probe::new(&evaluation.hierarchy);
-        let mut local = vec![Transform::IDENTITY; skeleton.len()];
+        let mut local = vec![Transform::IDENTITY; evaluation.skeleton().len()];
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
         let mut samples: Vec<Vec<Sample>> = vec![Vec::with_capacity(run.len()); bones.len()];
-        // Per asked bone at the time: its shear on the matrix, and the largest contribution found yet.
-        let mut shears = vec![(0.0, 0.0); bones.len()];
+        let mut judged: Vec<Judged> = Vec::with_capacity(bones.len());
         for &time in run {
             let pose = source.evaluate(time);
-            evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
-            for (k, &bone) in bones.iter().enumerate() {
+            group.evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
+            judged.clear();
+            judged.extend(bones.iter().zip(&mut starts).map(|(&bone, start)| {
                 let m = &pose.model.model[bone];
-                let assessment = Assessment::near(m, tolerances, starts[k]);
-                starts[k] = assessment.parts.stretch;
-                shears[k] = (column_shear(m), 0.0);
+                let assessment = Assessment::near(m, tolerances, *start);
+                *start = assessment.parts.stretch;
+                Judged { assessment, shear: column_shear(m), largest: 0.0, main_cause: None }
+            }));
+            group.find_main_causes(&mut probe, &mut local, &mut judged, tolerances);
+            for (samples, judged) in samples.iter_mut().zip(&judged) {
+                let Judged { assessment, main_cause, .. } = judged;
                 let (shear_deg, stretched) = (assessment.shear_deg, assessment.findings.stretched);
-                samples[k].push(Sample { shear_deg, stretched, main_cause: None });
-            }
-            // Parents first: each flagged bone meets the squashes of its chain in the chain's order.
-            for &squash in &evaluated {
-                let flagged = || below[squash].iter().copied().filter(|&k| samples[k].last().unwrap().stretched);
-                if anisotropy(local[squash].scale) <= tolerances.min_anisotropy || flagged().next().is_none() {
-                    continue;
-                }
-                let flagged: Vec<usize> = flagged().collect();
-                let models = probe.models(&mut local, &reach[squash], &[squash]);
-                for k in flagged {
-                    let (shear, largest) = &mut shears[k];
-                    let contribution = *shear - column_shear(&models[bones[k]]);
-                    if contribution > *largest {
-                        *largest = contribution;
-                        samples[k].last_mut().unwrap().main_cause = Some(squash);
-                    }
-                }
+                samples.push(Sample { shear_deg, stretched, main_cause: *main_cause });
             }
         }
         samples
@@ -224,6 +200,81 @@ fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerance
         each.iter_mut().zip(run).for_each(|(samples, run)| samples.extend(run));
     }
     each
+}
+
+/// Bones whose causes one pass finds: the bones evaluated for them, and what each squash made uniform changes.
+struct Group<'b> {
+    bones: &'b [usize],
+    /// The bones and their ancestors, parents first.
+    evaluated: Vec<usize>,
+    /// Per bone of the rig, the bones of the group below it (itself included), by their place in the group.
+    below: Vec<Vec<usize>>,
+    /// Per bone evaluated, those bones and their ancestors: what its squash made uniform needs evaluated.
+    reach: Vec<Vec<usize>>,
+}
+
+/// One bone of a group at one time: its verdict, its shear on the matrix, and the largest contribution to it found
+/// so far with its bone.
+struct Judged {
+    assessment: Assessment,
+    shear: f64,
+    largest: f64,
+    main_cause: Option<usize>,
+}
+
+impl<'b> Group<'b> {
+    fn new(skeleton: &Skeleton, bones: &'b [usize]) -> Self {
+        let evaluated = skeleton.with_ancestors(bones);
+        let chains: Vec<Vec<usize>> = bones.iter().map(|&bone| skeleton.chain(bone)).collect();
+        let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
+        for (k, chain) in chains.iter().enumerate() {
+            chain.iter().for_each(|&b| below[b].push(k));
+        }
+        // The union of the chains below each bone evaluated, in the order evaluated (marked, then unmarked again).
+        let mut reach: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
+        let mut wanted = vec![false; skeleton.len()];
+        for &squash in &evaluated {
+            let mark = |wanted: &mut [bool], to: bool| {
+                below[squash].iter().flat_map(|&k| &chains[k]).for_each(|&b| wanted[b] = to)
+            };
+            mark(&mut wanted, true);
+            reach[squash] = evaluated.iter().copied().filter(|&b| wanted[b]).collect();
+            mark(&mut wanted, false);
+        }
+        Group { bones, evaluated, below, reach }
+    }
+
+    /// Each flagged bone's main cause at one time (`local`, the group's bones' local transforms, and `judged`): each
+    /// squash of the chains made uniform once for every flagged bone below it, parents first, so that each bone meets
+    /// the squashes of its chain in the chain's order.
+    fn find_main_causes(
+        &self,
+        probe: &mut Probe,
+        local: &mut [Transform],
+        judged: &mut [Judged],
+        tolerances: &Tolerances,
+    ) {
+        for &squash in &self.evaluated {
+            if anisotropy(local[squash].scale) <= tolerances.min_anisotropy {
+                continue;
+            }
+            let below = &self.below[squash];
+            if !below.iter().any(|&k| judged[k].assessment.findings.stretched) {
+                continue;
+            }
+            let models = probe.models(local, &self.reach[squash], &[squash]);
+            for &k in below {
+                let judged = &mut judged[k];
+                if !judged.assessment.findings.stretched {
+                    continue;
+                }
+                let contribution = judged.shear - column_shear(&models[self.bones[k]]);
+                if contribution > judged.largest {
+                    (judged.largest, judged.main_cause) = (contribution, Some(squash));
+                }
+            }
+        }
+    }
 }
 
 /// One sample of the explained bone over a clip.
