@@ -1,9 +1,11 @@
 //! Whose scale shears a bone: every bone of its chain asked how much shear is left without its squash.
 
+use std::sync::OnceLock;
+
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 
-use crate::analysis::{Assessment, Tolerances};
+use crate::analysis::{Assessment, SAME_SHEAR_DEG, Tolerances};
 use crate::eval::layers::uniform_scale;
 use crate::eval::{BonesEvaluator, Evaluation, Hierarchy, ModelPose, over_runs};
 use crate::math::{AffineParts, shear_deg};
@@ -205,12 +207,15 @@ fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerance
 /// Bones whose causes one pass finds: the bones evaluated for them, and what each squash made uniform changes.
 struct Group<'b> {
     bones: &'b [usize],
+    /// Each bone's chain, the root first.
+    chains: Vec<Vec<usize>>,
     /// The bones and their ancestors, parents first.
     evaluated: Vec<usize>,
     /// Per bone of the rig, the bones of the group below it (itself included), by their place in the group.
     below: Vec<Vec<usize>>,
-    /// Per bone evaluated, those bones and their ancestors: what its squash made uniform needs evaluated.
-    reach: Vec<Vec<usize>>,
+    /// Per bone of the rig, found when its squash is first made uniform: the chains of the bones below it, parents
+    /// first (what the squash made uniform needs evaluated).
+    reach: Vec<OnceLock<Vec<usize>>>,
 }
 
 /// One bone of a group at one time: its verdict, its shear on the matrix, and the largest contribution to it found
@@ -224,24 +229,25 @@ struct Judged {
 
 impl<'b> Group<'b> {
     fn new(skeleton: &Skeleton, bones: &'b [usize]) -> Self {
-        let evaluated = skeleton.with_ancestors(bones);
         let chains: Vec<Vec<usize>> = bones.iter().map(|&bone| skeleton.chain(bone)).collect();
         let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
         for (k, chain) in chains.iter().enumerate() {
             chain.iter().for_each(|&b| below[b].push(k));
         }
-        // The union of the chains below each bone evaluated, in the order evaluated (marked, then unmarked again).
-        let mut reach: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
-        let mut wanted = vec![false; skeleton.len()];
-        for &squash in &evaluated {
-            let mark = |wanted: &mut [bool], to: bool| {
-                below[squash].iter().flat_map(|&k| &chains[k]).for_each(|&b| wanted[b] = to)
-            };
-            mark(&mut wanted, true);
-            reach[squash] = evaluated.iter().copied().filter(|&b| wanted[b]).collect();
-            mark(&mut wanted, false);
-        }
-        Group { bones, evaluated, below, reach }
+        let reach = (0..skeleton.len()).map(|_| OnceLock::new()).collect();
+        Group { bones, chains, evaluated: skeleton.with_ancestors(bones), below, reach }
+    }
+
+    /// What `squash` made uniform needs evaluated ([`Group::reach`]).
+    fn reach(&self, squash: usize) -> &[usize] {
+        self.reach[squash].get_or_init(|| {
+            let mut bones: Vec<usize> =
+                self.below[squash].iter().flat_map(|&k| self.chains[k].iter().copied()).collect();
+            // Parents come first in bone order.
+            bones.sort_unstable();
+            bones.dedup();
+            bones
+        })
     }
 
     /// Each flagged bone's main cause at one time (`local`, the group's bones' local transforms, and `judged`): each
@@ -262,7 +268,7 @@ impl<'b> Group<'b> {
             if !below.iter().any(|&k| judged[k].assessment.findings.stretched) {
                 continue;
             }
-            let models = probe.models(local, &self.reach[squash], &[squash]);
+            let models = probe.models(local, self.reach(squash), &[squash]);
             for &k in below {
                 let judged = &mut judged[k];
                 if !judged.assessment.findings.stretched {
@@ -372,7 +378,7 @@ fn link(
         turn_deg: turn,
         shear_left_deg: shear_left,
         // A difference within rounding is none (and never prints as −0).
-        contribution_deg: if (shear - shear_left).abs() < 1e-9 { 0.0 } else { shear - shear_left },
+        contribution_deg: if (shear - shear_left).abs() < SAME_SHEAR_DEG { 0.0 } else { shear - shear_left },
     }
 }
 
