@@ -46,7 +46,7 @@ impl Channel {
         stage.visit_time_samples(attribute.path().clone(), |sample| reading.add(sample)).map_err(said)?;
         if reading.channel.is_none() && !reading.mixed && reading.refused.is_none() {
             let Some(value) = attribute.get::<Value>().map_err(said)? else { return Ok(None) };
-            reading.add(TimeSample { index: 0, time: 0.0, value, count: 1 });
+            reading.add(TimeSample { at: vec![(0, 0.0)], value, count: 1 });
         }
         reading.finish()
     }
@@ -115,14 +115,15 @@ struct Reading {
 }
 
 impl Reading {
-    /// Takes a sample (none at a time code that is not finite).
+    /// Takes a value with the samples that hold it (none at a time code that is not finite).
     fn add(&mut self, sample: TimeSample) {
-        let TimeSample { index, time: code, value, count: of } = sample;
-        if !code.is_finite() || self.mixed || self.refused.is_some() {
+        let TimeSample { mut at, value, count: of } = sample;
+        at.retain(|(_, code)| code.is_finite());
+        if at.is_empty() || self.mixed || self.refused.is_some() {
             return;
         }
         let len = Length { len: self.len, of };
-        let at = Place { index, code };
+        let at = &at;
         let added = match value {
             Value::Vec3hVec(a) => {
                 let values = widen(&mut self.widened, bytemuck::cast_slice(&a))
@@ -190,23 +191,16 @@ fn widen<'a>(into: &'a mut Vec<f32>, halves: &[f16]) -> &'a [f32] {
     into
 }
 
-/// Where a sample is: its index among the channel's samples, and its time code.
-#[derive(Clone, Copy)]
-struct Place {
-    index: usize,
-    code: f64,
-}
-
-/// Adds a sample of `count` `values` at `at` to `channel`, which it starts as `variant` where it is `None`; `false`
-/// where the channel holds another type or precision. Starting it charges the reading's budget for what it keeps
-/// besides the columns (which are charged as they are made): a time code per sample, the first sample's values and
-/// the samples staged.
+/// Adds a value of `count` `values` held at the samples `at` (each one's index among the channel's samples, and its
+/// time code) to `channel`, which it starts as `variant` where it is `None`; `false` where the channel holds another
+/// type or precision. Starting it charges the reading's budget for what it keeps besides the columns (which are
+/// charged as they are made): a time code per sample, the first sample's values and the samples staged.
 fn push<V: Stored>(
     channel: &mut Option<Channel>,
     variant: fn(Columns<V>) -> Channel,
     precision: Precision,
     length: Length,
-    at: Place,
+    at: &[(usize, f64)],
     count: usize,
     values: impl Iterator<Item = V>,
 ) -> Result<bool, String> {
@@ -214,6 +208,7 @@ fn push<V: Stored>(
         charge::<f64>(length.of)?;
         charge::<bool>(length.of)?;
         charge::<V>(length.len.saturating_mul(STAGED + 1))?;
+        charge::<(usize, usize)>(length.of)?;
         *channel = Some(variant(Columns::new(precision, length)));
     }
     match channel.as_mut().and_then(V::columns) {
@@ -230,8 +225,11 @@ pub enum Precision {
     Double,
 }
 
-/// How many samples are staged before they are written into the columns.
+/// How many values are staged before they are written into the columns.
 const STAGED: usize = 256;
+
+/// How many columns are written together: the values of neighbouring elements share the staged rows' cache lines.
+const WRITTEN_TOGETHER: usize = 4;
 
 /// A channel's samples by element, sorted by time code.
 pub struct Columns<V> {
@@ -249,9 +247,10 @@ pub struct Columns<V> {
     /// stands in for it at a sample that does not fit, and at those not written yet). Made as large as the layer
     /// says at once: a moving joint's column becomes its track as it is.
     columns: Vec<Option<Arc<[V]>>>,
-    /// Fitting samples not yet written into the columns: their values, sample after sample, and their indices.
+    /// Values of fitting samples not yet written into the columns, one after the other (each differing from `first`
+    /// in some bit), and each of their samples as (value, sample).
     staged: Vec<V>,
-    staged_samples: Vec<usize>,
+    staged_at: Vec<(usize, usize)>,
 }
 
 /// How a value at one time code is read from the samples.
@@ -269,70 +268,80 @@ impl<V: Stored> Columns<V> {
     fn new(precision: Precision, Length { len, of }: Length) -> Self {
         let columns = (0..len).map(|_| None).collect();
         let (codes, fits) = (vec![f64::NAN; of], vec![false; of]);
-        Columns { precision, len, codes, fits, first: None, columns, staged: Vec::new(), staged_samples: Vec::new() }
+        Columns { precision, len, codes, fits, first: None, columns, staged: Vec::new(), staged_at: Vec::new() }
     }
 
-    /// A column holding `value` at every sample but `v` at `sample`, charged to the reading's budget before it is
-    /// made.
-    fn column(&self, value: V, sample: usize, v: V) -> Result<Arc<[V]>, String> {
+    /// A column holding `value` at every sample, charged to the reading's budget before it is made.
+    fn column(&self, value: V) -> Result<Arc<[V]>, String> {
         charge::<V>(self.codes.len())?;
-        let mut column: Arc<[V]> = std::iter::repeat_n(value, self.codes.len()).collect();
-        Arc::make_mut(&mut column)[sample] = v;
-        Ok(column)
+        Ok(std::iter::repeat_n(value, self.codes.len()).collect())
     }
 
-    /// Adds the `count` `values` of the sample at `at` (samples come in any order, once each); an error where a
-    /// column it starts would pass the reading's budget.
-    fn push(&mut self, at: Place, count: usize, values: impl Iterator<Item = V>) -> Result<(), String> {
-        let sample = at.index;
-        if sample >= self.codes.len() {
+    /// Adds the `count` `values` held at the samples `at` (values come in any order, each sample once); an error
+    /// where a column it starts would pass the reading's budget.
+    fn push(&mut self, at: &[(usize, f64)], count: usize, values: impl Iterator<Item = V>) -> Result<(), String> {
+        let of = self.codes.len();
+        let samples: Vec<usize> = at.iter().map(|&(sample, _)| sample).filter(|&s| s < of).collect();
+        if samples.is_empty() {
             return Ok(());
         }
-        self.codes[sample] = at.code;
-        self.fits[sample] = count == self.len;
+        for &(sample, code) in at.iter().filter(|&&(sample, _)| sample < of) {
+            self.codes[sample] = code;
+            self.fits[sample] = count == self.len;
+        }
         if count != self.len {
             return Ok(());
         }
-        if self.first.is_none() {
+        let Some(first) = &self.first else {
             let first: Vec<V> = values.collect();
             // A value unequal to itself (NaN) is never held.
             for (e, v) in first.iter().enumerate().filter(|(_, v)| v.is_nan()) {
-                self.columns[e] = Some(self.column(*v, sample, *v)?);
+                self.columns[e] = Some(self.column(*v)?);
             }
             self.first = Some(first);
             return Ok(());
-        }
+        };
+        let row = self.staged.len() / self.len;
         self.staged.extend(values);
-        self.staged_samples.push(sample);
-        if self.staged_samples.len() == STAGED {
+        // A column holds `first`'s value wherever nothing is written: a value the same to the bit needs no writing.
+        if V::same_bits(&self.staged[row * self.len..], first) {
+            self.staged.truncate(row * self.len);
+            return Ok(());
+        }
+        self.staged_at.extend(samples.into_iter().map(|sample| (row, sample)));
+        if row + 1 == STAGED {
             self.flush()?;
         }
         Ok(())
     }
 
-    /// Writes the staged samples into the columns, starting the column of an element where one differs from the
-    /// first.
+    /// Writes the staged values into the columns of their samples, starting the column of an element where a value
+    /// differs from the first.
     fn flush(&mut self) -> Result<(), String> {
         let Some(first) = &self.first else { return Ok(()) };
         let mut columns = std::mem::take(&mut self.columns);
-        let rows = self.staged_samples.iter().copied().zip(self.staged.chunks_exact(self.len));
         // The elements that start to move, found row by row: a row is contiguous, and most rows of a channel that
-        // mostly holds are the first sample's.
-        for (sample, row) in rows.clone().filter(|(_, row)| *row != first.as_slice()) {
+        // mostly holds equal the first sample's.
+        for row in self.staged.chunks_exact(self.len).filter(|row| *row != first.as_slice()) {
             for ((column, v), held) in columns.iter_mut().zip(row).zip(first) {
                 if column.is_none() && v != held {
-                    *column = Some(self.column(*held, sample, *v)?);
+                    *column = Some(self.column(*held)?);
                 }
             }
         }
-        // The moving elements' values, a column at a time: each is reached for writing once per flush.
-        for (e, column) in columns.iter_mut().enumerate().filter_map(|(e, c)| Some((e, c.as_mut()?))) {
-            let column = Arc::make_mut(column);
-            rows.clone().for_each(|(sample, row)| column[sample] = row[e]);
+        // The moving elements' values, a few columns at a time: each staged row is read from memory once per few
+        // columns, and each column reached for writing once per flush.
+        let mut moving: Vec<(usize, &mut [V])> =
+            columns.iter_mut().enumerate().filter_map(|(e, c)| Some((e, Arc::make_mut(c.as_mut()?)))).collect();
+        for together in moving.chunks_mut(WRITTEN_TOGETHER) {
+            for &(row, sample) in &self.staged_at {
+                let row = &self.staged[row * self.len..][..self.len];
+                together.iter_mut().for_each(|(e, column)| column[sample] = row[*e]);
+            }
         }
         self.columns = columns;
         self.staged.clear();
-        self.staged_samples.clear();
+        self.staged_at.clear();
         Ok(())
     }
 
@@ -413,7 +422,7 @@ impl<V: Stored> Columns<V> {
 }
 
 /// A value as a channel keeps it: the numbers stored, exactly (half and float widen to `f32` without loss).
-pub trait Stored: Copy + PartialEq {
+pub trait Stored: bytemuck::Pod + PartialEq {
     /// Its columns, where `channel` holds values of its type.
     fn columns(channel: &mut Channel) -> Option<&mut Columns<Self>>;
 
@@ -422,6 +431,11 @@ pub trait Stored: Copy + PartialEq {
 
     /// Whether a number of it is NaN: it is unequal to itself.
     fn is_nan(self) -> bool;
+
+    /// Whether `a` and `b` hold the same numbers to the bit (`==` takes −0 for 0 and NaN for no number).
+    fn same_bits(a: &[Self], b: &[Self]) -> bool {
+        bytemuck::cast_slice::<Self, u8>(a) == bytemuck::cast_slice::<Self, u8>(b)
+    }
 }
 
 /// The part of [`Stored`] alike for every type: the channel variant that holds `$type`, and NaN as `$type` finds it.
@@ -539,7 +553,7 @@ mod tests {
         for &(index, time, x) in samples {
             let moving = x.map(|x| gf::vec3f(x, 0.0, 0.0));
             let array = [Some(gf::vec3f(1.0, 1.0, 1.0)), moving].into_iter().flatten().collect();
-            reading.add(TimeSample { index, time, value: Value::Vec3fVec(array), count: samples.len() });
+            reading.add(TimeSample { at: vec![(index, time)], value: Value::Vec3fVec(array), count: samples.len() });
         }
         reading.finish().expect("within the budget").expect("one type throughout")
     }
@@ -561,6 +575,25 @@ mod tests {
     }
 
     #[test]
+    fn a_value_several_samples_share_is_read_at_each_of_them_to_the_bit() {
+        // Handed on as a binary layer hands them: each value once, with every sample that holds it. The second
+        // element moves (0 → 5 → 5 → 0 → −0); −0 equals the first sample's 0 but is kept as stored.
+        let value = |x: f32| Value::Vec3fVec(vec![gf::vec3f(1.0, 1.0, 1.0), gf::vec3f(x, 0.0, 0.0)]);
+        let mut reading = Reading { channel: None, mixed: false, refused: None, len: 2, widened: Vec::new() };
+        for (at, x) in [(vec![(0, 0.0), (3, 3.0)], 0.0), (vec![(2, 2.0), (1, 1.0)], 5.0), (vec![(4, 4.0)], -0.0)] {
+            reading.add(TimeSample { at, value: value(x), count: 5 });
+        }
+        let codes = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let shared = reading.finish().unwrap().expect("a channel").vectors(&codes, Vec3::ZERO).unwrap();
+        let one_by_one = [(0, 0.0, Some(0.0)), (1, 1.0, Some(5.0)), (2, 2.0, Some(5.0)), (3, 3.0, Some(0.0))];
+        let one_by_one = channel(&[one_by_one.as_slice(), &[(4, 4.0, Some(-0.0))]].concat());
+        assert_eq!(shared, one_by_one.vectors(&codes, Vec3::ZERO).unwrap());
+        let Keys::Moving(moving) = &shared[1] else { panic!("the second element moves: {shared:?}") };
+        let xs: Vec<u32> = moving.iter().map(|v| v.x.to_bits()).collect();
+        assert_eq!(xs, [0.0f32, 5.0, 5.0, 0.0, -0.0].map(f32::to_bits));
+    }
+
+    #[test]
     fn a_sample_at_no_finite_time_is_dropped_and_one_that_does_not_fit_reads_as_the_identity() {
         // Stored unsorted: index 1 is the last in time.
         let samples = [(0, 0.0, Some(0.0)), (1, 3.0, None), (2, f64::NAN, Some(9.0)), (3, 2.0, Some(2.0))];
@@ -578,16 +611,15 @@ mod tests {
     fn a_half_precision_sample_is_widened_exactly_and_a_second_type_is_no_channel() {
         let half = |x: f32| gf::Vec3h { x: f16::from_f32(x), y: f16::ZERO, z: f16::from_f32(-x) };
         let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
-        reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 1 });
+        reading.add(TimeSample { at: vec![(0, 0.0)], value: Value::Vec3hVec(vec![half(0.1)]), count: 1 });
         let widened = f16::from_f32(0.1).to_f32();
         let keys = reading.finish().unwrap().expect("a channel").vectors(&[0.0], Vec3::ZERO).unwrap();
         assert_eq!(keys, vec![Keys::Held(Vec3::new(widened, 0.0, -widened))]);
 
         let mut reading = Reading { channel: None, mixed: false, refused: None, len: 1, widened: Vec::new() };
-        reading.add(TimeSample { index: 0, time: 0.0, value: Value::Vec3hVec(vec![half(0.1)]), count: 2 });
+        reading.add(TimeSample { at: vec![(0, 0.0)], value: Value::Vec3hVec(vec![half(0.1)]), count: 2 });
         reading.add(TimeSample {
-            index: 1,
-            time: 1.0,
+            at: vec![(1, 1.0)],
             value: Value::Vec3fVec(vec![gf::vec3f(0.1, 0.0, 0.0)]),
             count: 2,
         });
@@ -601,7 +633,7 @@ mod tests {
         let (samples, joints) = (1 << 16, 100);
         let sample = |index: usize, x: f32| {
             let value = Value::Vec3fVec(vec![gf::vec3f(x, 0.0, 0.0); joints]);
-            TimeSample { index, time: index as f64, value, count: samples }
+            TimeSample { at: vec![(index, index as f64)], value, count: samples }
         };
         let column = samples * size_of::<Vec3>();
         let read = |budget: usize| {

@@ -1045,7 +1045,7 @@ impl IndexCache {
         self.ensure_index(graph, &path.prim_path())
     }
 
-    /// bonescope: the property at `path`'s composed `timeSamples` handed to `visit` sample by sample, in stage
+    /// bonescope: the property at `path`'s composed `timeSamples` handed to `visit` value by value, in stage
     /// time (`resolve_field` of `timeSamples` without the map); `true` where it has samples.
     pub(crate) fn visit_time_samples(
         &mut self,

@@ -511,7 +511,7 @@ impl PrimIndex {
         })
     }
 
-    /// bonescope: the strongest authored `timeSamples`, retimed to stage time, handed to `visit` sample by sample
+    /// bonescope: the strongest authored `timeSamples`, retimed to stage time, handed to `visit` value by value
     /// as its layer decodes them ([`resolve_time_samples`](Self::resolve_time_samples) without the map). `true`
     /// where a layer had samples; `false` where none has or one blocks them.
     pub(crate) fn visit_time_samples(
@@ -522,7 +522,10 @@ impl PrimIndex {
     ) -> Result<bool> {
         for site in self.contributing_sites(prop_suffix) {
             let ContributingSite { layer, offset, query_path, .. } = site?;
-            let mut retimed = |sample: sdf::TimeSample| visit(sdf::TimeSample { time: offset.apply(sample.time), ..sample });
+            let mut retimed = |mut sample: sdf::TimeSample| {
+                sample.at.iter_mut().for_each(|(_, time)| *time = offset.apply(*time));
+                visit(sample)
+            };
             match stack.layer(layer).data().visit_time_samples(&query_path, &mut retimed)? {
                 None | Some(sdf::TimeSamplesField::NotSamples) => continue,
                 Some(sdf::TimeSamplesField::Blocked) => return Ok(false),

@@ -23,12 +23,12 @@ pub enum TimeSamplesField {
     NotSamples,
 }
 
-/// bonescope: one of a field's time samples, as [`AbstractData::visit_time_samples`] hands it on.
+/// bonescope: a value of a field's time samples, as [`AbstractData::visit_time_samples`] hands it on, with every
+/// sample that holds it (a binary layer stores a value once however many samples share it).
 #[derive(Clone, Debug)]
 pub struct TimeSample {
-    /// Where it is among the field's samples, in their order.
-    pub index: usize,
-    pub time: f64,
+    /// The samples holding it: each one's place among the field's samples, in their order, and its time.
+    pub at: Vec<(usize, f64)>,
     pub value: Value,
     /// How many samples the field holds.
     pub count: usize,
@@ -40,12 +40,12 @@ pub fn visit_decoded(field: Cow<'_, Value>, visit: &mut dyn FnMut(TimeSample)) -
         Cow::Owned(Value::TimeSamples(samples)) => {
             let count = samples.len();
             let samples = samples.into_iter().enumerate();
-            samples.for_each(|(index, (time, value))| visit(TimeSample { index, time, value, count }))
+            samples.for_each(|(index, (time, value))| visit(TimeSample { at: vec![(index, time)], value, count }))
         }
         Cow::Borrowed(Value::TimeSamples(samples)) => {
             let count = samples.len();
             let samples = samples.iter().enumerate().map(|(index, (time, value))| (index, *time, value.clone()));
-            samples.for_each(|(index, time, value)| visit(TimeSample { index, time, value, count }))
+            samples.for_each(|(index, time, value)| visit(TimeSample { at: vec![(index, time)], value, count }))
         }
         Cow::Borrowed(Value::ValueBlock) | Cow::Owned(Value::ValueBlock) => return TimeSamplesField::Blocked,
         _ => return TimeSamplesField::NotSamples,

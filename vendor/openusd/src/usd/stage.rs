@@ -2352,8 +2352,8 @@ impl Stage {
         })
     }
 
-    /// bonescope: the composed `timeSamples` of an attribute handed to `visit` one by one, each with its place among
-    /// them, in any order, retimed as [`Self::time_samples`] retimes them: a binary layer decodes each value as it
+    /// bonescope: the composed `timeSamples` of an attribute handed to `visit` value by value, each with the samples
+    /// that hold it (their places among them), in any order, retimed as [`Self::time_samples`] retimes them: a binary layer decodes each value as it
     /// hands it on, so a reader building arrays of its own never holds every sample at once. `false` where the attribute has
     /// none. `visit` must not read the stage. Asset-path values are handed on unanchored.
     pub fn visit_time_samples(

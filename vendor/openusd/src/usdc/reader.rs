@@ -922,9 +922,9 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
         self.reader.read_vec(count)
     }
 
-    /// bonescope: hands the time samples `value` holds to `visit` one by one, decoding each value as it goes, in
-    /// the order the values lie in the file (a value several samples share decoded once, and handed on once per
-    /// sample). `visit` drops each: what a value was charged to the budget is released once it is handed on (a
+    /// bonescope: hands the values of the time samples `value` holds to `visit` one by one, decoding each as it
+    /// goes, in the order they lie in the file (a value several samples share decoded once, and handed on once with
+    /// all of them). `visit` drops each: what a value was charged to the budget is released once it is handed on (a
     /// visitor that keeps what it is handed charges that itself).
     pub fn visit_time_samples(&mut self, value: ValueRep, visit: &mut dyn FnMut(sdf::TimeSample)) -> Result<()> {
         self.visit_samples(value, Held::Dropped, visit)
@@ -977,11 +977,8 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
                 // Each sample keeps a copy of its own.
                 super::budget::charge_bytes(charged.saturating_mul(shared.len() as u64 - 1))?;
             }
-            let (&last, others) = shared.split_last().expect("a chunk is never empty");
-            for &index in others {
-                visit(sdf::TimeSample { index, time: times[index], value: value.clone(), count });
-            }
-            visit(sdf::TimeSample { index: last, time: times[last], value, count });
+            let at = shared.iter().map(|&index| (index, times[index])).collect();
+            visit(sdf::TimeSample { at, value, count });
             if held == Held::Dropped {
                 super::budget::release(charged);
             }
@@ -1419,9 +1416,13 @@ impl<R: io::Read + io::Seek> CrateFile<R> {
             // bonescope: decoded by the visit, in the order the values lie in the file, then put in time order.
             Type::TimeSamples => {
                 let mut samples = Vec::new();
-                self.visit_samples(value, Held::Kept, &mut |sample| samples.push(sample))?;
-                samples.sort_by_key(|sample| sample.index);
-                sdf::Value::TimeSamples(samples.into_iter().map(|sample| (sample.time, sample.value)).collect())
+                self.visit_samples(value, Held::Kept, &mut |sample| {
+                    let (last, others) = sample.at.split_last().expect("a value has a sample");
+                    samples.extend(others.iter().map(|&(index, time)| (index, time, sample.value.clone())));
+                    samples.push((last.0, last.1, sample.value));
+                })?;
+                samples.sort_by_key(|&(index, ..)| index);
+                sdf::Value::TimeSamples(samples.into_iter().map(|(_, time, value)| (time, value)).collect())
             }
 
             // Empty dictionary.
