@@ -177,20 +177,20 @@ fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerance
         let mut local = vec![Transform::IDENTITY; evaluation.skeleton().len()];
         let mut starts = vec![DQuat::IDENTITY; bones.len()];
         let mut samples: Vec<Vec<Sample>> = vec![Vec::with_capacity(run.len()); bones.len()];
-        let mut judged: Vec<Judged> = Vec::with_capacity(bones.len());
+        let mut now: Vec<AtTime> = Vec::with_capacity(bones.len());
         for &time in run {
             let pose = source.evaluate(time);
             group.evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
-            judged.clear();
-            judged.extend(bones.iter().zip(&mut starts).map(|(&bone, start)| {
+            now.clear();
+            now.extend(bones.iter().zip(&mut starts).map(|(&bone, start)| {
                 let m = &pose.model.model[bone];
                 let assessment = Assessment::near(m, tolerances, *start);
                 *start = assessment.parts.stretch;
-                Judged { assessment, shear: column_shear(m), largest: 0.0, main_cause: None }
+                AtTime { assessment, shear: column_shear(m), largest: 0.0, main_cause: None }
             }));
-            group.find_main_causes(&mut probe, &mut local, &mut judged, tolerances);
-            for (samples, judged) in samples.iter_mut().zip(&judged) {
-                let Judged { assessment, main_cause, .. } = judged;
+            group.find_main_causes(&mut probe, &mut local, &mut now, tolerances);
+            for (samples, bone) in samples.iter_mut().zip(&now) {
+                let AtTime { assessment, main_cause, .. } = bone;
                 let (shear_deg, stretched) = (assessment.shear_deg, assessment.findings.stretched);
                 samples.push(Sample { shear_deg, stretched, main_cause: *main_cause });
             }
@@ -220,7 +220,7 @@ struct Group<'b> {
 
 /// One bone of a group at one time: its verdict, its shear on the matrix, and the largest contribution to it found
 /// so far with its bone.
-struct Judged {
+struct AtTime {
     assessment: Assessment,
     shear: f64,
     largest: f64,
@@ -250,14 +250,14 @@ impl<'b> Group<'b> {
         })
     }
 
-    /// Each flagged bone's main cause at one time (`local`, the group's bones' local transforms, and `judged`): each
+    /// Each flagged bone's main cause at one time (`local`, the group's bones' local transforms, and `now`): each
     /// squash of the chains made uniform once for every flagged bone below it, parents first, so that each bone meets
     /// the squashes of its chain in the chain's order.
     fn find_main_causes(
         &self,
         probe: &mut Probe,
         local: &mut [Transform],
-        judged: &mut [Judged],
+        now: &mut [AtTime],
         tolerances: &Tolerances,
     ) {
         for &squash in &self.evaluated {
@@ -265,18 +265,18 @@ impl<'b> Group<'b> {
                 continue;
             }
             let below = &self.below[squash];
-            if !below.iter().any(|&k| judged[k].assessment.findings.stretched) {
+            if !below.iter().any(|&k| now[k].assessment.findings.stretched) {
                 continue;
             }
             let models = probe.models(local, self.reach(squash), &[squash]);
             for &k in below {
-                let judged = &mut judged[k];
-                if !judged.assessment.findings.stretched {
+                let bone = &mut now[k];
+                if !bone.assessment.findings.stretched {
                     continue;
                 }
-                let contribution = judged.shear - column_shear(&models[self.bones[k]]);
-                if contribution > judged.largest {
-                    (judged.largest, judged.main_cause) = (contribution, Some(squash));
+                let contribution = bone.shear - column_shear(&models[self.bones[k]]);
+                if contribution > bone.largest {
+                    (bone.largest, bone.main_cause) = (contribution, Some(squash));
                 }
             }
         }

@@ -6,9 +6,10 @@
 //! neither normalised. The `openusd` crate rounds once and normalises a near-linear slerp: the same within the
 //! precision of a `float`, not to the bit UsdSkel computes.
 //!
-//! A channel is read sample by sample as the layer decodes it and kept by element (joint or blend shape): an element
-//! whose value never changes is kept once, one that moves as its column of values, one per sample. So a clip's
-//! samples are never all in memory at once, and a moving joint's column is its track.
+//! A channel is read value by value as the layer decodes it (a value several samples share comes once, with all of
+//! them) and kept by element (joint or blend shape): an element whose value never changes is kept once, one that
+//! moves as its column of values, one per sample. So a clip's samples are never all in memory at once, and a moving
+//! joint's column is its track.
 
 use std::sync::Arc;
 
@@ -281,15 +282,13 @@ impl<V: Stored> Columns<V> {
     /// where a column it starts would pass the reading's budget.
     fn push(&mut self, at: &[(usize, f64)], count: usize, values: impl Iterator<Item = V>) -> Result<(), String> {
         let of = self.codes.len();
-        let samples: Vec<usize> = at.iter().map(|&(sample, _)| sample).filter(|&s| s < of).collect();
-        if samples.is_empty() {
-            return Ok(());
-        }
+        let mut read = false;
         for &(sample, code) in at.iter().filter(|&&(sample, _)| sample < of) {
             self.codes[sample] = code;
             self.fits[sample] = count == self.len;
+            read = true;
         }
-        if count != self.len {
+        if !read || count != self.len {
             return Ok(());
         }
         let Some(first) = &self.first else {
@@ -308,7 +307,7 @@ impl<V: Stored> Columns<V> {
             self.staged.truncate(row * self.len);
             return Ok(());
         }
-        self.staged_at.extend(samples.into_iter().map(|sample| (row, sample)));
+        self.staged_at.extend(at.iter().filter(|&&(sample, _)| sample < of).map(|&(sample, _)| (row, sample)));
         if row + 1 == STAGED {
             self.flush()?;
         }

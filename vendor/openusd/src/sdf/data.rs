@@ -96,9 +96,9 @@ pub trait AbstractData {
         })
     }
 
-    /// bonescope: the `timeSamples` field at `path`, its samples handed to `visit` one by one, in any order, each
-    /// with its place among them (a binary layer decodes each value as it hands it on, in the order they lie in the
-    /// file, so the caller never holds all of them at once); `Ok(None)` where it is not authored.
+    /// bonescope: the `timeSamples` field at `path`, its values handed to `visit` one by one, in any order, each
+    /// with the samples that hold it (a binary layer decodes each value as it hands it on, in the order they lie in
+    /// the file, so the caller never holds all of them at once); `Ok(None)` where it is not authored.
     fn visit_time_samples(
         &self,
         path: &Path,
@@ -325,7 +325,7 @@ impl<T: AbstractData + ?Sized> AbstractData for Box<T> {
         (**self).try_field(path, field)
     }
 
-    // bonescope: forwarded, so that a boxed crate layer still decodes sample by sample.
+    // bonescope: forwarded, so that a boxed crate layer still decodes value by value.
     fn visit_time_samples(
         &self,
         path: &Path,

@@ -146,7 +146,7 @@ where
         }
     }
 
-    /// bonescope: a crate's time samples decoded one by one as they are handed on.
+    /// bonescope: a crate's time-sample values decoded one by one as they are handed on.
     fn visit_time_samples(
         &self,
         path: &sdf::Path,
