@@ -80,7 +80,8 @@ pub(super) fn inherits_stretch(evaluation: &Evaluation, bone: usize) -> bool {
     evaluation.skeleton().parent(bone).is_none() || evaluation.modes()[bone] == InheritMode::Full
 }
 
-/// What one chunk of samples produced.
+/// What one chunk of samples produced, for each bone it holds (every bone of the rig, or a few: see
+/// [`super::scan::assemble`]), by their place among them.
 pub(super) struct ChunkResult {
     pub summaries: Vec<BoneSummary>,
     /// `words` words of flags per bone.

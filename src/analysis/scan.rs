@@ -53,7 +53,8 @@ pub fn analyze(
         })
         .collect();
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
-    let mut analysis = assemble(skeleton.figure(), times, curves, chunks);
+    let every: Vec<usize> = (0..skeleton.len()).collect();
+    let mut analysis = assemble(skeleton.figure(), times, curves, chunks, &every);
     peak::refine(evaluation, &analysis.times, &mut analysis.scan.bones, &Judge::new(&options.tolerances));
     Some(analysis)
 }
@@ -95,12 +96,14 @@ fn pieces(samples: &mut [Components], len: usize) -> impl Iterator<Item = Option
     samples.chunks_mut(len).map(Some).chain(std::iter::repeat_with(|| None))
 }
 
-/// The chunks' results as one analysis; `figure` (one flag per bone) says which bones count for "any bone".
+/// The chunks' results as one analysis; `figure` (one flag per bone) says which bones count for "any bone", and
+/// `held` which bone each chunk's entries stand for (every bone of the rig, or a few; the others stay empty).
 pub(super) fn assemble(
     figure: &[bool],
     times: Vec<f64>,
     curves: Vec<(usize, Curves)>,
     chunks: Vec<ChunkResult>,
+    held: &[usize],
 ) -> ClipAnalysis {
     let bones = figure.len();
     let words_per_bone = times.len().div_ceil(64);
@@ -110,7 +113,7 @@ pub(super) fn assemble(
     let mut first_word = 0;
     for chunk in chunks {
         let words = first_word..first_word + chunk.words;
-        for (bone, (summary, bits)) in chunk.summaries.iter().zip(chunk.bits.chunks(chunk.words)).enumerate() {
+        for (&bone, (summary, bits)) in held.iter().zip(chunk.summaries.iter().zip(chunk.bits.chunks(chunk.words))) {
             summaries[bone].merge(summary);
             stretched_bits[bone * words_per_bone..][words.clone()].copy_from_slice(bits);
             if figure[bone] {

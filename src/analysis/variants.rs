@@ -42,8 +42,9 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
             let mut stretches = vec![Stretch::NONE; skeleton.len()];
             let mut variant_stretches: Vec<Vec<Stretch>> =
                 variants.iter().map(|v| vec![Stretch::NONE; v.bones.len()]).collect();
+            // Each variant's own bones alone, by their place among them.
             let mut results: Vec<ChunkResult> =
-                variants.iter().map(|_| ChunkResult::new(skeleton.len(), run.len())).collect();
+                variants.iter().map(|v| ChunkResult::new(v.bones.len(), run.len())).collect();
             for (sample, &time) in run.iter().enumerate() {
                 reference.evaluate(time);
                 let pose = reference.pose();
@@ -60,7 +61,7 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
                         let over = parent.map_or(root, |p| p.stretch(own, &stretches));
                         let local = variant.local(&pose.local, bone);
                         own[k] = judged(inherits, over, &local, &out.model[bone], own[k].frame(), &judge);
-                        result.add(bone, sample, time, &own[k].verdict(&judge));
+                        result.add(k, sample, time, &own[k].verdict(&judge));
                     }
                 }
             }
@@ -75,7 +76,7 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
         .into_par_iter()
         .zip(variants)
         .map(|(chunks, variant)| {
-            let mut analysis = assemble(skeleton.figure(), times.clone(), Vec::new(), chunks);
+            let mut analysis = assemble(skeleton.figure(), times.clone(), Vec::new(), chunks, &variant.bones);
             peak::refine(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &judge);
             analysis.scan
         })

@@ -281,7 +281,8 @@ pub fn compare_at_size(a: &Evaluation, b: &Evaluation, pairs: &Pairs, times: &[f
 /// `rig_size`: [`compare_at_size`] of each, in one pass over time that evaluates, decomposes and skins A once per
 /// time for all of them (one evaluation weighed against many changes of it).
 pub fn compare_each(a: &Evaluation, sides: &[(&Evaluation, &Pairs)], times: &[f64], rig_size: f64) -> Vec<Comparison> {
-    let compared = compare_each_within(a, sides, times, rig_size, f64::INFINITY);
+    let sides: Vec<_> = sides.iter().map(|&(b, pairs)| (b, pairs, f64::INFINITY)).collect();
+    let compared = compare_each_within(a, &sides, times, rig_size);
     compared.into_iter().map(|c| c.expect("no distance passes an infinite limit")).collect()
 }
 
@@ -295,32 +296,32 @@ pub fn compare_within(
     rig_size: f64,
     limit: f64,
 ) -> Option<Comparison> {
-    compare_each_within(a, &[(b, pairs)], times, rig_size, limit).pop().flatten()
+    compare_each_within(a, &[(b, pairs, limit)], times, rig_size).pop().flatten()
 }
 
-/// [`compare_each`], each side given up (`None`) once a probe point or a vertex lies further apart than `limit`.
-fn compare_each_within(
+/// [`compare_each`] of `sides` (an evaluation, its pairs with `a`, and a limit), each side given up (`None`) once a
+/// probe point or a vertex lies further apart than its limit.
+pub fn compare_each_within(
     a: &Evaluation,
-    sides: &[(&Evaluation, &Pairs)],
+    sides: &[(&Evaluation, &Pairs, f64)],
     times: &[f64],
     rig_size: f64,
-    limit: f64,
 ) -> Vec<Option<Comparison>> {
     let probe_length = rig_size * PROBE_FRACTION;
-    let reaches: Vec<Vec<Option<Reach>>> = sides.iter().map(|&(b, pairs)| reaches(a, b, pairs)).collect();
+    let reaches: Vec<Vec<Option<Reach>>> = sides.iter().map(|&(b, pairs, _)| reaches(a, b, pairs)).collect();
     let fresh = || {
         let sides = sides.iter().zip(&reaches);
-        sides.map(|(&(b, pairs), reaches)| Differences::new(a, b, pairs, reaches, rig_size)).collect::<Vec<_>>()
+        sides.map(|(&(b, pairs, _), reaches)| Differences::new(a, b, pairs, reaches, rig_size)).collect::<Vec<_>>()
     };
     let plan_a = Plan::new(
         a,
-        sides.iter().flat_map(|(_, pairs)| pairs.bones.pairs.iter().map(|p| p.0)),
-        sides.iter().flat_map(|(_, pairs)| pairs.meshes.iter().map(|m| (m.a, m.vertices.as_deref()))),
-        sides.iter().any(|(_, pairs)| pairs.measure == Measure::Everything),
+        sides.iter().flat_map(|(_, pairs, _)| pairs.bones.pairs.iter().map(|p| p.0)),
+        sides.iter().flat_map(|(_, pairs, _)| pairs.meshes.iter().map(|m| (m.a, m.vertices.as_deref()))),
+        sides.iter().any(|(_, pairs, _)| pairs.measure == Measure::Everything),
     );
     let plans: Vec<Plan> = sides
         .iter()
-        .map(|&(b, pairs)| {
+        .map(|&(b, pairs, _)| {
             let meshes = pairs.meshes.iter().map(|m| (m.b, m.vertices.as_deref()));
             Plan::new(b, pairs.bones.pairs.iter().map(|p| p.1), meshes, pairs.measure == Measure::Everything)
         })
@@ -355,8 +356,10 @@ fn compare_each_within(
                 break;
             }
             side_a.evaluate(time);
-            let compared = others.iter_mut().zip(&mut differences).zip(&given_up);
-            for ((side_b, found), given_up) in compared.filter(|(_, given_up)| !given_up.load(Ordering::Relaxed)) {
+            let compared = others.iter_mut().zip(&mut differences).zip(sides.iter().zip(&given_up));
+            for ((side_b, found), (&(.., limit), given_up)) in
+                compared.filter(|(_, (_, given_up))| !given_up.load(Ordering::Relaxed))
+            {
                 side_b.evaluate_beside(time, &side_a);
                 found.add(&mut side_a, side_b, probe_length, time);
                 if found.largest > limit {
@@ -369,7 +372,7 @@ fn compare_each_within(
     let totals =
         runs.into_iter().reduce(|earlier, later| earlier.into_iter().zip(later).map(|(x, y)| x.merge(y)).collect());
     let count = times.len().max(1) as f64;
-    let finish = |found: Differences| {
+    let finish = |(found, &(.., limit)): (Differences, &(&Evaluation, &Pairs, f64))| {
         if found.largest > limit {
             return None;
         }
@@ -377,7 +380,7 @@ fn compare_each_within(
         let meshes = found.meshes.into_iter().map(mean).collect();
         Some(Comparison { samples: times.len(), rig_size, bones: found.bones, meshes })
     };
-    totals.unwrap_or_else(fresh).into_iter().map(finish).collect()
+    totals.unwrap_or_else(fresh).into_iter().zip(sides).map(finish).collect()
 }
 
 /// The differences found over some of the times.

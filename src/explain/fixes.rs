@@ -12,7 +12,8 @@ use crate::analysis::{
 };
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
-    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_within, comparison_times,
+    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each_within, compare_within,
+    comparison_times,
 };
 use crate::eval::{Evaluation, Setup, Variant};
 use crate::import;
@@ -61,7 +62,7 @@ impl Change {
     }
 
     /// The bone below which (itself included) the change changes anything; `None` for the whole rig.
-    fn changed_below(&self) -> Option<usize> {
+    pub(super) fn changed_below(&self) -> Option<usize> {
         match *self {
             Change::Mode { bone, .. } | Change::UniformScale { bone } => Some(bone),
             Change::Bake { .. } => None,
@@ -285,41 +286,52 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// [`Baseline::cost`] where it is at most `limit`; `None` once something moves further (the comparison given
-    /// up there).
-    pub fn cost_within(&self, change: Change, applied: &Applied, limit: f64) -> Result<Option<Cost>, String> {
-        let on = self.compared_on(change, applied.baked.as_ref())?;
+    /// up there). Needs the change made only for a bake (`baked`: the rig it writes).
+    fn cost_within(&self, change: Change, baked: Option<&Rig>, limit: f64) -> Result<Option<Cost>, String> {
+        let on = self.compared_on(change, baked)?;
         let Scale { times, size } = &*on.scale;
         Ok(compare_within(self.source, &on.fixed, &on.pairs, times, *size, limit).map(|c| self.visible(&c)))
     }
 
-    /// What each of `changes` (made) costs, as [`Baseline::cost`] says: those that keep the clip's times (all but
-    /// bakes) compared [`BATCH`] at a time in one pass that evaluates and skins the source once per time for the
-    /// batch, the bakes each on its own beside them.
+    /// What each of `changes` (made) costs, as [`Baseline::cost`] says ([`Baseline::costs_within`], no limit).
     pub fn costs(&self, changes: &[(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
-        let (bakes, kept): (Vec<_>, Vec<_>) = changes.iter().partition(|(c, _)| c.changed_below().is_none());
-        let bake_costs = || bakes.into_iter().map(|&(change, made)| (change, self.cost(change, made))).collect();
+        let asked: Vec<_> =
+            changes.iter().map(|&(change, made)| (change, made.baked.as_ref(), f64::INFINITY)).collect();
+        let costs = self.costs_within(&asked).into_iter();
+        costs.map(|(change, cost)| (change, cost.map(|c| c.expect("no cost passes an infinite limit")))).collect()
+    }
+
+    /// What each of `asked` (a change, for a bake the rig it writes, and a limit) costs, as [`Baseline::cost_within`]
+    /// says: those that keep the clip's times (all but bakes) compared [`BATCH`] at a time in one pass that evaluates
+    /// and skins the source once per time for the batch, the bakes each on its own beside them.
+    pub fn costs_within(&self, asked: &[(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
+        let (bakes, kept): (Vec<_>, Vec<_>) = asked.iter().partition(|(c, ..)| c.changed_below().is_none());
+        let bake_costs = || {
+            bakes.into_iter().map(|&(change, made, limit)| (change, self.cost_within(change, made, limit))).collect()
+        };
         let (mut costs, baked): (Vec<_>, Vec<_>) = rayon::join(|| self.costs_kept(&kept), bake_costs);
         costs.extend(baked);
         costs
     }
 
-    /// [`Baseline::costs`] of changes that keep the clip's times, [`BATCH`] at a time.
-    fn costs_kept(&self, kept: &[&(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
+    /// [`Baseline::costs_within`] of changes that keep the clip's times, [`BATCH`] at a time.
+    fn costs_kept(&self, kept: &[&(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
         let mut costs = Vec::new();
         for batch in kept.chunks(BATCH) {
             let mut fixed = Vec::new();
-            for &&(change, made) in batch {
-                match self.fixed(change, made.baked.as_ref()) {
+            for &&(change, baked, limit) in batch {
+                match self.fixed(change, baked) {
                     Ok(evaluation) => {
                         let pairs = self.pairs(change, &evaluation);
-                        fixed.push((change, evaluation, pairs));
+                        fixed.push((change, evaluation, pairs, limit));
                     }
                     Err(why) => costs.push((change, Err(why))),
                 }
             }
-            let sides: Vec<(&Evaluation, &Pairs)> = fixed.iter().map(|(_, e, p)| (e, p)).collect();
-            let compared = compare_each(self.source, &sides, &self.scale.times, self.scale.size);
-            costs.extend(fixed.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c)))));
+            let sides: Vec<(&Evaluation, &Pairs, f64)> = fixed.iter().map(|(_, e, p, limit)| (e, p, *limit)).collect();
+            let compared = compare_each_within(self.source, &sides, &self.scale.times, self.scale.size);
+            let visible = |c: Option<Comparison>| Ok(c.map(|c| self.visible(&c)));
+            costs.extend(fixed.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
         }
         costs
     }

@@ -31,7 +31,7 @@ use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
 use crate::analysis::{ClipScan, CurveRequest, SAME_SHEAR_DEG, ScanOptions, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
-use crate::model::{Tool, Unit, significant};
+use crate::model::{Rig, Tool, Unit, significant};
 use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.
@@ -252,20 +252,21 @@ pub fn explain(
             known.costs = baseline.costs(&made).into_iter().collect();
         }
         Costs::Best => {
-            // Bones that share no change share nothing a search learns: their searches run side by side, each
-            // group's bones in the order asked (what one learns is the same whichever runs first).
-            let searched = sharing(&changes).into_par_iter().map(|group| {
-                let mut known = Known::default();
-                for i in group {
-                    let (bone, changes) = (bones[i], &changes[i]);
-                    if cheapest_removal(&baseline, bone, changes, tool, &mut known).is_none() {
-                        known.make(&baseline, changes);
-                        cheapest(&baseline, &contenders(bone, changes, &known.applied, tool), &mut known);
-                    }
-                }
-                known
-            });
-            known = searched.reduce(Known::default, Known::merge);
+            let bakes: Vec<Change> =
+                changes.iter().flatten().copied().filter(|c| c.changed_below().is_none()).collect();
+            known.make(&baseline, &bakes);
+            let own = |changes: &[Change]| changes.iter().copied().filter(|&c| !is_other_mode(c, tool)).collect();
+            let own: Vec<Vec<Change>> = changes.iter().map(|changes| own(changes)).collect();
+            known.bound(&baseline, &own.concat());
+            let mut searches: Vec<Removal> =
+                bones.iter().zip(&own).map(|(&bone, own)| Removal::new(bone, own, &known.bounds)).collect();
+            remove(&baseline, &mut searches, &mut known);
+            // Where no change removes the shear, the best is among every change made.
+            let unremoved: Vec<usize> = (0..bones.len()).filter(|&i| searches[i].best.is_none()).collect();
+            known.make(&baseline, &unremoved.iter().flat_map(|&i| changes[i].iter().copied()).collect::<Vec<_>>());
+            for i in unremoved {
+                cheapest(&baseline, &contenders(bones[i], &changes[i], &known.applied, tool), &mut known);
+            }
         }
     }
     let Known { applied, costs, .. } = known;
@@ -304,14 +305,6 @@ struct Known {
 }
 
 impl Known {
-    /// What two searches learnt of changes neither shares with the other.
-    fn merge(mut self, other: Known) -> Known {
-        self.applied.extend(other.applied);
-        self.costs.extend(other.costs);
-        self.bounds.extend(other.bounds);
-        self
-    }
-
     /// Makes each of `changes` not yet made, in parallel.
     fn make(&mut self, baseline: &Baseline, changes: &[Change]) {
         let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
@@ -341,55 +334,144 @@ impl Known {
     }
 }
 
-/// The best fix of `bone` where a change of `changes` that sets no mode foreign to `tool` leaves it unflagged: the
-/// cheapest such change (ties: the first in `changes`), found making and costing (into `known`) as few changes as it
-/// takes. Changes are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]: a bake's once it is
-/// made, any other's from its setup), until the next bound exceeds the cheapest cost found (a bound never exceeds
-/// its cost). `None` where no such change removes the shear: then the best is among every change made
-/// ([`contenders`]).
-fn cheapest_removal(
-    baseline: &Baseline,
+/// One bone's search for the cheapest of its changes that leaves it unflagged (ties: the first in its changes),
+/// making and costing as few changes as it takes. Its changes (those that set no mode foreign to the file's tool)
+/// are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]: a bake's once it is made, any
+/// other's from its setup), until the next bound exceeds the cheapest cost found (a bound never exceeds its cost).
+/// What it finds depends on what each change is alone, whoever made or costed it, so the searches of every bone go on
+/// side by side ([`remove`]), each needing one change made or costed at a time.
+struct Removal {
     bone: usize,
-    changes: &[Change],
-    tool: Option<Tool>,
-    known: &mut Known,
-) -> Option<Change> {
-    let bakes: Vec<Change> = changes.iter().copied().filter(|c| matches!(c, Change::Bake { .. })).collect();
-    known.make(baseline, &bakes);
-    let own: Vec<(usize, Change)> =
-        changes.iter().copied().enumerate().filter(|&(_, change)| !is_other_mode(change, tool)).collect();
-    let bounds = known.bound(baseline, &own.iter().map(|&(_, change)| change).collect::<Vec<_>>());
-    let mut bounded: Vec<(f64, usize, Change)> =
-        own.into_iter().zip(bounds).filter_map(|((index, change), bound)| Some((bound?, index, change))).collect();
-    bounded.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    let mut best: Option<(f64, usize, Change)> = None;
-    for (bound, index, change) in bounded {
-        if best.is_some_and(|(cost, ..)| bound > cost) {
-            break;
-        }
-        if !known.applied.contains_key(&change) && baseline.leaves_flagged(change, bone) {
-            continue;
-        }
-        let Ok(made) = known.applied.entry(change).or_insert_with(|| baseline.apply(change)) else { continue };
-        if made.standing(bone, false).0 {
-            continue;
-        }
-        let cost = match (known.costs.get(&change), best) {
-            (Some(known), _) => known.clone(),
-            // Only a cost at most the cheapest's matters: the comparison is given up past it.
-            (None, Some((cheapest, ..))) => match baseline.cost_within(change, made, cheapest) {
-                Ok(None) => continue,
-                within => within.map(|c| c.expect("within the limit")),
-            },
-            (None, None) => baseline.cost(change, made),
-        };
-        let Ok(cost) = known.costs.entry(change).or_insert(cost) else { continue };
-        let cost = cost.distance.max;
-        if best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && index < first)) {
-            best = Some((cost, index, change));
+    /// The changes by their bound, then their place among the bone's changes: (bound, place, change).
+    order: Vec<(f64, usize, Change)>,
+    /// The first of `order` not yet settled.
+    next: usize,
+    /// Whether the change at `next` was looked at on the run of samples where the bone is worst, and not settled.
+    looked: bool,
+    /// Whether the comparison of the change at `next` was given up past the cheapest cost found: it costs more.
+    given_up: bool,
+    /// The cheapest removal found: (cost, place, change).
+    best: Option<(f64, usize, Change)>,
+}
+
+/// What a search needs to go on: a change made, or a change costed where it costs at most a limit (the cheapest
+/// cost found; a comparison past it is given up).
+#[derive(Clone, Copy)]
+enum Need {
+    Made(Change),
+    Costed(Change, f64),
+}
+
+impl Need {
+    fn made(self) -> Option<Change> {
+        match self {
+            Need::Made(change) => Some(change),
+            Need::Costed(..) => None,
         }
     }
-    best.map(|(.., change)| change)
+
+    fn costed(self) -> Option<(Change, f64)> {
+        match self {
+            Need::Costed(change, limit) => Some((change, limit)),
+            Need::Made(_) => None,
+        }
+    }
+}
+
+impl Removal {
+    /// The search of `bone` through `changes`, given their lower bounds (a change without one is no contender).
+    fn new(bone: usize, changes: &[Change], bounds: &HashMap<Change, Option<f64>>) -> Self {
+        let bounded = changes.iter().enumerate().filter_map(|(place, &change)| Some((bounds[&change]?, place, change)));
+        let mut order: Vec<(f64, usize, Change)> = bounded.collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Removal { bone, order, next: 0, looked: false, given_up: false, best: None }
+    }
+
+    /// Goes on as far as what is `known` settles; what it needs next, or `None` once the search is over.
+    fn advance(&mut self, baseline: &Baseline, known: &Known) -> Option<Need> {
+        while let Some(&(bound, place, change)) = self.order.get(self.next) {
+            if self.best.is_some_and(|(cost, ..)| bound > cost) {
+                break;
+            }
+            match self.look(baseline, known, place, change) {
+                Ok(Some(cost)) => self.best = Some((cost, place, change)),
+                Ok(None) => {}
+                Err(need) => return Some(need),
+            }
+            (self.next, self.looked, self.given_up) = (self.next + 1, false, false);
+        }
+        self.next = self.order.len();
+        None
+    }
+
+    /// What `change` (at `place` among the bone's changes) is to the search: a cheaper removal (its cost), not one
+    /// (`None`), or not known yet (what is needed to know). A change not made yet is first looked at on the run of
+    /// samples where the bone is worst ([`Baseline::leaves_flagged`]), which settles most that leave it flagged;
+    /// once a removal is known, a change is costed (up to the cheapest cost) before it is made, as most cost more.
+    fn look(&mut self, baseline: &Baseline, known: &Known, place: usize, change: Change) -> Result<Option<f64>, Need> {
+        let made = known.applied.get(&change);
+        let first_look = made.is_none() && !std::mem::replace(&mut self.looked, true);
+        if self.given_up || (first_look && baseline.leaves_flagged(change, self.bone)) {
+            return Ok(None);
+        }
+        let cheaper = |cost: f64| {
+            self.best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && place < first))
+        };
+        let limit = self.best.map_or(f64::INFINITY, |(cost, ..)| cost);
+        match (made, known.costs.get(&change)) {
+            (Some(Err(_)), _) | (_, Some(Err(_))) => Ok(None),
+            (_, Some(Ok(cost))) if !cheaper(cost.distance.max) => Ok(None),
+            (None, None) if self.best.is_some() => Err(Need::Costed(change, limit)),
+            (None, _) => Err(Need::Made(change)),
+            (Some(Ok(made)), _) if made.standing(self.bone, false).0 => Ok(None),
+            (Some(Ok(_)), None) => Err(Need::Costed(change, limit)),
+            (Some(Ok(_)), Some(Ok(cost))) => Ok(Some(cost.distance.max)),
+        }
+    }
+}
+
+/// The searches for each bone's cheapest removal, side by side: in each round every search goes on as far as what
+/// is known settles, then what they need is made, and costed, together ([`Baseline::apply_each`] and
+/// [`Baseline::costs_within`]: the changes of one part of the rig in one pass over the clip, the source evaluated
+/// once per time for them all). A change several searches need is made or costed once (at the largest limit).
+fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
+    loop {
+        let known_now = &*known;
+        let needs: Vec<(usize, Need)> = searches
+            .par_iter_mut()
+            .enumerate()
+            .filter_map(|(i, search)| Some((i, search.advance(baseline, known_now)?)))
+            .collect();
+        if needs.is_empty() {
+            return;
+        }
+        let made: Vec<Change> = needs.iter().filter_map(|&(_, need)| need.made()).collect();
+        known.make(baseline, &made);
+        let mut limits: HashMap<Change, f64> = HashMap::new();
+        for (change, limit) in needs.iter().filter_map(|&(_, need)| need.costed()) {
+            let at = limits.entry(change).or_insert(limit);
+            *at = at.max(limit);
+        }
+        let baked = |change: &Change| match known.applied.get(change) {
+            Some(Ok(made)) => made.baked.as_ref(),
+            _ => None,
+        };
+        let asked: Vec<(Change, Option<&Rig>, f64)> = distinct(limits.keys().copied())
+            .into_iter()
+            .map(|change| (change, baked(&change), limits[&change]))
+            .collect();
+        let mut given_up = Vec::new();
+        for (change, cost) in baseline.costs_within(&asked) {
+            match cost {
+                Ok(Some(cost)) => drop(known.costs.insert(change, Ok(cost))),
+                Ok(None) => given_up.push(change),
+                Err(why) => drop(known.costs.insert(change, Err(why))),
+            }
+        }
+        for (i, need) in needs {
+            searches[i].given_up = need.costed().is_some_and(|(change, _)| given_up.contains(&change));
+        }
+    }
 }
 
 /// Costs enough of `contenders` (made) into `known` for the cheapest to be among them, exactly: lower bounds of every
@@ -413,42 +495,6 @@ fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
             cheapest = cheapest.min(cost.distance.max);
         }
     }
-}
-
-/// The bones (indices of `changes`, each bone's candidate changes) in groups that share no change, each group in
-/// the order given, the groups in the order of their first bone: bones are in one group where a chain of shared
-/// changes links them.
-fn sharing(changes: &[Vec<Change>]) -> Vec<Vec<usize>> {
-    // Union-find over the bones, a bone linked to the first bone that had each of its changes.
-    let mut leader: Vec<usize> = (0..changes.len()).collect();
-    let mut first: HashMap<Change, usize> = HashMap::new();
-    for (i, changes) in changes.iter().enumerate() {
-        for &change in changes {
-            let other = *first.entry(change).or_insert(i);
-            let (a, b) = (root(&mut leader, i), root(&mut leader, other));
-            leader[a.max(b)] = a.min(b);
-        }
-    }
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut group_of: HashMap<usize, usize> = HashMap::new();
-    for i in 0..changes.len() {
-        let at = *group_of.entry(root(&mut leader, i)).or_insert_with(|| {
-            groups.push(Vec::new());
-            groups.len() - 1
-        });
-        groups[at].push(i);
-    }
-    groups
-}
-
-/// The bone that leads `i`'s group in the union-find `leader` (each bone's link towards it), the links on the way
-/// halved.
-fn root(leader: &mut [usize], mut i: usize) -> usize {
-    while leader[i] != i {
-        leader[i] = leader[leader[i]];
-        i = leader[i];
-    }
-    i
 }
 
 /// Each change once, in a stable order.
@@ -600,21 +646,6 @@ mod tests {
         let alone: Vec<Causes> = asked.iter().map(|&(b, at)| causes(&evaluation, b, &times, at, &tolerances)).collect();
         assert!(together.iter().filter(|c| c.stretched_samples > 0 && !c.spans.is_empty()).count() > 2);
         assert!(together == alone, "a bone's causes depend on the bones found with it");
-    }
-
-    #[test]
-    fn bones_that_share_a_change_are_searched_together_in_the_order_given() {
-        let mode = |bone| Change::Mode { bone, mode: InheritMode::SegmentCompensate };
-        let uniform = |bone| Change::UniformScale { bone };
-        // 0 and 2 share bone 5's mode, 2 and 3 bone 6's scale: one group through 2; 1 and 4 stand alone.
-        let changes =
-            vec![vec![mode(5), uniform(1)], vec![mode(7)], vec![uniform(6), mode(5)], vec![uniform(6)], vec![]];
-        assert_eq!(sharing(&changes), vec![vec![0, 2, 3], vec![1], vec![4]]);
-        // A link found late still joins the groups formed before it: 3 links 2 (bone 3's mode) to 0 (bone 1's).
-        let changes = vec![vec![mode(1)], vec![mode(2)], vec![mode(3)], vec![mode(3), mode(1)]];
-        assert_eq!(sharing(&changes), vec![vec![0, 2, 3], vec![1]]);
-        let changes = vec![vec![mode(1)], vec![mode(2)], vec![mode(2), mode(1)]];
-        assert_eq!(sharing(&changes), vec![vec![0, 1, 2]]);
     }
 
     #[test]
