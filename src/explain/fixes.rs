@@ -12,7 +12,7 @@ use crate::analysis::{
 };
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
-    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each_within, compare_within,
+    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_each_within, compare_within,
     comparison_times,
 };
 use crate::eval::{Evaluation, Setup, Variant};
@@ -305,7 +305,10 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// says: those that keep the clip's times (all but bakes) compared [`BATCH`] at a time in one pass that evaluates
     /// and skins the source once per time for the batch, the bakes each on its own beside them.
     pub fn costs_within(&self, asked: &[(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
-        let (bakes, kept): (Vec<_>, Vec<_>) = asked.iter().partition(|(c, ..)| c.changed_below().is_none());
+        let (bakes, mut kept): (Vec<&(Change, Option<&Rig>, f64)>, Vec<_>) =
+            asked.iter().partition(|(c, ..)| c.changed_below().is_none());
+        // Changes of one part of the rig together: each batch evaluates the source where its changes hang from.
+        kept.sort_by_key(|(change, ..)| change.changed_below());
         let bake_costs = || {
             bakes.into_iter().map(|&(change, made, limit)| (change, self.cost_within(change, made, limit))).collect()
         };
@@ -318,22 +321,64 @@ impl<'e, 'a> Baseline<'e, 'a> {
     fn costs_kept(&self, kept: &[&(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
         let mut costs = Vec::new();
         for batch in kept.chunks(BATCH) {
-            let mut fixed = Vec::new();
-            for &&(change, baked, limit) in batch {
-                match self.fixed(change, baked) {
-                    Ok(evaluation) => {
-                        let pairs = self.pairs(change, &evaluation);
-                        fixed.push((change, evaluation, pairs, limit));
-                    }
-                    Err(why) => costs.push((change, Err(why))),
-                }
-            }
-            let sides: Vec<(&Evaluation, &Pairs, f64)> = fixed.iter().map(|(_, e, p, limit)| (e, p, *limit)).collect();
-            let compared = compare_each_within(self.source, &sides, &self.scale.times, self.scale.size);
+            let (sides, failed) = self.sides(batch.iter().map(|&&(change, baked, limit)| (change, baked, limit)), true);
+            costs.extend(failed.into_iter().map(|(change, why)| (change, Err(why))));
+            let compared: Vec<(&Evaluation, &Pairs, f64)> =
+                sides.iter().map(|(_, e, p, limit)| (e, p, *limit)).collect();
+            let compared = compare_each_within(self.source, &compared, &self.scale.times, self.scale.size);
             let visible = |c: Option<Comparison>| Ok(c.map(|c| self.visible(&c)));
-            costs.extend(fixed.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
+            costs.extend(sides.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
         }
         costs
+    }
+
+    /// What each of `changes` (with, for a bake, the rig it writes, and a limit) is compared with the source on:
+    /// the evaluation it gives and the pairs, with the meshes where `skin` says; and the changes that cannot be made.
+    #[allow(clippy::type_complexity)]
+    fn sides<'r>(
+        &self,
+        changes: impl Iterator<Item = (Change, Option<&'r Rig>, f64)>,
+        skin: bool,
+    ) -> (Vec<(Change, Evaluation<'r>, Pairs, f64)>, Vec<(Change, String)>)
+    where
+        'a: 'r,
+    {
+        let (mut sides, mut failed) = (Vec::new(), Vec::new());
+        for (change, baked, limit) in changes {
+            match self.fixed(change, baked) {
+                Ok(evaluation) => {
+                    let mut pairs = self.pairs(change, &evaluation);
+                    if !skin {
+                        pairs.meshes.clear();
+                    }
+                    sides.push((change, evaluation, pairs, limit));
+                }
+                Err(why) => failed.push((change, why)),
+            }
+        }
+        (sides, failed)
+    }
+
+    /// The lower bound of [`Baseline::cost`] of each of `asked` (a change, and for a bake the rig it writes:
+    /// [`Baseline::cost_bound`]): those that keep the clip's times compared [`BATCH`] at a time in one pass over
+    /// the bound's times that evaluates the source once per time for the batch, the batches and the bakes in
+    /// parallel.
+    pub fn cost_bounds(&self, asked: &[(Change, Option<&Rig>)]) -> Vec<(Change, Result<f64, String>)> {
+        let (bakes, mut kept): (Vec<&(Change, Option<&Rig>)>, Vec<_>) =
+            asked.iter().partition(|(c, _)| c.changed_below().is_none());
+        kept.sort_by_key(|(change, _)| change.changed_below());
+        let stride = (self.scale.times.len() / BOUND_TIMES).max(1);
+        let times: Vec<f64> = self.scale.times.iter().copied().step_by(stride).collect();
+        let kept = kept.par_chunks(BATCH).flat_map_iter(|batch| {
+            let (sides, failed) = self.sides(batch.iter().map(|&&(change, _)| (change, None, f64::INFINITY)), false);
+            let compared: Vec<(&Evaluation, &Pairs)> = sides.iter().map(|(_, e, p, _)| (e, p)).collect();
+            let compared = compare_each(self.source, &compared, &times, self.scale.size);
+            let bounds =
+                sides.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c).distance.max)));
+            failed.into_iter().map(|(change, why)| (change, Err(why))).chain(bounds.collect::<Vec<_>>())
+        });
+        let bakes = bakes.par_iter().map(|&&(change, baked)| (change, self.cost_bound(change, baked)));
+        kept.chain(bakes).collect()
     }
 
     /// A lower bound of [`Baseline::cost`] for a fraction of the work: the bones alone, no skin, at about

@@ -311,25 +311,21 @@ impl Known {
         self.applied.extend(baseline.apply_each(&missing));
     }
 
-    /// The lower bound of the cost of each of `changes`, those not known yet found in parallel (a bake's needs it
-    /// made: one that is not has none).
+    /// The lower bound of the cost of each of `changes`, those not known yet found together
+    /// ([`Baseline::cost_bounds`]; a bake's needs it made: one that is not has none).
     fn bound(&mut self, baseline: &Baseline, changes: &[Change]) -> Vec<Option<f64>> {
         let missing = distinct(changes.iter().copied().filter(|change| !self.bounds.contains_key(change)));
-        let applied = &self.applied;
-        let found: Vec<_> = missing
-            .into_par_iter()
-            .map(|change| {
-                let baked = match change {
-                    Change::Bake { .. } => match applied.get(&change) {
-                        Some(Ok(Applied { baked: Some(rig), .. })) => Some(rig),
-                        _ => return (change, None),
-                    },
-                    _ => None,
-                };
-                (change, baseline.cost_bound(change, baked).ok())
-            })
-            .collect();
-        self.bounds.extend(found);
+        let (mut asked, mut unbounded) = (Vec::new(), Vec::new());
+        for change in missing {
+            match (change.changed_below(), self.applied.get(&change)) {
+                (Some(_), _) => asked.push((change, None)),
+                (None, Some(Ok(Applied { baked: Some(rig), .. }))) => asked.push((change, Some(rig))),
+                (None, _) => unbounded.push(change),
+            }
+        }
+        let found = baseline.cost_bounds(&asked).into_iter().map(|(change, bound)| (change, bound.ok()));
+        let found: Vec<(Change, Option<f64>)> = found.collect();
+        self.bounds.extend(found.into_iter().chain(unbounded.into_iter().map(|change| (change, None))));
         changes.iter().map(|change| self.bounds[change]).collect()
     }
 }
