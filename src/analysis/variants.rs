@@ -37,7 +37,7 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
     let runs: Vec<Vec<ChunkResult>> = times
         .par_chunks(run_length(times.len()))
         .map(|run| {
-            let mut reference = Reference::new(source, &evaluated).expect("variants have a clip");
+            let mut reference = Reference::new(source, &evaluated, &tops).expect("variants have a clip");
             let mut out = ModelPose::default();
             let mut stretches = vec![Stretch::NONE; skeleton.len()];
             let mut variant_stretches: Vec<Vec<Stretch>> =

@@ -333,12 +333,14 @@ pub fn compare_each_within(
     let reference = variants.iter().any(Option::is_some).then(|| {
         let held = variants.iter().zip(&plans).filter(|(v, _)| v.is_some()).map(|(_, plan)| &plan.needed);
         let bones: Vec<usize> = plan_a.needed.iter().chain(held.flatten()).copied().collect();
-        a.skeleton().with_ancestors(&bones)
+        let hanging_from: Vec<usize> = variants.iter().flatten().filter_map(|v| a.skeleton().parent(v.top)).collect();
+        (a.skeleton().with_ancestors(&bones), hanging_from)
     });
     // A side given up in one run is given up: its comparison is `None` whatever the other runs find, so they stop it.
     let given_up: Vec<AtomicBool> = sides.iter().map(|_| AtomicBool::new(false)).collect();
     let runs = over_runs(times, |run| {
-        let mut side_a = match reference.as_ref().and_then(|bones| Reference::new(a, bones)) {
+        let reference = reference.as_ref().and_then(|(bones, hanging_from)| Reference::new(a, bones, hanging_from));
+        let mut side_a = match reference {
             Some(reference) => Side::new(&plan_a, Posing::Reference(Box::new(reference))),
             None => Side::alone(&plan_a),
         };

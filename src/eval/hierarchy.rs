@@ -136,10 +136,16 @@ impl Hierarchy {
     }
 
     /// The same hierarchy evaluating, besides every model matrix, the matrices a child under any mode reads of its
-    /// parent: a reference that changes of mode below any bone are evaluated from ([`Hierarchy::evaluate_below`]).
-    /// Its model matrices are this hierarchy's.
-    pub fn reference(&self) -> Hierarchy {
-        Hierarchy { needs_unscaled: vec![true; self.parents.len()], needs_rigid: true, ..self.clone() }
+    /// parent at the bones `hanging_from`: a reference that changes of mode below their children are evaluated from
+    /// ([`Hierarchy::evaluate_below`]). Its model matrices are this hierarchy's.
+    pub fn reference(&self, hanging_from: &[usize]) -> Hierarchy {
+        let mut needs_unscaled = self.needs_unscaled.clone();
+        for &bone in hanging_from {
+            if let Some(needs) = needs_unscaled.get_mut(bone) {
+                *needs = true;
+            }
+        }
+        Hierarchy { needs_unscaled, needs_rigid: true, ..self.clone() }
     }
 
     pub fn modes(&self) -> &[InheritMode] {

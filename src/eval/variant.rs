@@ -71,10 +71,11 @@ pub struct Reference<'e> {
 
 impl<'e> Reference<'e> {
     /// `reference` (read bone by bone, as its variants are) evaluated on `bones`: sorted, with every ancestor of each,
-    /// holding each variant's bones. `None` without a clip: a rest pose has no variants.
-    pub fn new(reference: &'e Evaluation, bones: &'e [usize]) -> Option<Self> {
+    /// holding each variant's bones; `hanging_from` are the bones the variants hang from (their tops' parents).
+    /// `None` without a clip: a rest pose has no variants.
+    pub fn new(reference: &'e Evaluation, bones: &'e [usize], hanging_from: &[usize]) -> Option<Self> {
         let chains = Chains::new(reference.skeleton(), reference.clip?, bones);
-        Some(Reference { hierarchy: reference.hierarchy.reference(), chains })
+        Some(Reference { hierarchy: reference.hierarchy.reference(hanging_from), chains })
     }
 
     /// The reference at `time`.
@@ -147,7 +148,7 @@ pub(crate) mod tests {
                 let mut modes = vec![InheritMode::Full; skeleton.len()];
                 modes[5] = squash_mode;
                 let source = Evaluation::new(&rig, Some(clip), &modes).unwrap();
-                let mut reference = Reference::new(&source, &every).unwrap();
+                let mut reference = Reference::new(&source, &every, &every).unwrap();
                 let mut out = ModelPose::default();
                 for top in 1..skeleton.len() {
                     for changed in changes_of(&source, top) {
