@@ -820,6 +820,18 @@ mod tests {
             let within = compare_within(&full, &compensated, &pairs, &times, 1.0, largest);
             assert!(within.as_ref() == Some(&whole), "within its own largest distance, the whole comparison");
             assert!(compare_within(&full, &compensated, &pairs, &times, 1.0, largest * (1.0 - 1e-9)).is_none());
+            // In one pass each side keeps its own limit: the side given up stops no other.
+            let aligned = every_bone(&rig, InheritMode::BlenderAligned);
+            let aligned_pairs = Pairs { measure: Measure::Largest, ..Pairs::by_name(&full, &aligned) };
+            let sides = [
+                (&compensated, &pairs, largest * (1.0 - 1e-9)),
+                (&aligned, &aligned_pairs, f64::INFINITY),
+                (&compensated, &pairs, largest),
+            ];
+            let each = compare_each_within(&full, &sides, &times, 1.0);
+            assert!(each[0].is_none(), "given up past its limit");
+            assert!(each[1] == Some(compare_at_size(&full, &aligned, &aligned_pairs, &times, 1.0)));
+            assert!(each[2].as_ref() == Some(&whole), "the same side within its largest distance");
         });
     }
 

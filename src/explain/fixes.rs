@@ -307,9 +307,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// What each of `asked` (a change, for a bake the rig it writes, and a limit) costs, as [`Baseline::cost_within`]
     /// says: those that keep the clip's times (all but bakes) compared [`BATCH`] at a time in one pass that evaluates
     /// and skins the source once per time for the batch, the bakes each on its own beside them.
-    pub fn costs_within(&self, asked: &[(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
-        let (bakes, mut kept): (Vec<&(Change, Option<&Rig>, f64)>, Vec<_>) =
-            asked.iter().partition(|(c, ..)| c.changed_below().is_none());
+    pub fn costs_within(&self, asked: &[Asked]) -> Vec<(Change, Result<Option<Cost>, String>)> {
+        let (bakes, mut kept): (Vec<&Asked>, Vec<_>) = asked.iter().partition(|(c, ..)| c.changed_below().is_none());
         // Changes of one part of the rig together: each batch evaluates the source where its changes hang from.
         kept.sort_by_key(|(change, ..)| change.changed_below());
         let bake_costs = || {
@@ -321,7 +320,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// [`Baseline::costs_within`] of changes that keep the clip's times, [`BATCH`] at a time.
-    fn costs_kept(&self, kept: &[&(Change, Option<&Rig>, f64)]) -> Vec<(Change, Result<Option<Cost>, String>)> {
+    fn costs_kept(&self, kept: &[&Asked]) -> Vec<(Change, Result<Option<Cost>, String>)> {
         let mut costs = Vec::new();
         for batch in kept.chunks(BATCH) {
             let (sides, failed) = self.sides(batch.iter().map(|&&(change, baked, limit)| (change, baked, limit)), true);
@@ -337,12 +336,11 @@ impl<'e, 'a> Baseline<'e, 'a> {
 
     /// What each of `changes` (with, for a bake, the rig it writes, and a limit) is compared with the source on:
     /// the evaluation it gives and the pairs, with the meshes where `skin` says; and the changes that cannot be made.
-    #[allow(clippy::type_complexity)]
     fn sides<'r>(
         &self,
-        changes: impl Iterator<Item = (Change, Option<&'r Rig>, f64)>,
+        changes: impl Iterator<Item = Asked<'r>>,
         skin: bool,
-    ) -> (Vec<(Change, Evaluation<'r>, Pairs, f64)>, Vec<(Change, String)>)
+    ) -> (Vec<Compared<'r>>, Vec<(Change, String)>)
     where
         'a: 'r,
     {
@@ -452,6 +450,14 @@ impl<'e, 'a> Baseline<'e, 'a> {
         move |b: usize| below.as_ref().is_none_or(|bones| bones.binary_search(&b).is_ok())
     }
 }
+
+/// A change asked to be costed: the change, for a bake the rig it writes, and the limit past which its comparison is
+/// given up.
+pub(super) type Asked<'r> = (Change, Option<&'r Rig>, f64);
+
+/// A change made ready to be compared with the source: the change, the evaluation it gives, the pairs compared, and
+/// its limit.
+type Compared<'r> = (Change, Evaluation<'r>, Pairs, f64);
 
 /// What a change is compared with the source on: the evaluation it gives, the pairs, and the source's scale at the
 /// times the two are compared at.

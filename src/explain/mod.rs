@@ -31,8 +31,8 @@ use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
 use crate::analysis::{ClipScan, CurveRequest, SAME_SHEAR_DEG, ScanOptions, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
-use crate::model::{Rig, Tool, Unit, significant};
-use fixes::{Applied, Baseline, bakes_reproduce, candidates, rank};
+use crate::model::{Tool, Unit, significant};
+use fixes::{Applied, Asked, Baseline, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -452,7 +452,7 @@ fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
             Some(Ok(made)) => made.baked.as_ref(),
             _ => None,
         };
-        let asked: Vec<(Change, Option<&Rig>, f64)> = distinct(limits.keys().copied())
+        let asked: Vec<Asked> = distinct(limits.keys().copied())
             .into_iter()
             .map(|change| (change, baked(&change), limits[&change]))
             .collect();
