@@ -458,10 +458,10 @@ fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
             .collect();
         let mut given_up = Vec::new();
         for (change, cost) in baseline.costs_within(&asked) {
-            match cost {
-                Ok(Some(cost)) => drop(known.costs.insert(change, Ok(cost))),
-                Ok(None) => given_up.push(change),
-                Err(why) => drop(known.costs.insert(change, Err(why))),
+            match cost.transpose() {
+                // Past the largest limit asked: it costs more than the cheapest removal of every search that asked.
+                None => given_up.push(change),
+                Some(cost) => _ = known.costs.insert(change, cost),
             }
         }
         for (i, need) in needs {
