@@ -120,8 +120,8 @@ const VARIANTS: usize = 32;
 
 /// About how many times a lower bound of a cost compares ([`Baseline::cost_bound`]). The fixes of one bone often
 /// cost within a few percent of each other: a bound over fewer times ranks them too loosely to rule many out, and
-/// each one not ruled out is made or costed over the whole clip (the production clip of the benchmarks: at 64 times
-/// its search made 121 changes and costed 175, at 512 98 and 110; 1,024 cost more bounding than they saved).
+/// each one not ruled out is made or costed over the whole clip; over many more, bounding costs more than it saves
+/// (measured in BENCHMARKS.md, §11).
 const BOUND_TIMES: usize = 512;
 
 /// How large the character is over a clip: the times an evaluation and its changes are compared at (its own
@@ -291,7 +291,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// [`Baseline::cost`] where it is at most `limit`; `None` once something moves further (the comparison given
     /// up there). Needs the change made only for a bake (`baked`: the rig it writes).
     fn cost_within(&self, change: Change, baked: Option<&Rig>, limit: f64) -> Result<Option<Cost>, String> {
-        let on = self.compared_on(change, baked)?;
+        let on = self.compared_on(change, baked, true)?;
         let Scale { times, size } = &*on.scale;
         Ok(compare_within(self.source, &on.fixed, &on.pairs, times, *size, limit).map(|c| self.visible(&c)))
     }
@@ -323,41 +323,34 @@ impl<'e, 'a> Baseline<'e, 'a> {
     fn costs_kept(&self, kept: &[&Asked]) -> Vec<(Change, Result<Option<Cost>, String>)> {
         let mut costs = Vec::new();
         for batch in kept.chunks(BATCH) {
-            let (sides, failed) = self.sides(batch.iter().map(|&&(change, baked, limit)| (change, baked, limit)), true);
+            let (on, failed) = self.compared_on_each(batch.iter().map(|&&asked| asked), true);
             costs.extend(failed.into_iter().map(|(change, why)| (change, Err(why))));
-            let compared: Vec<(&Evaluation, &Pairs, f64)> =
-                sides.iter().map(|(_, e, p, limit)| (e, p, *limit)).collect();
-            let compared = compare_each_within(self.source, &compared, &self.scale.times, self.scale.size);
+            let sides: Vec<_> = on.iter().map(|(_, on, limit)| (&on.fixed, &on.pairs, *limit)).collect();
+            let compared = compare_each_within(self.source, &sides, &self.scale.times, self.scale.size);
             let visible = |c: Option<Comparison>| Ok(c.map(|c| self.visible(&c)));
-            costs.extend(sides.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
+            costs.extend(on.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
         }
         costs
     }
 
-    /// What each of `changes` (with, for a bake, the rig it writes, and a limit) is compared with the source on:
-    /// the evaluation it gives and the pairs, with the meshes where `skin` says; and the changes that cannot be made.
-    fn sides<'r>(
+    /// What each of `changes` (with, for a bake, the rig it writes, and what the caller keeps with it) is compared
+    /// with the source on ([`Baseline::compared_on`]), and why each that cannot be made cannot.
+    fn compared_on_each<'r, T>(
         &self,
-        changes: impl Iterator<Item = Asked<'r>>,
+        changes: impl Iterator<Item = (Change, Option<&'r Rig>, T)>,
         skin: bool,
-    ) -> (Vec<Compared<'r>>, Vec<(Change, String)>)
+    ) -> (Vec<(Change, ComparedOn<'r, '_>, T)>, Vec<Unmade>)
     where
         'a: 'r,
     {
-        let (mut sides, mut failed) = (Vec::new(), Vec::new());
-        for (change, baked, limit) in changes {
-            match self.fixed(change, baked) {
-                Ok(evaluation) => {
-                    let mut pairs = self.pairs(change, &evaluation);
-                    if !skin {
-                        pairs.meshes.clear();
-                    }
-                    sides.push((change, evaluation, pairs, limit));
-                }
+        let (mut on, mut failed) = (Vec::new(), Vec::new());
+        for (change, baked, kept) in changes {
+            match self.compared_on(change, baked, skin) {
+                Ok(compared) => on.push((change, compared, kept)),
                 Err(why) => failed.push((change, why)),
             }
         }
-        (sides, failed)
+        (on, failed)
     }
 
     /// The lower bound of [`Baseline::cost`] of each of `asked` (a change, and for a bake the rig it writes:
@@ -371,11 +364,10 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let stride = (self.scale.times.len() / BOUND_TIMES).max(1);
         let times: Vec<f64> = self.scale.times.iter().copied().step_by(stride).collect();
         let kept = kept.par_chunks(BATCH).flat_map_iter(|batch| {
-            let (sides, failed) = self.sides(batch.iter().map(|&&(change, _)| (change, None, f64::INFINITY)), false);
-            let compared: Vec<(&Evaluation, &Pairs)> = sides.iter().map(|(_, e, p, _)| (e, p)).collect();
-            let compared = compare_each(self.source, &compared, &times, self.scale.size);
-            let bounds =
-                sides.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c).distance.max)));
+            let (on, failed) = self.compared_on_each(batch.iter().map(|&&(change, _)| (change, None, ())), false);
+            let sides: Vec<(&Evaluation, &Pairs)> = on.iter().map(|(_, on, _)| (&on.fixed, &on.pairs)).collect();
+            let compared = compare_each(self.source, &sides, &times, self.scale.size);
+            let bounds = on.iter().zip(compared).map(|((change, ..), c)| (*change, Ok(self.visible(&c).distance.max)));
             failed.into_iter().map(|(change, why)| (change, Err(why))).chain(bounds.collect::<Vec<_>>())
         });
         let bakes = bakes.par_iter().map(|&&(change, baked)| (change, self.cost_bound(change, baked)));
@@ -394,21 +386,22 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time, with the
     /// skin where `skin` says (else on the bones alone).
     fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize, skin: bool) -> Result<Cost, String> {
-        let mut on = self.compared_on(change, baked)?;
-        if !skin {
-            on.pairs.meshes.clear();
-        }
+        let on = self.compared_on(change, baked, skin)?;
         let compared: Vec<f64> = on.scale.times.iter().copied().step_by(stride).collect();
         Ok(self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &compared, on.scale.size)))
     }
 
-    /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on.
-    fn compared_on<'r>(&self, change: Change, baked: Option<&'r Rig>) -> Result<ComparedOn<'r, '_>, String>
+    /// What `change` (for a bake, `baked` the rig it writes) is compared with the source on, with the meshes where
+    /// `skin` says (else on the bones alone).
+    fn compared_on<'r>(&self, change: Change, baked: Option<&'r Rig>, skin: bool) -> Result<ComparedOn<'r, '_>, String>
     where
         'a: 'r,
     {
         let fixed = self.fixed(change, baked)?;
-        let pairs = self.pairs(change, &fixed);
+        let mut pairs = self.pairs(change, &fixed);
+        if !skin {
+            pairs.meshes.clear();
+        }
         // A change that keeps the clip's times (any but a bake) keeps the scale found once.
         let scale = match baked {
             None => Cow::Borrowed(&*self.scale),
@@ -455,9 +448,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
 /// given up.
 pub(super) type Asked<'r> = (Change, Option<&'r Rig>, f64);
 
-/// A change made ready to be compared with the source: the change, the evaluation it gives, the pairs compared, and
-/// its limit.
-type Compared<'r> = (Change, Evaluation<'r>, Pairs, f64);
+/// A change that cannot be made, and why.
+type Unmade = (Change, String);
 
 /// What a change is compared with the source on: the evaluation it gives, the pairs, and the source's scale at the
 /// times the two are compared at.
