@@ -551,6 +551,20 @@ fn accessor_out_of_range_is_an_error() {
 }
 
 #[test]
+fn the_first_channel_that_fails_is_the_one_named() {
+    // Outputs are decoded on every core before the channels are read in order: an output that does not decode is
+    // named only where its channel comes first, and an earlier channel's own failure still comes first.
+    let mut sample = sample();
+    sample.json["accessors"][2]["normalized"] = json!(false);
+    sample.json["animations"][0]["channels"][0]["sampler"] = json!(7);
+    assert_fails(load_glb(&sample), "animations[0].channels[0].sampler", "refers to samplers[7]");
+    sample.json["animations"][0]["channels"][0]["sampler"] = json!(1);
+    sample.json["animations"][0]["channels"][0]["target"]["path"] = json!("rotation");
+    sample.json["animations"][0]["channels"][1]["target"]["node"] = json!(0);
+    assert_fails(load_glb(&sample), "accessors[2]", "rotation output must be VEC4");
+}
+
+#[test]
 fn accessor_types_are_checked() {
     let mut sample = sample();
     sample.json["accessors"][2]["normalized"] = json!(false);

@@ -6,7 +6,7 @@ use std::path::Path;
 use super::ImportError;
 
 /// What went wrong, and where in the file.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub(super) struct Failure {
     pub place: Option<String>,
     pub message: String,

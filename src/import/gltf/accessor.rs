@@ -8,8 +8,8 @@
 //! [`MAX_ZEROS`] bytes so a tiny hostile file cannot ask for gigabytes.
 
 use std::borrow::Cow;
-use std::cell::OnceCell;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use glam::{DMat4, Quat, Vec3};
 
@@ -67,15 +67,15 @@ pub(super) struct Accessors<'a> {
     root: &'a Root,
     buffers: &'a Buffers<'a>,
     /// Per buffer view, its bytes once decoded, where `EXT_meshopt_compression` compresses it.
-    decoded: Vec<OnceCell<std::result::Result<Vec<u8>, String>>>,
+    decoded: Vec<OnceLock<std::result::Result<Vec<u8>, String>>>,
     /// Per accessor, the bytes a `KHR_draco_mesh_compression` primitive decoded for it (tightly packed).
-    supplied: Vec<OnceCell<Vec<u8>>>,
+    supplied: Vec<OnceLock<Vec<u8>>>,
 }
 
 impl<'a> Accessors<'a> {
     pub fn new(root: &'a Root, buffers: &'a Buffers<'a>) -> Self {
-        let decoded = root.buffer_views.iter().map(|_| OnceCell::new()).collect();
-        Accessors { root, buffers, decoded, supplied: root.accessors.iter().map(|_| OnceCell::new()).collect() }
+        let decoded = root.buffer_views.iter().map(|_| OnceLock::new()).collect();
+        Accessors { root, buffers, decoded, supplied: root.accessors.iter().map(|_| OnceLock::new()).collect() }
     }
 
     /// Decodes a Draco-compressed primitive (at `place`): its accessors then read what it decodes to.

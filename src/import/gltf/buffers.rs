@@ -10,10 +10,10 @@
 //! stays bounded by what the files actually hold.
 
 use std::borrow::Cow;
-use std::cell::OnceCell;
 use std::io::Read;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use super::schema::{self, Uint};
 use super::source::Region;
@@ -25,7 +25,7 @@ pub(super) struct Buffers<'a> {
     declared: &'a [schema::Buffer],
     blob: Option<Region<'a>>,
     folder: &'a Path,
-    loaded: Vec<OnceCell<std::result::Result<Data<'a>, String>>>,
+    loaded: Vec<OnceLock<std::result::Result<Data<'a>, String>>>,
 }
 
 /// A buffer's bytes: in memory (a `data:` URI's, decoded as the JSON was read, or a file's beside the glTF file), or
@@ -37,7 +37,7 @@ enum Data<'a> {
 
 impl<'a> Buffers<'a> {
     pub fn new(declared: &'a [schema::Buffer], blob: Option<Region<'a>>, folder: &'a Path) -> Self {
-        Buffers { declared, blob, folder, loaded: declared.iter().map(|_| OnceCell::new()).collect() }
+        Buffers { declared, blob, folder, loaded: declared.iter().map(|_| OnceLock::new()).collect() }
     }
 
     /// The length of `buffers[index]` (its `byteLength`, which its data has been checked to hold); `user`

@@ -8,7 +8,6 @@
 
 use std::borrow::Cow;
 use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
 use std::ops::Range;
 
 /// The whole file, in memory or on disk.
@@ -40,14 +39,30 @@ impl<'a> Source<'a> {
                 if range.end > *len {
                     return Err(outside(*len));
                 }
-                let mut file: &File = file;
                 let mut bytes = vec![0; range.len()];
-                file.seek(SeekFrom::Start(range.start as u64))?;
-                file.read_exact(&mut bytes)?;
+                read_at(file, &mut bytes, range.start as u64)?;
                 Ok(Cow::Owned(bytes))
             }
         }
     }
+}
+
+/// Fills `bytes` from `file` at `offset`, leaving the file's own position alone: accessors are read on several
+/// threads at once.
+#[cfg(unix)]
+fn read_at(file: &File, bytes: &mut [u8], offset: u64) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, bytes, offset)
+}
+
+#[cfg(windows)]
+fn read_at(file: &File, mut bytes: &mut [u8], mut offset: u64) -> std::io::Result<()> {
+    while !bytes.is_empty() {
+        match std::os::windows::fs::FileExt::seek_read(file, bytes, offset)? {
+            0 => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+            read => (bytes, offset) = (&mut bytes[read..], offset + read as u64),
+        }
+    }
+    Ok(())
 }
 
 fn outside(len: usize) -> std::io::Error {
