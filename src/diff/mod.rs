@@ -428,7 +428,7 @@ impl<'p> Differences<'p> {
         for difference in &mut self.bones {
             let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
-            let probe = probe_distance(wa, wb, probe_length).max(probe_distance(wb, wa, probe_length));
+            let probe = probe_distance(wa, wb, probe_length);
             difference.probe.add(probe, time);
             self.largest = self.largest.max(probe);
             if self.measure != Measure::Everything {
@@ -710,19 +710,20 @@ pub fn model_curves(evaluation: &Evaluation, bones: &[usize], times: &[f64]) -> 
     (0..bones.len()).map(|b| chunks.iter().flat_map(|chunk| chunk[b].iter().copied()).collect()).collect()
 }
 
-/// The largest distance between where `wa` and `wb` put the origin and the points `probe_length` along each of
-/// `wa`'s axes (axes of zero length have no probe).
+/// The largest distance between where `wa` and `wb` put the origin and the points `probe_length` along each axis
+/// of either (axes of zero length have no probe).
 fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
+    // One side's difference is the other's negated, the same distances; compared squared, the root of the largest
+    // being the largest root.
     let difference = *wa - *wb;
-    let origin = difference.w_axis.truncate().length();
-    (0..3).fold(origin, |largest, axis| {
-        let length = wa.col(axis).truncate().length();
-        if length == 0.0 {
-            return largest;
-        }
-        let point = DVec3::AXES[axis] * (probe_length / length);
-        largest.max(difference.transform_point3(point).length())
-    })
+    let probes = [wa, wb].into_iter().flat_map(|w| {
+        (0..3).filter_map(move |axis| {
+            let length = w.col(axis).truncate().length();
+            let point = move || DVec3::AXES[axis] * (probe_length / length);
+            (length != 0.0).then(|| difference.transform_point3(point()).length_squared())
+        })
+    });
+    probes.fold(difference.w_axis.truncate().length_squared(), f64::max).sqrt()
 }
 
 /// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other
