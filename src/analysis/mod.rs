@@ -20,4 +20,4 @@ pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};
 pub use scan::{analyze, flagged_in_run, scan};
-pub use variants::scan_variants;
+pub use variants::{JudgedRun, VariantJudges, scan_variants};

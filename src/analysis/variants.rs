@@ -15,7 +15,7 @@ use super::peak;
 use super::request::ScanOptions;
 use super::scan::assemble;
 use super::stretch::Stretch;
-use crate::eval::{Evaluation, ModelPose, Reference, Variant, run_length};
+use crate::eval::{Beside, Evaluation, ModelPose, Pose, Reference, Variant, run_length};
 use crate::model::Transform;
 
 /// Each variant of `source` scanned as [`super::analyze`] scans it judging its top's subtree
@@ -25,62 +25,125 @@ pub fn scan_variants(source: &Evaluation, variants: &[Variant], options: &ScanOp
     if variants.is_empty() {
         return Vec::new();
     }
-    let skeleton = source.skeleton();
     let times = source.times(options.rate);
-    let judge = Judge::new(&options.tolerances);
-    let own: Vec<Judging> = variants.iter().map(|v| Judging::of_variant(v)).collect();
-    let tops: Vec<usize> = variants.iter().filter_map(|v| skeleton.parent(v.top)).collect();
-    let above = Judging::of_bones(source, &skeleton.with_ancestors(&tops));
-    let every: Vec<usize> = variants.iter().flat_map(|v| v.bones.iter().copied()).collect();
-    let evaluated = skeleton.with_ancestors(&every);
-    let root = Stretch::uniform(skeleton.placement().conversion_scale());
-    let runs: Vec<Vec<ChunkResult>> = times
+    let judges = VariantJudges::new(source, variants, options);
+    let runs: Vec<JudgedRun> = times
         .par_chunks(run_length(times.len()))
         .map(|run| {
-            let mut reference = Reference::new(source, &evaluated, &tops).expect("variants have a clip");
+            let mut reference =
+                Reference::new(source, judges.bones(), &judges.hanging_from).expect("variants have a clip");
             let mut out = ModelPose::default();
-            let mut stretches = vec![Stretch::NONE; skeleton.len()];
-            let mut variant_stretches: Vec<Vec<Stretch>> =
-                variants.iter().map(|v| vec![Stretch::NONE; v.bones.len()]).collect();
-            // Each variant's own bones alone, by their place among them.
-            let mut results: Vec<ChunkResult> =
-                variants.iter().map(|v| ChunkResult::new(v.bones.len(), run.len())).collect();
+            let mut judged = judges.run(run.len());
             for (sample, &time) in run.iter().enumerate() {
-                reference.evaluate(time);
-                let pose = reference.pose();
-                for &(bone, inherits, parent) in &above.bones {
-                    let over = parent.map_or(root, |p| p.stretch(&[], &stretches));
-                    let start = stretches[bone].frame();
-                    stretches[bone] = judged(inherits, over, &pose.local[bone], &pose.model.model[bone], start, &judge);
-                }
-                for ((variant, judging), (own, result)) in
-                    variants.iter().zip(&own).zip(variant_stretches.iter_mut().zip(&mut results))
-                {
+                judges.reference(&mut judged, reference.evaluate(time));
+                for (k, variant) in variants.iter().enumerate() {
                     reference.evaluate_variant(variant, &mut out);
-                    for (k, &(bone, inherits, parent)) in judging.bones.iter().enumerate() {
-                        let over = parent.map_or(root, |p| p.stretch(own, &stretches));
-                        let local = variant.local(&pose.local, bone);
-                        own[k] = judged(inherits, over, &local, &out.model[bone], own[k].frame(), &judge);
-                        result.add(k, sample, time, &own[k].verdict(&judge));
-                    }
+                    judges.variant(&mut judged, k, sample, time, reference.pose(), &out);
                 }
             }
-            results
+            judged
         })
         .collect();
-    let mut per_variant: Vec<Vec<ChunkResult>> = variants.iter().map(|_| Vec::new()).collect();
-    for run in runs {
-        per_variant.iter_mut().zip(run).for_each(|(chunks, chunk)| chunks.push(chunk));
+    judges.scans(times, runs)
+}
+
+/// Variants of one evaluation judged as [`scan_variants`] judges them, by whichever pass over the clip evaluates
+/// them ([`Beside`]): a scan of its own, or a comparison of the variants with their source that judges them on the
+/// way ([`crate::diff::compare_each_beside`]), each variant evaluated once for both.
+pub struct VariantJudges<'v, 'e, 'a> {
+    source: &'v Evaluation<'a>,
+    variants: &'v [Variant<'e, 'a>],
+    judge: Judge,
+    /// Each variant's bones, and the bones above them (judged on the source).
+    own: Vec<Judging>,
+    above: Judging,
+    /// What a root inherits: the placement's scale.
+    root: Stretch,
+    /// Every variant's bones with their ancestors, and the bones the variants hang from (their tops' parents).
+    evaluated: Vec<usize>,
+    hanging_from: Vec<usize>,
+}
+
+/// What one run of samples found: the stretches of the bones above the variants at its last sample, each variant's
+/// own, and each variant's summaries of its bones.
+pub struct JudgedRun {
+    above: Vec<Stretch>,
+    own: Vec<Vec<Stretch>>,
+    results: Vec<ChunkResult>,
+}
+
+impl<'v, 'e, 'a> VariantJudges<'v, 'e, 'a> {
+    /// `variants` of `source`, judged with `options`' tolerances.
+    pub fn new(source: &'v Evaluation<'a>, variants: &'v [Variant<'e, 'a>], options: &ScanOptions) -> Self {
+        let skeleton = source.skeleton();
+        let hanging_from: Vec<usize> = variants.iter().filter_map(|v| skeleton.parent(v.top)).collect();
+        let every: Vec<usize> = variants.iter().flat_map(|v| v.bones.iter().copied()).collect();
+        VariantJudges {
+            source,
+            variants,
+            judge: Judge::new(&options.tolerances),
+            own: variants.iter().map(Judging::of_variant).collect(),
+            above: Judging::of_bones(source, &skeleton.with_ancestors(&hanging_from)),
+            root: Stretch::uniform(skeleton.placement().conversion_scale()),
+            evaluated: skeleton.with_ancestors(&every),
+            hanging_from,
+        }
     }
-    per_variant
-        .into_par_iter()
-        .zip(variants)
-        .map(|(chunks, variant)| {
-            let mut analysis = assemble(skeleton.figure(), times.clone(), Vec::new(), chunks, &variant.bones);
-            peak::refine(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &judge);
-            analysis.scan
-        })
-        .collect()
+
+    /// Each variant's scan from the runs of samples at `times` (the analysis's, [`Evaluation::times`]) in time
+    /// order: its summaries assembled, each worst shear refined between samples.
+    pub fn scans(&self, times: Vec<f64>, runs: Vec<JudgedRun>) -> Vec<ClipScan> {
+        let mut per_variant: Vec<Vec<ChunkResult>> = self.variants.iter().map(|_| Vec::new()).collect();
+        for run in runs {
+            per_variant.iter_mut().zip(run.results).for_each(|(chunks, chunk)| chunks.push(chunk));
+        }
+        let figure = self.source.skeleton().figure();
+        per_variant
+            .into_par_iter()
+            .zip(self.variants)
+            .map(|(chunks, variant)| {
+                let mut analysis = assemble(figure, times.clone(), Vec::new(), chunks, &variant.bones);
+                peak::refine(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &self.judge);
+                analysis.scan
+            })
+            .collect()
+    }
+}
+
+impl Beside for VariantJudges<'_, '_, '_> {
+    type Run = JudgedRun;
+
+    fn bones(&self) -> &[usize] {
+        &self.evaluated
+    }
+
+    fn run(&self, samples: usize) -> JudgedRun {
+        JudgedRun {
+            above: vec![Stretch::NONE; self.source.skeleton().len()],
+            own: self.variants.iter().map(|v| vec![Stretch::NONE; v.bones.len()]).collect(),
+            // Each variant's own bones alone, by their place among them.
+            results: self.variants.iter().map(|v| ChunkResult::new(v.bones.len(), samples)).collect(),
+        }
+    }
+
+    fn reference(&self, run: &mut JudgedRun, pose: &Pose) {
+        let stretches = &mut run.above;
+        for &(bone, inherits, parent) in &self.above.bones {
+            let over = parent.map_or(self.root, |p| p.stretch(&[], stretches));
+            let start = stretches[bone].frame();
+            stretches[bone] = judged(inherits, over, &pose.local[bone], &pose.model.model[bone], start, &self.judge);
+        }
+    }
+
+    fn variant(&self, run: &mut JudgedRun, k: usize, sample: usize, time: f64, reference: &Pose, model: &ModelPose) {
+        let (variant, own, result) = (&self.variants[k], &mut run.own[k], &mut run.results[k]);
+        for (i, &(bone, inherits, parent)) in self.own[k].bones.iter().enumerate() {
+            let over = parent.map_or(self.root, |p| p.stretch(own, &run.above));
+            let local = variant.local(&reference.local, bone);
+            own[i] = judged(inherits, over, &local, &model.model[bone], own[i].frame(), &self.judge);
+            result.add(i, sample, time, &own[i].verdict(&self.judge));
+        }
+    }
 }
 
 /// A bone's stretch (`start`: where a decomposition starts its search) under `over`, its parent's (or what a root

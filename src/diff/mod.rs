@@ -33,7 +33,7 @@ use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
 use crate::eval::skinning::Skinner;
-use crate::eval::{BonesEvaluator, Evaluation, Pose, Reach, Reference, Variant, over_runs};
+use crate::eval::{Beside, BonesEvaluator, Evaluation, ModelPose, Pose, Reach, Reference, Variant, over_runs};
 use crate::math::{AffineParts, angle_between, decompose, decompose_all};
 use crate::model::{MAX_FRAMES, Rig, sample_times};
 
@@ -307,6 +307,55 @@ pub fn compare_each_within(
     times: &[f64],
     rig_size: f64,
 ) -> Vec<Option<Comparison>> {
+    let (compared, _) = compare_sides(a, sides, times, rig_size, None::<&Unseen>).expect("nothing beside");
+    compared
+}
+
+/// [`compare_each`] of `sides`, each a variant of `a` ([`Variant`]), and in the same pass `beside` given A's pose and
+/// each side's at every time, in the runs of samples of [`over_runs`] (what it kept of each run, in time order): a
+/// variant evaluated once for both. `None`, before any work, where a side is not evaluated from A's pose (another
+/// clip, layers, morph targets).
+pub fn compare_each_beside<B: Beside>(
+    a: &Evaluation,
+    sides: &[(&Evaluation, &Pairs)],
+    times: &[f64],
+    rig_size: f64,
+    beside: &B,
+) -> Option<(Vec<Comparison>, Vec<B::Run>)> {
+    let sides: Vec<_> = sides.iter().map(|&(b, pairs)| (b, pairs, f64::INFINITY)).collect();
+    let (compared, runs) = compare_sides(a, &sides, times, rig_size, Some(beside))?;
+    Some((compared.into_iter().map(|c| c.expect("no distance passes an infinite limit")).collect(), runs))
+}
+
+/// Nothing beside a comparison.
+struct Unseen;
+
+impl Beside for Unseen {
+    type Run = ();
+
+    fn bones(&self) -> &[usize] {
+        &[]
+    }
+
+    fn run(&self, _: usize) {}
+
+    fn reference(&self, (): &mut (), _: &Pose) {}
+
+    fn variant(&self, (): &mut (), _: usize, _: usize, _: f64, _: &Pose, _: &ModelPose) {}
+}
+
+/// What one comparison pass found: each side's comparison (`None` where given up), and what a [`Beside`] kept of each
+/// run of samples.
+type Passed<R> = (Vec<Option<Comparison>>, Vec<R>);
+
+/// [`compare_each_within`], and `beside` where given ([`compare_each_beside`]: `None` where a side is no variant).
+fn compare_sides<B: Beside>(
+    a: &Evaluation,
+    sides: &[(&Evaluation, &Pairs, f64)],
+    times: &[f64],
+    rig_size: f64,
+    beside: Option<&B>,
+) -> Option<Passed<B::Run>> {
     let probe_length = rig_size * PROBE_FRACTION;
     let reaches: Vec<Vec<Option<Reach>>> = sides.iter().map(|&(b, pairs, _)| reaches(a, b, pairs)).collect();
     let fresh = || {
@@ -330,9 +379,13 @@ pub fn compare_each_within(
     // and every variant's bones with what they hang from.
     let variants: Vec<Option<Variant>> =
         plans.iter().map(|plan| Variant::of(a, plan.evaluation).filter(|_| !plan.morphs && !plan_a.morphs)).collect();
+    if beside.is_some() && variants.iter().any(Option::is_none) {
+        return None;
+    }
     let reference = variants.iter().any(Option::is_some).then(|| {
         let held = variants.iter().zip(&plans).filter(|(v, _)| v.is_some()).map(|(_, plan)| &plan.needed);
-        let bones: Vec<usize> = plan_a.needed.iter().chain(held.flatten()).copied().collect();
+        let seen = beside.map_or(&[][..], |beside| beside.bones());
+        let bones: Vec<usize> = plan_a.needed.iter().chain(held.flatten()).chain(seen).copied().collect();
         let hanging_from: Vec<usize> = variants.iter().flatten().filter_map(|v| a.skeleton().parent(v.top)).collect();
         (a.skeleton().with_ancestors(&bones), hanging_from)
     });
@@ -353,26 +406,36 @@ pub fn compare_each_within(
             })
             .collect();
         let mut differences = fresh();
-        for &time in run {
+        let mut kept = beside.map(|beside| beside.run(run.len()));
+        for (sample, &time) in run.iter().enumerate() {
             if given_up.iter().all(|given_up| given_up.load(Ordering::Relaxed)) {
                 break;
             }
             side_a.evaluate(time);
-            let compared = others.iter_mut().zip(&mut differences).zip(sides.iter().zip(&given_up));
-            for ((side_b, found), (&(.., limit), given_up)) in
-                compared.filter(|(_, (_, given_up))| !given_up.load(Ordering::Relaxed))
+            let mut seen = beside.zip(kept.as_mut());
+            if let Some((beside, seen)) = &mut seen {
+                beside.reference(seen, side_a.posing.pose());
+            }
+            let compared = others.iter_mut().zip(&mut differences).zip(sides.iter().zip(&given_up)).enumerate();
+            for (k, ((side_b, found), (&(.., limit), given_up))) in
+                compared.filter(|(_, (_, (_, given_up)))| !given_up.load(Ordering::Relaxed))
             {
                 side_b.evaluate_beside(time, &side_a);
+                if let Some((beside, seen)) = &mut seen {
+                    beside.variant(seen, k, sample, time, side_a.posing.pose(), &side_b.posing.pose().model);
+                }
                 found.add(&mut side_a, side_b, probe_length, time);
                 if found.largest > limit {
                     given_up.store(true, Ordering::Relaxed);
                 }
             }
         }
-        differences
+        (differences, kept)
     });
-    let totals =
-        runs.into_iter().reduce(|earlier, later| earlier.into_iter().zip(later).map(|(x, y)| x.merge(y)).collect());
+    let (differences, kept): (Vec<_>, Vec<_>) = runs.into_iter().unzip();
+    let totals = differences
+        .into_iter()
+        .reduce(|earlier, later| earlier.into_iter().zip(later).map(|(x, y)| x.merge(y)).collect());
     let count = times.len().max(1) as f64;
     let finish = |(found, &(.., limit)): (Differences, &(&Evaluation, &Pairs, f64))| {
         if found.largest > limit {
@@ -382,7 +445,8 @@ pub fn compare_each_within(
         let meshes = found.meshes.into_iter().map(mean).collect();
         Some(Comparison { samples: times.len(), rig_size, bones: found.bones, meshes })
     };
-    totals.unwrap_or_else(fresh).into_iter().zip(sides).map(finish).collect()
+    let compared = totals.unwrap_or_else(fresh).into_iter().zip(sides).map(finish).collect();
+    Some((compared, kept.into_iter().flatten().collect()))
 }
 
 /// The differences found over some of the times.

@@ -32,4 +32,4 @@ pub use setup::{Setup, SetupError};
 pub use skinning::{Method as SkinningMethod, Reach, skin_meshes};
 #[cfg(test)]
 pub(crate) use variant::tests::changes_of as variant_changes_of;
-pub use variant::{Reference, Variant};
+pub use variant::{Beside, Reference, Variant};

@@ -62,6 +62,29 @@ fn only_uniform_scales(evaluation: &Evaluation) -> Option<Vec<usize>> {
     (*stack.layers() == Layers { uniform_scale: uniform.clone(), ..Layers::default() }).then(|| uniform.clone())
 }
 
+/// What else a pass over the clip that evaluates variants of a reference does with them, time after time in the runs
+/// of samples of [`super::over_runs`]: at each time the reference's pose once, then each variant's model matrices.
+/// A scan judges the variants so; a comparison of the variants with the reference can judge them on its way, each
+/// evaluated once for both.
+pub trait Beside: Sync {
+    /// What a run of samples keeps.
+    type Run: Send;
+
+    /// The bones the reference is evaluated on for this (sorted, with every ancestor of each), besides the pass's
+    /// own.
+    fn bones(&self) -> &[usize];
+
+    /// A new run of `samples` samples.
+    fn run(&self, samples: usize) -> Self::Run;
+
+    /// The reference at the run's next time.
+    fn reference(&self, run: &mut Self::Run, pose: &Pose);
+
+    /// Variant `k` at sample `sample` of the run, at `time`: the reference's pose there, and the variant's model
+    /// matrices (its own bones' at least).
+    fn variant(&self, run: &mut Self::Run, k: usize, sample: usize, time: f64, reference: &Pose, model: &ModelPose);
+}
+
 /// A reference evaluated for its variants, time after time: the bones they hang from and their own bones, read bone
 /// by bone, with every matrix a variant's modes may read ([`Hierarchy::reference`]).
 pub struct Reference<'e> {

@@ -8,12 +8,12 @@ use std::sync::atomic::AtomicBool;
 use rayon::prelude::*;
 
 use crate::analysis::{
-    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, analyze, flagged_in_run, scan_variants,
+    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, VariantJudges, analyze, flagged_in_run, scan_variants,
 };
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
-    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_each_within, compare_within,
-    comparison_times,
+    Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_each_beside,
+    compare_each_within, compare_within, comparison_times,
 };
 use crate::eval::{Evaluation, Setup, Variant};
 use crate::import;
@@ -206,7 +206,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// mode or a uniform scale at one bone) scanned together, [`VARIANTS`] at a time in one pass over the clip
     /// ([`scan_variants`]); the others one by one, and the bakes beside them all, one after the other (each is
     /// parallel within, with a part that is not, and holds every sample of every bone while it runs).
-    pub fn apply_each(&self, changes: &[Change]) -> Vec<(Change, Result<Applied, String>)> {
+    pub fn apply_each(&self, changes: &[Change]) -> Vec<Made> {
         // Only a change below one bone may be a variant; a bake is a rig of its own.
         let (below, bakes): (Vec<Change>, Vec<Change>) =
             changes.iter().partition(|change| change.changed_below().is_some());
@@ -218,8 +218,75 @@ impl<'e, 'a> Baseline<'e, 'a> {
         applied
     }
 
+    /// Each of `changes` made and scanned ([`Baseline::apply_each`]) and, where made, costed ([`Baseline::costs`]):
+    /// the variants of the source scanned in the passes that compare them with it, [`BATCH`] at a time
+    /// ([`compare_each_beside`]: each variant evaluated once for both); the others (the bakes beside them all) made,
+    /// then costed.
+    pub fn made_and_costed(&self, changes: &[Change]) -> (Vec<Made>, Vec<Costed>) {
+        // A scan samples the analysis's times, a comparison the comparison's: one pass serves both where they agree.
+        let beside = self.analysis_times == self.scale.times;
+        let (below, apart): (Vec<Change>, Vec<Change>) =
+            changes.iter().partition(|change| beside && change.changed_below().is_some());
+        let ((mut made, mut costs, left), (made_apart, costs_apart)) =
+            rayon::join(|| self.made_beside(below), || self.made_then_costed(&apart));
+        let (made_left, costs_left) = self.made_then_costed(&left);
+        made.extend(made_apart.into_iter().chain(made_left));
+        costs.extend(costs_apart.into_iter().chain(costs_left));
+        (made, costs)
+    }
+
+    /// [`Baseline::made_and_costed`] of changes below one bone each, scanned as they are compared, and those left
+    /// to be made apart (those that are no variants of the source).
+    fn made_beside(&self, mut below: Vec<Change>) -> (Vec<Made>, Vec<Costed>, Vec<Change>) {
+        let (mut made, mut costs, mut left) = (Vec::new(), Vec::new(), Vec::new());
+        // Changes of one part of the rig together: each batch evaluates the source where its changes hang from.
+        below.sort_by_key(|change| change.changed_below());
+        for batch in below.chunks(BATCH) {
+            let (on, failed) = self.compared_on_each(batch.iter().map(|&change| (change, None, ())), true);
+            made.extend(failed.into_iter().map(|(change, why)| (change, Err(why))));
+            // Those not read bone by bone (layers, another unit, no clip) are made apart.
+            let (on, alone): (Vec<_>, Vec<_>) =
+                on.into_iter().partition(|(_, on, ())| Variant::of(self.source, &on.fixed).is_some());
+            left.extend(alone.into_iter().map(|(change, ..)| change));
+            match self.scanned_beside(&on) {
+                Some(found) => {
+                    for (change, applied, cost) in found {
+                        made.push((change, Ok(applied)));
+                        costs.push((change, Ok(cost)));
+                    }
+                }
+                None => left.extend(on.iter().map(|(change, ..)| *change)),
+            }
+        }
+        (made, costs, left)
+    }
+
+    /// Each of `changes` made ([`Baseline::apply_each`]), then those made costed ([`Baseline::costs`]).
+    fn made_then_costed(&self, changes: &[Change]) -> (Vec<Made>, Vec<Costed>) {
+        let made = self.apply_each(changes);
+        let costed: Vec<(Change, &Applied)> =
+            made.iter().filter_map(|(change, made)| Some((*change, made.as_ref().ok()?))).collect();
+        let costs = self.costs(&costed);
+        (made, costs)
+    }
+
+    /// Changes that are variants of the source (with what each is compared on) made, scanned and costed in one
+    /// pass over the clip; `None` where the comparison cannot evaluate one from the source's pose (morph targets).
+    fn scanned_beside(&self, on: &[(Change, ComparedOn, ())]) -> Option<Vec<(Change, Applied, Cost)>> {
+        let variants: Vec<Variant> = on.iter().filter_map(|(_, on, ())| Variant::of(self.source, &on.fixed)).collect();
+        let judges = VariantJudges::new(self.source, &variants, self.options);
+        let sides: Vec<(&Evaluation, &Pairs)> = on.iter().map(|(_, on, ())| (&on.fixed, &on.pairs)).collect();
+        let (compared, runs) = compare_each_beside(self.source, &sides, &self.scale.times, self.scale.size, &judges)?;
+        let scans = judges.scans(self.analysis_times.clone(), runs);
+        let found = on.iter().zip(scans).zip(compared);
+        let made = found.map(|(((change, ..), scan), comparison)| {
+            (*change, self.applied(*change, None, &scan), self.visible(&comparison))
+        });
+        Some(made.collect())
+    }
+
     /// [`Baseline::apply_each`] of changes below one bone each.
-    fn apply_below(&self, mut below: Vec<Change>) -> Vec<(Change, Result<Applied, String>)> {
+    fn apply_below(&self, mut below: Vec<Change>) -> Vec<Made> {
         let (mut applied, mut alone) = (Vec::new(), Vec::new());
         // Changes of one part of the rig together, each batch's evaluations made for it alone.
         below.sort_by_key(|change| change.changed_below());
@@ -297,7 +364,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says ([`Baseline::costs_within`], no limit).
-    pub fn costs(&self, changes: &[(Change, &Applied)]) -> Vec<(Change, Result<Cost, String>)> {
+    pub fn costs(&self, changes: &[(Change, &Applied)]) -> Vec<Costed> {
         let asked: Vec<_> =
             changes.iter().map(|&(change, made)| (change, made.baked.as_ref(), f64::INFINITY)).collect();
         let costs = self.costs_within(&asked).into_iter();
@@ -450,6 +517,12 @@ pub(super) type Asked<'r> = (Change, Option<&'r Rig>, f64);
 
 /// A change that cannot be made, and why.
 type Unmade = (Change, String);
+
+/// A change made, or why it cannot be.
+pub(super) type Made = (Change, Result<Applied, String>);
+
+/// What a change costs, or why that cannot be found.
+pub(super) type Costed = (Change, Result<Cost, String>);
 
 /// What a change is compared with the source on: the evaluation it gives, the pairs, and the source's scale at the
 /// times the two are compared at.
@@ -665,6 +738,35 @@ mod tests {
         rank(&mut fixes, None);
         let order: Vec<usize> = fixes.iter().map(|f| f.change.changed_below().unwrap()).collect();
         assert_eq!(order, [4, 2, 3, 1], "less shear left first, then the same shear by cost");
+    }
+
+    #[test]
+    fn a_change_scanned_as_it_is_compared_is_the_change_scanned_and_compared_apart() {
+        // Every mode of every bone and each bone's scale made uniform, on the demo rig (a skinned tube) and the stress
+        // rig (a spine, chains squashing on their fifth bone), and a bake: made and costed in the passes that compare
+        // them with the source, each is what it is made and costed on its own, bit for bit. A mode a bone already
+        // has, and the bake, are no variants: made apart.
+        for rig in [crate::import::demo_rig(), crate::import::stress_rig(12, 300, 3)] {
+            let source = Evaluation::declared(&rig, rig.clips.first());
+            let options = ScanOptions::default();
+            let before = crate::analysis::scan(&source, &options, &|_, _| {});
+            let baseline = Baseline::new(&source, &before, &options, None);
+            let of_bone = |bone: usize| {
+                let modes = InheritMode::ALL.iter().map(move |&mode| Change::Mode { bone, mode });
+                modes.chain([Change::UniformScale { bone }])
+            };
+            let mut changes: Vec<Change> = (1..rig.skeleton.len()).flat_map(of_bone).collect();
+            changes.push(Change::Bake { strategy: Strategy::Trs });
+            let (applied, costs) = baseline.made_and_costed(&changes);
+            let costs: std::collections::HashMap<Change, Cost> =
+                costs.into_iter().map(|(change, cost)| (change, cost.unwrap())).collect();
+            assert_eq!((applied.len(), costs.len()), (changes.len(), changes.len()));
+            for (change, made) in applied {
+                let (made, alone) = (made.unwrap(), baseline.apply(change).unwrap());
+                assert_eq!(made.shear, alone.shear, "{change:?}");
+                assert_eq!(costs[&change], baseline.cost(change, &alone).unwrap(), "{change:?}");
+            }
+        }
     }
 
     #[test]

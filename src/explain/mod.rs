@@ -245,11 +245,7 @@ pub fn explain(
     match question.costs {
         Costs::Every => {
             let every: Vec<Change> = changes.iter().flatten().copied().collect();
-            known.make(&baseline, &every);
-            let made = distinct(every).into_iter();
-            let made: Vec<_> =
-                made.filter_map(|change| Some((change, known.applied[&change].as_ref().ok()?))).collect();
-            known.costs = baseline.costs(&made).into_iter().collect();
+            known.make_costed(&baseline, &every);
         }
         Costs::Best => {
             let bakes: Vec<Change> =
@@ -309,6 +305,17 @@ impl Known {
     fn make(&mut self, baseline: &Baseline, changes: &[Change]) {
         let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
         self.applied.extend(baseline.apply_each(&missing));
+    }
+
+    /// Makes and costs each of `changes` not yet made, in one pass over the clip for both where they are variants
+    /// of the source ([`Baseline::made_and_costed`]); a cost found before is kept.
+    fn make_costed(&mut self, baseline: &Baseline, changes: &[Change]) {
+        let missing = distinct(changes.iter().copied().filter(|change| !self.applied.contains_key(change)));
+        let (applied, costs) = baseline.made_and_costed(&missing);
+        self.applied.extend(applied);
+        for (change, cost) in costs {
+            self.costs.entry(change).or_insert(cost);
+        }
     }
 
     /// The lower bound of the cost of each of `changes`, those not known yet found together
@@ -441,7 +448,11 @@ fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
         if needs.is_empty() {
             return;
         }
-        let made: Vec<Change> = needs.iter().filter_map(|&(_, need)| need.made()).collect();
+        // A change made whose cost is not known yet is costed in the same pass: it is needed by a search that has
+        // found no removal, and is costed next where it is one.
+        let (costed, made): (Vec<Change>, Vec<Change>) =
+            needs.iter().filter_map(|&(_, need)| need.made()).partition(|change| !known.costs.contains_key(change));
+        known.make_costed(baseline, &costed);
         known.make(baseline, &made);
         let mut limits: HashMap<Change, f64> = HashMap::new();
         for (change, limit) in needs.iter().filter_map(|&(_, need)| need.costed()) {
