@@ -780,14 +780,23 @@ fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
     // One side's difference is the other's negated, the same distances; compared squared, the root of the largest
     // being the largest root.
     let difference = *wa - *wb;
-    let probes = [wa, wb].into_iter().flat_map(|w| {
-        (0..3).filter_map(move |axis| {
+    // The difference moves a point `s` along an axis by the axis's column times `s` plus the origin's: the whole
+    // product but for terms of zero, where nothing is infinite (which would make them not a number).
+    let finite = difference.is_finite();
+    let moved = |axis: usize, s: f64| match finite {
+        true => (difference.col(axis) * s + difference.w_axis).truncate(),
+        false => difference.transform_point3(DVec3::AXES[axis] * s),
+    };
+    let mut largest = difference.w_axis.truncate().length_squared();
+    for w in [wa, wb] {
+        for axis in 0..3 {
             let length = w.col(axis).truncate().length();
-            let point = move || DVec3::AXES[axis] * (probe_length / length);
-            (length != 0.0).then(|| difference.transform_point3(point()).length_squared())
-        })
-    });
-    probes.fold(difference.w_axis.truncate().length_squared(), f64::max).sqrt()
+            if length != 0.0 {
+                largest = largest.max(moved(axis, probe_length / length).length_squared());
+            }
+        }
+    }
+    largest.sqrt()
 }
 
 /// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other
@@ -941,6 +950,13 @@ mod tests {
         let a = DMat4::IDENTITY;
         let b = DMat4::from_rotation_translation(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2), DVec3::X);
         assert!((probe_distance(&a, &b, 2.0) - 5f64.sqrt()).abs() < 1e-12);
+        // Where a difference is infinite the whole product is taken, as before: every probe then meets infinity
+        // times zero, which is not a number and ignored, leaving the origins' distance (the columns alone would find
+        // √5 along A's X axis). A's Y axis has no length, so no probe meets the infinite column itself.
+        let flat = DMat4::from_cols(glam::DVec4::X, glam::DVec4::ZERO, glam::DVec4::Z, glam::DVec4::W);
+        let mut infinite = b;
+        infinite.y_axis = glam::DVec4::new(f64::INFINITY, 0.0, 0.0, 0.0);
+        assert_eq!(probe_distance(&flat, &infinite, 2.0), 1.0);
         assert!((angle_between(DQuat::IDENTITY, DQuat::from_rotation_y(0.3)) - 0.3).abs() < 1e-15);
         assert_eq!(scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(4.0, 1.0, 2.0)), 1.0, "order does not matter");
         assert!((scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(1.0, 2.5, 4.0)) - 1.25).abs() < 1e-15);
