@@ -2,7 +2,8 @@
 //! pass over the clip:
 //! the bones above the variants are sampled, evaluated and judged once per time for all of them, and each variant
 //! evaluates and judges its own subtree under them. Explaining a shear weighs every mode of every bone below a
-//! squash; scanned one by one, each would evaluate its chain from the root again.
+//! squash; scanned one by one, each would evaluate its chain from the root again. The judging is its own type
+//! ([`VariantJudges`]), so that a pass that compares the variants with the evaluation judges them on its way.
 
 use rayon::prelude::*;
 
