@@ -244,18 +244,22 @@ impl<'e, 'a> Baseline<'e, 'a> {
         for batch in below.chunks(BATCH) {
             let (on, failed) = self.compared_on_each(batch.iter().map(|&change| (change, None, ())), true);
             made.extend(failed.into_iter().map(|(change, why)| (change, Err(why))));
-            // Those not read bone by bone (layers, another unit, no clip) are made apart.
-            let (on, alone): (Vec<_>, Vec<_>) =
-                on.into_iter().partition(|(_, on, ())| Variant::of(self.source, &on.fixed).is_some());
-            left.extend(alone.into_iter().map(|(change, ..)| change));
-            match self.scanned_beside(&on) {
+            let mut variants = Vec::new();
+            for (change, on, ()) in &on {
+                match Variant::of(self.source, &on.fixed) {
+                    Some(variant) => variants.push((*change, on, variant)),
+                    // Not read bone by bone (layers, another unit, no clip): made apart.
+                    None => left.push(*change),
+                }
+            }
+            match self.scanned_beside(&variants) {
                 Some(found) => {
                     for (change, applied, cost) in found {
                         made.push((change, Ok(applied)));
                         costs.push((change, Ok(cost)));
                     }
                 }
-                None => left.extend(on.iter().map(|(change, ..)| *change)),
+                None => left.extend(variants.iter().map(|(change, ..)| *change)),
             }
         }
         (made, costs, left)
@@ -270,15 +274,16 @@ impl<'e, 'a> Baseline<'e, 'a> {
         (made, costs)
     }
 
-    /// Changes that are variants of the source (with what each is compared on) made, scanned and costed in one
-    /// pass over the clip; `None` where the comparison cannot evaluate one from the source's pose (morph targets).
-    fn scanned_beside(&self, on: &[(Change, ComparedOn, ())]) -> Option<Vec<(Change, Applied, Cost)>> {
-        let variants: Vec<Variant> = on.iter().filter_map(|(_, on, ())| Variant::of(self.source, &on.fixed)).collect();
+    /// Changes that are variants of the source (with what each is compared on, and the variant it is) made, scanned
+    /// and costed in one pass over the clip; `None` where the comparison cannot evaluate one from the source's pose
+    /// (morph targets).
+    fn scanned_beside(&self, changes: &[(Change, &ComparedOn, Variant)]) -> Option<Vec<(Change, Applied, Cost)>> {
+        let variants: Vec<Variant> = changes.iter().map(|(.., variant)| variant.clone()).collect();
         let judges = VariantJudges::new(self.source, &variants, self.options);
-        let sides: Vec<(&Evaluation, &Pairs)> = on.iter().map(|(_, on, ())| (&on.fixed, &on.pairs)).collect();
+        let sides: Vec<(&Evaluation, &Pairs)> = changes.iter().map(|(_, on, _)| (&on.fixed, &on.pairs)).collect();
         let (compared, runs) = compare_each_beside(self.source, &sides, &self.scale.times, self.scale.size, &judges)?;
         let scans = judges.scans(self.analysis_times.clone(), runs);
-        let found = on.iter().zip(scans).zip(compared);
+        let found = changes.iter().zip(scans).zip(compared);
         let made = found.map(|(((change, ..), scan), comparison)| {
             (*change, self.applied(*change, None, &scan), self.visible(&comparison))
         });

@@ -75,6 +75,14 @@ impl Property {
         }
     }
 
+    /// What a channel's output accessor holds for this property, as errors name it (rotations have their own).
+    fn output(self) -> &'static str {
+        match self {
+            Property::Scale => "scale output",
+            _ => "translation output",
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Property::Translation => "translation",
@@ -121,11 +129,10 @@ impl Reader<'_, '_> {
                 let read = self.bone_of_node.get(node).is_some_and(Option::is_some);
                 let sampler = self.sampler(animation, channel.sampler, &channel_place);
                 let Some(output) = sampler.ok().filter(|_| read).map(|s| s.output) else { continue };
-                let place = format!("animations[{index}].samplers[{}]", channel.sampler.0);
+                let place = sampler_place(index, channel.sampler);
                 match property {
                     Property::Translation | Property::Scale if seen.insert((false, output)) => {
-                        let what = if property == Property::Scale { "scale output" } else { "translation output" };
-                        vec3s.push((output, place, what));
+                        vec3s.push((output, place, property.output()));
                     }
                     Property::Rotation if seen.insert((true, output)) => rotations.push((output, place)),
                     _ => {}
@@ -170,23 +177,21 @@ impl Reader<'_, '_> {
                 continue;
             };
             let sampler = self.sampler(animation, channel.sampler, &channel_place)?;
-            let place = format!("animations[{index}].samplers[{}]", channel.sampler.0);
+            let place = sampler_place(index, channel.sampler);
             let times = self.times(sampler.input, &place)?;
             let interpolation = interpolation(sampler, &place)?;
             let output = sampler.output;
             // A bone whose only channels are morph weights gets an empty entry, dropped below.
             let bone_tracks = tracks.entry(bone).or_insert_with(|| BoneTracks::new(bone));
             match property {
-                Property::Translation => {
-                    let values = decoded(&mut self.vec3s, output, || {
-                        self.accessors.vec3s(output, &place, "translation output")
-                    })?;
-                    bone_tracks.translation = Some(track(times, values, interpolation, &place)?);
-                }
-                Property::Scale => {
+                Property::Translation | Property::Scale => {
                     let values =
-                        decoded(&mut self.vec3s, output, || self.accessors.vec3s(output, &place, "scale output"))?;
-                    bone_tracks.scale = Some(track(times, values, interpolation, &place)?);
+                        decoded(&mut self.vec3s, output, || self.accessors.vec3s(output, &place, property.output()))?;
+                    let track = Some(track(times, values, interpolation, &place)?);
+                    match property {
+                        Property::Scale => bone_tracks.scale = track,
+                        _ => bone_tracks.translation = track,
+                    }
                 }
                 Property::Rotation => {
                     let values = decoded(&mut self.rotations, output, || self.accessors.rotations(output, &place))?;
@@ -262,7 +267,7 @@ impl Reader<'_, '_> {
         sampler_index: Uint,
         animation: usize,
     ) -> Result<MorphWeights> {
-        let place = format!("animations[{animation}].samplers[{}]", sampler_index.0);
+        let place = sampler_place(animation, sampler_index);
         let times = self.times(sampler.input, &place)?;
         let interpolation = interpolation(sampler, &place)?;
         let outputs = self.accessors.morph_weights(sampler.output, &place)?;
@@ -277,6 +282,11 @@ impl Reader<'_, '_> {
             Entry::Vacant(entry) => Ok(entry.insert(self.accessors.times(input, place)?.into()).clone()),
         }
     }
+}
+
+/// Where a channel's sampler is, as errors name it.
+fn sampler_place(animation: usize, sampler: Uint) -> String {
+    format!("animations[{animation}].samplers[{}]", sampler.0)
 }
 
 /// The values of `accessor`, decoded by `decode` on first use (or ahead: [`Reader::decode_ahead`]).
