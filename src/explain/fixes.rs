@@ -158,6 +158,9 @@ pub(super) struct Baseline<'e, 'a> {
     /// The times a scan of the source samples, which a change of modes or a uniform scale keeps (they follow the
     /// clip, and layers only where they retime it).
     analysis_times: Vec<f64>,
+    /// The source's bones and meshes paired with themselves by name: what every change of the source's own rig (any
+    /// but a bake) is compared on, before the pairs it leaves alone are dropped.
+    own_pairs: Pairs,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
@@ -171,7 +174,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let scale = scale.map_or_else(|| Cow::Owned(Scale::of(source, options.rate)), Cow::Borrowed);
         debug_assert_eq!(scale.times, comparison_times(source, source, options.rate), "the source's scale");
         let analysis_times = source.times(options.rate);
-        Baseline { source, before, options, scale, analysis_times }
+        let own_pairs = Pairs::by_name(source, source);
+        Baseline { source, before, options, scale, analysis_times, own_pairs }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -487,7 +491,11 @@ impl<'e, 'a> Baseline<'e, 'a> {
     fn pairs(&self, change: Change, fixed: &Evaluation) -> Pairs {
         let changed = self.changed(change);
         let figure = self.source.skeleton().figure();
-        let mut pairs = Pairs { measure: Measure::Largest, ..Pairs::by_name(self.source, fixed) };
+        let by_name = match std::ptr::eq(fixed.rig, self.source.rig) {
+            true => self.own_pairs.clone(),
+            false => Pairs::by_name(self.source, fixed),
+        };
+        let mut pairs = Pairs { measure: Measure::Largest, ..by_name };
         pairs.bones.pairs.retain(|&(a, _)| changed(a) && figure[a]);
         let moving =
             |pair: MeshPair| Some(MeshPair { vertices: following(self.source.rig, pair.a, &changed)?, ..pair });
