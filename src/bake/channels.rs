@@ -7,11 +7,13 @@
 //! rotations), keyed by [`reduce`]. A channel that only repeats its node's default is left out; one that holds a
 //! single value keeps two keys.
 
+use std::collections::VecDeque;
+
 use glam::DQuat;
 use rayon::prelude::*;
 
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property};
-use super::keys::{Metrics, reduce, weights_error};
+use super::keys::{BoneMetric, Metrics, Reducer, reduce, weights_error};
 use super::layout::{NodePlan, unit};
 use super::nodes::{NodeSample, Sampled};
 use super::times::BakeTimes;
@@ -55,81 +57,184 @@ fn bone_channels(
     document: &GltfDocument,
     bone: usize,
 ) -> Vec<Channel> {
-    let helper = layout.helper_node[bone].is_some();
     let series = &clip.sampled.series[bone];
-    let baked: Vec<NodeSample> = series.nodes.iter().map(|n| n.as_baked(helper)).collect();
-    let values = NodeValues::of(&baked, helper);
-    let (keys, interpolation) = match values.steps(&clip.base.step_flags(&series.times)) {
-        Some(keys) => (keys, Interpolation::Step),
-        None => {
-            let metric = metrics.bone(&clip.sampled.stats.parent_gain, bone);
-            let error = |i, j, k| metric.error(&series.times, &baked, (i, j, k));
-            (reduce(series.times.len(), metrics.budget, error), Interpolation::Linear)
-        }
-    };
-    let keys = distinct_f32_times(&keys, &series.times);
-    let key_times: Vec<f32> = keys.iter().map(|&k| series.times[k] as f32).collect();
-    let (outer, own) = (layout.helper_node[bone].unwrap_or(layout.bone_node[bone]), layout.bone_node[bone]);
-    let mut wanted = vec![
-        (outer, Property::Translation, &values.translation, 3),
-        (outer, Property::Rotation, &values.rotation, 4),
-        (outer, Property::Scale, &values.scale, 3),
-    ];
-    if helper {
-        wanted.push((own, Property::Rotation, &values.own_rotation, 4));
+    let mut keys = BoneKeys::new(layout, metrics, &clip.sampled.stats.parent_gain, bone);
+    for (&time, node) in series.times.iter().zip(&series.nodes) {
+        keys.push(time, node, clip.base);
     }
-    wanted
-        .into_iter()
-        .filter_map(|(node, property, all, width)| {
-            let at_keys = keys.iter().flat_map(|&k| all[k * width..(k + 1) * width].iter().copied()).collect();
-            let default = default_values(&document.nodes[node], property);
-            channel(node, property, interpolation, &key_times, at_keys, &default)
-        })
-        .collect()
+    keys.channels(layout, document, bone)
 }
 
-/// A bone's node values at every sample, as written (single precision).
-struct NodeValues {
-    translation: Vec<f32>,
-    rotation: Vec<f32>,
-    scale: Vec<f32>,
-    /// The bone's own node's rotation `Uᵀ` under a helper (empty without one).
-    own_rotation: Vec<f32>,
+/// One bone's keys, chosen as its samples come in time order (each bone's nodes as sampled, frames followed): every
+/// sample as written, the keys as far as the samples known settle them, and only the samples the keys still to come
+/// may need.
+///
+/// A bone whose nodes only ever change at a stepped key of the source (between the sample before the key and the
+/// key) holds still between keys: its channels are written with STEP interpolation, keyed where the values change,
+/// which reproduces the jump exactly. The others are linear (slerp for rotations), keyed by [`Reducer`].
+struct BoneKeys {
+    helper: bool,
+    metric: BoneMetric,
+    budget: f64,
+    /// How many samples came.
+    count: usize,
+    /// The samples from the first the reducer may still need on: (time, nodes as baked, as written).
+    window: VecDeque<(f64, NodeSample, Written)>,
+    reducer: Reducer,
+    /// How many of the reducer's keys are in `linear`.
+    taken: usize,
+    /// The reducer's keys so far, as written.
+    linear: Vec<Written>,
+    stepped: Steps,
+    /// The last sample as written.
+    last: Option<Written>,
 }
 
-impl NodeValues {
-    /// From a bone's samples as baked (with a `helper` or without).
-    fn of(samples: &[NodeSample], helper: bool) -> Self {
-        NodeValues {
-            translation: samples.iter().flat_map(|s| s.translation.as_vec3().to_array()).collect(),
-            rotation: continuous(samples.iter().map(|s| s.rotation)),
-            scale: samples.iter().flat_map(|s| s.scale.as_vec3().to_array()).collect(),
-            own_rotation: if helper { continuous(samples.iter().map(|s| s.stretch.conjugate())) } else { Vec::new() },
+impl BoneKeys {
+    fn new(layout: &NodePlan, metrics: &Metrics, gains: &[f64], bone: usize) -> Self {
+        BoneKeys {
+            helper: layout.helper_node[bone].is_some(),
+            metric: metrics.bone(gains, bone),
+            budget: metrics.budget,
+            count: 0,
+            window: VecDeque::new(),
+            reducer: Reducer::default(),
+            taken: 0,
+            linear: Vec::new(),
+            stepped: Steps(Some(Vec::new())),
+            last: None,
         }
     }
 
-    /// Whether sample `s` and the next are written alike.
-    fn same(&self, s: usize) -> bool {
-        let equal = |values: &[f32], width: usize| {
-            values.is_empty() || values[s * width..(s + 1) * width] == values[(s + 1) * width..(s + 2) * width]
+    /// The next sample: the bone's `node` at `time` (frames followed), of a clip first sampled at `base`.
+    fn push(&mut self, time: f64, node: &NodeSample, base: &BakeTimes) {
+        let baked = node.as_baked(self.helper);
+        let written = Written::of(time, &baked, self.helper, self.last.as_ref());
+        self.stepped.push(self.last.as_ref(), written, base.is_step(time));
+        self.window.push_back((time, baked, written));
+        self.count += 1;
+        self.last = Some(written);
+        self.choose(false);
+    }
+
+    /// Lets the reducer choose what the samples so far settle (`all`: every sample came), records its keys, and
+    /// drops the samples it no longer needs.
+    fn choose(&mut self, all: bool) {
+        let offset = self.count - self.window.len();
+        let (metric, window) = (&self.metric, &self.window);
+        let sample = |s: usize| {
+            let (time, node, _) = &window[s - offset];
+            (*time, node)
         };
-        equal(&self.translation, 3) && equal(&self.rotation, 4) && equal(&self.scale, 3) && equal(&self.own_rotation, 4)
+        let error = |i: usize, j: usize, k: usize| metric.error([i, j, k].map(sample));
+        match all {
+            true => self.reducer.finish(self.count, self.budget, error),
+            false => self.reducer.grow(self.count, self.budget, error),
+        }
+        for &key in &self.reducer.keys[self.taken..] {
+            self.linear.push(self.window[key - offset].2);
+        }
+        self.taken = self.reducer.keys.len();
+        self.window.drain(..self.reducer.from() - offset);
     }
 
-    /// The samples to key with STEP interpolation (the first, and every stepped key where the values change), when
-    /// the values only ever change at stepped keys; `None` otherwise.
-    fn steps(&self, steps: &[bool]) -> Option<Vec<usize>> {
-        let mut keys = vec![0];
-        for s in 0..steps.len().saturating_sub(1) {
-            if self.same(s) {
-                continue;
+    /// The bone's channels, every sample having come.
+    fn channels(mut self, layout: &NodePlan, document: &GltfDocument, bone: usize) -> Vec<Channel> {
+        let (keys, interpolation) = match std::mem::replace(&mut self.stepped, Steps(None)).keys() {
+            Some(keys) => (keys, Interpolation::Step),
+            None => {
+                self.choose(true);
+                (self.linear, Interpolation::Linear)
             }
-            if !steps[s + 1] {
-                return None;
-            }
-            keys.push(s + 1);
+        };
+        let keys = distinct_f32_times(keys, |key| key.time);
+        let key_times: Vec<f32> = keys.iter().map(|k| k.time as f32).collect();
+        let (outer, own) = (layout.helper_node[bone].unwrap_or(layout.bone_node[bone]), layout.bone_node[bone]);
+        let mut wanted: Vec<(usize, Property, WrittenValues)> = vec![
+            (outer, Property::Translation, |w| &w.translation),
+            (outer, Property::Rotation, |w| &w.rotation),
+            (outer, Property::Scale, |w| &w.scale),
+        ];
+        if self.helper {
+            wanted.push((own, Property::Rotation, |w| &w.own_rotation));
         }
-        (keys.len() > 1).then_some(keys)
+        wanted
+            .into_iter()
+            .filter_map(|(node, property, values)| {
+                let at_keys = keys.iter().flat_map(|k| values(k).iter().copied()).collect();
+                let default = default_values(&document.nodes[node], property);
+                channel(node, property, interpolation, &key_times, at_keys, &default)
+            })
+            .collect()
+    }
+}
+
+/// The keys of a bone whose values only ever change at stepped keys: the first sample and every stepped key where
+/// the values change; `None` once they change anywhere else.
+struct Steps(Option<Vec<Written>>);
+
+impl Steps {
+    /// The next sample, `written`, after `last`; `stepped` where a stepped key is at it.
+    fn push(&mut self, last: Option<&Written>, written: Written, stepped: bool) {
+        let Some(keys) = &mut self.0 else { return };
+        match last {
+            None => keys.push(written),
+            Some(last) if last.same(&written) => {}
+            Some(_) if stepped => keys.push(written),
+            Some(_) => self.0 = None,
+        }
+    }
+
+    /// The keys, where the values changed at stepped keys alone, and at one at least.
+    fn keys(self) -> Option<Vec<Written>> {
+        self.0.filter(|keys| keys.len() > 1)
+    }
+}
+
+/// The numbers of one node's property in a sample as written.
+type WrittenValues = fn(&Written) -> &[f32];
+
+/// One sample of a bone's nodes as written (single precision), with its time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Written {
+    time: f64,
+    translation: [f32; 3],
+    /// In the hemisphere of the sample before (slerp between keys then takes the short way whether or not a player
+    /// checks).
+    rotation: [f32; 4],
+    scale: [f32; 3],
+    /// The bone's own node's rotation `Uᵀ` under a helper (nothing without one), in the hemisphere of the sample
+    /// before.
+    own_rotation: [f32; 4],
+    /// Both rotations before they were written, whose hemispheres the next sample's follow.
+    turns: [DQuat; 2],
+}
+
+impl Written {
+    /// `node` (as baked, with a `helper` or without) at `time`, after the sample `before`.
+    fn of(time: f64, node: &NodeSample, helper: bool, before: Option<&Written>) -> Self {
+        let near = |q: DQuat, k: usize| match before {
+            Some(before) if before.turns[k].dot(q) < 0.0 => -q,
+            _ => q,
+        };
+        let rotation = near(node.rotation, 0);
+        let own = if helper { near(node.stretch.conjugate(), 1) } else { DQuat::IDENTITY };
+        Written {
+            time,
+            translation: node.translation.as_vec3().to_array(),
+            rotation: unit(rotation),
+            scale: node.scale.as_vec3().to_array(),
+            own_rotation: if helper { unit(own) } else { [0.0; 4] },
+            turns: [rotation, own],
+        }
+    }
+
+    /// Whether `other` is written alike.
+    fn same(&self, other: &Written) -> bool {
+        self.translation == other.translation
+            && self.rotation == other.rotation
+            && self.scale == other.scale
+            && self.own_rotation == other.own_rotation
     }
 }
 
@@ -158,7 +263,7 @@ fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, doc
             })
             .collect();
         let keys = reduce(times.len(), metrics.budget, |i, j, k| weights_error(&samples, times, &amplitude, (i, j, k)));
-        let keys = distinct_f32_times(&keys, times);
+        let keys = distinct_f32_times(keys, |&k| times[k]);
         let key_times: Vec<f32> = keys.iter().map(|&k| times[k] as f32).collect();
         let values = keys.iter().flat_map(|&k| samples[k].iter().map(|&w| w as f32)).collect();
         let linear = Interpolation::Linear;
@@ -167,22 +272,6 @@ fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, doc
         }
     }
     channels
-}
-
-/// Rotation keys in single precision, each in the hemisphere of the one before (slerp between them then takes the
-/// short way whether or not a player checks).
-fn continuous(rotations: impl Iterator<Item = DQuat>) -> Vec<f32> {
-    let mut previous: Option<DQuat> = None;
-    let mut values = Vec::new();
-    for q in rotations {
-        let q = match previous {
-            Some(p) if p.dot(q) < 0.0 => -q,
-            _ => q,
-        };
-        values.extend(unit(q));
-        previous = Some(q);
-    }
-    values
 }
 
 /// The node's default value of `property`, as the numbers a channel of it holds per key.
@@ -237,13 +326,13 @@ fn near(a: &[f32], b: &[f32], resolution: f32) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x == y || (x - y).abs() <= resolution)
 }
 
-/// `keys` without the samples whose time rounds to the same `f32` as an earlier one's (glTF's times are `f32` and
-/// strictly increasing).
-fn distinct_f32_times(keys: &[usize], times: &[f64]) -> Vec<usize> {
-    let mut out: Vec<usize> = Vec::with_capacity(keys.len());
-    for &k in keys {
-        if out.last().is_none_or(|&last| (times[k] as f32) > (times[last] as f32)) {
-            out.push(k);
+/// `keys` without those whose time rounds to the same `f32` as an earlier one's (glTF's times are `f32` and strictly
+/// increasing).
+fn distinct_f32_times<K>(keys: Vec<K>, time: impl Fn(&K) -> f64) -> Vec<K> {
+    let mut out: Vec<K> = Vec::with_capacity(keys.len());
+    for key in keys {
+        if out.last().is_none_or(|last| (time(&key) as f32) > (time(last) as f32)) {
+            out.push(key);
         }
     }
     out
@@ -253,22 +342,27 @@ fn distinct_f32_times(keys: &[usize], times: &[f64]) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    fn values(translations: &[f32]) -> NodeValues {
-        NodeValues {
-            translation: translations.iter().flat_map(|&x| [x, 0.0, 0.0]).collect(),
-            rotation: translations.iter().flat_map(|_| [0.0, 0.0, 0.0, 1.0]).collect(),
-            scale: translations.iter().flat_map(|_| [1.0; 3]).collect(),
-            own_rotation: Vec::new(),
+    /// The step keys of samples moved along X by `translations`, a stepped key at the samples `steps` flags: the
+    /// indices of the samples keyed.
+    fn step_keys(translations: &[f64], steps: &[bool]) -> Option<Vec<usize>> {
+        let mut stepped = Steps(Some(Vec::new()));
+        let mut last: Option<Written> = None;
+        for (k, (&x, &step)) in translations.iter().zip(steps).enumerate() {
+            let node = NodeSample { translation: glam::DVec3::X * x, ..NodeSample::IDENTITY };
+            let written = Written::of(k as f64, &node, false, last.as_ref());
+            stepped.push(last.as_ref(), written, step);
+            last = Some(written);
         }
+        stepped.keys().map(|keys| keys.iter().map(|k| k.time as usize).collect())
     }
 
     #[test]
     fn values_that_change_only_at_stepped_keys_are_steps() {
         // Samples: 0, lead, key, frame, lead, key.
         let steps = [false, false, true, false, false, true];
-        assert_eq!(values(&[1.0, 1.0, 2.0, 2.0, 2.0, 3.0]).steps(&steps), Some(vec![0, 2, 5]));
-        assert_eq!(values(&[1.0, 1.5, 2.0, 2.0, 2.0, 3.0]).steps(&steps), None, "a change that is not a jump");
-        assert_eq!(values(&[1.0; 6]).steps(&steps), None, "nothing to step");
+        assert_eq!(step_keys(&[1.0, 1.0, 2.0, 2.0, 2.0, 3.0], &steps), Some(vec![0, 2, 5]));
+        assert_eq!(step_keys(&[1.0, 1.5, 2.0, 2.0, 2.0, 3.0], &steps), None, "a change that is not a jump");
+        assert_eq!(step_keys(&[1.0; 6], &steps), None, "nothing to step");
     }
 
     #[test]
@@ -287,6 +381,7 @@ mod tests {
         assert_eq!(kept.times.len(), 3, "a motion single precision resolves is kept");
         let near_default = [2e-14, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -1e-15, 1.0];
         assert_eq!(channel(0, Property::Translation, linear, &times, near_default.to_vec(), &[0.0, 0.0, 1.0]), None);
-        assert_eq!(distinct_f32_times(&[0, 1, 2], &[0.5, 0.5 + 1e-12, 1.0]), [0, 2], "one f32 time");
+        let times = [0.5, 0.5 + 1e-12, 1.0];
+        assert_eq!(distinct_f32_times(vec![0, 1, 2], |&k| times[k]), [0, 2], "one f32 time");
     }
 }

@@ -24,36 +24,90 @@ use crate::math::angle_between;
 /// The indices of the samples to keep among `count` (the first and last always), such that
 /// `error(i, j, k) ≤ tolerance` for every dropped `k` between its kept neighbours `i < k < j`.
 pub fn reduce(count: usize, tolerance: f64, error: impl Fn(usize, usize, usize) -> f64) -> Vec<usize> {
-    if count <= 2 {
-        return (0..count).collect();
+    let mut reducer = Reducer::default();
+    reducer.finish(count, tolerance, error);
+    reducer.keys
+}
+
+/// [`reduce`] as the samples come: it keeps the keys it can choose from the samples known so far, and needs no
+/// sample before [`Reducer::from`] again, so a caller may drop them. The keys are [`reduce`]'s whatever the samples'
+/// arrival.
+#[derive(Clone, Debug, Default)]
+pub struct Reducer {
+    /// The keys chosen so far.
+    pub keys: Vec<usize>,
+    /// The last key, from which the next is pushed as far as it goes.
+    from: usize,
+    /// The farthest sample the span from `from` is known to reach, and how far the next try goes beyond it.
+    good: usize,
+    step: usize,
+}
+
+impl Reducer {
+    /// The first sample the keys still to come may need.
+    pub fn from(&self) -> usize {
+        self.from
     }
-    let spans = |from: usize, to: usize| (from + 1..to).all(|k| error(from, to, k) <= tolerance);
-    let last = count - 1;
-    let mut keys = vec![0];
-    let mut from = 0;
-    while from < last {
-        let (mut good, mut step) = (from + 1, 1);
-        let mut bad = None;
-        while good < last {
-            let candidate = (good + step).min(last);
-            if spans(from, candidate) {
-                good = candidate;
-                step *= 2;
-            } else {
-                bad = Some(candidate);
-                break;
-            }
-        }
-        if let Some(mut bad) = bad {
-            while bad - good > 1 {
-                let middle = good + (bad - good) / 2;
-                if spans(from, middle) { good = middle } else { bad = middle }
-            }
-        }
-        keys.push(good);
-        from = good;
+
+    /// Chooses the keys `count` samples known so far settle (more follow).
+    pub fn grow(&mut self, count: usize, tolerance: f64, error: impl Fn(usize, usize, usize) -> f64) {
+        self.choose(count, None, tolerance, error);
     }
-    keys
+
+    /// Chooses the rest of the keys, `count` being every sample.
+    pub fn finish(&mut self, count: usize, tolerance: f64, error: impl Fn(usize, usize, usize) -> f64) {
+        if count == 0 {
+            return;
+        }
+        self.choose(count, Some(count - 1), tolerance, error);
+    }
+
+    /// From each key the next one is pushed as far as it goes: the span doubles while every sample inside it is
+    /// reproduced, then a binary search finds the farthest span that still is. Without `last` (the last sample's
+    /// index), it stops where a span would reach past the `known` samples.
+    fn choose(
+        &mut self,
+        known: usize,
+        last: Option<usize>,
+        tolerance: f64,
+        error: impl Fn(usize, usize, usize) -> f64,
+    ) {
+        if known == 0 {
+            return;
+        }
+        let spans = |from: usize, to: usize| (from + 1..to).all(|k| error(from, to, k) <= tolerance);
+        if self.keys.is_empty() {
+            self.keys.push(0);
+            (self.good, self.step) = (1, 1);
+        }
+        while last.is_none_or(|last| self.from < last) {
+            let mut bad = None;
+            loop {
+                let candidate = match last {
+                    Some(last) if self.good >= last => break,
+                    Some(last) => (self.good + self.step).min(last),
+                    None if self.good + self.step >= known => return,
+                    None => self.good + self.step,
+                };
+                if spans(self.from, candidate) {
+                    self.good = candidate;
+                    self.step *= 2;
+                } else {
+                    bad = Some(candidate);
+                    break;
+                }
+            }
+            if let Some(mut bad) = bad {
+                while bad - self.good > 1 {
+                    let middle = self.good + (bad - self.good) / 2;
+                    if spans(self.from, middle) { self.good = middle } else { bad = middle }
+                }
+            }
+            self.keys.push(self.good);
+            self.from = self.good;
+            (self.good, self.step) = (self.from + 1, 1);
+        }
+    }
 }
 
 /// How far each bone's nodes may stray between keys, and how it is measured ([`BoneMetric`]).
@@ -152,11 +206,10 @@ pub struct BoneMetric {
 }
 
 impl BoneMetric {
-    /// The model-space distance bound for sample `k` of a bone's `nodes` (as baked, at `times`) interpolated
-    /// between its samples `i` and `j`.
-    pub fn error(&self, times: &[f64], nodes: &[NodeSample], (i, j, k): (usize, usize, usize)) -> f64 {
-        let t = (times[k] - times[i]) / (times[j] - times[i]);
-        self.between([&nodes[i], &nodes[j]], t, &nodes[k])
+    /// The model-space distance bound for a bone's sample `k` interpolated between its samples `i` and `j`, each
+    /// its time and nodes as baked: `[i, j, k]`.
+    pub fn error(&self, [(ti, i), (tj, j), (tk, k)]: [(f64, &NodeSample); 3]) -> f64 {
+        self.between([i, j], (tk - ti) / (tj - ti), k)
     }
 
     /// The model-space distance bound between `exact` and the nodes a fraction `t` of the way between `ends`,
@@ -309,7 +362,7 @@ mod tests {
         let metric = |rotations| BoneMetric { gain: 1.0, reach, rotations };
         let keys = |rotations| {
             let metric = metric(rotations);
-            reduce(count, budget, |i, j, k| metric.error(&times, &nodes, (i, j, k)))
+            reduce(count, budget, |i, j, k| metric.error([i, j, k].map(|s| (times[s], &nodes[s]))))
         };
         assert_eq!(keys(&[RotationInterpolation::Slerp]), [0, count - 1]);
         let widest = (240.0 * budget / (std::f64::consts::SQRT_2 * reach)).cbrt();
@@ -344,6 +397,39 @@ mod tests {
         assert_eq!(reduce(50, 1e-12, linear(&corner)), [0, 20, 49]);
         assert_eq!(reduce(1, 0.0, linear(&[1.0])), [0]);
         assert_eq!(reduce(0, 0.0, linear(&[])), Vec::<usize>::new());
+    }
+
+    #[test]
+    fn keys_chosen_as_the_samples_come_are_those_chosen_from_all_of_them() {
+        // A sine with corners and a still stretch, fed a few samples at a time (one, seven, a hundred): the same keys
+        // as the whole curve gives, and no sample asked for before the reducer's first needed one.
+        let values: Vec<f64> = (0..600)
+            .map(|k| f64::from(k) * 0.05)
+            .map(|x| if (10.0..15.0).contains(&x) { 0.3 } else { x.sin() + (x - 20.0).abs() * 0.1 })
+            .collect();
+        let error = |i: usize, j: usize, k: usize| {
+            let t = (k - i) as f64 / (j - i) as f64;
+            (values[i] + (values[j] - values[i]) * t - values[k]).abs()
+        };
+        for tolerance in [1e-1, 1e-3] {
+            let whole = reduce(values.len(), tolerance, error);
+            for chunk in [1, 7, 100] {
+                let mut reducer = Reducer::default();
+                let mut known = 0;
+                while known < values.len() {
+                    known = (known + chunk).min(values.len());
+                    let needed = reducer.from();
+                    let checked = |i: usize, j: usize, k: usize| {
+                        assert!(i >= needed && j < known && k < known, "{i} {j} {k}: from {needed}, {known} known");
+                        error(i, j, k)
+                    };
+                    reducer.grow(known, tolerance, checked);
+                    assert!(reducer.keys.iter().all(|&key| key < known));
+                }
+                reducer.finish(values.len(), tolerance, error);
+                assert_eq!(reducer.keys, whole, "{tolerance}, {chunk} at a time");
+            }
+        }
     }
 
     #[test]

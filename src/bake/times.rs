@@ -26,7 +26,12 @@ pub struct BakeTimes {
 impl BakeTimes {
     /// Per time of `times`: whether a stepped key is at it.
     pub fn step_flags(&self, times: &[f64]) -> Vec<bool> {
-        times.iter().map(|t| self.steps.binary_search_by(|s| s.total_cmp(t)).is_ok()).collect()
+        times.iter().map(|&t| self.is_step(t)).collect()
+    }
+
+    /// Whether a stepped key is at `time`.
+    pub fn is_step(&self, time: f64) -> bool {
+        self.steps.binary_search_by(|s| s.total_cmp(&time)).is_ok()
     }
 }
 
