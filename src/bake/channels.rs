@@ -12,57 +12,43 @@ use std::collections::VecDeque;
 use glam::DQuat;
 use rayon::prelude::*;
 
+use super::DenseClip;
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property};
 use super::keys::{BoneMetric, Metrics, Reducer, reduce, weights_error};
 use super::layout::{NodePlan, unit};
-use super::nodes::{NodeSample, Sampled};
+use super::nodes::NodeSample;
 use super::times::BakeTimes;
-use crate::eval::{Evaluation, MorphPose};
+use crate::eval::MorphPose;
 
 /// One clip's samples, ready to become channels.
 pub struct ClipSamples<'a> {
     pub name: &'a str,
-    pub source: &'a Evaluation<'a>,
-    /// The times every bone was sampled at, and the stepped keys among them.
-    pub base: &'a BakeTimes,
-    pub sampled: &'a Sampled,
+    pub dense: &'a DenseClip<'a>,
 }
 
-/// The channels of `clip` for the nodes of `layout` in `document`.
+/// The channels of `clip` for the nodes of `layout` in `document`: every bone's keys chosen as a last run through
+/// the clip hands its samples on.
 pub fn animation(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Animation {
-    let per_bone: Vec<Vec<Channel>> = (0..clip.sampled.series.len())
-        .into_par_iter()
-        .map(|bone| bone_channels(layout, clip, metrics, document, bone))
-        .collect();
+    let dense = clip.dense;
+    let gains = &dense.refined.stats.parent_gain;
+    let mut keys: Vec<BoneKeys> =
+        (0..layout.bone_node.len()).map(|bone| BoneKeys::new(layout, metrics, gains, bone)).collect();
+    dense.run(&mut keys, |keys, samples| samples.iter().for_each(|(time, node)| keys.push(*time, node, dense.base)));
+    let per_bone: Vec<Vec<Channel>> =
+        keys.into_par_iter().enumerate().map(|(bone, keys)| keys.channels(layout, document, bone)).collect();
     let mut channels: Vec<Channel> = per_bone.into_iter().flatten().collect();
     channels.extend(weight_channels(layout, clip, metrics, document));
     if channels.is_empty()
         && let Some(node) = document.nodes.first()
     {
         // glTF wants at least one channel; one that holds the first node still says how long the clip is.
-        let end = clip.sampled.times.last().copied().unwrap_or(0.0) as f32;
+        let end = dense.refined.times.last().copied().unwrap_or(0.0) as f32;
         let times = if end > 0.0 { vec![0.0, end] } else { vec![0.0] };
         let values = times.iter().flat_map(|_| node.rotation).collect();
         let interpolation = Interpolation::Linear;
         channels.push(Channel { node: 0, property: Property::Rotation, interpolation, times, values });
     }
     Animation { name: clip.name.to_owned(), channels }
-}
-
-/// The channels of one bone's nodes.
-fn bone_channels(
-    layout: &NodePlan,
-    clip: &ClipSamples,
-    metrics: &Metrics,
-    document: &GltfDocument,
-    bone: usize,
-) -> Vec<Channel> {
-    let series = &clip.sampled.series[bone];
-    let mut keys = BoneKeys::new(layout, metrics, &clip.sampled.stats.parent_gain, bone);
-    for (&time, node) in series.times.iter().zip(&series.nodes) {
-        keys.push(time, node, clip.base);
-    }
-    keys.channels(layout, document, bone)
 }
 
 /// One bone's keys, chosen as its samples come in time order (each bone's nodes as sampled, frames followed): every
@@ -86,8 +72,10 @@ struct BoneKeys {
     /// The reducer's keys so far, as written.
     linear: Vec<Written>,
     stepped: Steps,
-    /// The last sample as written.
+    /// The last sample as written, and its rotations before they were written (whose hemispheres the next sample's
+    /// follow).
     last: Option<Written>,
+    turns: Option<[DQuat; 2]>,
 }
 
 impl BoneKeys {
@@ -103,13 +91,14 @@ impl BoneKeys {
             linear: Vec::new(),
             stepped: Steps(Some(Vec::new())),
             last: None,
+            turns: None,
         }
     }
 
     /// The next sample: the bone's `node` at `time` (frames followed), of a clip first sampled at `base`.
     fn push(&mut self, time: f64, node: &NodeSample, base: &BakeTimes) {
         let baked = node.as_baked(self.helper);
-        let written = Written::of(time, &baked, self.helper, self.last.as_ref());
+        let written = Written::of(time, &baked, self.helper, &mut self.turns);
         self.stepped.push(self.last.as_ref(), written, base.is_step(time));
         self.window.push_back((time, baked, written));
         self.count += 1;
@@ -148,7 +137,7 @@ impl BoneKeys {
             }
         };
         let keys = distinct_f32_times(keys, |key| key.time);
-        let key_times: Vec<f32> = keys.iter().map(|k| k.time as f32).collect();
+        let key_times: Vec<f32> = keys.iter().map(|k| k.time).collect();
         let (outer, own) = (layout.helper_node[bone].unwrap_or(layout.bone_node[bone]), layout.bone_node[bone]);
         let mut wanted: Vec<(usize, Property, WrittenValues)> = vec![
             (outer, Property::Translation, |w| &w.translation),
@@ -197,7 +186,7 @@ type WrittenValues = fn(&Written) -> &[f32];
 /// One sample of a bone's nodes as written (single precision), with its time.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Written {
-    time: f64,
+    time: f32,
     translation: [f32; 3],
     /// In the hemisphere of the sample before (slerp between keys then takes the short way whether or not a player
     /// checks).
@@ -206,26 +195,26 @@ struct Written {
     /// The bone's own node's rotation `Uᵀ` under a helper (nothing without one), in the hemisphere of the sample
     /// before.
     own_rotation: [f32; 4],
-    /// Both rotations before they were written, whose hemispheres the next sample's follow.
-    turns: [DQuat; 2],
 }
 
 impl Written {
-    /// `node` (as baked, with a `helper` or without) at `time`, after the sample `before`.
-    fn of(time: f64, node: &NodeSample, helper: bool, before: Option<&Written>) -> Self {
+    /// `node` (as baked, with a `helper` or without) at `time`; `turns` are the rotations of the sample before, as
+    /// they were before they were written, and become this sample's.
+    fn of(time: f64, node: &NodeSample, helper: bool, turns: &mut Option<[DQuat; 2]>) -> Self {
+        let before = *turns;
         let near = |q: DQuat, k: usize| match before {
-            Some(before) if before.turns[k].dot(q) < 0.0 => -q,
+            Some(before) if before[k].dot(q) < 0.0 => -q,
             _ => q,
         };
         let rotation = near(node.rotation, 0);
         let own = if helper { near(node.stretch.conjugate(), 1) } else { DQuat::IDENTITY };
+        *turns = Some([rotation, own]);
         Written {
-            time,
+            time: time as f32,
             translation: node.translation.as_vec3().to_array(),
             rotation: unit(rotation),
             scale: node.scale.as_vec3().to_array(),
             own_rotation: if helper { unit(own) } else { [0.0; 4] },
-            turns: [rotation, own],
         }
     }
 
@@ -240,8 +229,8 @@ impl Written {
 
 /// The morph weights of every mesh group whose bone the clip animates them on.
 fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
-    let Some(source) = clip.source.clip else { return Vec::new() };
-    let (times, rig) = (&clip.base.times, clip.source.rig);
+    let Some(source) = clip.dense.source.clip else { return Vec::new() };
+    let (times, rig) = (&clip.dense.base.times, clip.dense.source.rig);
     let mut channels = Vec::new();
     let mut morph = MorphPose::default();
     for (group, (node, meshes)) in document.meshes.iter().zip(&layout.groups) {
@@ -263,7 +252,7 @@ fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, doc
             })
             .collect();
         let keys = reduce(times.len(), metrics.budget, |i, j, k| weights_error(&samples, times, &amplitude, (i, j, k)));
-        let keys = distinct_f32_times(keys, |&k| times[k]);
+        let keys = distinct_f32_times(keys, |&k| times[k] as f32);
         let key_times: Vec<f32> = keys.iter().map(|&k| times[k] as f32).collect();
         let values = keys.iter().flat_map(|&k| samples[k].iter().map(|&w| w as f32)).collect();
         let linear = Interpolation::Linear;
@@ -326,12 +315,12 @@ fn near(a: &[f32], b: &[f32], resolution: f32) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x == y || (x - y).abs() <= resolution)
 }
 
-/// `keys` without those whose time rounds to the same `f32` as an earlier one's (glTF's times are `f32` and strictly
-/// increasing).
-fn distinct_f32_times<K>(keys: Vec<K>, time: impl Fn(&K) -> f64) -> Vec<K> {
+/// `keys` without those whose time in single precision (`time`) is an earlier one's (glTF's times are `f32` and
+/// strictly increasing).
+fn distinct_f32_times<K>(keys: Vec<K>, time: impl Fn(&K) -> f32) -> Vec<K> {
     let mut out: Vec<K> = Vec::with_capacity(keys.len());
     for key in keys {
-        if out.last().is_none_or(|last| (time(&key) as f32) > (time(last) as f32)) {
+        if out.last().is_none_or(|last| time(&key) > time(last)) {
             out.push(key);
         }
     }
@@ -346,10 +335,10 @@ mod tests {
     /// indices of the samples keyed.
     fn step_keys(translations: &[f64], steps: &[bool]) -> Option<Vec<usize>> {
         let mut stepped = Steps(Some(Vec::new()));
-        let mut last: Option<Written> = None;
+        let (mut last, mut turns): (Option<Written>, _) = (None, None);
         for (k, (&x, &step)) in translations.iter().zip(steps).enumerate() {
             let node = NodeSample { translation: glam::DVec3::X * x, ..NodeSample::IDENTITY };
-            let written = Written::of(k as f64, &node, false, last.as_ref());
+            let written = Written::of(k as f64, &node, false, &mut turns);
             stepped.push(last.as_ref(), written, step);
             last = Some(written);
         }
@@ -382,6 +371,6 @@ mod tests {
         let near_default = [2e-14, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, -1e-15, 1.0];
         assert_eq!(channel(0, Property::Translation, linear, &times, near_default.to_vec(), &[0.0, 0.0, 1.0]), None);
         let times = [0.5, 0.5 + 1e-12, 1.0];
-        assert_eq!(distinct_f32_times(vec![0, 1, 2], |&k| times[k]), [0, 2], "one f32 time");
+        assert_eq!(distinct_f32_times(vec![0, 1, 2], |&k| times[k] as f32), [0, 2], "one f32 time");
     }
 }

@@ -39,9 +39,8 @@ pub use times::{BakeTimes, bake_times};
 use channels::ClipSamples;
 use keys::Metrics;
 use layout::NodePlan;
-use nodes::{NodeSample, Sampled};
-use rayon::prelude::*;
-use refine::refine;
+use nodes::{NodeSample, Stats};
+use refine::{Dense, Refined};
 
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
@@ -227,19 +226,19 @@ pub fn bake(request: &Request) -> Baked {
     let size = if size > 0.0 { size } else { request.rest().size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
     let metrics = Metrics::new(request.rest(), size, tolerance, request.engine.rotations());
-    let sampled: Vec<Sampled> =
-        sources.iter().zip(&base).map(|(source, base)| sample_densely(source, strategy, base, &metrics)).collect();
+    let dense: Vec<DenseClip> =
+        sources.iter().zip(&base).map(|(&source, base)| DenseClip::new(source, strategy, base, &metrics)).collect();
     let rest = nodes::sample(request.rest(), &[0.0], strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
-        .map(|bone| rest.stats.stretched[bone] || sampled.iter().any(|s| s.stats.stretched[bone]))
+        .map(|bone| rest.stats.stretched[bone] || dense.iter().any(|d| d.refined.stats.stretched[bone]))
         .collect();
     let layout = NodePlan::new(rig, &helpers);
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
-    for ((clip, base), sampled) in request.clips().iter().zip(&base).zip(&sampled) {
-        let samples = ClipSamples { name: &clip.name, source: &clip.source, base, sampled };
-        let times = &sampled.times;
+    for (clip, dense) in request.clips().iter().zip(&dense) {
+        let samples = ClipSamples { name: &clip.name, dense };
+        let times = &dense.refined.times;
         if clip.source.clip.is_none() && clip.source.layers().is_none() {
             // The rest pose is what the nodes hold without an animation.
             animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys: 0 });
@@ -250,24 +249,55 @@ pub fn bake(request: &Request) -> Baked {
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
         document.animations.push(animation);
     }
-    notes.extend(source_notes(rig, sampled.iter().map(|s| s.stats.singular).sum()));
+    notes.extend(source_notes(rig, dense.iter().map(|d| d.refined.stats.singular).sum()));
     Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }
 }
 
-/// Every bone's nodes at the base times, and wherever between them the source needs more ([`refine`]; not with a
-/// zero tolerance, which no halving could reach).
-fn sample_densely(source: &Evaluation, strategy: Strategy, base: &BakeTimes, metrics: &Metrics) -> Sampled {
-    let mut sampled = nodes::sample(source, &base.times, strategy);
-    sampled.series.par_iter_mut().for_each(nodes::follow_frames);
-    if metrics.budget == 0.0 {
-        return sampled;
+/// One clip sampled at its base times and wherever between them the source needs more ([`refine`]; not with a zero
+/// tolerance, which no halving could reach), pass after pass: the samples are handed on as they come, never all held.
+/// What the base samples teach (which bones' stretch rotations matter, how much their parents scale) decides where
+/// to halve, so it is learnt first; what every sample teaches decides the file's nodes and each bone's tolerance, so a
+/// pass through every sample learns it before another chooses the keys.
+pub struct DenseClip<'a> {
+    pub source: &'a Evaluation<'a>,
+    strategy: Strategy,
+    /// The times every bone is sampled at, and the stepped keys among them.
+    pub base: &'a BakeTimes,
+    steps: Vec<bool>,
+    metrics: &'a Metrics,
+    /// What the base samples teach.
+    first: Stats,
+    /// What every sample teaches, and every time some bone is sampled at.
+    pub refined: Refined,
+}
+
+impl<'a> DenseClip<'a> {
+    fn new(source: &'a Evaluation<'a>, strategy: Strategy, base: &'a BakeTimes, metrics: &'a Metrics) -> Self {
+        let first = nodes::stats(source, &base.times, strategy);
+        let steps = base.step_flags(&base.times);
+        let refined = Refined { stats: first.clone(), times: Vec::new() };
+        let mut clip = DenseClip { source, strategy, base, steps, metrics, first, refined };
+        clip.refined = clip.run(&mut [] as &mut [()], |_, _| {});
+        clip
     }
-    let gains = sampled.stats.parent_gain.clone();
-    let misses = |bone: usize, ends: [&NodeSample; 2], fraction: f64, exact: &NodeSample| {
-        let metric = metrics.bone(&gains, bone);
-        metric.between(ends, fraction, exact) > metrics.budget || metric.parting(ends) > metrics.budget
-    };
-    refine(source, strategy, &base.step_flags(&base.times), sampled, &misses)
+
+    /// Runs through the clip, each bone's samples handed to `feed` with its state ([`Dense::run`]).
+    pub fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
+        let (metrics, gains) = (self.metrics, &self.first.parent_gain);
+        let misses = |bone: usize, ends: [&NodeSample; 2], fraction: f64, exact: &NodeSample| {
+            let metric = metrics.bone(gains, bone);
+            metric.between(ends, fraction, exact) > metrics.budget || metric.parting(ends) > metrics.budget
+        };
+        let dense = Dense {
+            source: self.source,
+            strategy: self.strategy,
+            times: &self.base.times,
+            steps: &self.steps,
+            helper: &self.first.stretched,
+            misses: (metrics.budget > 0.0).then_some(&misses),
+        };
+        dense.run(states, feed)
+    }
 }
 
 /// What the source has that glTF says differently.

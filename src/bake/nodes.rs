@@ -13,9 +13,8 @@
 //!   solved against its parent as baked and the errors do not add up down the chain.
 //!
 //! Where a parent's matrix is singular (a bone scaled to zero) `L` is taken from the source's own local transform.
-//! Each bone's samples are a [`Series`] of its own, since refinement samples only the bones that need it between
-//! the times all share; they are computed in parallel over chunks of time, and [`follow_frames`] then makes each
-//! bone's nodes (its `U` above all) continuous over time.
+//! Every bone is solved at each time, in parallel over runs of time ([`solve`]); a [`Follower`] then makes each
+//! bone's nodes (its `U` above all) continuous over time as they come.
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
@@ -99,46 +98,17 @@ pub struct Series {
     pub nodes: Vec<NodeSample>,
 }
 
-impl Series {
-    /// `self` with `extra` (time, nodes) merged in, by time.
-    pub fn merged(self, mut extra: Vec<(f64, NodeSample)>) -> Series {
-        if extra.is_empty() {
-            return self;
-        }
-        extra.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut merged = Series {
-            times: Vec::with_capacity(self.times.len() + extra.len()),
-            nodes: Vec::with_capacity(self.times.len() + extra.len()),
-        };
-        let mut extra = extra.into_iter().peekable();
-        for (time, node) in self.times.into_iter().zip(self.nodes) {
-            while let Some((t, n)) = extra.next_if(|(t, _)| *t < time) {
-                merged.times.push(t);
-                merged.nodes.push(n);
-            }
-            merged.times.push(time);
-            merged.nodes.push(node);
-        }
-        for (t, n) in extra {
-            merged.times.push(t);
-            merged.nodes.push(n);
-        }
-        merged
-    }
-}
-
-/// Every bone's nodes over one evaluation, each bone sampled at its own times.
+/// Every bone's nodes at a few times, every bone at each (the rest pose's).
 #[derive(Clone, Debug)]
 pub struct Sampled {
     /// One per bone.
     pub series: Vec<Series>,
-    /// Every time some bone is sampled at, sorted.
-    pub times: Vec<f64>,
     pub stats: Stats,
 }
 
-/// How many times are sampled between two appends to the bones' series: what is held twice at once.
-const BATCH: usize = 4096;
+/// How many consecutive times are solved together (in runs of [`RUN`]), every bone at each: what is held at once
+/// before it is handed on.
+pub const BATCH: usize = 512;
 
 /// How many consecutive times one solver solves, each search started near the time before (the first from the
 /// identity): the same on every machine, so that the nodes, and the file, do not depend on the number of cores.
@@ -151,22 +121,50 @@ pub fn sample(source: &Evaluation, times: &[f64], strategy: Strategy) -> Sampled
     let mut series = vec![empty; bones];
     let mut stats = Stats::new(bones);
     for batch in times.chunks(BATCH) {
-        let rows = over_runs_of(batch, RUN, |run| {
-            let mut solver = NodeSolver::new(source, strategy);
-            let mut rows = Vec::with_capacity(run.len() * bones);
-            for &time in run {
-                rows.extend_from_slice(solver.solve_at(time));
-            }
-            (rows, solver.stats)
-        });
-        for (rows, found) in rows {
-            stats = stats.merge(found);
-            for row in rows.chunks_exact(bones.max(1)) {
-                series.iter_mut().zip(row).for_each(|(series, node)| series.nodes.push(*node));
-            }
+        let (rows, found) = solve(source, batch, strategy);
+        stats = stats.merge(found);
+        for row in rows.chunks_exact(bones.max(1)) {
+            series.iter_mut().zip(row).for_each(|(series, node)| series.nodes.push(*node));
         }
     }
-    Sampled { series, times: times.to_vec(), stats }
+    Sampled { series, stats }
+}
+
+/// Every bone's nodes at each of `times` (consecutive times of the clip from a multiple of [`RUN`] on), a row of
+/// one per bone after another, and what solving them learnt. The times are solved in runs of [`RUN`], each run's
+/// searches starting afresh, so a time's nodes are the same whichever times are solved with it.
+pub fn solve(source: &Evaluation, times: &[f64], strategy: Strategy) -> (Vec<NodeSample>, Stats) {
+    let bones = source.skeleton().len();
+    let runs = over_runs_of(times, RUN, |run| {
+        let mut solver = NodeSolver::new(source, strategy);
+        let mut rows = Vec::with_capacity(run.len() * bones);
+        for &time in run {
+            rows.extend_from_slice(solver.solve_at(time));
+        }
+        (rows, solver.stats)
+    });
+    let mut stats = Stats::new(bones);
+    let mut rows = Vec::with_capacity(times.len() * bones);
+    for (run, found) in runs {
+        rows.extend(run);
+        stats = stats.merge(found);
+    }
+    (rows, stats)
+}
+
+/// What solving every bone at `times` (sorted) learns about the bones, [`BATCH`] times at a time: the nodes are not
+/// kept.
+pub fn stats(source: &Evaluation, times: &[f64], strategy: Strategy) -> Stats {
+    let bones = source.skeleton().len();
+    let batches = times.chunks(BATCH).map(|batch| {
+        let runs = over_runs_of(batch, RUN, |run| {
+            let mut solver = NodeSolver::new(source, strategy);
+            run.iter().for_each(|&time| _ = solver.solve_at(time));
+            solver.stats
+        });
+        runs.into_iter().fold(Stats::new(bones), Stats::merge)
+    });
+    batches.fold(Stats::new(bones), Stats::merge)
 }
 
 /// What sampling learns about the bones.
@@ -319,18 +317,50 @@ fn frobenius(m: &DMat4) -> f64 {
     (linear.x_axis.length_squared() + linear.y_axis.length_squared() + linear.z_axis.length_squared()).sqrt()
 }
 
-/// Makes a bone's nodes continuous over time ([`align`] each sample to the one before); a bone scaled to nothing
-/// from the start takes its rotations from the first sample where it is not.
+/// Makes a bone's nodes continuous over time ([`Follower`]), the whole series at once.
+#[cfg(test)]
 pub fn follow_frames(series: &mut Series) {
-    let nodes = &mut series.nodes;
-    for s in 1..nodes.len() {
-        let previous = nodes[s - 1];
-        align(&mut nodes[s], &previous);
+    let mut follower = Follower::default();
+    let mut followed = Vec::with_capacity(series.nodes.len());
+    for (&time, &node) in series.times.iter().zip(&series.nodes) {
+        follower.push(time, node, &mut followed);
     }
-    for s in (0..nodes.len().saturating_sub(1)).rev() {
-        if nodes[s].scale == DVec3::ZERO {
-            (nodes[s].rotation, nodes[s].stretch) = (nodes[s + 1].rotation, nodes[s + 1].stretch);
+    follower.finish(&mut followed);
+    series.nodes = followed.into_iter().map(|(_, node)| node).collect();
+}
+
+/// Makes a bone's nodes continuous over time as they come in time order: each sample [`align`]ed to the one before.
+/// A sample of the bone scaled to nothing is held back until one where it is not, whose rotations it then takes
+/// (where the bone is scaled to nothing from the start, the first where it is not); those at the end keep the
+/// rotations before them.
+#[derive(Clone, Debug, Default)]
+pub struct Follower {
+    last: Option<NodeSample>,
+    held: Vec<(f64, NodeSample)>,
+}
+
+impl Follower {
+    /// The bone's nodes at `time`, after those pushed before: what it settles goes to `out`, in time order.
+    pub fn push(&mut self, time: f64, mut node: NodeSample, out: &mut Vec<(f64, NodeSample)>) {
+        if let Some(last) = &self.last {
+            align(&mut node, last);
         }
+        self.last = Some(node);
+        if node.scale == DVec3::ZERO {
+            self.held.push((time, node));
+            return;
+        }
+        out.extend(
+            self.held
+                .drain(..)
+                .map(|(t, held)| (t, NodeSample { rotation: node.rotation, stretch: node.stretch, ..held })),
+        );
+        out.push((time, node));
+    }
+
+    /// Every sample pushed having come: those held back go to `out`.
+    pub fn finish(&mut self, out: &mut Vec<(f64, NodeSample)>) {
+        out.append(&mut self.held);
     }
 }
 
@@ -420,15 +450,6 @@ mod tests {
     }
 
     #[test]
-    fn extra_samples_merge_in_time_order() {
-        let node = |x: f64| NodeSample { translation: DVec3::X * x, ..NodeSample::IDENTITY };
-        let series = Series { times: vec![1.0, 2.0], nodes: vec![node(1.0), node(2.0)] };
-        let merged = series.merged(vec![(2.5, node(2.5)), (0.5, node(0.5)), (1.5, node(1.5))]);
-        assert_eq!(merged.times, [0.5, 1.0, 1.5, 2.0, 2.5]);
-        assert!(merged.times.iter().zip(&merged.nodes).all(|(t, n)| n.translation.x == *t));
-    }
-
-    #[test]
     fn frames_follow_the_previous_sample() {
         // One bone whose stretch frame is handed over swapped at every other sample.
         let swap = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
@@ -451,6 +472,32 @@ mod tests {
             assert!(node.stretch.abs_diff_eq(frame, 1e-12), "sample {s}: {:?}", node.stretch);
             assert_eq!(node.scale, k);
         }
+    }
+
+    #[test]
+    fn a_bone_scaled_to_nothing_takes_the_rotations_of_the_next_sample_where_it_is_not() {
+        // Samples 0–1 and 4–5 scaled to nothing, 2–3 and 6 not, 7–8 to nothing again: 0–1 take sample 2's rotations,
+        // 4–5 sample 6's, and 7–8 (nothing after them) keep those before them, whatever order they came in.
+        let turned = |angle: f64, scale: f64| NodeSample {
+            rotation: DQuat::from_rotation_z(angle),
+            scale: DVec3::splat(scale),
+            ..NodeSample::IDENTITY
+        };
+        let scales = [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0];
+        let nodes: Vec<NodeSample> = scales.iter().enumerate().map(|(s, &k)| turned(0.1 * s as f64, k)).collect();
+        let mut follower = Follower::default();
+        let mut out = Vec::new();
+        let mut settled = Vec::new();
+        for (s, node) in nodes.iter().enumerate() {
+            follower.push(s as f64, *node, &mut out);
+            settled.push(out.len());
+        }
+        assert_eq!(settled, [0, 0, 3, 4, 4, 4, 7, 7, 7], "held back while scaled to nothing");
+        follower.finish(&mut out);
+        let angles: Vec<f64> = out.iter().map(|(_, n)| 2.0 * n.rotation.z.atan2(n.rotation.w)).collect();
+        let expected = [0.2, 0.2, 0.2, 0.3, 0.6, 0.6, 0.6, 0.6, 0.6];
+        assert!(angles.iter().zip(expected).all(|(a, e)| (a - e).abs() < 1e-12), "{angles:?}");
+        assert!(out.iter().enumerate().all(|(s, (t, n))| *t == s as f64 && n.scale == nodes[s].scale));
     }
 
     #[test]

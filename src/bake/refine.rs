@@ -11,12 +11,17 @@
 //! halvings. Only the bones that miss are sampled deeper (a pose is evaluated whole, but only their nodes are kept),
 //! so a few compensating bones do not multiply the samples of the whole rig. Every midpoint sampled stays a sample
 //! of the bones it was taken for, so the keys chosen later are checked against it too.
+//!
+//! A clip is sampled [`BATCH`] base times at a time and each batch's samples handed on as soon as they are settled
+//! ([`Dense::run`]), so what is held is a batch, not the clip: a long clip of many bones has millions of samples.
+
+use std::collections::VecDeque;
 
 use rayon::prelude::*;
 
 use super::Strategy;
 use super::keys::too_far;
-use super::nodes::{NodeSample, NodeSolver, Sampled, Series, Stats, align, follow_frames};
+use super::nodes::{BATCH, Follower, NodeSample, NodeSolver, Stats, align, solve};
 use super::times::{MIN_KEY_SPACING, in_single_precision};
 use crate::eval::Evaluation;
 
@@ -28,32 +33,162 @@ const MAX_DEPTH: usize = 8;
 pub trait Misses: Fn(usize, [&NodeSample; 2], f64, &NodeSample) -> bool + Sync {}
 impl<F: Fn(usize, [&NodeSample; 2], f64, &NodeSample) -> bool + Sync> Misses for F {}
 
-/// `sampled` (every bone at the same sorted times, frames followed) with midpoints added to each bone wherever
-/// `misses` says the interpolation of an interval's ends misses its midpoint; frames followed again. The interval
-/// that ends at a stepped key (`steps`, per time) holds the key's jump, which no halving brings closer: it is left as
-/// it is.
-pub fn refine(
-    source: &Evaluation,
-    strategy: Strategy,
-    steps: &[bool],
-    sampled: Sampled,
-    misses: &impl Misses,
-) -> Sampled {
-    let bones = sampled.series.len();
-    let halving = Halving { sampled: &sampled, misses };
-    let (stats, found) = (1..sampled.times.len())
-        .into_par_iter()
-        .filter(|&i| !steps[i])
-        .fold(
-            || (NodeSolver::new(source, strategy), Found::new(bones)),
-            |(mut worker, mut found), i| {
-                halving.base_interval(&mut worker, i, &mut found);
-                (worker, found)
+/// One clip sampled at its base times (sorted) and, where `misses` says the interpolation of an interval's ends
+/// misses its midpoint, between them; `helper` says which bones' stretch rotations matter at the base times (the
+/// others are judged without it). The interval that ends at a stepped key (`steps`, per base time) holds the key's
+/// jump, which no halving brings closer: it is left as it is. Without `misses` (a zero tolerance, which no halving
+/// could reach) the base times alone.
+pub struct Dense<'a, M> {
+    pub source: &'a Evaluation<'a>,
+    pub strategy: Strategy,
+    pub times: &'a [f64],
+    pub steps: &'a [bool],
+    pub helper: &'a [bool],
+    pub misses: Option<&'a M>,
+}
+
+/// What a run through a clip learnt: about the bones, from every sample, and every time some bone was sampled at
+/// (sorted).
+pub struct Refined {
+    pub stats: Stats,
+    pub times: Vec<f64>,
+}
+
+impl<M: Misses> Dense<'_, M> {
+    /// Runs through the clip in batches of base times: each batch solved, every bone's base samples made continuous
+    /// ([`Follower`]), the intervals between them halved where they miss, and each bone's samples (base and
+    /// midpoints, in time order, made continuous again) handed to `feed` with its state, one of `states` per bone
+    /// (none: the samples are not wanted).
+    pub fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
+        let bones = self.source.skeleton().len();
+        let mut pass = Pass {
+            stats: Stats::new(bones),
+            times: Vec::with_capacity(self.times.len()),
+            base: vec![Follower::default(); bones],
+            dense: vec![Follower::default(); bones],
+            settled: vec![VecDeque::new(); bones],
+            first: 0,
+            handed: false,
+        };
+        for (b, batch) in self.times.chunks(BATCH).enumerate() {
+            let (rows, found) = solve(self.source, batch, self.strategy);
+            pass.stats = std::mem::replace(&mut pass.stats, Stats::new(bones)).merge(found);
+            pass.base.par_iter_mut().zip(&mut pass.settled).enumerate().for_each(|(bone, (follower, settled))| {
+                let mut followed = Vec::with_capacity(batch.len());
+                for (s, &time) in batch.iter().enumerate() {
+                    follower.push(time, rows[s * bones + bone], &mut followed);
+                }
+                settled.extend(followed.iter().map(|(_, node)| *node));
+            });
+            let last = b * BATCH + batch.len() == self.times.len();
+            if last {
+                self.settle_the_rest(&mut pass);
+            }
+            self.hand_on(&mut pass, states, &feed, last);
+        }
+        pass.times.sort_by(f64::total_cmp);
+        pass.times.dedup();
+        Refined { stats: pass.stats, times: pass.times }
+    }
+
+    /// Every sample held back settled: the clip is over.
+    fn settle_the_rest(&self, pass: &mut Pass) {
+        for (follower, settled) in pass.base.iter_mut().zip(&mut pass.settled) {
+            let mut followed = Vec::new();
+            follower.finish(&mut followed);
+            settled.extend(followed.iter().map(|(_, node)| *node));
+        }
+    }
+
+    /// Halves the intervals between the base samples every bone has settled, and hands each bone's samples up to
+    /// the last of them on (all that are left, at the clip's `end`).
+    fn hand_on<S: Send>(
+        &self,
+        pass: &mut Pass,
+        states: &mut [S],
+        feed: &(impl Fn(&mut S, &[(f64, NodeSample)]) + Sync),
+        end: bool,
+    ) {
+        let ready = pass.settled.iter().map(VecDeque::len).min().unwrap_or(0);
+        if ready == 0 {
+            return;
+        }
+        let (first, from) = (pass.first, usize::from(pass.handed));
+        // Base sample `first + s` is handed on after the midpoints of the interval that ends at it (the clip's first
+        // sample has none).
+        let intervals = (first + 1..first + ready).filter(|&k| !self.steps[k]).collect();
+        let found = self.halved(pass, intervals);
+        pass.times.extend(&self.times[first + from..first + ready]);
+        pass.times.extend(&found.times);
+        let mut found = found.per_bone;
+        let settled = &pass.settled;
+        states.par_iter_mut().zip(&mut pass.dense).zip(&mut found).enumerate().for_each(
+            |(bone, ((state, follower), midpoints))| {
+                midpoints.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut midpoints = midpoints.drain(..).peekable();
+                let mut out = Vec::new();
+                for (s, &node) in settled[bone].iter().enumerate().take(ready).skip(from) {
+                    let time = self.times[first + s];
+                    if self.misses.is_none() {
+                        // Nothing halved: the base samples, already continuous.
+                        out.push((time, node));
+                        continue;
+                    }
+                    while let Some((t, midpoint)) = midpoints.next_if(|(t, _)| *t < time) {
+                        follower.push(t, midpoint, &mut out);
+                    }
+                    follower.push(time, node, &mut out);
+                }
+                if end {
+                    follower.finish(&mut out);
+                }
+                feed(state, &out);
             },
-        )
-        .map(|(worker, found)| (worker.stats, found))
-        .reduce(|| (Stats::new(bones), Found::new(bones)), |(a, one), (b, other)| (a.merge(b), one.merge(other)));
-    found.merged_into(sampled, stats)
+        );
+        // The last base sample handed on starts the next interval.
+        pass.settled.iter_mut().for_each(|settled| _ = settled.drain(..ready - 1));
+        (pass.first, pass.handed) = (first + ready - 1, true);
+    }
+
+    /// The midpoints taken in the intervals that end at base samples `ends` (each starting at the sample before),
+    /// every bone's starting from `pass.settled` (whose front is base sample `pass.first`), in parallel: each
+    /// interval's searches start from its start, so whichever worker takes it finds the same.
+    fn halved(&self, pass: &mut Pass, ends: Vec<usize>) -> Found {
+        let bones = pass.settled.len();
+        let Some(misses) = self.misses else { return Found::new(bones) };
+        let halving = Halving { helper: self.helper, misses };
+        let (settled, first) = (&pass.settled, pass.first);
+        let (stats, found) = ends
+            .into_par_iter()
+            .fold(
+                || (NodeSolver::new(self.source, self.strategy), Found::new(bones)),
+                |(mut worker, mut found), k| {
+                    let ends = (0..bones).map(|bone| (bone, settled[bone][k - 1 - first], settled[bone][k - first]));
+                    let span = (self.times[k - 1], self.times[k]);
+                    halving.interval(&mut worker, span, ends.collect(), &mut found);
+                    (worker, found)
+                },
+            )
+            .map(|(worker, found)| (worker.stats, found))
+            .reduce(|| (Stats::new(bones), Found::new(bones)), |(a, one), (b, other)| (a.merge(b), one.merge(other)));
+        pass.stats = std::mem::replace(&mut pass.stats, Stats::new(bones)).merge(stats);
+        found
+    }
+}
+
+/// A run through a clip while it goes on.
+struct Pass {
+    stats: Stats,
+    /// Every time sampled so far.
+    times: Vec<f64>,
+    /// Per bone: its base samples and all its samples, made continuous.
+    base: Vec<Follower>,
+    dense: Vec<Follower>,
+    /// Per bone: its base samples made continuous and settled, from base sample `first` on, not handed on yet (but
+    /// the first where `handed`: it starts the next interval).
+    settled: Vec<VecDeque<NodeSample>>,
+    first: usize,
+    handed: bool,
 }
 
 /// The midpoints taken: per bone, (time, nodes) of those taken for it; and every time taken.
@@ -74,45 +209,23 @@ impl Found {
         self.times.extend(other.times);
         self
     }
-
-    /// `sampled` with the midpoints merged into their bones' series (frames followed again), every time any bone
-    /// has, and what the midpoints taught about the bones (`stats`).
-    fn merged_into(self, sampled: Sampled, stats: Stats) -> Sampled {
-        let mut times = sampled.times;
-        times.extend(self.times);
-        times.sort_by(f64::total_cmp);
-        times.dedup();
-        let series: Vec<Series> = sampled
-            .series
-            .into_par_iter()
-            .zip(self.per_bone)
-            .map(|(series, extra)| {
-                let mut merged = series.merged(extra);
-                follow_frames(&mut merged);
-                merged
-            })
-            .collect();
-        Sampled { series, times, stats: sampled.stats.merge(stats) }
-    }
 }
 
 /// The ends of an interval for one bone that is still being halved: (bone, nodes at the start, nodes at the end).
 type Ends = (usize, NodeSample, NodeSample);
 
+/// The halving of intervals: which bones' stretch rotations matter at the base samples, and where a bone misses.
 struct Halving<'a, M> {
-    sampled: &'a Sampled,
+    helper: &'a [bool],
     misses: &'a M,
 }
 
 impl<M: Misses> Halving<'_, M> {
-    /// Halves the interval of base samples `i − 1` to `i` for every bone, its searches started from the interval's
-    /// start (whichever interval a worker took before, the result is the same).
-    fn base_interval(&self, worker: &mut NodeSolver, i: usize, found: &mut Found) {
-        let ends: Vec<Ends> =
-            self.sampled.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[i - 1], s.nodes[i])).collect();
+    /// Halves the interval `span` for the bones of `ends` (every bone, with its nodes at both ends), its searches
+    /// started from the interval's start (whichever interval a worker took before, the result is the same).
+    fn interval(&self, worker: &mut NodeSolver, span: (f64, f64), ends: Vec<Ends>, found: &mut Found) {
         worker.start_near(ends.iter().map(|(_, start, _)| start));
-        let times = &self.sampled.times;
-        self.halve(worker, (times[i - 1], times[i]), ends, 0, found);
+        self.halve(worker, span, ends, 0, found);
     }
 
     /// Samples the bones of `ends` at the middle of `span` (in single precision, where their keys will be; a span
@@ -126,7 +239,7 @@ impl<M: Misses> Halving<'_, M> {
         }
         // The middle in single precision is not quite half way.
         let fraction = (time - span.0) / (span.1 - span.0);
-        let helper = &self.sampled.stats.stretched;
+        let helper = self.helper;
         let row = worker.solve_at(time);
         found.times.push(time);
         let (mut left, mut right) = (Vec::new(), Vec::new());
@@ -149,9 +262,61 @@ impl<M: Misses> Halving<'_, M> {
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
+    use glam::{DQuat, DVec3, Quat, Vec3};
+
     use super::*;
+    use crate::bake::nodes::{self, Series, follow_frames};
     use crate::import::demo_rig;
-    use crate::model::InheritMode;
+    use crate::model::{Bone, BoneTracks, Clip, InheritMode, Interpolation, Rig, Skeleton, Track, Transform};
+
+    /// Every bone's samples of `side` at `times` as [`Dense::run`] hands them on, and what it learnt.
+    fn densely(side: &Evaluation, times: &[f64], steps: &[bool], misses: &impl Misses) -> (Vec<Series>, Refined) {
+        let first = nodes::stats(side, times, Strategy::Exact);
+        let dense = Dense {
+            source: side,
+            strategy: Strategy::Exact,
+            times,
+            steps,
+            helper: &first.stretched,
+            misses: Some(misses),
+        };
+        let mut series = vec![Series::default(); side.skeleton().len()];
+        let refined = dense.run(&mut series, |series, samples| {
+            for &(time, node) in samples {
+                series.times.push(time);
+                series.nodes.push(node);
+            }
+        });
+        (series, refined)
+    }
+
+    /// The same, the whole clip at once: every base sample, then every interval halved, then each bone's midpoints
+    /// merged in and its frames followed again.
+    fn whole(side: &Evaluation, times: &[f64], steps: &[bool], misses: &impl Misses) -> Vec<Series> {
+        let mut base = nodes::sample(side, times, Strategy::Exact);
+        base.series.iter_mut().for_each(follow_frames);
+        let halving = Halving { helper: &base.stats.stretched, misses };
+        let mut found = Found::new(base.series.len());
+        for k in (1..times.len()).filter(|&k| !steps[k]) {
+            let mut worker = NodeSolver::new(side, Strategy::Exact);
+            let ends = base.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[k - 1], s.nodes[k]));
+            halving.interval(&mut worker, (times[k - 1], times[k]), ends.collect(), &mut found);
+        }
+        base.series
+            .into_iter()
+            .zip(found.per_bone)
+            .map(|(series, extra)| {
+                let mut all: Vec<(f64, NodeSample)> = series.times.into_iter().zip(series.nodes).chain(extra).collect();
+                all.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (times, nodes) = all.into_iter().unzip();
+                let mut merged = Series { times, nodes };
+                follow_frames(&mut merged);
+                merged
+            })
+            .collect()
+    }
 
     #[test]
     fn only_the_bones_that_miss_are_halved_further() {
@@ -159,20 +324,62 @@ mod tests {
         let modes = vec![InheritMode::Full; rig.skeleton.len()];
         let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) * 0.25).collect();
-        let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
         let missing = 2;
-        let refined = refine(&side, Strategy::Exact, &[false; 5], base.clone(), &|bone, _, _, _: &_| bone == missing);
+        let (refined, found) = densely(&side, &times, &[false; 5], &|bone, _, _, _: &_| bone == missing);
         let intervals = times.len() - 1;
-        for (bone, series) in refined.series.iter().enumerate() {
+        for (bone, series) in refined.iter().enumerate() {
             // Every interval's midpoint for every bone; for the one that misses, every level of halving.
             let expected = times.len() + intervals * if bone == missing { (1 << MAX_DEPTH) - 1 } else { 1 };
             assert_eq!(series.times.len(), expected, "bone {bone}");
             assert!(series.times.windows(2).all(|w| w[0] < w[1]), "bone {bone}: sorted and distinct");
-            assert_eq!(series.times.len(), series.nodes.len());
         }
-        assert_eq!(refined.times, refined.series[missing].times, "every time some bone has");
-        let stepped = refine(&side, Strategy::Exact, &[false, true, true, true, true], base, &|_, _, _, _: &_| false);
-        assert_eq!(stepped.series[0].times.len(), times.len(), "intervals that end at stepped keys are left");
+        assert_eq!(found.times, refined[missing].times, "every time some bone has");
+        let (stepped, _) = densely(&side, &times, &[false, true, true, true, true], &|_, _, _, _: &_| false);
+        assert_eq!(stepped[0].times, times, "intervals that end at stepped keys are left");
+    }
+
+    /// A chain of three bones whose middle one turns and is scaled to nothing from 4.2 s to 6 s of a 13 s clip.
+    fn vanishing_rig() -> Rig {
+        let track = |times: &[f64], values: Vec<Vec3>| {
+            Some(Track::new(Arc::from(times), values, Interpolation::Linear).unwrap())
+        };
+        let mut middle = BoneTracks::new(1);
+        let scale = [Vec3::ONE, Vec3::ONE, Vec3::ZERO, Vec3::ZERO, Vec3::ONE, Vec3::new(2.0, 1.0, 1.0)];
+        middle.scale = track(&[0.0, 4.0, 4.2, 6.0, 6.5, 13.0], scale.to_vec());
+        let turns: Vec<Quat> = (0..14).map(|s| Quat::from_rotation_z(0.4 * s as f32)).collect();
+        let times: Vec<f64> = (0..14).map(f64::from).collect();
+        middle.rotation = Some(Track::new(Arc::from(times.as_slice()), turns, Interpolation::Linear).unwrap());
+        let along = Transform::from_trs(DVec3::X, DQuat::from_rotation_y(0.3), DVec3::ONE);
+        let bones = vec![
+            Bone::joint("root", None, Transform::IDENTITY),
+            Bone::joint("middle", Some(0), along),
+            Bone::joint("tip", Some(1), along),
+        ];
+        let clip = Clip::new(0, None, vec![middle], vec![]);
+        Rig { skeleton: Skeleton::new(bones).unwrap(), clips: vec![clip], ..Rig::default() }
+    }
+
+    #[test]
+    fn a_clip_sampled_a_batch_at_a_time_is_the_clip_sampled_whole() {
+        // 1,301 base times, so batches end inside the stretch where the middle bone is scaled to nothing (its samples
+        // held back until it is not) and inside deep halvings; a stepped key at every 97th time. Under segment
+        // compensate the tip's stretch turns, so where each search starts shows in the nodes.
+        let rig = vanishing_rig();
+        for mode in [InheritMode::Full, InheritMode::SegmentCompensate] {
+            let side = Evaluation::new(&rig, rig.clips.first(), &[InheritMode::Full, InheritMode::Full, mode]).unwrap();
+            let times: Vec<f64> = (0..=1300).map(|k| f64::from(k) / 100.0).collect();
+            let steps: Vec<bool> = (0..times.len()).map(|k| k.is_multiple_of(97)).collect();
+            let misses = |bone: usize, _: [&NodeSample; 2], _: f64, exact: &NodeSample| {
+                bone == 2 && exact.translation.x.to_bits().is_multiple_of(5)
+            };
+            let (series, refined) = densely(&side, &times, &steps, &misses);
+            assert_eq!(series, whole(&side, &times, &steps, &misses), "{mode:?}");
+            assert!(series[2].times.len() > times.len() * 6 / 5, "the tip is halved further in places");
+            let zero = series[1].nodes.iter().filter(|n| n.scale == DVec3::ZERO).count();
+            assert!(zero > 150, "the middle bone is scaled to nothing across a batch's end: {zero}");
+            let every: Vec<f64> = series[2].times.clone();
+            assert_eq!(refined.times, every, "every time some bone has");
+        }
     }
 
     #[test]
@@ -185,16 +392,18 @@ mod tests {
         let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
         let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=8).map(|k| f64::from(k) * 0.25).collect();
-        let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
+        let mut base = nodes::sample(&side, &times, Strategy::Exact);
+        base.series.iter_mut().for_each(follow_frames);
         fn always(_: usize, _: [&NodeSample; 2], _: f64, _: &NodeSample) -> bool {
             true
         }
-        let halving = Halving { sampled: &base, misses: &always };
+        let halving = Halving { helper: &base.stats.stretched, misses: &always };
         let halved = |earlier: &[f64]| {
             let mut worker = NodeSolver::new(&side, Strategy::Exact);
             earlier.iter().for_each(|&time| _ = worker.solve_at(time));
             let mut found = Found::new(rig.skeleton.len());
-            halving.base_interval(&mut worker, 3, &mut found);
+            let ends = base.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[2], s.nodes[3]));
+            halving.interval(&mut worker, (times[2], times[3]), ends.collect(), &mut found);
             found.per_bone
         };
         let fresh = halved(&[]);
@@ -210,9 +419,8 @@ mod tests {
         let modes = vec![InheritMode::Full; rig.skeleton.len()];
         let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         let times: Vec<f64> = (0..=4).map(|k| f64::from(k) / 24.0).collect();
-        let base = super::super::nodes::sample(&side, &times, Strategy::Exact);
-        let refined = refine(&side, Strategy::Exact, &[false; 5], base, &|bone, _, _, _: &_| bone == 2);
-        let series = &refined.series[2].times;
+        let (refined, _) = densely(&side, &times, &[false; 5], &|bone, _, _, _: &_| bone == 2);
+        let series = &refined[2].times;
         assert_eq!(series.len(), times.len() + 4 * 63);
         let closest = series.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
         assert!((MIN_KEY_SPACING..2.0 * MIN_KEY_SPACING).contains(&closest), "{closest}");
