@@ -40,6 +40,7 @@ use channels::ClipSamples;
 use keys::Metrics;
 use layout::NodePlan;
 use nodes::{NodeSample, Stats};
+use rayon::prelude::*;
 use refine::{Dense, Refined};
 
 use crate::eval::Evaluation;
@@ -219,6 +220,11 @@ pub struct Baked {
 
 /// Bakes `request` into a glTF binary.
 pub fn bake(request: &Request) -> Baked {
+    bake_keeping(request, HELD)
+}
+
+/// [`bake`], keeping up to `held` bytes of samples between passes ([`HELD`]).
+fn bake_keeping(request: &Request, held: usize) -> Baked {
     let (rig, strategy) = (request.rig(), request.strategy);
     let sources: Vec<&Evaluation> = request.clips().iter().map(|c| &c.source).collect();
     let base: Vec<BakeTimes> = sources.iter().map(|source| bake_times(source)).collect();
@@ -226,8 +232,11 @@ pub fn bake(request: &Request) -> Baked {
     let size = if size > 0.0 { size } else { request.rest().size(&[0.0]) };
     let tolerance = request.tolerance.max(0.0) * size;
     let metrics = Metrics::new(request.rest(), size, tolerance, request.engine.rotations());
-    let dense: Vec<DenseClip> =
-        sources.iter().zip(&base).map(|(&source, base)| DenseClip::new(source, strategy, base, &metrics)).collect();
+    let dense: Vec<DenseClip> = sources
+        .iter()
+        .zip(&base)
+        .map(|(&source, base)| DenseClip::new(source, strategy, base, &metrics, held))
+        .collect();
     let rest = nodes::sample(request.rest(), &[0.0], strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
         .map(|bone| rest.stats.stretched[bone] || dense.iter().any(|d| d.refined.stats.stretched[bone]))
@@ -253,11 +262,17 @@ pub fn bake(request: &Request) -> Baked {
     Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }
 }
 
+/// How many bytes of samples a bake keeps from the pass that learns what every sample teaches for the pass that
+/// chooses the keys, rather than sampling the clip again: a clip of a few dozen bones over a minute keeps them; a
+/// long clip of hundreds of bones, whose samples would take hundreds of megabytes, is sampled twice.
+const HELD: usize = 64 << 20;
+
 /// One clip sampled at its base times and wherever between them the source needs more ([`refine`]; not with a zero
-/// tolerance, which no halving could reach), pass after pass: the samples are handed on as they come, never all held.
-/// What the base samples teach (which bones' stretch rotations matter, how much their parents scale) decides where
-/// to halve, so it is learnt first; what every sample teaches decides the file's nodes and each bone's tolerance, so a
-/// pass through every sample learns it before another chooses the keys.
+/// tolerance, which no halving could reach), pass after pass, its samples handed on as they come. What the base
+/// samples teach (which bones' stretch rotations matter, how much their parents scale) decides where to halve, so it
+/// is learnt first; what every sample teaches decides the file's nodes and each bone's tolerance, so a pass through
+/// every sample learns it before the keys are chosen. Where they fit in [`HELD`] (about two samples per base time
+/// and bone), that pass keeps the samples for the keys; else the keys are chosen in a pass of their own.
 pub struct DenseClip<'a> {
     pub source: &'a Evaluation<'a>,
     strategy: Strategy,
@@ -269,20 +284,47 @@ pub struct DenseClip<'a> {
     first: Stats,
     /// What every sample teaches, and every time some bone is sampled at.
     pub refined: Refined,
+    /// Every bone's samples, where they are kept.
+    held: Option<Vec<Vec<(f64, NodeSample)>>>,
 }
 
 impl<'a> DenseClip<'a> {
-    fn new(source: &'a Evaluation<'a>, strategy: Strategy, base: &'a BakeTimes, metrics: &'a Metrics) -> Self {
+    /// The clip of `source` at `base`'s times, keeping up to `held` bytes of samples.
+    fn new(
+        source: &'a Evaluation<'a>,
+        strategy: Strategy,
+        base: &'a BakeTimes,
+        metrics: &'a Metrics,
+        held: usize,
+    ) -> Self {
         let first = nodes::stats(source, &base.times, strategy);
         let steps = base.step_flags(&base.times);
         let refined = Refined { stats: first.clone(), times: Vec::new() };
-        let mut clip = DenseClip { source, strategy, base, steps, metrics, first, refined };
-        clip.refined = clip.run(&mut [] as &mut [()], |_, _| {});
+        let mut clip = DenseClip { source, strategy, base, steps, metrics, first, refined, held: None };
+        // Each bone's share of what may be kept; a bone past it (halved deep) gives it up, and the clip is sampled
+        // again.
+        let bones = source.skeleton().len();
+        let share = held / (bones.max(1) * std::mem::size_of::<(f64, NodeSample)>());
+        let mut held: Vec<Option<Vec<(f64, NodeSample)>>> =
+            vec![Some(Vec::new()); if 2 * base.times.len() <= share { bones } else { 0 }];
+        clip.refined = clip.sample(&mut held, |held, samples| match held {
+            Some(kept) if kept.len() + samples.len() <= share => kept.extend_from_slice(samples),
+            _ => *held = None,
+        });
+        clip.held = held.into_iter().collect::<Option<Vec<_>>>().filter(|held| held.len() == bones && bones > 0);
         clip
     }
 
+    /// Hands each bone's samples, in time order, to `feed` with its state, one of `states` per bone.
+    pub fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) {
+        match &self.held {
+            Some(held) => states.par_iter_mut().zip(held).for_each(|(state, samples)| feed(state, samples)),
+            None => _ = self.sample(states, feed),
+        }
+    }
+
     /// Runs through the clip, each bone's samples handed to `feed` with its state ([`Dense::run`]).
-    pub fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
+    fn sample<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
         let (metrics, gains) = (self.metrics, &self.first.parent_gain);
         let misses = |bone: usize, ends: [&NodeSample; 2], fraction: f64, exact: &NodeSample| {
             let metric = metrics.bone(gains, bone);
@@ -347,6 +389,25 @@ pub fn save(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::import::stress_rig;
+    use crate::model::InheritMode;
+
+    #[test]
+    fn a_clip_whose_samples_are_kept_is_baked_as_one_sampled_twice() {
+        // The stress rig with its chains compensating the squash above them (so that bones are halved deep), baked
+        // keeping every sample between the passes, none, and some (bones halved deep give theirs up): one file.
+        let rig = stress_rig(12, 300, 3);
+        let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
+        let source = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
+        for strategy in [Strategy::Exact, Strategy::Trs] {
+            let request = Request::every_clip(&source, None, strategy, DEFAULT_TOLERANCE);
+            let kept = bake_keeping(&request, usize::MAX);
+            assert_eq!(bake_keeping(&request, 0).glb, kept.glb, "{strategy:?}");
+            assert_eq!(bake_keeping(&request, 1 << 20).glb, kept.glb, "{strategy:?}");
+        }
+    }
+
     #[test]
     fn save_replaces_the_file_whole_with_a_new_file_s_permissions() {
         let dir = tempfile::tempdir().unwrap();
