@@ -72,7 +72,7 @@ impl<M: Misses> Dense<'_, M> {
         };
         for (b, batch) in self.times.chunks(BATCH).enumerate() {
             let (rows, found) = solve(self.source, batch, self.strategy);
-            pass.stats = std::mem::replace(&mut pass.stats, Stats::new(bones)).merge(found);
+            pass.learn(found);
             pass.base.par_iter_mut().zip(&mut pass.settled).enumerate().for_each(|(bone, (follower, settled))| {
                 let mut followed = Vec::with_capacity(batch.len());
                 for (s, &time) in batch.iter().enumerate() {
@@ -171,7 +171,7 @@ impl<M: Misses> Dense<'_, M> {
             )
             .map(|(worker, found)| (worker.stats, found))
             .reduce(|| (Stats::new(bones), Found::new(bones)), |(a, one), (b, other)| (a.merge(b), one.merge(other)));
-        pass.stats = std::mem::replace(&mut pass.stats, Stats::new(bones)).merge(stats);
+        pass.learn(stats);
         found
     }
 }
@@ -189,6 +189,14 @@ struct Pass {
     settled: Vec<VecDeque<NodeSample>>,
     first: usize,
     handed: bool,
+}
+
+impl Pass {
+    /// What solving some samples learnt, added to what is known.
+    fn learn(&mut self, stats: Stats) {
+        let bones = self.base.len();
+        self.stats = std::mem::replace(&mut self.stats, Stats::new(bones)).merge(stats);
+    }
 }
 
 /// The midpoints taken: per bone, (time, nodes) of those taken for it; and every time taken.
