@@ -69,8 +69,8 @@ struct BoneKeys {
     reducer: Reducer,
     /// How many of the reducer's keys are in `linear`.
     taken: usize,
-    /// The reducer's keys so far, as written.
-    linear: Vec<Written>,
+    /// The reducer's keys so far.
+    linear: Keys,
     stepped: Steps,
     /// The last sample as written, and its rotations before they were written (whose hemispheres the next sample's
     /// follow).
@@ -88,7 +88,7 @@ impl BoneKeys {
             window: VecDeque::new(),
             reducer: Reducer::default(),
             taken: 0,
-            linear: Vec::new(),
+            linear: Keys::default(),
             stepped: Steps(Some(Vec::new())),
             last: None,
             turns: None,
@@ -121,7 +121,7 @@ impl BoneKeys {
             false => self.reducer.grow(self.count, self.budget, error),
         }
         for &key in &self.reducer.keys[self.taken..] {
-            self.linear.push(self.window[key - offset].2);
+            self.linear.push(&self.window[key - offset].2);
         }
         self.taken = self.reducer.keys.len();
         self.window.drain(..self.reducer.from() - offset);
@@ -133,7 +133,7 @@ impl BoneKeys {
             Some(keys) => (keys, Interpolation::Step),
             None => {
                 self.choose(true);
-                (self.linear, Interpolation::Linear)
+                (self.linear.written(), Interpolation::Linear)
             }
         };
         let keys = distinct_f32_times(keys, |key| key.time);
@@ -156,6 +156,67 @@ impl BoneKeys {
             })
             .collect()
     }
+}
+
+/// A bone's keys as written, each node value's in runs of keys that hold it (most channels hold still): what a bake
+/// holds of a bone while its samples come.
+#[derive(Default)]
+struct Keys {
+    times: Vec<f32>,
+    translation: Runs<3>,
+    rotation: Runs<4>,
+    scale: Runs<3>,
+    own_rotation: Runs<4>,
+}
+
+impl Keys {
+    fn push(&mut self, key: &Written) {
+        grow(&mut self.times, key.time);
+        self.translation.push(key.translation);
+        self.rotation.push(key.rotation);
+        self.scale.push(key.scale);
+        self.own_rotation.push(key.own_rotation);
+    }
+
+    /// The keys, in order.
+    fn written(&self) -> Vec<Written> {
+        let values = self.translation.values().zip(self.rotation.values()).zip(self.scale.values());
+        let keys = self.times.iter().zip(values).zip(self.own_rotation.values());
+        let written = |((&time, ((translation, rotation), scale)), own_rotation)| Written {
+            time,
+            translation,
+            rotation,
+            scale,
+            own_rotation,
+        };
+        keys.map(written).collect()
+    }
+}
+
+/// Values of `N` numbers, each with how many keys in a row hold it.
+#[derive(Default)]
+struct Runs<const N: usize>(Vec<([f32; N], u32)>);
+
+impl<const N: usize> Runs<N> {
+    fn push(&mut self, value: [f32; N]) {
+        match self.0.last_mut() {
+            Some((last, count)) if *last == value && *count < u32::MAX => *count += 1,
+            _ => grow(&mut self.0, (value, 1)),
+        }
+    }
+
+    fn values(&self) -> impl Iterator<Item = [f32; N]> + '_ {
+        self.0.iter().flat_map(|&(value, count)| std::iter::repeat_n(value, count as usize))
+    }
+}
+
+/// Pushes `item`, growing `list` by a quarter at a time rather than doubling it: a bone's keys are most of what a
+/// bake holds.
+fn grow<T>(list: &mut Vec<T>, item: T) {
+    if list.len() == list.capacity() {
+        list.reserve_exact(list.len() / 4 + 16);
+    }
+    list.push(item);
 }
 
 /// The keys of a bone whose values only ever change at stepped keys: the first sample and every stepped key where

@@ -66,7 +66,7 @@ impl<M: Misses> Dense<'_, M> {
             times: Vec::with_capacity(self.times.len()),
             base: vec![Follower::default(); bones],
             dense: vec![Follower::default(); bones],
-            settled: vec![VecDeque::new(); bones],
+            settled: (0..bones).map(|_| VecDeque::with_capacity(BATCH + 1)).collect(),
             first: 0,
             handed: false,
         };
@@ -119,12 +119,12 @@ impl<M: Misses> Dense<'_, M> {
         let intervals = (first + 1..first + ready).filter(|&k| !self.steps[k]).collect();
         let found = self.halved(pass, intervals);
         pass.times.extend(&self.times[first + from..first + ready]);
-        pass.times.extend(&found.times);
-        let mut found = found.per_bone;
+        pass.times.extend(found.iter().flat_map(|found| &found.times));
+        // Without states nothing is handed on: what the pass learns is all it is for.
+        let mut found = if states.is_empty() { Vec::new() } else { per_bone(found, pass.settled.len()) };
         let settled = &pass.settled;
         states.par_iter_mut().zip(&mut pass.dense).zip(&mut found).enumerate().for_each(
             |(bone, ((state, follower), midpoints))| {
-                midpoints.sort_by(|a, b| a.0.total_cmp(&b.0));
                 let mut midpoints = midpoints.drain(..).peekable();
                 let mut out = Vec::new();
                 for (s, &node) in settled[bone].iter().enumerate().take(ready).skip(from) {
@@ -150,29 +150,34 @@ impl<M: Misses> Dense<'_, M> {
         (pass.first, pass.handed) = (first + ready - 1, true);
     }
 
-    /// The midpoints taken in the intervals that end at base samples `ends` (each starting at the sample before),
-    /// every bone's starting from `pass.settled` (whose front is base sample `pass.first`), in parallel: each
-    /// interval's searches start from its start, so whichever worker takes it finds the same.
-    fn halved(&self, pass: &mut Pass, ends: Vec<usize>) -> Found {
+    /// The midpoints taken in each of the intervals that end at base samples `ends` (each starting at the sample
+    /// before), every bone's starting from `pass.settled` (whose front is base sample `pass.first`), in parallel:
+    /// each interval's searches start from its start, so whichever worker takes it finds the same.
+    fn halved(&self, pass: &mut Pass, ends: Vec<usize>) -> Vec<Found> {
         let bones = pass.settled.len();
-        let Some(misses) = self.misses else { return Found::new(bones) };
+        let Some(misses) = self.misses else { return Vec::new() };
         let halving = Halving { helper: self.helper, misses };
         let (settled, first) = (&pass.settled, pass.first);
-        let (stats, found) = ends
+        let found: Vec<(Found, Stats)> = ends
             .into_par_iter()
-            .fold(
-                || (NodeSolver::new(self.source, self.strategy), Found::new(bones)),
-                |(mut worker, mut found), k| {
+            .map_init(
+                || NodeSolver::new(self.source, self.strategy),
+                |worker, k| {
                     let ends = (0..bones).map(|bone| (bone, settled[bone][k - 1 - first], settled[bone][k - first]));
                     let span = (self.times[k - 1], self.times[k]);
-                    halving.interval(&mut worker, span, ends.collect(), &mut found);
-                    (worker, found)
+                    let mut found = Found::default();
+                    halving.interval(worker, span, ends.collect(), &mut found);
+                    (found, std::mem::replace(&mut worker.stats, Stats::new(bones)))
                 },
             )
-            .map(|(worker, found)| (worker.stats, found))
-            .reduce(|| (Stats::new(bones), Found::new(bones)), |(a, one), (b, other)| (a.merge(b), one.merge(other)));
-        pass.learn(stats);
+            .collect();
         found
+            .into_iter()
+            .map(|(found, stats)| {
+                pass.learn(stats);
+                found
+            })
+            .collect()
     }
 }
 
@@ -199,24 +204,23 @@ impl Pass {
     }
 }
 
-/// The midpoints taken: per bone, (time, nodes) of those taken for it; and every time taken.
+/// The midpoints taken in one interval: (bone, time, nodes) of those taken for each bone; and every time taken.
+#[derive(Default)]
 struct Found {
-    per_bone: Vec<Vec<(f64, NodeSample)>>,
+    midpoints: Vec<(usize, f64, NodeSample)>,
     times: Vec<f64>,
 }
 
-impl Found {
-    fn new(bones: usize) -> Self {
-        Found { per_bone: vec![Vec::new(); bones], times: Vec::new() }
+/// Each of `bones`' midpoints among `found`, in time order.
+fn per_bone(found: Vec<Found>, bones: usize) -> Vec<Vec<(f64, NodeSample)>> {
+    let mut counts = vec![0; bones];
+    found.iter().flat_map(|f| &f.midpoints).for_each(|&(bone, ..)| counts[bone] += 1);
+    let mut per_bone: Vec<Vec<(f64, NodeSample)>> = counts.into_iter().map(Vec::with_capacity).collect();
+    for (bone, time, node) in found.into_iter().flat_map(|f| f.midpoints) {
+        per_bone[bone].push((time, node));
     }
-
-    fn merge(mut self, other: Found) -> Self {
-        for (mine, theirs) in self.per_bone.iter_mut().zip(other.per_bone) {
-            mine.extend(theirs);
-        }
-        self.times.extend(other.times);
-        self
-    }
+    per_bone.iter_mut().for_each(|midpoints| midpoints.sort_by(|a, b| a.0.total_cmp(&b.0)));
+    per_bone
 }
 
 /// The ends of an interval for one bone that is still being halved: (bone, nodes at the start, nodes at the end).
@@ -254,7 +258,7 @@ impl<M: Misses> Halving<'_, M> {
         for (bone, a, b) in ends {
             let mut exact = row[bone];
             align(&mut exact, &a);
-            found.per_bone[bone].push((time, exact));
+            found.midpoints.push((bone, time, exact));
             // Bones whose stretch rotation never matters at the base samples are judged without it (it turns at
             // random where the factors are nearly equal, and it will be dropped).
             let [a_baked, b_baked, middle] = [&a, &b, &exact].map(|n| n.as_baked(helper[bone]));
@@ -306,15 +310,16 @@ mod tests {
         let mut base = nodes::sample(side, times, Strategy::Exact);
         base.series.iter_mut().for_each(follow_frames);
         let halving = Halving { helper: &base.stats.stretched, misses };
-        let mut found = Found::new(base.series.len());
+        let mut found = Found::default();
         for k in (1..times.len()).filter(|&k| !steps[k]) {
             let mut worker = NodeSolver::new(side, Strategy::Exact);
             let ends = base.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[k - 1], s.nodes[k]));
             halving.interval(&mut worker, (times[k - 1], times[k]), ends.collect(), &mut found);
         }
+        let bones = base.series.len();
         base.series
             .into_iter()
-            .zip(found.per_bone)
+            .zip(per_bone(vec![found], bones))
             .map(|(series, extra)| {
                 let mut all: Vec<(f64, NodeSample)> = series.times.into_iter().zip(series.nodes).chain(extra).collect();
                 all.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -409,10 +414,10 @@ mod tests {
         let halved = |earlier: &[f64]| {
             let mut worker = NodeSolver::new(&side, Strategy::Exact);
             earlier.iter().for_each(|&time| _ = worker.solve_at(time));
-            let mut found = Found::new(rig.skeleton.len());
+            let mut found = Found::default();
             let ends = base.series.iter().enumerate().map(|(bone, s)| (bone, s.nodes[2], s.nodes[3]));
             halving.interval(&mut worker, (times[2], times[3]), ends.collect(), &mut found);
-            found.per_bone
+            per_bone(vec![found], rig.skeleton.len())
         };
         let fresh = halved(&[]);
         assert!(fresh.iter().all(|taken| taken.len() == (1 << MAX_DEPTH) - 1), "every bone halved throughout");
