@@ -416,6 +416,24 @@ mod tests {
     }
 
     #[test]
+    fn keys_held_in_runs_are_the_keys_pushed() {
+        // Translations that hold still, step and hold again, a rotation that turns at every key.
+        let keys: Vec<Written> = (0..40)
+            .map(|k| Written {
+                time: k as f32 * 0.5,
+                translation: [if k < 10 { 1.0 } else { 2.0 }, 0.0, 0.0],
+                rotation: [0.0, 0.0, (k as f32 * 0.01).sin(), (k as f32 * 0.01).cos()],
+                scale: [1.0; 3],
+                own_rotation: [0.0; 4],
+            })
+            .collect();
+        let mut held = Keys::default();
+        keys.iter().for_each(|key| held.push(key));
+        assert_eq!(held.written(), keys);
+        assert_eq!((held.translation.0.len(), held.scale.0.len(), held.rotation.0.len()), (2, 1, 40));
+    }
+
+    #[test]
     fn constant_and_default_channels() {
         let times = [0.0, 0.5, 1.0];
         let linear = Interpolation::Linear;
