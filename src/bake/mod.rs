@@ -273,7 +273,7 @@ const HELD: usize = 64 << 20;
 /// is learnt first; what every sample teaches decides the file's nodes and each bone's tolerance, so a pass through
 /// every sample learns it before the keys are chosen. Where they fit in [`HELD`] (about two samples per base time
 /// and bone), that pass keeps the samples for the keys; else the keys are chosen in a pass of their own.
-pub struct DenseClip<'a> {
+struct DenseClip<'a> {
     pub source: &'a Evaluation<'a>,
     strategy: Strategy,
     /// The times every bone is sampled at, and the stepped keys among them.
