@@ -12,32 +12,33 @@ use std::collections::VecDeque;
 use glam::DQuat;
 use rayon::prelude::*;
 
-use super::DenseClip;
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property};
 use super::keys::{BoneMetric, Metrics, Reducer, reduce, weights_error};
 use super::layout::{NodePlan, unit};
 use super::nodes::NodeSample;
 use super::times::BakeTimes;
+use super::{DenseClip, Sampling};
 use crate::eval::MorphPose;
 
-/// One clip's samples, ready to become channels.
-pub struct ClipSamples<'a> {
-    pub name: &'a str,
-    pub dense: &'a DenseClip<'a>,
-}
-
-/// The channels of `clip` for the nodes of `layout` in `document`: every bone's keys chosen as a last run through
-/// the clip hands its samples on.
-pub fn animation(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Animation {
-    let dense = clip.dense;
+/// The animation `name`: the channels of `dense`'s clip for the nodes of `layout` in `document`, every bone's keys
+/// chosen as a last run through the clip hands its samples on.
+pub fn animation(
+    layout: &NodePlan,
+    name: &str,
+    dense: &DenseClip,
+    metrics: &Metrics,
+    document: &GltfDocument,
+) -> Animation {
     let gains = &dense.refined.stats.parent_gain;
     let mut keys: Vec<BoneKeys> =
         (0..layout.bone_node.len()).map(|bone| BoneKeys::new(layout, metrics, gains, bone)).collect();
-    dense.run(&mut keys, |keys, samples| samples.iter().for_each(|(time, node)| keys.push(*time, node, dense.base)));
+    dense.run(&mut keys, |keys, samples| {
+        samples.iter().for_each(|(time, node)| keys.push(*time, node, dense.sampling.base))
+    });
     let per_bone: Vec<Vec<Channel>> =
         keys.into_par_iter().enumerate().map(|(bone, keys)| keys.channels(layout, document, bone)).collect();
     let mut channels: Vec<Channel> = per_bone.into_iter().flatten().collect();
-    channels.extend(weight_channels(layout, clip, metrics, document));
+    channels.extend(weight_channels(layout, dense, metrics, document));
     if channels.is_empty()
         && let Some(node) = document.nodes.first()
     {
@@ -48,7 +49,7 @@ pub fn animation(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, docum
         let interpolation = Interpolation::Linear;
         channels.push(Channel { node: 0, property: Property::Rotation, interpolation, times, values });
     }
-    Animation { name: clip.name.to_owned(), channels }
+    Animation { name: name.to_owned(), channels }
 }
 
 /// One bone's keys, chosen as its samples come in time order (each bone's nodes as sampled, frames followed): every
@@ -289,9 +290,10 @@ impl Written {
 }
 
 /// The morph weights of every mesh group whose bone the clip animates them on.
-fn weight_channels(layout: &NodePlan, clip: &ClipSamples, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
-    let Some(source) = clip.dense.source.clip else { return Vec::new() };
-    let (times, rig) = (&clip.dense.base.times, clip.dense.source.rig);
+fn weight_channels(layout: &NodePlan, dense: &DenseClip, metrics: &Metrics, document: &GltfDocument) -> Vec<Channel> {
+    let Sampling { source: evaluation, base, .. } = &dense.sampling;
+    let Some(source) = evaluation.clip else { return Vec::new() };
+    let (times, rig) = (&base.times, evaluation.rig);
     let mut channels = Vec::new();
     let mut morph = MorphPose::default();
     for (group, (node, meshes)) in document.meshes.iter().zip(&layout.groups) {

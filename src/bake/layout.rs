@@ -5,7 +5,7 @@
 use glam::DQuat;
 
 use super::document::{GltfDocument, MeshGroup, Node};
-use super::nodes::{NodeSample, Sampled, under_conversion};
+use super::nodes::{NodeSample, under_conversion};
 use super::skins::{skins, unique_name};
 use crate::diff::HELPER_SUFFIX;
 use crate::math::decompose;
@@ -70,13 +70,13 @@ impl NodePlan {
         }
     }
 
-    /// The nodes, meshes and skins, with each node's default TRS from the rest pose; what a user should know of
-    /// them goes to `notes`.
-    pub fn document<'a>(&self, rig: &'a Rig, rest: &Sampled, notes: &mut Vec<String>) -> GltfDocument<'a> {
+    /// The nodes, meshes and skins, with each node's default TRS from the rest pose (`rest`, one per bone); what a
+    /// user should know of them goes to `notes`.
+    pub fn document<'a>(&self, rig: &'a Rig, rest: &[NodeSample], notes: &mut Vec<String>) -> GltfDocument<'a> {
         let mut document =
             GltfDocument { generator: format!("bonescope {}", env!("CARGO_PKG_VERSION")), ..GltfDocument::default() };
         for (bone, b) in rig.skeleton.bones().iter().enumerate() {
-            let node = &rest.series[bone].nodes[0].as_baked(self.helper_node[bone].is_some());
+            let node = &rest[bone].as_baked(self.helper_node[bone].is_some());
             let parent = b.parent.map(|p| self.bone_node[p]);
             match self.helper_node[bone] {
                 Some(helper) => {

@@ -36,7 +36,6 @@ pub use engine::Engine;
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
 
-use channels::ClipSamples;
 use keys::Metrics;
 use layout::NodePlan;
 use nodes::{NodeSample, Stats};
@@ -237,23 +236,22 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
         .zip(&base)
         .map(|(&source, base)| DenseClip::new(source, strategy, base, &metrics, held))
         .collect();
-    let rest = nodes::sample(request.rest(), &[0.0], strategy);
+    let (rest, at_rest) = nodes::solve(request.rest(), &[0.0], strategy);
     let helpers: Vec<bool> = (0..rig.skeleton.len())
-        .map(|bone| rest.stats.stretched[bone] || dense.iter().any(|d| d.refined.stats.stretched[bone]))
+        .map(|bone| at_rest.stretched[bone] || dense.iter().any(|d| d.refined.stats.stretched[bone]))
         .collect();
     let layout = NodePlan::new(rig, &helpers);
     let mut notes = layout.notes.clone();
     let mut document = layout.document(rig, &rest, &mut notes);
     let mut animations = Vec::new();
     for (clip, dense) in request.clips().iter().zip(&dense) {
-        let samples = ClipSamples { name: &clip.name, dense };
         let times = &dense.refined.times;
         if clip.source.clip.is_none() && clip.source.layers().is_none() {
             // The rest pose is what the nodes hold without an animation.
             animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys: 0 });
             continue;
         }
-        let animation = channels::animation(&layout, &samples, &metrics, &document);
+        let animation = channels::animation(&layout, &clip.name, dense, &metrics, &document);
         let keys = animation.channels.iter().map(|c| c.times.len()).sum();
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
         document.animations.push(animation);
@@ -274,14 +272,7 @@ const HELD: usize = 64 << 20;
 /// every sample learns it before the keys are chosen. Where they fit in [`HELD`] (about two samples per base time
 /// and bone), that pass keeps the samples for the keys; else the keys are chosen in a pass of their own.
 struct DenseClip<'a> {
-    pub source: &'a Evaluation<'a>,
-    strategy: Strategy,
-    /// The times every bone is sampled at, and the stepped keys among them.
-    pub base: &'a BakeTimes,
-    steps: Vec<bool>,
-    metrics: &'a Metrics,
-    /// What the base samples teach.
-    first: Stats,
+    pub sampling: Sampling<'a>,
     /// What every sample teaches, and every time some bone is sampled at.
     pub refined: Refined,
     /// Every bone's samples, where they are kept.
@@ -299,32 +290,44 @@ impl<'a> DenseClip<'a> {
     ) -> Self {
         let first = nodes::stats(source, &base.times, strategy);
         let steps = base.step_flags(&base.times);
-        let refined = Refined { stats: first.clone(), times: Vec::new() };
-        let mut clip = DenseClip { source, strategy, base, steps, metrics, first, refined, held: None };
+        let sampling = Sampling { source, strategy, base, steps, metrics, first };
         // Each bone's share of what may be kept; a bone past it (halved deep) gives it up, and the clip is sampled
         // again.
         let bones = source.skeleton().len();
         let share = held / (bones.max(1) * std::mem::size_of::<(f64, NodeSample)>());
         let mut held: Vec<Option<Vec<(f64, NodeSample)>>> =
             vec![Some(Vec::new()); if 2 * base.times.len() <= share { bones } else { 0 }];
-        clip.refined = clip.sample(&mut held, |held, samples| match held {
+        let refined = sampling.run(&mut held, |held, samples| match held {
             Some(kept) if kept.len() + samples.len() <= share => kept.extend_from_slice(samples),
             _ => *held = None,
         });
-        clip.held = held.into_iter().collect::<Option<Vec<_>>>().filter(|held| held.len() == bones && bones > 0);
-        clip
+        let held = held.into_iter().collect::<Option<Vec<_>>>().filter(|held| held.len() == bones && bones > 0);
+        DenseClip { sampling, refined, held }
     }
 
     /// Hands each bone's samples, in time order, to `feed` with its state, one of `states` per bone.
     pub fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) {
         match &self.held {
             Some(held) => states.par_iter_mut().zip(held).for_each(|(state, samples)| feed(state, samples)),
-            None => _ = self.sample(states, feed),
+            None => _ = self.sampling.run(states, feed),
         }
     }
+}
 
+/// What a run through one clip needs: the clip, its base times, and what its base samples teach.
+struct Sampling<'a> {
+    pub source: &'a Evaluation<'a>,
+    strategy: Strategy,
+    /// The times every bone is sampled at, and the stepped keys among them.
+    pub base: &'a BakeTimes,
+    steps: Vec<bool>,
+    metrics: &'a Metrics,
+    first: Stats,
+}
+
+impl Sampling<'_> {
     /// Runs through the clip, each bone's samples handed to `feed` with its state ([`Dense::run`]).
-    fn sample<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
+    fn run<S: Send>(&self, states: &mut [S], feed: impl Fn(&mut S, &[(f64, NodeSample)]) + Sync) -> Refined {
         let (metrics, gains) = (self.metrics, &self.first.parent_gain);
         let misses = |bone: usize, ends: [&NodeSample; 2], fraction: f64, exact: &NodeSample| {
             let metric = metrics.bone(gains, bone);

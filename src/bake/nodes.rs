@@ -93,13 +93,15 @@ impl NodeSample {
 
 /// One bone's nodes at the times it is sampled at, in time order.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg(test)]
 pub struct Series {
     pub times: Vec<f64>,
     pub nodes: Vec<NodeSample>,
 }
 
-/// Every bone's nodes at a few times, every bone at each (the rest pose's).
+/// Every bone's nodes at some times, bone by bone (what the tests compare).
 #[derive(Clone, Debug)]
+#[cfg(test)]
 pub struct Sampled {
     /// One per bone.
     pub series: Vec<Series>,
@@ -114,7 +116,8 @@ pub const BATCH: usize = 512;
 /// identity): the same on every machine, so that the nodes, and the file, do not depend on the number of cores.
 const RUN: usize = 256;
 
-/// Samples `source` at `times` (sorted) for `strategy`, every bone at every time.
+/// Samples `source` at `times` (sorted) for `strategy`, every bone at every time, bone by bone.
+#[cfg(test)]
 pub fn sample(source: &Evaluation, times: &[f64], strategy: Strategy) -> Sampled {
     let bones = source.skeleton().len();
     let empty = Series { times: times.to_vec(), nodes: Vec::with_capacity(times.len()) };
