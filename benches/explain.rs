@@ -13,7 +13,7 @@
 use std::hint::black_box;
 use std::sync::Arc;
 
-use bonescope::analysis::{BindTolerance, ScanOptions, check_bind, scan};
+use bonescope::analysis::{BindTolerance, ScanOptions, check_bind, scan_analysis};
 use bonescope::eval::Evaluation;
 use bonescope::explain::{Costs, Question, Scale, causes, explain};
 use bonescope::model::{BoneTracks, Interpolation, Rig, Track};
@@ -54,14 +54,14 @@ fn explain_on_mocap(c: &mut Criterion) {
     let (rig, hand) = squashed_walk();
     let evaluation = Evaluation::declared(&rig, rig.clips.first());
     let options = ScanOptions { rate: 120.0, ..ScanOptions::default() };
-    let before = scan(&evaluation, &options, &|_, _| {});
-    assert!(before.bones[hand].stretched(), "the squash shears the hand");
-    let times = evaluation.times(options.rate);
-    eprintln!("squashed CMU walk ×40: {} samples, {} bones, hand {hand}", times.len(), rig.skeleton.len());
+    let before = scan_analysis(&evaluation, &options);
+    let worst = &before.scan.bones[hand];
+    assert!(worst.stretched(), "the squash shears the hand");
+    eprintln!("squashed CMU walk ×40: {} samples, {} bones, hand {hand}", before.times.len(), rig.skeleton.len());
     let mut group = c.benchmark_group("explain");
     group.sample_size(10);
     group.bench_function("the hand's causes over 175 s at 120 Hz", |b| {
-        b.iter(|| black_box(causes(&evaluation, hand, &times, None, &options.tolerances)))
+        b.iter(|| black_box(causes(&evaluation, &before, hand, worst.worst_shear_time, &options.tolerances)))
     });
     group.bench_function("the hand explained, every fix measured", |b| {
         let question = Question { bones: Some(&[hand]), ..Question::default() };
@@ -80,8 +80,8 @@ fn explain_on_a_production_clip(c: &mut Criterion) {
     let rig = squashing_limbs();
     let evaluation = Evaluation::declared(&rig, rig.clips.first());
     let options = ScanOptions::default();
-    let before = scan(&evaluation, &options, &|_, _| {});
-    let flagged = before.stretched_worst_first();
+    let before = scan_analysis(&evaluation, &options);
+    let flagged = before.scan.stretched_worst_first();
     let bone = flagged.last().expect("the limbs shear").index;
     eprintln!("generated limbs: {} bones flagged; explained: {}", flagged.len(), rig.skeleton.bone(bone).name);
     let mut group = c.benchmark_group("explain a production clip");

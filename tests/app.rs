@@ -1083,7 +1083,7 @@ fn ranked_fixes(app: &BonescopeApp, bone: usize) -> Vec<bonescope::explain::Fix>
     let evaluation = app.session.doc.evaluation();
     let options =
         bonescope::analysis::ScanOptions { rate: app.session.doc.analysis_rate(), tolerances: app.settings.tolerances };
-    let before = bonescope::analysis::scan(&evaluation, &options, &|_, _| {});
+    let before = bonescope::analysis::scan_analysis(&evaluation, &options);
     let question = bonescope::explain::Question { bones: Some(&[bone]), ..Default::default() };
     bonescope::explain::explain(&evaluation, &before, question, &options).remove(0).fixes
 }

@@ -10,7 +10,7 @@ mod common;
 #[allow(dead_code)]
 mod generated_gltf;
 
-use bonescope::analysis::{ClipScan, ScanOptions, scan};
+use bonescope::analysis::{ClipScan, ScanOptions, scan, scan_analysis};
 use bonescope::diff::{PROBE_FRACTION, Pairs, compare_at_size, comparison_times};
 use bonescope::eval::{Evaluation, LayerStack, Layers};
 use bonescope::explain::{Change, Costs, Explanation, Fix, Measured, Question, Scale, explain};
@@ -145,7 +145,7 @@ fn made_again<'a>(source: &Evaluation<'a>, change: Change) -> Option<Evaluation<
 /// Every mode and uniform-scale fix of every explained bone of `source`, made again here with the library's own
 /// evaluation types, checked ([`check_fix`]). Returns the explanations.
 fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Explanation> {
-    let before = scan(source, options, &|_, _| {});
+    let before = scan_analysis(source, options);
     let explained = explain(source, &before, Question::default(), options);
     assert!(!explained.is_empty(), "something is flagged");
     for explanation in &explained {
@@ -153,7 +153,7 @@ fn check_fixes_in_memory(source: &Evaluation, options: &ScanOptions) -> Vec<Expl
         for fix in &explanation.fixes {
             if let Some(fixed) = made_again(source, fix.change) {
                 check_fix(source, &fixed, explanation.bone, fix, options);
-                check_elsewhere(&before, &scan(&fixed, options, &|_, _| {}), explanation.bone, fix, options);
+                check_elsewhere(&before.scan, &scan(&fixed, options, &|_, _| {}), explanation.bone, fix, options);
             }
         }
     }
@@ -262,8 +262,8 @@ fn on_the_generated_rig_the_fixes_of_a_sheared_bone_hold() {
     let rig = bonescope::import::load(&path).unwrap();
     let options = ScanOptions { rate: 0.0, ..ScanOptions::default() };
     let source = Evaluation::declared(&rig, rig.clips.first());
-    let before = scan(&source, &options, &|_, _| {});
-    let flagged = before.stretched_worst_first();
+    let before = scan_analysis(&source, &options);
+    let flagged = before.scan.stretched_worst_first();
     let bone = flagged.last().expect("the squashes shear the bones below them").index;
     let explained = explain(&source, &before, Question { bones: Some(&[bone]), ..Question::default() }, &options);
     let explanation = &explained[0];
@@ -338,7 +338,7 @@ fn costing_only_the_contenders_finds_the_same_best_fix() {
     for (file, rig) in rigs {
         let options = ScanOptions::default();
         let source = Evaluation::declared(&rig, rig.clips.first());
-        let before = scan(&source, &options, &|_, _| {});
+        let before = scan_analysis(&source, &options);
         let every = explain(&source, &before, Question::default(), &options);
         let best = explain(&source, &before, Question { costs: Costs::Best, ..Question::default() }, &options);
         assert!(!every.is_empty(), "{file}");

@@ -318,7 +318,7 @@ impl Rig {
         };
         let evaluation = Evaluation::of(&self.rig, &setup).map_err(error)?;
         let explained = py.detach(|| {
-            let before = bonescope_core::analysis::scan(&evaluation, &options, &|_, _| {});
+            let before = bonescope_core::analysis::scan_analysis(&evaluation, &options);
             let question = Question { bones: bones.as_deref(), at: time, costs: Costs::Every, scale: None };
             explain(&evaluation, &before, question, &options)
         });

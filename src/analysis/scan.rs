@@ -22,6 +22,13 @@ pub fn scan(evaluation: &Evaluation, options: &ScanOptions, progress: &(dyn Fn(u
         .scan
 }
 
+/// [`scan`]'s analysis, with where each bone is flagged: what `explain` starts from.
+pub fn scan_analysis(evaluation: &Evaluation, options: &ScanOptions) -> ClipAnalysis {
+    let never = AtomicBool::new(false);
+    analyze(evaluation, CurveRequest::default(), options, &|_, _| {}, &never)
+        .expect("an analysis that is never cancelled completes")
+}
+
 /// The whole-clip analysis behind [`scan`] and the app's plots. Returns `None` when `cancel` was set.
 pub fn analyze(
     evaluation: &Evaluation,

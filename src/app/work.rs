@@ -11,8 +11,8 @@ use super::identity::RigId;
 use super::job::{Job, Key, Progress};
 use crate::analysis::storage::{StorageOptions, StorageReport, storage_report};
 use crate::analysis::{
-    BindCheck, BindTolerance, ClipAnalysis, ClipScan, Components, CurveRequest, Judged, ScanOptions, Tolerances,
-    analyze, check_bind,
+    BindCheck, BindTolerance, ClipAnalysis, Components, CurveRequest, Judged, ScanOptions, Tolerances, analyze,
+    check_bind,
 };
 use crate::diff::{Pairs, compare, comparison_times, model_curves};
 use crate::eval::{Evaluation, Setup};
@@ -275,7 +275,7 @@ impl Work {
         };
         if !job.busy_with_other(&key) {
             let explained = key.clone();
-            let work = || move |_: &Progress| explanation(&rig, &explained, &before.scan, scale.as_deref());
+            let work = || move |_: &Progress| explanation(&rig, &explained, &before, scale.as_deref());
             Work::start(&self.waker, job, key, work);
         }
     }
@@ -347,9 +347,9 @@ fn analysis(
     }
 }
 
-/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it, given the clip's scan `before` (the
+/// The bone `key` asks of `rig` explained, as `bonescope explain` explains it, given the clip's analysis `before` (the
 /// window's: the same setup and options) and its scale where measured.
-fn explanation(rig: &Rig, key: &Key<WhyRequest>, before: &ClipScan, scale: Option<&Scale>) -> Option<Explanation> {
+fn explanation(rig: &Rig, key: &Key<WhyRequest>, before: &ClipAnalysis, scale: Option<&Scale>) -> Option<Explanation> {
     let evaluation = key.evaluation(rig)?;
     let (bone, options) = (key.request.bone, &key.request.options);
     let question = Question { bones: Some(&[bone]), costs: key.request.costs, scale, ..Question::default() };

@@ -11,7 +11,7 @@ use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
-use crate::analysis::{ScanOptions, scan};
+use crate::analysis::{ScanOptions, scan_analysis};
 use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, Report, explain, is_other_mode};
 use crate::import;
 use crate::model::{InheritMode, Rig, Unit};
@@ -49,7 +49,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let bones = args.bone.iter().map(|name| bone_index(&rig, "--bone", name)).collect::<anyhow::Result<Vec<_>>>()?;
     let options = ScanOptions { rate: args.rate, tolerances: args.tolerances.tolerances()? };
     let evaluation = evaluation(&rig, &setup)?;
-    let before = scan(&evaluation, &options, &|_, _| {});
+    let before = scan_analysis(&evaluation, &options);
     let asked = (!bones.is_empty()).then_some(bones.as_slice());
     let question = Question { bones: asked, at: args.time, costs: Costs::Every, scale: None };
     let explained = explain(&evaluation, &before, question, &options);

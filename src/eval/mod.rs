@@ -26,7 +26,7 @@ pub use hierarchy::{Hierarchy, HierarchyError, ModelPose};
 pub use layers::{LayerStack, Layers};
 pub use morph::MorphPose;
 pub use pose::Pose;
-pub use runs::{over_runs, over_runs_of, run_length};
+pub use runs::{over_runs, over_runs_from, over_runs_of, run_length};
 pub use sample::{Interpolate, sample_clip, sample_track};
 pub use setup::{Setup, SetupError};
 pub use skinning::{Method as SkinningMethod, Reach, skin_meshes};

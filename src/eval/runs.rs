@@ -27,6 +27,12 @@ pub fn over_runs<R: Send>(times: &[f64], work: impl Fn(&[f64]) -> R + Sync + Sen
     over_runs_of(times, run_length(times.len()), work)
 }
 
+/// [`over_runs`], each run's work also given the index of its first time.
+pub fn over_runs_from<R: Send>(times: &[f64], work: impl Fn(usize, &[f64]) -> R + Sync + Send) -> Vec<R> {
+    let length = run_length(times.len());
+    times.par_chunks(length).enumerate().map(|(k, run)| work(k * length, run)).collect()
+}
+
 /// [`over_runs`] in runs of `length` times: for work that needs runs of its own length.
 pub fn over_runs_of<R: Send>(times: &[f64], length: usize, work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
     times.par_chunks(length.max(1)).map(work).collect()

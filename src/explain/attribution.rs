@@ -5,11 +5,11 @@ use std::sync::OnceLock;
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use rayon::prelude::*;
 
-use crate::analysis::{Assessment, SAME_SHEAR_DEG, Tolerances};
+use crate::analysis::{Assessment, ClipAnalysis, SAME_SHEAR_DEG, Tolerances};
 use crate::eval::layers::uniform_scale;
-use crate::eval::{BonesEvaluator, Evaluation, Hierarchy, ModelPose, over_runs};
+use crate::eval::{BoneCursor, BonesEvaluator, Evaluation, Hierarchy, ModelPose, over_runs_from};
 use crate::math::{AffineParts, shear_deg};
-use crate::model::{Skeleton, Transform};
+use crate::model::{InheritMode, Skeleton, Transform};
 
 /// One bone of the explained bone's chain (the explained bone included) at one time.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -107,9 +107,16 @@ pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &T
     Attribution { bone, time, shear_deg: shear, stretched, chain: links, sufficient }
 }
 
-/// Why `bone` shears over `times` (sorted) of `evaluation`, with the detail at `at` (the worst time for `None`).
-pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f64>, tolerances: &Tolerances) -> Causes {
-    causes_each(evaluation, &[(bone, at)], times, tolerances).pop().expect("one bone asked")
+/// Why `bone` shears over the clip `scanned` analysed (every bone judged, as `scan` judges them) of `evaluation`, with
+/// the detail at `at`.
+pub fn causes(
+    evaluation: &Evaluation,
+    scanned: &ClipAnalysis,
+    bone: usize,
+    at: f64,
+    tolerances: &Tolerances,
+) -> Causes {
+    causes_each(evaluation, scanned, &[(bone, at)], tolerances).pop().expect("one bone asked")
 }
 
 /// How many bones' causes one pass over the clip finds ([`causes_each`]): each holds a sample per time while the
@@ -117,12 +124,13 @@ pub fn causes(evaluation: &Evaluation, bone: usize, times: &[f64], at: Option<f6
 const TOGETHER: usize = 8;
 
 /// [`causes`] of each of `bones` (each with the time to detail), in the order asked: a few at a time in bone
-/// order (the bones of one chain lie together), the groups in parallel. A group's chains are evaluated once per time
-/// for all its bones, and each squash on them made uniform once for every flagged bone below it.
+/// order (the bones of one chain lie together), the groups in parallel. Where a group's bones are flagged, their
+/// main causes are read from the local scales where those settle them; elsewhere the group's chains are evaluated
+/// once for all its bones, and each squash on them made uniform once for every flagged bone below it.
 pub fn causes_each(
     evaluation: &Evaluation,
-    bones: &[(usize, Option<f64>)],
-    times: &[f64],
+    scanned: &ClipAnalysis,
+    bones: &[(usize, f64)],
     tolerances: &Tolerances,
 ) -> Vec<Causes> {
     let mut order: Vec<usize> = (0..bones.len()).collect();
@@ -131,10 +139,16 @@ pub fn causes_each(
         .par_chunks(TOGETHER)
         .map(|group| {
             let asked: Vec<usize> = group.iter().map(|&i| bones[i].0).collect();
-            let samples = samples_of(evaluation, &asked, times, tolerances);
+            let samples = samples_of(evaluation, scanned, &asked, tolerances);
             let summarised = group.iter().zip(samples).map(|(&i, samples)| {
                 let (bone, at) = bones[i];
-                (i, summarised(evaluation, bone, &samples, times, at, tolerances))
+                let causes = Causes {
+                    samples: samples.len(),
+                    stretched_samples: samples.iter().filter(|s| s.stretched).count(),
+                    at: attribute(evaluation, bone, at, tolerances),
+                    spans: spans(evaluation.skeleton(), &samples, &scanned.times),
+                };
+                (i, causes)
             });
             summarised.collect()
         })
@@ -144,60 +158,48 @@ pub fn causes_each(
     causes.into_iter().map(|(_, causes)| causes).collect()
 }
 
-/// `bone`'s causes from its `samples` at `times`, with the detail at `at` (the worst time for `None`).
-fn summarised(
+/// Each of `bones`' samples at the times `scanned` analysed: whether the analysis flags it, and where it does its
+/// main cause, the bone of its chain, among those scaled unequally, whose uniform scale leaves the least shear
+/// (shears measured on the matrix, without a decomposition). Only the flagged samples are looked at, and most of
+/// those without evaluating a matrix ([`Group::certain_causes`]).
+fn samples_of(
     evaluation: &Evaluation,
-    bone: usize,
-    samples: &[Sample],
-    times: &[f64],
-    at: Option<f64>,
+    scanned: &ClipAnalysis,
+    bones: &[usize],
     tolerances: &Tolerances,
-) -> Causes {
-    // The first flagged sample with the largest shear (the largest shear where none is flagged).
-    let key = |s: &Sample| (s.stretched, s.shear_deg);
-    let worst = (0..samples.len()).reduce(|w, s| if key(&samples[s]) > key(&samples[w]) { s } else { w });
-    let worst = worst.map_or(0.0, |s| times[s]);
-    let time = at.unwrap_or(worst);
-    Causes {
-        samples: samples.len(),
-        stretched_samples: samples.iter().filter(|s| s.stretched).count(),
-        at: attribute(evaluation, bone, time, tolerances),
-        spans: spans(evaluation.skeleton(), samples, times),
-    }
-}
-
-/// Each of `bones`' samples at `times`: its shear and verdict, and where it is flagged its main cause, the bone of its
-/// chain, among those scaled unequally, whose uniform scale leaves the least shear (shears measured on the matrix,
-/// without a decomposition).
-fn samples_of(evaluation: &Evaluation, bones: &[usize], times: &[f64], tolerances: &Tolerances) -> Vec<Vec<Sample>> {
-    let group = Group::new(evaluation.skeleton(), bones);
-    let runs = over_runs(times, |run| {
-        let mut source = BonesEvaluator::new(evaluation, &group.evaluated);
+) -> Vec<Vec<Sample>> {
+    let group = Group::new(evaluation, bones);
+    let runs = over_runs_from(&scanned.times, |first, run| {
+        let mut source: Option<BonesEvaluator> = None;
+        let mut scales = group.scales(evaluation);
         let mut probe = Probe::new(&evaluation.hierarchy);
         let mut local = vec![Transform::IDENTITY; evaluation.skeleton().len()];
-        let mut starts = vec![DQuat::IDENTITY; bones.len()];
         let mut samples: Vec<Vec<Sample>> = vec![Vec::with_capacity(run.len()); bones.len()];
         let mut now: Vec<AtTime> = Vec::with_capacity(bones.len());
-        for &time in run {
-            let pose = source.evaluate(time);
-            group.evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
+        for (sample, &time) in (first..).zip(run) {
             now.clear();
-            now.extend(bones.iter().zip(&mut starts).map(|(&bone, start)| {
-                let m = &pose.model.model[bone];
-                let assessment = Assessment::near(m, tolerances, *start);
-                *start = assessment.parts.stretch;
-                AtTime { assessment, shear: column_shear(m), largest: 0.0, main_cause: None }
-            }));
-            group.find_main_causes(&mut probe, &mut local, &mut now, tolerances);
+            now.extend(bones.iter().map(|&bone| AtTime::new(scanned.stretched_at(bone, sample))));
+            if now.iter().any(|bone| bone.stretched) {
+                if let Some(scales) = &mut scales {
+                    group.certain_causes(scales.read(time), &mut now, tolerances);
+                }
+                if now.iter().any(|bone| bone.open) {
+                    let source = source.get_or_insert_with(|| BonesEvaluator::new(evaluation, &group.evaluated));
+                    let pose = source.evaluate(time);
+                    group.evaluated.iter().for_each(|&b| local[b] = pose.local[b]);
+                    for (bone, &b) in now.iter_mut().zip(bones).filter(|(bone, _)| bone.open) {
+                        bone.shear = column_shear(&pose.model.model[b]);
+                    }
+                    group.find_main_causes(&mut probe, &mut local, &mut now, tolerances);
+                }
+            }
             for (samples, bone) in samples.iter_mut().zip(&now) {
-                let AtTime { assessment, main_cause, .. } = bone;
-                let (shear_deg, stretched) = (assessment.shear_deg, assessment.findings.stretched);
-                samples.push(Sample { shear_deg, stretched, main_cause: *main_cause });
+                samples.push(Sample { stretched: bone.stretched, main_cause: bone.main_cause });
             }
         }
         samples
     });
-    let mut each: Vec<Vec<Sample>> = vec![Vec::with_capacity(times.len()); bones.len()];
+    let mut each: Vec<Vec<Sample>> = vec![Vec::with_capacity(scanned.times.len()); bones.len()];
     for run in runs {
         each.iter_mut().zip(run).for_each(|(samples, run)| samples.extend(run));
     }
@@ -209,6 +211,9 @@ struct Group<'b> {
     bones: &'b [usize],
     /// Each bone's chain, the root first.
     chains: Vec<Vec<usize>>,
+    /// Per bone, whether every bone of its chain passes its stretch down as a product of local matrices (full
+    /// inheritance, or a root): what [`Group::certain_causes`] reasons from.
+    products: Vec<bool>,
     /// The bones and their ancestors, parents first.
     evaluated: Vec<usize>,
     /// Per bone of the rig, the bones of the group below it (itself included), by their place in the group.
@@ -218,24 +223,79 @@ struct Group<'b> {
     reach: Vec<OnceLock<Vec<usize>>>,
 }
 
-/// One bone of a group at one time: its verdict, its shear on the matrix, and the largest contribution to it found
-/// so far with its bone.
+/// The local scales of some bones, read from the clip one time after another.
+struct Scales<'a> {
+    cursors: Vec<(usize, BoneCursor<'a>)>,
+    /// By bone: the scale at the time last read (the others' entries mean nothing).
+    at: Vec<DVec3>,
+}
+
+impl Scales<'_> {
+    fn read(&mut self, time: f64) -> &[DVec3] {
+        for (b, cursor) in &mut self.cursors {
+            self.at[*b] = cursor.scale(time);
+        }
+        &self.at
+    }
+}
+
+/// One bone of a group at one time: whether it is flagged, whether its main cause is still to be found from the
+/// matrices (`open`), its shear on the matrix there, and the largest contribution to it found so far with its bone.
 struct AtTime {
-    assessment: Assessment,
+    stretched: bool,
+    open: bool,
     shear: f64,
     largest: f64,
     main_cause: Option<usize>,
 }
 
+impl AtTime {
+    fn new(stretched: bool) -> Self {
+        AtTime { stretched, open: stretched, shear: 0.0, largest: 0.0, main_cause: None }
+    }
+}
+
 impl<'b> Group<'b> {
-    fn new(skeleton: &Skeleton, bones: &'b [usize]) -> Self {
+    fn new(evaluation: &Evaluation, bones: &'b [usize]) -> Self {
+        let skeleton = evaluation.skeleton();
         let chains: Vec<Vec<usize>> = bones.iter().map(|&bone| skeleton.chain(bone)).collect();
+        let inherits = |b: &usize| skeleton.parent(*b).is_none() || evaluation.modes()[*b] == InheritMode::Full;
+        let products = chains.iter().map(|chain| chain.iter().all(inherits)).collect();
         let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
         for (k, chain) in chains.iter().enumerate() {
             chain.iter().for_each(|&b| below[b].push(k));
         }
         let reach = (0..skeleton.len()).map(|_| OnceLock::new()).collect();
-        Group { bones, chains, evaluated: skeleton.with_ancestors(bones), below, reach }
+        Group { bones, chains, products, evaluated: skeleton.with_ancestors(bones), below, reach }
+    }
+
+    /// The local scales of the bones the group evaluates, where the clip is read bone by bone (no layers, lengths in
+    /// the rig's unit): [`Group::certain_causes`] reads them alone.
+    fn scales<'a>(&self, evaluation: &Evaluation<'a>) -> Option<Scales<'a>> {
+        let clip = evaluation.clip.filter(|_| evaluation.reads_bone_by_bone())?;
+        let cursors = self.evaluated.iter().map(|&b| (b, BoneCursor::new(evaluation.skeleton(), clip, b))).collect();
+        Some(Scales { cursors, at: vec![DVec3::ONE; evaluation.skeleton().len()] })
+    }
+
+    /// The main causes that the local scales alone settle (`scales`, by bone); `now`'s bones left open are not. A
+    /// flagged bone whose chain holds no unequal scale has none; one whose chain holds one has it, wherever the
+    /// chain's other scales are too near uniform to shear it by half the shear tolerance once that one is made
+    /// uniform ([`largest_shear_deg`] of the product of their condition numbers), since a flagged bone shears by
+    /// more than the tolerance: the squash made uniform takes shear away, as the matrices would say.
+    fn certain_causes(&self, scales: &[DVec3], now: &mut [AtTime], tolerances: &Tolerances) {
+        for (k, bone) in now.iter_mut().enumerate().filter(|(k, bone)| bone.stretched && self.products[*k]) {
+            let (mut squashes, mut squash, mut others) = (0, None, 1.0);
+            for &b in &self.chains[k] {
+                if anisotropy(scales[b]) > tolerances.min_anisotropy {
+                    (squashes, squash) = (squashes + 1, Some(b));
+                } else {
+                    others *= condition(scales[b]);
+                }
+            }
+            if squashes == 0 || (squashes == 1 && largest_shear_deg(others) < 0.5 * tolerances.min_shear_deg) {
+                (bone.main_cause, bone.open) = (squash, false);
+            }
+        }
     }
 
     /// What `squash` made uniform needs evaluated ([`Group::reach`]).
@@ -250,8 +310,8 @@ impl<'b> Group<'b> {
         })
     }
 
-    /// Each flagged bone's main cause at one time (`local`, the group's bones' local transforms, and `now`): each
-    /// squash of the chains made uniform once for every flagged bone below it, parents first, so that each bone meets
+    /// The main cause at one time (`local`, the group's bones' local transforms, and `now`) of each open bone: each
+    /// squash of the chains made uniform once for every open bone below it, parents first, so that each bone meets
     /// the squashes of its chain in the chain's order.
     fn find_main_causes(
         &self,
@@ -265,13 +325,13 @@ impl<'b> Group<'b> {
                 continue;
             }
             let below = &self.below[squash];
-            if !below.iter().any(|&k| now[k].assessment.findings.stretched) {
+            if !below.iter().any(|&k| now[k].open) {
                 continue;
             }
             let models = probe.models(local, self.reach(squash), &[squash]);
             for &k in below {
                 let bone = &mut now[k];
-                if !bone.assessment.findings.stretched {
+                if !bone.open {
                     continue;
                 }
                 let contribution = bone.shear - column_shear(&models[self.bones[k]]);
@@ -286,7 +346,6 @@ impl<'b> Group<'b> {
 /// One sample of the explained bone over a clip.
 #[derive(Clone, Copy, Debug)]
 struct Sample {
-    shear_deg: f64,
     stretched: bool,
     /// The chain bone whose uniform scale removes the most shear, when the bone is flagged.
     main_cause: Option<usize>,
@@ -340,6 +399,20 @@ impl<'a> Probe<'a> {
 /// The shear of `m`'s columns in degrees.
 fn column_shear(m: &DMat4) -> f64 {
     shear_deg(&DMat3::from_mat4(*m))
+}
+
+/// The largest shear, in degrees, of a matrix whose condition number is at most `condition`: it turns orthogonal
+/// directions at most `asin((κ² − 1)/(κ² + 1))` off a right angle (Wielandt's inequality), and the condition number
+/// of a product is at most the product of its factors'.
+fn largest_shear_deg(condition: f64) -> f64 {
+    (1.0 - 2.0 / (condition * condition + 1.0)).asin().to_degrees()
+}
+
+/// `max|k|/min|k|`, the condition number of a matrix scaling by `scale` (infinite for a zero scale).
+fn condition(scale: DVec3) -> f64 {
+    let k = scale.abs();
+    let (min, max) = (k.min_element(), k.max_element());
+    if min > 0.0 { max / min } else { f64::INFINITY }
 }
 
 /// `max|k|/min|k| − 1` (0 for a zero scale: nothing to compare).
@@ -414,4 +487,50 @@ fn sufficient(
 /// The bones of the candidates whose bits are set in `mask`.
 fn pick(candidates: &[&Link], mask: u32) -> Vec<usize> {
     candidates.iter().enumerate().filter(|(i, _)| mask >> i & 1 == 1).map(|(_, l)| l.bone).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    fn quat() -> impl Strategy<Value = DQuat> {
+        prop::array::uniform4(-1.0..1.0f64)
+            .prop_filter("not near zero", |q| q.iter().map(|c| c * c).sum::<f64>() > 1e-3)
+            .prop_map(|q| DQuat::from_array(q).normalize())
+    }
+
+    proptest! {
+        /// A chain of turned, unequally scaled bones shears no more than the product of their scales' condition
+        /// numbers allows, near uniform or far from it.
+        #[test]
+        fn a_chain_shears_at_most_as_its_scales_condition_allows(
+            chain in prop::collection::vec((quat(), quat(), prop::array::uniform3(0.0..1.0f64)), 1..10),
+            spread in prop_oneof![Just(1e-4), Just(1e-2), Just(1.0)],
+        ) {
+            let (mut model, mut condition) = (DMat4::IDENTITY, 1.0);
+            for (rotation, stretch, scale) in &chain {
+                let scale = DVec3::from_array(scale.map(|k| 1.0 + spread * k));
+                let local = Transform { translation: DVec3::X, rotation: *rotation, scale, stretch: *stretch };
+                model *= local.matrix();
+                condition *= super::condition(scale);
+            }
+            let shear = column_shear(&model);
+            prop_assert!(shear <= largest_shear_deg(condition) + 1e-9, "{shear} > {}", largest_shear_deg(condition));
+        }
+    }
+
+    #[test]
+    fn the_largest_shear_of_a_condition_number() {
+        // diag(κ, 1) turned 45°: columns (κ+1, κ−1)/2 and (κ−1, κ+1)/2 meet at cos = (κ²−1)/(κ²+1), the bound.
+        let kappa: f64 = 1.5;
+        let m = DMat3::from_quat(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4))
+            * DMat3::from_diagonal(DVec3::new(kappa, 1.0, 1.0))
+            * DMat3::from_quat(DQuat::from_rotation_z(-std::f64::consts::FRAC_PI_4));
+        let reached = column_shear(&DMat4::from_mat3(m));
+        assert!((reached - largest_shear_deg(kappa)).abs() < 1e-12, "{reached} against {}", largest_shear_deg(kappa));
+        assert_eq!(largest_shear_deg(1.0), 0.0);
+        assert_eq!(largest_shear_deg(f64::INFINITY), 90.0, "a zero scale shears without bound");
+    }
 }

@@ -28,7 +28,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
-use crate::analysis::{ClipScan, CurveRequest, SAME_SHEAR_DEG, ScanOptions, analyze};
+use crate::analysis::{ClipAnalysis, CurveRequest, SAME_SHEAR_DEG, ScanOptions, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
 use crate::model::{Tool, Unit, significant};
@@ -168,14 +168,14 @@ pub fn scan_clip(
     explained: bool,
     cancel: &AtomicBool,
 ) -> Option<AnimationScan> {
-    let result = analyze(evaluation, CurveRequest::default(), options, &|_, _| {}, cancel)?.scan;
+    let analysis = analyze(evaluation, CurveRequest::default(), options, &|_, _| {}, cancel)?;
     let briefs = match explained {
         _ if cancel.load(Ordering::Relaxed) => return None,
-        true => explain(evaluation, &result, Question { costs: Costs::Best, ..Question::default() }, options),
+        true => explain(evaluation, &analysis, Question { costs: Costs::Best, ..Question::default() }, options),
         false => Vec::new(),
     };
     let inherit = evaluation.setup().modes.label().to_owned();
-    let scanned = AnimationScan::new(evaluation.skeleton(), evaluation.clip, inherit, options.rate, result);
+    let scanned = AnimationScan::new(evaluation.skeleton(), evaluation.clip, inherit, options.rate, analysis.scan);
     let explained = briefs.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
     Some(AnimationScan { explained, ..scanned })
 }
@@ -208,27 +208,29 @@ pub struct Question<'q> {
     pub scale: Option<&'q Scale>,
 }
 
-/// Explains the bones `question` asks about over `evaluation`'s clip. `before` is the clip's scan with `options`
-/// (what the fixes change). A change shared by several bones' fixes is made and measured once.
+/// Explains the bones `question` asks about over `evaluation`'s clip. `analysis` is the clip's with `options`, every
+/// bone judged ([`crate::analysis::scan`]'s: where each bone is flagged, and what the fixes change). A change shared
+/// by several bones' fixes is made and measured once.
 pub fn explain(
     evaluation: &Evaluation,
-    before: &ClipScan,
+    analysis: &ClipAnalysis,
     question: Question,
     options: &ScanOptions,
 ) -> Vec<Explanation> {
+    let before = &analysis.scan;
     let flagged = || before.stretched_worst_first().iter().map(|b| b.index).collect();
     let bones = question.bones.map_or_else(flagged, <[usize]>::to_vec);
     if bones.is_empty() {
         // Nothing sheared, nothing asked: no baseline to measure (a whole evaluation of a long clip).
         return Vec::new();
     }
-    let times = evaluation.times(options.rate);
+    debug_assert_eq!(analysis.times, evaluation.times(options.rate), "the analysis's times");
     let tolerances = &options.tolerances;
     // Detailed at the time asked for, else where the scan found the bone's worst shear (refined between samples):
     // one figure per bone, whatever the sampling.
-    let at = |bone: usize| question.at.or_else(|| before.bones.get(bone).map(|b| b.worst_shear_time));
-    let asked: Vec<(usize, Option<f64>)> = bones.iter().map(|&bone| (bone, at(bone))).collect();
-    let causes = causes_each(evaluation, &asked, &times, tolerances);
+    let at = |bone: usize| question.at.unwrap_or_else(|| before.bones.get(bone).map_or(0.0, |b| b.worst_shear_time));
+    let asked: Vec<(usize, f64)> = bones.iter().map(|&bone| (bone, at(bone))).collect();
+    let causes = causes_each(evaluation, analysis, &asked, tolerances);
     // A bake that reproduces the clip leaves every shear where it was: no candidate for the best fix.
     let bakes = question.costs == Costs::Every || !bakes_reproduce(evaluation);
     let changes: Vec<Vec<Change>> = bones
@@ -452,6 +454,7 @@ fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
         // found no removal, and is costed next where it is one.
         let (costed, made): (Vec<Change>, Vec<Change>) =
             needs.iter().filter_map(|&(_, need)| need.made()).partition(|change| !known.costs.contains_key(change));
+
         known.make_costed(baseline, &costed);
         known.make(baseline, &made);
         let mut limits: HashMap<Change, f64> = HashMap::new();
@@ -557,7 +560,7 @@ mod tests {
     /// `bones` (the flagged ones for `None`) of `evaluation` explained with the default options.
     fn explained(evaluation: &Evaluation, bones: Option<&[usize]>) -> Vec<Explanation> {
         let options = ScanOptions::default();
-        let before = crate::analysis::scan(evaluation, &options, &|_, _| {});
+        let before = crate::analysis::scan_analysis(evaluation, &options);
         explain(evaluation, &before, Question { bones, ..Question::default() }, &options)
     }
 
@@ -610,26 +613,42 @@ mod tests {
         Track::new(Arc::from(times), values.to_vec(), Interpolation::Linear).unwrap()
     }
 
-    #[test]
-    fn each_squash_is_the_main_cause_while_it_lasts() {
-        // root → a → m → b; a squashes along X until 1 s and is uniform from 1.5 s; m squashes along Y from 2 s on,
-        // uniform until 1.5 s. m turns a's axes 30° about Z, b turns m's 30° about X: b shears under either squash.
+    /// root → a → m → b, a and m scaled by the tracks `a` and `m`: m turns a's axes 30° about Z, b turns m's 30°
+    /// about X, so b shears under a squash of either.
+    fn squashed_chain(a: Track<Vec3>, m: Track<Vec3>) -> Rig {
         let bones = vec![
             Bone::joint("root", None, Transform::IDENTITY),
             Bone::joint("a", Some(0), Transform::from_trs(DVec3::X, DQuat::IDENTITY, DVec3::ONE)),
             Bone::joint("m", Some(1), turned(DVec3::Z, 30.0)),
             Bone::joint("b", Some(2), turned(DVec3::X, 30.0)),
         ];
-        let squash = |x: f32, y: f32| Vec3::new(x, y, 1.0);
-        let mut a = BoneTracks::new(1);
-        a.scale = Some(track(&[0.0, 1.0, 1.5, 3.0], &[squash(1.5, 1.0), squash(1.5, 1.0), Vec3::ONE, Vec3::ONE]));
-        let mut m = BoneTracks::new(2);
-        m.scale = Some(track(&[0.0, 1.5, 2.0, 3.0], &[Vec3::ONE, Vec3::ONE, squash(1.0, 1.5), squash(1.0, 1.5)]));
-        m.rotation = Some(track(&[0.0], &[Quat::from_rotation_z(30f32.to_radians())]));
-        let rig = rig(bones, vec![Clip::new(0, None, vec![a, m], vec![])]);
+        let (mut a_tracks, mut m_tracks) = (BoneTracks::new(1), BoneTracks::new(2));
+        (a_tracks.scale, m_tracks.scale) = (Some(a), Some(m));
+        m_tracks.rotation = Some(track(&[0.0], &[Quat::from_rotation_z(30f32.to_radians())]));
+        rig(bones, vec![Clip::new(0, None, vec![a_tracks, m_tracks], vec![])])
+    }
+
+    /// a squashes along X until 1 s and is uniform from 1.5 s, m along Y from 2 s on, uniform until 1.5 s; a's
+    /// scale is `a_scale` times that.
+    fn squashes_in_turn(a_scale: Vec3) -> Rig {
+        let (x, y) = (Vec3::new(1.5, 1.0, 1.0), Vec3::new(1.0, 1.5, 1.0));
+        let a = track(&[0.0, 1.0, 1.5, 3.0], &[x * a_scale, x * a_scale, a_scale, a_scale]);
+        squashed_chain(a, track(&[0.0, 1.5, 2.0, 3.0], &[Vec3::ONE, Vec3::ONE, y, y]))
+    }
+
+    /// `bones`' causes over `evaluation`'s clip at 10 samples a second, each detailed at its worst shear.
+    fn causes_at_worst(evaluation: &Evaluation, bones: &[usize]) -> Vec<Causes> {
+        let scanned = crate::analysis::scan_analysis(evaluation, &ScanOptions { rate: 10.0, ..ScanOptions::default() });
+        let asked: Vec<(usize, f64)> = bones.iter().map(|&b| (b, scanned.scan.bones[b].worst_shear_time)).collect();
+        causes_each(evaluation, &scanned, &asked, &Default::default())
+    }
+
+    #[test]
+    fn each_squash_is_the_main_cause_while_it_lasts() {
+        // a squashes until 1 s and is uniform from 1.5 s, m from 2 s on, uniform until 1.5 s.
+        let rig = squashes_in_turn(Vec3::ONE);
         let evaluation = Evaluation::declared(&rig, rig.clips.first());
-        let times = evaluation.times(10.0);
-        let causes = causes(&evaluation, 3, &times, None, &Default::default());
+        let causes = causes_at_worst(&evaluation, &[3]).remove(0);
         let spans: Vec<(&str, f64, f64)> = causes.spans.iter().map(|s| (s.name.as_str(), s.from, s.to)).collect();
         assert_eq!(spans.len(), 2, "{spans:?}");
         assert_eq!((spans[0].0, spans[0].1), ("a", 0.0));
@@ -640,17 +659,59 @@ mod tests {
     }
 
     #[test]
+    fn main_causes_read_from_the_scales_are_those_the_matrices_give() {
+        // Where the clip is read bone by bone, a flagged sample whose chain holds one squash takes it as its main cause
+        // from the scales alone; lengths measured in another unit read whole poses, and every main cause is found
+        // from the matrices. Both agree: on the stress rig (chains squashing on their fifth bone), and where a
+        // chain holds two squashes at once (a fading out while m fades in), the one that shears less first.
+        let mut stress = crate::import::stress_rig(24, 120, 3);
+        // a's squash grows from 1.2 to 1.6 over the first second and fades out by 3 s, while m's stays at 1.3: the
+        // cause changes twice.
+        let a = track(&[0.0, 1.0, 3.0], &[Vec3::new(1.2, 1.0, 1.0), Vec3::new(1.6, 1.0, 1.0), Vec3::ONE]);
+        let mut overlapping = squashed_chain(a, track(&[0.0], &[Vec3::new(1.0, 1.3, 1.0)]));
+        // a's scale uneven by 0.009 %, under the anisotropy tolerance but enough to shear b by more than half the
+        // shear tolerance alone: not certain from the scales.
+        let uneven = squashes_in_turn(Vec3::new(1.0, 1.00009, 1.0));
+        for rig in [&mut stress, &mut overlapping, &mut { uneven }] {
+            rig.unit = Some(crate::model::Unit::METRE);
+            let by_bone = Evaluation::declared(rig, rig.clips.first());
+            let whole = by_bone.clone().measured_in(crate::model::Unit::metres(0.01));
+            assert!(by_bone.reads_bone_by_bone() && !whole.reads_bone_by_bone());
+            let scanned =
+                crate::analysis::scan_analysis(&by_bone, &ScanOptions { rate: 10.0, ..ScanOptions::default() });
+            let bones: Vec<usize> = (0..rig.skeleton.len()).filter(|&b| scanned.scan.bones[b].stretched()).collect();
+            let asked: Vec<(usize, f64)> = bones.iter().map(|&b| (b, scanned.scan.bones[b].worst_shear_time)).collect();
+            let spans = |evaluation: &Evaluation| {
+                let causes = causes_each(evaluation, &scanned, &asked, &Default::default());
+                causes.into_iter().map(|c| (c.stretched_samples, c.spans)).collect::<Vec<_>>()
+            };
+            let read = spans(&by_bone);
+            assert!(read.iter().any(|(_, spans)| !spans.is_empty()), "some bone has a main cause");
+            assert_eq!(read, spans(&whole));
+        }
+        let changing = causes_at_worst(&Evaluation::declared(&overlapping, overlapping.clips.first()), &[3]);
+        let causes: Vec<&str> = changing[0].spans.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(causes, ["m", "a", "m"], "a's squash outgrows m's, then fades");
+    }
+
+    #[test]
     fn causes_found_together_are_each_bone_s_found_alone() {
         // Every bone of the stress rig (a spine, chains squashing on their fifth bone), asked in reverse bone order,
-        // some with a time to detail: the shared pass over the group's chains gives each bone's causes bit for bit.
+        // some detailed at another time than their worst: the shared pass over the group's chains gives each bone's
+        // causes bit for bit.
         let rig = crate::import::stress_rig(12, 300, 3);
         let evaluation = Evaluation::declared(&rig, rig.clips.first());
-        let times = evaluation.times(30.0);
+        let scanned =
+            crate::analysis::scan_analysis(&evaluation, &ScanOptions { rate: 30.0, ..ScanOptions::default() });
+        let times = &scanned.times;
+        let at = |b: usize| {
+            if b.is_multiple_of(3) { times[b % times.len()] } else { scanned.scan.bones[b].worst_shear_time }
+        };
+        let asked: Vec<(usize, f64)> = (0..rig.skeleton.len()).rev().map(|b| (b, at(b))).collect();
         let tolerances = crate::analysis::Tolerances::default();
-        let asked: Vec<(usize, Option<f64>)> =
-            (0..rig.skeleton.len()).rev().map(|b| (b, (b % 3 == 0).then_some(times[b % times.len()]))).collect();
-        let together = causes_each(&evaluation, &asked, &times, &tolerances);
-        let alone: Vec<Causes> = asked.iter().map(|&(b, at)| causes(&evaluation, b, &times, at, &tolerances)).collect();
+        let together = causes_each(&evaluation, &scanned, &asked, &tolerances);
+        let alone: Vec<Causes> =
+            asked.iter().map(|&(b, at)| causes(&evaluation, &scanned, b, at, &tolerances)).collect();
         assert!(together.iter().filter(|c| c.stretched_samples > 0 && !c.spans.is_empty()).count() > 2);
         assert!(together == alone, "a bone's causes depend on the bones found with it");
     }
@@ -665,7 +726,7 @@ mod tests {
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let before = crate::analysis::scan(&evaluation, &options, &|_, _| {});
+                let before = crate::analysis::scan_analysis(&evaluation, &options);
                 let explained = explain(&evaluation, &before, Question::default(), &options);
                 (format!("{before:?}"), explained)
             })
