@@ -96,6 +96,37 @@ pub(crate) fn shear_cosine(parts: &AffineParts, m: &DMat4) -> f64 {
     if parts.stretch == DQuat::IDENTITY { 0.0 } else { largest_column_cosine(&DMat3::from_mat4(*m)) }
 }
 
+/// How far apart, relatively, the tolerances of [`clearly_stretched`]'s two judges lie: far beyond what rounding moves
+/// a decomposition by (1e-12 and less: any start, any order of products), far within what a tolerance means.
+const CLEAR: f64 = 1e-6;
+
+/// Whether `m` is stretched, where rounding cannot change that: the verdict under tolerances [`CLEAR`] tighter and
+/// under tolerances as much looser agree (each tolerance only ever clears a matrix that a tighter one flags, so
+/// every tolerance between them agrees too), so that any other decomposition of `m`, from any start or through the
+/// products it is evaluated by, judges it the same. `None` near a tolerance, and where a tolerance leaves no room
+/// for rounding (too small to tell a uniform scale from its rounding).
+pub(crate) fn clearly_stretched(m: &DMat4, tolerances: &Tolerances) -> Option<bool> {
+    let roomy = tolerances.min_anisotropy >= CERTIFIABLE_ANISOTROPY
+        && tolerances.min_stretch_deg > 0.0
+        && tolerances.min_shear_deg > 0.0;
+    if !roomy {
+        return None;
+    }
+    let parts = decompose_near(m, DQuat::IDENTITY);
+    let cosine = shear_cosine(&parts, m);
+    let stretched = |factor: f64| {
+        let scaled = Tolerances {
+            min_anisotropy: tolerances.min_anisotropy * factor,
+            min_stretch_deg: tolerances.min_stretch_deg * factor,
+            min_shear_deg: tolerances.min_shear_deg * factor,
+            ..*tolerances
+        };
+        Judge::new(&scaled).verdict(parts.stretch, parts.scale, parts.sign, cosine * cosine).findings.stretched
+    };
+    let (tighter, looser) = (stretched(1.0 - CLEAR), stretched(1.0 + CLEAR));
+    (tighter == looser).then_some(looser)
+}
+
 /// The tolerances prepared for judging many matrices.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Judge {
@@ -239,5 +270,52 @@ mod tests {
         assert!(assess(shear(0.02)).findings.stretched);
         let lenient = Tolerances { min_shear_deg: 0.0, ..tolerances };
         assert!(Assessment::of(&shear(0.005), &lenient).findings.stretched);
+    }
+    /// A squash `(k, 1, 1)` seen from a child turned 45° about Z: a shear of `asin((k² − 1)/(k² + 1))`.
+    fn squash_turned(k: f64) -> DMat4 {
+        let turn = DMat4::from_quat(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4));
+        DMat4::from_scale(DVec3::new(k, 1.0, 1.0)) * turn
+    }
+
+    /// The squash whose shear is `deg` degrees.
+    fn squash_shearing(deg: f64) -> DMat4 {
+        let sine = deg.to_radians().sin();
+        squash_turned(((1.0 + sine) / (1.0 - sine)).sqrt())
+    }
+
+    #[test]
+    fn a_verdict_is_clear_away_from_every_tolerance() {
+        let tolerances = Tolerances::default();
+        assert_eq!(clearly_stretched(&squash_turned(1.5), &tolerances), Some(true));
+        assert_eq!(clearly_stretched(&DMat4::from_quat(DQuat::from_rotation_y(0.8)), &tolerances), Some(false));
+        assert_eq!(clearly_stretched(&DMat4::from_scale(DVec3::new(2.0, 1.0, 1.0)), &tolerances), Some(false));
+        // The shear a billionth of itself past the shear tolerance: flagged, but not clearly.
+        let edge = squash_shearing(0.01 * (1.0 + 1e-9));
+        assert!(Assessment::of(&edge, &tolerances).findings.stretched);
+        assert_eq!(clearly_stretched(&edge, &tolerances), None);
+        assert_eq!(clearly_stretched(&squash_shearing(0.01 * (1.0 + 1e-4)), &tolerances), Some(true));
+        // No tolerance, no margin: a uniform scale and its rounding could be told apart.
+        let none = Tolerances { min_anisotropy: 0.0, ..tolerances };
+        assert_eq!(clearly_stretched(&squash_turned(1.5), &none), None);
+    }
+
+    proptest::proptest! {
+        /// Where one decomposition clearly judges a matrix, a decomposition from any start judges it so.
+        #[test]
+        fn a_clear_verdict_is_every_decomposition_s(
+            k in 1.0..1.001f64,
+            turn in proptest::array::uniform4(-1.0..1.0f64),
+            start in proptest::array::uniform4(-1.0..1.0f64),
+        ) {
+            let unit = |q: [f64; 4]| {
+                let q = DQuat::from_array(q);
+                if q.length() > 1e-3 { q.normalize() } else { DQuat::IDENTITY }
+            };
+            let m = DMat4::from_scale(DVec3::new(k, 1.0, 1.0)) * DMat4::from_quat(unit(turn));
+            let tolerances = Tolerances::default();
+            if let Some(clear) = clearly_stretched(&m, &tolerances) {
+                proptest::prop_assert_eq!(Assessment::near(&m, &tolerances, unit(start)).findings.stretched, clear);
+            }
+        }
     }
 }

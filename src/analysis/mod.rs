@@ -19,5 +19,5 @@ pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves,
 pub use findings::{Assessment, Findings, Tolerances};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};
-pub use scan::{analyze, flagged_in_run, scan, scan_analysis};
+pub use scan::{analyze, clearly_flagged_at, flagged_in_run, scan, scan_analysis};
 pub use variants::{JudgedRun, VariantJudges, scan_variants};

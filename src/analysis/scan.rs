@@ -8,10 +8,10 @@ use rayon::prelude::*;
 
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
-use super::findings::Judge;
+use super::findings::{Judge, clearly_stretched};
 use super::peak;
 use super::request::{CurveRequest, Judged, ScanOptions};
-use crate::eval::{Evaluation, run_length};
+use crate::eval::{BonesEvaluator, Evaluation, run_length};
 
 /// Scans `evaluation` over its whole clip. `progress(done, total)` is called from worker threads as samples
 /// complete.
@@ -68,19 +68,43 @@ pub fn analyze(
 
 /// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time`, from the run's
 /// first sample to the one at `time` (or the first after it; the last sample for a later time): exactly what the
-/// whole-clip analysis finds there, since a run is judged on its own from its first sample on, here for the bone's
-/// chain alone. `times` are the analysis's, `evaluation.times(options.rate)` (found once by a caller asking many
-/// times). A cheap first look where a change is expected to leave a bone flagged where it was worst.
+/// whole-clip analysis finds there. The sample at `time` alone settles it where it is clearly flagged
+/// ([`clearly_stretched`]: whatever rounding the analysis meets there); else the run is judged as the analysis judges
+/// it, on its own from its first sample on, here for the bone's chain alone. `times` are the analysis's,
+/// `evaluation.times(options.rate)` (found once by a caller asking many times). A cheap first look where a change is
+/// expected to leave a bone flagged where it was worst.
 pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[f64], options: &ScanOptions) -> bool {
     debug_assert_eq!(times, evaluation.times(options.rate), "the analysis's times");
     let Some(last) = times.len().checked_sub(1) else {
         return false;
     };
+    if clearly_flagged_at(evaluation, bone, time, times, options) {
+        return true;
+    }
     let at = times.partition_point(|&t| t < time).min(last);
     let first = at - at % run_length(times.len());
     let request = CurveRequest { judged: Judged::Chain(bone), ..CurveRequest::default() };
     let plan = Plan::new(evaluation, request.bones, request.judged);
     analyze_chunk(evaluation, &plan, request, options, &times[first..=at], CurveSlices::default()).flagged(bone)
+}
+
+/// Whether `bone` is clearly flagged ([`clearly_stretched`]) at the sample of `times` at `time` (or the first after
+/// it; the last sample for a later time): flagged there by a whole-clip analysis, whatever rounding it meets. `false`
+/// says nothing. `times` are the analysis's ([`flagged_in_run`]).
+pub fn clearly_flagged_at(
+    evaluation: &Evaluation,
+    bone: usize,
+    time: f64,
+    times: &[f64],
+    options: &ScanOptions,
+) -> bool {
+    let Some(last) = times.len().checked_sub(1) else {
+        return false;
+    };
+    let at = times.partition_point(|&t| t < time).min(last);
+    let chain = evaluation.skeleton().with_ancestors(&[bone]);
+    let model = BonesEvaluator::new(evaluation, &chain).evaluate(times[at]).model.model[bone];
+    clearly_stretched(&model, &options.tolerances) == Some(true)
 }
 
 /// Each curve cut into `count` pieces of `len` samples, gathered per piece: what each chunk writes.

@@ -89,10 +89,20 @@ impl Hierarchy {
 
     /// [`Hierarchy::of_rig`] of modes known to be one per bone (resolved from the rig's own skeleton).
     pub(super) fn of_rig_fitting(rig: &Rig, modes: &[InheritMode]) -> Self {
+        Hierarchy::of_rig_bound(rig, modes, None)
+    }
+
+    /// [`Hierarchy::of_rig_fitting`], given the rig's bind pose ([`super::bind_pose`]) where it is known: the
+    /// Blender modes rest bones in it.
+    pub(super) fn of_rig_bound(rig: &Rig, modes: &[InheritMode], bind_pose: Option<&[Transform]>) -> Self {
         let skeleton = &rig.skeleton;
-        let blender = modes.iter().any(|m| m.is_blender());
-        let bone_rest = if blender { super::bind_pose(rig) } else { skeleton.rest_pose() };
-        Hierarchy::build(skeleton, modes, &bone_rest)
+        if !modes.iter().any(|m| m.is_blender()) {
+            return Hierarchy::build(skeleton, modes, &skeleton.rest_pose());
+        }
+        match bind_pose {
+            Some(bind_pose) => Hierarchy::build(skeleton, modes, bind_pose),
+            None => Hierarchy::build(skeleton, modes, &super::bind_pose(rig)),
+        }
     }
 
     /// `modes`, one mode per bone, and `bone_rest`, the local transform each bone rests in for the Blender modes

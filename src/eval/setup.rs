@@ -5,7 +5,7 @@
 
 use super::layers::LayerError;
 use super::{Evaluation, Hierarchy, LayerStack, Layers, SkinningMethod};
-use crate::model::{Choice, Modes, Rig, Skeleton, Unit};
+use crate::model::{Choice, Modes, Rig, Skeleton, Transform, Unit};
 
 /// Everything that decides an evaluation of a rig, the rig aside.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -124,11 +124,24 @@ impl<'a> Evaluation<'a> {
         Ok(Evaluation::prepared(rig, setup, setup.prepare(rig)?))
     }
 
+    /// [`Evaluation::of`], given the rig's bind pose ([`super::bind_pose`]: where the Blender modes' bones rest):
+    /// found once for the many setups of one rig a caller evaluates.
+    pub fn of_bound(rig: &'a Rig, setup: &Setup, bind_pose: &[Transform]) -> Result<Self, SetupError> {
+        let hierarchy = Hierarchy::of_rig_bound(rig, &setup.modes.resolve(&rig.skeleton), Some(bind_pose));
+        Ok(Evaluation::with_hierarchy(rig, setup, setup.prepare(rig)?, hierarchy))
+    }
+
     /// `setup` of `rig` through `layers`, what [`Setup::prepare`] made of it for `rig` (prepared once, evaluated
     /// often).
     pub fn prepared(rig: &'a Rig, setup: &Setup, layers: LayerStack) -> Self {
+        let hierarchy = Hierarchy::of_rig_bound(rig, &setup.modes.resolve(&rig.skeleton), None);
+        Evaluation::with_hierarchy(rig, setup, layers, hierarchy)
+    }
+
+    /// `setup` of `rig` through `layers`, its modes made `hierarchy`.
+    fn with_hierarchy(rig: &'a Rig, setup: &Setup, layers: LayerStack, hierarchy: Hierarchy) -> Self {
         let clip = setup.clip.and_then(|c| rig.clips.get(c));
-        Evaluation::under(rig, clip, Hierarchy::of_rig_fitting(rig, &setup.modes.resolve(&rig.skeleton)))
+        Evaluation::under(rig, clip, hierarchy)
             .with_layers(layers)
             .with_skinning(setup.skinning)
             .measured_in(setup.unit)

@@ -3,21 +3,23 @@
 
 use std::borrow::Cow;
 use std::path::Path;
+use std::sync::OnceLock;
 use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
 use crate::analysis::{
-    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, VariantJudges, analyze, flagged_in_run, scan_variants,
+    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, VariantJudges, analyze, clearly_flagged_at,
+    flagged_in_run, scan_variants,
 };
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
     Comparison, Extreme, Measure, MeshPair, Pairs, compare_at_size, compare_each, compare_each_beside,
     compare_each_within, compare_within, comparison_times,
 };
-use crate::eval::{Evaluation, Setup, Variant};
+use crate::eval::{Evaluation, Setup, Variant, bind_pose};
 use crate::import;
-use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Unit};
+use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig, Skeleton, Tool, Transform, Unit};
 
 /// A change to how the clip is evaluated that may take a bone's shear away.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -161,6 +163,9 @@ pub(super) struct Baseline<'e, 'a> {
     /// The source's bones and meshes paired with themselves by name: what every change of the source's own rig (any
     /// but a bake) is compared on, before the pairs it leaves alone are dropped.
     own_pairs: Pairs,
+    /// The rig's bind pose, found when a change first needs it (a Blender mode rests bones in it): every change of
+    /// the rig is evaluated from it.
+    bind_pose: OnceLock<Vec<Transform>>,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
@@ -175,7 +180,7 @@ impl<'e, 'a> Baseline<'e, 'a> {
         debug_assert_eq!(scale.times, comparison_times(source, source, options.rate), "the source's scale");
         let analysis_times = source.times(options.rate);
         let own_pairs = Pairs::by_name(source, source);
-        Baseline { source, before, options, scale, analysis_times, own_pairs }
+        Baseline { source, before, options, scale, analysis_times, own_pairs, bind_pose: OnceLock::new() }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -358,6 +363,18 @@ impl<'e, 'a> Baseline<'e, 'a> {
         }
     }
 
+    /// Whether `change` clearly leaves `bone` flagged where the bone is worst in the source
+    /// ([`clearly_flagged_at`]): what [`Baseline::leaves_flagged`] settles from one sample. `false` says nothing.
+    pub fn clearly_leaves_flagged(&self, change: Change, bone: usize) -> bool {
+        let worst = self.before.bones.get(bone).map(|b| b.worst_shear_time);
+        match (change.changed_below(), worst, self.fixed(change, None)) {
+            (Some(_), Some(worst), Ok(fixed)) => {
+                clearly_flagged_at(&fixed, bone, worst, &self.analysis_times, self.options)
+            }
+            _ => false,
+        }
+    }
+
     /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the
     /// changed bones and the meshes that follow them (nothing else differs).
     pub fn cost(&self, change: Change, applied: &Applied) -> Result<Cost, String> {
@@ -512,7 +529,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
             Some(rig) => Ok(Evaluation::declared(rig, rig.clips.first())),
             None => {
                 let setup = change.apply(&self.source.setup(), self.source.skeleton())?;
-                Evaluation::of(self.source.rig, &setup).map_err(|e| e.to_string())
+                let bind_pose = self.bind_pose.get_or_init(|| bind_pose(self.source.rig));
+                Evaluation::of_bound(self.source.rig, &setup, bind_pose).map_err(|e| e.to_string())
             }
         }
     }

@@ -253,11 +253,10 @@ pub fn explain(
             let bakes: Vec<Change> =
                 changes.iter().flatten().copied().filter(|c| c.changed_below().is_none()).collect();
             known.make(&baseline, &bakes);
-            let own = |changes: &[Change]| changes.iter().copied().filter(|&c| !is_other_mode(c, tool)).collect();
-            let own: Vec<Vec<Change>> = changes.iter().map(|changes| own(changes)).collect();
-            known.bound(&baseline, &own.concat());
+            let open = open_changes(&baseline, &bones, &changes, tool);
+            known.bound(&baseline, &open.iter().flatten().map(|&(_, change)| change).collect::<Vec<_>>());
             let mut searches: Vec<Removal> =
-                bones.iter().zip(&own).map(|(&bone, own)| Removal::new(bone, own, &known.bounds)).collect();
+                bones.iter().zip(&open).map(|(&bone, open)| Removal::new(bone, open, &known.bounds)).collect();
             remove(&baseline, &mut searches, &mut known);
             // Where no change removes the shear, the best is among every change made.
             let unremoved: Vec<usize> = (0..bones.len()).filter(|&i| searches[i].best.is_none()).collect();
@@ -339,10 +338,38 @@ impl Known {
     }
 }
 
-/// One bone's search for the cheapest of its changes that leaves it unflagged (ties: the first in its changes),
-/// making and costing as few changes as it takes. Its changes (those that set no mode foreign to the file's tool)
-/// are tried in the order of their cost's lower bound ([`Baseline::cost_bound`]: a bake's once it is made, any
-/// other's from its setup), until the next bound exceeds the cheapest cost found (a bound never exceeds its cost).
+/// Each bone's changes that may remove its shear, with their places among its changes: those that set no mode
+/// foreign to the file's tool, but for those that clearly leave the bone flagged where it is worst
+/// ([`Baseline::clearly_leaves_flagged`]: one sample, where a bound is a pass over the bound's times). A change that
+/// does not remove a shear most often leaves it there: most are settled so, whatever they cost.
+fn open_changes(
+    baseline: &Baseline,
+    bones: &[usize],
+    changes: &[Vec<Change>],
+    tool: Option<Tool>,
+) -> Vec<Vec<(usize, Change)>> {
+    let asked: Vec<(usize, usize, usize, Change)> = bones
+        .iter()
+        .zip(changes)
+        .enumerate()
+        .flat_map(|(i, (&bone, changes))| {
+            let own = changes.iter().enumerate().filter(move |(_, change)| !is_other_mode(**change, tool));
+            own.map(move |(place, &change)| (i, bone, place, change))
+        })
+        .collect();
+    let open: Vec<bool> =
+        asked.par_iter().map(|&(_, bone, _, change)| !baseline.clearly_leaves_flagged(change, bone)).collect();
+    let mut each = vec![Vec::new(); bones.len()];
+    for ((i, _, place, change), _) in asked.into_iter().zip(open).filter(|(_, open)| *open) {
+        each[i].push((place, change));
+    }
+    each
+}
+
+/// One bone's search for the cheapest of its open changes ([`open_changes`]) that leaves it unflagged (ties: the
+/// first in its changes), making and costing as few changes as it takes. They are tried in the order of their cost's
+/// lower bound ([`Baseline::cost_bound`]: a bake's once it is made, any other's from its setup), until the next
+/// bound exceeds the cheapest cost found (a bound never exceeds its cost).
 /// What it finds depends on what each change is alone, whoever made or costed it, so the searches of every bone go on
 /// side by side ([`remove`]), each needing one change made or costed at a time.
 struct Removal {
@@ -385,8 +412,8 @@ impl Need {
 
 impl Removal {
     /// The search of `bone` through `changes`, given their lower bounds (a change without one is no contender).
-    fn new(bone: usize, changes: &[Change], bounds: &HashMap<Change, Option<f64>>) -> Self {
-        let bounded = changes.iter().enumerate().filter_map(|(place, &change)| Some((bounds[&change]?, place, change)));
+    fn new(bone: usize, changes: &[(usize, Change)], bounds: &HashMap<Change, Option<f64>>) -> Self {
+        let bounded = changes.iter().filter_map(|&(place, change)| Some((bounds[&change]?, place, change)));
         let mut order: Vec<(f64, usize, Change)> = bounded.collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         Removal { bone, order, next: 0, looked: false, given_up: false, best: None }
