@@ -97,8 +97,8 @@ fn joint_matrix(skin: &Skin, model: &[DMat4], moved: Option<DMat4>, j: usize) ->
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reach {
     /// Per joint some vertex is weighted to (a skin's joint index, or the mesh's bone for an unskinned mesh), the
-    /// corners of those vertices' box.
-    joints: Vec<(usize, [DVec3; 8])>,
+    /// points that bound those vertices' distances ([`Hull`]).
+    joints: Vec<(usize, Hull)>,
     /// The largest `Σ|w_j|` of a vertex (1 unskinned).
     weight: f64,
     skin: Option<usize>,
@@ -118,10 +118,13 @@ impl Reach {
         let position = |v: usize| Some(mesh.positions[v].as_dvec3()).filter(|p| p.is_finite());
         let skin = mesh.skin.filter(|&s| s < skins.len() && mesh.joints.len() == mesh.positions.len());
         let Some(skin) = skin else {
-            let points: Option<Vec<DVec3>> = chosen.iter().map(|&v| position(v)).collect();
-            return Some(Reach { joints: vec![(mesh.bone, corners(&points?)?)], weight: 1.0, skin: None });
+            let mut hull = Hull::default();
+            for &v in &chosen {
+                hull.add(position(v)?);
+            }
+            return Some(Reach { joints: vec![(mesh.bone, hull.closed()?)], weight: 1.0, skin: None });
         };
-        let mut boxes: Vec<Option<(DVec3, DVec3)>> = vec![None; skins[skin].joints.len()];
+        let mut hulls: Vec<Hull> = vec![Hull::default(); skins[skin].joints.len()];
         let mut weight: f64 = 0.0;
         for v in chosen {
             if method.dq_weight(mesh, v) != 0.0 {
@@ -131,41 +134,77 @@ impl Reach {
             let influences = mesh.joints[v].iter().zip(weights).filter(|(_, w)| **w != 0.0);
             let mut sum = 0.0;
             for (&j, &w) in influences {
-                let slot = boxes.get_mut(usize::from(j))?;
-                *slot = Some(slot.map_or((p, p), |(low, high)| (low.min(p), high.max(p))));
+                hulls.get_mut(usize::from(j))?.add(p);
                 sum += f64::from(w).abs();
             }
             weight = weight.max(sum);
         }
-        let joints = boxes.iter().enumerate().filter_map(|(j, b)| Some((j, box_corners((*b)?))));
+        let joints = hulls.into_iter().enumerate().filter_map(|(j, hull)| Some((j, hull.closed()?)));
         Some(Reach { joints: joints.collect(), weight, skin: Some(skin) })
     }
 
     /// The most any of the vertices lies apart under the poses whose model matrices (of every bone) are `a` and `b`.
     pub fn bound(&self, skins: &[Skin], a: &[DMat4], b: &[DMat4]) -> f64 {
-        let apart = |d: DMat4, corners: &[DVec3; 8]| {
-            corners.iter().map(|&c| (d * c.extend(1.0)).truncate().length()).fold(0.0, f64::max)
-        };
         let skin = self.skin.map(|s| &skins[s]);
         let moved = skin.map(|skin| (moved_since_bind(skin, a), moved_since_bind(skin, b)));
-        let joints = self.joints.iter().map(|(joint, corners)| {
+        let joints = self.joints.iter().map(|(joint, hull)| {
             let difference = match (skin, moved) {
+                // (A − B)·I: one product, and none where the joint does not move (a variant's joints above it).
+                (Some(skin), Some((None, None))) => {
+                    let bone = skin.joints[*joint];
+                    if a[bone] == b[bone] {
+                        return 0.0;
+                    }
+                    (a[bone] - b[bone]) * skin.inverse_bind[*joint]
+                }
                 (Some(skin), Some((moved_a, moved_b))) => {
                     joint_matrix(skin, a, moved_a, *joint) - joint_matrix(skin, b, moved_b, *joint)
                 }
                 _ => a[*joint] - b[*joint],
             };
-            apart(difference, corners)
+            hull.apart(&difference)
         });
         self.weight * joints.fold(0.0, f64::max)
     }
 }
 
-/// The corners of the box of `points`; `None` for no points.
-fn corners(points: &[DVec3]) -> Option<[DVec3; 8]> {
-    let first = *points.first()?;
-    let (low, high) = points.iter().fold((first, first), |(low, high), &p| (low.min(p), high.max(p)));
-    Some(box_corners((low, high)))
+/// The points whose distances under a joint's motion bound those of every vertex weighted to it: the vertices
+/// themselves while there are at most eight, else the eight corners of their box.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Hull {
+    /// The first eight vertices (or fewer, the rest unused), and the box of them all.
+    points: [DVec3; 8],
+    count: usize,
+    low: DVec3,
+    high: DVec3,
+}
+
+impl Hull {
+    fn add(&mut self, p: DVec3) {
+        if let Some(slot) = self.points.get_mut(self.count) {
+            *slot = p;
+        }
+        (self.low, self.high) = match self.count {
+            0 => (p, p),
+            _ => (self.low.min(p), self.high.max(p)),
+        };
+        self.count += 1;
+    }
+
+    /// The hull once every vertex is added: its points are the box's corners where there are more than eight;
+    /// `None` for no vertex.
+    fn closed(mut self) -> Option<Self> {
+        if self.count > self.points.len() {
+            (self.points, self.count) = (box_corners((self.low, self.high)), self.points.len());
+        }
+        (self.count > 0).then_some(self)
+    }
+
+    /// How far `difference` (`J − J′`) moves the farthest point.
+    fn apart(&self, difference: &DMat4) -> f64 {
+        let points = &self.points[..self.count];
+        points.iter().map(|&p| (*difference * p.extend(1.0)).truncate().length()).fold(0.0, f64::max)
+    }
 }
 
 /// The eight corners of the box from `low` to `high`.
@@ -409,9 +448,9 @@ mod tests {
 
     #[test]
     fn a_reach_bounds_how_far_every_vertex_lies_apart() {
-        // Random skins of 40 vertices over 5 joints (a node bind on every other one) under random sheared poses:
-        // the bound is never below the largest vertex distance, and for one joint moved by a translation alone it
-        // is that translation.
+        // Random skins of 40 vertices over 5 joints, or of 6 (a joint's vertices bounding it themselves, fewer than
+        // its box's corners), a node bind on every other one, under random sheared poses: the bound is never below
+        // the largest vertex distance, and for one joint moved by a translation alone it is that translation.
         use rand::{RngExt, SeedableRng};
         let mut rng = rand_xorshift::XorShiftRng::seed_from_u64(11);
         let mut noise = |scale: f64| DVec3::from_array(std::array::from_fn(|_| (rng.random::<f64>() - 0.5) * scale));
@@ -425,7 +464,7 @@ mod tests {
                 (case % 2 == 0).then(|| crate::model::NodeBind { bone: 0, inverse_bind: matrix(&mut noise) });
             let skin = Skin { joints: (0..joints).collect(), inverse_bind, node_bind, ..Skin::default() };
             let mut mesh = Mesh { skin: Some(0), ..Mesh::default() };
-            for _ in 0..40 {
+            for _ in 0..if case % 3 == 0 { 6 } else { 40 } {
                 mesh.positions.push(noise(4.0).as_vec3());
                 let picked: [u16; 4] = std::array::from_fn(|_| (noise(1.0).x.abs() * 9.9) as u16 % joints as u16);
                 let weights = noise(1.0).abs();
