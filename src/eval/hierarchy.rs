@@ -44,7 +44,8 @@ pub struct Hierarchy {
     /// For Blender modes: the rest offset `O = T·R` of the bone and its inverse.
     offsets: Vec<Option<(DMat4, DMat4)>>,
     needs_unscaled: Vec<bool>,
-    needs_rigid: bool,
+    /// Per bone, whether its rigid matrix is read: by a bone below it that inherits an unscaled parent.
+    needs_rigid: Vec<bool>,
     /// The skeleton's conversion and conversion nodes.
     placement: Placement,
     /// Per bone, the conversion node whose placed matrix places it (itself for a conversion node), or `None` for
@@ -52,6 +53,15 @@ pub struct Hierarchy {
     placed_by: Vec<Option<usize>>,
     /// Whether any bone is placed: children are then evaluated from their parents' matrices in the file's space.
     places: bool,
+}
+
+/// Marks `bone` and every bone above it in `marks` (by bone; `parents` gives each bone's parent).
+fn mark_chain(parents: &[Option<usize>], marks: &mut [bool], bone: usize) {
+    let mut at = Some(bone);
+    while let Some(bone) = at.filter(|&b| !marks[b]) {
+        marks[bone] = true;
+        at = parents[bone];
+    }
 }
 
 /// Modes or rest transforms that are not one per bone.
@@ -138,7 +148,12 @@ impl Hierarchy {
                 needs_unscaled[*p] = true;
             }
         }
-        let needs_rigid = modes.contains(&InheritMode::UnscaledParent);
+        let mut needs_rigid = vec![false; parents.len()];
+        for (bone, mode) in modes.iter().enumerate() {
+            if *mode == InheritMode::UnscaledParent {
+                mark_chain(&parents, &mut needs_rigid, bone);
+            }
+        }
         let placement = skeleton.placement().clone();
         let placed_by = skeleton.placed_by().to_vec();
         let places = !placed_by.is_empty() || placement.conversion != DMat4::IDENTITY;
@@ -149,13 +164,12 @@ impl Hierarchy {
     /// parent at the bones `hanging_from`: a reference that changes of mode below their children are evaluated from
     /// ([`Hierarchy::evaluate_below`]). Its model matrices are this hierarchy's.
     pub fn reference(&self, hanging_from: &[usize]) -> Hierarchy {
-        let mut needs_unscaled = self.needs_unscaled.clone();
-        for &bone in hanging_from {
-            if let Some(needs) = needs_unscaled.get_mut(bone) {
-                *needs = true;
-            }
+        let (mut needs_unscaled, mut needs_rigid) = (self.needs_unscaled.clone(), self.needs_rigid.clone());
+        for &bone in hanging_from.iter().filter(|&&bone| bone < self.parents.len()) {
+            needs_unscaled[bone] = true;
+            mark_chain(&self.parents, &mut needs_rigid, bone);
         }
-        Hierarchy { needs_unscaled, needs_rigid: true, ..self.clone() }
+        Hierarchy { needs_unscaled, needs_rigid, ..self.clone() }
     }
 
     pub fn modes(&self) -> &[InheritMode] {
@@ -264,7 +278,7 @@ impl Hierarchy {
             return;
         };
         let parent = if self.places { out.file[p] } else { out.model[p] };
-        if self.needs_rigid {
+        if self.needs_rigid[i] {
             out.rigid[i] = out.rigid[p] * local.rigid_matrix();
         }
         let (mut inherit_scale, mut carried_scale) = (local.scale, DVec3::ONE);
