@@ -537,7 +537,7 @@ fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
 /// Each change once, in a stable order.
 fn distinct(changes: impl IntoIterator<Item = Change>) -> Vec<Change> {
     let mut distinct: Vec<Change> = changes.into_iter().collect();
-    distinct.sort_by_key(|c| format!("{c:?}"));
+    distinct.sort_by_cached_key(|c| format!("{c:?}"));
     distinct.dedup();
     distinct
 }
