@@ -69,7 +69,7 @@ pub fn analyze(
 /// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time`, from the run's
 /// first sample to the one at `time` (or the first after it; the last sample for a later time): exactly what the
 /// whole-clip analysis finds there. The sample at `time` alone settles it where it is clearly flagged
-/// ([`clearly_stretched`]: whatever rounding the analysis meets there); else the run is judged as the analysis judges
+/// ([`clearly_flagged_at`]: whatever rounding the analysis meets there); else the run is judged as the analysis judges
 /// it, on its own from its first sample on, here for the bone's chain alone. `times` are the analysis's,
 /// `evaluation.times(options.rate)` (found once by a caller asking many times). A cheap first look where a change is
 /// expected to leave a bone flagged where it was worst.
@@ -88,9 +88,10 @@ pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[
     analyze_chunk(evaluation, &plan, request, options, &times[first..=at], CurveSlices::default()).flagged(bone)
 }
 
-/// Whether `bone` is clearly flagged ([`clearly_stretched`]) at the sample of `times` at `time` (or the first after
-/// it; the last sample for a later time): flagged there by a whole-clip analysis, whatever rounding it meets. `false`
-/// says nothing. `times` are the analysis's ([`flagged_in_run`]).
+/// Whether `bone` is clearly flagged at the sample of `times` at `time` (or the first after it; the last sample for a
+/// later time): its model matrix there, decomposed, is flagged under tolerances a millionth tighter and a millionth
+/// looser alike, so that a whole-clip analysis flags it there whatever rounding it meets. `false` says nothing.
+/// `times` are the analysis's ([`flagged_in_run`]).
 pub fn clearly_flagged_at(
     evaluation: &Evaluation,
     bone: usize,

@@ -196,12 +196,7 @@ mod tests {
 
     use super::*;
     use crate::analysis::{Assessment, Tolerances};
-
-    fn quat() -> impl Strategy<Value = DQuat> {
-        prop::array::uniform4(-1.0..1.0f64)
-            .prop_filter("not near zero", |q| q.iter().map(|c| c * c).sum::<f64>() > 1e-3)
-            .prop_map(|q| DQuat::from_array(q).normalize())
-    }
+    use crate::math::strategies::unit_quat as quat;
 
     /// A local scale: uniform, non-uniform, with a negative factor, or the identity (each case has its path).
     fn scale() -> impl Strategy<Value = DVec3> {

@@ -494,12 +494,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-
-    fn quat() -> impl Strategy<Value = DQuat> {
-        prop::array::uniform4(-1.0..1.0f64)
-            .prop_filter("not near zero", |q| q.iter().map(|c| c * c).sum::<f64>() > 1e-3)
-            .prop_map(|q| DQuat::from_array(q).normalize())
-    }
+    use crate::math::strategies::unit_quat as quat;
 
     proptest! {
         /// A chain of turned, unequally scaled bones shears no more than the product of their scales' condition

@@ -350,27 +350,26 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// Whether `change` certainly leaves `bone` flagged: it is flagged in the run of samples that holds the bone's
-    /// worst shear in the source, judged exactly as [`Baseline::apply`]'s scan judges that run. A change that does
-    /// not remove a shear most often leaves it there, so this settles most of them for a run's work; `false` says
-    /// nothing (the change must be made to know). A bake is its own rig: never settled here.
+    /// worst shear in the source, judged exactly as [`Baseline::apply`]'s scan judges that run
+    /// ([`flagged_in_run`]). A change that does not remove a shear most often leaves it there, so this settles most
+    /// of them for a run's work; `false` says nothing (the change must be made to know). A bake is its own rig:
+    /// never settled here.
     pub fn leaves_flagged(&self, change: Change, bone: usize) -> bool {
-        let worst = self.before.bones.get(bone).map(|b| b.worst_shear_time);
-        match (change.changed_below(), worst, self.fixed(change, None)) {
-            (Some(_), Some(worst), Ok(fixed)) => {
-                flagged_in_run(&fixed, bone, worst, &self.analysis_times, self.options)
-            }
-            _ => false,
-        }
+        self.judged_at_worst(change, bone, flagged_in_run)
     }
 
-    /// Whether `change` clearly leaves `bone` flagged where the bone is worst in the source
+    /// Whether `change` clearly leaves `bone` flagged at the bone's worst sample in the source
     /// ([`clearly_flagged_at`]): what [`Baseline::leaves_flagged`] settles from one sample. `false` says nothing.
     pub fn clearly_leaves_flagged(&self, change: Change, bone: usize) -> bool {
+        self.judged_at_worst(change, bone, clearly_flagged_at)
+    }
+
+    /// What `judge` (of a bone of an evaluation at a time, over the analysis's times) says of `bone` under `change`
+    /// at the bone's worst time in the source; `false` for a bake or a change that cannot be made.
+    fn judged_at_worst(&self, change: Change, bone: usize, judge: WorstJudge) -> bool {
         let worst = self.before.bones.get(bone).map(|b| b.worst_shear_time);
         match (change.changed_below(), worst, self.fixed(change, None)) {
-            (Some(_), Some(worst), Ok(fixed)) => {
-                clearly_flagged_at(&fixed, bone, worst, &self.analysis_times, self.options)
-            }
+            (Some(_), Some(worst), Ok(fixed)) => judge(&fixed, bone, worst, &self.analysis_times, self.options),
             _ => false,
         }
     }
@@ -545,6 +544,9 @@ impl<'e, 'a> Baseline<'e, 'a> {
 /// A change asked to be costed: the change, for a bake the rig it writes, and the limit past which its comparison is
 /// given up.
 pub(super) type Asked<'r> = (Change, Option<&'r Rig>, f64);
+
+/// A judge of whether a bone of an evaluation is flagged around a time: the bone, the time, the analysis's times.
+type WorstJudge = fn(&Evaluation, usize, f64, &[f64], &ScanOptions) -> bool;
 
 /// A change that cannot be made, and why.
 type Unmade = (Change, String);

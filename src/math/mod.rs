@@ -12,3 +12,17 @@ pub use polar::{
     stretch_half_cosine_within, stretch_nearest,
 };
 pub use quat::{Slerp, nlerp, slerp};
+
+/// Property-test inputs shared by the modules' tests.
+#[cfg(test)]
+pub(crate) mod strategies {
+    use glam::DQuat;
+    use proptest::prelude::*;
+
+    /// A unit quaternion, from four components away from zero.
+    pub fn unit_quat() -> impl Strategy<Value = DQuat> {
+        prop::array::uniform4(-1.0..1.0f64)
+            .prop_filter("not near zero", |q| q.iter().map(|c| c * c).sum::<f64>() > 1e-3)
+            .prop_map(|q| DQuat::from_array(q).normalize())
+    }
+}
