@@ -55,7 +55,7 @@ pub struct VariantJudges<'v, 'e, 'a> {
     source: &'v Evaluation<'a>,
     variants: &'v [Variant<'e, 'a>],
     judge: Judge,
-    /// Each variant's bones, and the bones above them (judged on the source).
+    /// Each variant's bones, and the bones above those that inherit their parent's stretch (judged on the source).
     own: Vec<Judging>,
     above: Judging,
     /// What a root inherits: the placement's scale.
@@ -79,12 +79,15 @@ impl<'v, 'e, 'a> VariantJudges<'v, 'e, 'a> {
         let skeleton = source.skeleton();
         let hanging_from: Vec<usize> = variants.iter().filter_map(|v| skeleton.parent(v.top)).collect();
         let every: Vec<usize> = variants.iter().flat_map(|v| v.bones.iter().copied()).collect();
+        // Only a top that inherits its parent's stretch reads it (another mode's is its model matrix's).
+        let inheriting = variants.iter().filter(|v| inherits_stretch(v.evaluation, v.top));
+        let read: Vec<usize> = inheriting.filter_map(|v| skeleton.parent(v.top)).collect();
         VariantJudges {
             source,
             variants,
             judge: Judge::new(&options.tolerances),
             own: variants.iter().map(Judging::of_variant).collect(),
-            above: Judging::of_bones(source, &skeleton.with_ancestors(&hanging_from)),
+            above: Judging::of_bones(source, &skeleton.with_ancestors(&read)),
             root: Stretch::uniform(skeleton.placement().conversion_scale()),
             evaluated: skeleton.with_ancestors(&every),
             hanging_from,
