@@ -15,15 +15,15 @@ use super::request::{CurveRequest, Judged, ScanOptions};
 use super::stretch::{CursorAt, Stretch};
 use crate::eval::{BoneCursor, BonesEvaluator, Chains, Evaluation, Hierarchy};
 use crate::math::{decompose_near, decompose_with_stretch};
-use crate::model::{BoneTracks, Clip, InheritMode, Transform};
+use crate::model::{BoneTracks, Clip, Transform};
 
 /// What the workers need to know about the evaluation, found once per analysis.
 pub(super) struct Plan<'a> {
     hierarchy: &'a Hierarchy,
     /// The clip, when it is judged bone by bone: no layers, every bone inheriting fully (or a root).
     by_bone: Option<&'a Clip>,
-    /// Each bone's parent, and whether its stretch passes down from it ([`Stretch::child`]: full inheritance, or a
-    /// root) rather than coming from its model matrix.
+    /// Each bone's parent, and whether its stretch passes down from it ([`Stretch::child`]:
+    /// [`Evaluation::inherits_fully`]) rather than coming from its model matrix.
     parents: Vec<Option<usize>>,
     inherits: Vec<bool>,
     /// How many children each bone has: a bone's stretches are dropped once they are all judged.
@@ -45,7 +45,7 @@ impl<'a> Plan<'a> {
     pub fn new(evaluation: &'a Evaluation, plotted: &[usize], judged: Judged) -> Self {
         let (skeleton, hierarchy) = (evaluation.skeleton(), &evaluation.hierarchy);
         let parents: Vec<Option<usize>> = (0..skeleton.len()).map(|b| skeleton.parent(b)).collect();
-        let inherits: Vec<bool> = (0..skeleton.len()).map(|b| inherits_stretch(evaluation, b)).collect();
+        let inherits: Vec<bool> = (0..skeleton.len()).map(|b| evaluation.inherits_fully(b)).collect();
         let by_bone = evaluation.clip.filter(|_| evaluation.layers().is_none() && inherits.iter().all(|&full| full));
         let varying = |track: fn(&BoneTracks) -> bool| -> Vec<bool> {
             (0..skeleton.len()).map(|b| by_bone.and_then(|c| c.tracks_of(b)).is_some_and(track)).collect()
@@ -71,13 +71,6 @@ impl<'a> Plan<'a> {
             },
         }
     }
-}
-
-/// Whether `bone`'s stretch passes down from its parent's under `evaluation` ([`Stretch::child`]): full
-/// inheritance, or a root. A root's mode changes nothing (it has no parent to inherit from): FBX files declare
-/// cameras and other top-level nodes componentwise, and that must not take the whole rig off the bone-by-bone path.
-pub(super) fn inherits_stretch(evaluation: &Evaluation, bone: usize) -> bool {
-    evaluation.skeleton().parent(bone).is_none() || evaluation.modes()[bone] == InheritMode::Full
 }
 
 /// What one chunk of samples produced, for each bone it holds (every bone of the rig, or a few: see

@@ -68,19 +68,15 @@ pub fn analyze(
 
 /// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time`, from the run's
 /// first sample to the one at `time` (or the first after it; the last sample for a later time): exactly what the
-/// whole-clip analysis finds there. The sample at `time` alone settles it where it is clearly flagged
-/// ([`clearly_flagged_at`]: whatever rounding the analysis meets there); else the run is judged as the analysis judges
-/// it, on its own from its first sample on, here for the bone's chain alone. `times` are the analysis's,
-/// `evaluation.times(options.rate)` (found once by a caller asking many times). A cheap first look where a change is
-/// expected to leave a bone flagged where it was worst.
+/// whole-clip analysis finds there, since a run is judged on its own from its first sample on, here for the bone's
+/// chain alone. `times` are the analysis's, `evaluation.times(options.rate)` (found once by a caller asking many
+/// times). A first look where a change is expected to leave a bone flagged where it was worst, and
+/// [`clearly_flagged_at`] has not settled it from that sample alone.
 pub fn flagged_in_run(evaluation: &Evaluation, bone: usize, time: f64, times: &[f64], options: &ScanOptions) -> bool {
     debug_assert_eq!(times, evaluation.times(options.rate), "the analysis's times");
     let Some(last) = times.len().checked_sub(1) else {
         return false;
     };
-    if clearly_flagged_at(evaluation, bone, time, times, options) {
-        return true;
-    }
     let at = times.partition_point(|&t| t < time).min(last);
     let first = at - at % run_length(times.len());
     let request = CurveRequest { judged: Judged::Chain(bone), ..CurveRequest::default() };
@@ -177,7 +173,8 @@ mod tests {
     fn a_run_is_judged_as_the_whole_clip_judges_it() {
         // The demo's arm judged bone by bone (full inheritance) and sample by sample (the forearm compensating):
         // every bone's verdict from the start of a run to a sample, looked up from that sample's time or from just
-        // before it, equals the whole analysis's over those samples.
+        // before it, equals the whole analysis's over those samples; where the sample alone says the bone is clearly
+        // flagged, the whole analysis flags it there.
         let rig = demo_rig();
         let declared = Evaluation::declared(&rig, rig.clips.first());
         let mut modes = declared.modes().to_vec();
@@ -185,7 +182,7 @@ mod tests {
         let compensating = declared.with_modes(&modes).unwrap();
         let options = ScanOptions { rate: 240.0, ..ScanOptions::default() };
         let never = AtomicBool::new(false);
-        let mut flagged_runs = 0;
+        let (mut flagged_runs, mut clearly_flagged) = (0, 0);
         for evaluation in [&declared, &compensating] {
             let whole = analyze(evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
             let times = &whole.times;
@@ -198,12 +195,15 @@ mod tests {
                         for time in [samples[at], samples[at] - 1e-9] {
                             let found = flagged_in_run(evaluation, bone, time, times, &options);
                             assert_eq!(found, expected, "bone {bone}, run {run}, sample {at}, {time} s");
+                            let clearly = clearly_flagged_at(evaluation, bone, time, times, &options);
+                            assert!(!clearly || whole.stretched_at(bone, first + at), "bone {bone}, {time} s");
+                            clearly_flagged += usize::from(clearly);
                         }
                         flagged_runs += usize::from(expected);
                     }
                 }
             }
         }
-        assert!(flagged_runs > 0, "the demo's forearm shears somewhere");
+        assert!(flagged_runs > 0 && clearly_flagged > 0, "the demo's forearm shears somewhere");
     }
 }

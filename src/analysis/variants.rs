@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use glam::{DMat4, DQuat};
 
-use super::chunk::{ChunkResult, inherits_stretch};
+use super::chunk::ChunkResult;
 use super::clip_analysis::ClipScan;
 use super::findings::Judge;
 use super::peak;
@@ -80,7 +80,7 @@ impl<'v, 'e, 'a> VariantJudges<'v, 'e, 'a> {
         let hanging_from: Vec<usize> = variants.iter().filter_map(|v| skeleton.parent(v.top)).collect();
         let every: Vec<usize> = variants.iter().flat_map(|v| v.bones.iter().copied()).collect();
         // Only a top that inherits its parent's stretch reads it (another mode's is its model matrix's).
-        let inheriting = variants.iter().filter(|v| inherits_stretch(v.evaluation, v.top));
+        let inheriting = variants.iter().filter(|v| v.evaluation.inherits_fully(v.top));
         let read: Vec<usize> = inheriting.filter_map(|v| skeleton.parent(v.top)).collect();
         VariantJudges {
             source,
@@ -178,7 +178,7 @@ impl Parent {
 }
 
 /// The bones a pass judges, parents first: each with whether it inherits its parent's stretch
-/// ([`inherits_stretch`]), and where its parent is judged (`None` for a root).
+/// ([`Evaluation::inherits_fully`]), and where its parent is judged (`None` for a root).
 struct Judging {
     bones: Vec<(usize, bool, Option<Parent>)>,
 }
@@ -187,7 +187,7 @@ impl Judging {
     /// `bones` (parents first) of `evaluation`, judged above the variants.
     fn of_bones(evaluation: &Evaluation, bones: &[usize]) -> Self {
         let skeleton = evaluation.skeleton();
-        let judged = bones.iter().map(|&b| (b, inherits_stretch(evaluation, b), skeleton.parent(b).map(Parent::Above)));
+        let judged = bones.iter().map(|&b| (b, evaluation.inherits_fully(b), skeleton.parent(b).map(Parent::Above)));
         Judging { bones: judged.collect() }
     }
 
@@ -198,7 +198,7 @@ impl Judging {
             let p = skeleton.parent(b)?;
             Some(variant.bones.binary_search(&p).map_or(Parent::Above(p), Parent::Own))
         };
-        let judged = variant.bones.iter().map(|&b| (b, inherits_stretch(variant.evaluation, b), parent(b)));
+        let judged = variant.bones.iter().map(|&b| (b, variant.evaluation.inherits_fully(b), parent(b)));
         Judging { bones: judged.collect() }
     }
 }

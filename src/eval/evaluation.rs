@@ -110,6 +110,13 @@ impl<'a> Evaluation<'a> {
         self.hierarchy.modes()
     }
 
+    /// Whether `bone`'s model matrix is its parent's times its local matrix: full inheritance, or a root. A root's
+    /// mode changes nothing (it has no parent to inherit from): FBX files declare cameras and other top-level nodes
+    /// componentwise, and that must not take the whole rig off the paths that pass a parent's stretch down.
+    pub fn inherits_fully(&self, bone: usize) -> bool {
+        self.skeleton().parent(bone).is_none() || self.modes()[bone] == InheritMode::Full
+    }
+
     /// The modes as chosen: a setup's, or the file's with the bones that differ given their own.
     pub fn chosen_modes(&self) -> Modes {
         self.chosen.clone().unwrap_or_else(|| Modes::of_bones(self.skeleton(), self.modes()))

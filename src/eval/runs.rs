@@ -24,7 +24,7 @@ pub fn run_length(count: usize) -> usize {
 
 /// `work` of each run of consecutive `times` (of [`run_length`]), in parallel; the results in time order.
 pub fn over_runs<R: Send>(times: &[f64], work: impl Fn(&[f64]) -> R + Sync + Send) -> Vec<R> {
-    over_runs_of(times, run_length(times.len()), work)
+    over_runs_from(times, |_, run| work(run))
 }
 
 /// [`over_runs`], each run's work also given the index of its first time.

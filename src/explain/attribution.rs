@@ -9,7 +9,7 @@ use crate::analysis::{Assessment, ClipAnalysis, SAME_SHEAR_DEG, Tolerances};
 use crate::eval::layers::uniform_scale;
 use crate::eval::{BoneCursor, BonesEvaluator, Evaluation, Hierarchy, ModelPose, over_runs_from};
 use crate::math::{AffineParts, shear_deg};
-use crate::model::{InheritMode, Skeleton, Transform};
+use crate::model::{Skeleton, Transform};
 
 /// One bone of the explained bone's chain (the explained bone included) at one time.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -259,8 +259,7 @@ impl<'b> Group<'b> {
     fn new(evaluation: &Evaluation, bones: &'b [usize]) -> Self {
         let skeleton = evaluation.skeleton();
         let chains: Vec<Vec<usize>> = bones.iter().map(|&bone| skeleton.chain(bone)).collect();
-        let inherits = |b: &usize| skeleton.parent(*b).is_none() || evaluation.modes()[*b] == InheritMode::Full;
-        let products = chains.iter().map(|chain| chain.iter().all(inherits)).collect();
+        let products = chains.iter().map(|chain| chain.iter().all(|&b| evaluation.inherits_fully(b))).collect();
         let mut below: Vec<Vec<usize>> = vec![Vec::new(); skeleton.len()];
         for (k, chain) in chains.iter().enumerate() {
             chain.iter().for_each(|&b| below[b].push(k));
@@ -417,9 +416,7 @@ fn condition(scale: DVec3) -> f64 {
 
 /// `max|k|/min|k| − 1` (0 for a zero scale: nothing to compare).
 fn anisotropy(scale: DVec3) -> f64 {
-    let k = scale.abs();
-    let (min, max) = (k.min_element(), k.max_element());
-    if min > 0.0 { max / min - 1.0 } else { 0.0 }
+    if scale.abs().min_element() > 0.0 { condition(scale) - 1.0 } else { 0.0 }
 }
 
 /// The link of bone `bone`, whose local transform is `local` and whose chain down to the explained bone turns by

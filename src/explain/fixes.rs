@@ -741,9 +741,7 @@ pub(super) fn candidates(evaluation: &Evaluation, bone: usize, scaled: &[usize],
 /// Whether a bake of `evaluation` reproduces it, shear and all: every bone inherits fully (a root's mode changes
 /// nothing) and no layer changes the clip, so each bone's local transform is already the TRS a glTF node holds.
 pub(super) fn bakes_reproduce(evaluation: &Evaluation) -> bool {
-    let skeleton = evaluation.skeleton();
-    let full = |b: usize| skeleton.parent(b).is_none() || evaluation.modes()[b] == InheritMode::Full;
-    evaluation.layers().is_none() && (0..skeleton.len()).all(full)
+    evaluation.layers().is_none() && (0..evaluation.skeleton().len()).all(|b| evaluation.inherits_fully(b))
 }
 
 #[cfg(test)]
