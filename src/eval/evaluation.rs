@@ -44,7 +44,7 @@ impl<'a> Evaluation<'a> {
 
     /// `clip` of `rig` with the modes its file declares.
     pub fn declared(rig: &'a Rig, clip: Option<&'a Clip>) -> Self {
-        Evaluation::under(rig, clip, Hierarchy::of_rig_fitting(rig, &rig.skeleton.declared_modes()))
+        Evaluation::under(rig, clip, Hierarchy::of_rig_bound(rig, &rig.skeleton.declared_modes(), None))
     }
 
     /// The same through `layers` (built, and so checked, for this rig). Layers that change nothing are no layers:

@@ -94,16 +94,11 @@ impl Hierarchy {
     /// is what Blender's bones rest in (an FBX file's nodes may hold another pose by default).
     pub fn of_rig(rig: &Rig, modes: &[InheritMode]) -> Result<Self, HierarchyError> {
         one_per_bone(&rig.skeleton, modes.len(), "inheritance modes")?;
-        Ok(Hierarchy::of_rig_fitting(rig, modes))
+        Ok(Hierarchy::of_rig_bound(rig, modes, None))
     }
 
-    /// [`Hierarchy::of_rig`] of modes known to be one per bone (resolved from the rig's own skeleton).
-    pub(super) fn of_rig_fitting(rig: &Rig, modes: &[InheritMode]) -> Self {
-        Hierarchy::of_rig_bound(rig, modes, None)
-    }
-
-    /// [`Hierarchy::of_rig_fitting`], given the rig's bind pose ([`super::bind_pose`]) where it is known: the
-    /// Blender modes rest bones in it.
+    /// [`Hierarchy::of_rig`] of modes known to be one per bone (resolved from the rig's own skeleton), given the
+    /// rig's bind pose ([`super::bind_pose`]) where it is known: the Blender modes rest bones in it.
     pub(super) fn of_rig_bound(rig: &Rig, modes: &[InheritMode], bind_pose: Option<&[Transform]>) -> Self {
         let skeleton = &rig.skeleton;
         if !modes.iter().any(|m| m.is_blender()) {

@@ -269,9 +269,9 @@ impl<'b> Group<'b> {
     }
 
     /// The local scales of the bones the group evaluates, where the clip is read bone by bone (no layers, lengths in
-    /// the rig's unit): [`Group::certain_causes`] reads them alone.
+    /// the rig's unit) and some chain is a product of local matrices: [`Group::certain_causes`] reads them alone.
     fn scales<'a>(&self, evaluation: &Evaluation<'a>) -> Option<Scales<'a>> {
-        let clip = evaluation.clip.filter(|_| evaluation.reads_bone_by_bone())?;
+        let clip = evaluation.clip.filter(|_| evaluation.reads_bone_by_bone() && self.products.contains(&true))?;
         let cursors = self.evaluated.iter().map(|&b| (b, BoneCursor::new(evaluation.skeleton(), clip, b))).collect();
         Some(Scales { cursors, at: vec![DVec3::ONE; evaluation.skeleton().len()] })
     }
