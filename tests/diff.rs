@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 use std::sync::Arc;
 
-use bonescope::diff::{Clips, FileSide, diff_files};
+use bonescope::diff::{Align, Clips, FileSide, diff_files};
 use bonescope::eval::Setup;
 use bonescope::eval::layers::RotationInterpolation;
 use bonescope::model::{Bone, BoneTracks, Clip, Interpolation, Rig, Skeleton, Track, Transform};
@@ -308,7 +308,9 @@ fn nlerp_playback_departs_from_slerp_as_its_formula_says() {
         FileSide { file: "turn".into(), rig: &rig, setup }
     };
     let orientation = |interp| {
-        let diff = diff_files(&side(RotationInterpolation::Slerp), &side(interp), Clips::ByName, &[], 60.0).unwrap();
+        let diff =
+            diff_files(&side(RotationInterpolation::Slerp), &side(interp), Clips::ByName, &[], 60.0, Align::Clocks)
+                .unwrap();
         assert_eq!(diff.interp_b, interp);
         diff.animations[0].bones[0].orientation_deg
     };

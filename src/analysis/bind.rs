@@ -328,7 +328,8 @@ fn bind_frame(
     let rate = clip.frame_rate();
     let joints: Vec<usize> = skins.iter().flat_map(|(skin, _)| skin.joints.iter().map(|j| j.bone)).collect();
     let bones = authored.skeleton().with_ancestors(&joints);
-    let times = sample_times([], 0.0, clip.duration(), rate, MAX_FRAMES).times;
+    let span = clip.span();
+    let times = sample_times([], span.start, span.end, rate, MAX_FRAMES).times;
     let closest = |a: (f64, f64), b: (f64, f64)| if b.0 < a.0 { b } else { a };
     // Bones are evaluated parents first, so each skin's last root's bone brings every root of it.
     let last_roots: Vec<Option<usize>> =
@@ -518,7 +519,8 @@ mod tests {
             gaps.map(|gap| gap.excess(&tolerance)).fold(0.0, f64::max)
         };
         let clip = &rig.clips[0];
-        let times = sample_times([], 0.0, clip.duration(), clip.frame_rate(), MAX_FRAMES).times;
+        let span = clip.span();
+        let times = sample_times([], span.start, span.end, clip.frame_rate(), MAX_FRAMES).times;
         let excesses: Vec<(f64, f64)> = times.iter().map(|&time| (excess(time), time)).collect();
         assert!(excesses.iter().filter(|(e, _)| *e <= 1.0).count() >= 3, "several frames pass: {excesses:?}");
         let closest = excesses.into_iter().reduce(|a, b| if b.0 < a.0 { b } else { a }).unwrap();

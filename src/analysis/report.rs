@@ -41,6 +41,10 @@ impl Parts {
 pub struct AnimationInfo {
     pub index: usize,
     pub name: Option<String>,
+    /// Where the clip starts on its file's clock, seconds ([`Clip::span`]).
+    #[serde(default)]
+    pub start: f64,
+    /// How long it plays, seconds.
     pub duration: f64,
     /// Frames per second: the file's, or for glTF the rate its key times show ([`Clip::frame_rate`]).
     pub frame_rate: f64,
@@ -51,19 +55,20 @@ impl AnimationInfo {
         AnimationInfo {
             index: clip.index,
             name: clip.name.clone(),
-            duration: clip.duration(),
+            start: clip.span().start,
+            duration: clip.span().length(),
             frame_rate: clip.frame_rate(),
         }
     }
 
-    /// `animation 0 `walk` (1.333 s)`, or the rest pose when there is no animation.
+    /// `animation 0 `walk` (1.333 s)` (`(2.000 s from 0.0333 s)` for a clip that does not start at 0 on its file's
+    /// clock), or the rest pose when there is no animation.
     pub fn describe(animation: Option<&AnimationInfo>) -> String {
-        match animation {
-            Some(a) => match &a.name {
-                Some(name) => format!("animation {} `{name}` ({:.3} s)", a.index, a.duration),
-                None => format!("animation {} ({:.3} s)", a.index, a.duration),
-            },
-            None => "rest pose (no animations)".to_owned(),
+        let Some(a) = animation else { return "rest pose (no animations)".to_owned() };
+        let from = if a.start == 0.0 { String::new() } else { format!(" from {:.4} s", a.start) };
+        match &a.name {
+            Some(name) => format!("animation {} `{name}` ({:.3} s{from})", a.index, a.duration),
+            None => format!("animation {} ({:.3} s{from})", a.index, a.duration),
         }
     }
 }

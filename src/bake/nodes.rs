@@ -413,7 +413,9 @@ mod tests {
         let rig = demo_rig();
         let modes = vec![InheritMode::SegmentCompensate; rig.skeleton.len()];
         let side = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
-        let times: Vec<f64> = (0..=count).map(|k| f64::from(k) * side.duration() / f64::from(count)).collect();
+        let span = side.span();
+        let times: Vec<f64> =
+            (0..=count).map(|k| span.start + f64::from(k) * span.length() / f64::from(count)).collect();
         test(&side, &times);
     }
 

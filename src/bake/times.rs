@@ -54,7 +54,7 @@ pub fn bake_times(side: &Evaluation) -> BakeTimes {
     source_keys.dedup();
     keys.extend(steps.iter().map(|t| (t - STEP_LEAD).max(0.0)));
     keys.extend(inside);
-    let mut times = sample_times(keys, 0.0, end(side), rate, MAX_FRAMES).times;
+    let mut times = sample_times(keys, side.span().start, end(side), rate, MAX_FRAMES).times;
     times.iter_mut().chain(&mut steps).for_each(|t| *t = in_single_precision(*t));
     times.dedup();
     steps.sort_by(f64::total_cmp);
@@ -99,13 +99,13 @@ enum Rank {
     Kept,
 }
 
-/// Where sampling ends: the duration, or for a synced blend's cycle, which wraps to its start at its length, the
+/// Where sampling ends: the span's end, or for a synced blend's cycle, which wraps to its start at its length, the
 /// last `f32` time before it (a player looping the baked clip wraps there too).
 fn end(side: &Evaluation) -> f64 {
-    let duration = side.duration();
+    let span = side.span();
     let wraps = side.layers().is_some_and(|layers| layers.synced_cycle(side.rig, side.clip).is_some());
-    let just_before = f32::from_bits((duration as f32).to_bits().saturating_sub(1));
-    if wraps && duration > 0.0 { f64::from(just_before) } else { duration }
+    let just_before = f64::from((span.end as f32).next_down());
+    if wraps && span.length() > 0.0 { just_before } else { span.end }
 }
 
 /// `time` rounded to the nearest `f32`: glTF stores key times in single precision, so a sample taken at exactly such

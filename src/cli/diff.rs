@@ -8,10 +8,10 @@ use clap::Args;
 use super::OutputFormat;
 use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
-use crate::diff::{AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
+use crate::diff::{Align, AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
-use crate::model::{Choice, ModeChoice, Rig, Unit, UpAxis};
+use crate::model::{At, Choice, ModeChoice, Rig, Unit, UpAxis, frames};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -54,7 +54,12 @@ pub struct DiffArgs {
     /// keys each quaternion component as a curve of its own (Blender, Unity, Unreal) plays a bake.
     #[arg(long, value_parser = choice::<RotationInterpolation>(), value_name = "MODE", default_value = RotationInterpolation::default().id())]
     pub interp: RotationInterpolation,
-    /// Samples per second over the shorter clip, on top of both files' key times.
+    /// How the second file's clock meets the first's: `clocks` compares equal times of both files' own clocks (a
+    /// time reads the same in every format), `start` plays the second clip from the first's start (one exporter
+    /// starts each take at 0, another at its first frame), a number of seconds plays the second that much later.
+    #[arg(long, value_name = "clocks|start|SECONDS", default_value = "clocks", allow_hyphen_values = true)]
+    pub align: Align,
+    /// Samples per second where both clips play, on top of both files' key times.
     #[arg(long, value_name = "HZ", default_value_t = crate::diff::DEFAULT_RATE, value_parser = parse_rate)]
     pub rate: f64,
     #[arg(long, value_enum, default_value_t)]
@@ -81,13 +86,51 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let mut b = FileSide::new(shown(&args.b), &rig_b, args.inherit_b, clip_b);
     b.setup.layers.interpolation.rotation = args.interp;
     let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
-    let diff = diff_files(&a, &b, clips, &args.map, args.rate)?;
+    let diff = diff_files(&a, &b, clips, &args.map, args.rate, args.align)?;
     match args.format {
         OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&diff)?))?,
         OutputFormat::Table => super::print_out(render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()]))?,
     }
+    if let Some(apart) = diff.animations.iter().find(|a| a.samples == 0) {
+        anyhow::bail!("`{}` and `{}` never play at the same time: {}", apart.a, apart.b, never_together(apart));
+    }
     let over = |a: &AnimationDiff| args.fail_above.is_some_and(|limit| a.worst.max > limit.units(a.rig_size));
     Ok(if diff.animations.iter().any(over) { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// Where two clips that never play at once lie, and how to meet them.
+fn never_together(animation: &AnimationDiff) -> String {
+    let (a, b) = (animation.span_a, animation.span_b);
+    format!(
+        "A from {:.4} to {:.4} s, B from {:.4} to {:.4} s on their own clocks (B played {:.4} s later); --align start \
+         plays B from A's start",
+        a.start, a.end, b.start, b.end, animation.delay_b
+    )
+}
+
+/// What to say of two clips' clocks: how far apart their starts are where nothing aligned them, or how B was moved.
+fn clocks_note(animation: &AnimationDiff) -> Option<String> {
+    let gap = animation.span_a.start - animation.span_b.start;
+    let frames = |seconds: f64| match animation.frame_rate {
+        Some(rate) => {
+            let count = frames(seconds * rate);
+            let noun = if count == "1" { "frame" } else { "frames" };
+            format!(" ({count} {noun} at {rate} fps)")
+        }
+        None => String::new(),
+    };
+    if animation.delay_b != 0.0 {
+        let d = animation.delay_b;
+        return Some(format!("B played {d:.4} s{} later than its clock says, to meet A's", frames(d)));
+    }
+    (gap.abs() > 1e-6).then(|| {
+        let (how, lead) = if gap > 0.0 { ("before", gap) } else { ("after", -gap) };
+        format!(
+            "B's clip starts {lead:.4} s{} {how} A's on its own clock; compared at equal times (--align start compares \
+             them start to start)",
+            frames(lead)
+        )
+    })
 }
 
 /// The clips `--anim-a` and `--anim-b` choose ([`chosen_clips`]), a clip a file lacks named with the file and the
@@ -156,15 +199,18 @@ pub(super) fn render_animation(animation: &AnimationDiff) -> String {
     let mut out = String::new();
     let percent = |v: f64| format!("{:.4} %", 100.0 * v / animation.rig_size);
     out.push_str(&format!(
-        "`{}` against `{}`: {} samples, rig size {:.4}; worst distance {:.3e} ({}) at {:.4} s\n",
+        "`{}` against `{}`: {} samples, rig size {:.4}; worst distance {:.3e} ({}) at {}\n",
         animation.a,
         animation.b,
         animation.samples,
         animation.rig_size,
         animation.worst.max,
         percent(animation.worst.max),
-        animation.worst.time
+        At { time: animation.worst.time, rate: animation.frame_rate }
     ));
+    if let Some(note) = clocks_note(animation) {
+        out.push_str(&format!("  {note}\n"));
+    }
     let mut bones = Table::new(&[
         ("bone", false),
         ("position", true),

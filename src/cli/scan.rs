@@ -16,7 +16,7 @@ use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::ScanOptions;
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
 use crate::analysis::storage::{RuntimeError, StorageOptions, StorageReport, storage_report};
-use crate::diff::{AnimationDiff, Clips, FileSide, diff_files};
+use crate::diff::{Align, AnimationDiff, Clips, FileSide, diff_files};
 use crate::eval::{Evaluation, Setup};
 use crate::explain::scan_clip;
 use crate::import;
@@ -416,7 +416,7 @@ fn compare_animations(path: &Path, args: &ScanArgs, sides: [ModeChoice; 2]) -> a
     let clip = args.eval.anim.as_ref().map(|name| clip_index(&rig, "--anim", name)).transpose()?;
     let [a, b] = sides.map(|modes| FileSide::new(shown(path), &rig, modes, clip));
     let clips = if clip.is_some() { Clips::Chosen } else { Clips::ByName };
-    Ok(diff_files(&a, &b, clips, &[], args.rate)?.animations)
+    Ok(diff_files(&a, &b, clips, &[], args.rate, Align::Clocks)?.animations)
 }
 
 /// The table form: per file its clips, or why it could not be loaded.

@@ -25,7 +25,7 @@ pub use matching::{
     BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
     standing_apart,
 };
-pub use report::{AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_clips, diff_files};
+pub use report::{Align, AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_clips, diff_files};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -221,6 +221,22 @@ pub enum DiffError {
     /// What a side evaluates does not fit its file.
     #[error("{file}: {error}")]
     Setup { file: String, error: crate::eval::SetupError },
+    /// Both files have clips and none pairs with the other's by name: nothing would be compared.
+    #[error(
+        "no animation of the first file pairs with one of the second by name (first: {}; second: {}): choose them \
+         with --anim-a and --anim-b",
+        listed(a),
+        listed(b)
+    )]
+    NoClipPairs { a: Vec<String>, b: Vec<String> },
+}
+
+/// Names in backquotes, separated by commas; `none` for none.
+fn listed(names: &[String]) -> String {
+    if names.is_empty() {
+        return "none".to_owned();
+    }
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }
 
 /// The result of comparing two evaluations.
@@ -257,12 +273,13 @@ impl Comparison {
     }
 }
 
-/// The times two evaluations are compared at: every key time of either within the shorter duration, and `rate`
-/// times a second over it (sorted, near-duplicates counted once).
+/// The times two evaluations are compared at: every key time of either where both play (the overlap of their spans,
+/// each on its own clock, a delay included: [`Evaluation::delayed`]), and `rate` times a second over it (sorted,
+/// near-duplicates counted once); empty where they never play at once.
 pub fn comparison_times(a: &Evaluation, b: &Evaluation, rate: f64) -> Vec<f64> {
-    let end = a.duration().min(b.duration());
+    let Some(both) = a.span().overlap(b.span()) else { return Vec::new() };
     let keys = a.key_times().into_iter().chain(b.key_times());
-    sample_times(keys, 0.0, end, rate, MAX_FRAMES).times
+    sample_times(keys, both.start, both.end, rate, MAX_FRAMES).times
 }
 
 /// Compares `a` and `b` at `times` (sorted), in the units each is measured in: to compare two files, measure `b` in

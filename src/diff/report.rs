@@ -4,7 +4,7 @@
 use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup};
-use crate::model::{ModeChoice, Modes, Rig, Unit};
+use crate::model::{Clip, ModeChoice, Modes, Rig, Span, Unit};
 
 /// The clips `names` choose, `[in A, in B]`, each a name or an index: a name given for one side only is looked up on
 /// both (the other file's clip named as the chosen clip is). `None`: every clip, paired by name. The error is a clip
@@ -57,6 +57,48 @@ impl<'a> FileSide<'a> {
     }
 }
 
+/// How B's clock meets A's in a file comparison. Each file keeps its own clock (a time reads the same in every
+/// format), so two exports of one scene whose exporters put its first frame at different times (Blender's FBX starts
+/// each take at 0, its glTF and USD at the frame's own time) are a frame or more apart until aligned.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Align {
+    /// Equal times of both clocks are compared.
+    #[default]
+    Clocks,
+    /// B's clip is played from A's clip's start.
+    Start,
+    /// B is played this many seconds later than its clock says.
+    Delay(f64),
+}
+
+impl std::str::FromStr for Align {
+    type Err = String;
+
+    /// `clocks`, `start`, or a number of seconds B is played later.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text.trim() {
+            "clocks" => Ok(Align::Clocks),
+            "start" => Ok(Align::Start),
+            seconds => match seconds.parse::<f64>() {
+                Ok(seconds) if seconds.is_finite() => Ok(Align::Delay(seconds)),
+                _ => Err(format!("expected `clocks`, `start` or a number of seconds, got `{text}`")),
+            },
+        }
+    }
+}
+
+impl Align {
+    /// How many seconds later B is played for its clip over `b` to meet A's over `a`.
+    fn delay(self, a: Span, b: Span) -> f64 {
+        match self {
+            Align::Clocks => 0.0,
+            Align::Start => a.start - b.start,
+            Align::Delay(seconds) => seconds,
+        }
+    }
+}
+
 /// Which clips a file comparison compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Clips {
@@ -72,6 +114,14 @@ pub struct AnimationDiff {
     /// The clips' names (`rest pose` for a file without clips).
     pub a: String,
     pub b: String,
+    /// Where each clip lies on its own file's clock (B's as its file says, before any delay).
+    pub span_a: Span,
+    pub span_b: Span,
+    /// How many seconds later than its clock says B was played ([`Align`]); times are A's.
+    pub delay_b: f64,
+    /// A's frame rate, which the times' frames are counted at.
+    pub frame_rate: Option<f64>,
+    /// How many times were compared: none where the two clips never play at once.
     pub samples: usize,
     /// The larger of the two rigs' sizes, which percentages are of.
     pub rig_size: f64,
@@ -110,17 +160,23 @@ pub struct FileDiff {
     pub clips_only_b: Vec<String>,
 }
 
-/// Compares `a` with `b` at their key times and `rate` times a second, lengths in A's unit; `map` pairs bones by
-/// name explicitly.
+/// Compares `a` with `b` at their key times and `rate` times a second where both play, B's clock meeting A's as
+/// `align` says, lengths in A's unit; `map` pairs bones by name explicitly. Two files with clips none of which pair
+/// by name are an error that lists them ([`DiffError::NoClipPairs`]).
 pub fn diff_files<'a>(
     a: &FileSide<'a>,
     b: &FileSide<'a>,
     clips: Clips,
     map: &[(String, String)],
     rate: f64,
+    align: Align,
 ) -> Result<FileDiff, DiffError> {
     let (pairs, only_a, only_b) = pair_clips(a, b, clips);
     let label = |rig: &Rig, clip: Option<usize>| clip.map_or_else(|| "rest pose".to_owned(), |c| rig.clips[c].label());
+    if pairs.is_empty() {
+        let labels = |rig: &Rig| (0..rig.clips.len()).map(|c| label(rig, Some(c))).collect();
+        return Err(DiffError::NoClipPairs { a: labels(a.rig), b: labels(b.rig) });
+    }
     let evaluation = |side: &FileSide<'a>, clip, unit| {
         let setup = Setup { clip, unit, ..side.setup.clone() };
         Evaluation::of(side.rig, &setup).map_err(|error| DiffError::Setup { file: side.file.clone(), error })
@@ -130,12 +186,19 @@ pub fn diff_files<'a>(
         .map(|&(ca, cb)| {
             let side_a = evaluation(a, ca, None)?;
             let side_b = evaluation(b, cb, a.rig.unit)?;
+            let (span_a, span_b) = (side_a.span(), side_b.span());
+            let delay_b = align.delay(span_a, span_b);
+            let side_b = side_b.delayed(delay_b);
             let pairs = Pairs::mapped(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
             Ok(AnimationDiff {
                 a: label(a.rig, ca),
                 b: label(b.rig, cb),
+                span_a,
+                span_b,
+                delay_b,
+                frame_rate: side_a.clip.map(Clip::frame_rate),
                 samples: comparison.samples,
                 rig_size: comparison.rig_size,
                 worst: comparison.worst_distance(),

@@ -8,7 +8,7 @@ use super::hierarchy::HierarchyError;
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
 use super::{Hierarchy, LayerStack, Pose, over_runs};
-use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Unit, sample_times};
+use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Span, Unit, sample_times};
 
 /// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
 #[derive(Clone, Debug)]
@@ -27,6 +27,8 @@ pub struct Evaluation<'a> {
     unit: Option<Unit>,
     /// What the model matrices multiply lengths by: 1 in the rig's own unit.
     length_scale: f64,
+    /// How many seconds later than its file's clock the clip plays ([`Evaluation::delayed`]).
+    delay: f64,
 }
 
 impl<'a> Evaluation<'a> {
@@ -39,7 +41,8 @@ impl<'a> Evaluation<'a> {
     /// `clip` of `rig` under `hierarchy` (the rig's), as sampled, skinned as the file says.
     pub(super) fn under(rig: &'a Rig, clip: Option<&'a Clip>, hierarchy: Hierarchy) -> Self {
         let skinning = SkinningMethod::AsFile;
-        Evaluation { rig, clip, hierarchy, chosen: None, layers: None, skinning, unit: None, length_scale: 1.0 }
+        let (unit, length_scale, delay) = (None, 1.0, 0.0);
+        Evaluation { rig, clip, hierarchy, chosen: None, layers: None, skinning, unit, length_scale, delay }
     }
 
     /// `clip` of `rig` with the modes its file declares.
@@ -77,6 +80,19 @@ impl<'a> Evaluation<'a> {
             _ => 1.0,
         };
         self
+    }
+
+    /// The same played `seconds` later: the pose at time `t` is the clip's at `t − seconds` on its file's clock, and
+    /// its span, key times and sample times move with it. How two files whose clocks disagree (one exporter starts
+    /// a take at 0, the other at its first frame) are compared at corresponding times.
+    pub fn delayed(mut self, seconds: f64) -> Self {
+        self.delay = if seconds.is_finite() { seconds } else { 0.0 };
+        self
+    }
+
+    /// How many seconds later than its file's clock the clip plays.
+    pub fn delay(&self) -> f64 {
+        self.delay
     }
 
     /// The same clip through the same layers under other modes, one per bone (a ghost: "what if every bone
@@ -142,13 +158,15 @@ impl<'a> Evaluation<'a> {
         self.layers.as_ref()
     }
 
-    /// How long the evaluation runs: the clip's duration, or the layered timeline's (a synced blend's cycle, a
-    /// crossfade into a longer clip).
-    pub fn duration(&self) -> f64 {
-        match &self.layers {
-            Some(layers) => layers.duration(self.rig, self.clip),
-            None => self.clip.map_or(0.0, Clip::duration),
-        }
+    /// Where the evaluation runs on its clock: the clip's span, or the layered timeline's from the clip's start (a
+    /// synced blend's cycle, a crossfade into a longer clip); at 0 for the rest pose. Moved by the delay.
+    pub fn span(&self) -> Span {
+        let own = self.clip.map_or(Span::at(0.0), Clip::span);
+        let span = match &self.layers {
+            Some(layers) => Span::new(own.start, own.start + layers.length(self.rig, self.clip)),
+            None => own,
+        };
+        span.shifted(self.delay)
     }
 
     /// The times at which the evaluation has keys: the clip's key times, or, where layers make a timeline of their
@@ -156,32 +174,43 @@ impl<'a> Evaluation<'a> {
     pub fn key_times(&self) -> Vec<f64> {
         match &self.layers {
             Some(_) => self.times(0.0),
-            None => self.clip.map_or_else(|| vec![0.0], Clip::key_times),
+            None => self.clip.map_or_else(|| vec![0.0], |clip| self.delayed_times(clip.key_times())),
         }
     }
 
-    /// The times a whole-clip pass visits: every key time, plus `0, 1/rate, 2/rate, …` up to the duration, plus
-    /// the duration; sorted, without duplicates (thinned between sparse keys past [`MAX_FRAMES`] frames). Where the
-    /// layers change the timeline (a synced blend plays a cycle of another length, a crossfade runs on into the
-    /// incoming clip), the grid over the layered duration and its end. Just `[0]` for the rest pose.
+    /// The times a whole-clip pass visits: every key time, plus every frame `k / rate` within the span, plus its two
+    /// ends; sorted, without duplicates (thinned between sparse keys past [`MAX_FRAMES`] frames). Where the layers
+    /// change the timeline (a synced blend plays a cycle of another length, a crossfade runs on into the incoming
+    /// clip), the grid over the layered span and its ends. Just the start for the rest pose.
     pub fn times(&self, rate: f64) -> Vec<f64> {
         let (rig, clip) = (self.rig, self.clip);
-        let main = clip.map_or(0.0, Clip::duration);
+        let own = clip.map_or(Span::at(0.0), Clip::span);
         let retimed = self
             .layers
             .as_ref()
-            .is_some_and(|layers| layers.synced_cycle(rig, clip).is_some() || layers.duration(rig, clip) != main);
+            .is_some_and(|layers| layers.synced_cycle(rig, clip).is_some() || layers.length(rig, clip) != own.length());
+        let span = self.span();
         match clip {
-            _ if retimed => sample_times([], 0.0, self.duration(), rate, MAX_FRAMES).times,
-            Some(clip) => sample_times(clip.key_times(), 0.0, main, rate, MAX_FRAMES).times,
-            None => vec![0.0],
+            _ if retimed => sample_times([], span.start, span.end, rate, MAX_FRAMES).times,
+            Some(clip) => {
+                sample_times(self.delayed_times(clip.key_times()), span.start, span.end, rate, MAX_FRAMES).times
+            }
+            None => vec![span.start],
         }
     }
 
+    /// Times of the clip's clock as the evaluation plays them.
+    fn delayed_times(&self, mut times: Vec<f64>) -> Vec<f64> {
+        if self.delay != 0.0 {
+            times.iter_mut().for_each(|t| *t += self.delay);
+        }
+        times
+    }
+
     /// Whether a pose's bones can be read from the clip one at a time ([`super::Chains`]): no layers (which read
-    /// whole poses) and lengths in the rig's own unit.
+    /// whole poses), lengths in the rig's own unit and the file's own clock.
     pub fn reads_bone_by_bone(&self) -> bool {
-        self.layers.is_none() && self.in_rig_unit()
+        self.layers.is_none() && self.in_rig_unit() && self.delay == 0.0
     }
 
     /// Whether lengths are in the rig's own unit (no [`Evaluation::measured_in`] that scales them).
@@ -261,6 +290,7 @@ impl<'e, 'a> Evaluator<'e, 'a> {
     /// Evaluates the pose at `time`.
     pub fn evaluate(&mut self, time: f64) -> &Pose {
         let e = self.evaluation;
+        let time = time - e.delay;
         match &mut self.layers {
             Some(stack) => self.pose.evaluate_layered(e.rig, e.clip, &e.hierarchy, stack, time),
             None => self.pose.evaluate(&e.rig.skeleton, e.clip, &e.hierarchy, time),
@@ -306,7 +336,7 @@ mod tests {
         let evaluation = Evaluation::declared(&rig, rig.clips.first());
         let times = evaluation.times(30.0);
         assert_eq!(times.first(), Some(&0.0));
-        assert_eq!(times.last(), Some(&evaluation.duration()));
+        assert_eq!(times.last(), Some(&evaluation.span().end));
         let size = evaluation.size(&times);
         let rest = rig.skeleton.rest_model_matrices();
         let span = rest.iter().map(|m| m.w_axis.truncate().length()).fold(0.0, f64::max);
@@ -334,9 +364,9 @@ mod tests {
         let crossfade = Crossfade { clip: 1, at: 1.5, duration: 0.5, curve: Default::default() };
         let stack = LayerStack::new(&rig, &Layers { crossfade: Some(crossfade), ..Layers::default() }).unwrap();
         let layered = Evaluation::declared(&rig, Some(main)).with_layers(stack);
-        let end = 1.5 + rig.clips[1].duration();
-        assert!(end > main.duration());
-        assert_eq!(layered.duration(), end);
+        let end = 1.5 + rig.clips[1].span().length();
+        assert!(end > main.span().end);
+        assert_eq!(layered.span(), Span::new(0.0, end));
         let times = layered.times(10.0);
         assert_eq!((times[0], *times.last().unwrap(), times.len()), (0.0, end, 36));
         assert!(times.windows(2).all(|w| (w[1] - w[0] - 0.1).abs() < 1e-12), "{times:?}");

@@ -28,6 +28,7 @@ impl<'e, 'a> Variant<'e, 'a> {
             && reference.clip.is_some()
             && reference.clip.map(std::ptr::from_ref) == evaluation.clip.map(std::ptr::from_ref)
             && reference.skinning == evaluation.skinning
+            && reference.delay() == evaluation.delay()
             && reference.reads_bone_by_bone()
             && evaluation.in_rig_unit();
         let skeleton = evaluation.skeleton();

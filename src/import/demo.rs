@@ -249,7 +249,7 @@ mod tests {
     fn the_stress_rig_has_the_asked_size() {
         let rig = stress_rig(50, 300, 5);
         assert_eq!(rig.skeleton.len(), 50);
-        assert!((rig.clips[0].duration() - 10.0).abs() < 1e-12);
+        assert!((rig.clips[0].span().length() - 10.0).abs() < 1e-12);
         assert_eq!(rig.clips[0].tracks()[0].rotation.as_ref().unwrap().times().len(), 61);
         assert_eq!(rig.skeleton.parent(11), Some(0));
         assert_eq!(rig.skeleton.parent(12), Some(11));

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{DQuat, Quat, Vec3};
 
-use super::Transform;
+use super::{Span, Transform};
 
 /// How values between keys are computed (glTF's sampler interpolations).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -46,7 +46,7 @@ pub enum TrackError {
     Empty,
     #[error("{values} output values for {keys} keys with {interpolation:?} interpolation (expected {expected})")]
     CountMismatch { keys: usize, values: usize, expected: usize, interpolation: Interpolation },
-    #[error("key time {index} ({time}) is not finite, negative, or before the previous key")]
+    #[error("key time {index} ({time}) is not finite, or before the previous key")]
     BadTime { index: usize, time: f64 },
     #[error("output value {index} is not finite")]
     NonFinite { index: usize },
@@ -92,7 +92,7 @@ impl KeyValue for Quat {
 }
 
 impl<T: KeyValue> Track<T> {
-    /// Checks the glTF rules: times finite, non-negative and increasing; one value per key (three for cubic
+    /// Checks the glTF rules: times finite and increasing (before 0 too: a file's clock may start there); one value per key (three for cubic
     /// splines, at least two keys); every value finite. Keys closer than [`KEY_TIME_RESOLUTION`] (equal times
     /// included, as exporters and zero-filled accessors write them) count once: the last of them holds from that
     /// time on, as a jump does.
@@ -210,17 +210,17 @@ fn spacing_rate(arrays: &[&[f64]]) -> Option<f64> {
     (count >= 2 && count * 4 >= total && rate > 0).then(|| rate as f64 / 1000.0)
 }
 
-/// The first time that is not finite, negative, or before the one before it.
+/// The first time that is not finite, or before the one before it.
 fn first_bad_time(times: &[f64]) -> Option<usize> {
     // Folded without stopping, as the values are (the same array is checked for every track that shares it).
     let finite = times.iter().fold(true, |finite, t| finite & t.is_finite());
     let sorted = times.windows(2).fold(true, |sorted, w| sorted & (w[0] <= w[1]));
-    if finite && sorted && times.first().is_none_or(|&t| t >= 0.0) {
+    if finite && sorted {
         return None;
     }
     let mut previous = f64::NEG_INFINITY;
     times.iter().position(|&time| {
-        let bad = !time.is_finite() || time < 0.0 || time < previous;
+        let bad = !time.is_finite() || time < previous;
         previous = time;
         bad
     })
@@ -295,8 +295,8 @@ pub struct MorphWeights {
 }
 
 impl MorphWeights {
-    fn last_time(&self) -> f64 {
-        self.weights.iter().map(Track::last_time).fold(0.0, f64::max)
+    fn time_arrays(&self) -> impl Iterator<Item = &[f64]> {
+        self.weights.iter().map(Track::times)
     }
 }
 
@@ -310,21 +310,31 @@ pub struct Clip {
     tracks: Vec<BoneTracks>,
     /// Sorted by bone, at most one entry per bone.
     morph: Vec<MorphWeights>,
-    duration: f64,
+    span: Span,
     /// Frames per second: the rate the file states (FBX, BVH), else the rate its key times show (see
     /// [`Clip::frame_rate`]).
     frame_rate: Option<f64>,
 }
 
 impl Clip {
-    /// Sorts the tracks and morph weights by bone; the duration is the last key time of any track (glTF clips start
-    /// at t = 0).
+    /// Sorts the tracks and morph weights by bone; the clip spans its keys, from the first key time of any track to
+    /// the last (a glTF animation has no span of its own: its keys are where it plays), at t = 0 without keys.
     pub fn new(index: usize, name: Option<String>, mut tracks: Vec<BoneTracks>, mut morph: Vec<MorphWeights>) -> Self {
         tracks.sort_by_key(|t| t.bone);
         morph.sort_by_key(|m| m.bone);
-        let duration = tracks.iter().flat_map(BoneTracks::time_arrays).map(|t| t[t.len() - 1]).fold(0.0, f64::max);
-        let duration = morph.iter().map(MorphWeights::last_time).fold(duration, f64::max);
-        Clip { index, name, tracks, morph, duration, frame_rate: None }
+        let arrays =
+            tracks.iter().flat_map(BoneTracks::time_arrays).chain(morph.iter().flat_map(MorphWeights::time_arrays));
+        let (first, last) = arrays
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(first, last), t| (first.min(t[0]), last.max(t[t.len() - 1])));
+        let span = if first <= last { Span::new(first, last) } else { Span::at(0.0) };
+        Clip { index, name, tracks, morph, span, frame_rate: None }
+    }
+
+    /// The clip over `span`, the stretch of the file's clock its format says it plays (an FBX take's start and stop,
+    /// a USD stage's start and end time codes) rather than its keys'.
+    pub fn with_span(mut self, span: Span) -> Self {
+        self.span = span;
+        self
     }
 
     /// The clip with the rate its key times show as its frame rate, for a format that states none (glTF): the
@@ -358,9 +368,9 @@ impl Clip {
         &self.morph
     }
 
-    /// Seconds from t = 0 to the last key.
-    pub fn duration(&self) -> f64 {
-        self.duration
+    /// Where the clip lies on its file's clock.
+    pub fn span(&self) -> Span {
+        self.span
     }
 
     /// A name for people: the clip's name, or `animation <index>`.
@@ -509,6 +519,7 @@ mod tests {
             Track::new(times(&[1.0, 0.5]), v.clone(), Interpolation::Linear),
             Err(TrackError::BadTime { index: 1, .. })
         ));
+        assert!(Track::new(times(&[-1.0, 0.5]), v.clone(), Interpolation::Linear).is_ok(), "a clock before 0");
         assert!(matches!(
             Track::new(times(&[0.0, f64::NAN]), v.clone(), Interpolation::Linear),
             Err(TrackError::BadTime { index: 1, .. })
@@ -544,14 +555,18 @@ mod tests {
     }
 
     #[test]
-    fn duration_and_key_times_cover_all_tracks() {
+    fn span_and_key_times_cover_all_tracks() {
         let mut a = BoneTracks::new(3);
         a.translation = Some(Track::new(times(&[0.5, 2.0]), vec![Vec3::ZERO; 2], Interpolation::Linear).unwrap());
         let mut b = BoneTracks::new(1);
-        b.rotation = Some(Track::new(times(&[0.0, 0.5, 1.0]), vec![Quat::IDENTITY; 3], Interpolation::Step).unwrap());
-        let clip = Clip::new(0, None, vec![a, b], vec![]);
-        assert_eq!(clip.duration(), 2.0);
-        assert_eq!(clip.key_times(), vec![0.0, 0.5, 1.0, 2.0]);
+        b.rotation = Some(Track::new(times(&[0.25, 0.5, 1.0]), vec![Quat::IDENTITY; 3], Interpolation::Step).unwrap());
+        let weights = vec![Track::new(times(&[-0.5, 0.0]), vec![0.0f32; 2], Interpolation::Linear).unwrap()];
+        let clip = Clip::new(0, None, vec![a.clone(), b.clone()], vec![]);
+        assert_eq!(clip.span(), Span::new(0.25, 2.0), "from the first key to the last, not from 0");
+        let morphed = Clip::new(0, None, vec![a, b], vec![MorphWeights { bone: 0, weights }]);
+        assert_eq!(morphed.span(), Span::new(-0.5, 2.0), "morph weights count, before 0 too");
+        assert_eq!(Clip::new(0, None, vec![], vec![]).span(), Span::at(0.0));
+        assert_eq!(clip.key_times(), vec![0.25, 0.5, 1.0, 2.0]);
         assert_eq!(clip.tracks()[0].bone, 1, "tracks are sorted by bone");
         assert!(clip.tracks_of(3).is_some() && clip.tracks_of(2).is_none());
         assert_eq!(clip.label(), "animation 0");
@@ -573,6 +588,6 @@ mod tests {
         tracks[1].scale = Some(Track::new(times(&[0.5, 1.0, 2.5]), vec![Vec3::ONE; 3], Interpolation::Linear).unwrap());
         let two_arrays = Clip::new(0, None, tracks, vec![]);
         assert_eq!(two_arrays.key_times(), vec![0.0, 0.5, 1.0, 2.0, 2.5]);
-        assert_eq!(two_arrays.duration(), 2.5);
+        assert_eq!(two_arrays.span(), Span::new(0.0, 2.5));
     }
 }

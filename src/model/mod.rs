@@ -21,7 +21,7 @@ pub use inherit::{InheritMode, ModeChoice, Modes, UnknownInheritMode, UnknownMod
 pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, NodeRole, ParentOrderError, Placement, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
-pub use timeline::{MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, sample_times};
+pub use timeline::{At, MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, Span, frames, sample_times};
 pub use tool::Tool;
 pub use transform::{Transform, affine};
 pub(crate) use unit::significant;
@@ -55,7 +55,7 @@ impl Rig {
         let longest = || {
             // The first of equally long clips.
             let keyed = self.clips.iter().enumerate().rev().filter(|(_, c)| moving(c));
-            keyed.max_by(|(_, a), (_, b)| a.duration().total_cmp(&b.duration())).map(|(i, _)| i)
+            keyed.max_by(|(_, a), (_, b)| a.span().length().total_cmp(&b.span().length())).map(|(i, _)| i)
         };
         first.or_else(longest).or((!self.clips.is_empty()).then_some(0))
     }

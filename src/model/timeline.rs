@@ -1,4 +1,5 @@
-//! Which times to sample a clip at: every frame of a rate and every key time, with a bound for long, sparse clips.
+//! A clip's stretch of its file's clock ([`Span`]), how a time reads as a frame ([`At`]), and which times to sample
+//! a clip at: every frame of a rate and every key time, with a bound for long, sparse clips.
 //!
 //! A clip may legally span millions of frames with a few dozen keys (Maya's long-keyframe tests: 41 keys over
 //! ±166,666 s). Sampling every frame of such a clip costs memory and time out of all proportion to its content, so
@@ -17,6 +18,83 @@ pub const MAX_FRAMES: usize = 1 << 20;
 
 /// How many times a long gap between two keys is sampled at when the grid is thinned.
 pub const SAMPLES_PER_SPARSE_GAP: usize = 64;
+
+/// Where a clip lies on its file's clock, in seconds: from its first frame to its last. Each format's own clock is
+/// kept (a glTF key written at 1/24 s is at 1/24 s, a USD time code `c` at `c / timeCodesPerSecond`, an FBX key at
+/// its stored time), so two exports of one scene read the same times where their exporters wrote the same times.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Span {
+    pub start: f64,
+    pub end: f64,
+}
+
+impl Span {
+    /// The span from `start` to `end`; an empty one at `start` where `end` comes before it (or either is not finite).
+    pub fn new(start: f64, end: f64) -> Span {
+        let start = if start.is_finite() { start } else { 0.0 };
+        Span { start, end: if end.is_finite() { end.max(start) } else { start } }
+    }
+
+    /// The span at one time.
+    pub fn at(time: f64) -> Span {
+        Span::new(time, time)
+    }
+
+    /// Seconds from start to end.
+    pub fn length(&self) -> f64 {
+        self.end - self.start
+    }
+
+    /// `time` held within the span.
+    pub fn clamp(&self, time: f64) -> f64 {
+        time.clamp(self.start, self.end)
+    }
+
+    /// The same span `by` seconds later.
+    pub fn shifted(self, by: f64) -> Span {
+        Span { start: self.start + by, end: self.end + by }
+    }
+
+    /// The times both spans hold, `None` where they do not meet.
+    pub fn overlap(self, other: Span) -> Option<Span> {
+        let (start, end) = (self.start.max(other.start), self.end.min(other.end));
+        (start <= end).then_some(Span { start, end })
+    }
+}
+
+/// A time as people read it beside a frame rate: `0.5833 s (frame 14)`, the frame `time × rate` on the clip's own
+/// clock (whole where the time is within a thousandth of a frame of one, else to a tenth); the seconds alone without
+/// a rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct At {
+    pub time: f64,
+    pub rate: Option<f64>,
+}
+
+impl At {
+    /// The frame `time` falls on at the rate, where there is a usable rate.
+    pub fn frame(&self) -> Option<f64> {
+        let rate = self.rate.filter(|r| r.is_finite() && *r > 0.0)?;
+        let frame = self.time * rate;
+        frame.is_finite().then_some(frame)
+    }
+}
+
+impl std::fmt::Display for At {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:.4} s", self.time)?;
+        match self.frame() {
+            Some(frame) => write!(f, " (frame {})", frames(frame)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A number of frames as people read it: whole where it is within a thousandth of a whole number, else to a tenth.
+pub fn frames(count: f64) -> String {
+    let whole = count.round();
+    if (count - whole).abs() < 1e-3 { format!("{}", whole + 0.0) } else { format!("{count:.1}") }
+}
 
 /// The sorted, distinct times to sample, and whether some frames were left out.
 #[derive(Clone, Debug, PartialEq)]
@@ -95,6 +173,31 @@ fn keep_anchors(anchors: Vec<f64>, mut others: Vec<f64>) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spans_meet_shift_and_hold() {
+        let a = Span::new(1.0 / 24.0, 2.0);
+        assert_eq!(a.length(), 2.0 - 1.0 / 24.0);
+        assert_eq!(a.shifted(-1.0 / 24.0), Span::new(0.0, 2.0 - 1.0 / 24.0));
+        assert_eq!(a.overlap(Span::new(0.0, 1.0)), Some(Span::new(1.0 / 24.0, 1.0)));
+        assert_eq!(a.overlap(Span::new(3.0, 4.0)), None);
+        assert_eq!(a.clamp(0.0), 1.0 / 24.0);
+        assert_eq!(Span::new(2.0, 1.0), Span::at(2.0), "a reversed span is empty at its start");
+        assert_eq!(Span::new(f64::NAN, f64::INFINITY), Span::at(0.0));
+    }
+
+    #[test]
+    fn times_read_with_their_frames() {
+        let at = |time, rate| At { time, rate }.to_string();
+        assert_eq!(at(14.0 / 24.0, Some(24.0)), "0.5833 s (frame 14)");
+        assert_eq!(at(0.55, Some(24.0)), "0.5500 s (frame 13.2)");
+        assert_eq!(at(-1.0 / 30.0, Some(30.0)), "-0.0333 s (frame -1)");
+        assert_eq!(at(0.0, Some(30.0)), "0.0000 s (frame 0)");
+        assert_eq!(at(0.5, None), "0.5000 s");
+        assert_eq!(at(0.5, Some(0.0)), "0.5000 s");
+        // A single-precision key time a hair off its frame still reads as the frame.
+        assert_eq!(at(f64::from((11.0f64 / 24.0) as f32), Some(24.0)), "0.4583 s (frame 11)");
+    }
 
     #[test]
     fn every_frame_and_key_when_within_the_limit() {

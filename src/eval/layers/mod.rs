@@ -110,8 +110,8 @@ impl Layers {
         }
         if let Some(b) = &layers.blend {
             let sync = if b.sync {
-                let other = rig.clips.get(b.clip).map_or(0.0, Clip::duration);
-                let cycle = SyncedCycle::new(clip.map_or(0.0, Clip::duration), other, b.weight);
+                let other = length(rig.clips.get(b.clip));
+                let cycle = SyncedCycle::new(length(clip), other, b.weight);
                 format!(", synced: cycle {:.4} s, rates {:.4} and {:.4}", cycle.length, cycle.rates[0], cycle.rates[1])
             } else {
                 String::new()
@@ -256,61 +256,73 @@ impl LayerStack {
     pub fn synced_cycle(&self, rig: &Rig, clip: Option<&Clip>) -> Option<SyncedCycle> {
         let blend = self.layers.blend.filter(|b| b.sync)?;
         let other = rig.clips.get(blend.clip)?;
-        Some(SyncedCycle::new(clip.map_or(0.0, Clip::duration), other.duration(), blend.weight))
+        Some(SyncedCycle::new(length(clip), other.span().length(), blend.weight))
     }
 
-    /// How long the layered timeline runs: the synced cycle, or the main clip until the crossfade has brought the
-    /// incoming clip to its end (the main clip's duration without either).
-    pub fn duration(&self, rig: &Rig, clip: Option<&Clip>) -> f64 {
+    /// How long the layered timeline runs from the main clip's start: the synced cycle, or the main clip until the
+    /// crossfade has brought the incoming clip to its end (the main clip's length without either).
+    pub fn length(&self, rig: &Rig, clip: Option<&Clip>) -> f64 {
         if let Some(cycle) = self.synced_cycle(rig, clip) {
             return cycle.length;
         }
-        let main = clip.map_or(0.0, Clip::duration);
-        let incoming = self.layers.crossfade.and_then(|c| Some(c.at.max(0.0) + rig.clips.get(c.clip)?.duration()));
+        let main = length(clip);
+        let incoming = self.layers.crossfade.and_then(|c| Some(c.at.max(0.0) + rig.clips.get(c.clip)?.span().length()));
         incoming.filter(|end| end.is_finite()).map_or(main, |end| end.max(main))
     }
 
     /// The local pose of every bone of `rig` at `time` with the layers applied, written into `local`. `clip` is
     /// the main clip (`None`: the rest pose); `rig` must be the one the stack was built for.
+    ///
+    /// `time` is on the main clip's clock. The layers count from the main clip's start (a crossfade `at` 1 s begins
+    /// a second after it), and every other clip plays from its own start then: each file's clock is its own, and a
+    /// clip that starts at frame 1 is not played from before its first frame.
     pub fn evaluate(&mut self, rig: &Rig, clip: Option<&Clip>, time: f64, local: &mut Vec<Transform>) {
         let skeleton = &rig.skeleton;
         let time = if time.is_finite() { time } else { 0.0 };
+        let elapsed = time - clip.map_or(0.0, |c| c.span().start);
+        let at = |other: &Clip, elapsed: f64| other.span().start + elapsed;
         let layers = &self.layers;
         let resampling = &layers.interpolation;
-        let [main_time, blend_time] = self.synced_cycle(rig, clip).map_or([time, time], |c| c.clip_times(time));
+        let [main_elapsed, blend_elapsed] =
+            self.synced_cycle(rig, clip).map_or([elapsed, elapsed], |c| c.clip_times(elapsed));
         let [main_hints, blend_hints, additive_hints, incoming_hints] = &mut self.hints;
-        sample(skeleton, clip, main_time, resampling, local, Some(main_hints));
+        sample(skeleton, clip, time - elapsed + main_elapsed, resampling, local, Some(main_hints));
         if !self.bind.is_empty() {
             mix_poses(local, &self.bind, 1.0 - unit_weight(layers.bind_weight), RotationBlend::Slerp);
         }
         if let Some(blend) = &layers.blend
             && let Some(other) = rig.clips.get(blend.clip)
         {
-            sample(skeleton, Some(other), blend_time, resampling, &mut self.scratch, Some(blend_hints));
+            sample(skeleton, Some(other), at(other, blend_elapsed), resampling, &mut self.scratch, Some(blend_hints));
             mix_poses(local, &self.scratch, blend.weight, blend.rotation);
         }
         if let Some(additive) = &layers.additive
             && let Some(other) = rig.clips.get(additive.clip)
         {
-            sample(skeleton, Some(other), time, resampling, &mut self.scratch, Some(additive_hints));
+            sample(skeleton, Some(other), at(other, elapsed), resampling, &mut self.scratch, Some(additive_hints));
             add_poses(local, &self.scratch, &self.reference, additive.weight, additive.order);
         }
         if let Some(crossfade) = &layers.crossfade
             && let Some(incoming) = rig.clips.get(crossfade.clip)
         {
-            let weight = crossfade.weight(time);
+            let weight = crossfade.weight(elapsed);
             if weight > 0.0 {
-                let at = crossfade.incoming_time(time);
-                sample(skeleton, Some(incoming), at, resampling, &mut self.scratch, Some(incoming_hints));
+                let time = at(incoming, crossfade.incoming_time(elapsed));
+                sample(skeleton, Some(incoming), time, resampling, &mut self.scratch, Some(incoming_hints));
                 mix_poses(local, &self.scratch, weight, RotationBlend::Slerp);
             }
         }
         if let Some(shake) = &layers.shake {
-            shake_pose(local, &self.modifiers, &shake.params, time);
+            shake_pose(local, &self.modifiers, &shake.params, elapsed);
         }
         uniform_pose(local, &layers.uniform_scale);
         pin_pose(skeleton, local, &layers.targets, &mut self.chain);
     }
+}
+
+/// How long `clip` plays (0 for the rest pose).
+fn length(clip: Option<&Clip>) -> f64 {
+    clip.map_or(0.0, |c| c.span().length())
 }
 
 /// `clip` sampled at `time` (the rest pose for `None`), the key searches starting from `hints` when given.

@@ -9,8 +9,8 @@
 //! (slerp for rotations), which is what a game runtime given the same keys would do.
 //!
 //! A clip covers its stack's time span (the take's start and stop, which is what DCCs play); keys outside it are
-//! not sampled. Times are the file's, in seconds; a stack that starts before t = 0 is shifted to start at 0 (and
-//! says so). A long stack with sparse keys is thinned between keys ([`sample_times`]), so the samples stay bounded by
+//! not sampled. Times are the file's, in seconds, as stored (a take that starts before 0 or after it starts there:
+//! Blender writes each action's take from 0, Maya a take at its scene frames). A long stack with sparse keys is thinned between keys ([`sample_times`]), so the samples stay bounded by
 //! the keys, and the grid's size is checked against the file's size before anything is evaluated. (The key times are
 //! read from the curves here rather than from `ufbx_bake_anim`, whose run time a hostile file can make unbounded.)
 //!
@@ -33,7 +33,7 @@ use super::channels::{Channels, evaluated_from_own_properties};
 use super::mesh::{blend_channels, shape_weights};
 use super::{Failure, Result, memory_limit, node_name};
 use crate::model::{
-    BoneTracks, Clip, Interpolation, MAX_FRAMES, MorphWeights, SAMPLES_PER_SPARSE_GAP, Track, sample_times,
+    BoneTracks, Clip, Interpolation, MAX_FRAMES, MorphWeights, SAMPLES_PER_SPARSE_GAP, Span, Track, sample_times,
 };
 
 /// Frames per second assumed when the file states none that makes sense.
@@ -116,23 +116,17 @@ impl StackReader<'_> {
             .filter_map(|id| Some((bone_of_node.get(id).copied().flatten()?, id, moving[id])))
             .collect();
         let (begin, end) = self.span(keys.iter().copied());
-        let grid = self.grid(begin, end, keys, animated.len(), notes)?;
-        let shift = if begin < 0.0 { -begin } else { 0.0 };
-        if shift > 0.0 {
-            notes.push(format!("{} starts at t = {begin} s; its clip is shifted to start at 0", self.place()));
-        }
-        let times: Arc<[f64]> = grid.iter().map(|t| t + shift).collect();
-        let sampler =
-            NodeSampler { scene: self.scene, stack: self.index, place: self.place(), grid: &grid, times: &times };
+        let grid: Arc<[f64]> = self.grid(begin, end, keys, animated.len(), notes)?.into();
+        let sampler = NodeSampler { scene: self.scene, stack: self.index, place: self.place(), grid: &grid };
         let tracks = animated
             .par_iter()
             .map(|&(bone, node, moves)| sampler.sample(bone, node, moves))
             .collect::<Result<Vec<_>>>()?;
-        let morph = self.morph_weights(bone_of_node, &channels, &grid, &times)?;
+        let morph = self.morph_weights(bone_of_node, &channels, &grid)?;
         let samples = grid.len() * (tracks.len() + morph.len());
         let name: &str = &self.stack.element.name;
         let clip = Clip::new(self.index, (!name.is_empty()).then(|| name.to_owned()), tracks, morph);
-        Ok((clip.with_frame_rate(self.fps), samples))
+        Ok((clip.with_frame_rate(self.fps).with_span(Span::new(begin, end)), samples))
     }
 
     /// What the stack animates, and every key time of it.
@@ -239,8 +233,7 @@ impl StackReader<'_> {
         &self,
         bone_of_node: &[Option<usize>],
         animated: &[bool],
-        grid: &[f64],
-        times: &Arc<[f64]>,
+        grid: &Arc<[f64]>,
     ) -> Result<Vec<MorphWeights>> {
         let mut morph = Vec::new();
         for node in self.scene.nodes.iter() {
@@ -254,7 +247,7 @@ impl StackReader<'_> {
             let mut weights = Vec::new();
             for channel in channels {
                 let mut shares: Vec<Vec<f32>> = vec![Vec::with_capacity(grid.len()); channel.keyframes.len()];
-                for &time in grid {
+                for &time in grid.iter() {
                     let weight = ufbx::evaluate_blend_weight(&self.stack.anim, channel, time);
                     for (share, value) in shares.iter_mut().zip(shape_weights(channel, weight)) {
                         share.push(value as f32);
@@ -262,7 +255,7 @@ impl StackReader<'_> {
                 }
                 for values in shares {
                     let place = || format!("{}, blend channel `{}`", self.place(), &*channel.element.name);
-                    let track = Track::new(times.clone(), values, Interpolation::Linear)
+                    let track = Track::new(grid.clone(), values, Interpolation::Linear)
                         .map_err(|e| Failure::at(place(), format!("weight: {e}")))?;
                     weights.push(track);
                 }
@@ -280,9 +273,8 @@ struct NodeSampler<'a> {
     stack: usize,
     /// The stack, for errors.
     place: String,
-    grid: &'a [f64],
-    /// The grid as the clip's times.
-    times: &'a Arc<[f64]>,
+    /// The times sampled, which are the clip's key times.
+    grid: &'a Arc<[f64]>,
 }
 
 impl NodeSampler<'_> {
@@ -301,7 +293,7 @@ impl NodeSampler<'_> {
             None => ufbx::evaluate_transform(&stack.anim, node, time),
         };
         let held = if moves { None } else { self.grid.first().map(|&time| evaluate(time)) };
-        for &time in self.grid {
+        for &time in self.grid.iter() {
             let t = held.unwrap_or_else(|| evaluate(time));
             translations.push(Vec3::new(t.translation.x as f32, t.translation.y as f32, t.translation.z as f32));
             rotations.push(Quat::from_xyzw(
@@ -314,7 +306,7 @@ impl NodeSampler<'_> {
         }
         let fail =
             |what: &str, e| Failure::at(format!("{}, node `{}`", self.place, node_name(node)), format!("{what}: {e}"));
-        let times = || self.times.clone();
+        let times = || self.grid.clone();
         let mut tracks = BoneTracks::new(bone);
         tracks.translation =
             Some(Track::new(times(), translations, Interpolation::Linear).map_err(|e| fail("translation", e))?);

@@ -7,7 +7,9 @@
 //! ([`mesh`], [`blend`]).
 //!
 //! UsdSkel has no scale-inheritance modes: every joint inherits its parent fully, so each joint declares `full`.
-//! Times: a time code `t` is at `(t − startTimeCode) / timeCodesPerSecond` seconds. Units and axes: the stage's
+//! Times: a time code `t` is at `t / timeCodesPerSecond` seconds, the stage's own clock (Blender writes frame `f` at
+//! time code `f`, so its frame 1 is at 1/24 s as in its glTF export), and the clip spans the stage's start and end
+//! time codes where it states them. Units and axes: the stage's
 //! `metersPerUnit` (0.01 where unauthored, as USD says) and `upAxis` (Y where unauthored) are converted to Y-up
 //! metres above the roots, like an FBX file's; in the file's own space nothing is converted.
 //!
@@ -27,7 +29,7 @@ use glam::{DMat4, DVec3};
 use openusd::usd::{PrimPredicate, Stage};
 
 use super::{ImportError, Options, Space};
-use crate::model::{Clip, MorphWeights, Placement, Rig, Skeleton, Unit};
+use crate::model::{Clip, MorphWeights, Placement, Rig, Skeleton, Span, Unit};
 use resolver::FolderResolver;
 
 /// USD's `metersPerUnit` where a stage authors none: centimetres.
@@ -82,7 +84,7 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     if !moving.is_empty() {
         animations.push(skeleton::Animation { name: None, tracks: moving });
     }
-    let clips = clip(animations, morph, conversion.timing.codes_per_second).into_iter().collect();
+    let clips = clip(animations, morph, &conversion.timing).into_iter().collect();
     notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
     let skeleton = Skeleton::new(bones).map_err(|e| fail(None, e.to_string()))?;
     let (skeleton, unit) = match options.space {
@@ -93,8 +95,8 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
 }
 
 /// The skeletons' animations (and the tracks of moving nodes), and the blend-shape weights they animate, as one
-/// clip, named after the animation where there is one; `None` for none.
-fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, frame_rate: f64) -> Option<Clip> {
+/// clip over the stage's range, named after the animation where there is one; `None` for none.
+fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, timing: &Timing) -> Option<Clip> {
     let mut named = animations.iter().filter_map(|a| a.name.clone());
     let name = match (named.next(), named.next()) {
         _ if animations.is_empty() => return None,
@@ -102,7 +104,11 @@ fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, frame_ra
         _ => None,
     };
     let tracks = animations.into_iter().flat_map(|a| a.tracks).collect();
-    Some(Clip::new(0, name, tracks, morph).with_frame_rate(frame_rate))
+    let clip = Clip::new(0, name, tracks, morph).with_frame_rate(timing.codes_per_second);
+    Some(match timing.span() {
+        Some(span) => clip.with_span(span),
+        None => clip,
+    })
 }
 
 /// Reads a USD file already in memory: written to a folder of its own first (USD reads layers by path), so any
@@ -154,17 +160,25 @@ fn said(error: impl std::fmt::Display) -> String {
     format!("{error:#}")
 }
 
-/// How the stage's time codes are seconds.
+/// How the stage's time codes are seconds, and which of them it plays.
 #[derive(Clone, Copy, Debug)]
 pub struct Timing {
     pub codes_per_second: f64,
-    /// The time code at 0 s.
+    /// The first time code played: the stage's start time code (0 where it states none).
     pub start: f64,
+    /// The stage's end time code, where it states a range.
+    pub end: Option<f64>,
 }
 
 impl Timing {
     pub fn seconds(&self, code: f64) -> f64 {
-        (code - self.start) / self.codes_per_second
+        code / self.codes_per_second
+    }
+
+    /// The stage's range in seconds, where it states one.
+    fn span(&self) -> Option<Span> {
+        let end = self.end.filter(|end| *end >= self.start)?;
+        Some(Span::new(self.seconds(self.start), self.seconds(end)))
     }
 }
 
@@ -185,9 +199,10 @@ impl Conversion {
         };
         let z_up = matches!(meta("upAxis"), Some(openusd::sdf::Value::Token(axis)) if axis.as_str() == "Z");
         let codes_per_second = Some(stage.time_codes_per_second()).filter(|r| *r > 0.0 && r.is_finite());
-        let start = if stage.has_authored_time_code_range() { stage.start_time_code() } else { 0.0 };
-        let start = if start.is_finite() { start } else { 0.0 };
-        let timing = Timing { codes_per_second: codes_per_second.unwrap_or(24.0), start };
+        let authored = stage.has_authored_time_code_range();
+        let start = Some(stage.start_time_code()).filter(|s| authored && s.is_finite()).unwrap_or(0.0);
+        let end = Some(stage.end_time_code()).filter(|e| authored && e.is_finite());
+        let timing = Timing { codes_per_second: codes_per_second.unwrap_or(24.0), start, end };
         Conversion { meters_per_unit, z_up, timing }
     }
 
@@ -202,7 +217,7 @@ impl Conversion {
         let up = if self.z_up { "Z up" } else { "Y up" };
         let unit = Unit::metres(self.meters_per_unit).map_or_else(|| "no unit".to_owned(), |u| u.to_string());
         let timing = &self.timing;
-        let time = format!("time code t at (t − {}) / {} s", timing.start, timing.codes_per_second);
+        let time = format!("time code t at t / {} s", timing.codes_per_second);
         match space {
             Space::YUpMetres => {
                 format!("units and axes: in the file {up}, {unit}; converted to Y-up metres above the roots; {time}")
