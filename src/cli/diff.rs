@@ -108,6 +108,29 @@ fn never_together(animation: &AnimationDiff) -> String {
     )
 }
 
+/// The frame conventions found, one line for each (bones that share one listed together): what was taken out of the
+/// probes, orientations and scales.
+fn conventions(animation: &AnimationDiff) -> Vec<String> {
+    let mut groups: Vec<(String, Vec<&str>)> = Vec::new();
+    for bone in &animation.bones {
+        let Some(c) = &bone.convention else { continue };
+        let turn = format!("turned {:.2}° about ({:.3}, {:.3}, {:.3})", c.turn_deg, c.axis.x, c.axis.y, c.axis.z);
+        let scaled =
+            if (c.scale_ratio - 1.0).abs() > 1e-6 { format!(", scaled {:.6}×", c.scale_ratio) } else { String::new() };
+        let what = format!("{turn}{scaled}");
+        match groups.iter_mut().find(|(w, _)| *w == what) {
+            Some((_, bones)) => bones.push(&bone.name),
+            None => groups.push((what, vec![&bone.name])),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(what, bones)| {
+            format!("frames of B {what} from A's (the files' conventions, taken out): {}", bones.join(", "))
+        })
+        .collect()
+}
+
 /// What to say of two clips' clocks: how far apart their starts are where nothing aligned them, or how B was moved.
 fn clocks_note(animation: &AnimationDiff) -> Option<String> {
     let gap = animation.span_a.start - animation.span_b.start;
@@ -247,6 +270,9 @@ pub(super) fn render_animation(animation: &AnimationDiff) -> String {
     if !animation.meshes.is_empty() {
         out.push_str(&mesh_differences(&animation.meshes, animation.rig_size).to_string());
     }
+    for line in conventions(animation) {
+        out.push_str(&format!("  {line}\n"));
+    }
     if !animation.only_a.is_empty() {
         out.push_str(&format!("  bones only in A: {}\n", animation.only_a.join(", ")));
     }
@@ -255,6 +281,14 @@ pub(super) fn render_animation(animation: &AnimationDiff) -> String {
     }
     if animation.helpers > 0 {
         out.push_str(&format!("  {} bake helper nodes (`*.stretch`) left out\n", animation.helpers));
+    }
+    for (side, nodes) in [("A", &animation.skinned_a), ("B", &animation.skinned_b)] {
+        if !nodes.is_empty() {
+            out.push_str(&format!(
+                "  skinned meshes' nodes of {side} left out (their skins follow the joints): {}\n",
+                nodes.join(", ")
+            ));
+        }
     }
     for (side, nodes) in [("A", &animation.conversion_a), ("B", &animation.conversion_b)] {
         if !nodes.is_empty() {

@@ -1,8 +1,13 @@
 //! Which bone, mesh and clip of one file is which of another's.
 //!
-//! Bones are matched by name in three passes, each over what the earlier ones left: the user's explicit pairs
-//! (`--map a=b`), exact names, then names compared without case and without a namespace prefix (`mixamorig:Hips`,
-//! `Armature|Hips` and `hips` are one name). Repeated names pair up in file order. The helper nodes a bake inserts
+//! Bones are matched by name in four passes, each over what the earlier ones left: the user's explicit pairs
+//! (`--map a=b`), exact names, names compared without case and without a namespace prefix (`mixamorig:Hips`,
+//! `Armature|Hips` and `hips` are one name), then names as USD must spell them, every character that is not a
+//! letter, digit or `_` made `_` (Blender's `Bone.001` is `Bone_001` in its USD export). Names pair only within one
+//! kind of node ([`Kind`]): Blender names a mesh object parented to a bone after the bone, and the mesh is not the
+//! joint. Repeated names pair up in file order. The node of a skinned mesh is no bone either: its vertices follow
+//! the skin's joints, wherever the exporter put the node (Blender's glb puts it at the armature, its FBX where the
+//! object stood), so it is left out and the skin is compared instead. The helper nodes a bake inserts
 //! (`<name>.stretch`, whose child is the bone `<name>`) are not bones of the rig and are left out of both sides, and
 //! so are conversion nodes ([`Rig::conversion_nodes`]): whatever their names, they only state a file's axes and
 //! unit, which the bones below them already carry into model space.
@@ -10,7 +15,7 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use super::DiffError;
-use crate::model::{Clip, Mesh, Rig, Skeleton, UpAxis};
+use crate::model::{Clip, Mesh, NodeRole, Rig, Skeleton, UpAxis};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
 pub const HELPER_SUFFIX: &str = ".stretch";
@@ -28,6 +33,25 @@ pub struct BoneMatching {
     /// The conversion nodes of each side, left out, in bone order.
     pub conversion_a: Vec<usize>,
     pub conversion_b: Vec<usize>,
+    /// The nodes of each side's skinned meshes, left out, in bone order.
+    pub skinned_a: Vec<usize>,
+    pub skinned_b: Vec<usize>,
+}
+
+/// For each bone, whether it is the node of a skinned mesh (and nothing else: no joint of a skin).
+fn skinned_nodes(rig: &Rig) -> Vec<bool> {
+    let mut skinned = vec![false; rig.skeleton.len()];
+    for mesh in rig.meshes.iter().filter(|m| m.skin.is_some()) {
+        if let Some(node) = skinned.get_mut(mesh.bone) {
+            *node = true;
+        }
+    }
+    for joint in rig.skins.iter().flat_map(|s| &s.joints) {
+        if let Some(node) = skinned.get_mut(*joint) {
+            *node = false;
+        }
+    }
+    skinned
 }
 
 /// For each bone, whether it is a bake's helper node: named `<name>.stretch` with a child named `<name>`.
@@ -47,6 +71,35 @@ pub fn helpers(skeleton: &Skeleton) -> Vec<bool> {
 /// The name without case and without a namespace prefix (everything up to the last `:` or `|`).
 pub fn loose_name(name: &str) -> String {
     name.rsplit([':', '|']).next().unwrap_or(name).to_lowercase()
+}
+
+/// The loose name as a USD identifier spells it: every character but ASCII letters, digits and `_` made `_`, and
+/// `_` before a leading digit.
+pub fn usd_name(name: &str) -> String {
+    let loose = loose_name(name);
+    let spelled: String = loose.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+    if spelled.starts_with(|c: char| c.is_ascii_digit()) { format!("_{spelled}") } else { spelled }
+}
+
+/// What a node is for pairing: names pair only within one kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Kind {
+    /// Joints, end sites and the nodes that carry them (a null, an armature).
+    Transform,
+    Mesh,
+    Camera,
+    Light,
+}
+
+impl Kind {
+    fn of(role: NodeRole) -> Kind {
+        match role {
+            NodeRole::Mesh => Kind::Mesh,
+            NodeRole::Camera => Kind::Camera,
+            NodeRole::Light => Kind::Light,
+            NodeRole::Joint | NodeRole::EndSite | NodeRole::Helper => Kind::Transform,
+        }
+    }
 }
 
 /// Pairs the bones of `a` and `b` by name (see the module's documentation).
@@ -84,10 +137,12 @@ struct Unmatched<'s> {
     helpers: usize,
     conversion_a: Vec<usize>,
     conversion_b: Vec<usize>,
+    skinned_a: Vec<usize>,
+    skinned_b: Vec<usize>,
 }
 
 impl<'s> Unmatched<'s> {
-    /// Every bone of both but the helper and conversion nodes.
+    /// Every bone of both but the helper, conversion and skinned meshes' nodes.
     fn new(a: &'s Rig, b: &'s Rig) -> Self {
         let (helpers_a, helpers_b) = (helpers(&a.skeleton), helpers(&b.skeleton));
         let helpers = [&helpers_a, &helpers_b].iter().map(|h| h.iter().filter(|&&h| h).count()).sum();
@@ -100,6 +155,8 @@ impl<'s> Unmatched<'s> {
         };
         let (conversion_a, left_a) = split(&apart(a, &nodes_a, b, &nodes_b), &helpers_a);
         let (conversion_b, left_b) = split(&apart(b, &nodes_b, a, &nodes_a), &helpers_b);
+        let (skinned_a, left_a) = apart_from(left_a, &skinned_nodes(a));
+        let (skinned_b, left_b) = apart_from(left_b, &skinned_nodes(b));
         Unmatched {
             a: &a.skeleton,
             b: &b.skeleton,
@@ -109,16 +166,18 @@ impl<'s> Unmatched<'s> {
             helpers,
             conversion_a,
             conversion_b,
+            skinned_a,
+            skinned_b,
         }
     }
 
-    /// The bones left paired by exact name, then by loose name.
+    /// The bones left paired by exact name, then by loose name, then as USD spells them, each within its kind.
     fn by_name(mut self) -> BoneMatching {
         let (a, b) = (self.a, self.b);
-        let exact = |s: &Skeleton, i: usize| s.bone(i).name.clone();
-        pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, exact);
-        let loose = |s: &Skeleton, i: usize| loose_name(&s.bone(i).name);
-        pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, loose);
+        for spelling in [str::to_owned, loose_name, usd_name] {
+            let key = |s: &Skeleton, i: usize| (Kind::of(s.bone(i).role), spelling(&s.bone(i).name));
+            pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, key);
+        }
         self.pairs.sort_unstable();
         BoneMatching {
             pairs: self.pairs,
@@ -127,6 +186,8 @@ impl<'s> Unmatched<'s> {
             helpers: self.helpers,
             conversion_a: self.conversion_a,
             conversion_b: self.conversion_b,
+            skinned_a: self.skinned_a,
+            skinned_b: self.skinned_b,
         }
     }
 }
@@ -138,17 +199,22 @@ fn split(conversion: &[bool], helper: &[bool]) -> (Vec<usize>, Vec<usize>) {
     (conversion, pair)
 }
 
+/// The bones of `left` that are `flagged`, and the others.
+fn apart_from(left: Vec<usize>, flagged: &[bool]) -> (Vec<usize>, Vec<usize>) {
+    left.into_iter().partition(|&i| flagged[i])
+}
+
 /// Pairs the bones left on each side whose `key` agrees, the k-th of a key in A with the k-th in B, and removes
 /// them from what is left.
-fn pair_by_key(
+fn pair_by_key<K: std::hash::Hash + Eq>(
     a: &Skeleton,
     b: &Skeleton,
     left_a: &mut Vec<usize>,
     left_b: &mut Vec<usize>,
     pairs: &mut Vec<(usize, usize)>,
-    key: impl Fn(&Skeleton, usize) -> String,
+    key: impl Fn(&Skeleton, usize) -> K,
 ) {
-    let mut by_key: HashMap<String, VecDeque<usize>> = HashMap::new();
+    let mut by_key: HashMap<K, VecDeque<usize>> = HashMap::new();
     for &j in left_b.iter() {
         by_key.entry(key(b, j)).or_default().push_back(j);
     }
@@ -287,6 +353,34 @@ mod tests {
         assert_eq!(pairs, [(0, 1), (1, 0), (2, 2)]);
         assert!(only_a.is_empty());
         assert_eq!(only_b, [3]);
+    }
+
+    #[test]
+    fn joints_pair_with_joints_and_meshes_with_meshes_each_once() {
+        // Blender's glb and FBX both name a mesh object parented to the bone `Foot.L` after it.
+        let with_roles = |roles: [NodeRole; 3], parents: [Option<usize>; 3]| {
+            let names = ["Hips", "Foot.L", "Foot.L"];
+            let mut r = rig(&names.into_iter().zip(parents).collect::<Vec<_>>());
+            let bones = r.skeleton.bones().iter().zip(roles).map(|(b, role)| Bone { role, ..b.clone() });
+            r.skeleton = Skeleton::new(bones.collect()).unwrap();
+            r
+        };
+        // A: the joint, then the mesh object hanging from it; B: the mesh object first, beside the joint.
+        let a = with_roles([NodeRole::Joint, NodeRole::Joint, NodeRole::Mesh], [None, Some(0), Some(1)]);
+        let b = with_roles([NodeRole::Joint, NodeRole::Mesh, NodeRole::Joint], [None, Some(0), Some(0)]);
+        let m = match_bones(&a, &b);
+        assert_eq!(m.pairs, [(0, 0), (1, 2), (2, 1)], "the joint with the joint, the mesh with the mesh");
+        assert!(m.only_a.is_empty() && m.only_b.is_empty());
+    }
+
+    #[test]
+    fn usd_spelling_pairs_last() {
+        let a = rig(&[("Bone", None), ("Bone.001", Some(0)), ("2nd-arm", Some(1)), ("Bone_001", None)]);
+        let b = rig(&[("Bone", None), ("Bone_001", Some(0)), ("_2nd_arm", Some(1)), ("Bone_001", None)]);
+        let m = match_bones(&a, &b);
+        assert_eq!(m.pairs, [(0, 0), (1, 3), (2, 2), (3, 1)], "the exact `Bone_001` first, then the spellings");
+        assert_eq!(usd_name("mixamorig:Left Hand.001"), "left_hand_001");
+        assert_eq!(usd_name("3d"), "_3d");
     }
 
     #[test]

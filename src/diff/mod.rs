@@ -12,6 +12,13 @@
 //! - **scale**: the largest ratio between corresponding stretch factors `K` (sorted, so the frame does not matter);
 //! - **stretch**: the angle between the two stretch frames `U`, ignoring turns that leave `U·K·Uᵀ` the same.
 //!
+//! Two files need not give a bone the same frame: exporters choose their own axes for a node (Blender's FBX turns
+//! every object a quarter about X, its glTF export does not), and BVH gives its joints none. Where the pairs are
+//! compared [`Frames::UpToConvention`], the constant map between each pair's frames is found at the first time
+//! compared (`M = L_b⁻¹·L_a` of the two linear parts there), reported once ([`Convention`]), and B's matrix is read
+//! in A's frame (`W_b·M`) from then on: the probe points, orientations, scales and stretches measure what moves, and
+//! the origins and the skin are as they are.
+//!
 //! Meshes are paired by name and vertex count; each pair is skinned on both sides and the vertex distances kept
 //! (largest, and mean over every vertex and time). Every largest value comes with the first time it happens.
 //!
@@ -29,7 +36,7 @@ pub use report::{Align, AnimationDiff, Clips, FileDiff, FileSide, MissingClip, c
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use glam::{DMat4, DQuat, DVec3};
+use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
 use crate::eval::skinning::Skinner;
@@ -51,9 +58,9 @@ pub struct Extreme {
 }
 
 impl Extreme {
-    /// Starting from `floor` (no difference) at t = 0.
-    fn from(floor: f64) -> Self {
-        Extreme { max: floor, time: 0.0 }
+    /// Starting from `floor` (no difference) at `time`, the first time compared.
+    fn from(floor: f64, time: f64) -> Self {
+        Extreme { max: floor, time }
     }
 
     fn add(&mut self, value: f64, time: f64) {
@@ -90,20 +97,57 @@ pub struct BoneDifference {
     pub scale_ratio: Extreme,
     /// Angle between the stretch frames, degrees.
     pub stretch_deg: Extreme,
+    /// How B's frame differs from A's at the first time compared, taken out of everything above but the position,
+    /// where the pairs are compared up to conventions and it differs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub convention: Option<Convention>,
 }
 
+/// The constant map between a pair's frames: B's axes against A's at the first time compared (two exporters' axis
+/// conventions, a joint that BVH gives no orientation).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Convention {
+    /// The turn's angle, degrees, and its axis in B's frame.
+    pub turn_deg: f64,
+    pub axis: DVec3,
+    /// The largest ratio between the two frames' scale factors (1: one scale).
+    pub scale_ratio: f64,
+}
+
+impl Convention {
+    /// B's frame against A's, from the `map` that reads B's in A's ([`FrameMaps`]: B's is A's times its inverse),
+    /// where they differ by more than rounding.
+    fn of(map: &DMat4) -> Option<Self> {
+        let parts = decompose(&map.inverse());
+        let (axis, angle) = parts.rotation.to_axis_angle();
+        let turn_deg = angle.to_degrees();
+        let scale_ratio = scale_ratio(parts.scale, DVec3::ONE);
+        let turned = turn_deg > CONVENTION_DEG || (scale_ratio - 1.0).abs() > CONVENTION_SCALE;
+        turned.then_some(Convention { turn_deg, axis, scale_ratio })
+    }
+}
+
+/// The smallest turn between two frames reported as a convention, degrees.
+const CONVENTION_DEG: f64 = 1e-3;
+
+/// The smallest difference of scale between two frames reported as a convention.
+const CONVENTION_SCALE: f64 = 1e-6;
+
 impl BoneDifference {
-    fn new(a: usize, b: usize, name: &str, name_b: &str) -> Self {
+    /// No difference yet, from `start`, the first time compared.
+    fn new((a, b): (usize, usize), (name, name_b): (&str, &str), start: f64) -> Self {
+        let none = Extreme::from(0.0, start);
         BoneDifference {
             a,
             b,
             name: name.to_owned(),
             name_b: (name != name_b).then(|| name_b.to_owned()),
-            position: Extreme::default(),
-            probe: Extreme::default(),
-            orientation_deg: Extreme::default(),
-            scale_ratio: Extreme::from(1.0),
-            stretch_deg: Extreme::default(),
+            position: none,
+            probe: none,
+            orientation_deg: none,
+            scale_ratio: Extreme::from(1.0, start),
+            stretch_deg: none,
+            convention: None,
         }
     }
 
@@ -147,6 +191,18 @@ pub struct Pairs {
     pub bones: BoneMatching,
     pub meshes: Vec<MeshPair>,
     pub measure: Measure,
+    pub frames: Frames,
+}
+
+/// How a pair of bones' frames are compared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Frames {
+    /// As they are: both sides should give each bone one frame (a bake and its source, a rig under two modes).
+    #[default]
+    Same,
+    /// Up to the constant map between them at the first time compared: two files, whose exporters may choose each
+    /// node's axes ([`Convention`]).
+    UpToConvention,
 }
 
 /// What a comparison measures of each pair of bones.
@@ -197,18 +253,19 @@ impl Pairs {
         a.size_of(times, &shown_a, &meshes_a).max(b.size_of(times, &shown_b, &meshes_b))
     }
 
-    /// Bones by name and meshes by name and vertex count.
+    /// Bones by name and meshes by name and vertex count, their frames compared as they are.
     pub fn by_name(a: &Evaluation, b: &Evaluation) -> Self {
         let bones = match_bones(a.rig, b.rig);
         let meshes = match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect();
-        Pairs { bones, meshes, measure: Measure::Everything }
+        Pairs { bones, meshes, measure: Measure::Everything, frames: Frames::Same }
     }
 
-    /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones.
-    pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
+    /// Two files' bones and meshes paired as [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`),
+    /// which must name bones; their frames compared up to their exporters' conventions.
+    pub fn of_files(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
         let bones = match_bones_mapped(a.rig, b.rig, map)?;
         let meshes = match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect();
-        Ok(Pairs { bones, meshes, measure: Measure::Everything })
+        Ok(Pairs { bones, meshes, measure: Measure::Everything, frames: Frames::UpToConvention })
     }
 }
 
@@ -377,7 +434,10 @@ fn compare_sides<B: Beside>(
     let reaches: Vec<Vec<Option<Reach>>> = sides.iter().map(|&(b, pairs, _)| reaches(a, b, pairs)).collect();
     let fresh = || {
         let sides = sides.iter().zip(&reaches);
-        sides.map(|(&(b, pairs, _), reaches)| Differences::new(a, b, pairs, reaches, rig_size)).collect::<Vec<_>>()
+        let start = times.first().copied().unwrap_or_default();
+        sides
+            .map(|(&(b, pairs, _), reaches)| Differences::new(a, b, pairs, reaches, (rig_size, start)))
+            .collect::<Vec<_>>()
     };
     let plan_a = Plan::new(
         a,
@@ -406,6 +466,15 @@ fn compare_sides<B: Beside>(
         let hanging_from: Vec<usize> = variants.iter().flatten().filter_map(|v| a.skeleton().parent(v.top)).collect();
         (a.skeleton().with_ancestors(&bones), hanging_from)
     });
+    // Each side's map from B's frames onto A's, found once at the first time (by bone of B; none where compared as is).
+    let frames: Vec<FrameMaps> = sides
+        .iter()
+        .zip(&plans)
+        .map(|(&(_, pairs, _), plan)| match (pairs.frames, times.first()) {
+            (Frames::UpToConvention, Some(&first)) => FrameMaps::at(&plan_a, plan, &pairs.bones.pairs, first),
+            _ => FrameMaps::default(),
+        })
+        .collect();
     // A side given up in one run is given up: its comparison is `None` whatever the other runs find, so they stop it.
     let given_up: Vec<AtomicBool> = sides.iter().map(|_| AtomicBool::new(false)).collect();
     let runs = over_runs(times, |run| {
@@ -417,9 +486,13 @@ fn compare_sides<B: Beside>(
         let mut others: Vec<Side> = plans
             .iter()
             .zip(&variants)
-            .map(|(plan, variant)| match variant {
-                Some(variant) => Side::new(plan, Posing::variant(variant.clone(), plan)),
-                None => Side::alone(plan),
+            .zip(&frames)
+            .map(|((plan, variant), frames)| {
+                let side = match variant {
+                    Some(variant) => Side::new(plan, Posing::variant(variant.clone(), plan)),
+                    None => Side::alone(plan),
+                };
+                side.in_frames(frames)
             })
             .collect();
         let mut differences = fresh();
@@ -462,8 +535,44 @@ fn compare_sides<B: Beside>(
         let meshes = found.meshes.into_iter().map(mean).collect();
         Some(Comparison { samples: times.len(), rig_size, bones: found.bones, meshes })
     };
-    let compared = totals.unwrap_or_else(fresh).into_iter().zip(sides).map(finish).collect();
+    let totals = totals.unwrap_or_else(fresh).into_iter().zip(&frames).map(|(mut found, frames)| {
+        for bone in &mut found.bones {
+            bone.convention = frames.maps.get(bone.b).and_then(Convention::of);
+        }
+        found
+    });
+    let compared = totals.zip(sides).map(finish).collect();
     Some((compared, kept.into_iter().flatten().collect()))
+}
+
+/// How side B's frames are read in A's: per bone of B, the map `M = L_b⁻¹·L_a` of the linear parts of both model
+/// matrices at the first time compared (the identity where unpaired, or where B's cannot be inverted), and the
+/// partner's length scale ([`Evaluation::length_scales`]).
+#[derive(Default)]
+struct FrameMaps {
+    maps: Vec<DMat4>,
+    length_scales: Vec<f64>,
+}
+
+impl FrameMaps {
+    fn at(plan_a: &Plan, plan_b: &Plan, pairs: &[(usize, usize)], time: f64) -> Self {
+        let (mut a, mut b) = (Side::alone(plan_a), Side::alone(plan_b));
+        a.evaluate(time);
+        b.evaluate(time);
+        let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
+        let mut maps = vec![DMat4::IDENTITY; model_b.len()];
+        let mut length_scales = b.length_scales.clone();
+        for &(i, j) in pairs {
+            let linear = |m: &DMat4| DMat4::from_mat3(DMat3::from_mat4(*m));
+            let (la, lb) = (linear(&model_a[i]), linear(&model_b[j]));
+            let map = lb.inverse() * la;
+            if lb.determinant() != 0.0 && map.is_finite() {
+                maps[j] = map;
+                length_scales[j] = a.length_scales[i];
+            }
+        }
+        FrameMaps { maps, length_scales }
+    }
 }
 
 /// The differences found over some of the times.
@@ -482,13 +591,20 @@ struct Differences<'p> {
 }
 
 impl<'p> Differences<'p> {
-    fn new(a: &Evaluation, b: &Evaluation, pairs: &'p Pairs, reaches: &'p [Option<Reach>], rig_size: f64) -> Self {
+    /// No difference yet between the pairs, of a rig of `rig_size`, from `start`, the first time compared.
+    fn new(
+        a: &Evaluation,
+        b: &Evaluation,
+        pairs: &'p Pairs,
+        reaches: &'p [Option<Reach>],
+        (rig_size, start): (f64, f64),
+    ) -> Self {
         let (sa, sb) = (&a.rig.skeleton, &b.rig.skeleton);
-        let bones =
-            pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new(i, j, &sa.bone(i).name, &sb.bone(j).name));
+        let names = |i: usize, j: usize| (sa.bone(i).name.as_str(), sb.bone(j).name.as_str());
+        let bones = pairs.bones.pairs.iter().map(|&(i, j)| BoneDifference::new((i, j), names(i, j), start));
         let meshes = pairs.meshes.iter().map(|pair| {
             let mesh = &a.rig.meshes[pair.a];
-            let (distance, sum) = (Extreme::default(), 0.0);
+            let (distance, sum) = (Extreme::from(0.0, start), 0.0);
             let vertices = pair.vertices.as_ref().map_or(mesh.positions.len(), Vec::len);
             MeshDifference { a: pair.a, b: pair.b, name: mesh.name.clone(), vertices, distance, mean: 0.0, sum }
         });
@@ -507,7 +623,7 @@ impl<'p> Differences<'p> {
     fn add(&mut self, a: &mut Side, b: &mut Side, probe_length: f64, time: f64) {
         let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
         for difference in &mut self.bones {
-            let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
+            let (wa, wb) = (&model_a[difference.a], &b.in_a_frame(model_b, difference.b));
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
             let probe = probe_distance(wa, wb, probe_length);
             difference.probe.add(probe, time);
@@ -647,6 +763,8 @@ struct Side<'e, 'a> {
     plan: &'e Plan<'a>,
     parts: Vec<AffineParts>,
     length_scales: Vec<f64>,
+    /// Per bone, the map that reads its frame in its partner's ([`frame_maps`]); empty where read as it is.
+    frames: &'e [DMat4],
     /// Per mesh, what skins the vertices the plan compares (`None` for a mesh not compared), where they are, and
     /// whether they are skinned at the time evaluated.
     skinners: Vec<Option<Skinner>>,
@@ -702,7 +820,24 @@ impl<'e, 'a> Side<'e, 'a> {
         let skinned = vec![Vec::new(); skinners.len()];
         let fresh = vec![false; skinners.len()];
         let length_scales = plan.evaluation.length_scales();
-        Side { posing, plan, parts: Vec::new(), length_scales, skinners, skinned, fresh }
+        Side { posing, plan, parts: Vec::new(), length_scales, frames: &[], skinners, skinned, fresh }
+    }
+
+    /// The same side with its frames read in its partner's through `frames` ([`frame_maps`]), and so its scales
+    /// authored as its partner's are (over the unit conversion above the partner).
+    fn in_frames(self, frames: &'e FrameMaps) -> Self {
+        match frames.maps.is_empty() {
+            true => self,
+            false => Side { frames: &frames.maps, length_scales: frames.length_scales.clone(), ..self },
+        }
+    }
+
+    /// The model matrix of `bone` among `model` (the side's pose) in its partner's frame.
+    fn in_a_frame(&self, model: &[DMat4], bone: usize) -> DMat4 {
+        match self.frames.get(bone) {
+            Some(map) => model[bone] * *map,
+            None => model[bone],
+        }
     }
 
     /// Evaluates the side's bones at `time` (its meshes are skinned when asked: [`Side::skin`]); a variant is
@@ -736,9 +871,18 @@ impl<'e, 'a> Side<'e, 'a> {
 
     /// What follows an evaluation: the compared bones' polar parts where asked for, no mesh skinned yet.
     fn evaluated(&mut self) {
-        let pose = self.posing.pose();
+        let model = &self.posing.pose().model.model;
         if self.plan.decompose {
-            self.parts = decompose_bones(&pose.model.model, &self.plan.bones);
+            self.parts = match self.frames {
+                [] => decompose_bones(model, &self.plan.bones),
+                _ => {
+                    let mut parts = vec![AffineParts::IDENTITY; model.len()];
+                    for &bone in &self.plan.bones {
+                        parts[bone] = decompose(&self.in_a_frame(model, bone));
+                    }
+                    parts
+                }
+            };
             for &bone in &self.plan.bones {
                 self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
             }
@@ -861,7 +1005,9 @@ mod tests {
         let rig = demo_rig();
         let side = Evaluation::declared(&rig, rig.clips.first());
         let pairs = Pairs::by_name(&side, &side);
-        assert_eq!(pairs.bones.pairs.len(), rig.skeleton.len());
+        // Every node is paired but the skinned mesh's, whose skin is compared instead.
+        assert_eq!(pairs.bones.skinned_a.len(), 1);
+        assert_eq!(pairs.bones.pairs.len() + pairs.bones.skinned_a.len(), rig.skeleton.len());
         let times = comparison_times(&side, &side, 30.0);
         let comparison = compare(&side, &side, &pairs, &times);
         assert_eq!(comparison.samples, times.len());
@@ -871,6 +1017,66 @@ mod tests {
             assert_eq!(bone.scale_ratio.max, 1.0);
         }
         assert_eq!(comparison.meshes.len(), rig.meshes.len());
+    }
+
+    /// The demo rig's bones with every frame turned a quarter about X (`W·Q`), as another exporter might give them:
+    /// a root's local transform times `Q`, every other's `Q⁻¹·L·Q` (its scale's Y and Z swapped), its clip's keys
+    /// likewise (the maps are linear, so cubic tangents map as values do); no meshes.
+    fn turned_demo() -> Rig {
+        use crate::model::{Clip, Track};
+        let rig = demo_rig();
+        let q = DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        let swap = |s: DVec3| DVec3::new(s.x, s.z, s.y);
+        let roots: Vec<bool> = rig.skeleton.bones().iter().map(|b| b.parent.is_none()).collect();
+        let turn = |bone: usize, r: DQuat| if roots[bone] { r * q } else { q.inverse() * r * q };
+        let carry = |bone: usize, t: DVec3| if roots[bone] { t } else { q.inverse() * t };
+        let bones = rig.skeleton.bones().iter().enumerate().map(|(i, b)| {
+            let rest = Transform::from_trs(carry(i, b.rest.translation), turn(i, b.rest.rotation), swap(b.rest.scale));
+            Bone { rest, ..b.clone() }
+        });
+        let remap = |clip: &Clip| {
+            let tracks = clip.tracks().iter().map(|t| {
+                let mut out = t.clone();
+                let values = |track: &Track<glam::Vec3>, f: &dyn Fn(DVec3) -> DVec3| {
+                    let values: Vec<glam::Vec3> = track.values().iter().map(|v| f(v.as_dvec3()).as_vec3()).collect();
+                    Track::new(track.times().into(), values, track.interpolation()).unwrap()
+                };
+                out.translation = t.translation.as_ref().map(|tr| values(tr, &|v| carry(t.bone, v)));
+                out.scale = t.scale.as_ref().map(|tr| values(tr, &swap));
+                out.rotation = t.rotation.as_ref().map(|tr| {
+                    let values: Vec<glam::Quat> =
+                        tr.values().iter().map(|r| turn(t.bone, r.as_dquat()).as_quat()).collect();
+                    Track::new(tr.times().into(), values, tr.interpolation()).unwrap()
+                });
+                out
+            });
+            Clip::new(clip.index, clip.name.clone(), tracks.collect(), vec![])
+        };
+        let skeleton = Skeleton::new(bones.collect()).unwrap();
+        Rig { skeleton, clips: rig.clips.iter().map(remap).collect(), skins: vec![], meshes: vec![], ..rig }
+    }
+
+    #[test]
+    fn a_turn_of_every_frame_is_a_convention_reported_once_and_taken_out() {
+        let (rig, turned) = (demo_rig(), turned_demo());
+        let (a, b) = (every_bone(&rig, InheritMode::Full), every_bone(&turned, InheritMode::Full));
+        let times = comparison_times(&a, &b, 30.0);
+        // The turn is real: each frame is W·Q, the origins where they were.
+        let (wa, wb) = (a.pose_at(0.7).model.model, b.pose_at(0.7).model.model);
+        let q = DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        assert!(wa.iter().zip(&wb).all(|(x, y)| (*x * q).abs_diff_eq(*y, 1e-6)));
+        let as_is = compare(&a, &b, &Pairs::by_name(&a, &b), &times);
+        let up_to = compare(&a, &b, &Pairs::of_files(&a, &b, &[]).unwrap(), &times);
+        for (same, conventional) in as_is.bones.iter().zip(&up_to.bones) {
+            assert!((same.orientation_deg.max - 90.0).abs() < 1e-4, "{same:?}");
+            assert!(same.convention.is_none());
+            let c = conventional.convention.expect("every frame turned");
+            assert!((c.turn_deg - 90.0).abs() < 1e-4 && c.axis.abs_diff_eq(DVec3::X, 1e-6), "{c:?}");
+            assert!((c.scale_ratio - 1.0).abs() < 1e-9, "a turn, no scale: {c:?}");
+            assert!(conventional.orientation_deg.max < 1e-4, "{conventional:?}");
+            assert!(conventional.probe.max < 1e-6, "the points of each frame, each in its own pose: {conventional:?}");
+            assert_eq!(conventional.position, same.position, "origins are compared as they are");
+        }
     }
 
     /// The demo's clip with every bone under `mode`.

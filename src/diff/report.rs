@@ -137,6 +137,9 @@ pub struct AnimationDiff {
     /// Conversion nodes, left out: nodes that only state the file's axes and unit.
     pub conversion_a: Vec<String>,
     pub conversion_b: Vec<String>,
+    /// Nodes of skinned meshes, left out: their skins are compared.
+    pub skinned_a: Vec<String>,
+    pub skinned_b: Vec<String>,
 }
 
 /// The whole comparison.
@@ -189,7 +192,7 @@ pub fn diff_files<'a>(
             let (span_a, span_b) = (side_a.span(), side_b.span());
             let delay_b = align.delay(span_a, span_b);
             let side_b = side_b.delayed(delay_b);
-            let pairs = Pairs::mapped(&side_a, &side_b, map)?;
+            let pairs = Pairs::of_files(&side_a, &side_b, map)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
             Ok(AnimationDiff {
@@ -207,6 +210,8 @@ pub fn diff_files<'a>(
                 helpers: pairs.bones.helpers,
                 conversion_a: names(a.rig, &pairs.bones.conversion_a),
                 conversion_b: names(b.rig, &pairs.bones.conversion_b),
+                skinned_a: names(a.rig, &pairs.bones.skinned_a),
+                skinned_b: names(b.rig, &pairs.bones.skinned_b),
                 bones: comparison.bones,
                 meshes: comparison.meshes,
             })

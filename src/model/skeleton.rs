@@ -109,6 +109,9 @@ impl Placement {
     }
 }
 
+/// How close to 1 a top-level node's model scale must be for its own scale to count as undoing the unit.
+const UNIT_UNDONE: f64 = 1e-6;
+
 /// The uniform scale of a similarity `m`: the cube root of its determinant's size.
 fn uniform_scale(m: &glam::DMat4) -> f64 {
     m.determinant().abs().cbrt()
@@ -170,7 +173,10 @@ impl Skeleton {
     }
 
     /// Per bone, the uniform scale of the conversion above it at rest (1 where none): what its model matrix's scale
-    /// factors are divided by to be the ones the file's author set, in the file's unit.
+    /// factors are divided by to be the ones the file's author set, in the file's unit. A top-level node whose own
+    /// uniform scale undoes the unit (its model scale is 1: Blender's FBX exporter writes every object of a scene
+    /// in metres so, ×100 in a file in centimetres) is read in metres as written, with everything below it: that
+    /// scale is the unit's, not its author's, as Blender's importer and the scene's glTF export say.
     pub fn length_scales(&self) -> &[f64] {
         &self.length_scales
     }
@@ -189,11 +195,19 @@ impl Skeleton {
             return vec![1.0; self.len()];
         }
         let rest = self.rest_model_matrices();
-        let above = |bone: Option<usize>| bone.map_or(self.placement.conversion_scale(), |b| uniform_scale(&rest[b]));
+        let mut tops: Vec<usize> = Vec::with_capacity(self.len());
+        for (i, bone) in self.bones.iter().enumerate() {
+            tops.push(bone.parent.map_or(i, |p| tops[p]));
+        }
+        let unit = |i: usize| {
+            let undone = (uniform_scale(&rest[tops[i]]) - 1.0).abs() < UNIT_UNDONE;
+            if undone { 1.0 } else { self.placement.conversion_scale() }
+        };
+        let above = |i: usize, bone: Option<usize>| bone.map_or_else(|| unit(i), |b| uniform_scale(&rest[b]));
         (0..self.len())
             .map(|i| match self.placed_by[i] {
-                Some(node) if node == i => above(self.bones[i].parent),
-                node => above(node),
+                Some(node) if node == i => above(i, self.bones[i].parent),
+                node => above(i, node),
             })
             .collect()
     }
