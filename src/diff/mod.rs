@@ -6,8 +6,8 @@
 //! are compared through their polar decompositions:
 //! - **position**: the distance between the two origins;
 //! - **probe**: the largest distance of a point of the bone's frame — its origin and one point on each of its axes,
-//!   [`PROBE_FRACTION`] of the rig's size from the origin, along A's axes and along B's — between where A and B put
-//!   it (rotation, scale and shear errors all show here, in model units);
+//!   [`PROBE_FRACTION`] of the rig's size from the origin — between where A and B put it, each in its own pose
+//!   (rotation and shear errors show here, in model units; a scale in the scale ratio and the skin);
 //! - **orientation**: the angle between the two polar rotations `R`;
 //! - **scale**: the largest ratio between corresponding stretch factors `K` (sorted, so the frame does not matter);
 //! - **stretch**: the angle between the two stretch frames `U`, ignoring turns that leave `U·K·Uᵀ` the same.
@@ -23,7 +23,7 @@
 //! (largest, and mean over every vertex and time). Every largest value comes with the first time it happens.
 //!
 //! Two files or two sets of modes compare the same whichever is A: the rig's size is the larger of the two sides'
-//! and the probe points lie along both sides' axes, so a tolerance passes or fails whatever the argument order.
+//! and each side's probe points lie along its own axes, so a tolerance passes or fails whatever the argument order.
 
 mod matching;
 mod report;
@@ -260,12 +260,12 @@ impl Pairs {
         Pairs { bones, meshes, measure: Measure::Everything, frames: Frames::Same }
     }
 
-    /// Two files' bones and meshes paired as [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`),
-    /// which must name bones; their frames compared up to their exporters' conventions.
-    pub fn of_files(a: &Evaluation, b: &Evaluation, map: &[(String, String)]) -> Result<Self, DiffError> {
+    /// [`Pairs::by_name`] after the explicit bone pairs of `map` (`--map`), which must name bones, their frames
+    /// compared as `frames` says.
+    pub fn mapped(a: &Evaluation, b: &Evaluation, map: &[(String, String)], frames: Frames) -> Result<Self, DiffError> {
         let bones = match_bones_mapped(a.rig, b.rig, map)?;
         let meshes = match_meshes(&a.rig.meshes, &b.rig.meshes).into_iter().map(MeshPair::whole).collect();
-        Ok(Pairs { bones, meshes, measure: Measure::Everything, frames: Frames::UpToConvention })
+        Ok(Pairs { bones, meshes, measure: Measure::Everything, frames })
     }
 }
 
@@ -935,29 +935,16 @@ pub fn model_curves(evaluation: &Evaluation, bones: &[usize], times: &[f64]) -> 
     (0..bones.len()).map(|b| chunks.iter().flat_map(|chunk| chunk[b].iter().copied()).collect()).collect()
 }
 
-/// The largest distance between where `wa` and `wb` put the origin and the points `probe_length` along each axis
-/// of either (axes of zero length have no probe).
+/// The largest distance between the points of a bone's frame in the two poses, each placed in its own pose: the
+/// origins, and for each axis the point `probe_length` along it (`o + ℓ·c/|c|` of the axis's column `c`; at the
+/// origin for an axis of no length, or of no finite one). How far a point a tenth of the rig out along the bone
+/// moved, whatever scale either frame carries: a scale differs in the scale ratio and in the skin.
 fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
-    // One side's difference is the other's negated, the same distances; compared squared, the root of the largest
-    // being the largest root.
-    let difference = *wa - *wb;
-    // The difference moves a point `s` along an axis by the axis's column times `s` plus the origin's: the whole
-    // product but for terms of zero, where nothing is infinite (which would make them not a number).
-    let finite = difference.is_finite();
-    let moved = |axis: usize, s: f64| match finite {
-        true => (difference.col(axis) * s + difference.w_axis).truncate(),
-        false => difference.transform_point3(DVec3::AXES[axis] * s),
-    };
-    let mut largest = difference.w_axis.truncate().length_squared();
-    for w in [wa, wb] {
-        for axis in 0..3 {
-            let length = w.col(axis).truncate().length();
-            if length != 0.0 {
-                largest = largest.max(moved(axis, probe_length / length).length_squared());
-            }
-        }
-    }
-    largest.sqrt()
+    let origins = (wa.w_axis - wb.w_axis).truncate();
+    let along = |w: &DMat4, axis: usize| w.col(axis).truncate().normalize_or_zero() * probe_length;
+    // Compared squared, the root of the largest being the largest root.
+    let axes = (0..3).map(|axis| (origins + along(wa, axis) - along(wb, axis)).length_squared());
+    axes.fold(origins.length_squared(), f64::max).sqrt()
 }
 
 /// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other
@@ -1066,7 +1053,7 @@ mod tests {
         let q = DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2);
         assert!(wa.iter().zip(&wb).all(|(x, y)| (*x * q).abs_diff_eq(*y, 1e-6)));
         let as_is = compare(&a, &b, &Pairs::by_name(&a, &b), &times);
-        let up_to = compare(&a, &b, &Pairs::of_files(&a, &b, &[]).unwrap(), &times);
+        let up_to = compare(&a, &b, &Pairs::mapped(&a, &b, &[], Frames::UpToConvention).unwrap(), &times);
         for (same, conventional) in as_is.bones.iter().zip(&up_to.bones) {
             assert!((same.orientation_deg.max - 90.0).abs() < 1e-4, "{same:?}");
             assert!(same.convention.is_none());
@@ -1173,13 +1160,16 @@ mod tests {
         let a = DMat4::IDENTITY;
         let b = DMat4::from_rotation_translation(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2), DVec3::X);
         assert!((probe_distance(&a, &b, 2.0) - 5f64.sqrt()).abs() < 1e-12);
-        // Where a difference is infinite the whole product is taken, as before: every probe then meets infinity
-        // times zero, which is not a number and ignored, leaving the origins' distance (the columns alone would find
-        // √5 along A's X axis). A's Y axis has no length, so no probe meets the infinite column itself.
+        // Each point in its own pose: B scaled 1000 along its axes moves none of them (the scale ratio says it).
+        let scaled = b * DMat4::from_scale(DVec3::splat(1000.0));
+        assert!((probe_distance(&a, &scaled, 2.0) - 5f64.sqrt()).abs() < 1e-12);
+        // An axis of no length, or of an infinite one, has its point at the origin: A's flat Y and B's infinite Y
+        // both stay there (1 apart, as the origins), while X still finds √5.
         let flat = DMat4::from_cols(glam::DVec4::X, glam::DVec4::ZERO, glam::DVec4::Z, glam::DVec4::W);
         let mut infinite = b;
         infinite.y_axis = glam::DVec4::new(f64::INFINITY, 0.0, 0.0, 0.0);
-        assert_eq!(probe_distance(&flat, &infinite, 2.0), 1.0);
+        assert!((probe_distance(&flat, &infinite, 2.0) - 5f64.sqrt()).abs() < 1e-12);
+        assert!(probe_distance(&flat, &infinite, 2.0).is_finite());
         assert!((angle_between(DQuat::IDENTITY, DQuat::from_rotation_y(0.3)) - 0.3).abs() < 1e-15);
         assert_eq!(scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(4.0, 1.0, 2.0)), 1.0, "order does not matter");
         assert!((scale_ratio(DVec3::new(1.0, 2.0, 4.0), DVec3::new(1.0, 2.5, 4.0)) - 1.25).abs() < 1e-15);

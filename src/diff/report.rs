@@ -1,7 +1,9 @@
 //! Two files compared as a whole: their animations paired (by name, or as chosen), each pair compared, and what
 //! had no partner listed.
 
-use super::{BoneDifference, DiffError, Extreme, MeshDifference, Pairs, compare, comparison_times, match_clips};
+use super::{
+    BoneDifference, DiffError, Extreme, Frames, MeshDifference, Pairs, compare, comparison_times, match_clips,
+};
 use crate::eval::layers::RotationInterpolation;
 use crate::eval::{Evaluation, Setup};
 use crate::model::{Clip, ModeChoice, Modes, Rig, Span, Unit};
@@ -176,6 +178,8 @@ pub fn diff_files<'a>(
 ) -> Result<FileDiff, DiffError> {
     let (pairs, only_a, only_b) = pair_clips(a, b, clips);
     let label = |rig: &Rig, clip: Option<usize>| clip.map_or_else(|| "rest pose".to_owned(), |c| rig.clips[c].label());
+    // One file under two sets of modes gives each bone one frame; two files may each choose their own.
+    let frames = if a.file == b.file { Frames::Same } else { Frames::UpToConvention };
     if pairs.is_empty() {
         let labels = |rig: &Rig| (0..rig.clips.len()).map(|c| label(rig, Some(c))).collect();
         return Err(DiffError::NoClipPairs { a: labels(a.rig), b: labels(b.rig) });
@@ -192,7 +196,7 @@ pub fn diff_files<'a>(
             let (span_a, span_b) = (side_a.span(), side_b.span());
             let delay_b = align.delay(span_a, span_b);
             let side_b = side_b.delayed(delay_b);
-            let pairs = Pairs::of_files(&side_a, &side_b, map)?;
+            let pairs = Pairs::mapped(&side_a, &side_b, map, frames)?;
             let comparison = compare(&side_a, &side_b, &pairs, &comparison_times(&side_a, &side_b, rate));
             let names = |rig: &Rig, bones: &[usize]| bones.iter().map(|&i| rig.skeleton.bone(i).name.clone()).collect();
             Ok(AnimationDiff {
