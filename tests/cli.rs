@@ -30,7 +30,9 @@ fn inspect_json_has_exactly_the_documented_shape() {
     assert_eq!(keys(&out), ["animation", "bind_mismatches", "file", "inherit", "layers", "notes", "samples"]);
     assert_eq!(out["layers"]["bind_weight"], 1.0, "no layers: {}", out["layers"]);
     assert_eq!(out["layers"]["blend"], Value::Null);
-    assert_eq!(keys(&out["animation"]), ["duration", "frame_rate", "index", "name"]);
+    assert_eq!(keys(&out["animation"]), ["duration", "frame_rate", "index", "name", "start"]);
+    // Blender's frame 1 on the glb's own clock, as glTF stores a time (single precision).
+    assert_eq!(out["animation"]["start"], f64::from(1.0f32 / 30.0));
     assert_eq!(out["animation"]["index"], 0);
     assert_eq!(out["animation"]["name"], "squash_stretch");
     assert_eq!(out["inherit"], "declared");
@@ -185,8 +187,9 @@ fn scan_json_reports_the_stretched_bones_with_when_and_how_much() {
     assert_eq!(scan["animation"]["name"], "squash_stretch");
     assert_eq!(scan["rate"], 60.0);
     let samples = scan["samples"].as_u64().unwrap();
-    // 2.033 s at 60 Hz gives 123 grid times; the 61 key times at 30 fps add those off the 60 Hz grid.
-    assert!(samples >= 123, "{samples}");
+    // Frames 1 to 61 at 30 fps, 1/30 s to 61/30 s on the file's clock: 121 grid times at 60 Hz; the key times
+    // add those off the 60 Hz grid.
+    assert!(samples >= 121, "{samples}");
     let stretched = scan["stretched"].as_array().unwrap();
     let names: Vec<&str> = stretched.iter().map(|b| b["name"].as_str().unwrap()).collect();
     assert!(names.contains(&"forearm") && names.contains(&"neck"), "{names:?}");
@@ -260,12 +263,18 @@ fn compare_inherit_reports_every_bone_and_when() {
         "bones",
         "conversion_a",
         "conversion_b",
+        "delay_b",
+        "frame_rate",
         "helpers",
         "meshes",
         "only_a",
         "only_b",
         "rig_size",
         "samples",
+        "skinned_a",
+        "skinned_b",
+        "span_a",
+        "span_b",
         "worst",
     ];
     assert_eq!(keys(comparison), diff_keys);
