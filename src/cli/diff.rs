@@ -137,7 +137,7 @@ fn clocks_note(animation: &AnimationDiff) -> Option<String> {
     let frames = |seconds: f64| match animation.frame_rate {
         Some(rate) => {
             let count = frames(seconds * rate);
-            let noun = if count == "1" { "frame" } else { "frames" };
+            let noun = if count.trim_start_matches('-') == "1" { "frame" } else { "frames" };
             format!(" ({count} {noun} at {rate} fps)")
         }
         None => String::new(),
