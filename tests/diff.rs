@@ -431,3 +431,100 @@ fn a_z_up_bvh_stands_up_when_given_its_axis() {
     // Turned back, it is the file's again.
     assert_eq!(stood.restood(UpAxis::Z, UpAxis::Y).skeleton.placement().conversion, glam::DMat4::IDENTITY);
 }
+
+/// A file of the corpus of Blender's scenes in three formats.
+fn blender_io(name: &str) -> String {
+    path(&asset("../corpus/blender-io").join(name))
+}
+
+#[test]
+fn two_clocks_are_compared_at_equal_times_and_aligned_on_request() {
+    // Blender's glb keys frame 1 at 1/30 s; its FBX starts each take at 0: one frame apart, and said so.
+    let (glb, fbx) = (path(&asset("blender/stretchy_full.glb")), path(&asset("blender/stretchy_full.fbx")));
+    let own = bonescope(&["diff", &glb, &fbx, "--anim-a", "squash_stretch"]);
+    let table = String::from_utf8_lossy(&own.stdout);
+    assert!(table.contains("B's clip starts 0.0333 s (1 frame at 30 fps) before A's on its own clock"), "{table}");
+    let report = |align: &str| json(&bonescope(&["diff", &glb, &fbx, "--align", align, "--format", "json"]));
+    let (clocks, aligned) = (report("clocks"), report("start"));
+    let (a, b) = (&clocks["animations"][0], &aligned["animations"][0]);
+    assert_eq!(a["span_a"]["start"], f64::from(1.0f32 / 30.0));
+    assert_eq!((a["span_b"]["start"].as_f64(), a["delay_b"].as_f64()), (Some(0.0), Some(0.0)));
+    assert_eq!(b["delay_b"], a["span_a"]["start"], "B played from A's start");
+    let worst = |v: &Value| v["worst"]["max"].as_f64().unwrap();
+    assert!(worst(b) < worst(a) / 10.0, "aligned {} against {}", worst(b), worst(a));
+    // A delay in seconds is the same alignment.
+    let delay = format!("{}", 1.0f32 / 30.0);
+    let by_hand = json(&bonescope(&["diff", &glb, &fbx, "--align", &delay, "--format", "json"]));
+    assert!((worst(&by_hand["animations"][0]) - worst(b)).abs() < 1e-9);
+    assert_eq!(bonescope(&["diff", &glb, &fbx, "--align", "soon"]).status.code(), Some(2));
+}
+
+#[test]
+fn a_diff_that_pairs_no_clip_fails_listing_the_clips() {
+    let (glb, bvh) = (path(&asset("blender/stretchy_full.glb")), path(&asset("blender/stretchy_full.bvh")));
+    let out = bonescope(&["diff", &glb, &bvh, "--up-b", "z"]);
+    assert_eq!(out.status.code(), Some(2));
+    let error = String::from_utf8_lossy(&out.stderr);
+    assert!(error.contains("`squash_stretch`, `wave`") && error.contains("`animation 0`"), "{error}");
+    // A name for A alone is looked up in B as names pair (Blender's FBX take `Stretchy|wave`); where B has none,
+    // the error names B's file and the option that chooses B's clip.
+    let fbx = path(&asset("blender/stretchy_full.fbx"));
+    assert!(bonescope(&["diff", &glb, &fbx, "--anim-a", "wave"]).status.success());
+    let missing = String::from_utf8_lossy(&bonescope(&["diff", &glb, &bvh, "--anim-a", "wave"]).stderr).into_owned();
+    assert!(missing.contains(&format!("{bvh}: no animation named as --anim-a chose")), "{missing}");
+    assert!(missing.contains("--anim-b"), "{missing}");
+}
+
+#[test]
+fn one_file_under_two_modes_measures_points_each_in_its_own_pose() {
+    // Maya's no-inherit rig, 2.9 m tall, its origins at most 2.76 m apart between full and compensated scale: a
+    // probe point a tenth of the rig out along each axis moves no further than the origins and twice that tenth.
+    let file = path(&asset("fbx-ufbx-data/maya_scale_no_inherit_7700_ascii.fbx"));
+    let args = ["diff", &file, &file, "--inherit-a", "full", "--inherit-b", "segment-compensate", "--format", "json"];
+    let report = json(&bonescope(&args));
+    let animation = &report["animations"][0];
+    let size = animation["rig_size"].as_f64().unwrap();
+    for bone in animation["bones"].as_array().unwrap() {
+        let (origin, probe) = (bone["position"]["max"].as_f64().unwrap(), bone["probe"]["max"].as_f64().unwrap());
+        assert!(probe <= origin + 2.0 * 0.1 * size + 1e-9, "{}: {probe} against {origin}", bone["name"]);
+        assert!(bone.get("convention").is_none(), "one file has one set of frames");
+    }
+    assert!(animation["worst"]["max"].as_f64().unwrap() < size, "{}", animation["worst"]);
+}
+
+#[test]
+fn joints_pair_with_joints_meshes_with_meshes_and_usd_spellings_meet() {
+    // RobotExpressive names its mesh objects after the bones they hang from; the glb skins `Hand.L`, whose node
+    // places nothing. Blender's USD export spells `Bone.001` as `Bone_001`.
+    let args =
+        ["--anim-a", "Robot_Idle", "--anim-b", "RobotArmature|Robot_Idle", "--align", "start", "--format", "json"];
+    let diff = |a: &str, b: &str, more: &[&str]| json(&bonescope(&[&["diff", a, b], more].concat()));
+    let robot = diff(&blender_io("RobotExpressive.glb"), &blender_io("RobotExpressive.fbx"), &args);
+    let animation = &robot["animations"][0];
+    let bones = animation["bones"].as_array().unwrap();
+    let mut seen = std::collections::HashSet::new();
+    for bone in bones {
+        assert!(seen.insert((bone["a"].as_u64(), "a")) && seen.insert((bone["b"].as_u64(), "b")), "{bone}");
+    }
+    assert!(names(&animation["skinned_a"]).contains(&"Hand.L"));
+    let worst = animation["worst"]["max"].as_f64().unwrap() / animation["rig_size"].as_f64().unwrap();
+    assert!(worst < 0.01, "{worst}");
+    let extras = diff(&blender_io("00_extras.glb"), &blender_io("00_extras.usdc"), &["--format", "json"]);
+    let animation = &extras["animations"][0];
+    assert!(animation["only_a"].as_array().unwrap().is_empty() && animation["only_b"].as_array().unwrap().is_empty());
+    let pair = animation["bones"].as_array().unwrap().iter().find(|b| b["name"] == "Bone.001").unwrap();
+    assert_eq!(pair["name_b"], "Bone_001");
+}
+
+#[test]
+fn a_usd_stage_clip_is_named_after_its_main_skel_animation() {
+    let out = bonescope(&["inspect", &blender_io("RobotExpressive.usdc"), "--format", "json"]);
+    let report = json(&out);
+    assert_eq!(report["animation"]["name"], "Robot_Death");
+    let notes: Vec<&str> = report["notes"].as_array().unwrap().iter().filter_map(Value::as_str).collect();
+    assert!(notes.iter().any(|n| n.contains("2 SkelAnimations (Robot_Death, Anim)")), "{notes:?}");
+    // Named so, the stage's clip pairs by name with the glb's action of that name.
+    let diff =
+        json(&bonescope(&["diff", &blender_io("00_extras.glb"), &blender_io("00_extras.usdc"), "--format", "json"]));
+    assert_eq!(diff["animations"][0]["b"], "ArmatureAction");
+}

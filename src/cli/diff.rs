@@ -114,10 +114,9 @@ fn conventions(animation: &AnimationDiff) -> Vec<String> {
     let mut groups: Vec<(String, Vec<&str>)> = Vec::new();
     for bone in &animation.bones {
         let Some(c) = &bone.convention else { continue };
-        let turn = format!("turned {:.2}° about ({:.3}, {:.3}, {:.3})", c.turn_deg, c.axis.x, c.axis.y, c.axis.z);
-        let scaled =
-            if (c.scale_ratio - 1.0).abs() > 1e-6 { format!(", scaled {:.6}×", c.scale_ratio) } else { String::new() };
-        let what = format!("{turn}{scaled}");
+        let round = |x: f64| (x * 1000.0).round() / 1000.0 + 0.0;
+        let (x, y, z) = (round(c.axis.x), round(c.axis.y), round(c.axis.z));
+        let what = format!("turned {:.2}° about ({x}, {y}, {z})", c.turn_deg);
         match groups.iter_mut().find(|(w, _)| *w == what) {
             Some((_, bones)) => bones.push(&bone.name),
             None => groups.push((what, vec![&bone.name])),
@@ -162,7 +161,14 @@ fn chosen(args: &DiffArgs, a: &Rig, b: &Rig) -> anyhow::Result<Option<[usize; 2]
     let names = [args.anim_a.as_deref(), args.anim_b.as_deref()];
     chosen_clips([a, b], names).map_err(|missing| {
         let file = shown(if missing.searched == 0 { &args.a } else { &args.b });
-        anyhow::anyhow!("{file}: {}: {}", ["--anim-a", "--anim-b"][missing.named_by], missing.why)
+        let [option, other] = [["--anim-a", "--anim-b"][missing.named_by], ["--anim-b", "--anim-a"][missing.named_by]];
+        match missing.searched == missing.named_by {
+            true => anyhow::anyhow!("{file}: {option}: {}", missing.why),
+            false => anyhow::anyhow!(
+                "{file}: no animation named as {option} chose in the other file ({}); choose this file's with {other}",
+                missing.why
+            ),
+        }
     })
 }
 

@@ -14,10 +14,11 @@
 //!
 //! Two files need not give a bone the same frame: exporters choose their own axes for a node (Blender's FBX turns
 //! every object a quarter about X, its glTF export does not), and BVH gives its joints none. Where the pairs are
-//! compared [`Frames::UpToConvention`], the constant map between each pair's frames is found at the first time
-//! compared (`M = L_b⁻¹·L_a` of the two linear parts there), reported once ([`Convention`]), and B's matrix is read
-//! in A's frame (`W_b·M`) from then on: the probe points, orientations, scales and stretches measure what moves, and
-//! the origins and the skin are as they are.
+//! compared [`Frames::UpToConvention`], the constant turn between each pair's frames is found at the first time
+//! compared (`M = R_b⁻¹·R_a` of the two polar rotations there), reported once ([`Convention`]), and B's matrix is
+//! read in A's frame (`W_b·M`) from then on, A's in B's (`W_a·M⁻¹`) for the probe points seen from B: the probes,
+//! orientations and stretches measure what moves, and the origins, scales and the skin are as they are. Either
+//! file may be A: the turn found the other way is `M⁻¹`.
 //!
 //! Meshes are paired by name and vertex count; each pair is skinned on both sides and the vertex distances kept
 //! (largest, and mean over every vertex and time). Every largest value comes with the first time it happens.
@@ -103,35 +104,27 @@ pub struct BoneDifference {
     pub convention: Option<Convention>,
 }
 
-/// The constant map between a pair's frames: B's axes against A's at the first time compared (two exporters' axis
+/// The constant turn between a pair's frames: B's axes against A's at the first time compared (two exporters' axis
 /// conventions, a joint that BVH gives no orientation).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Convention {
     /// The turn's angle, degrees, and its axis in B's frame.
     pub turn_deg: f64,
     pub axis: DVec3,
-    /// The largest ratio between the two frames' scale factors (1: one scale).
-    pub scale_ratio: f64,
 }
 
 impl Convention {
-    /// B's frame against A's, from the `map` that reads B's in A's ([`FrameMaps`]: B's is A's times its inverse),
-    /// where they differ by more than rounding.
-    fn of(map: &DMat4) -> Option<Self> {
-        let parts = decompose(&map.inverse());
-        let (axis, angle) = parts.rotation.to_axis_angle();
+    /// B's frame against A's, from the `map` that reads B's in A's ([`FrameMaps`]: B's is A's turned by its
+    /// inverse), where they differ by more than rounding.
+    fn of(map: DQuat) -> Option<Self> {
+        let (axis, angle) = map.inverse().to_axis_angle();
         let turn_deg = angle.to_degrees();
-        let scale_ratio = scale_ratio(parts.scale, DVec3::ONE);
-        let turned = turn_deg > CONVENTION_DEG || (scale_ratio - 1.0).abs() > CONVENTION_SCALE;
-        turned.then_some(Convention { turn_deg, axis, scale_ratio })
+        (turn_deg > CONVENTION_DEG).then_some(Convention { turn_deg, axis })
     }
 }
 
 /// The smallest turn between two frames reported as a convention, degrees.
 const CONVENTION_DEG: f64 = 1e-3;
-
-/// The smallest difference of scale between two frames reported as a convention.
-const CONVENTION_SCALE: f64 = 1e-6;
 
 impl BoneDifference {
     /// No difference yet, from `start`, the first time compared.
@@ -466,13 +459,14 @@ fn compare_sides<B: Beside>(
         let hanging_from: Vec<usize> = variants.iter().flatten().filter_map(|v| a.skeleton().parent(v.top)).collect();
         (a.skeleton().with_ancestors(&bones), hanging_from)
     });
-    // Each side's map from B's frames onto A's, found once at the first time (by bone of B; none where compared as is).
-    let frames: Vec<FrameMaps> = sides
+    // Each side's turn from B's frames onto A's, found once at the first time (by bone of B; none where compared as
+    // is).
+    let frames: Vec<Vec<DQuat>> = sides
         .iter()
         .zip(&plans)
         .map(|(&(_, pairs, _), plan)| match (pairs.frames, times.first()) {
-            (Frames::UpToConvention, Some(&first)) => FrameMaps::at(&plan_a, plan, &pairs.bones.pairs, first),
-            _ => FrameMaps::default(),
+            (Frames::UpToConvention, Some(&first)) => frame_turns(&plan_a, plan, &pairs.bones.pairs, first),
+            _ => Vec::new(),
         })
         .collect();
     // A side given up in one run is given up: its comparison is `None` whatever the other runs find, so they stop it.
@@ -537,7 +531,7 @@ fn compare_sides<B: Beside>(
     };
     let totals = totals.unwrap_or_else(fresh).into_iter().zip(&frames).map(|(mut found, frames)| {
         for bone in &mut found.bones {
-            bone.convention = frames.maps.get(bone.b).and_then(Convention::of);
+            bone.convention = frames.get(bone.b).copied().and_then(Convention::of);
         }
         found
     });
@@ -545,34 +539,21 @@ fn compare_sides<B: Beside>(
     Some((compared, kept.into_iter().flatten().collect()))
 }
 
-/// How side B's frames are read in A's: per bone of B, the map `M = L_b⁻¹·L_a` of the linear parts of both model
-/// matrices at the first time compared (the identity where unpaired, or where B's cannot be inverted), and the
-/// partner's length scale ([`Evaluation::length_scales`]).
-#[derive(Default)]
-struct FrameMaps {
-    maps: Vec<DMat4>,
-    length_scales: Vec<f64>,
-}
-
-impl FrameMaps {
-    fn at(plan_a: &Plan, plan_b: &Plan, pairs: &[(usize, usize)], time: f64) -> Self {
-        let (mut a, mut b) = (Side::alone(plan_a), Side::alone(plan_b));
-        a.evaluate(time);
-        b.evaluate(time);
-        let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
-        let mut maps = vec![DMat4::IDENTITY; model_b.len()];
-        let mut length_scales = b.length_scales.clone();
-        for &(i, j) in pairs {
-            let linear = |m: &DMat4| DMat4::from_mat3(DMat3::from_mat4(*m));
-            let (la, lb) = (linear(&model_a[i]), linear(&model_b[j]));
-            let map = lb.inverse() * la;
-            if lb.determinant() != 0.0 && map.is_finite() {
-                maps[j] = map;
-                length_scales[j] = a.length_scales[i];
-            }
+/// Per bone of B, the turn `M = R_b⁻¹·R_a` that reads its frame in its partner's: the polar rotations of both model
+/// matrices at `time`; the identity where unpaired, or where the two are alike to rounding ([`Convention::of`]).
+fn frame_turns(plan_a: &Plan, plan_b: &Plan, pairs: &[(usize, usize)], time: f64) -> Vec<DQuat> {
+    let (mut a, mut b) = (Side::alone(plan_a), Side::alone(plan_b));
+    a.evaluate(time);
+    b.evaluate(time);
+    let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
+    let mut turns = vec![DQuat::IDENTITY; model_b.len()];
+    for &(i, j) in pairs {
+        let turn = decompose(&model_b[j]).rotation.inverse() * decompose(&model_a[i]).rotation;
+        if turn.is_finite() && Convention::of(turn).is_some() {
+            turns[j] = turn.normalize();
         }
-        FrameMaps { maps, length_scales }
     }
+    turns
 }
 
 /// The differences found over some of the times.
@@ -623,9 +604,17 @@ impl<'p> Differences<'p> {
     fn add(&mut self, a: &mut Side, b: &mut Side, probe_length: f64, time: f64) {
         let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
         for difference in &mut self.bones {
-            let (wa, wb) = (&model_a[difference.a], &b.in_a_frame(model_b, difference.b));
+            let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
-            let probe = probe_distance(wa, wb, probe_length);
+            let probe = match b.frames.get(difference.b).map(|&turn| DMat4::from_quat(turn)) {
+                // Each seen from the other's frame, so that either file may be A.
+                Some(turn) => probe_distance(wa, &(*wb * turn), probe_length).max(probe_distance(
+                    wb,
+                    &(*wa * turn.inverse()),
+                    probe_length,
+                )),
+                None => probe_distance(wa, wb, probe_length),
+            };
             difference.probe.add(probe, time);
             self.largest = self.largest.max(probe);
             if self.measure != Measure::Everything {
@@ -763,8 +752,8 @@ struct Side<'e, 'a> {
     plan: &'e Plan<'a>,
     parts: Vec<AffineParts>,
     length_scales: Vec<f64>,
-    /// Per bone, the map that reads its frame in its partner's ([`frame_maps`]); empty where read as it is.
-    frames: &'e [DMat4],
+    /// Per bone, the turn that reads its frame in its partner's ([`frame_turns`]); empty where read as it is.
+    frames: &'e [DQuat],
     /// Per mesh, what skins the vertices the plan compares (`None` for a mesh not compared), where they are, and
     /// whether they are skinned at the time evaluated.
     skinners: Vec<Option<Skinner>>,
@@ -823,21 +812,9 @@ impl<'e, 'a> Side<'e, 'a> {
         Side { posing, plan, parts: Vec::new(), length_scales, frames: &[], skinners, skinned, fresh }
     }
 
-    /// The same side with its frames read in its partner's through `frames` ([`frame_maps`]), and so its scales
-    /// authored as its partner's are (over the unit conversion above the partner).
-    fn in_frames(self, frames: &'e FrameMaps) -> Self {
-        match frames.maps.is_empty() {
-            true => self,
-            false => Side { frames: &frames.maps, length_scales: frames.length_scales.clone(), ..self },
-        }
-    }
-
-    /// The model matrix of `bone` among `model` (the side's pose) in its partner's frame.
-    fn in_a_frame(&self, model: &[DMat4], bone: usize) -> DMat4 {
-        match self.frames.get(bone) {
-            Some(map) => model[bone] * *map,
-            None => model[bone],
-        }
+    /// The same side with its frames read in its partner's through `frames` ([`frame_turns`]).
+    fn in_frames(self, frames: &'e [DQuat]) -> Self {
+        Side { frames, ..self }
     }
 
     /// Evaluates the side's bones at `time` (its meshes are skinned when asked: [`Side::skin`]); a variant is
@@ -873,18 +850,14 @@ impl<'e, 'a> Side<'e, 'a> {
     fn evaluated(&mut self) {
         let model = &self.posing.pose().model.model;
         if self.plan.decompose {
-            self.parts = match self.frames {
-                [] => decompose_bones(model, &self.plan.bones),
-                _ => {
-                    let mut parts = vec![AffineParts::IDENTITY; model.len()];
-                    for &bone in &self.plan.bones {
-                        parts[bone] = decompose(&self.in_a_frame(model, bone));
-                    }
-                    parts
-                }
-            };
+            self.parts = decompose_bones(model, &self.plan.bones);
             for &bone in &self.plan.bones {
                 self.parts[bone] = self.parts[bone].authored(self.length_scales[bone]);
+                // `W·M` turns the polar rotation and the stretch frame alike and leaves the scales.
+                if let Some(&turn) = self.frames.get(bone) {
+                    let parts = &mut self.parts[bone];
+                    (parts.rotation, parts.stretch) = (parts.rotation * turn, turn.inverse() * parts.stretch);
+                }
             }
         }
         self.fresh.fill(false);
@@ -1059,7 +1032,6 @@ mod tests {
             assert!(same.convention.is_none());
             let c = conventional.convention.expect("every frame turned");
             assert!((c.turn_deg - 90.0).abs() < 1e-4 && c.axis.abs_diff_eq(DVec3::X, 1e-6), "{c:?}");
-            assert!((c.scale_ratio - 1.0).abs() < 1e-9, "a turn, no scale: {c:?}");
             assert!(conventional.orientation_deg.max < 1e-4, "{conventional:?}");
             assert!(conventional.probe.max < 1e-6, "the points of each frame, each in its own pose: {conventional:?}");
             assert_eq!(conventional.position, same.position, "origins are compared as they are");

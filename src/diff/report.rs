@@ -9,26 +9,34 @@ use crate::eval::{Evaluation, Setup};
 use crate::model::{Clip, ModeChoice, Modes, Rig, Span, Unit};
 
 /// The clips `names` choose, `[in A, in B]`, each a name or an index: a name given for one side only is looked up on
-/// both (the other file's clip named as the chosen clip is). `None`: every clip, paired by name. The error is a clip
-/// one file lacks: [`MissingClip`].
+/// both (the other file's clip named as the chosen clip is, exactly or as [`match_clips`] compares names: Blender's
+/// FBX names a take `Armature|walk`). `None`: every clip, paired by name. The error is a clip one file lacks:
+/// [`MissingClip`].
 pub fn chosen_clips(rigs: [&Rig; 2], names: [Option<&str>; 2]) -> Result<Option<[usize; 2]>, MissingClip> {
     let find = |searched: usize, named_by: usize, name: &str| {
         let rig = rigs[searched];
         let clip = rig.clip_named(name).map_err(|why| MissingClip { searched, named_by, why })?;
         Ok(rig.clips.iter().position(|c| std::ptr::eq(c, clip)).expect("a clip of the rig"))
     };
-    let named_alike =
-        |side: usize, clip: usize, given: &str| rigs[side].clips[clip].name.clone().unwrap_or(given.into());
+    // The other side's clip named like `clip` of side `chosen`.
+    let alike = |chosen: usize, clip: usize| {
+        let other = 1 - chosen;
+        let one = std::slice::from_ref(&rigs[chosen].clips[clip]);
+        match match_clips(one, &rigs[other].clips).0[..] {
+            [(_, j)] => Ok(j),
+            _ => find(other, chosen, &rigs[chosen].clips[clip].label()),
+        }
+    };
     Ok(Some(match names {
         [None, None] => return Ok(None),
         [Some(x), Some(y)] => [find(0, 0, x)?, find(1, 1, y)?],
         [Some(x), None] => {
             let i = find(0, 0, x)?;
-            [i, find(1, 0, &named_alike(0, i, x))?]
+            [i, alike(0, i)?]
         }
         [None, Some(y)] => {
             let j = find(1, 1, y)?;
-            [find(0, 1, &named_alike(1, j, y))?, j]
+            [alike(1, j)?, j]
         }
     }))
 }
@@ -241,11 +249,12 @@ pub fn diff_files<'a>(
 type ClipPairs = (Vec<(Option<usize>, Option<usize>)>, Vec<usize>, Vec<usize>);
 
 /// The clips to compare: the ones chosen, else every clip paired by name; two files without clips compare their rest
-/// poses.
+/// poses, and two with one clip each those whatever their names (a BVH's unnamed motion, a USD stage's timeline).
 fn pair_clips(a: &FileSide, b: &FileSide, clips: Clips) -> ClipPairs {
     match clips {
         Clips::Chosen => (vec![(a.setup.clip, b.setup.clip)], vec![], vec![]),
         Clips::ByName if a.rig.clips.is_empty() && b.rig.clips.is_empty() => (vec![(None, None)], vec![], vec![]),
+        Clips::ByName if a.rig.clips.len() == 1 && b.rig.clips.len() == 1 => (vec![(Some(0), Some(0))], vec![], vec![]),
         Clips::ByName => {
             let (pairs, only_a, only_b) = match_clips(&a.rig.clips, &b.rig.clips);
             (pairs.into_iter().map(|(i, j)| (Some(i), Some(j))).collect(), only_a, only_b)

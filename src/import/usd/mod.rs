@@ -84,6 +84,7 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
     if !moving.is_empty() {
         animations.push(skeleton::Animation { name: None, tracks: moving });
     }
+    notes.extend(animations_note(&animations));
     let clips = clip(animations, morph, &conversion.timing).into_iter().collect();
     notes.push("modes: UsdSkel has none: every joint inherits its parent fully (declared full)".to_owned());
     let skeleton = Skeleton::new(bones).map_err(|e| fail(None, e.to_string()))?;
@@ -95,19 +96,38 @@ fn read(path: &Path, options: &Options) -> Result<Rig, ImportError> {
 }
 
 /// The skeletons' animations (and the tracks of moving nodes), and the blend-shape weights they animate, as one
-/// clip over the stage's range, named after the animation where there is one; `None` for none.
+/// clip over the stage's range, named after its main animation ([`main_animation`]); `None` for none.
 fn clip(animations: Vec<skeleton::Animation>, morph: Vec<MorphWeights>, timing: &Timing) -> Option<Clip> {
-    let mut named = animations.iter().filter_map(|a| a.name.clone());
-    let name = match (named.next(), named.next()) {
-        _ if animations.is_empty() => return None,
-        (Some(one), None) => Some(one),
-        _ => None,
-    };
+    if animations.is_empty() {
+        return None;
+    }
+    let name = main_animation(&animations).and_then(|a| a.name.clone());
     let tracks = animations.into_iter().flat_map(|a| a.tracks).collect();
     let clip = Clip::new(0, name, tracks, morph).with_frame_rate(timing.codes_per_second);
     Some(match timing.span() {
         Some(span) => clip.with_span(span),
         None => clip,
+    })
+}
+
+/// The SkelAnimation a stage's clip is named after: the one that animates the most joints, the first of equals (a
+/// character's beside a skeleton Blender writes for a mesh parented to one of its bones).
+fn main_animation(animations: &[skeleton::Animation]) -> Option<&skeleton::Animation> {
+    let named = animations.iter().filter(|a| a.name.is_some());
+    named.rev().max_by_key(|a| a.tracks.len())
+}
+
+/// What to say where several SkelAnimations play as the stage's one clip.
+fn animations_note(animations: &[skeleton::Animation]) -> Option<String> {
+    let names: Vec<&str> = animations.iter().filter_map(|a| a.name.as_deref()).collect();
+    let main = main_animation(animations)?.name.as_deref()?;
+    (names.len() > 1).then(|| {
+        format!(
+            "animation: the stage's {} SkelAnimations ({}) play on its one timeline as one clip, named after `{main}` \
+             (the most joints)",
+            names.len(),
+            names.join(", ")
+        )
     })
 }
 
