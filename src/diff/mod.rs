@@ -37,7 +37,7 @@ pub use report::{Align, AnimationDiff, Clips, FileDiff, FileSide, MissingClip, c
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use glam::{DMat3, DMat4, DQuat, DVec3};
+use glam::{DMat4, DQuat, DVec3};
 
 use crate::analysis::{Components, Tolerances};
 use crate::eval::skinning::Skinner;
