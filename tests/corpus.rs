@@ -186,7 +186,8 @@ fn two_exports_of_one_scene_differ_by_nothing_but_their_conventions() {
                         "{what}: `{}` paired twice",
                         bone.name
                     );
-                    (seen_a.push(bone.a), seen_b.push(bone.b));
+                    seen_a.push(bone.a);
+                    seen_b.push(bone.b);
                 }
                 compared += 1;
             }
