@@ -85,7 +85,7 @@ fn generated_usd(c: &mut Criterion) {
 /// Every joint's local transform at rest and at each frame of the rig's clip, as `generated_usd.py` reads them.
 fn write_poses(rig: &bonescope::model::Rig, path: &Path) {
     let clip = &rig.clips[0];
-    let frames = (clip.duration() * clip.frame_rate()).round() as usize + 1;
+    let frames = (clip.span().length() * clip.frame_rate()).round() as usize + 1;
     let joints: Vec<String> = (0..rig.skeleton.len()).map(|b| rig.skeleton.path(b)).collect();
     let header = serde_json::json!({"joints": joints, "frames": frames, "rate": clip.frame_rate()});
     let mut out = std::io::BufWriter::new(std::fs::File::create(path).expect("writable"));

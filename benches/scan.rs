@@ -245,7 +245,7 @@ fn describe(case: &Case, times: &[f64], models: &[DMat4]) {
          flagged stretched; {:.1}% of bone-samples take the decompose shortcut",
         case.name,
         case.rig.skeleton.len(),
-        case.rig.clips[0].duration(),
+        case.rig.clips[0].span().length(),
         times.len(),
         percent(stretched_samples, n),
         percent(models.iter().filter(|m| shortcut_eligible(m)).count(), n),

@@ -34,7 +34,10 @@ class Clip:
 
     index: int
     name: Optional[str]
-    #: Seconds.
+    #: Where it starts on its file's clock, seconds (a glb's first key, a USD stage's start time code over its
+    #: rate, an FBX take's stored start).
+    start: float
+    #: How long it plays, seconds.
     duration: float
     #: Frames per second: the file's, or the one its key times show.
     frame_rate: float
@@ -162,8 +165,12 @@ def diff(
     unit_b: Optional[str] = None,
     up_a: Optional[str] = None,
     up_b: Optional[str] = None,
+    align: Optional[Union[str, float]] = None,
 ) -> Json:
-    """Two files compared over time, bone by bone and vertex by vertex, as `bonescope diff A B --format json`."""
+    """Two files compared over time, bone by bone and vertex by vertex, as `bonescope diff A B --format json`.
+
+    `align`: `"clocks"` compares equal times of both files' clocks, `"start"` plays B from A's start, a number of
+    seconds plays B that much later (``--align``)."""
 
 def bake(
     path: Path,

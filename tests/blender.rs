@@ -30,10 +30,10 @@ use serde_json::Value;
 /// the bake stopped writing keys closer than that (`bake::times::MIN_KEY_SPACING`).
 const KNOWN: &[(&str, &str)] = &[];
 
-/// Every frame of `source`'s clip and every half frame, in seconds.
+/// Every frame of `source`'s clip and every half frame from 0 to its end, in seconds.
 fn frames_and_halves(source: &Evaluation) -> Vec<f64> {
     let rate = source.clip.map_or(30.0, |c| c.frame_rate());
-    let halves = (2.0 * source.duration() * rate).floor() as usize;
+    let halves = (2.0 * source.span().end * rate).floor() as usize;
     (0..=halves).map(|h| h as f64 / (2.0 * rate)).collect()
 }
 

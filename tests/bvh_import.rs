@@ -48,7 +48,7 @@ fn every_shared_bvh_matches_its_manifest() {
         for (k, &t) in times.iter().enumerate() {
             assert_eq!(t, k as f64 * frame_time, "{file}: frame {k}");
         }
-        assert_eq!(clip.duration(), (frames - 1) as f64 * frame_time, "{file}");
+        assert_eq!(clip.span().length(), (frames - 1) as f64 * frame_time, "{file}");
         let listed = rig.notes.iter().find(|n| n.starts_with("rotation orders")).expect("a note on rotation orders");
         for order in orders {
             assert!(listed.contains(order), "{file}: {order} in `{listed}`");
@@ -56,7 +56,7 @@ fn every_shared_bvh_matches_its_manifest() {
     }
     // "120 fps, ≈4.4 s".
     let walk = import::load(&asset("bvh/cmu_12_01_walk.bvh")).unwrap();
-    assert!((walk.clips[0].duration() - 4.4).abs() < 0.05);
+    assert!((walk.clips[0].span().length() - 4.4).abs() < 0.05);
 }
 
 #[test]

@@ -77,8 +77,8 @@ fn proanimationbank_files_have_the_manifest_takes() {
         assert_eq!(names, takes.iter().map(|t| t.0).collect::<Vec<_>>(), "{file}");
         for (clip, &(name, frame_count, rounded)) in rig.clips.iter().zip(takes.iter()) {
             // "30 fps"; "41 frames (≈1.33 s)": frames k/30 for k = 0..40, so the clip lasts 40/30 s.
-            assert_eq!(frames(clip.duration(), 30.0), frame_count, "{file} {name}");
-            assert!((clip.duration() - rounded).abs() <= 0.005, "{file} {name}: {} s", clip.duration());
+            assert_eq!(frames(clip.span().end, 30.0), frame_count, "{file} {name}");
+            assert!((clip.span().end - rounded).abs() <= 0.005, "{file} {name}: {} s", clip.span().end);
             assert!(rig.notes.iter().any(|n| n.contains("(30 fps)")), "{:?}", rig.notes);
         }
         // "Biped-style skeleton, 66 bones as Blender counts them": ufbx finds 67 limb nodes (Hips and its 66
@@ -137,7 +137,7 @@ fn ufbx_data_files_show_what_their_readme_says() {
     assert!(rig.clips.iter().all(|c| c.tracks().is_empty()));
     // Curve interpolation modes: the clip is sampled at every frame (30 fps, 2 s).
     let rig = load_asset("fbx-ufbx-data/maya_anim_interpolation_7700_ascii.fbx");
-    assert_eq!(frames(rig.clips[0].duration(), 30.0), 61);
+    assert_eq!(frames(rig.clips[0].span().end, 30.0), 61);
     assert!(rig.clips[0].key_times().len() >= 61);
     // Skinned meshes, from 3ds Max (FBX 7.5 and the old FBX 5 binary), Maya and Blender.
     for file in [
@@ -167,7 +167,7 @@ fn blender_fbx_files_have_both_actions() {
         let rig = load_asset(&format!("blender/{file}"));
         let names: Vec<String> = rig.clips.iter().map(|c| c.label()).collect();
         assert_eq!(names, [format!("{prefix}|squash_stretch"), format!("{prefix}|wave")], "{file}");
-        let durations: Vec<usize> = rig.clips.iter().map(|c| frames(c.duration(), 30.0)).collect();
+        let durations: Vec<usize> = rig.clips.iter().map(|c| frames(c.span().end, 30.0)).collect();
         assert_eq!(durations, [61, 41], "{file}");
         for joint in ["hips", "spine", "chest", "upper_arm", "forearm", "hand", "neck", "head"] {
             assert!(rig.skeleton.find(joint).is_some(), "{file}: {joint}");
@@ -451,7 +451,7 @@ fn a_take_of_ten_thousand_years_loads_sampled_at_its_keys() {
     let rig = import::load_bytes(&path, long.as_bytes()).unwrap();
     assert!(started.elapsed().as_secs() < 5);
     let clip = &rig.clips[0];
-    assert!((clip.duration() - 9223372036854775807.0 / 46186158000.0).abs() < 1.0, "{}", clip.duration());
+    assert!((clip.span().end - 9223372036854775807.0 / 46186158000.0).abs() < 1.0, "{}", clip.span().end);
     let samples = clip.key_times().len();
     assert!(samples < 1000, "{samples} samples");
     assert!(rig.notes.iter().any(|n| n.contains("with few keys: sampled at its key times")), "{:#?}", rig.notes);

@@ -62,7 +62,7 @@ fn synced_blend_plays_both_clips_at_one_phase_of_the_blended_cycle() {
     let stack = LayerStack::new(&rig, &layers).unwrap();
     let cycle = stack.synced_cycle(&rig, rig.clips.first()).unwrap();
     assert_eq!(cycle, SyncedCycle::new(1.2, 0.8, 0.25));
-    assert!((cycle.length - 1.1).abs() < 1e-15 && (stack.duration(&rig, rig.clips.first()) - 1.1).abs() < 1e-15);
+    assert!((cycle.length - 1.1).abs() < 1e-15 && (stack.length(&rig, rig.clips.first()) - 1.1).abs() < 1e-15);
     // Without sync both play at their own speed: walk at 0.55 s (5.5), run at 0.55 s (11): 4.125 + 2.75 = 6.875.
     let unsynced = Layers { blend: Some(Blend { sync: false, ..blend }), ..Layers::default() };
     assert!((root_x(&rig, &unsynced, 0.55) - 6.875).abs() < 1e-5);
@@ -144,7 +144,7 @@ fn a_crossfade_runs_from_the_end_of_one_clip_into_the_start_of_another() {
     // After the fade: clip 1 alone, at 1.5 − 0.8 = 0.7 s.
     assert!((root_x(&rig, &layers, 1.5) - 14.0).abs() < 1e-5);
     let stack = LayerStack::new(&rig, &layers).unwrap();
-    assert!((stack.duration(&rig, rig.clips.first()) - 1.8).abs() < 1e-12, "the timeline runs to the end of clip 1");
+    assert!((stack.length(&rig, rig.clips.first()) - 1.8).abs() < 1e-12, "the timeline runs to the end of clip 1");
 }
 
 #[test]
@@ -361,7 +361,7 @@ fn a_synced_walk_run_blend_plants_the_feet_at_the_same_phases() {
     let rig = locomotions();
     let index = |name: &str| rig.clips.iter().position(|c| c.name.as_deref() == Some(name)).unwrap();
     let (walk, run) = (index("walk"), index("run"));
-    let (t1, t2) = (rig.clips[walk].duration(), rig.clips[run].duration());
+    let (t1, t2) = (rig.clips[walk].span().length(), rig.clips[run].span().length());
     assert!((t1 - 4.0 / 3.0).abs() < 0.01 && (t2 - 2.0 / 3.0).abs() < 0.01, "{t1} {t2}");
     const STEPS: usize = 200;
     for foot in ["LeftFoot", "RightFoot"] {

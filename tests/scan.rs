@@ -113,7 +113,7 @@ fn a_stretched_camera_is_reported_but_does_not_mark_the_figure_stretched() {
 fn brute_force(skeleton: &Skeleton, clip: &Clip, hierarchy: &Hierarchy, options: &ScanOptions) -> Vec<BruteSummary> {
     let mut pose = Pose::default();
     let mut summaries = vec![BruteSummary::default(); skeleton.len()];
-    for time in sample_times(clip.key_times(), 0.0, clip.duration(), options.rate, MAX_FRAMES).times {
+    for time in sample_times(clip.key_times(), clip.span().start, clip.span().end, options.rate, MAX_FRAMES).times {
         pose.evaluate(skeleton, Some(clip), hierarchy, time);
         for (summary, model) in summaries.iter_mut().zip(&pose.model.model) {
             let a = Assessment::of(model, &options.tolerances);

@@ -9,7 +9,7 @@ use base64::Engine;
 use bonescope::eval::Evaluation;
 use bonescope::import::{self, Options, Space};
 use bonescope::math::decompose;
-use bonescope::model::{Bone, Choice, Clip, InheritMode, Placement, Rig, Skeleton, Transform};
+use bonescope::model::{Bone, Choice, Clip, InheritMode, Placement, Rig, Skeleton, Span, Transform};
 use common::{asset, bonescope, json};
 use glam::{DMat4, DQuat, DVec3, Quat};
 use serde_json::{Value, json as object};
@@ -33,10 +33,10 @@ fn load(path: &Path, space: Space) -> Rig {
     import::load_with(path, &Options { space }).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Three times of the first clip (its rest pose where it has none).
+/// Three times of the first clip: its start, a time within, its end (0 for its rest pose where it has none).
 fn times(rig: &Rig) -> Vec<f64> {
-    let duration = rig.clips.first().map_or(0.0, Clip::duration);
-    vec![0.0, 0.37 * duration, duration]
+    let span = rig.clips.first().map_or(Span::at(0.0), Clip::span);
+    vec![span.start, span.start + 0.37 * span.length(), span.end]
 }
 
 /// Every bone's model matrix and every skinned vertex of `modes` at `time`.

@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyString};
 use bonescope_core::analysis::report::FileReport;
 use bonescope_core::analysis::{ScanOptions, Tolerances, sample};
 use bonescope_core::bake::{Engine, Request, Strategy};
-use bonescope_core::diff::{Clips, FileSide, chosen_clips, diff_files};
+use bonescope_core::diff::{Align, Clips, FileSide, chosen_clips, diff_files};
 use bonescope_core::eval::layers::RotationInterpolation;
 use bonescope_core::eval::{Evaluation, Layers, Setup};
 use bonescope_core::explain::{Costs, Question, Report, explain, scan_clip};
@@ -124,7 +124,10 @@ struct Bone {
 struct Clip {
     index: usize,
     name: Option<String>,
-    /// Seconds.
+    /// Where it starts on its file's clock, seconds (a glb's first key, a USD stage's start time code over its rate,
+    /// an FBX take's stored start).
+    start: f64,
+    /// How long it plays, seconds.
     duration: f64,
     /// Frames per second: the file's, or the one its key times show.
     frame_rate: f64,
@@ -174,7 +177,8 @@ impl Rig {
             .map(|c| Clip {
                 index: c.index,
                 name: c.name.clone(),
-                duration: c.duration(),
+                start: c.span().start,
+                duration: c.span().length(),
                 frame_rate: c.frame_rate(),
                 key_times: c.key_times(),
             })
@@ -479,10 +483,11 @@ impl EvaluationArrays {
 
 /// Two files compared over time, bone by bone and vertex by vertex, as `bonescope diff A B --format json` says it.
 /// `a` and `b` are paths; the keyword arguments are `diff`'s options (`anim_a="walk"`, `inherit_b="full"`,
-/// `map={"Hips": "pelvis"}`, `interp="nlerp"`, `unit_b="cm"`, `up_b="z"`, …).
+/// `map={"Hips": "pelvis"}`, `interp="nlerp"`, `unit_b="cm"`, `up_b="z"`, `align="start"`, …).
 #[pyfunction]
 #[pyo3(signature = (a, b, *, anim_a = None, anim_b = None, inherit_a = "declared", inherit_b = "declared",
-    map = None, interp = None, rate = 60.0, unit_a = None, unit_b = None, up_a = None, up_b = None))]
+    map = None, interp = None, rate = 60.0, unit_a = None, unit_b = None, up_a = None, up_b = None,
+    align = None))]
 #[allow(clippy::too_many_arguments)]
 fn diff(
     py: Python<'_>,
@@ -499,8 +504,13 @@ fn diff(
     unit_b: Option<&str>,
     up_a: Option<&str>,
     up_b: Option<&str>,
+    align: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
     let paths = [path_of(a)?, path_of(b)?];
+    let align = match align {
+        Some(align) => align.str()?.to_string().parse().map_err(|why: String| error(format!("align: {why}")))?,
+        None => Align::Clocks,
+    };
     let names = [
         anim_a.map(|n| n.str().map(|s| s.to_string())).transpose()?,
         anim_b.map(|n| n.str().map(|s| s.to_string())).transpose()?,
@@ -532,7 +542,7 @@ fn diff(
             side_b.setup.layers.interpolation.rotation = interp;
         }
         let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
-        diff_files(&side_a, &side_b, clips, &map, rate).map_err(|e| e.to_string())
+        diff_files(&side_a, &side_b, clips, &map, rate, align).map_err(|e| e.to_string())
     });
     json_value(py, &compared.map_err(error)?)
 }
