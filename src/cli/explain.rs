@@ -14,7 +14,7 @@ use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan_analysis};
 use crate::explain::{Change, Costs, Explanation, Fix, Measured, Question, Report, explain, is_other_mode};
 use crate::import;
-use crate::model::{InheritMode, Rig, Unit};
+use crate::model::{At, InheritMode, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct ExplainArgs {
@@ -83,14 +83,21 @@ fn render_table(report: &Report, rig: &Rig, modes: &[InheritMode], shown: Shown)
     }
     for explained in report.bones {
         out.push('\n');
-        out.push_str(&render_bone(explained, rig, modes, report.unit, shown));
+        let rate = report.animation.as_ref().map(|a| a.frame_rate);
+        out.push_str(&render_bone(explained, rig, modes, (report.unit, rate), shown));
     }
     out
 }
 
-/// One bone: both answers, the chain at the detailed time, the main causes over the clip, the fixes, and what the
-/// declared modes on the chain are worth.
-fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: Option<Unit>, shown: Shown) -> String {
+/// One bone: both answers, the chain at the detailed time (with its frame at the clip's `rate`), the main causes over
+/// the clip, the fixes, and what the declared modes on the chain are worth.
+fn render_bone(
+    explained: &Explanation,
+    rig: &Rig,
+    modes: &[InheritMode],
+    (unit, rate): (Option<Unit>, Option<f64>),
+    shown: Shown,
+) -> String {
     let (causes, at) = (&explained.causes, &explained.causes.at);
     let mut out = format!("{}\n", explained.headline(unit));
     if causes.stretched_samples == 0 {
@@ -100,9 +107,9 @@ fn render_bone(explained: &Explanation, rig: &Rig, modes: &[InheritMode], unit: 
         out.push_str(&format!("  {answer}\n"));
     }
     out.push_str(&format!(
-        "  shears {:.3}° at {:.4} s{}; flagged at {} of {} samples\n",
+        "  shears {:.3}° at {}{}; flagged at {} of {} samples\n",
         at.shear_deg,
-        at.time,
+        At { time: at.time, rate },
         if at.stretched { "" } else { " (not flagged there)" },
         causes.stretched_samples,
         causes.samples

@@ -11,7 +11,7 @@ use super::table::{Table, shown, vector};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};
 use crate::import;
-use crate::model::Choice;
+use crate::model::{At, Choice};
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
@@ -74,10 +74,11 @@ fn render_table(layered: &LayeredInspectReport, layers_summary: &str) -> String 
     for m in &layered.bind_mismatches {
         out.push_str(&format!("  warning: {}: the skin is broken there\n", m.says()));
     }
+    let rate = report.animation.as_ref().map(|a| a.frame_rate);
     for sample in &report.samples {
         out.push_str(&format!(
-            "\nt = {:.4} s   (model space; * = stretched: scale along axes that shear)\n",
-            sample.time
+            "\nt = {}   (model space; * = stretched: scale along axes that shear)\n",
+            At { time: sample.time, rate }
         ));
         let mut table = Table::new(&[
             ("", false),
