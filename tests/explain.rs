@@ -16,7 +16,7 @@ use bonescope::eval::{Evaluation, LayerStack, Layers};
 use bonescope::explain::{Change, Costs, Explanation, Fix, Measured, Question, Scale, explain};
 use bonescope::model::{InheritMode, Rig};
 use common::{asset, bonescope, json, load_asset};
-use glam::DVec3;
+use glam::DMat4;
 
 /// The rule a fix's cost follows, applied to `diff`'s own comparison of `a` with `b`: the largest vertex distance
 /// of any mesh, and the largest probe distance of any bone of the figure.
@@ -32,8 +32,8 @@ fn visible_distance(a: &Evaluation, b: &Evaluation, rate: f64) -> (f64, bool) {
 }
 
 /// How far `fixed` moves anything of `source` at `times`, found here from the two evaluations' poses and skins
-/// alone: the origin of every bone of the figure and the points `probe` along each of its axes, and every vertex
-/// of every mesh (bones and meshes matched by name).
+/// alone: the origin of every bone of the figure and the points `probe` out along each of its axes (each in its own
+/// pose), and every vertex of every mesh (bones and meshes matched by name).
 fn moved_for_real(source: &Evaluation, fixed: &Evaluation, times: &[f64], probe: f64) -> f64 {
     let (a, b) = (source.skeleton(), fixed.skeleton());
     let figure = a.figure();
@@ -50,10 +50,13 @@ fn moved_for_real(source: &Evaluation, fixed: &Evaluation, times: &[f64], probe:
         on_b.evaluate(time);
         let (ma, mb) = (&on_a.pose.model.model, &on_b.pose.model.model);
         for &(i, j) in &bones {
-            // The origin, and a point `probe` away along each of the source's axes, in the bone's own frame.
-            let along = |axis: usize| DVec3::AXES[axis] * probe / ma[i].col(axis).truncate().length();
-            let points = [DVec3::ZERO, along(0), along(1), along(2)].into_iter().filter(|p| p.is_finite());
-            points.for_each(|p| largest = largest.max(ma[i].transform_point3(p).distance(mb[j].transform_point3(p))));
+            // The origin, and the point `probe` out along each axis, each placed in its own pose.
+            let origin = |m: &DMat4| m.w_axis.truncate();
+            largest = largest.max(origin(&ma[i]).distance(origin(&mb[j])));
+            for axis in 0..3 {
+                let along = |m: &DMat4| origin(m) + m.col(axis).truncate().normalize_or_zero() * probe;
+                largest = largest.max(along(&ma[i]).distance(along(&mb[j])));
+            }
         }
         for &(i, j) in &meshes {
             source.skin(&on_a.pose, i, &mut skin_a);

@@ -3,11 +3,11 @@
 //! Bones are matched by name in four passes, each over what the earlier ones left: the user's explicit pairs
 //! (`--map a=b`), exact names, names compared without case and without a namespace prefix (`mixamorig:Hips`,
 //! `Armature|Hips` and `hips` are one name), then names as USD must spell them, every character that is not a
-//! letter, digit or `_` made `_` (Blender's `Bone.001` is `Bone_001` in its USD export). Names pair only within one
-//! kind of node ([`Kind`]): Blender names a mesh object parented to a bone after the bone, and the mesh is not the
-//! joint. Repeated names pair up in file order. The node of a skinned mesh is no bone either: its vertices follow
+//! letter, digit or `_` made `_` (Blender's `Bone.001` is `Bone_001` in its USD export). A mesh object (a node a
+//! mesh hangs on) pairs only with a mesh object: Blender names one parented to a bone after the bone, and the mesh
+//! is not the joint. Repeated names pair up in file order. The node of a skinned mesh is no bone either: its vertices follow
 //! the skin's joints, wherever the exporter put the node (Blender's glb puts it at the armature, its FBX where the
-//! object stood), so it is left out and the skin is compared instead. The helper nodes a bake inserts
+//! object stood), so it is left out, and so is the other file's node of its name, and the skin is compared instead. The helper nodes a bake inserts
 //! (`<name>.stretch`, whose child is the bone `<name>`) are not bones of the rig and are left out of both sides, and
 //! so are conversion nodes ([`Rig::conversion_nodes`]): whatever their names, they only state a file's axes and
 //! unit, which the bones below them already carry into model space.
@@ -15,7 +15,7 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use super::DiffError;
-use crate::model::{Clip, Mesh, NodeRole, Rig, Skeleton, UpAxis};
+use crate::model::{Clip, Mesh, Rig, Skeleton, UpAxis};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
 pub const HELPER_SUFFIX: &str = ".stretch";
@@ -38,20 +38,30 @@ pub struct BoneMatching {
     pub skinned_b: Vec<usize>,
 }
 
-/// For each bone, whether it is the node of a skinned mesh (and nothing else: no joint of a skin).
-fn skinned_nodes(rig: &Rig) -> Vec<bool> {
-    let mut skinned = vec![false; rig.skeleton.len()];
-    for mesh in rig.meshes.iter().filter(|m| m.skin.is_some()) {
-        if let Some(node) = skinned.get_mut(mesh.bone) {
+/// For each bone, whether a mesh hangs on it, skinned ones only where `skinned` (a joint of a skin never: it is the
+/// skeleton's).
+fn mesh_nodes(rig: &Rig, skinned: bool) -> Vec<bool> {
+    let mut nodes = vec![false; rig.skeleton.len()];
+    for mesh in rig.meshes.iter().filter(|m| !skinned || m.skin.is_some()) {
+        if let Some(node) = nodes.get_mut(mesh.bone) {
             *node = true;
         }
     }
     for joint in rig.skins.iter().flat_map(|s| &s.joints) {
-        if let Some(node) = skinned.get_mut(*joint) {
+        if let Some(node) = nodes.get_mut(*joint) {
             *node = false;
         }
     }
-    skinned
+    nodes
+}
+
+/// For each bone of `rig`, whether it is left out as a skinned mesh's node: it is one, or `other` has one of its
+/// name (which of the two files skins there, its skin is compared, not the node).
+fn skinned_nodes(rig: &Rig, other: &Rig) -> Vec<bool> {
+    let (own, theirs) = (mesh_nodes(rig, true), mesh_nodes(other, true));
+    let names: HashSet<&str> =
+        other.skeleton.bones().iter().zip(theirs).filter(|(_, s)| *s).map(|(b, _)| b.name.as_str()).collect();
+    rig.skeleton.bones().iter().zip(own).map(|(bone, own)| own || names.contains(bone.name.as_str())).collect()
 }
 
 /// For each bone, whether it is a bake's helper node: named `<name>.stretch` with a child named `<name>`.
@@ -81,27 +91,6 @@ pub fn usd_name(name: &str) -> String {
     if spelled.starts_with(|c: char| c.is_ascii_digit()) { format!("_{spelled}") } else { spelled }
 }
 
-/// What a node is for pairing: names pair only within one kind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Kind {
-    /// Joints, end sites and the nodes that carry them (a null, an armature).
-    Transform,
-    Mesh,
-    Camera,
-    Light,
-}
-
-impl Kind {
-    fn of(role: NodeRole) -> Kind {
-        match role {
-            NodeRole::Mesh => Kind::Mesh,
-            NodeRole::Camera => Kind::Camera,
-            NodeRole::Light => Kind::Light,
-            NodeRole::Joint | NodeRole::EndSite | NodeRole::Helper => Kind::Transform,
-        }
-    }
-}
-
 /// Pairs the bones of `a` and `b` by name (see the module's documentation).
 pub fn match_bones(a: &Rig, b: &Rig) -> BoneMatching {
     Unmatched::new(a, b).by_name()
@@ -129,8 +118,8 @@ fn take(left: &mut Vec<usize>, skeleton: &Skeleton, name: &str) -> Option<usize>
 
 /// Two skeletons' bones while they are being paired: the pairs so far and the bones left on each side.
 struct Unmatched<'s> {
-    a: &'s Skeleton,
-    b: &'s Skeleton,
+    a: &'s Rig,
+    b: &'s Rig,
     left_a: Vec<usize>,
     left_b: Vec<usize>,
     pairs: Vec<(usize, usize)>,
@@ -155,28 +144,20 @@ impl<'s> Unmatched<'s> {
         };
         let (conversion_a, left_a) = split(&apart(a, &nodes_a, b, &nodes_b), &helpers_a);
         let (conversion_b, left_b) = split(&apart(b, &nodes_b, a, &nodes_a), &helpers_b);
-        let (skinned_a, left_a) = apart_from(left_a, &skinned_nodes(a));
-        let (skinned_b, left_b) = apart_from(left_b, &skinned_nodes(b));
-        Unmatched {
-            a: &a.skeleton,
-            b: &b.skeleton,
-            left_a,
-            left_b,
-            pairs: Vec::new(),
-            helpers,
-            conversion_a,
-            conversion_b,
-            skinned_a,
-            skinned_b,
-        }
+        let (skinned_a, left_a) = apart_from(left_a, &skinned_nodes(a, b));
+        let (skinned_b, left_b) = apart_from(left_b, &skinned_nodes(b, a));
+        Unmatched { a, b, left_a, left_b, pairs: Vec::new(), helpers, conversion_a, conversion_b, skinned_a, skinned_b }
     }
 
-    /// The bones left paired by exact name, then by loose name, then as USD spells them, each within its kind.
+    /// The bones left paired by exact name, then by loose name, then as USD spells them, mesh objects with mesh
+    /// objects.
     fn by_name(mut self) -> BoneMatching {
-        let (a, b) = (self.a, self.b);
+        let (a, b) = (&self.a.skeleton, &self.b.skeleton);
+        let (meshes_a, meshes_b) = (mesh_nodes(self.a, false), mesh_nodes(self.b, false));
         for spelling in [str::to_owned, loose_name, usd_name] {
-            let key = |s: &Skeleton, i: usize| (Kind::of(s.bone(i).role), spelling(&s.bone(i).name));
-            pair_by_key(a, b, &mut self.left_a, &mut self.left_b, &mut self.pairs, key);
+            let key_a = |i: usize| (meshes_a[i], spelling(&a.bone(i).name));
+            let key_b = |j: usize| (meshes_b[j], spelling(&b.bone(j).name));
+            pair_by_key(&mut self.left_a, &mut self.left_b, &mut self.pairs, key_a, key_b);
         }
         self.pairs.sort_unstable();
         BoneMatching {
@@ -204,22 +185,21 @@ fn apart_from(left: Vec<usize>, flagged: &[bool]) -> (Vec<usize>, Vec<usize>) {
     left.into_iter().partition(|&i| flagged[i])
 }
 
-/// Pairs the bones left on each side whose `key` agrees, the k-th of a key in A with the k-th in B, and removes
-/// them from what is left.
+/// Pairs the bones left on each side whose keys agree, the k-th of a key in A with the k-th in B, and removes them
+/// from what is left.
 fn pair_by_key<K: std::hash::Hash + Eq>(
-    a: &Skeleton,
-    b: &Skeleton,
     left_a: &mut Vec<usize>,
     left_b: &mut Vec<usize>,
     pairs: &mut Vec<(usize, usize)>,
-    key: impl Fn(&Skeleton, usize) -> K,
+    key_a: impl Fn(usize) -> K,
+    key_b: impl Fn(usize) -> K,
 ) {
     let mut by_key: HashMap<K, VecDeque<usize>> = HashMap::new();
     for &j in left_b.iter() {
-        by_key.entry(key(b, j)).or_default().push_back(j);
+        by_key.entry(key_b(j)).or_default().push_back(j);
     }
     let mut matched_b = HashSet::new();
-    left_a.retain(|&i| match by_key.get_mut(&key(a, i)).and_then(VecDeque::pop_front) {
+    left_a.retain(|&i| match by_key.get_mut(&key_a(i)).and_then(VecDeque::pop_front) {
         Some(j) => {
             pairs.push((i, j));
             matched_b.insert(j);
@@ -288,7 +268,7 @@ mod tests {
     use glam::{DQuat, DVec3};
 
     use super::*;
-    use crate::model::{Bone, NodeRole, Transform, named_skeleton};
+    use crate::model::{Bone, Mesh, NodeRole, Skin, Transform, named_skeleton};
 
     /// A rig of bones named and parented, each a step along X from its parent (so that none is a conversion node).
     fn rig(bones: &[(&str, Option<usize>)]) -> Rig {
@@ -357,20 +337,27 @@ mod tests {
 
     #[test]
     fn joints_pair_with_joints_and_meshes_with_meshes_each_once() {
-        // Blender's glb and FBX both name a mesh object parented to the bone `Foot.L` after it.
-        let with_roles = |roles: [NodeRole; 3], parents: [Option<usize>; 3]| {
-            let names = ["Hips", "Foot.L", "Foot.L"];
+        // Blender's glb and FBX both name a mesh object parented to the bone `Foot.L` after it; a skinned mesh's
+        // node is left out, and so is the other file's node of its name, wherever it stands.
+        let with_mesh = |parents: [Option<usize>; 4], object: usize, skinned: Option<usize>| {
+            let names = ["Hips", "Foot.L", "Foot.L", "Body"];
             let mut r = rig(&names.into_iter().zip(parents).collect::<Vec<_>>());
-            let bones = r.skeleton.bones().iter().zip(roles).map(|(b, role)| Bone { role, ..b.clone() });
-            r.skeleton = Skeleton::new(bones.collect()).unwrap();
+            let skin = Skin { joints: vec![0], ..Skin::default() };
+            r.skins = vec![skin];
+            let mesh =
+                |bone: usize, skin: Option<usize>| Mesh { name: names[bone].into(), bone, skin, ..Mesh::default() };
+            r.meshes =
+                [Some(mesh(object, None)), skinned.map(|bone| mesh(bone, Some(0)))].into_iter().flatten().collect();
             r
         };
-        // A: the joint, then the mesh object hanging from it; B: the mesh object first, beside the joint.
-        let a = with_roles([NodeRole::Joint, NodeRole::Joint, NodeRole::Mesh], [None, Some(0), Some(1)]);
-        let b = with_roles([NodeRole::Joint, NodeRole::Mesh, NodeRole::Joint], [None, Some(0), Some(0)]);
+        // A: the joint, then the mesh object hanging from it, the skinned body; B: the mesh object first, beside the
+        // joint, and the body a plain node.
+        let a = with_mesh([None, Some(0), Some(1), None], 2, Some(3));
+        let b = with_mesh([None, Some(0), Some(0), None], 1, None);
         let m = match_bones(&a, &b);
         assert_eq!(m.pairs, [(0, 0), (1, 2), (2, 1)], "the joint with the joint, the mesh with the mesh");
-        assert!(m.only_a.is_empty() && m.only_b.is_empty());
+        assert!(m.only_a.is_empty() && m.only_b.is_empty(), "{m:?}");
+        assert_eq!((m.skinned_a, m.skinned_b), (vec![3], vec![3]));
     }
 
     #[test]
