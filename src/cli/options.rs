@@ -109,6 +109,10 @@ pub struct ToleranceArgs {
     /// ...and it shears by more than this many degrees (the largest deviation from 90° between two axes).
     #[arg(long, value_name = "DEGREES", default_value_t = Tolerances::default().min_shear_deg)]
     pub min_shear_deg: f64,
+    /// A bone not stretched counts as non-uniformly scaled when max/min of its scale factors exceeds 1 + this (below
+    /// it, the rounding exporters leave on a scale of 1).
+    #[arg(long, value_name = "RATIO", default_value_t = Tolerances::default().min_non_uniform)]
+    pub min_non_uniform: f64,
 }
 
 impl ToleranceArgs {
@@ -117,6 +121,7 @@ impl ToleranceArgs {
             ("--min-anisotropy", self.min_anisotropy),
             ("--min-stretch-deg", self.min_stretch_deg),
             ("--min-shear-deg", self.min_shear_deg),
+            ("--min-non-uniform", self.min_non_uniform),
         ];
         for (name, value) in values {
             if !(value >= 0.0 && value.is_finite()) {
@@ -127,6 +132,7 @@ impl ToleranceArgs {
             min_anisotropy: self.min_anisotropy,
             min_stretch_deg: self.min_stretch_deg,
             min_shear_deg: self.min_shear_deg,
+            min_non_uniform: self.min_non_uniform,
             ..Tolerances::default()
         })
     }
