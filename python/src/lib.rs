@@ -236,7 +236,8 @@ impl Rig {
         min_non_uniform: Option<f64>,
     ) -> PyResult<EvaluationArrays> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let ScanOptions { rate, tolerances } = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform])?;
+        let ScanOptions { rate, tolerances } =
+            scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform])?;
         if let Some(bad) = times.iter().flatten().find(|t| !t.is_finite()) {
             return Err(error(format!("times must be finite numbers of seconds, got {bad}")));
         }
