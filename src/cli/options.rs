@@ -5,6 +5,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, ValueEnum};
 
 use crate::analysis::Tolerances;
+use crate::import::Format;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -95,6 +96,12 @@ pub fn parse_comparison(s: &str) -> Result<[ModeChoice; 2], String> {
     let (a, b) = s.split_once(',').ok_or_else(|| format!("expected two modes separated by a comma, got `{s}`"))?;
     let parse = |p: &str| p.trim().parse::<ModeChoice>().map_err(|e| e.to_string());
     Ok([parse(a)?, parse(b)?])
+}
+
+/// The help of an argument naming animation files: `what`, the formats read ([`Format::listed`]), then `rest` (what
+/// more it may name; a help line ends without a full stop).
+pub fn files_help(what: &str, rest: &str) -> String {
+    format!("{what} ({}; recognised by content){rest}", Format::listed())
 }
 
 /// The thresholds of the verdicts.
