@@ -84,22 +84,12 @@ fn mutate(input: &mut Vec<u8>, seeds: &[Vec<u8>], noise: &mut XorShiftRng) {
 }
 
 fn parse_format(format: &str) -> Format {
-    match format {
-        "gltf" => Format::Gltf,
-        "fbx" => Format::Fbx,
-        "bvh" => Format::Bvh,
-        "usd" => Format::Usd,
-        other => panic!("unknown format `{other}` (gltf, fbx, bvh, usd)"),
-    }
+    let found = Format::ALL.into_iter().find(|f| f.name().eq_ignore_ascii_case(format));
+    let names = Format::ALL.map(|f| f.name().to_lowercase()).join(", ");
+    found.unwrap_or_else(|| panic!("unknown format `{format}` ({names})"))
 }
 
-fn seeds(format: &str) -> Vec<(PathBuf, Vec<u8>)> {
-    let extensions: &[&str] = match parse_format(format) {
-        Format::Gltf => &["gltf", "glb"],
-        Format::Fbx => &["fbx"],
-        Format::Bvh => &["bvh"],
-        Format::Usd => &["usda", "usdc", "usdz"],
-    };
+fn seeds(format: Format) -> Vec<(PathBuf, Vec<u8>)> {
     let mut files = Vec::new();
     for folder in std::fs::read_dir(shared_assets::root()).expect("../shared/assets") {
         let folder = folder.unwrap().path();
@@ -108,7 +98,7 @@ fn seeds(format: &str) -> Vec<(PathBuf, Vec<u8>)> {
         }
         for file in std::fs::read_dir(&folder).unwrap() {
             let file = file.unwrap().path();
-            let matches = file.extension().and_then(|e| e.to_str()).is_some_and(|e| extensions.contains(&e));
+            let matches = Format::named_by(&file) == Some(format);
             // Large seeds make every execution slow: mutate the small ones (under 2 MB they all are).
             if matches && std::fs::metadata(&file).unwrap().len() < 2_000_000 {
                 files.push((file.clone(), std::fs::read(&file).unwrap()));
@@ -116,7 +106,7 @@ fn seeds(format: &str) -> Vec<(PathBuf, Vec<u8>)> {
         }
     }
     files.sort();
-    assert!(!files.is_empty(), "no {format} seeds");
+    assert!(!files.is_empty(), "no {} seeds", format.name());
     files
 }
 
@@ -135,7 +125,7 @@ fn main() {
     let seed: u64 = args.get(2).map_or(0x9e37_79b9_7f4a_7c15, |s| s.parse().expect("seed"));
     let skip: u64 = args.get(3).map_or(0, |s| s.parse().expect("skip"));
     let parsed = parse_format(&format);
-    let seeds = seeds(&format);
+    let seeds = seeds(parsed);
     let seed_bytes: Vec<Vec<u8>> = seeds.iter().map(|s| s.1.clone()).collect();
     let artifacts = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/artifacts");
     // A path that names no real folder, so a glTF's external buffers are never found on disk.

@@ -116,6 +116,7 @@ class Rig:
         min_anisotropy: Optional[float] = None,
         min_stretch_deg: Optional[float] = None,
         min_shear_deg: Optional[float] = None,
+        min_non_uniform: Optional[float] = None,
     ) -> Evaluation:
         """Every bone at `times` (seconds; default every key time plus `rate` per second, as `scan` samples).
         `layers` are the runtime techniques as `bonescope inspect --format json` echoes them."""
@@ -130,6 +131,7 @@ class Rig:
         min_anisotropy: Optional[float] = None,
         min_stretch_deg: Optional[float] = None,
         min_shear_deg: Optional[float] = None,
+        min_non_uniform: Optional[float] = None,
     ) -> Json:
         """Whole clips (default every one) as `bonescope scan FILE --format json` reports this file; Ctrl+C stops it."""
     def explain(
@@ -144,6 +146,7 @@ class Rig:
         min_anisotropy: Optional[float] = None,
         min_stretch_deg: Optional[float] = None,
         min_shear_deg: Optional[float] = None,
+        min_non_uniform: Optional[float] = None,
     ) -> Json:
         """Why bones shear and every fix ranked, as `bonescope explain FILE --format json` says it."""
 

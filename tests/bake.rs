@@ -233,6 +233,35 @@ fn every_baked_file_passes_the_khronos_validator() {
     assert!(failing.is_empty(), "{} files with errors:\n{}", failing.len(), failing.join("\n"));
 }
 
+#[test]
+fn a_mesh_without_faces_is_left_out_with_a_note_and_the_bake_validates() {
+    // Blender's barbarian carries an empty placeholder mesh; Blender's weights scene three skinned meshes of one
+    // vertex and no face. Written as they were, each gave accessors of count 0 with min/max of null.
+    let folder = tempfile::tempdir().unwrap();
+    let sources = [
+        (asset("fbx-ufbx-corpus/blender_293_barbarian_7400_binary.fbx"), "Prop_Tree_Oak_1"),
+        (common::corpus("blender-io/32_weights_influence_4.fbx"), "Plane, Plane.001, Plane.002"),
+    ];
+    let mut files = Vec::new();
+    for (source, faceless) in sources {
+        let rig = import::load(&source).unwrap_or_else(|e| panic!("{e}"));
+        let request = Request::every_clip(&Evaluation::declared(&rig, None), None, Strategy::Exact, 1e-4);
+        let baked = bake::bake(&request);
+        let note = format!("meshes without faces left out (glTF has no empty mesh): {faceless}");
+        assert!(baked.notes.contains(&note), "{}: {:?}", source.display(), baked.notes);
+        let with_faces: Vec<&str> =
+            rig.meshes.iter().filter(|m| !m.indices.is_empty()).map(|m| m.name.as_str()).collect();
+        let back = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+        assert_eq!(back.meshes.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(), with_faces);
+        let path = folder.path().join(format!("{faceless}.glb"));
+        bake::save(&path, &baked.glb).unwrap();
+        files.push(path);
+    }
+    for report in validate(&files) {
+        assert_eq!(report["errors"], 0, "{}: {}", report["file"], report["messages"]);
+    }
+}
+
 /// The vertices `bonescope export` writes for `file` at `time`.
 fn exported(file: &Path, time: f64, folder: &Path) -> Vec<glam::DVec3> {
     let out = folder.join(format!("{}_{time}.obj", file.file_stem().unwrap().to_string_lossy()));

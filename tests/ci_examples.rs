@@ -8,7 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use bonescope::library::ANIMATION_EXTENSIONS;
+use bonescope::import::Format;
 use common::asset;
 use yaml_rust2::{Yaml, YamlLoader};
 
@@ -162,7 +162,7 @@ mod github {
         let script = scripts(scan).into_iter().find(|s| s.contains("bonescope scan")).unwrap();
         let globs: Vec<glob::Pattern> =
             option_values(script, "--include").iter().map(|g| glob::Pattern::new(g).unwrap()).collect();
-        for extension in ANIMATION_EXTENSIONS {
+        for extension in Format::every_extension() {
             let name = format!("walk.{}", extension.to_uppercase());
             let options = glob::MatchOptions { case_sensitive: false, ..glob::MatchOptions::new() };
             assert!(globs.iter().any(|g| g.matches_with(&name, options)), "--include leaves out .{extension}");

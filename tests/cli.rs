@@ -205,6 +205,25 @@ fn scan_json_reports_the_stretched_bones_with_when_and_how_much() {
     assert!(scan["non_uniform"].as_array().unwrap().iter().any(|n| n == "chest"));
 }
 
+#[test]
+fn the_non_uniform_tolerance_is_an_option_of_its_own() {
+    let file = stretchy();
+    let scan = |tolerance: &str| {
+        let args = ["scan", &file, "--anim", "squash_stretch", "--format", "json", "--min-non-uniform", tolerance];
+        json(&bonescope(&args))[0]["animations"][0].clone()
+    };
+    let shears = |scan: &Value| -> Vec<Value> {
+        scan["stretched"].as_array().unwrap().iter().map(|b| b["worst_shear_deg"].clone()).collect()
+    };
+    let (strict, lenient) = (scan("1e-3"), scan("100"));
+    // The chest squashes along its own axes by far less than 100× and more than 0.1 %; the shears are the same.
+    assert!(strict["non_uniform"].as_array().unwrap().iter().any(|n| n == "chest"), "{strict}");
+    assert_eq!(lenient["non_uniform"], serde_json::json!([]));
+    assert!(!shears(&strict).is_empty() && shears(&strict) == shears(&lenient));
+    let err = stderr_of(&["scan", &file, "--min-non-uniform=-1"]);
+    assert_eq!(err.trim_end(), "error: --min-non-uniform must be a finite number ≥ 0, got -1");
+}
+
 fn fbx(name: &str) -> String {
     asset(&format!("fbx-ufbx-data/{name}")).display().to_string()
 }

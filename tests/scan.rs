@@ -5,7 +5,7 @@ mod common;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use bonescope::analysis::{Assessment, Components, CurveRequest, Judged, ScanOptions, analyze, scan};
+use bonescope::analysis::{Assessment, Components, CurveRequest, Judged, ScanOptions, Tolerances, analyze, scan};
 use bonescope::eval::{Evaluation, Hierarchy, Pose};
 use bonescope::import::{demo_rig, stress_rig};
 use bonescope::model::{
@@ -350,4 +350,77 @@ fn curves_of_the_chains_alone_equal_those_of_the_whole_analysis() {
             assert_eq!(chains.scan.bones[bone], whole.scan.bones[bone], "bone {bone}");
         }
     }
+}
+
+/// `max/min − 1` of the scale factors of `m`, from nalgebra's singular values (not bonescope's decomposition).
+fn anisotropy(m: &DMat4) -> f64 {
+    let cols = glam::DMat3::from_mat4(*m).to_cols_array();
+    let singular = nalgebra::Matrix3::from_column_slice(&cols).singular_values();
+    singular.max() / singular.min() - 1.0
+}
+
+#[test]
+fn a_bone_is_non_uniform_beyond_its_tolerance_and_not_for_rounding() {
+    // Constant scales 2e-3 and 5e-4 apart (each bone turning, so that its axes are not the parent's).
+    let bones = vec![
+        Bone::joint("squashed", None, Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(1.0, 1.002, 1.0))),
+        Bone::joint("rounded", None, Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, DVec3::new(1.0, 1.0005, 1.0))),
+    ];
+    let times: Arc<[f64]> = Arc::from([0.0, 1.0].as_slice());
+    let turns = vec![Quat::IDENTITY, Quat::from_rotation_x(1.0)];
+    let tracks = (0..2)
+        .map(|bone| {
+            let mut tracks = BoneTracks::new(bone);
+            tracks.rotation = Some(Track::new(times.clone(), turns.clone(), Interpolation::Linear).unwrap());
+            tracks
+        })
+        .collect();
+    let rig = rig_of((Skeleton::new(bones).unwrap(), Clip::new(0, None, tracks, vec![])));
+    let evaluation = Evaluation::declared(&rig, rig.clips.first());
+    let listed = |tolerances: Tolerances| {
+        let found = scan(&evaluation, &ScanOptions { rate: 4.0, tolerances }, &|_, _| {});
+        found.bones.iter().map(|b| b.non_uniform_samples > 0).collect::<Vec<_>>()
+    };
+    assert_eq!(listed(Tolerances::default()), [true, false]);
+    assert_eq!(listed(Tolerances { min_non_uniform: 1e-4, ..Tolerances::default() }), [true, true]);
+    assert_eq!(listed(Tolerances { min_non_uniform: 3e-3, ..Tolerances::default() }), [false, false]);
+}
+
+/// Godot's mannequin scales legs and fingers by factors uniform to 1e-3 (exporter rounding), and a few bones by
+/// more: a bone is listed non-uniform exactly where, at a sample where it is not stretched, nalgebra's singular
+/// values of its model matrix lie more than 1e-3 apart.
+#[test]
+fn the_mannequin_s_non_uniform_bones_are_those_beyond_the_tolerance() {
+    let path = common::corpus("realworld/godot_mannequiny.glb");
+    let rig = match bonescope::import::load(&path) {
+        Ok(rig) => rig,
+        Err(e) => return eprintln!("skipping godot_mannequiny.glb: {e}"),
+    };
+    let options = ScanOptions::default();
+    let tolerance = options.tolerances.min_non_uniform;
+    let never = AtomicBool::new(false);
+    let (mut listed, mut beside_the_tolerance) = (0, 0);
+    for clip in &rig.clips {
+        let evaluation = Evaluation::declared(&rig, Some(clip));
+        let analysis = analyze(&evaluation, CurveRequest::default(), &options, &|_, _| {}, &never).unwrap();
+        let mut largest = vec![0.0f64; rig.skeleton.len()];
+        for (sample, &time) in analysis.times.iter().enumerate() {
+            let pose = evaluation.pose_at(time);
+            for (bone, model) in pose.model.model.iter().enumerate() {
+                if !analysis.stretched_at(bone, sample) {
+                    largest[bone] = largest[bone].max(anisotropy(model));
+                }
+            }
+        }
+        for (summary, &largest) in analysis.scan.bones.iter().zip(&largest) {
+            let name = &rig.skeleton.bone(summary.index).name;
+            // Rounding between the two decompositions is far below this margin.
+            assert!((largest - tolerance).abs() > 1e-9, "{name} in {:?}: {largest} on the tolerance", clip.name);
+            assert_eq!(summary.non_uniform_samples > 0, largest > tolerance, "{name} in {:?}: {largest}", clip.name);
+            listed += usize::from(largest > tolerance);
+            beside_the_tolerance += usize::from(largest > 1e-4 && largest <= tolerance);
+        }
+    }
+    // Both kinds are there: bones listed, and bones the old tolerance of 1e-4 listed for rounding.
+    assert!(listed > 0 && beside_the_tolerance > 0, "{listed} listed, {beside_the_tolerance} left out");
 }

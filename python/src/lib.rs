@@ -224,7 +224,7 @@ impl Rig {
     /// a dict of bone names to modes (the others as declared); `layers` the runtime techniques as
     /// `bonescope inspect --format json` echoes them (`{"uniform_scale": [3], "bind_weight": 0.5, …}`).
     #[pyo3(signature = (clip = None, times = None, *, modes = None, layers = None, rate = 60.0,
-        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None))]
+        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None, min_non_uniform = None))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate(
         &self,
@@ -237,9 +237,11 @@ impl Rig {
         min_anisotropy: Option<f64>,
         min_stretch_deg: Option<f64>,
         min_shear_deg: Option<f64>,
+        min_non_uniform: Option<f64>,
     ) -> PyResult<EvaluationArrays> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let ScanOptions { rate, tolerances } = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
+        let ScanOptions { rate, tolerances } =
+            scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform])?;
         if let Some(bad) = times.iter().flatten().find(|t| !t.is_finite()) {
             return Err(error(format!("times must be finite numbers of seconds, got {bad}")));
         }
@@ -257,7 +259,7 @@ impl Rig {
     /// "animations": [...]}`, each animation with its stretched bones (worst shear, when, how often) and, with
     /// `explain=True`, each one's main cause and best fix. `clip` as for `evaluate` (default: every clip).
     #[pyo3(signature = (clip = None, *, modes = None, layers = None, rate = 60.0, explain = false,
-        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None))]
+        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None, min_non_uniform = None))]
     #[allow(clippy::too_many_arguments)]
     fn scan(
         &self,
@@ -270,9 +272,10 @@ impl Rig {
         min_anisotropy: Option<f64>,
         min_stretch_deg: Option<f64>,
         min_shear_deg: Option<f64>,
+        min_non_uniform: Option<f64>,
     ) -> PyResult<Py<PyAny>> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
+        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform])?;
         let clips: Vec<Option<usize>> = match (clip, self.rig.clips.len()) {
             (Some(_), _) => vec![setup.clip],
             (None, 0) => vec![None],
@@ -293,7 +296,7 @@ impl Rig {
     /// every fix ranked by how far it moves the skin. `time` details the chain there (default: where each bone
     /// shears most).
     #[pyo3(signature = (bone = None, *, time = None, clip = None, modes = None, layers = None, rate = 60.0,
-        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None))]
+        min_anisotropy = None, min_stretch_deg = None, min_shear_deg = None, min_non_uniform = None))]
     #[allow(clippy::too_many_arguments)]
     fn explain(
         &self,
@@ -307,9 +310,10 @@ impl Rig {
         min_anisotropy: Option<f64>,
         min_stretch_deg: Option<f64>,
         min_shear_deg: Option<f64>,
+        min_non_uniform: Option<f64>,
     ) -> PyResult<Py<PyAny>> {
         let setup = self.setup(py, clip, modes, layers)?;
-        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg])?;
+        let options = scan_options(rate, [min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform])?;
         if let Some(time) = time.filter(|t| !t.is_finite()) {
             return Err(error(format!("time must be a finite number of seconds, got {time}")));
         }
@@ -391,9 +395,9 @@ fn mode_choice(id: &str) -> PyResult<ModeChoice> {
 }
 
 /// How clips are sampled and judged: `rate` samples per second (finite, > 0) on top of the key times, and the
-/// verdicts' tolerances `[min_anisotropy, min_stretch_deg, min_shear_deg]`, each a finite number ≥ 0 (the defaults
-/// for `None`).
-fn scan_options(rate: f64, [anisotropy, stretch, shear]: [Option<f64>; 3]) -> PyResult<ScanOptions> {
+/// verdicts' tolerances `[min_anisotropy, min_stretch_deg, min_shear_deg, min_non_uniform]`, each a finite number
+/// ≥ 0 (the defaults for `None`).
+fn scan_options(rate: f64, [anisotropy, stretch, shear, non_uniform]: [Option<f64>; 4]) -> PyResult<ScanOptions> {
     let defaults = Tolerances::default();
     let value = |name: &str, given: Option<f64>, default: f64| match given {
         None => Ok(default),
@@ -404,6 +408,7 @@ fn scan_options(rate: f64, [anisotropy, stretch, shear]: [Option<f64>; 3]) -> Py
         min_anisotropy: value("min_anisotropy", anisotropy, defaults.min_anisotropy)?,
         min_stretch_deg: value("min_stretch_deg", stretch, defaults.min_stretch_deg)?,
         min_shear_deg: value("min_shear_deg", shear, defaults.min_shear_deg)?,
+        min_non_uniform: value("min_non_uniform", non_uniform, defaults.min_non_uniform)?,
         ..defaults
     };
     Ok(ScanOptions { rate: positive_rate(rate)?, tolerances })

@@ -166,6 +166,7 @@ def test_what_the_rig_holds():
         (lambda: bonescope.load(STRETCHY, max_memory="1KiB"), ["inspect", "--max-memory", "1KiB", STRETCHY]),
         (lambda: bonescope.diff(STRETCHY, STRETCHY, anim_a="nope"), None),
         (lambda: bonescope.load(STRETCHY).scan(min_shear_deg=-1.0), None),
+        (lambda: bonescope.load(STRETCHY).scan(min_non_uniform=-1.0), None),
         (lambda: bonescope.load(STRETCHY).evaluate(rate=0.0), None),
     ],
 )

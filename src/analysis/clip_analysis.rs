@@ -5,7 +5,7 @@ use glam::{DMat4, DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::findings::{Tolerances, Verdict, shear_cosine};
-use super::peak::Peaks;
+use super::peak::{self, Peaks};
 use crate::math::{AffineParts, angle_of_half_cosine, decompose_near, shear_deg_of_cosine};
 
 /// One bone over a whole clip. Times are in seconds.
@@ -29,9 +29,9 @@ pub struct BoneSummary {
     pub(super) worst_shear_cosine_squared: f64,
     #[serde(skip)]
     worst_stretch_half_cosine: f64,
-    /// The highest peaks of the sampled shear, where [`super::peak`] refines it.
+    /// The highest peaks of the sampled shear, where [`BoneSummary::refine_shear`] searches between samples.
     #[serde(skip)]
-    pub(super) shear_peaks: Peaks,
+    shear_peaks: Peaks,
 }
 
 impl BoneSummary {
@@ -92,6 +92,15 @@ impl BoneSummary {
         self.non_uniform_samples += count * usize::from(f.non_uniform);
         self.mirrored_samples += count * usize::from(f.mirrored);
         self.degenerate_samples += count * usize::from(f.degenerate);
+    }
+
+    /// Refines the worst shear between the samples at `times` (those this summary was made of): `shear_at(time)` is
+    /// the bone's shear there as its cosine squared.
+    pub(super) fn refine_shear(&mut self, times: &[f64], shear_at: impl FnMut(f64) -> f64) {
+        let sampled = (self.worst_shear_time, self.worst_shear_cosine_squared);
+        (self.worst_shear_time, self.worst_shear_cosine_squared) =
+            peak::refine(&self.shear_peaks, times, sampled, shear_at);
+        self.finish();
     }
 
     /// Turns the worst cosines into angles.

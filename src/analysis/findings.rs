@@ -11,7 +11,8 @@ use crate::math::{
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Tolerances {
-    /// Scale factors count as unequal when `max/min − 1` exceeds this (default 1e-4, i.e. 0.01 %).
+    /// Scale factors count as unequal in judging a stretch when `max/min − 1` exceeds this (default 1e-4, i.e.
+    /// 0.01 %).
     pub min_anisotropy: f64,
     /// A stretch rotation counts as not the identity when its angle exceeds this many degrees (default 0.01°).
     pub min_stretch_deg: f64,
@@ -20,11 +21,21 @@ pub struct Tolerances {
     pub min_shear_deg: f64,
     /// A matrix is degenerate when its smallest scale factor is below this fraction of its largest (default 1e-9).
     pub degenerate_ratio: f64,
+    /// A bone not stretched is non-uniformly scaled when `max/min − 1` of its scale factors exceeds this (default
+    /// 1e-3, i.e. 0.1 %): exporters leave factors of 1 apart by rounding (a Mixamo leg at (0.99989, 1.0000001,
+    /// 0.99998)), which no one reads as a scale. The stretched verdict keeps `min_anisotropy`.
+    pub min_non_uniform: f64,
 }
 
 impl Default for Tolerances {
     fn default() -> Self {
-        Tolerances { min_anisotropy: 1e-4, min_stretch_deg: 0.01, min_shear_deg: 0.01, degenerate_ratio: 1e-9 }
+        Tolerances {
+            min_anisotropy: 1e-4,
+            min_stretch_deg: 0.01,
+            min_shear_deg: 0.01,
+            degenerate_ratio: 1e-9,
+            min_non_uniform: 1e-3,
+        }
     }
 }
 
@@ -136,7 +147,8 @@ pub(crate) struct Judge {
     /// `sin²(min_shear_deg)`: a shear of angle `φ` has a largest column cosine of `sin φ`.
     shear_cosine_squared: f64,
     /// The square of the largest spread `e/g` of `MᵀM` around `g·I` ([`Judge::certainly_uniform`]) that keeps the
-    /// scale factors' ratio below `1 + min_anisotropy/2`; 0 where the tolerances leave no room for that.
+    /// scale factors' ratio below 1 + half the smaller of `min_anisotropy` and `min_non_uniform`; 0 where the
+    /// tolerances leave no room for that.
     uniform_spread_squared: f64,
 }
 
@@ -149,10 +161,11 @@ impl Judge {
         let shear_cosine_squared = tolerances.min_shear_deg.to_radians().sin().powi(2);
         // Eigenvalues of MᵀM within g·(1 ± s) put the factors' ratio at most √((1+s)/(1−s)); half the tolerance is
         // the target, the other half the margin for rounding (some 1e-15 here, in the SVD's factors).
-        let ratio_squared = (1.0 + 0.5 * tolerances.min_anisotropy).powi(2);
+        let anisotropy = tolerances.min_anisotropy.min(tolerances.min_non_uniform);
+        let ratio_squared = (1.0 + 0.5 * anisotropy).powi(2);
         let spread = (ratio_squared - 1.0) / (ratio_squared + 1.0);
-        let certifiable = tolerances.min_anisotropy >= CERTIFIABLE_ANISOTROPY
-            && tolerances.degenerate_ratio * (1.0 + tolerances.min_anisotropy) < 1.0;
+        let certifiable =
+            anisotropy >= CERTIFIABLE_ANISOTROPY && tolerances.degenerate_ratio * (1.0 + anisotropy) < 1.0;
         let uniform_spread_squared = if certifiable { spread * spread } else { 0.0 };
         Judge { tolerances: *tolerances, stretch_half_cosine, shear_cosine_squared, uniform_spread_squared }
     }
@@ -163,9 +176,10 @@ impl Judge {
         shear_cosine_squared > self.shear_cosine_squared
     }
 
-    /// Whether a matrix with the Gram matrix `gram` (`MᵀM`) certainly has scale factors within half the anisotropy
-    /// tolerance of each other: every eigenvalue of `MᵀM` lies within `‖MᵀM − g·I‖_F` of `g`, its mean. Its
-    /// verdicts are then [`Judge::uniform_verdict`]'s, whatever its stretch frame.
+    /// Whether a matrix with the Gram matrix `gram` (`MᵀM`) certainly has scale factors within half the smaller
+    /// anisotropy tolerance (`min_anisotropy`, `min_non_uniform`) of each other: every eigenvalue of `MᵀM` lies
+    /// within `‖MᵀM − g·I‖_F` of `g`, its mean. Its verdicts are then [`Judge::uniform_verdict`]'s, whatever its
+    /// stretch frame.
     #[inline]
     pub fn certainly_uniform(&self, gram: &DMat3) -> bool {
         let g = (gram.x_axis.x + gram.y_axis.y + gram.z_axis.z) / 3.0;
@@ -189,15 +203,16 @@ impl Judge {
     pub fn verdict(&self, stretch: DQuat, scale: DVec3, sign: f64, shear_cosine_squared: f64) -> Verdict {
         let tolerances = &self.tolerances;
         let (min, max) = (scale.min_element(), scale.max_element());
-        // `max/min − 1 > min_anisotropy` (`AffineParts::anisotropy`), without the division.
-        let anisotropic = max > min * (1.0 + tolerances.min_anisotropy);
+        // `max/min − 1 > tolerance` (`AffineParts::anisotropy`), without the division.
+        let beyond = |tolerance: f64| max > min * (1.0 + tolerance);
+        let anisotropic = beyond(tolerances.min_anisotropy);
         let stretch_half_cosine =
             if anisotropic { stretch_half_cosine_within(stretch, scale, tolerances.min_anisotropy) } else { 1.0 };
         let stretched =
             stretch_half_cosine < self.stretch_half_cosine && shear_cosine_squared > self.shear_cosine_squared;
         let findings = Findings {
             stretched,
-            non_uniform: anisotropic && !stretched,
+            non_uniform: beyond(tolerances.min_non_uniform) && !stretched,
             mirrored: sign < 0.0,
             degenerate: min <= tolerances.degenerate_ratio * max,
         };
@@ -263,7 +278,8 @@ mod tests {
             let t = deg.to_radians().tan();
             DMat4::from_cols(glam::DVec4::X, glam::DVec4::new(t, 1.0, 0.0, 0.0), glam::DVec4::Z, glam::DVec4::W)
         };
-        let tolerances = Tolerances { min_anisotropy: 0.0, min_stretch_deg: 0.0, ..Tolerances::default() };
+        let tolerances =
+            Tolerances { min_anisotropy: 0.0, min_stretch_deg: 0.0, min_non_uniform: 0.0, ..Tolerances::default() };
         let assess = |m: DMat4| Assessment::of(&m, &tolerances);
         let faint = assess(shear(0.005));
         assert!(!faint.findings.stretched && faint.findings.non_uniform, "{faint:?}");

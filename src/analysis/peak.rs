@@ -2,14 +2,6 @@
 //! beside the clip's true maximum: a search over the two sample intervals around each finds that maximum to well
 //! under 0.001°, and every sampling rate (`scan --rate 30`, 60, 240, the app) reports one figure and one time.
 
-use glam::DQuat;
-use rayon::prelude::*;
-
-use super::clip_analysis::BoneSummary;
-use super::findings::Judge;
-use super::stretch::Stretch;
-use crate::eval::{BonesEvaluator, Evaluation};
-
 /// Golden-section steps: each keeps 0.618 of the interval, so two sample intervals shrink below 10⁻⁶ of their
 /// length (7 ns at 60 samples a second).
 const STEPS: usize = 32;
@@ -102,32 +94,18 @@ fn vertex_gain(p: f64, v: f64, n: f64) -> f64 {
     if curvature > 0.0 { (n - p) * (n - p) / (8.0 * curvature) } else { 0.0 }
 }
 
-/// Refines each judged bone's worst shear in `summaries` (sampled at `times`, sorted) to the largest value between
-/// the samples beside each of its highest sampled peaks: those whose sampled shear passes the tolerance (a shear of
-/// rounding noise is left as sampled). The worst stretch angle stays the sampled one: an angle of the stretch
-/// rotation jumps where two scale factors cross, so no search between samples is sure to find its maximum.
-pub(super) fn refine(evaluation: &Evaluation, times: &[f64], summaries: &mut [BoneSummary], judge: &Judge) {
-    let seen = |s: &&mut BoneSummary| judge.sees_shear(s.worst_shear_cosine_squared);
-    summaries.par_iter_mut().filter(seen).for_each(|summary| {
-        let chain = evaluation.skeleton().with_ancestors(&[summary.index]);
-        let mut evaluator = BonesEvaluator::new(evaluation, &chain);
-        let mut verdict = |time: f64| {
-            let model = &evaluator.evaluate(time).model.model[summary.index];
-            Stretch::of_matrix(model, DQuat::IDENTITY).verdict(judge)
-        };
-        // The shear as its cosine squared: larger is worse.
-        let peaks = summary.shear_peaks.highest();
-        let highest = peaks.first().map_or(0.0, |p| p.value);
-        // The highest peak, and those whose parabola reaches past it.
-        for sampled in peaks.iter().enumerate().filter(|(i, p)| *i == 0 || p.reach >= highest).map(|(_, p)| p.time) {
-            let (lo, hi) = around(times, sampled);
-            let (time, value) = largest(lo, sampled, hi, |t| verdict(t).shear_cosine_squared);
-            if value > summary.worst_shear_cosine_squared * (1.0 + GAIN) {
-                (summary.worst_shear_cosine_squared, summary.worst_shear_time) = (value, time);
-            }
-        }
-        summary.finish();
-    });
+/// The worst of a sampled shear (`worst`: its time and value) refined between the samples (`times`, sorted) beside
+/// the highest of `peaks`, and beside those whose parabola reaches past it: the largest value of `f` found there,
+/// where it passes the sampled one by more than [`GAIN`].
+pub(super) fn refine(peaks: &Peaks, times: &[f64], worst: (f64, f64), mut f: impl FnMut(f64) -> f64) -> (f64, f64) {
+    let peaks = peaks.highest();
+    let highest = peaks.first().map_or(0.0, |p| p.value);
+    let searched = peaks.iter().enumerate().filter(|(i, p)| *i == 0 || p.reach >= highest).map(|(_, p)| p.time);
+    searched.fold(worst, |worst, sampled| {
+        let (lo, hi) = around(times, sampled);
+        let found = largest(lo, sampled, hi, &mut f);
+        if found.1 > worst.1 * (1.0 + GAIN) { found } else { worst }
+    })
 }
 
 /// The samples before and after the one at `time` (itself at either end of the clip).

@@ -4,13 +4,14 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+use glam::DQuat;
 use rayon::prelude::*;
 
 use super::chunk::{ChunkResult, CurveSlices, Plan, analyze_chunk};
 use super::clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves};
 use super::findings::{Judge, clearly_stretched};
-use super::peak;
 use super::request::{CurveRequest, Judged, ScanOptions};
+use super::stretch::Stretch;
 use crate::eval::{BonesEvaluator, Evaluation, run_length};
 
 /// Scans `evaluation` over its whole clip. `progress(done, total)` is called from worker threads as samples
@@ -62,8 +63,25 @@ pub fn analyze(
     let chunks: Vec<ChunkResult> = chunks.into_iter().collect::<Option<_>>()?;
     let every: Vec<usize> = (0..skeleton.len()).collect();
     let mut analysis = assemble(skeleton.figure(), times, curves, chunks, &every);
-    peak::refine(evaluation, &analysis.times, &mut analysis.scan.bones, &Judge::new(&options.tolerances));
+    refine_shears(evaluation, &analysis.times, &mut analysis.scan.bones, &Judge::new(&options.tolerances));
     Some(analysis)
+}
+
+/// Refines each judged bone's worst shear in `summaries` (sampled at `times`, sorted) between samples: those whose
+/// sampled shear passes the tolerance (a shear of rounding noise is left as sampled). The worst stretch angle stays
+/// the sampled one: an angle of the stretch rotation jumps where two scale factors cross, so no search between
+/// samples is sure to find its maximum.
+pub(super) fn refine_shears(evaluation: &Evaluation, times: &[f64], summaries: &mut [BoneSummary], judge: &Judge) {
+    let seen = |s: &&mut BoneSummary| judge.sees_shear(s.worst_shear_cosine_squared);
+    summaries.par_iter_mut().filter(seen).for_each(|summary| {
+        let bone = summary.index;
+        let chain = evaluation.skeleton().with_ancestors(&[bone]);
+        let mut evaluator = BonesEvaluator::new(evaluation, &chain);
+        summary.refine_shear(times, |time| {
+            let model = &evaluator.evaluate(time).model.model[bone];
+            Stretch::of_matrix(model, DQuat::IDENTITY).verdict(judge).shear_cosine_squared
+        });
+    });
 }
 
 /// Whether `bone` is flagged at some sample of the run of [`analyze`]'s samples that holds `time`, from the run's

@@ -12,9 +12,8 @@ use glam::{DMat4, DQuat};
 use super::chunk::ChunkResult;
 use super::clip_analysis::ClipScan;
 use super::findings::Judge;
-use super::peak;
 use super::request::ScanOptions;
-use super::scan::assemble;
+use super::scan::{assemble, refine_shears};
 use super::stretch::Stretch;
 use crate::eval::{Beside, Evaluation, ModelPose, Pose, Reference, Variant, run_length};
 use crate::model::Transform;
@@ -107,7 +106,7 @@ impl<'v, 'e, 'a> VariantJudges<'v, 'e, 'a> {
             .zip(self.variants)
             .map(|(chunks, variant)| {
                 let mut analysis = assemble(figure, times.clone(), Vec::new(), chunks, &variant.bones);
-                peak::refine(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &self.judge);
+                refine_shears(variant.evaluation, &analysis.times, &mut analysis.scan.bones, &self.judge);
                 analysis.scan
             })
             .collect()

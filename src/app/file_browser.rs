@@ -11,9 +11,7 @@ use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
 use super::notifications::Notifications;
-
-/// File extensions bonescope reads, shown in the browser.
-const EXTENSIONS: [&str; 8] = ["glb", "gltf", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
+use crate::import::Format;
 
 /// A native dialog that answers sooner than this without a file did not really open.
 const TOO_FAST: Duration = Duration::from_millis(300);
@@ -60,7 +58,8 @@ impl DialogOutcome {
 /// Runs the native dialog and times it.
 fn run_native_dialog() -> DialogOutcome {
     let started = Instant::now();
-    let choice = rfd::FileDialog::new().add_filter("animation", &EXTENSIONS).add_filter("any file", &["*"]).pick_file();
+    let extensions: Vec<&str> = Format::every_extension().collect();
+    let choice = rfd::FileDialog::new().add_filter("animation", &extensions).add_filter("any file", &["*"]).pick_file();
     DialogOutcome::of(choice, started.elapsed())
 }
 
@@ -242,9 +241,7 @@ fn list(folder: &Path) -> std::io::Result<Vec<(String, bool)>> {
             continue;
         }
         let is_folder = entry.path().is_dir();
-        let readable =
-            Path::new(&name).extension().is_some_and(|e| EXTENSIONS.iter().any(|x| e.eq_ignore_ascii_case(x)));
-        if is_folder || readable {
+        if is_folder || Format::named_by(Path::new(&name)).is_some() {
             entries.push((name, is_folder));
         }
     }

@@ -144,6 +144,13 @@ fn thresholds(ui: &mut egui::Ui, tolerances: &mut Tolerances, compare_percent: &
                 90.0,
                 "°",
             ),
+            (
+                "min non-uniform",
+                "a bone not stretched is non-uniform when max/min of its scale factors exceeds 1 + this",
+                &mut tolerances.min_non_uniform,
+                1.0,
+                "",
+            ),
         ];
         let compared = (
             "compared file",

@@ -42,13 +42,20 @@ impl NodePlan {
     }
 
     /// Every mesh on its bone's node; meshes that share a bone share its glTF mesh as primitives when they can
-    /// (the same skin and as many morph targets), else hang on child nodes of their own.
+    /// (the same skin and as many morph targets), else hang on child nodes of their own. A mesh without a face is
+    /// left out: glTF has no empty accessor, and a placeholder (as exporters leave on characters) shows nothing.
     fn place_meshes(&mut self, rig: &Rig) {
         let mut by_bone: Vec<Vec<usize>> = vec![Vec::new(); rig.skeleton.len()];
+        let mut faceless = Vec::new();
         for (m, mesh) in rig.meshes.iter().enumerate() {
-            if let Some(list) = by_bone.get_mut(mesh.bone) {
+            if mesh.indices.is_empty() {
+                faceless.push(mesh.name.clone());
+            } else if let Some(list) = by_bone.get_mut(mesh.bone) {
                 list.push(m);
             }
+        }
+        if !faceless.is_empty() {
+            self.notes.push(format!("meshes without faces left out (glTF has no empty mesh): {}", faceless.join(", ")));
         }
         let mut moved = Vec::new();
         for (bone, meshes) in by_bone.into_iter().enumerate() {

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use clap::Args;
 
-use super::options::{Distance, choice, parse_distance};
+use super::options::{Distance, choice, files_help, parse_distance};
 use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, OutputFormat};
@@ -17,7 +17,7 @@ use crate::model::Choice;
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content); without one, the built-in demo rig.
+    #[arg(help = files_help("The animation file", "; without one, the built-in demo rig"))]
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,

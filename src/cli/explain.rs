@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::Args;
 
 use super::layers::bone_index;
-use super::options::parse_rate;
+use super::options::{files_help, parse_rate};
 use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
@@ -18,7 +18,7 @@ use crate::model::{At, InheritMode, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct ExplainArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
+    #[arg(help = files_help("The animation file", ""))]
     pub file: PathBuf,
     /// The bone to explain, by name or index (repeatable; default: every stretched bone, the worst first).
     #[arg(long, value_name = "NAME|INDEX")]

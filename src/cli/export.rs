@@ -8,7 +8,7 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use super::options::choice;
+use super::options::{choice, files_help};
 use super::setup::evaluation;
 use crate::eval::{Setup, SkinningMethod};
 use crate::export::{EvaluatedMesh, write_obj};
@@ -24,7 +24,7 @@ pub enum ExportFormat {
 
 #[derive(Debug, Args)]
 pub struct ExportArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz).
+    #[arg(help = files_help("The animation file", ""))]
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 
+use super::options::files_help;
 use super::setup::evaluation;
 use super::table::{Table, shown, vector};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
@@ -15,7 +16,7 @@ use crate::model::{At, Choice};
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
+    #[arg(help = files_help("The animation file", ""))]
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,

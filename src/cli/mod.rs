@@ -42,7 +42,7 @@ pub struct Cli {
     /// at most a quarter of the process's address-space limit); a file estimated to need more is refused.
     #[arg(long, global = true, value_name = "SIZE", value_parser = crate::import::budget::parse_size)]
     pub max_memory: Option<u64>,
-    /// The animation file to open in the app (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz).
+    #[arg(help = options::files_help("The animation file to open in the app", ""))]
     pub file: Option<std::path::PathBuf>,
 }
 

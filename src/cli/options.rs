@@ -5,6 +5,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, ValueEnum};
 
 use crate::analysis::Tolerances;
+use crate::import::Format;
 use crate::model::{Choice, Clip, InheritMode, ModeChoice, Rig};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -97,6 +98,12 @@ pub fn parse_comparison(s: &str) -> Result<[ModeChoice; 2], String> {
     Ok([parse(a)?, parse(b)?])
 }
 
+/// The help of an argument naming animation files: `what`, the formats read ([`Format::listed`]), then `rest` (what
+/// more it may name; a help line ends without a full stop).
+pub fn files_help(what: &str, rest: &str) -> String {
+    format!("{what} ({}; recognised by content){rest}", Format::listed())
+}
+
 /// The thresholds of the verdicts.
 #[derive(Clone, Debug, Args)]
 pub struct ToleranceArgs {
@@ -109,6 +116,10 @@ pub struct ToleranceArgs {
     /// ...and it shears by more than this many degrees (the largest deviation from 90° between two axes).
     #[arg(long, value_name = "DEGREES", default_value_t = Tolerances::default().min_shear_deg)]
     pub min_shear_deg: f64,
+    /// A bone not stretched counts as non-uniformly scaled when max/min of its scale factors exceeds 1 + this (below
+    /// it, the rounding exporters leave on a scale of 1).
+    #[arg(long, value_name = "RATIO", default_value_t = Tolerances::default().min_non_uniform)]
+    pub min_non_uniform: f64,
 }
 
 impl ToleranceArgs {
@@ -117,6 +128,7 @@ impl ToleranceArgs {
             ("--min-anisotropy", self.min_anisotropy),
             ("--min-stretch-deg", self.min_stretch_deg),
             ("--min-shear-deg", self.min_shear_deg),
+            ("--min-non-uniform", self.min_non_uniform),
         ];
         for (name, value) in values {
             if !(value >= 0.0 && value.is_finite()) {
@@ -127,6 +139,7 @@ impl ToleranceArgs {
             min_anisotropy: self.min_anisotropy,
             min_stretch_deg: self.min_stretch_deg,
             min_shear_deg: self.min_shear_deg,
+            min_non_uniform: self.min_non_uniform,
             ..Tolerances::default()
         })
     }

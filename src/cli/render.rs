@@ -8,7 +8,7 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 
 use super::EvalArgs;
-use super::options::choice;
+use super::options::{choice, files_help};
 use crate::app::{BonescopeApp, Chrome, Compared, Document, Ghost, Pane, Settings};
 use crate::eval::SkinningMethod;
 use crate::import;
@@ -18,7 +18,7 @@ use crate::view::{SceneOptions, ViewKind};
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The animation file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz); without one, the built-in demo rig.
+    #[arg(help = files_help("The animation file", "; without one, the built-in demo rig"))]
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Args, ValueEnum};
 
 use super::layers::LayerArgs;
-use super::options::{clip_index, parse_angle, parse_comparison, parse_rate};
+use super::options::{clip_index, files_help, parse_angle, parse_comparison, parse_rate};
 use super::setup::evaluation;
 use super::table::{Table, shown};
 use super::{EvalArgs, ToleranceArgs};
@@ -24,13 +24,15 @@ use crate::import::text::printable;
 use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
 use crate::model::{Choice, ModeChoice, Rig};
 
+/// What else `scan` and `storage` take for files.
+const FILES_REST: &str = ", folders (walked: every file in them that is an animation), globs (`'exports/**/*.fbx'`), \
+                          or `-` for a list of paths on standard input";
+
 /// The files a report over a library covers, how many at once, and how it is written: what `scan` and `storage`
 /// share.
 #[derive(Debug, Args)]
 pub struct LibraryArgs {
-    /// The animation files (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content), folders (walked: every file in them
-    /// that is an animation), globs (`'exports/**/*.fbx'`), or `-` for a list of paths on standard input.
-    #[arg(required = true)]
+    #[arg(required = true, help = files_help("The animation files", FILES_REST))]
     pub files: Vec<PathBuf>,
     /// In folders, scan only files matching this glob (by name, or by path below the folder when it has a `/`;
     /// case-insensitive; repeatable), e.g. `--include '*.fbx'`.

@@ -10,12 +10,14 @@ mod bvh;
 mod demo;
 mod failure;
 mod fbx;
+mod format;
 mod gltf;
 mod magnitude;
 pub mod text;
 mod usd;
 
 pub use demo::{demo_rig, stress_rig};
+pub use format::Format;
 
 use std::borrow::Cow;
 use std::fmt;
@@ -104,19 +106,6 @@ fn printable_rig(mut rig: Rig) -> Rig {
         }
     }
     rig
-}
-
-/// The formats bonescope reads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Format {
-    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
-    Gltf,
-    /// FBX, binary or ASCII, any version ufbx reads (5.x to 7.x).
-    Fbx,
-    /// Biovision Hierarchy motion capture.
-    Bvh,
-    /// OpenUSD (UsdSkel), text (`.usda`), binary (`.usdc`) or packaged (`.usdz`).
-    Usd,
 }
 
 /// The space the model matrices of a loaded rig live in.
@@ -227,8 +216,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &Options) -> Result<R
         None => Err(ImportError::new(
             path,
             None,
-            "not a recognised animation file (expected glTF 2.0 .gltf/.glb, FBX binary or ASCII, BVH, or USD \
-             .usda/.usdc/.usdz)",
+            format!("not a recognised animation file (expected one of {})", Format::listed()),
         )),
     }
 }

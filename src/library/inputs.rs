@@ -3,7 +3,7 @@
 //! - A file is scanned as named, whatever its content (a file that is not an animation then fails to load, which
 //!   the report says).
 //! - A folder is walked recursively (symbolic links followed, loops detected by walkdir) and the files in it with an
-//!   animation's extension (`.gltf`, `.glb`, `.fbx`, `.bvh`, any case) or, without one, an unmistakable signature in
+//!   animation's extension (a format's, [`Format::extensions`], any case) or, without one, an unmistakable signature in
 //!   their first 64 KiB (GLB or FBX magic, FBX's ASCII header, BVH's `HIERARCHY`, JSON whose top-level `asset`
 //!   states a `version`: [`recognised`]) are scanned: a broken export is an error in the report, never passed over,
 //!   and a library's other files (manifests, reports, a test suite's `assets.json`) are left out;
@@ -19,6 +19,8 @@
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
+
+use crate::import::Format;
 
 /// How much of a file is read to recognise its format.
 const SNIFF_BYTES: u64 = 64 * 1024;
@@ -174,7 +176,7 @@ impl Inputs {
                     let relative = entry.path().strip_prefix(folder).unwrap_or(entry.path());
                     // Pipes and devices are never opened here: with an animation's name they fail to load, naming
                     // themselves; without one they are not animations.
-                    let animation = has_animation_extension(entry.path())
+                    let animation = Format::named_by(entry.path()).is_some()
                         || (entry.file_type().is_file() && recognised(entry.path()));
                     if filter.admits(relative) && animation {
                         let key = key_of(relative);
@@ -207,15 +209,6 @@ fn is_glob(path: &Path) -> bool {
     path.to_string_lossy().contains(['*', '?', '['])
 }
 
-/// The extensions of the formats bonescope reads (lower case).
-pub const ANIMATION_EXTENSIONS: &[&str] = &["gltf", "glb", "fbx", "bvh", "usd", "usda", "usdc", "usdz"];
-
-/// Whether `path` is named as an animation file.
-fn has_animation_extension(path: &Path) -> bool {
-    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    extension.is_some_and(|e| ANIMATION_EXTENSIONS.contains(&e.as_str()))
-}
-
 /// Whether a file not named as an animation carries a signature that cannot be mistaken, as a pipeline tells its
 /// files apart: GLB's magic, FBX's binary magic or ASCII header, BVH's `HIERARCHY`, USD's `#usda` or `PXR-USDC`, or JSON whose top-level `asset`
 /// states a `version` (every glTF's does; a manifest's `{"asset": {"generator": …}}`, a test suite's `assets.json` or
@@ -224,7 +217,7 @@ fn recognised(path: &Path) -> bool {
     let mut head = Vec::new();
     let read = std::fs::File::open(path).and_then(|f| f.take(SNIFF_BYTES).read_to_end(&mut head));
     match (read, crate::import::detect(&head)) {
-        (Ok(_), Some(crate::import::Format::Gltf)) if !head.starts_with(b"glTF") => {
+        (Ok(_), Some(Format::Gltf)) if !head.starts_with(b"glTF") => {
             (head.len() as u64) < SNIFF_BYTES && states_gltf_version(&head)
         }
         (Ok(_), format) => format.is_some(),

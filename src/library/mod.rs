@@ -6,7 +6,7 @@ mod junit;
 mod merged;
 mod pool;
 
-pub use inputs::{ANIMATION_EXTENSIONS, Filter, Found, InputProblem, Inputs, collect};
+pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
 pub use junit::{Case, junit, junit_of};
 pub use merged::{merge, read_json_lines};
 pub use pool::in_order;

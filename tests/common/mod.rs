@@ -56,6 +56,11 @@ pub fn asset(path: &str) -> PathBuf {
     assets().join(path)
 }
 
+/// A file of the shared corpus (`FOLDER/NAME`: whole sets of files, `blender-io/`, `realworld/`).
+pub fn corpus(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpus").join(path)
+}
+
 /// A file of the shared assets (`FOLDER/NAME`), loaded; panics with the import error.
 pub fn load_asset(path: &str) -> Rig {
     bonescope::import::load(&asset(path)).unwrap_or_else(|e| panic!("{e}"))

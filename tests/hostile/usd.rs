@@ -41,6 +41,11 @@ fn layer_with(sublayers: &[&str], reference: Option<&str>) -> Vec<u8> {
     text.into_bytes()
 }
 
+/// A prim with an attribute of a type USD does not know (`flaot[]`) holding `value`.
+fn unknown_type(value: &str) -> Vec<u8> {
+    format!("#usda 1.0\ndef Xform \"x\" {{\n    flaot[] weights = {value}\n}}\n").into_bytes()
+}
+
 /// Blender's binary export of the stretchy arm cut to `fraction` of its length.
 fn cut_crate(fraction: f64) -> Vec<u8> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/blender/stretchy_full.usdc");
@@ -77,6 +82,9 @@ pub fn cases() -> Vec<Case> {
         Case::new("usd_cut_crate", 4, "a.usdc", cut_crate(0.5), Expect::Refused("a.usdc")),
         Case::new("usd_crate_header", 4, "a.usdc", cut_crate(0.001), Expect::Refused("a.usdc")),
         Case::new("usda_unclosed", 4, "a.usda", b"#usda 1.0\ndef Xform \"x\" {\n".to_vec(), Expect::Refused("a.usda")),
+        // A type USD does not know: its value passed over, with a note; never closed, the layer is refused.
+        Case::new("usda_unknown_type", 4, "a.usda", unknown_type("[(1, -inf), [2]]"), Expect::Loads("flaot[]")),
+        Case::new("usda_unknown_type_unclosed", 4, "a.usda", unknown_type("[(1, [2]"), Expect::Refused("a.usda")),
         // 5. Control characters in joint names.
         Case::new("usd_names", 5, "a.usda", evil_names.into_bytes(), Expect::Loads("")),
         // 6. Outside the folder (the corpus's `outside/secret.bin`): a reference, a sublayer through a link; a pipe,

@@ -27,6 +27,7 @@ use std::path::Path;
 
 use glam::{DMat4, DVec3};
 use openusd::usd::{PrimPredicate, Stage};
+use openusd::usda::unregistered::Unregistered;
 
 use super::{ImportError, Options, Space};
 use crate::model::{Clip, MorphWeights, Placement, Rig, Skeleton, Span, Unit};
@@ -42,15 +43,28 @@ const DEFAULT_METERS_PER_UNIT: f64 = 0.01;
 /// charged to the memory budget before it is allocated (the counts in their headers say how large; a value dropped
 /// once read is given back): a file that would need more at once is refused with the budget's figures.
 pub fn load(path: &Path, options: &Options) -> Result<Rig, ImportError> {
-    let (read, needed) =
-        openusd::usdc::budget::within(super::budget::limit(), || guard::caught(|| read(path, options)));
+    let ((read, needed), unregistered) = openusd::usda::unregistered::within(|| {
+        openusd::usdc::budget::within(super::budget::limit(), || guard::caught(|| read(path, options)))
+    });
     let read = read.unwrap_or_else(|bug| {
         Err(ImportError::new(path, None, format!("the USD reader failed (a bug in openusd): {bug}")))
     });
-    read.map_err(|error| match within_budget(needed, || "the arrays read from its layers".to_owned()) {
-        Err(message) => ImportError::new(path, None, message),
-        Ok(()) => error,
-    })
+    let mut rig =
+        read.map_err(|error| match within_budget(needed, || "the arrays read from its layers".to_owned()) {
+            Err(message) => ImportError::new(path, None, message),
+            Ok(()) => error,
+        })?;
+    rig.notes.extend(unregistered_note(&unregistered));
+    Ok(rig)
+}
+
+/// What the text layers hold that no USD type reads: attributes of unknown types (a typo: `flaot[]`), whose values
+/// Pixar's USD keeps as text no schema reads, and so does the `openusd` crate. A reader asking for one finds no
+/// value of its type: it is skipped.
+fn unregistered_note(unregistered: &[Unregistered]) -> Option<String> {
+    let listed: Vec<String> =
+        unregistered.iter().map(|u| format!("{} ({})", u.attribute.as_str(), u.type_name)).collect();
+    (!listed.is_empty()).then(|| format!("attributes of types USD does not know, skipped: {}", listed.join(", ")))
 }
 
 /// [`load`], unguarded.

@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 
 pub mod parser;
 pub mod token;
+pub mod unregistered;
 mod writer;
 
 use parser::Parser;

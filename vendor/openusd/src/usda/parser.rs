@@ -571,6 +571,11 @@ impl<'a> Parser<'a> {
         let type_info = self.try_parse_type()?.context("attribute type expected")?;
 
         let name = self.expect_name().context("attribute name expected")?;
+        if type_info.ty == Type::Custom {
+            // bonescope: listed for the caller (`unregistered`); its value is kept as text.
+            let type_name = type_info.to_string();
+            super::unregistered::found(current_path.append_property(name)?, type_name);
+        }
 
         // Read optional `.suffix` (e.g. `.connect`, `.timeSamples`, `.spline`).
         let suffix = if self.try_consume(Token::Punctuation('.')) {
@@ -1542,12 +1547,35 @@ impl<'a> Parser<'a> {
 
             (Type::Dictionary, _) => self.parse_dictionary()?,
 
-            (Type::Custom, _) => bail!("Cannot parse value for unrecognized type: {}", info.type_name),
+            // bonescope: kept as the text written, as Pixar's USD keeps it (`unregistered`).
+            (Type::Custom, _) => sdf::Value::UnregisteredValue(self.parse_unregistered_value()?.to_owned()),
 
             (ty, true) => bail!("Array of {ty:?} is not supported"),
         };
 
         Ok(value)
+    }
+
+    /// bonescope: the text of a value of an unknown type: one token (a sign and what it signs), or a `[...]`,
+    /// `(...)` or `{...}` block whole.
+    fn parse_unregistered_value(&mut self) -> Result<&'a str> {
+        let start = self.iter.peek().map(|(_, span)| span.start).context("Unexpected end of tokens")?;
+        let mut depth = 0usize;
+        loop {
+            match self.fetch_next()? {
+                Token::Punctuation('[' | '(' | '{') => depth += 1,
+                Token::Punctuation(']' | ')' | '}') => {
+                    depth = depth.checked_sub(1).context("Unbalanced brackets in a value")?;
+                }
+                Token::Punctuation('-' | '+') if depth == 0 => continue,
+                _ => {}
+            }
+            if depth == 0 {
+                break;
+            }
+        }
+        let end = self.last_span.as_ref().map_or(start, |span| span.end);
+        Ok(&self.source[start..end])
     }
 
     /// Parses a scalar type name into a `Type`. Does not handle arrays.
