@@ -82,7 +82,7 @@ fn clip_analysis(c: &mut Criterion) {
 fn selection_curves(c: &mut Criterion) {
     let rig = shared_assets::repeated_cmu_walk(40);
     let clip = rig.clips.first();
-    eprintln!("repeated CMU walk: {:.1} s, {} bones", clip.map_or(0.0, |c| c.duration()), rig.skeleton.len());
+    eprintln!("repeated CMU walk: {:.1} s, {} bones", clip.map_or(0.0, |c| c.span().length()), rig.skeleton.len());
     let hierarchy = Hierarchy::new(&rig.skeleton, &rig.skeleton.declared_modes()).unwrap();
     let hand = rig.skeleton.bones().iter().position(|b| b.name.contains("Hand")).unwrap_or(rig.skeleton.len() - 1);
     let options = ScanOptions { rate: clip.map_or(30.0, |c| c.frame_rate()), ..ScanOptions::default() };

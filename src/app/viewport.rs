@@ -42,7 +42,7 @@ impl Viewport {
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
-        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.duration(), MOTION_SAMPLES, pose_at);
+        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at);
     }
 
     /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
