@@ -511,6 +511,18 @@ fn another_clip_holds_the_time_within_its_own_span() {
 }
 
 #[test]
+fn the_controls_after_the_time_hold_still_as_it_changes() {
+    let mut harness = blender_app();
+    let length = harness.get_by_label("of 2.000 s").rect();
+    // Between two frames ("frame 1.5") and at the last ("frame 61"): the field keeps its width.
+    for time in [1.5 / 30.0, harness.state().session.doc.span().end] {
+        harness.state_mut().window.time = time;
+        harness.run();
+        assert_eq!(harness.get_by_label("of 2.000 s").rect(), length, "at {time} s");
+    }
+}
+
+#[test]
 fn the_time_readout_takes_a_typed_time() {
     let mut harness = demo_app();
     harness.get_by_role_and_label(Role::SpinButton, "current time").click();

@@ -6,6 +6,7 @@ use egui::{Color32, Rect, Sense, Stroke, pos2, vec2};
 use super::panel::Shared;
 use super::reduce::merge_spans;
 use super::settings::TimeUnit;
+use super::text::text_width;
 use crate::model::{Clip, Span};
 use crate::view::Badge;
 
@@ -118,6 +119,7 @@ fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64,
     let field = egui::DragValue::new(shared.time)
         .range(span.start..=span.end)
         .speed(span.length().max(1e-3) / 500.0)
+        .min_size(vec2(time_field_width(ui, unit, rate, span), ui.spacing().interact_size.y))
         .custom_formatter(move |seconds, _| unit.format(seconds, rate))
         .custom_parser(move |text| unit.parse(text, rate));
     let response = ui.add(field).on_hover_text("type a time, a frame or a tick in the chosen unit");
@@ -125,6 +127,15 @@ fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64,
     if response.changed() {
         *shared.playing = false;
     }
+}
+
+/// As wide as the time field's widest text, so the controls after it hold still while the clip plays: either end
+/// of the span half a frame farther from 0 (the most digits, and a frame's decimal).
+fn time_field_width(ui: &egui::Ui, unit: TimeUnit, rate: f64, span: Span) -> f32 {
+    let font = ui.style().drag_value_text_style.resolve(ui.style());
+    let half_frame = 0.5 / rate;
+    let widest = [span.start, span.end].map(|t| text_width(ui, &unit.format(t + half_frame.copysign(t), rate), &font));
+    widest[0].max(widest[1]) + 2.0 * ui.spacing().button_padding.x
 }
 
 /// The timeline's frame rate: the clip's own (from its file), or one the user types; "file's rate" goes back.

@@ -98,10 +98,8 @@ impl Viewport {
 fn caption(shared: &Shared) -> Vec<String> {
     let doc = &*shared.doc;
     let clip = doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
-    let settings = &*shared.settings;
     let modes = doc.common_mode().map_or_else(|| "mixed modes".to_owned(), |m| format!("mode: {}", m.id()));
-    let mut lines =
-        vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, doc.frame_rate()), modes];
+    let mut lines = vec![format!("{} · {clip}", doc.title()), shared.time_text(*shared.time), modes];
     let layers = doc.layers().summary(&doc.rig, doc.clip());
     lines.extend(layers.split("; ").filter(|l| !l.is_empty()).map(str::to_owned));
     lines
