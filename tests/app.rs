@@ -219,15 +219,16 @@ fn the_layers_panel_turns_on_a_synced_blend_and_the_timeline_follows_its_cycle()
     let blend = doc.layers().blend.expect("the checkbox turned the blend on");
     // The demo's second clip ("bend"), half way, synced: the cycle is (T2 − T1)·a + T1.
     assert_eq!((blend.clip, blend.weight, blend.sync), (1, 0.5, true));
-    let (t1, t2) = (doc.rig.clips[0].duration(), doc.rig.clips[1].duration());
+    let (t1, t2) = (doc.rig.clips[0].span().length(), doc.rig.clips[1].span().length());
     let cycle = (t2 - t1) * 0.5 + t1;
-    assert!((doc.duration() - cycle).abs() < 1e-12, "timeline {} s, cycle {cycle} s", doc.duration());
+    let timeline = doc.span().length();
+    assert!((timeline - cycle).abs() < 1e-12, "timeline {timeline} s, cycle {cycle} s");
     harness.get_by_label(&format!("cycle (T2 − T1)·a + T1 = {cycle:.4} s"));
     // Turning it off again restores the clip's own length.
     harness.get_by_label("blend a second clip").click();
     settle(&mut harness);
     assert!(harness.state().session.doc.layers().is_empty());
-    assert_eq!(harness.state().session.doc.duration(), t1);
+    assert_eq!(harness.state().session.doc.span().length(), t1);
 }
 
 #[test]
@@ -343,11 +344,13 @@ fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
         .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(Some(path), rig)));
     harness.get_by_label("pCube1").click();
     settle(&mut harness);
-    assert!(harness.state().session.doc.clip().unwrap().duration() > 333_000.0);
+    assert!(harness.state().session.doc.clip().unwrap().span().length() > 333_000.0);
     harness.get_by_label("time bar");
     harness.get_by_label("Next frame").click();
     settle(&mut harness);
-    assert!((harness.state().window.time - 1.0 / 30.0).abs() < 1e-9, "one frame on: {}", harness.state().window.time);
+    // The take starts where Maya stored it, far before 0: one frame after that.
+    let (time, start) = (harness.state().window.time, harness.state().session.doc.span().start);
+    assert!(start < -166_000.0 && (time - start - 1.0 / 30.0).abs() < 1e-9, "one frame on from {start}: {time}");
 }
 
 #[test]
@@ -418,7 +421,7 @@ fn frames_are_the_clips_own_and_whole() {
     // End and Home go to the ends; Play at the end without Loop starts again.
     harness.key_press(egui::Key::End);
     harness.run();
-    assert_eq!(harness.state().window.time, harness.state().session.doc.duration());
+    assert_eq!(harness.state().window.time, harness.state().session.doc.span().end);
     harness.get_by_label("Loop").click();
     harness.run();
     harness.get_by_label("Play").click();
@@ -430,6 +433,93 @@ fn frames_are_the_clips_own_and_whole() {
     harness.key_press(egui::Key::Home);
     harness.run();
     assert_eq!(harness.state().window.time, 0.0);
+}
+
+/// Blender's glTF export, on its own clock: both clips start at frame 1 (1/30 s); `squash_stretch` (opened) plays
+/// 2 s, to frame 61, `wave` 1.33 s.
+fn blender_app() -> Harness<'static, BonescopeApp> {
+    asset_app("blender/stretchy_full.glb")
+}
+
+/// The current time in frames of the document's rate.
+fn frame(harness: &Harness<'static, BonescopeApp>) -> f64 {
+    harness.state().window.time * harness.state().session.doc.frame_rate()
+}
+
+#[test]
+fn a_clip_from_frame_1_opens_there_and_steps_to_frame_2() {
+    let mut harness = blender_app();
+    let span = harness.state().session.doc.span();
+    assert!((span.start - 1.0 / 30.0).abs() < 1e-7, "{span:?}");
+    assert_eq!(harness.state().window.time, span.start, "the playhead at the clip's start, not at 0");
+    harness.key_press(egui::Key::ArrowRight);
+    harness.run();
+    assert!((frame(&harness) - 2.0).abs() < 1e-9, "frame {}", frame(&harness));
+    // Back, and no further than the first frame.
+    for _ in 0..2 {
+        harness.get_by_label("Previous frame").click();
+        harness.run();
+    }
+    assert_eq!(harness.state().window.time, span.start);
+}
+
+#[test]
+fn home_and_end_go_to_the_ends_of_the_clips_span() {
+    let mut harness = blender_app();
+    harness.state_mut().window.time = 1.0;
+    harness.key_press(egui::Key::End);
+    harness.run();
+    let span = harness.state().session.doc.span();
+    assert!((span.end - 61.0 / 30.0).abs() < 1e-7, "{span:?}");
+    assert_eq!(harness.state().window.time, span.end);
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    assert_eq!(harness.state().window.time, span.start, "frame 1, not 0");
+}
+
+#[test]
+fn a_loop_goes_round_within_the_clips_span() {
+    // A mocked clock, as in `a_pause_or_an_idle_spell_never_counts_as_playing`.
+    let mut harness = blender_app();
+    let at = |harness: &mut Harness<'static, BonescopeApp>, t: f64| {
+        harness.input_mut().time = Some(t);
+        harness.step();
+    };
+    let span = harness.state().session.doc.span();
+    assert!(harness.state().settings.looping);
+    at(&mut harness, 100.0);
+    harness.state_mut().window.time = span.end - 0.05;
+    harness.state_mut().toggle_play();
+    at(&mut harness, 100.0);
+    at(&mut harness, 100.1);
+    // 0.05 s past the end goes on 0.05 s after the clip's start, not 0.05 s after 0.
+    let time = harness.state().window.time;
+    assert!(harness.state().window.playing && (time - (span.start + 0.05)).abs() < 1e-9, "{time} in {span:?}");
+}
+
+#[test]
+fn another_clip_holds_the_time_within_its_own_span() {
+    let mut harness = blender_app();
+    harness.state_mut().window.time = 1.8;
+    harness.get_by_role_and_label(Role::ComboBox, "Animation").click();
+    harness.run();
+    harness.get_by_label("wave (1.33 s)").click();
+    settle(&mut harness);
+    let doc = &harness.state().session.doc;
+    assert_eq!(doc.clip().map(|c| c.label()).as_deref(), Some("wave"));
+    assert_eq!(harness.state().window.time, doc.span().end, "1.8 s is past its end");
+}
+
+#[test]
+fn the_controls_after_the_time_hold_still_as_it_changes() {
+    let mut harness = blender_app();
+    let length = harness.get_by_label("of 2.000 s").rect();
+    // Between two frames ("frame 1.5") and at the last ("frame 61"): the field keeps its width.
+    for time in [1.5 / 30.0, harness.state().session.doc.span().end] {
+        harness.state_mut().window.time = time;
+        harness.run();
+        assert_eq!(harness.get_by_label("of 2.000 s").rect(), length, "at {time} s");
+    }
 }
 
 #[test]
@@ -850,7 +940,7 @@ fn a_pause_or_an_idle_spell_never_counts_as_playing() {
     );
     harness.state_mut().window.playing = false;
     // At the end of a clip without Loop, Play after an idle spell plays from the start.
-    let end = harness.state().session.doc.duration();
+    let end = harness.state().session.doc.span().end;
     harness.state_mut().settings.looping = false;
     harness.state_mut().window.time = end;
     at(&mut harness, 200.0);
@@ -889,7 +979,7 @@ fn frames_are_frames_everywhere_once_chosen() {
         .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
     settle(&mut harness);
     let rate = harness.state().session.doc.frame_rate();
-    let frames = (harness.state().session.doc.duration() * rate).round();
+    let frames = (harness.state().session.doc.span().length() * rate).round();
     harness.get_by_label(&format!("of {frames} frames"));
     // A click anywhere on the time bar lands on a whole frame.
     let bar = harness.get_by_label("time bar").rect();

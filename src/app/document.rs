@@ -9,7 +9,7 @@ use super::identity::RigId;
 use crate::analysis::ScanOptions;
 use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};
-use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton};
+use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton, Span};
 
 /// A second pose drawn translucent over the first and plotted dashed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -173,10 +173,11 @@ impl Document {
         self.frame_rate().max(ScanOptions::default().rate)
     }
 
-    /// How long the timeline runs: the clip's duration, or what the layers make of it (a synced blend's cycle, a
-    /// crossfade into a longer clip).
-    pub fn duration(&self) -> f64 {
-        self.layers.duration(&self.rig, self.clip())
+    /// Where the timeline runs on the clip's own clock: from the clip's start for as long as the clip plays, or as
+    /// long as the layers make it (a synced blend's cycle, a crossfade into a longer clip); at 0 for the rest pose.
+    pub fn span(&self) -> Span {
+        let start = self.clip().map_or(0.0, |clip| clip.span().start);
+        Span::new(start, start + self.layers.length(&self.rig, self.clip()))
     }
 
     /// What the document shows: its clip under its modes, through its layers.
@@ -317,6 +318,21 @@ mod tests {
         doc.ghost = Some(Ghost::Unlayered);
         let unlayered = doc.ghost_evaluation().unwrap();
         assert_eq!((unlayered.modes(), unlayered.layers().is_none()), (doc.modes(), true));
+    }
+
+    #[test]
+    fn the_timeline_runs_on_the_clips_clock_and_its_layers_count_from_its_start() {
+        // The demo's stretch on a file's clock that starts at 0.5 s (an FBX take's stored start).
+        let mut rig = import::demo_rig();
+        rig.clips[0] = rig.clips[0].clone().with_span(Span::new(0.5, 2.5));
+        let mut doc = Document::new(None, rig);
+        doc.set_clip(Some(0)).unwrap();
+        assert_eq!(doc.span(), Span::new(0.5, 2.5));
+        // A crossfade 1.8 s after the clip's start runs on until the incoming clip ends.
+        let incoming = doc.rig.clips[1].span().length();
+        let crossfade = crate::eval::layers::Crossfade { clip: 1, at: 1.8, duration: 0.2, curve: Default::default() };
+        doc.set_layers(&Layers { crossfade: Some(crossfade), ..Layers::default() }).unwrap();
+        assert_eq!(doc.span(), Span::new(0.5, 0.5 + (1.8 + incoming)));
     }
 
     #[test]

@@ -161,8 +161,8 @@ fn blend_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
         ui.checkbox(&mut blend.sync, "sync (normalised time)");
         value_combo(ui, "rotations", &mut blend.rotation);
         if blend.sync {
-            let t1 = shared.doc.clip().map_or(0.0, |c| c.duration());
-            let t2 = rig.clips.get(blend.clip).map_or(0.0, |c| c.duration());
+            let t1 = shared.doc.clip().map_or(0.0, |c| c.span().length());
+            let t2 = rig.clips.get(blend.clip).map_or(0.0, |c| c.span().length());
             let cycle = SyncedCycle::new(t1, t2, blend.weight);
             ui.monospace(format!("cycle (T2 − T1)·a + T1 = {:.4} s", cycle.length));
             ui.monospace(format!("rates T1/len {:.4}, T2/len {:.4}", cycle.rates[0], cycle.rates[1]));
@@ -193,19 +193,20 @@ fn additive_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
 fn crossfade_section(ui: &mut Ui, shared: &mut Shared, layers: &mut Layers) {
     let rig = shared.doc.rig.clone();
     let main = shared.doc.setup().clip;
-    let duration = shared.doc.clip().map_or(0.0, |c| c.duration());
+    // The fade's times count from the main clip's start: by default it begins 0.25 s before the clip's end.
+    let length = shared.doc.clip().map_or(0.0, |c| c.span().length());
     CollapsingHeader::new("Crossfade").default_open(layers.crossfade.is_some()).show(ui, |ui| {
         let default = || Crossfade {
             clip: other_clip(&rig, main),
-            at: (duration - 0.25).max(0.0),
-            duration: 0.25_f64.min(duration.max(0.01)),
+            at: (length - 0.25).max(0.0),
+            duration: 0.25_f64.min(length.max(0.01)),
             curve: Default::default(),
         };
         enable(ui, "fade into another clip", &mut layers.crossfade, default);
         let Some(fade) = &mut layers.crossfade else { return };
         clip_combo(ui, "into", &rig, &mut fade.clip);
-        seconds(ui, "starts at", &mut fade.at);
-        seconds(ui, "lasts", &mut fade.duration);
+        seconds(ui, "starts at", "seconds after the main clip's start", &mut fade.at);
+        seconds(ui, "lasts", "seconds from the main clip alone to the other alone", &mut fade.duration);
         value_combo(ui, "weights", &mut fade.curve);
     });
 }
@@ -361,7 +362,7 @@ fn clip_combo(ui: &mut Ui, label: &str, rig: &Rig, clip: &mut usize) {
             .selected_text(current)
             .show_ui(ui, |ui| {
                 for c in &rig.clips {
-                    ui.selectable_value(clip, c.index, format!("{} ({:.2} s)", c.label(), c.duration()));
+                    ui.selectable_value(clip, c.index, super::text::clip_choice(c));
                 }
             })
             .response
@@ -391,10 +392,11 @@ fn weight_slider(ui: &mut Ui, weight: &mut f64, label: &str) -> egui::Response {
     ui.add(Slider::new(weight, 0.0..=1.0).text(label))
 }
 
-fn seconds(ui: &mut Ui, label: &str, value: &mut f64) {
+fn seconds(ui: &mut Ui, label: &str, hint: &str, value: &mut f64) {
     ui.horizontal(|ui| {
         let label = ui.label(label);
-        ui.add(DragValue::new(value).speed(0.01).range(0.0..=f64::MAX).suffix(" s")).labelled_by(label.id);
+        let field = DragValue::new(value).speed(0.01).range(0.0..=f64::MAX).suffix(" s");
+        ui.add(field).labelled_by(label.id).on_hover_text(hint);
     });
 }
 

@@ -144,14 +144,11 @@ impl BonescopeApp {
         if actions.frame_all {
             self.window.frame_all(&self.session.doc);
         }
-        if actions.clip_changed {
-            self.window.time = 0.0;
-        }
     }
 
     /// Play or pause; playing at the end of a clip that does not loop starts it again.
     pub fn toggle_play(&mut self) {
-        self.window.toggle_play(self.settings.looping, self.session.doc.duration());
+        self.window.toggle_play(self.settings.looping, self.session.doc.span());
     }
 
     /// Undoes the last edit of what the document evaluates (Edit → Undo, Ctrl+Z).

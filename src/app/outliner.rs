@@ -254,12 +254,12 @@ impl Notes {
         }
         if let (Some(worst), Some(summary)) = (self.worst, stretched_summary(shared, bone)) {
             let worst = ui.add(egui::Label::new(worst).sense(Sense::click())).on_hover_text(format!(
-                "stretched in {} of {} samples, first at {:.3} s; worst shear {:.2}° at {:.3} s (click to go there)",
+                "stretched in {} of {} samples, first at {}; worst shear {:.2}° at {} (click to go there)",
                 summary.flagged_samples,
                 shared.results.analysis.as_ref().map_or(0, |a| a.scan.samples),
-                summary.first_flagged_time.unwrap_or_default(),
+                shared.time_text(summary.first_flagged_time.unwrap_or_default()),
                 summary.worst_shear_deg,
-                summary.worst_shear_time
+                shared.time_text(summary.worst_shear_time)
             ));
             if worst.clicked() {
                 let time = summary.worst_shear_time;

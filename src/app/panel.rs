@@ -48,6 +48,11 @@ impl Shared<'_> {
         }
     }
 
+    /// `time` as the timeline shows it: in its unit, on the clip's clock (seconds with their frame beside them).
+    pub fn time_text(&self, time: f64) -> String {
+        self.settings.time_unit.format(time, self.doc.frame_rate())
+    }
+
     pub fn inspected(&self) -> Option<usize> {
         self.selection.last().copied()
     }

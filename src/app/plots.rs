@@ -228,7 +228,7 @@ impl Panel for Plots {
             ui.label(RichText::new("Select bones to plot their components over the clip.").weak());
             return;
         }
-        if shared.doc.duration() <= 0.0 {
+        if shared.doc.span().length() <= 0.0 {
             ui.label(RichText::new("One pose, no time to plot it over: the Inspector lists its values.").weak());
             return;
         }
@@ -389,19 +389,21 @@ fn plot(ui: &mut Ui, shared: &mut Shared, key: &SeriesKey, group: &mut Group, pl
         && let Some(at) = response.inner
     {
         *shared.playing = false;
-        *shared.time = unit.snap(at.x, rate).clamp(0.0, shared.doc.duration());
+        *shared.time = shared.doc.span().clamp(unit.snap(at.x, rate));
     }
 }
 
-/// The plot at `place`: the whole clip's time axis in the chosen unit, linked to the other plots' (the wheel zooms
-/// here, not egui_plot), reset when asked, and at least the curves' value range `(y_min, y_max)` tall.
+/// The plot at `place`: the whole clip's time axis, on its own clock, in the chosen unit, linked to the other plots'
+/// (the wheel zooms here, not egui_plot), reset when asked, and at least the curves' value range `(y_min, y_max)`
+/// tall.
 fn frame<'a>(shared: &Shared, place: &PlotPlace, (y_min, y_max): (f64, f64)) -> Plot<'a> {
+    let span = shared.doc.span();
     let mut plot = Plot::new(("components", place.index))
         .id(plot_id(place.index))
         .height(place.height)
         // The curves are reduced to the visible range, so auto-bounds alone would never widen past it.
-        .include_x(0.0)
-        .include_x(shared.doc.duration())
+        .include_x(span.start)
+        .include_x(span.end)
         // Never narrower than the value range (at least `MIN_SPAN`): rounding noise on a flat curve reads as flat.
         .include_y(y_min)
         .include_y(y_max)

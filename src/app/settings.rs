@@ -6,14 +6,16 @@ use std::path::PathBuf;
 use super::pane::{Layout, Pane, Visibility};
 use crate::analysis::Tolerances;
 use crate::eval::layers::TICKS_PER_SECOND;
+use crate::model::{At, frames};
 use crate::view::{Camera, SceneOptions};
 
-/// How times are shown. The library always works in seconds.
+/// How times are shown, on the clip's own clock. The library always works in seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TimeUnit {
     #[default]
     Seconds,
-    /// Frames at the document's frame rate.
+    /// Frames at the document's frame rate, counted on the clip's clock: frame `n` at `n / rate` (Blender's first
+    /// frame, at 1/30 s, is frame 1).
     Frames,
     /// 3ds Max ticks, 4800 per second.
     Ticks,
@@ -30,20 +32,22 @@ impl TimeUnit {
         }
     }
 
-    /// The time `seconds` in this unit, as text: a frame number is whole on a frame, with a decimal between frames.
+    /// The time `seconds` in this unit, as text: seconds with their frame beside them; a frame number whole on a
+    /// frame, with a decimal between frames.
     pub fn format(self, seconds: f64, frame_rate: f64) -> String {
         match self {
-            TimeUnit::Seconds => format!("{seconds:.3} s"),
-            TimeUnit::Frames => format!("frame {}", frame_number(seconds * frame_rate)),
+            TimeUnit::Seconds => At { time: seconds, rate: Some(frame_rate) }.to_string(),
+            TimeUnit::Frames => format!("frame {}", frames(seconds * frame_rate)),
             TimeUnit::Ticks => format!("{:.0} ticks", seconds * TICKS_PER_SECOND),
         }
     }
 
-    /// A length of `seconds` (a clip's duration) in this unit, as text.
+    /// A length of `seconds` (how long a clip plays) in this unit, as text.
     pub fn format_length(self, seconds: f64, frame_rate: f64) -> String {
         match self {
-            TimeUnit::Frames => format!("{} frames", frame_number(seconds * frame_rate)),
-            _ => self.format(seconds, frame_rate),
+            TimeUnit::Seconds => format!("{seconds:.3} s"),
+            TimeUnit::Frames => format!("{} frames", frames(seconds * frame_rate)),
+            TimeUnit::Ticks => self.format(seconds, frame_rate),
         }
     }
 
@@ -69,11 +73,6 @@ impl TimeUnit {
             TimeUnit::Ticks => value / TICKS_PER_SECOND,
         })
     }
-}
-
-/// A frame number: whole within a thousandth of a frame, else with one decimal.
-fn frame_number(frames: f64) -> String {
-    if (frames - frames.round()).abs() < 1e-3 { format!("{:.0}", frames + 0.0) } else { format!("{frames:.1}") }
 }
 
 /// Which plotted quantity, and how rotations are shown.
@@ -170,8 +169,10 @@ mod tests {
 
     #[test]
     fn time_units() {
-        assert_eq!(TimeUnit::Seconds.format(1.5, 30.0), "1.500 s");
+        assert_eq!(TimeUnit::Seconds.format(1.5, 30.0), "1.5000 s (frame 45)");
+        assert_eq!(TimeUnit::Seconds.format_length(1.5, 30.0), "1.500 s");
         assert_eq!(TimeUnit::Frames.format(1.5, 30.0), "frame 45");
+        assert_eq!(TimeUnit::Frames.format(1.0 / 30.0, 30.0), "frame 1", "Blender's first frame");
         assert_eq!(TimeUnit::Frames.format(1.51, 30.0), "frame 45.3");
         assert_eq!(TimeUnit::Frames.format_length(20959.0 / 120.0, 120.0), "20959 frames");
         assert_eq!(TimeUnit::Frames.snap(1.51, 30.0), 1.5);

@@ -4,10 +4,17 @@
 
 use egui::{FontId, Response, RichText, Sense, TextStyle, Ui, WidgetText};
 
+use crate::model::Clip;
+
 /// The library's words in the app's font, which has no arrow: "forearm → segment-compensate" reads "forearm to
 /// segment-compensate".
 pub fn drawable(text: &str) -> String {
     text.replace('→', "to")
+}
+
+/// A clip as the pickers list it: its name and how long it plays, "walk (2.03 s)".
+pub fn clip_choice(clip: &Clip) -> String {
+    format!("{} ({:.2} s)", clip.label(), clip.span().length())
 }
 
 /// Below this a value is shown as 0: floating-point noise of a matrix, not a measurement.

@@ -6,7 +6,8 @@ use egui::{Color32, Rect, Sense, Stroke, pos2, vec2};
 use super::panel::Shared;
 use super::reduce::merge_spans;
 use super::settings::TimeUnit;
-use crate::model::Clip;
+use super::text::text_width;
+use crate::model::{Clip, Span};
 use crate::view::Badge;
 
 pub fn ui(ui: &mut egui::Ui, shared: &mut Shared) {
@@ -17,14 +18,15 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared) {
 }
 
 /// The whole frame before or after `time` at `rate` (from between two frames, the nearer one in that direction;
-/// from a frame, the next), within `[0, duration]`.
-pub fn step_frame(time: f64, rate: f64, forward: bool, duration: f64) -> f64 {
+/// from a frame, the next), within `span`. Frames count on the clip's own clock, frame `n` at `n / rate`: a clip
+/// that starts at frame 1 steps to 2, 3 …
+pub fn step_frame(time: f64, rate: f64, forward: bool, span: Span) -> f64 {
     // Times within a millionth of a frame of a frame are on it.
     const ON_FRAME: f64 = 1e-6;
     let rate = if rate.is_finite() && rate > 0.0 { rate } else { 30.0 };
     let frame = time * rate;
     let next = if forward { (frame + ON_FRAME).floor() + 1.0 } else { (frame - ON_FRAME).ceil() - 1.0 };
-    (next / rate).clamp(0.0, duration.max(0.0))
+    span.clamp(next / rate)
 }
 
 /// The playback's clock: the seconds between frames while playing, measured from the frame that started playing, so
@@ -49,30 +51,44 @@ impl PlayClock {
     }
 }
 
-/// Play or pause; playing at the end of a clip that does not loop starts it again.
-pub fn toggle_play(playing: &mut bool, time: &mut f64, looping: bool, duration: f64) {
+/// Play or pause; playing at the end of a clip that does not loop starts it again from its start.
+pub fn toggle_play(playing: &mut bool, time: &mut f64, looping: bool, span: Span) {
     *playing = !*playing;
-    if *playing && !looping && *time >= duration {
-        *time = 0.0;
+    if *playing && !looping && *time >= span.end {
+        *time = span.start;
+    }
+}
+
+/// Where `seconds` of playing take the clip from `time`, and whether it plays on: past the end a loop goes round
+/// within the span (on from its start, what overran carried over), else playing stops at the end.
+pub fn played(time: f64, seconds: f64, span: Span, looping: bool) -> (f64, bool) {
+    let time = time + seconds;
+    if time <= span.end {
+        (time, true)
+    } else if looping && span.length() > 0.0 {
+        (span.start + (time - span.start) % span.length(), true)
+    } else {
+        (span.end, false)
     }
 }
 
 fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
-    let duration = shared.doc.duration();
+    let span = shared.doc.span();
     let rate = shared.doc.frame_rate();
-    frame_button(ui, shared, "Previous frame", "← key", false, rate, duration);
+    frame_button(ui, shared, "Previous frame", "← key", false, rate, span);
     let play_label = if *shared.playing { "Pause" } else { "Play" };
     let play = super::text::steady_button(ui, play_label, "Pause");
     if ui.add(play).on_hover_text("Space; Home and End go to the ends").clicked() {
-        toggle_play(shared.playing, shared.time, shared.settings.looping, duration);
+        toggle_play(shared.playing, shared.time, shared.settings.looping, span);
     }
-    frame_button(ui, shared, "Next frame", "→ key", true, rate, duration);
+    frame_button(ui, shared, "Next frame", "→ key", true, rate, span);
     ui.checkbox(&mut shared.settings.looping, "Loop");
     ui.add(egui::DragValue::new(&mut shared.settings.speed).range(0.01..=10.0).speed(0.01).prefix("speed ×"));
     ui.separator();
     let unit = shared.settings.time_unit;
-    time_field(ui, shared, unit, rate, duration);
-    ui.label(format!("of {}", unit.format_length(duration, rate)));
+    time_field(ui, shared, unit, rate, span);
+    let ends = format!("from {} to {}", unit.format(span.start, rate), unit.format(span.end, rate));
+    ui.label(format!("of {}", unit.format_length(span.length(), rate))).on_hover_text(ends);
     let label = ui.label("in");
     egui::ComboBox::from_id_salt("time-unit")
         .selected_text(unit.label())
@@ -91,18 +107,19 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     }
 }
 
-fn frame_button(ui: &mut egui::Ui, shared: &mut Shared, label: &str, key: &str, forward: bool, rate: f64, end: f64) {
+fn frame_button(ui: &mut egui::Ui, shared: &mut Shared, label: &str, key: &str, forward: bool, rate: f64, span: Span) {
     if ui.button(label).on_hover_text(key).clicked() {
         *shared.playing = false;
-        *shared.time = step_frame(*shared.time, rate, forward, end);
+        *shared.time = step_frame(*shared.time, rate, forward, span);
     }
 }
 
-/// The current time in the chosen unit, editable: type a time, frame or tick (or drag to scrub).
-fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64, duration: f64) {
+/// The current time in the chosen unit, editable within the span: type a time, frame or tick (or drag to scrub).
+fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64, span: Span) {
     let field = egui::DragValue::new(shared.time)
-        .range(0.0..=duration)
-        .speed(duration.max(1e-3) / 500.0)
+        .range(span.start..=span.end)
+        .speed(span.length().max(1e-3) / 500.0)
+        .min_size(vec2(time_field_width(ui, unit, rate, span), ui.spacing().interact_size.y))
         .custom_formatter(move |seconds, _| unit.format(seconds, rate))
         .custom_parser(move |text| unit.parse(text, rate));
     let response = ui.add(field).on_hover_text("type a time, a frame or a tick in the chosen unit");
@@ -110,6 +127,15 @@ fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64,
     if response.changed() {
         *shared.playing = false;
     }
+}
+
+/// As wide as the time field's widest text, so the controls after it hold still while the clip plays: either end
+/// of the span half a frame farther from 0 (the most digits, and a frame's decimal).
+fn time_field_width(ui: &egui::Ui, unit: TimeUnit, rate: f64, span: Span) -> f32 {
+    let font = ui.style().drag_value_text_style.resolve(ui.style());
+    let half_frame = 0.5 / rate;
+    let widest = [span.start, span.end].map(|t| text_width(ui, &unit.format(t + half_frame.copysign(t), rate), &font));
+    widest[0].max(widest[1]) + 2.0 * ui.spacing().button_padding.x
 }
 
 /// The timeline's frame rate: the clip's own (from its file), or one the user types; "file's rate" goes back.
@@ -133,40 +159,67 @@ fn frame_rate_field(ui: &mut egui::Ui, shared: &mut Shared, rate: f64) {
 const BAR_HEIGHT: f32 = 34.0;
 const STRIP_HEIGHT: f32 = 6.0;
 
+/// The time bar's scale: the span from the bar's left edge to its right.
+#[derive(Clone, Copy)]
+struct Bar {
+    rect: Rect,
+    span: Span,
+}
+
+impl Bar {
+    /// Where `time` is drawn.
+    fn x(self, time: f64) -> f32 {
+        let length = self.span.length();
+        let fraction = if length > 0.0 { ((time - self.span.start) / length) as f32 } else { 0.0 };
+        self.rect.left() + fraction * self.rect.width()
+    }
+
+    /// The time at `x`.
+    fn time(self, x: f32) -> f64 {
+        self.span.start + f64::from((x - self.rect.left()) / self.rect.width().max(1.0)) * self.span.length()
+    }
+
+    /// Seconds a point of the bar covers.
+    fn seconds_per_point(self) -> f64 {
+        self.span.length() / f64::from(self.rect.width().max(1.0))
+    }
+}
+
 fn time_bar(ui: &mut egui::Ui, shared: &mut Shared) {
-    let duration = shared.doc.duration();
     let (rect, response) = ui.allocate_exact_size(vec2(ui.available_width(), BAR_HEIGHT), Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "time bar"));
-    let x_of = |t: f64| rect.left() + (if duration > 0.0 { (t / duration) as f32 } else { 0.0 }) * rect.width();
+    let bar = Bar { rect, span: shared.doc.span() };
+    let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
     if (response.clicked() || response.dragged())
         && let Some(p) = response.interact_pointer_pos()
     {
         *shared.playing = false;
-        let time = f64::from((p.x - rect.left()) / rect.width().max(1.0)) * duration;
-        *shared.time = shared.settings.time_unit.snap(time, shared.doc.frame_rate()).clamp(0.0, duration);
+        *shared.time = bar.span.clamp(unit.snap(bar.time(p.x), rate));
     }
     let painter = ui.painter_at(rect);
     let visuals = ui.visuals();
     painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
-    ruler(&painter, rect, duration, (shared.settings.time_unit, shared.doc.frame_rate()), visuals.weak_text_color());
+    ruler(&painter, bar, (unit, rate), visuals.weak_text_color());
     if let Some(clip) = shared.doc.clip() {
-        key_ticks(&painter, rect, clip, shared.selection, visuals.text_color(), x_of);
+        key_ticks(&painter, rect, clip, shared.selection, visuals.text_color(), |t| bar.x(t));
     }
-    stretch_strip(&painter, rect, shared, x_of);
-    let x = x_of(*shared.time);
+    stretch_strip(&painter, bar, shared);
+    let x = bar.x(*shared.time);
     painter.line_segment([pos2(x, rect.top()), pos2(x, rect.bottom())], Stroke::new(2.0, visuals.selection.bg_fill));
 }
 
-/// The ruler: a labelled tick at 1-2-5 steps of the timeline's unit.
-fn ruler(painter: &egui::Painter, rect: Rect, duration: f64, (unit, rate): (TimeUnit, f64), color: Color32) {
-    if duration <= 0.0 {
+/// The ruler: a labelled tick at 1-2-5 steps of the timeline's unit, on the clip's own clock (a clip from frame 1
+/// is ticked at frames 10, 20 …, not at its start plus those).
+fn ruler(painter: &egui::Painter, bar: Bar, (unit, rate): (TimeUnit, f64), color: Color32) {
+    let (span, rect) = (bar.span, bar.rect);
+    if span.length() <= 0.0 {
         return;
     }
-    let step = super::ticks::time_step(unit, rate, f64::from(rect.width()) / duration);
-    let x_of = |t: f64| rect.left() + (t / duration) as f32 * rect.width();
-    for i in 0..=(duration / step + 1e-9).floor() as usize {
+    let step = super::ticks::time_step(unit, rate, f64::from(rect.width()) / span.length());
+    let (first, last) = ((span.start / step - 1e-9).ceil() as i64, (span.end / step + 1e-9).floor() as i64);
+    for i in first..=last {
         let t = i as f64 * step;
-        let x = x_of(t);
+        let x = bar.x(t);
         painter.line_segment([pos2(x, rect.bottom() - 8.0), pos2(x, rect.bottom())], Stroke::new(1.0, color));
         painter.text(
             pos2(x + 2.0, rect.bottom() - 9.0),
@@ -221,12 +274,12 @@ fn key_ticks(
 }
 
 /// Stretched spans of the inspected bone (or of any bone) as a coloured strip, merged to what the pixels show.
-fn stretch_strip(painter: &egui::Painter, rect: Rect, shared: &Shared, x_of: impl Fn(f64) -> f32) {
+fn stretch_strip(painter: &egui::Painter, bar: Bar, shared: &Shared) {
+    let rect = bar.rect;
     // Between the key ticks (top) and the seconds labels (bottom), so neither is painted over.
     let strip = Rect::from_min_size(pos2(rect.left(), rect.top() + 11.0), vec2(rect.width(), STRIP_HEIGHT));
-    let pixel = shared.doc.duration() / f64::from(rect.width().max(1.0));
-    for (from, to) in merge_spans(shared.stretched, pixel) {
-        let (x0, x1) = (x_of(from), x_of(to));
+    for (from, to) in merge_spans(shared.stretched, bar.seconds_per_point()) {
+        let (x0, x1) = (bar.x(from), bar.x(to));
         painter.rect_filled(
             Rect::from_x_y_ranges(x0..=x1.max(x0 + 1.0), strip.y_range()),
             0.0,
@@ -241,19 +294,24 @@ mod tests {
 
     #[test]
     fn frame_steps_land_on_whole_frames() {
+        let ten = Span::new(0.0, 10.0);
         // 120 Hz mocap: one press is one source frame.
-        assert_eq!(step_frame(0.0, 120.0, true, 10.0), 1.0 / 120.0);
+        assert_eq!(step_frame(0.0, 120.0, true, ten), 1.0 / 120.0);
         // From between frames (a click at 17.98 frames of 30 fps), the next whole frame each way.
         let between = 17.98 / 30.0;
-        assert_eq!(step_frame(between, 30.0, true, 10.0), 18.0 / 30.0);
-        assert_eq!(step_frame(between, 30.0, false, 10.0), 17.0 / 30.0);
+        assert_eq!(step_frame(between, 30.0, true, ten), 18.0 / 30.0);
+        assert_eq!(step_frame(between, 30.0, false, ten), 17.0 / 30.0);
         // From a frame (up to rounding), the neighbours.
         let on = 18.0 / 30.0 + 1e-12;
-        assert_eq!(step_frame(on, 30.0, true, 10.0), 19.0 / 30.0);
-        assert_eq!(step_frame(on, 30.0, false, 10.0), 17.0 / 30.0);
+        assert_eq!(step_frame(on, 30.0, true, ten), 19.0 / 30.0);
+        assert_eq!(step_frame(on, 30.0, false, ten), 17.0 / 30.0);
         // Within the clip.
-        assert_eq!(step_frame(0.0, 30.0, false, 10.0), 0.0);
-        assert_eq!(step_frame(9.99, 30.0, true, 10.0), 10.0);
+        assert_eq!(step_frame(0.0, 30.0, false, ten), 0.0);
+        assert_eq!(step_frame(9.99, 30.0, true, ten), 10.0);
+        // On the clip's own clock: from Blender's first frame (1/30 s) the next is frame 2, the previous none.
+        let blender = Span::new(1.0 / 30.0, 2.0);
+        assert_eq!(step_frame(1.0 / 30.0, 30.0, true, blender), 2.0 / 30.0);
+        assert_eq!(step_frame(1.0 / 30.0, 30.0, false, blender), 1.0 / 30.0);
     }
 
     #[test]
@@ -271,13 +329,24 @@ mod tests {
 
     #[test]
     fn play_at_the_end_without_loop_starts_again() {
+        let span = Span::new(0.5, 2.0);
         let (mut playing, mut time) = (false, 2.0);
-        toggle_play(&mut playing, &mut time, false, 2.0);
-        assert_eq!((playing, time), (true, 0.0));
+        toggle_play(&mut playing, &mut time, false, span);
+        assert_eq!((playing, time), (true, 0.5), "from the clip's start");
         let (mut playing, mut time) = (false, 2.0);
-        toggle_play(&mut playing, &mut time, true, 2.0);
+        toggle_play(&mut playing, &mut time, true, span);
         assert_eq!((playing, time), (true, 2.0), "a looping clip goes on from where it is");
-        toggle_play(&mut playing, &mut time, false, 2.0);
+        toggle_play(&mut playing, &mut time, false, span);
         assert_eq!((playing, time), (false, 2.0));
+    }
+
+    #[test]
+    fn a_loop_goes_round_within_the_span() {
+        let span = Span::new(0.5, 2.0);
+        assert_eq!(played(1.0, 0.25, span, true), (1.25, true));
+        // 0.25 s past the end: 0.25 s after the start, not 0.25 s after 0.
+        assert_eq!(played(1.75, 0.5, span, true), (0.75, true));
+        assert_eq!(played(1.75, 0.5, span, false), (2.0, false), "without a loop it stops at the end");
+        assert_eq!(played(0.5, 0.1, Span::at(0.5), true), (0.5, false), "a single pose has nothing to loop");
     }
 }

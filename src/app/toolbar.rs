@@ -28,7 +28,6 @@ pub struct Actions {
     pub compare: Option<PathBuf>,
     pub open_demo: bool,
     pub frame_all: bool,
-    pub clip_changed: bool,
     pub undo: bool,
     pub redo: bool,
 }
@@ -64,7 +63,7 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut A
     });
     // On a narrow window the pickers wrap onto a second row rather than run off the edge.
     ui.horizontal_wrapped(|ui| {
-        clip_picker(ui, shared, actions);
+        clip_picker(ui, shared);
         ui.separator();
         mode_picker(ui, shared);
         ui.separator();
@@ -212,7 +211,7 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mu
 /// so the controls after it never move.
 const PICKER_WIDTH: f32 = 170.0;
 
-fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
+fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Animation");
     let clips = &shared.doc.rig.clips;
     let current = shared.doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
@@ -227,19 +226,16 @@ fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared, actions: &mut Actions) {
         .width(PICKER_WIDTH)
         .show_ui(ui, |ui| {
             for clip in clips {
-                ui.selectable_value(
-                    &mut chosen,
-                    Some(clip.index),
-                    format!("{} ({:.2} s)", clip.label(), clip.duration()),
-                );
+                ui.selectable_value(&mut chosen, Some(clip.index), text::clip_choice(clip));
             }
             ui.selectable_value(&mut chosen, None, "rest pose");
         })
         .response
         .labelled_by(label.id)
         .on_hover_text(current);
-    if chosen != shared.doc.setup().clip && shared.doc.set_clip(chosen).is_ok() {
-        actions.clip_changed = true;
+    if chosen != shared.doc.setup().clip {
+        // Only the rig's clips are listed. The window keeps the time within the new clip's span.
+        let _ = shared.doc.set_clip(chosen);
     }
 }
 

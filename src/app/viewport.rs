@@ -42,7 +42,7 @@ impl Viewport {
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
-        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.duration(), MOTION_SAMPLES, pose_at);
+        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at);
     }
 
     /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
@@ -98,10 +98,8 @@ impl Viewport {
 fn caption(shared: &Shared) -> Vec<String> {
     let doc = &*shared.doc;
     let clip = doc.clip().map_or_else(|| "rest pose".to_owned(), |c| c.label());
-    let settings = &*shared.settings;
     let modes = doc.common_mode().map_or_else(|| "mixed modes".to_owned(), |m| format!("mode: {}", m.id()));
-    let mut lines =
-        vec![format!("{} · {clip}", doc.title()), settings.time_unit.format(*shared.time, doc.frame_rate()), modes];
+    let mut lines = vec![format!("{} · {clip}", doc.title()), shared.time_text(*shared.time), modes];
     let layers = doc.layers().summary(&doc.rig, doc.clip());
     lines.extend(layers.split("; ").filter(|l| !l.is_empty()).map(str::to_owned));
     lines

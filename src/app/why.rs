@@ -214,8 +214,7 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
         let hint = "each bone's contribution: the shear minus what is left with its scale made uniform (all else as \
                     evaluated); scales compound and cancel, so contributions need not add up";
         ui.label(RichText::new("Chain at").strong()).on_hover_text(hint);
-        let time = shared.settings.time_unit.format(at.time, shared.doc.frame_rate());
-        if ui.link(time).on_hover_text("go to the time the bone shears most").clicked() {
+        if ui.link(shared.time_text(at.time)).on_hover_text("go to the time the bone shears most").clicked() {
             go_to(shared, at.time);
         }
         let shear = RichText::new(format!("shear {}°", compact(at.shear_deg)));
@@ -319,11 +318,10 @@ fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
         return;
     }
     ui.label(RichText::new("Main cause over the clip").strong());
-    let (unit, rate) = (shared.settings.time_unit, shared.doc.frame_rate());
     listed(ui, "why-more-spans", spans, SHOWN_SPANS, |ui, span| {
-        let text = format!("{}  {} – {}", span.name, unit.format(span.from, rate), unit.format(span.to, rate));
-        let hint =
-            format!("go to {}, where {}'s squash starts to be the main cause", unit.format(span.from, rate), span.name);
+        let (from, to) = (shared.time_text(span.from), shared.time_text(span.to));
+        let text = format!("{}  {from} – {to}", span.name);
+        let hint = format!("go to {from}, where {}'s squash starts to be the main cause", span.name);
         if ui.link(text).on_hover_text(hint).clicked() {
             go_to(shared, span.from);
         }
@@ -370,7 +368,7 @@ impl FixColumns {
 
 /// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
 fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, explained: &Explanation) {
-    let hint = fix_hint(fix, columns.unit);
+    let hint = fix_hint(fix, columns.unit, &shared.time_text(fix.cost.distance.time));
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
@@ -413,24 +411,25 @@ fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns,
         try_fix(shared, fix.change);
         go_to(shared, explained.causes.at.time);
         let setup = shared.doc.setup().clone();
-        shared.why.tried = Some(Tried { bone: explained.bone, setup, line: tried_line(fix, explained, columns.unit) });
+        let line = tried_line(fix, explained, columns.unit, &shared.time_text(fix.cost.distance.time));
+        shared.why.tried = Some(Tried { bone: explained.bone, setup, line });
     }
 }
 
-/// "Tried: forearm to blender-aligned: shear 18.666° before, 0° after; skin moved 11 cm at 0.567 s".
-fn tried_line(fix: &Fix, explained: &Explanation, unit: Option<Unit>) -> String {
+/// "Tried: forearm to blender-aligned: shear 18.666° before, 0° after; skin moved 11 cm at 0.5667 s (frame 17)",
+/// the time (`when`) as the timeline shows it.
+fn tried_line(fix: &Fix, explained: &Explanation, unit: Option<Unit>, when: &str) -> String {
     let moved = match fix.cost.measured {
         Measured::Skin => "skin",
         Measured::Bones => "bones",
     };
     let distance = fix.cost.distance;
     format!(
-        "Tried: {}: shear {}° before, {}° after; {moved} moved {} at {} s",
+        "Tried: {}: shear {}° before, {}° after; {moved} moved {} at {when}",
         drawable(&fix.label),
         compact(explained.worst_shear_deg),
         compact(if fix.removes { 0.0 } else { fix.shear_left_deg }),
         Unit::readable(unit, distance.max),
-        compact(distance.time)
     )
 }
 
@@ -471,8 +470,8 @@ fn distance(fix: &Fix, unit: Option<Unit>) -> String {
     format!("{seen} {}", Unit::readable(unit, fix.cost.distance.max))
 }
 
-/// A fix's numbers, exact.
-fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
+/// A fix's numbers, exact; `when` is the time it moves most, as the timeline shows it.
+fn fix_hint(fix: &Fix, unit: Option<Unit>, when: &str) -> String {
     let flagged = if fix.removes { "no longer flagged" } else { "still flagged" };
     let what = match fix.cost.measured {
         Measured::Skin => "the skin",
@@ -480,11 +479,10 @@ fn fix_hint(fix: &Fix, unit: Option<Unit>) -> String {
     };
     let distance = fix.cost.distance;
     let mut text = format!(
-        "{}: {}° of shear left over the clip ({flagged})\nmoves {what} at most {} at {} s, {} % of the rig's size",
+        "{}: {}° of shear left over the clip ({flagged})\nmoves {what} at most {} at {when}, {} % of the rig's size",
         drawable(&fix.label),
         compact(fix.shear_left_deg),
         Unit::readable(unit, distance.max),
-        compact(distance.time),
         compact(100.0 * fix.cost.fraction)
     );
     if !fix.cleared().is_empty() {

@@ -21,6 +21,7 @@ use super::why;
 use super::work::{Wanted, Work};
 use super::{inspector, layers, outliner, plots};
 use crate::analysis::ClipAnalysis;
+use crate::model::Span;
 
 /// What the window shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -54,8 +55,11 @@ impl SpanCache {
 /// The window's state.
 pub struct Window {
     pub chrome: Chrome,
+    /// On the clip's own clock, within the timeline's span.
     pub time: f64,
     pub playing: bool,
+    /// The timeline's span in the last frame, to notice it change.
+    span: Span,
     /// Selected bones; the last one is the inspected one.
     pub selection: Vec<usize>,
     viewport: Viewport,
@@ -77,6 +81,7 @@ impl Window {
             chrome: Chrome::Window,
             time: 0.0,
             playing: false,
+            span: Span::default(),
             selection: Vec::new(),
             viewport: Viewport::default(),
             panels: panels(),
@@ -91,13 +96,14 @@ impl Window {
         window
     }
 
-    /// Follows a document replaced in the session: another file starts at its beginning with nothing selected and
-    /// is framed; a reloaded one keeps time and selection, and the camera unless its bones changed.
+    /// Follows a document replaced in the session: another file starts at its clip's start with nothing selected
+    /// and is framed; a reloaded one keeps time and selection, and the camera unless its bones changed.
     pub fn replaced(&mut self, how: Replaced, doc: &Document) {
         match how {
             Replaced::Opened => {
                 self.selection.clear();
-                self.time = 0.0;
+                self.span = doc.span();
+                self.time = self.span.start;
                 self.viewport.frame_all(doc);
             }
             Replaced::Reloaded { same_bones } => {
@@ -108,7 +114,13 @@ impl Window {
                 }
             }
         }
-        self.time = self.time.clamp(0.0, doc.duration());
+    }
+
+    /// Keeps the time within the timeline when the timeline changes: another clip, an undo, a crossfade moved.
+    fn follow_span(&mut self, span: Span) {
+        if std::mem::replace(&mut self.span, span) != span {
+            self.time = span.clamp(self.time);
+        }
     }
 
     /// The viewport and the tiled panels.
@@ -145,6 +157,7 @@ impl Window {
         if std::mem::replace(&mut self.size, size) != size {
             ctx.request_repaint();
         }
+        self.follow_span(session.doc.span());
         let mut actions = self.input(&ctx, &session.doc, settings.looping);
         self.advance_playback(&ctx, settings, &session.doc);
         // The viewport alone shows nothing of the whole-clip analysis.
@@ -208,9 +221,9 @@ impl Window {
         actions
     }
 
-    /// Play or pause; playing at the end of a clip that does not loop starts it again.
-    pub fn toggle_play(&mut self, looping: bool, duration: f64) {
-        timeline::toggle_play(&mut self.playing, &mut self.time, looping, duration);
+    /// Play or pause; playing at the end of a clip that does not loop starts it again from its start.
+    pub fn toggle_play(&mut self, looping: bool, span: Span) {
+        timeline::toggle_play(&mut self.playing, &mut self.time, looping, span);
     }
 
     /// Where the next frame is framed: the document's whole motion.
@@ -240,18 +253,18 @@ impl Window {
         }
         toolbar::history_keys(ctx, &mut actions);
         let pressed = |key| ctx.input(|i| i.key_pressed(key));
-        let duration = doc.duration();
+        let span = doc.span();
         if pressed(egui::Key::Space) {
-            self.toggle_play(looping, duration);
+            self.toggle_play(looping, span);
         }
         for (key, forward) in [(egui::Key::ArrowLeft, false), (egui::Key::ArrowRight, true)] {
             // A held key repeats faster than slow frames come: every repeat is a frame.
             for _ in 0..ctx.input(|i| i.num_presses(key)) {
                 self.playing = false;
-                self.time = timeline::step_frame(self.time, doc.frame_rate(), forward, duration);
+                self.time = timeline::step_frame(self.time, doc.frame_rate(), forward, span);
             }
         }
-        for (key, to) in [(egui::Key::Home, 0.0), (egui::Key::End, duration)] {
+        for (key, to) in [(egui::Key::Home, span.start), (egui::Key::End, span.end)] {
             if pressed(key) {
                 self.playing = false;
                 self.time = to;
@@ -266,16 +279,7 @@ impl Window {
         if !self.playing {
             return;
         }
-        let duration = doc.duration();
-        self.time += dt;
-        if self.time > duration {
-            if settings.looping && duration > 0.0 {
-                self.time %= duration;
-            } else {
-                self.time = duration;
-                self.playing = false;
-            }
-        }
+        (self.time, self.playing) = timeline::played(self.time, dt, doc.span(), settings.looping);
         ctx.request_repaint();
     }
 

@@ -8,7 +8,7 @@ use super::style::Badge;
 use crate::analysis::{Assessment, Findings, Tolerances};
 use crate::eval::skinning::skin_meshes_with;
 use crate::eval::{MorphPose, SkinningMethod, bind_model_matrices, skin_meshes};
-use crate::model::{Clip, NodeRole, Rig};
+use crate::model::{Clip, NodeRole, Rig, Span};
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -278,14 +278,14 @@ pub fn typical_scale(rig: &Rig) -> f64 {
     scales.get(scales.len() / 2).copied().unwrap_or(1.0)
 }
 
-/// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `duration` by `pose_at`
+/// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
 /// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
 /// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes; the bounds grow by the size of the axis triads and
 /// boxes drawn around the joints.
 pub fn motion_bounds(
     rig: &Rig,
     clip: Option<&Clip>,
-    duration: f64,
+    span: Span,
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
 ) -> Option<Bounds> {
@@ -293,7 +293,7 @@ pub fn motion_bounds(
     let mut morph = MorphPose::default();
     let bounds = (0..samples.max(1))
         .filter_map(|i| {
-            let time = duration * i as f64 / (samples.max(2) - 1) as f64;
+            let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
             let model = pose_at(time);
             morph.evaluate(clip, time);
             let meshes = skin_meshes(rig, &model, &morph);
