@@ -14,7 +14,7 @@ use crate::analysis::{
     BindCheck, BindTolerance, ClipAnalysis, Components, CurveRequest, Judged, ScanOptions, Tolerances, analyze,
     check_bind,
 };
-use crate::diff::{Pairs, compare, comparison_times, model_curves};
+use crate::diff::{Frames, Pairs, compare, comparison_times, model_curves};
 use crate::eval::{Evaluation, Setup};
 use crate::explain::{Costs, Explanation, Question, Scale, explain};
 use crate::model::Rig;
@@ -366,8 +366,9 @@ fn differences(
     move |_| {
         let own = key.evaluation(&rig)?;
         let other = Evaluation::of(&compared.rig, &key.request.setup).ok()?;
-        // The badges need the bones alone: skinning every paired mesh at every time would be thrown away.
-        let pairs = Pairs { meshes: Vec::new(), ..Pairs::by_name(&own, &other) };
+        // The badges need the bones alone: skinning every paired mesh at every time would be thrown away. Two files'
+        // frames are compared up to their exporters' conventions, as `diff` compares them.
+        let pairs = Pairs { meshes: Vec::new(), frames: Frames::UpToConvention, ..Pairs::by_name(&own, &other) };
         let comparison = compare(&own, &other, &pairs, &comparison_times(&own, &other, key.request.rate));
         let mut bones = vec![None; rig.skeleton.len()];
         for difference in &comparison.bones {

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::Args;
 
 use super::OutputFormat;
-use super::options::{Distance, choice, parse_assignment, parse_distance, parse_rate};
+use super::options::{Distance, choice, files_help, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
 use crate::diff::{Align, AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
 use crate::eval::layers::RotationInterpolation;
@@ -15,7 +15,7 @@ use crate::model::{At, Choice, ModeChoice, Rig, Unit, UpAxis, frames};
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
-    /// The first file (glTF .gltf/.glb, FBX, BVH, USD .usda/.usdc/.usdz; recognised by content).
+    #[arg(help = files_help("The first file", ""))]
     pub a: PathBuf,
     /// The second file.
     pub b: PathBuf,
