@@ -1090,8 +1090,7 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
     settle(&mut harness);
     let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
     assert!(ghost / figure > 10.0, "as written: {figure} against {ghost}");
-    let worst = |bones: &[Option<f64>]| bones.iter().flatten().copied().fold(0.0, f64::max);
-    let before = worst(&harness.state().differences().expect("differences").bones);
+    let before = harness.state().differences().expect("differences").rig_size;
     harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh").click();
     harness.run();
     harness.get_by_label("CMU mocap units (1/0.45 in)").click();
@@ -1102,9 +1101,9 @@ fn a_bvh_compared_in_the_unit_picked_for_it_ghosts_at_the_figures_size() {
         harness.state().session.doc.compared.as_ref().unwrap().units()[1].map(|u| u.in_metres()),
         Some(0.0254 / 0.45)
     );
-    // The badges follow the unit: the bones now differ by what their motions do, not by a seventeenfold size.
-    let after = worst(&harness.state().differences().expect("differences in the unit picked").bones);
-    assert!(after < before / 2.0, "{before} then {after}");
+    // The badges follow the unit: they are fractions of a rig the runner's size, not of a ghost seventeen times it.
+    let after = harness.state().differences().expect("differences in the unit picked").rig_size;
+    assert!(after < before / 10.0 && (after - figure).abs() < 0.5 * figure, "{before} then {after} ({figure})");
     harness.get_by_role_and_label(Role::ComboBox, "unit of cmu_12_01_walk.bvh");
 }
 

@@ -198,7 +198,7 @@ fn scene_of(fbx_stem: &str) -> Option<&str> {
 }
 
 /// The clip and time of `when` in bonescope's rig of `fbx`: the take ufbx evaluates (the one named, else the stack
-/// the file marks current), at the file's frame rate, shifted as the importer shifts a take that starts before 0.
+/// the file marks current), at the file's frame rate, on the file's own clock (as ufbx's tests give the times).
 fn clip_time(fbx: &Path, rig: &Rig, when: When) -> (Option<usize>, f64) {
     let bytes = std::fs::read(fbx).unwrap();
     let scene = ufbx::load_memory(&bytes, import::fbx_load_opts(&Options { space: Space::File }, bytes.len())).unwrap();
@@ -216,8 +216,7 @@ fn clip_time(fbx: &Path, rig: &Rig, when: When) -> (Option<usize>, f64) {
         .iter()
         .position(|s| if take.is_empty() { is_default(s) } else { s.element.name.contains(take) })
         .filter(|&i| i < rig.clips.len());
-    let shift = stack.map_or(0.0, |i| (-scene.anim_stacks[i].time_begin).max(0.0));
-    (stack, seconds + shift)
+    (stack, seconds)
 }
 
 /// Every vertex of every mesh of `fbx` as bonescope evaluates `reference`'s pose, in the file's own space.

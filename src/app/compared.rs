@@ -36,8 +36,8 @@ pub struct Compared {
     document_unit: Option<Unit>,
     /// Per bone of the document: its partner here.
     pub bones: Vec<Option<usize>>,
-    /// Per bone of the document: whether it is a conversion node, left out of the comparison.
-    pub conversion: Vec<bool>,
+    /// Per bone of the document: why it is left out of the comparison, where it is.
+    pub left_out: Vec<Option<LeftOut>>,
     /// Per mesh of the document: its partner here (same name and vertex count).
     pub meshes: Vec<Option<usize>>,
     /// Per clip of the document: the clip here that stands for it, as `bonescope diff` pairs them (else the first).
@@ -45,6 +45,38 @@ pub struct Compared {
     /// How its linear rotation keys are played: as the file says (slerp), or as a component-wise runtime (Blender,
     /// Unity, Unreal) plays them (`bonescope diff --interp`).
     pub played: RotationInterpolation,
+}
+
+/// Why a bone of the document is left out of a comparison, as `diff` leaves it out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeftOut {
+    /// It only states the file's axes and unit.
+    Conversion,
+    /// It carries a skinned mesh, whose vertices follow the joints (the skin is compared).
+    SkinnedMesh,
+}
+
+impl LeftOut {
+    /// The word beside the bone's name.
+    pub fn word(self) -> &'static str {
+        match self {
+            LeftOut::Conversion => "converts",
+            LeftOut::SkinnedMesh => "skin",
+        }
+    }
+
+    /// Why, in a sentence.
+    pub fn why(self) -> &'static str {
+        match self {
+            LeftOut::Conversion => {
+                "only states the file's axes and unit: left out of the comparison, as `diff` leaves it"
+            }
+            LeftOut::SkinnedMesh => {
+                "carries a skinned mesh, whose vertices follow the joints: left out of the comparison (the skin is \
+                 compared), as `diff` leaves it"
+            }
+        }
+    }
 }
 
 impl Compared {
@@ -60,9 +92,12 @@ impl Compared {
         for &(a, b) in &matching.pairs {
             bones[a] = Some(b);
         }
-        let mut conversion = vec![false; document.skeleton.len()];
-        for &a in &matching.conversion_a {
-            conversion[a] = true;
+        let mut left_out = vec![None; document.skeleton.len()];
+        for (bones, why) in [(&matching.conversion_a, LeftOut::Conversion), (&matching.skinned_a, LeftOut::SkinnedMesh)]
+        {
+            for &a in bones {
+                left_out[a] = Some(why);
+            }
         }
         let mut meshes = vec![None; document.meshes.len()];
         for (a, b) in match_meshes(&document.meshes, &rig.meshes) {
@@ -76,7 +111,7 @@ impl Compared {
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
         let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
         let (up, apart) = (UpAxis::Y, standing_apart(document, &rig));
-        Compared { path, rig, rig_id, states_unit, up, apart, document_unit, bones, conversion, meshes, clips, played }
+        Compared { path, rig, rig_id, states_unit, up, apart, document_unit, bones, left_out, meshes, clips, played }
     }
 
     /// The same file paired with another document rig (the document was reloaded), keeping the units given and
@@ -139,9 +174,9 @@ impl Compared {
         crate::import::text::printable(&name).into_owned()
     }
 
-    /// How many of the document's bones (conversion nodes aside) have no partner here.
+    /// How many of the document's bones (those left out aside) have no partner here.
     pub fn unpaired(&self) -> usize {
-        self.bones.iter().zip(&self.conversion).filter(|(b, c)| b.is_none() && !**c).count()
+        self.bones.iter().zip(&self.left_out).filter(|(b, why)| b.is_none() && why.is_none()).count()
     }
 
     /// The clip here (an index) that stands for the document's clip `clip` (an index; `None`: the rest pose, for

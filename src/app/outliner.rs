@@ -6,6 +6,7 @@ use std::collections::HashSet;
 
 use egui::{RichText, Sense, vec2};
 
+use super::compared::LeftOut;
 use super::document::ModeScope;
 use super::pane::{Pane, Place, Visibility};
 use super::panel::{Panel, Shared};
@@ -287,8 +288,7 @@ fn difference_text(shared: &Shared, bone: usize) -> Option<RichText> {
             Some(RichText::new(format!("Δ {:.2}%", 100.0 * fraction)).small().color(color))
         }
         Some(_) => None,
-        None if converts(shared, bone) => Some(RichText::new("converts").small().weak()),
-        None => Some(RichText::new("unpaired").small().weak()),
+        None => Some(RichText::new(left_out(shared, bone).map_or("unpaired", LeftOut::word)).small().weak()),
     }
 }
 
@@ -306,16 +306,16 @@ fn difference_hint(shared: &Shared, bone: usize) -> String {
             100.0 * fraction,
             shared.settings.compare_threshold_percent,
         ),
-        None if converts(shared, bone) => {
-            "only states the file's axes and unit: left out of the comparison, as `diff` leaves it".to_owned()
-        }
-        None => format!("no bone of this name in {}", compared.title()),
+        None => match left_out(shared, bone) {
+            Some(why) => why.why().to_owned(),
+            None => format!("no bone of this name in {}", compared.title()),
+        },
     }
 }
 
-/// Whether `bone` is a conversion node of the document (its axes and unit), which comparisons leave out.
-fn converts(shared: &Shared, bone: usize) -> bool {
-    shared.doc.compared.as_ref().is_some_and(|compared| compared.conversion.get(bone).copied().unwrap_or(false))
+/// Why `bone` of the document is left out of the comparison, where it is.
+fn left_out(shared: &Shared, bone: usize) -> Option<LeftOut> {
+    shared.doc.compared.as_ref().and_then(|compared| compared.left_out.get(bone).copied().flatten())
 }
 
 /// The icons of a bone's findings, painted in a fixed-width slot so names line up.

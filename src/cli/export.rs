@@ -1,4 +1,5 @@
-//! `bonescope export`: every mesh as evaluated at one time, in the file's own units and axes.
+//! `bonescope export`: every mesh as evaluated at one time, in the file's own units and axes or in bonescope's
+//! Y-up metres (what `inspect` shows), the OBJ's header saying which.
 
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
@@ -40,14 +41,46 @@ pub struct ExportArgs {
     /// Where to write.
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
+    /// The space the positions are written in: `file`, the file's own axes and units (to compare with the authoring
+    /// tool's own export of the frame), or `y-up-metres`, bonescope's (what `inspect` and the app show).
+    #[arg(long, value_enum, default_value_t)]
+    pub space: ExportSpace,
+}
+
+/// The space `export` writes positions in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ExportSpace {
+    #[default]
+    File,
+    YUpMetres,
+}
+
+impl ExportSpace {
+    fn loaded_as(self) -> Space {
+        match self {
+            ExportSpace::File => Space::File,
+            ExportSpace::YUpMetres => Space::YUpMetres,
+        }
+    }
+
+    /// The header's line on the space, with the rig's unit as loaded.
+    fn says(self, unit: Option<crate::model::Unit>) -> String {
+        let unit =
+            unit.map_or_else(|| "the file's numbers as they are (it states no unit)".to_owned(), |u| u.to_string());
+        match self {
+            ExportSpace::File => {
+                format!("space: the file's own axes and units ({unit}); --space y-up-metres for bonescope's")
+            }
+            ExportSpace::YUpMetres => format!("space: Y up, {unit}, as inspect shows; --space file for the file's own"),
+        }
+    }
 }
 
 pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
     if !args.time.is_finite() {
         bail!("--time must be a finite number of seconds, got {}", args.time);
     }
-    // The file's own space, so the result compares with the authoring tool's own export of the same frame.
-    let rig = import::load_with(&args.file, &Options { space: Space::File })?;
+    let rig = import::load_with(&args.file, &Options { space: args.space.loaded_as() })?;
     if rig.meshes.is_empty() {
         bail!("{}: no meshes to export", args.file.display());
     }
@@ -71,6 +104,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<ExitCode> {
             args.skinning.label()
         ),
     ];
+    header.push(args.space.says(rig.unit));
     let layers = setup.layers.summary(&rig, clip);
     if !layers.is_empty() {
         header.push(format!("layers: {layers}"));

@@ -38,8 +38,8 @@ pub struct BoneMatching {
     pub skinned_b: Vec<usize>,
 }
 
-/// For each bone, whether a mesh hangs on it, skinned ones only where `skinned` (a joint of a skin never: it is the
-/// skeleton's).
+/// For each bone, whether it is a mesh object: a leaf a mesh hangs on (a skinned one only where `skinned`). A node
+/// with bones below it is the skeleton's, whatever it carries.
 fn mesh_nodes(rig: &Rig, skinned: bool) -> Vec<bool> {
     let mut nodes = vec![false; rig.skeleton.len()];
     for mesh in rig.meshes.iter().filter(|m| !skinned || m.skin.is_some()) {
@@ -47,10 +47,8 @@ fn mesh_nodes(rig: &Rig, skinned: bool) -> Vec<bool> {
             *node = true;
         }
     }
-    for joint in rig.skins.iter().flat_map(|s| &s.joints) {
-        if let Some(node) = nodes.get_mut(*joint) {
-            *node = false;
-        }
+    for parent in rig.skeleton.bones().iter().filter_map(|b| b.parent) {
+        nodes[parent] = false;
     }
     nodes
 }
