@@ -142,8 +142,11 @@ fn clocks_note(animation: &AnimationDiff) -> Option<String> {
         None => String::new(),
     };
     if animation.delay_b != 0.0 {
-        let d = animation.delay_b;
-        return Some(format!("B played {d:.4} s{} later than its clock says, to meet A's", frames(d)));
+        let (d, when) = match animation.delay_b {
+            d if d > 0.0 => (d, "later"),
+            d => (-d, "earlier"),
+        };
+        return Some(format!("B played {d:.4} s{} {when} than its clock says, to meet A's", frames(d)));
     }
     (gap.abs() > 1e-6).then(|| {
         let (how, lead) = if gap > 0.0 { ("before", gap) } else { ("after", -gap) };
