@@ -528,3 +528,26 @@ fn a_usd_stage_clip_is_named_after_its_main_skel_animation() {
         json(&bonescope(&["diff", &blender_io("00_extras.glb"), &blender_io("00_extras.usdc"), "--format", "json"]));
     assert_eq!(diff["animations"][0]["b"], "ArmatureAction");
 }
+
+#[test]
+fn a_file_without_a_unit_bakes_in_metres_in_the_unit_its_figure_stands_in() {
+    // Bandai Namco's capture states no unit; its figure stands about two hundred of them: centimetres, said so.
+    let bvh = path(&asset("../corpus/realworld/bandai_dataset-2_run_normal_001.bvh"));
+    let folder = tempfile::tempdir().unwrap();
+    let out = path(&folder.path().join("run.glb"));
+    let bake = |more: &[&str]| json(&bonescope(&[&["bake", &bvh, "--out", &out, "--format", "json"], more].concat()));
+    let assumed = bake(&[]);
+    let notes: Vec<&str> = assumed["notes"].as_array().unwrap().iter().filter_map(Value::as_str).collect();
+    assert!(notes.iter().any(|n| n.starts_with("the file states no unit: read in centimetres")), "{notes:?}");
+    let size = assumed["rig_size"].as_f64().unwrap();
+    assert!((1.0..10.0).contains(&size), "a person running, in metres: {size}");
+    let read = json(&bonescope(&["inspect", &out, "--format", "json"]));
+    assert!(read["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("metres")));
+    // Given a unit, the bake takes it and says nothing of it; a file that states one refuses another.
+    let given = bake(&["--unit", "mm"]);
+    assert!((given["rig_size"].as_f64().unwrap() - size / 10.0).abs() < 1e-9 * size);
+    let notes = given["notes"].as_array().unwrap();
+    assert!(!notes.iter().any(|n| n.as_str().unwrap().contains("states no unit")));
+    let glb = path(&asset("blender/stretchy_full.glb"));
+    assert_eq!(bonescope(&["bake", &glb, "--out", &out, "--unit", "cm"]).status.code(), Some(2));
+}

@@ -11,9 +11,9 @@ use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, OutputFormat};
 use crate::bake::{self, BakeReport, Engine, Request, Strategy};
-use crate::eval::Setup;
+use crate::eval::{Evaluation, Setup};
 use crate::import;
-use crate::model::Choice;
+use crate::model::{Choice, Rig, Unit};
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
@@ -41,6 +41,10 @@ pub struct BakeArgs {
     pub fail_above: Option<Distance>,
     #[arg(long, value_enum, default_value_t)]
     pub format: OutputFormat,
+    /// The source's unit where its file states none (BVH): m, cm, mm, in, ft, cmu, or its length in metres.
+    /// Without it, the unit its figure stands a person's height in, said in the report; the bake is in metres.
+    #[arg(long, value_name = "UNIT")]
+    pub unit: Option<Unit>,
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
@@ -54,14 +58,17 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     if rig.skeleton.is_empty() {
         bail!("{}: no nodes to bake", source_name(args));
     }
-    let setup = args.eval.setup(&rig)?;
+    let (rig, assumed) = with_unit(rig, args.unit)?;
+    // glTF is in metres: a source in another unit is measured in them.
+    let setup = Setup { unit: Some(Unit::METRE), ..args.eval.setup(&rig)? };
     let source = evaluation(&rig, &setup)?;
     let (strategy, tolerance) = (args.strategy.unwrap_or(args.engine.strategy()), args.tolerance);
     let only = args.eval.anim.is_some().then_some(source.clip).flatten();
     let request = Request::of(&source, only, strategy, tolerance).for_engine(args.engine);
     let baked = bake::bake(&request);
     let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
-    let report = bake::report(&request, &baked, &baked_rig);
+    let mut report = bake::report(&request, &baked, &baked_rig);
+    report.notes.extend(assumed);
     bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
     match args.format {
         OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&report)?))?,
@@ -70,6 +77,23 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     let worst = report.worst();
     let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));
     Ok(if over { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `rig` in a unit: its file's, the one `given` (only where the file states none), else the one its figure stands a
+/// person's height in, with a note saying so.
+fn with_unit(rig: Rig, given: Option<Unit>) -> anyhow::Result<(Rig, Option<String>)> {
+    let mut rig = rig.given_unit(given).map_err(|why| anyhow::anyhow!("--unit: {why}"))?;
+    if rig.unit.is_some() {
+        return Ok((rig, None));
+    }
+    let size = Evaluation::declared(&rig, None).size(&[0.0]);
+    let unit = Unit::likeliest_for_figure(size).unwrap_or(Unit::METRE);
+    rig.unit = Some(unit);
+    let tall = Unit::readable(Some(unit), size);
+    let note = format!(
+        "the file states no unit: read in {unit}, where its figure stands {tall} across at rest (--unit to choose)"
+    );
+    Ok((rig, Some(note)))
 }
 
 /// The source file's name, or the demo rig's.

@@ -22,6 +22,10 @@ const NAMED: [(&str, &str, f64); 6] = [
     ("cmu", "CMU mocap units (1/0.45 in)", 0.0254 / 0.45),
 ];
 
+/// The units a figure is commonly measured in, by id, and the height it then stands closest to: a person's.
+const FIGURE_UNITS: [&str; 4] = ["m", "cm", "mm", "in"];
+const FIGURE_HEIGHT_METRES: f64 = 1.7;
+
 /// How close two lengths in metres must be for a unit to take a name (a file's single-precision factor included).
 const SAME_LENGTH: f64 = 1e-6;
 
@@ -52,6 +56,15 @@ impl Unit {
 
     pub fn in_metres(self) -> f64 {
         self.metres
+    }
+
+    /// The unit in which a figure `size` units across is closest to a person's height (1.7 m, compared as ratios):
+    /// what a file that states none most likely measures in (a capture in centimetres stands about 170 of them).
+    /// `None` for a size that is not positive and finite.
+    pub fn likeliest_for_figure(size: f64) -> Option<Unit> {
+        let off = |unit: &Unit| (size * unit.metres / FIGURE_HEIGHT_METRES).ln().abs();
+        let units = FIGURE_UNITS.iter().filter_map(|id| id.parse::<Unit>().ok());
+        units.filter(|_| size > 0.0 && size.is_finite()).min_by(|a, b| off(a).total_cmp(&off(b)))
     }
 
     /// `length` (in this unit, or in a rig's own numbers for `None`) for people: in m, cm, mm or µm as its size
@@ -153,6 +166,15 @@ mod tests {
             assert!(bad.parse::<Unit>().is_err(), "{bad}");
         }
         assert_eq!(Unit::metres(f64::NAN), None);
+    }
+
+    #[test]
+    fn a_figure_is_measured_in_the_unit_it_stands_a_persons_height_in() {
+        let id = |size: f64| Unit::likeliest_for_figure(size).and_then(Unit::name).map(|(id, _)| id);
+        // Bandai Namco's capture stands 248 units tall: centimetres (2.48 m), not metres or inches (6.3 m).
+        assert_eq!(id(248.0), Some("cm"));
+        assert_eq!((id(1.8), id(1700.0), id(66.0)), (Some("m"), Some("mm"), Some("in")));
+        assert_eq!((id(0.0), id(f64::NAN), id(-3.0)), (None, None, None));
     }
 
     #[test]
