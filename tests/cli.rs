@@ -257,6 +257,30 @@ fn export_writes_the_evaluated_mesh_in_the_files_own_units() {
 }
 
 #[test]
+fn export_says_its_space_and_writes_bonescopes_on_request() {
+    // The same frame in the file's centimetres with Z up, and in Y-up metres: (x, y, z) → (x, z, −y) / 100.
+    let dir = tempfile::tempdir().unwrap();
+    let file = fbx("max_transformed_skin_7500_binary.fbx");
+    let export = |space: &str| {
+        let out = dir.path().join(format!("{space}.obj"));
+        let args =
+            ["export", &file, "--time", "0.1", "--format", "obj", "--space", space, "--out", out.to_str().unwrap()];
+        assert!(bonescope(&args).status.success());
+        std::fs::read_to_string(out).unwrap()
+    };
+    let first = |text: &str| -> Vec<f64> {
+        let line = text.lines().find_map(|l| l.strip_prefix("v ")).unwrap();
+        line.split(' ').map(|x| x.parse().unwrap()).collect()
+    };
+    let (file_space, metres) = (export("file"), export("y-up-metres"));
+    assert!(file_space.contains("# space: the file's own axes and units (centimetres); --space y-up-metres"));
+    assert!(metres.contains("# space: Y up, metres, as inspect shows; --space file for the file's own"));
+    let (p, q) = (first(&file_space), first(&metres));
+    let expected = [p[0] / 100.0, p[2] / 100.0, -p[1] / 100.0];
+    assert!(q.iter().zip(expected).all(|(a, b)| (a - b).abs() < 1e-9), "{p:?} → {q:?}");
+}
+
+#[test]
 fn export_without_meshes_or_time_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("none.obj");
