@@ -1098,3 +1098,10 @@ fn gpu_instances_are_each_a_mesh_where_their_transform_puts_it() {
     assert!(corner(0).distance(DVec3::new(3.0, 1.0, 0.0)) < 1e-6, "{}", corner(0));
     assert!(corner(1).distance(DVec3::new(0.0, 4.0, 0.0)) < 1e-6, "{}", corner(1));
 }
+
+#[test]
+fn a_key_time_before_zero_is_refused_as_the_validator_refuses_it() {
+    // glTF's clock starts at 0 (the validator's ACCESSOR_ANIMATION_INPUT_NEGATIVE), though other formats' may not.
+    let file = asset("gltf-validator-tests/base/data/animation_data/invalid_input_values.gltf");
+    assert_fails(import::load(&file), "animations[0].samplers[0]", "key time 0 (-1) is negative");
+}

@@ -275,11 +275,19 @@ impl Reader<'_, '_> {
         Ok(MorphWeights { bone, weights })
     }
 
-    /// The key times of an input accessor, read on first use.
+    /// The key times of an input accessor, read on first use. glTF's clock starts at 0: a time before it is
+    /// refused (the other formats' clocks may run before 0, so tracks take one).
     fn times(&mut self, input: Uint, place: &str) -> Result<Arc<[f64]>> {
         match self.times.entry(input) {
             Entry::Occupied(entry) => Ok(entry.get().clone()),
-            Entry::Vacant(entry) => Ok(entry.insert(self.accessors.times(input, place)?.into()).clone()),
+            Entry::Vacant(entry) => {
+                let times = self.accessors.times(input, place)?;
+                if let Some((index, time)) = times.iter().enumerate().find(|(_, t)| **t < 0.0) {
+                    let why = format!("key time {index} ({time}) is negative: glTF's key times start at 0");
+                    return Err(Failure::at(place, why));
+                }
+                Ok(entry.insert(times.into()).clone())
+            }
         }
     }
 }
