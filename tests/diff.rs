@@ -551,3 +551,23 @@ fn a_file_without_a_unit_bakes_in_metres_in_the_unit_its_figure_stands_in() {
     let glb = path(&asset("blender/stretchy_full.glb"));
     assert_eq!(bonescope(&["bake", &glb, "--out", &out, "--unit", "cm"]).status.code(), Some(2));
 }
+
+#[test]
+fn figures_are_looked_at_as_they_play_for_which_way_they_stand() {
+    // Blender's FBX rests its bones as they were edited, lying along Z, though every frame stands along Y as the
+    // glb does: no note. A BVH that lies along Z still gets one.
+    let (glb, fbx) = (blender_io("RobotExpressive.glb"), blender_io("RobotExpressive.fbx"));
+    let robot = bonescope(&["diff", &glb, &fbx, "--anim-a", "Robot_Idle", "--anim-b", "RobotArmature|Robot_Idle"]);
+    assert!(
+        !String::from_utf8_lossy(&robot.stderr).contains("stands along"),
+        "{}",
+        String::from_utf8_lossy(&robot.stderr)
+    );
+    let (glb, bvh) = (path(&asset("blender/stretchy_full.glb")), path(&asset("blender/stretchy_full.bvh")));
+    let lying = bonescope(&["diff", &glb, &bvh, "--anim-a", "squash_stretch", "--anim-b", "0"]);
+    assert!(
+        String::from_utf8_lossy(&lying.stderr).contains("B's along Z"),
+        "{}",
+        String::from_utf8_lossy(&lying.stderr)
+    );
+}

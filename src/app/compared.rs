@@ -29,7 +29,8 @@ pub struct Compared {
     states_unit: bool,
     /// The axis the file is read as standing along (Y: as it says).
     pub up: UpAxis,
-    /// The axes the document and this file stand along at rest, where they differ ([`standing_apart`]).
+    /// The axes the document and this file stand along as they play (the document's opening clip and its partner),
+    /// where they differ ([`standing_apart`]).
     pub apart: Option<[UpAxis; 2]>,
     /// The unit the file is measured in: the document's, or the one the user gave the document where its file
     /// states none.
@@ -110,7 +111,9 @@ impl Compared {
         }
         let (states_unit, document_unit) = (rig.unit.is_some(), document.unit);
         let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
-        let (up, apart) = (UpAxis::Y, standing_apart(document, &rig));
+        let opening = document.opening_clip();
+        let apart = standing_apart((document, opening), (&rig, opening.and_then(|o| clips[o])));
+        let up = UpAxis::Y;
         Compared { path, rig, rig_id, states_unit, up, apart, document_unit, bones, left_out, meshes, clips, played }
     }
 
@@ -148,7 +151,9 @@ impl Compared {
     /// The same file read as standing along `up` beside `document`: another rig to compare.
     pub fn given_up(&self, up: UpAxis, document: &Rig) -> Self {
         let rig = (*self.rig).clone().restood(self.up, up);
-        let apart = standing_apart(document, &rig);
+        let opening = document.opening_clip();
+        let apart =
+            standing_apart((document, opening), (&rig, opening.and_then(|o| self.clips.get(o).copied().flatten())));
         Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), up, apart, ..self.clone() }
     }
 

@@ -8,7 +8,9 @@ use clap::Args;
 use super::OutputFormat;
 use super::options::{Distance, choice, files_help, parse_assignment, parse_distance, parse_rate};
 use super::table::{Table, mesh_differences, shown};
-use crate::diff::{Align, AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, standing_apart};
+use crate::diff::{
+    Align, AnimationDiff, Clips, FileDiff, FileSide, chosen_clips, diff_files, match_clips, standing_apart,
+};
 use crate::eval::layers::RotationInterpolation;
 use crate::import;
 use crate::model::{At, Choice, ModeChoice, Rig, Unit, UpAxis, frames};
@@ -77,10 +79,10 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     };
     let rig_a = stated_unit(stood(import::load(&args.a)?, args.up_a), args.unit_a, "--unit-a")?;
     let rig_b = stated_unit(stood(import::load(&args.b)?, args.up_b), args.unit_b, "--unit-b")?;
-    if let Some(note) = lying_down(&rig_a, &rig_b) {
+    let chosen = chosen(args, &rig_a, &rig_b)?;
+    if let Some(note) = lying_down(&rig_a, &rig_b, chosen) {
         eprintln!("note: {note}");
     }
-    let chosen = chosen(args, &rig_a, &rig_b)?;
     let [clip_a, clip_b] = chosen.map_or([None, None], |[a, b]| [Some(a), Some(b)]);
     let a = FileSide::new(shown(&args.a), &rig_a, args.inherit_a, clip_a);
     let mut b = FileSide::new(shown(&args.b), &rig_b, args.inherit_b, clip_b);
@@ -181,8 +183,12 @@ fn stated_unit(rig: Rig, unit: Option<Unit>, option: &str) -> anyhow::Result<Rig
 }
 
 /// What to give where one file's skeleton lies down beside the other's.
-fn lying_down(a: &Rig, b: &Rig) -> Option<String> {
-    let [up_a, up_b] = standing_apart(a, b)?;
+fn lying_down(a: &Rig, b: &Rig, chosen: Option<[usize; 2]>) -> Option<String> {
+    // As they play: the clips chosen, else the first two that pair by name (or each file's only one).
+    let paired = || match_clips(&a.clips, &b.clips).0.first().map(|&(i, j)| [i, j]);
+    let one_each = (a.clips.len() == 1 && b.clips.len() == 1).then_some([0, 0]);
+    let [clip_a, clip_b] = chosen.or_else(paired).or(one_each).map_or([None, None], |[i, j]| [Some(i), Some(j)]);
+    let [up_a, up_b] = standing_apart((a, clip_a), (b, clip_b))?;
     let (side, option, up) = if up_a == UpAxis::Y { ("B", "--up-b", up_b) } else { ("A", "--up-a", up_a) };
     Some(format!(
         "A's skeleton stands along {}, B's along {}: every distance measures the turn; if {side} is {}-up, give \

@@ -15,6 +15,7 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use super::DiffError;
+use crate::eval::Evaluation;
 use crate::model::{Clip, Mesh, Rig, Skeleton, UpAxis};
 
 /// The suffix of the helper node a bake puts above a stretched bone.
@@ -248,16 +249,20 @@ pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, 
     (pairs, only_a, only_b)
 }
 
-/// The axes two rigs stand along at rest, `[A's, B's]`, where they differ: one file's skeleton lies down beside
-/// the other's (a Z-up BVH beside its Y-up glTF), and every distance between them would measure the turn, not the
-/// motion. `None` where they agree or either figure stands along neither Y nor Z clearly.
-pub fn standing_apart(a: &Rig, b: &Rig) -> Option<[UpAxis; 2]> {
-    let standing = |rig: &Rig| {
+/// The axes two rigs stand along, `[A's, B's]`, where they differ: one file's skeleton lies down beside the
+/// other's (a Z-up BVH beside its Y-up glTF), and every distance between them would measure the turn, not the
+/// motion. Each figure is looked at as it plays, at the start of its clip compared (its rest pose for `None`): a
+/// rest pose may lie otherwise than every frame (Blender's FBX rests its bones as they were edited, along Z).
+/// `None` where they agree or either figure stands along neither Y nor Z clearly.
+pub fn standing_apart((a, clip_a): (&Rig, Option<usize>), (b, clip_b): (&Rig, Option<usize>)) -> Option<[UpAxis; 2]> {
+    let standing = |rig: &Rig, clip: Option<usize>| {
         let figure = rig.skeleton.figure();
-        let heads = rig.skeleton.rest_model_matrices().into_iter().enumerate().filter(|&(i, _)| figure[i]);
+        let playing = Evaluation::declared(rig, clip.and_then(|c| rig.clips.get(c)));
+        let model = playing.pose_at(playing.span().start).model.model;
+        let heads = model.into_iter().enumerate().filter(|&(i, _)| figure[i]);
         UpAxis::standing(heads.map(|(_, m)| m.w_axis.truncate()))
     };
-    let (a, b) = (standing(a)?, standing(b)?);
+    let (a, b) = (standing(a, clip_a)?, standing(b, clip_b)?);
     (a != b).then_some([a, b])
 }
 
