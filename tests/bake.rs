@@ -568,3 +568,16 @@ fn files_nobody_here_wrote_bake_within_the_bound_they_state_and_validate() {
         assert_eq!(report["errors"], 0, "{}: {}", report["file"], report["messages"]);
     }
 }
+
+#[test]
+fn a_take_that_starts_before_zero_is_written_from_zero_and_said_so() {
+    // Maya's long-keyframe take runs from −166,666 s on its file's clock; glTF's clock starts at 0.
+    let folder = tempfile::tempdir().unwrap();
+    let out = folder.path().join("long.glb");
+    let report = bake_for("fbx-ufbx-corpus/maya_long_keyframes_7700_ascii.fbx", "generic", &out, &[]);
+    let notes: Vec<&str> = report["notes"].as_array().unwrap().iter().filter_map(Value::as_str).collect();
+    assert!(notes.iter().any(|n| n.starts_with("`Take 001` starts at -166666.66")), "{notes:?}");
+    let back = import::load(&out).unwrap_or_else(|e| panic!("{e}"));
+    let span = back.clips[0].span();
+    assert!(span.start >= 0.0 && span.length() > 333_000.0, "{span:?}");
+}

@@ -93,6 +93,16 @@ pub struct ClipToBake<'a> {
     pub source: Evaluation<'a>,
 }
 
+impl<'a> ClipToBake<'a> {
+    /// `source` baked as `name`, on its own clock where that starts at 0 or later, else played from 0 (glTF's clock
+    /// starts there: an FBX take from −166,666 s is written from 0, and the bake says so).
+    pub fn new(name: String, source: Evaluation<'a>) -> Self {
+        let start = source.span().start;
+        let source = if start < 0.0 { source.delayed(-start) } else { source };
+        ClipToBake { name, source }
+    }
+}
+
 /// What to bake: clips of one rig under one set of modes, over that rig at rest under those modes.
 #[derive(Clone, Debug)]
 pub struct Request<'a> {
@@ -151,10 +161,10 @@ impl<'a> Request<'a> {
             None => source.rig.clips.iter().collect(),
         };
         let clips = if clips.is_empty() {
-            vec![ClipToBake { name: "rest pose".to_owned(), source: rest.clone() }]
+            vec![ClipToBake::new("rest pose".to_owned(), rest.clone())]
         } else {
             let of = |clip: &'a Clip| rest.clone().with_clip(Some(clip));
-            clips.into_iter().map(|clip| ClipToBake { name: clip.label(), source: of(clip) }).collect()
+            clips.into_iter().map(|clip| ClipToBake::new(clip.label(), of(clip))).collect()
         };
         Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
@@ -169,7 +179,7 @@ impl<'a> Request<'a> {
         let main = source.clip.map_or_else(|| "rest pose".to_owned(), |c| c.label());
         let name = format!("{main} + {}", layers.summary(source.rig, source.clip));
         let rest = source.at_rest();
-        let clips = vec![ClipToBake { name, source: source.clone() }];
+        let clips = vec![ClipToBake::new(name, source.clone())];
         Request { rest, clips, strategy, tolerance, engine: Engine::Generic }
     }
 
@@ -255,6 +265,13 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
         let keys = animation.channels.iter().map(|c| c.times.len()).sum();
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
         document.animations.push(animation);
+    }
+    for clip in request.clips().iter().filter(|c| c.source.delay() != 0.0) {
+        let delay = clip.source.delay();
+        notes.push(format!(
+            "`{}` starts at {} s on its file's clock: written from 0 (glTF's clock starts there), {delay} s later",
+            clip.name, -delay
+        ));
     }
     notes.extend(source_notes(rig, dense.iter().map(|d| d.refined.stats.singular).sum()));
     Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }

@@ -78,7 +78,7 @@ impl Change {
             return None;
         };
         let name = source.clip.map_or_else(|| "rest pose".to_owned(), Clip::label);
-        let clips = vec![ClipToBake { name, source: source.clone() }];
+        let clips = vec![ClipToBake::new(name, source.clone())];
         let request = Request::new(source.at_rest(), clips, strategy, bake::DEFAULT_TOLERANCE);
         let baked = match request {
             Ok(request) => bake::bake(&request),
