@@ -17,6 +17,7 @@ mod variants;
 pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check_bind};
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves, SAME_SHEAR_DEG};
 pub use findings::{Assessment, Findings, Tolerances};
+pub(crate) use peak::{around, gains};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};
 pub use scan::{analyze, clearly_flagged_at, flagged_in_run, scan, scan_analysis};

@@ -104,12 +104,17 @@ pub(super) fn refine(peaks: &Peaks, times: &[f64], worst: (f64, f64), mut f: imp
     searched.fold(worst, |worst, sampled| {
         let (lo, hi) = around(times, sampled);
         let found = largest(lo, sampled, hi, &mut f);
-        if found.1 > worst.1 * (1.0 + GAIN) { found } else { worst }
+        if gains(found.1, worst.1) { found } else { worst }
     })
 }
 
+/// Whether a value found between samples replaces the sampled `value`: larger by more than [`GAIN`].
+pub(crate) fn gains(found: f64, value: f64) -> bool {
+    found > value * (1.0 + GAIN)
+}
+
 /// The samples before and after the one at `time` (itself at either end of the clip).
-fn around(times: &[f64], time: f64) -> (f64, f64) {
+pub(crate) fn around(times: &[f64], time: f64) -> (f64, f64) {
     let at = times.partition_point(|&t| t < time).min(times.len().saturating_sub(1));
     let before = times[at.saturating_sub(1)];
     let after = times.get(at + 1).copied().unwrap_or(times[at]);

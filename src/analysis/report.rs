@@ -176,6 +176,9 @@ pub struct ExplainedBone {
     pub name: String,
     /// The bone of its chain whose uniform scale would remove the most shear where it shears most.
     pub main_cause: Option<String>,
+    /// Where no one bone's squash causes it: the fewest bones whose scales, made uniform together, remove it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub together: Vec<String>,
     /// The best fix, what it leaves, and how far it moves the skin (or, without a mesh, the bones' probe points):
     /// in the rig's units and as a fraction of its size.
     pub best_fix: Option<String>,

@@ -42,19 +42,35 @@ pub struct Attribution {
     pub stretched: bool,
     /// The root first, the explained bone last.
     pub chain: Vec<Link>,
+    /// The bone whose squash made uniform takes the most shear away, where one takes away more than rounding does
+    /// ([`contributes`]).
+    pub cause: Option<usize>,
     /// The fewest bones of the chain whose scales, all made uniform, leave the bone unflagged (empty when it is
     /// not flagged). Contributions need not add up, since scales compound and cancel; this set is what suffices.
     pub sufficient: Vec<usize>,
 }
 
 impl Attribution {
-    /// The bone whose squash causes the most shear, if any causes some.
+    /// The link of the bone whose squash causes the most shear ([`Attribution::cause`]).
     pub fn main_cause(&self) -> Option<&Link> {
-        self.chain
-            .iter()
-            .filter(|l| l.contribution_deg > 0.0)
-            .max_by(|a, b| a.contribution_deg.total_cmp(&b.contribution_deg))
+        self.chain.iter().find(|l| Some(l.bone) == self.cause)
     }
+
+    /// Where no one bone's squash causes the shear, the links of the fewest whose squashes together do (the
+    /// [`Attribution::sufficient`] set); empty where one bone is the cause or none suffice.
+    pub fn together(&self) -> Vec<&Link> {
+        match self.cause {
+            Some(_) => Vec::new(),
+            None => self.chain.iter().filter(|l| self.sufficient.contains(&l.bone)).collect(),
+        }
+    }
+}
+
+/// Whether making a squash uniform takes `contribution` degrees of shear away as a cause does: more than half the
+/// shear tolerance. Rounding moves a shear by far less; and a flagged bone (sheared past the tolerance) whose chain's
+/// other scales can shear it by under half the tolerance has its one squash as its cause ([`Group::certain_causes`]).
+fn contributes(contribution: f64, tolerances: &Tolerances) -> bool {
+    contribution > 0.5 * tolerances.min_shear_deg
 }
 
 /// A stretch of time in which one bone's squash is the main cause of the shear.
@@ -102,9 +118,11 @@ pub fn attribute(evaluation: &Evaluation, bone: usize, time: f64, tolerances: &T
             link(skeleton, b, &local[b], turn, shear, shear_left, tolerances)
         })
         .collect();
+    let cause = links.iter().filter(|l| contributes(l.contribution_deg, tolerances));
+    let cause = cause.max_by(|a, b| a.contribution_deg.total_cmp(&b.contribution_deg)).map(|l| l.bone);
     let stretched = assessment.findings.stretched;
     let sufficient = if stretched { sufficient(&mut matrix, &mut local, &links, tolerances) } else { Vec::new() };
-    Attribution { bone, time, shear_deg: shear, stretched, chain: links, sufficient }
+    Attribution { bone, time, shear_deg: shear, stretched, chain: links, cause, sufficient }
 }
 
 /// Why `bone` shears over the clip `scanned` analysed (every bone judged, as `scan` judges them) of `evaluation`, with
@@ -334,7 +352,7 @@ impl<'b> Group<'b> {
                     continue;
                 }
                 let contribution = bone.shear - column_shear(&models[self.bones[k]]);
-                if contribution > bone.largest {
+                if contribution > bone.largest && contributes(contribution, tolerances) {
                     (bone.largest, bone.main_cause) = (contribution, Some(squash));
                 }
             }
@@ -346,7 +364,8 @@ impl<'b> Group<'b> {
 #[derive(Clone, Copy, Debug)]
 struct Sample {
     stretched: bool,
-    /// The chain bone whose uniform scale removes the most shear, when the bone is flagged.
+    /// The chain bone whose uniform scale removes the most shear, when the bone is flagged and one removes more
+    /// than rounding does ([`contributes`]).
     main_cause: Option<usize>,
 }
 

@@ -9,8 +9,8 @@ use std::sync::atomic::AtomicBool;
 use rayon::prelude::*;
 
 use crate::analysis::{
-    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, VariantJudges, analyze, clearly_flagged_at,
-    flagged_in_run, scan_variants,
+    ClipScan, CurveRequest, Judged, SAME_SHEAR_DEG, ScanOptions, VariantJudges, analyze, around, clearly_flagged_at,
+    flagged_in_run, gains, scan_variants,
 };
 use crate::bake::{self, ClipToBake, Request, Strategy};
 use crate::diff::{
@@ -112,6 +112,13 @@ pub struct Cost {
     pub measured: Measured,
 }
 
+/// How a cost is searched for between the times compared ([`Baseline::refined`]): the intervals each look divides
+/// its span into, and how many looks, each over the two intervals beside the largest found. The span, first the
+/// two intervals between times compared around the worst, shrinks to `2·(2/GRID)^ZOOMS` of one of them (1/128);
+/// near a smooth peak a distance falls short of it by the square of the time from it.
+const GRID: usize = 8;
+const ZOOMS: usize = 4;
+
 /// How many changes one pass over the clip compares with the source ([`Baseline::costs`]): each holds its poses and
 /// skinned meshes while the pass runs.
 const BATCH: usize = 16;
@@ -146,6 +153,16 @@ impl Scale {
         let times = comparison_times(source, other, rate);
         let size = source.size(&times);
         Scale { times, size }
+    }
+
+    /// The same size, at its times and the midpoints between them.
+    fn with_midpoints(self) -> Self {
+        let mut times = Vec::with_capacity(2 * self.times.len());
+        for pair in self.times.windows(2) {
+            times.extend([pair[0], 0.5 * (pair[0] + pair[1])]);
+        }
+        times.extend(self.times.last());
+        Scale { times, ..self }
     }
 }
 
@@ -292,9 +309,9 @@ impl<'e, 'a> Baseline<'e, 'a> {
         let sides: Vec<(&Evaluation, &Pairs)> = changes.iter().map(|(_, on, _)| (&on.fixed, &on.pairs)).collect();
         let (compared, runs) = compare_each_beside(self.source, &sides, &self.scale.times, self.scale.size, &judges)?;
         let scans = judges.scans(self.analysis_times.clone(), runs);
-        let found = changes.iter().zip(scans).zip(compared);
-        let made = found.map(|(((change, ..), scan), comparison)| {
-            (*change, self.applied(*change, None, &scan), self.visible(&comparison))
+        let found: Vec<_> = changes.iter().zip(scans).zip(compared).collect();
+        let made = found.into_par_iter().map(|(((change, on, _), scan), comparison)| {
+            (*change, self.applied(*change, None, &scan), self.refine(on, self.visible(&comparison)))
         });
         Some(made.collect())
     }
@@ -375,9 +392,30 @@ impl<'e, 'a> Baseline<'e, 'a> {
     }
 
     /// What `change`, made (`applied`), costs: the source and the change compared as `diff` compares them, on the
-    /// changed bones and the meshes that follow them (nothing else differs).
+    /// changed bones and the meshes that follow them (nothing else differs), at its largest between the times
+    /// compared too ([`Baseline::refine`]).
     pub fn cost(&self, change: Change, applied: &Applied) -> Result<Cost, String> {
-        self.cost_at(change, applied.baked.as_ref(), 1, true)
+        let cost = self.cost_within(change, applied.baked.as_ref(), f64::INFINITY)?;
+        Ok(cost.expect("no cost passes an infinite limit"))
+    }
+
+    /// `cost`, found at the times compared on `on`, where it is largest between those beside the time of its worst:
+    /// a cost is the largest distance over the clip, not over the times compared. Evenly spaced times between those
+    /// two, then between the times beside the largest found, [`ZOOMS`] times: a comparison pass each, as a pass costs
+    /// more to set up than a time costs to compare. A lower bound of the cost found at the times compared bounds
+    /// this one too.
+    fn refine(&self, on: &ComparedOn, mut cost: Cost) -> Cost {
+        let (mut lo, mut hi) = around(&on.scale.times, cost.distance.time);
+        for _ in 0..ZOOMS {
+            let step = (hi - lo) / GRID as f64;
+            let times: Vec<f64> = (1..GRID).map(|i| lo + step * i as f64).collect();
+            let found = self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &times, on.scale.size));
+            if gains(found.distance.max, cost.distance.max) {
+                cost = found;
+            }
+            (lo, hi) = ((cost.distance.time - step).max(lo), (cost.distance.time + step).min(hi));
+        }
+        cost
     }
 
     /// [`Baseline::cost`] where it is at most `limit`; `None` once something moves further (the comparison given
@@ -385,7 +423,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
     fn cost_within(&self, change: Change, baked: Option<&Rig>, limit: f64) -> Result<Option<Cost>, String> {
         let on = self.compared_on(change, baked, true)?;
         let Scale { times, size } = &*on.scale;
-        Ok(compare_within(self.source, &on.fixed, &on.pairs, times, *size, limit).map(|c| self.visible(&c)))
+        let compared = compare_within(self.source, &on.fixed, &on.pairs, times, *size, limit);
+        Ok(compared.map(|c| self.refine(&on, self.visible(&c))))
     }
 
     /// What each of `changes` (made) costs, as [`Baseline::cost`] says ([`Baseline::costs_within`], no limit).
@@ -419,8 +458,11 @@ impl<'e, 'a> Baseline<'e, 'a> {
             costs.extend(failed.into_iter().map(|(change, why)| (change, Err(why))));
             let sides: Vec<_> = on.iter().map(|(_, on, limit)| (&on.fixed, &on.pairs, *limit)).collect();
             let compared = compare_each_within(self.source, &sides, &self.scale.times, self.scale.size);
-            let visible = |c: Option<Comparison>| Ok(c.map(|c| self.visible(&c)));
-            costs.extend(on.iter().zip(compared).map(|((change, ..), c)| (*change, visible(c))));
+            let refined = on
+                .par_iter()
+                .zip(compared)
+                .map(|((change, on, _), c)| (*change, Ok(c.map(|c| self.refine(on, self.visible(&c))))));
+            costs.par_extend(refined);
         }
         costs
     }
@@ -472,13 +514,13 @@ impl<'e, 'a> Baseline<'e, 'a> {
     /// setup alone, before it is scanned.
     pub fn cost_bound(&self, change: Change, baked: Option<&Rig>) -> Result<f64, String> {
         let stride = (self.scale.times.len() / BOUND_TIMES).max(1);
-        Ok(self.cost_at(change, baked, stride, false)?.distance.max)
+        Ok(self.cost_at(change, baked, stride)?.distance.max)
     }
 
-    /// The cost of `change` (for a bake, `baked` the rig it writes) compared at every `stride`th time, with the
-    /// skin where `skin` says (else on the bones alone).
-    fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize, skin: bool) -> Result<Cost, String> {
-        let on = self.compared_on(change, baked, skin)?;
+    /// The cost of `change` (for a bake, `baked` the rig it writes) compared on the bones alone at every `stride`th
+    /// time.
+    fn cost_at(&self, change: Change, baked: Option<&Rig>, stride: usize) -> Result<Cost, String> {
+        let on = self.compared_on(change, baked, false)?;
         let compared: Vec<f64> = on.scale.times.iter().copied().step_by(stride).collect();
         Ok(self.visible(&compare_at_size(self.source, &on.fixed, &on.pairs, &compared, on.scale.size)))
     }
@@ -494,10 +536,11 @@ impl<'e, 'a> Baseline<'e, 'a> {
         if !skin {
             pairs.meshes.clear();
         }
-        // A change that keeps the clip's times (any but a bake) keeps the scale found once.
+        // A change that keeps the clip's times (any but a bake) keeps the scale found once. A bake is compared
+        // between its keys too, where it strays most (at them it matches the source best).
         let scale = match baked {
             None => Cow::Borrowed(&*self.scale),
-            Some(_) => Cow::Owned(Scale::against(self.source, &fixed, self.options.rate)),
+            Some(_) => Cow::Owned(Scale::against(self.source, &fixed, self.options.rate).with_midpoints()),
         };
         Ok(ComparedOn { fixed, pairs, scale })
     }

@@ -25,10 +25,11 @@ pub use fixes::{Change, Cost, Fix, Measured, Scale, ShearElsewhere, is_other_mod
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
-use crate::analysis::{ClipAnalysis, CurveRequest, SAME_SHEAR_DEG, ScanOptions, analyze};
+use crate::analysis::{ClipAnalysis, CurveRequest, SAME_SHEAR_DEG, ScanOptions, Tolerances, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
 use crate::model::{Tool, Unit, significant};
@@ -97,6 +98,7 @@ impl Explanation {
         ExplainedBone {
             name: self.name.clone(),
             main_cause: self.causes.at.main_cause().map(|l| l.name.clone()),
+            together: self.causes.at.together().iter().map(|l| l.name.clone()).collect(),
             best_fix: fix.map(|f| f.label.clone()),
             fix_removes: fix.map(|f| f.removes),
             fix_cost: fix.map(|f| f.cost.distance.max),
@@ -113,19 +115,48 @@ impl Explanation {
         if self.causes.stretched_samples == 0 {
             return format!("{name}: not sheared beyond the tolerances");
         }
-        let cause = match self.causes.at.main_cause() {
-            Some(link) if link.bone == self.bone => "its own stretch".to_owned(),
-            Some(link) => {
-                let [x, y, z] = link.scale.to_array().map(significant);
-                format!("{}'s scale ({x}, {y}, {z}) under a {:.0}° turn", link.name, link.turn_deg.unwrap_or(0.0))
+        let at = &self.causes.at;
+        let cause = match (at.main_cause(), at.together().as_slice()) {
+            (Some(link), _) if link.bone == self.bone => "its own stretch".to_owned(),
+            (Some(link), _) => {
+                let turn = link.turn_deg.unwrap_or(0.0);
+                format!("{}'s scale {} under a {turn:.0}° turn", link.name, scale_text(link.scale))
             }
-            None => "no single bone's scale".to_owned(),
+            (None, []) => "no single bone's scale".to_owned(),
+            (None, [one]) => format!("{}'s scale {}", one.name, scale_text(one.scale)),
+            (None, together) => {
+                let each: Vec<String> =
+                    together.iter().map(|l| format!("{} {}", l.name, scale_text(l.scale))).collect();
+                format!("the scales of {} together, no one alone", each.join(" and "))
+            }
         };
         match self.best_fix() {
             Some(fix) => format!("{name}: {cause}; fix: {}", fix.summary(unit)),
             None => format!("{name}: {cause}"),
         }
     }
+}
+
+/// A scale's factors with the digits that tell them apart: three significant ones, and more where factors unequal
+/// by the default anisotropy tolerance would print alike, up to six decimals ("(1.002, 1, 1)", not "(1, 1, 1)").
+fn scale_text(scale: DVec3) -> String {
+    let k = scale.to_array();
+    let unequal = Tolerances::default().min_anisotropy;
+    let apart = |d: usize| {
+        let differ = |i: usize, j: usize| (k[i] - k[j]).abs() > unequal * k[i].abs().min(k[j].abs());
+        let pairs = [(0, 1), (0, 2), (1, 2)];
+        pairs.iter().all(|&(i, j)| !differ(i, j) || format!("{:.d$}", k[i]) != format!("{:.d$}", k[j]))
+    };
+    let decimals = (0..=6).find(|&d| apart(d)).unwrap_or(6);
+    let text = |x: f64| {
+        let fixed = format!("{x:.decimals$}");
+        let fixed = if fixed.contains('.') { fixed.trim_end_matches('0').trim_end_matches('.') } else { &fixed };
+        let short = significant(x);
+        // Whichever shows more digits.
+        if fixed.len() > short.len() { fixed.to_owned() } else { short }
+    };
+    let [x, y, z] = k.map(text);
+    format!("({x}, {y}, {z})")
 }
 
 /// `explain`'s report of a file: the bones explained over one clip, as `explain --format json` prints it.
@@ -599,6 +630,16 @@ mod tests {
     fn parent_and_child(scale: DVec3, degrees: f64) -> Rig {
         let parent = Transform::from_trs(DVec3::ZERO, DQuat::IDENTITY, scale);
         rig(vec![Bone::joint("parent", None, parent), Bone::joint("child", Some(0), turned(DVec3::Z, degrees))], vec![])
+    }
+
+    #[test]
+    fn scales_print_with_the_digits_that_show_them_unequal() {
+        // Three significant digits, more where factors unequal by more than 0.01 % would print alike.
+        assert_eq!(scale_text(DVec3::new(1.0019, 1.0, 1.0)), "(1.002, 1, 1)");
+        assert_eq!(scale_text(DVec3::new(0.99999, 1.25442, 1.0)), "(1, 1.25, 1)");
+        assert_eq!(scale_text(DVec3::new(0.844, 1.4093, 0.844)), "(0.844, 1.41, 0.844)");
+        assert_eq!(scale_text(DVec3::new(1.00002, 1.0, 1.00001)), "(1, 1, 1)");
+        assert_eq!(scale_text(DVec3::new(1.0, 1.000_15, 1.0)), "(1, 1.0002, 1)");
     }
 
     #[test]
