@@ -8,7 +8,7 @@ use clap::Args;
 use super::layers::bone_index;
 use super::options::{files_help, parse_rate};
 use super::setup::evaluation;
-use super::table::{Table, shown};
+use super::table::{Table, frame_at, shown};
 use super::{EvalArgs, OutputFormat, ToleranceArgs};
 use crate::analysis::report::AnimationInfo;
 use crate::analysis::{ScanOptions, scan_analysis};
@@ -152,9 +152,9 @@ fn render_bone(
     // The modes of the file's own tool first (every mode for a format without a tool of its own), the others apart.
     let listed = explained.shown_fixes(shown.all, shown.min_shear_deg);
     let (other, first): (Vec<&Fix>, Vec<&Fix>) = listed.partition(|fix| is_other_mode(fix.change, rig.tool));
-    out.push_str(&render_fixes("  fixes, best first", &first, unit));
+    out.push_str(&render_fixes("  fixes, best first", &first, (unit, rate)));
     if !other.is_empty() {
-        out.push_str(&render_fixes("  other modes", &other, unit));
+        out.push_str(&render_fixes("  other modes", &other, (unit, rate)));
     }
     match explained.fixes.len() - first.len() - other.len() {
         0 => {}
@@ -168,7 +168,8 @@ fn render_bone(
     out
 }
 
-fn render_fixes(title: &'static str, fixes: &[&Fix], unit: Option<Unit>) -> String {
+/// The fixes' table, lengths in `unit`, times with their frames at `rate`.
+fn render_fixes(title: &'static str, fixes: &[&Fix], (unit, rate): (Option<Unit>, Option<f64>)) -> String {
     let mut table = Table::new(&[
         (title, false),
         ("shear left°", true),
@@ -176,6 +177,7 @@ fn render_fixes(title: &'static str, fixes: &[&Fix], unit: Option<Unit>) -> Stri
         ("moves", true),
         ("% of rig", true),
         ("at s", true),
+        ("frame", true),
         ("elsewhere", false),
     ]);
     for fix in fixes {
@@ -193,6 +195,7 @@ fn render_fixes(title: &'static str, fixes: &[&Fix], unit: Option<Unit>) -> Stri
             Unit::readable(unit, fix.cost.distance.max),
             format!("{:.4}", 100.0 * fix.cost.fraction),
             format!("{:.4}", fix.cost.distance.time),
+            frame_at(fix.cost.distance.time, rate),
             elsewhere.join("; "),
         ]);
     }

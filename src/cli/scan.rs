@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use super::layers::LayerArgs;
 use super::options::{clip_index, files_help, parse_angle, parse_comparison, parse_rate};
 use super::setup::evaluation;
-use super::table::{Table, shown};
+use super::table::{Table, frame_at, shown};
 use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::ScanOptions;
 use crate::analysis::report::{AnimationInfo, AnimationScan, FileReport, FileScan};
@@ -446,6 +446,7 @@ pub(super) fn render_animation(file: &str, scan: &AnimationScan) -> String {
             ("stretched bone", false),
             ("worst shear°", true),
             ("at s", true),
+            ("frame", true),
             ("worst stretch°", true),
             ("flagged", true),
             ("first s", true),
@@ -456,6 +457,7 @@ pub(super) fn render_animation(file: &str, scan: &AnimationScan) -> String {
                 bone.name.clone(),
                 format!("{:.3}", s.worst_shear_deg),
                 format!("{:.4}", s.worst_shear_time),
+                frame_at(s.worst_shear_time, scan.animation.as_ref().map(|a| a.frame_rate)),
                 format!("{:.3}", s.worst_stretch_deg),
                 format!("{}/{}", s.flagged_samples, scan.samples),
                 s.first_flagged_time.map_or_else(String::new, |t| format!("{t:.4}")),

@@ -3,6 +3,7 @@
 use std::fmt;
 
 use crate::diff::MeshDifference;
+use crate::model::At;
 
 /// Columns aligned by the widest cell; numbers (columns marked right-aligned) line up on the right.
 pub struct Table {
@@ -25,6 +26,11 @@ impl Table {
         debug_assert_eq!(cells.len(), self.headers.len());
         self.rows.push(cells);
     }
+}
+
+/// The frame `time` falls on at `rate`, for a table's frame column (empty without a usable rate).
+pub fn frame_at(time: f64, rate: Option<f64>) -> String {
+    At { time, rate }.frame().map_or_else(String::new, crate::model::frames)
 }
 
 impl fmt::Display for Table {
