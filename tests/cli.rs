@@ -557,6 +557,28 @@ fn scan_walks_folders_by_content_with_include_globs() {
     assert!(String::from_utf8_lossy(&output.stdout).contains("stretchy_full.bvh"));
 }
 
+#[test]
+fn a_folder_without_animations_fails_the_scan_unless_allowed() {
+    // A CI job pointed at the wrong folder must not pass with an empty report.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("notes.txt"), "not an animation").unwrap();
+    let folder = dir.path().display().to_string();
+    for command in ["scan", "storage"] {
+        let out = bonescope(&[command, &folder]);
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        assert_eq!(String::from_utf8_lossy(&out.stderr), format!("error: no animation files under {folder}\n"));
+        assert!(out.stdout.is_empty(), "{command}");
+        let allowed = bonescope(&[command, &folder, "--allow-empty", "--format", "json"]);
+        assert_eq!(allowed.status.code(), Some(0), "{command}: {}", String::from_utf8_lossy(&allowed.stderr));
+        assert_eq!(json(&allowed), serde_json::json!([]), "{command}");
+    }
+    // A folder with one file split in two shards: the shard without it passes.
+    std::os::unix::fs::symlink(stretchy(), dir.path().join("stretchy_full.glb")).unwrap();
+    for shard in ["1/2", "2/2"] {
+        assert_eq!(bonescope(&["scan", &folder, "--shard", shard]).status.code(), Some(0), "{shard}");
+    }
+}
+
 /// Element names of an XML document, in order, with their attributes.
 fn xml_elements(xml: &str) -> Vec<(String, std::collections::HashMap<String, String>)> {
     let mut reader = quick_xml::Reader::from_str(xml);
