@@ -846,13 +846,29 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
     // program stopped by the closed pipe does (status 141), with nothing on stderr: no panic, no error line.
     // The pipe's reading end is closed before the command starts: closed after, a fast command could write its whole
     // report into the pipe's buffer first and rightly exit 0.
+    // Every command that writes a report to standard output, in each way it writes one.
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
-    for args in [["explain", "--format", "json"], ["inspect", "--format", "table"]] {
+    let dir = tempfile::tempdir().unwrap();
+    let (file, baked) = (stretchy(), dir.path().join("baked.glb").display().to_string());
+    let file = file.as_str();
+    let lines = dir.path().join("scan.jsonl");
+    std::fs::write(&lines, bonescope(&["scan", file, "--format", "jsonl"]).stdout).unwrap();
+    let lines = lines.display().to_string();
+    for args in [
+        vec!["explain", file, "--format", "json"],
+        vec!["inspect", file, "--format", "table"],
+        vec!["inspect", file, "--format", "json"],
+        vec!["scan", file, "--format", "json"],
+        vec!["scan", file, "--format", "jsonl"],
+        vec!["diff", file, file, "--format", "json"],
+        vec!["bake", file, "--out", &baked, "--format", "json"],
+        vec!["report", &lines, "--format", "json"],
+    ] {
         let (reader, writer) = std::io::pipe().expect("a pipe");
         drop(reader);
         let out = Command::new(env!("CARGO_BIN_EXE_bonescope"))
-            .args([args[0], &stretchy(), args[1], args[2]])
+            .args(&args)
             .stdout(writer)
             .stderr(Stdio::piped())
             .output()

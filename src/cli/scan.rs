@@ -244,7 +244,7 @@ fn report_files<T: serde::Serialize + Send>(
     progress.finish();
     written?;
     match format {
-        ScanFormat::Json => writeln!(out, "{}", serde_json::to_string_pretty(&files)?)?,
+        ScanFormat::Json => super::print_json(&files)?,
         ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
         ScanFormat::Junit => writeln!(out, "{}", junit(&files))?,
         ScanFormat::Jsonl => {}
