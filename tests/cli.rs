@@ -579,6 +579,22 @@ fn a_folder_without_animations_fails_the_scan_unless_allowed() {
     }
 }
 
+#[test]
+fn bake_names_the_path_it_cannot_write_with_the_systems_reason() {
+    // Not the temporary file it writes first: the user never named that.
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing/baked.glb").display().to_string();
+    let folder = dir.path().display().to_string();
+    for (out, reason) in
+        [(&missing, "No such file or directory (os error 2)"), (&folder, "Is a directory (os error 21)")]
+    {
+        let run = bonescope(&["bake", &stretchy(), "--out", out]);
+        assert_eq!(run.status.code(), Some(2), "{out}");
+        assert_eq!(String::from_utf8_lossy(&run.stderr), format!("error: cannot write {out}: {reason}\n"));
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no temporary file left");
+}
+
 /// Element names of an XML document, in order, with their attributes.
 fn xml_elements(xml: &str) -> Vec<(String, std::collections::HashMap<String, String>)> {
     let mut reader = quick_xml::Reader::from_str(xml);
