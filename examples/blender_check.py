@@ -1,7 +1,7 @@
 """bonescope inside Blender: which bones of the active armature shear, and the cheapest fix of each.
 
 Install the bonescope wheel into Blender's Python once (`<blender>/<version>/python/bin/python3.11 -m pip install
-bonescope-*.whl`), then either run this file in Blender's Text Editor (Run Script) with an armature active, or install
+--no-deps bonescope-*.whl`: Blender's own numpy stays), then either run this file in Blender's Text Editor (Run Script) with an armature active, or install
 it as an add-on (Edit → Preferences → Add-ons → Install) and use Object → bonescope: check shear. The armature is
 exported with Blender's own glTF exporter to a temporary file, analysed by bonescope in the same Python, and each
 stretched bone is reported with its worst shear, its main cause and its best fix.

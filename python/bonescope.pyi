@@ -15,6 +15,9 @@ ModesChoice = Union[str, Mapping[Union[str, int], str]]
 #: A report as the command line's JSON: dicts, lists, strings, numbers, None.
 Json = Dict[str, Any]
 
+#: The version of the wheel, which is the command line's (`bonescope --version`).
+__version__: str
+
 class Error(Exception):
     """What bonescope cannot read or do: one line naming the file and the place, as the command line says it."""
 
@@ -77,7 +80,9 @@ class Evaluation:
     scale: npt.NDArray[np.float64]
     #: (T, B): F, 1 or -1 (mirrored).
     sign: npt.NDArray[np.float64]
-    #: (T, B): the largest deviation from 90° between two columns of the model matrix, in degrees.
+    #: (T, B): the largest deviation from 90° between two columns of the model matrix, in degrees, at each time: its
+    #: maximum over the times is the sampled worst, which `Rig.scan` refines between the samples (`worst_shear_deg`,
+    #: as the command line reports it).
     shear_deg: npt.NDArray[np.float64]
     #: (T, B): the angle of U, in degrees.
     stretch_deg: npt.NDArray[np.float64]

@@ -1,7 +1,7 @@
 //! The CI examples of `.ci/examples` as their CI systems would take them: what keeps a broken file from hiding the
 //! report (the scan steps and pods succeed with its error recorded; the report runs whatever the scans did), what
 //! bounds the pods, and their exact `scan` and `report` command lines, run by the shell on a few shared assets and
-//! one broken file.
+//! one broken file; and the README's short CI lines, as a `set -e` job runs them.
 
 mod common;
 
@@ -103,6 +103,41 @@ fn cargo_config_env(name: &str) -> String {
 fn option_values<'a>(script: &'a str, option: &str) -> Vec<&'a str> {
     let words: Vec<&str> = script.split_whitespace().collect();
     words.windows(2).filter(|w| w[0] == option).map(|w| w[1].trim_matches(['\'', '"'])).collect()
+}
+
+/// The lines the README shows for CI (its first `sh` block after `## In CI`), which docs/ci.md shows too.
+fn readme_ci_lines() -> String {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let section = readme.split("\n## In CI\n").nth(1).expect("the README has a section `In CI`");
+    section.split("```sh\n").nth(1).and_then(|block| block.split("```").next()).unwrap().to_owned()
+}
+
+/// The README's CI lines in a `set -e` shell: each machine's `scan` line (`$K` of the shards it names) records the
+/// broken file and succeeds, then the report's lines give the JUnit file and the verdict 2; a folder with no
+/// animation file fails the scan line.
+#[test]
+fn the_readmes_ci_lines_record_a_broken_file_in_a_set_e_job() {
+    let lines = readme_ci_lines();
+    let ci_page = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ci.md")).unwrap();
+    assert!(ci_page.contains(&lines), "docs/ci.md shows the README's CI lines");
+    let (scan, report): (Vec<&str>, Vec<&str>) =
+        lines.lines().filter(|line| !line.starts_with('#')).partition(|line| line.contains("bonescope scan"));
+    let shards: usize = option_values(&scan.join(" "), "--shard")[0].split('/').nth(1).unwrap().parse().unwrap();
+    const SET_E: &[&str] = &["bash", "-e", "-c"];
+    let workspace = library();
+    let dir = workspace.path();
+    for k in 1..=shards {
+        let output = run_script(SET_E, &scan.join("\n"), dir, &[("K".to_owned(), k.to_string())]);
+        assert!(output.status.success(), "shard {k}: {}", String::from_utf8_lossy(&output.stderr));
+    }
+    let verdict = run_script(SET_E, &report.join("\n"), dir, &[]);
+    let stderr = String::from_utf8_lossy(&verdict.stderr);
+    assert_reported(dir, shards, verdict.status.code(), &stderr, &dir.join("bonescope.xml"));
+    let empty = tempfile::tempdir().unwrap();
+    std::fs::create_dir(empty.path().join("exports")).unwrap();
+    let output = run_script(SET_E, &scan.join("\n"), empty.path(), &[("K".to_owned(), "1".to_owned())]);
+    assert_eq!(output.status.code(), Some(1), "the scan line fails on an empty folder");
+    assert_eq!(String::from_utf8_lossy(&output.stderr), "error: no animation files under exports\n");
 }
 
 mod github {

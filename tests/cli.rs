@@ -557,6 +557,44 @@ fn scan_walks_folders_by_content_with_include_globs() {
     assert!(String::from_utf8_lossy(&output.stdout).contains("stretchy_full.bvh"));
 }
 
+#[test]
+fn a_folder_without_animations_fails_the_scan_unless_allowed() {
+    // A CI job pointed at the wrong folder must not pass with an empty report.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("notes.txt"), "not an animation").unwrap();
+    let folder = dir.path().display().to_string();
+    for command in ["scan", "storage"] {
+        let out = bonescope(&[command, &folder]);
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        assert_eq!(String::from_utf8_lossy(&out.stderr), format!("error: no animation files under {folder}\n"));
+        assert!(out.stdout.is_empty(), "{command}");
+        let allowed = bonescope(&[command, &folder, "--allow-empty", "--format", "json"]);
+        assert_eq!(allowed.status.code(), Some(0), "{command}: {}", String::from_utf8_lossy(&allowed.stderr));
+        assert_eq!(json(&allowed), serde_json::json!([]), "{command}");
+    }
+    // A folder with one file split in two shards: the shard without it passes.
+    std::os::unix::fs::symlink(stretchy(), dir.path().join("stretchy_full.glb")).unwrap();
+    for shard in ["1/2", "2/2"] {
+        assert_eq!(bonescope(&["scan", &folder, "--shard", shard]).status.code(), Some(0), "{shard}");
+    }
+}
+
+#[test]
+fn bake_names_the_path_it_cannot_write_with_the_systems_reason() {
+    // Not the temporary file it writes first: the user never named that.
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing/baked.glb").display().to_string();
+    let folder = dir.path().display().to_string();
+    for (out, reason) in
+        [(&missing, "No such file or directory (os error 2)"), (&folder, "Is a directory (os error 21)")]
+    {
+        let run = bonescope(&["bake", &stretchy(), "--out", out]);
+        assert_eq!(run.status.code(), Some(2), "{out}");
+        assert_eq!(String::from_utf8_lossy(&run.stderr), format!("error: cannot write {out}: {reason}\n"));
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no temporary file left");
+}
+
 /// Element names of an XML document, in order, with their attributes.
 fn xml_elements(xml: &str) -> Vec<(String, std::collections::HashMap<String, String>)> {
     let mut reader = quick_xml::Reader::from_str(xml);
@@ -824,13 +862,29 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
     // program stopped by the closed pipe does (status 141), with nothing on stderr: no panic, no error line.
     // The pipe's reading end is closed before the command starts: closed after, a fast command could write its whole
     // report into the pipe's buffer first and rightly exit 0.
+    // Every command that writes a report to standard output, in each way it writes one.
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
-    for args in [["explain", "--format", "json"], ["inspect", "--format", "table"]] {
+    let dir = tempfile::tempdir().unwrap();
+    let (file, baked) = (stretchy(), dir.path().join("baked.glb").display().to_string());
+    let file = file.as_str();
+    let lines = dir.path().join("scan.jsonl");
+    std::fs::write(&lines, bonescope(&["scan", file, "--format", "jsonl"]).stdout).unwrap();
+    let lines = lines.display().to_string();
+    for args in [
+        vec!["explain", file, "--format", "json"],
+        vec!["inspect", file, "--format", "table"],
+        vec!["inspect", file, "--format", "json"],
+        vec!["scan", file, "--format", "json"],
+        vec!["scan", file, "--format", "jsonl"],
+        vec!["diff", file, file, "--format", "json"],
+        vec!["bake", file, "--out", &baked, "--format", "json"],
+        vec!["report", &lines, "--format", "json"],
+    ] {
         let (reader, writer) = std::io::pipe().expect("a pipe");
         drop(reader);
         let out = Command::new(env!("CARGO_BIN_EXE_bonescope"))
-            .args([args[0], &stretchy(), args[1], args[2]])
+            .args(&args)
             .stdout(writer)
             .stderr(Stdio::piped())
             .output()

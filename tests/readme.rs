@@ -76,13 +76,13 @@ fn options(command: &str) -> Vec<String> {
     options
 }
 
-/// Every crate the package and the Python module depend on (normal and dev) has a row in the README's table of
-/// dependencies, which says why it is there.
+/// Every crate the package and the Python module depend on (normal and dev) has a row in the table of
+/// `docs/dependencies.md`, which says why it is there.
 #[test]
-fn every_dependency_says_why_in_the_readme() {
+fn every_dependency_says_why_in_the_docs() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let rows: Vec<&str> = readme.lines().filter(|line| line.starts_with("| ")).collect();
+    let page = std::fs::read_to_string(root.join("docs/dependencies.md")).unwrap();
+    let rows: Vec<&str> = page.lines().filter(|line| line.starts_with("| ")).collect();
     let mut missing = Vec::new();
     for manifest in ["Cargo.toml", "python/Cargo.toml"] {
         let text = std::fs::read_to_string(root.join(manifest)).unwrap();
@@ -95,7 +95,7 @@ fn every_dependency_says_why_in_the_readme() {
             }
         }
     }
-    assert!(missing.is_empty(), "dependencies without a row in the README's table: {missing:?}");
+    assert!(missing.is_empty(), "dependencies without a row in docs/dependencies.md: {missing:?}");
 }
 
 /// The names in a manifest's `[dependencies]` and `[dev-dependencies]` tables (renamed ones by their package name).

@@ -146,6 +146,50 @@ struct Mesh {
     morph_targets: usize,
 }
 
+/// `name` as Python writes a string in a repr, or `None`.
+fn quoted(name: Option<&str>) -> String {
+    name.map_or_else(|| "None".to_owned(), |name| format!("{name:?}"))
+}
+
+#[pymethods]
+impl Bone {
+    fn __repr__(&self) -> String {
+        let parent = self.parent.map_or_else(|| "None".to_owned(), |p| p.to_string());
+        format!(
+            "<bonescope.Bone {} {}: {}, parent {parent}, mode {}>",
+            self.index,
+            quoted(Some(&self.name)),
+            self.role,
+            self.mode
+        )
+    }
+}
+
+#[pymethods]
+impl Clip {
+    fn __repr__(&self) -> String {
+        let (name, keys) = (quoted(self.name.as_deref()), self.key_times.len());
+        format!(
+            "<bonescope.Clip {} {name}: {:.3} s from {:.4} s, {} fps, {keys} key times>",
+            self.index, self.duration, self.start, self.frame_rate
+        )
+    }
+}
+
+#[pymethods]
+impl Mesh {
+    fn __repr__(&self) -> String {
+        let skinned = if self.skinned { "skinned" } else { "not skinned" };
+        format!(
+            "<bonescope.Mesh {}: {} vertices on bone {}, {skinned}, {} morph targets>",
+            quoted(Some(&self.name)),
+            self.vertices,
+            self.bone,
+            self.morph_targets
+        )
+    }
+}
+
 #[pymethods]
 impl Rig {
     /// The path the rig was loaded from.
@@ -445,7 +489,9 @@ struct EvaluationArrays {
     scale: Py<PyAny>,
     /// `(T, B)`: `F`, 1 or −1 (mirrored).
     sign: Py<PyAny>,
-    /// `(T, B)`: the largest deviation from 90° between two columns of the model matrix, in degrees.
+    /// `(T, B)`: the largest deviation from 90° between two columns of the model matrix, in degrees, at each time:
+    /// its maximum over the times is the sampled worst, which `Rig.scan` refines between the samples
+    /// (`worst_shear_deg`, as the command line reports it).
     shear_deg: Py<PyAny>,
     /// `(T, B)`: the angle of `U`, in degrees (scale factors within the anisotropy tolerance of each other merged).
     stretch_deg: Py<PyAny>,
@@ -617,6 +663,7 @@ fn bake(
 #[pymodule]
 #[pyo3(name = "bonescope")]
 fn init(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     module.add("Error", module.py().get_type::<Error>())?;
     module.add_function(wrap_pyfunction!(load, module)?)?;
     module.add_function(wrap_pyfunction!(diff, module)?)?;

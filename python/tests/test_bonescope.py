@@ -152,6 +152,14 @@ def test_what_the_rig_holds():
     forearm = next(b for b in rig.bones if b.name == "forearm")
     assert (forearm.mode, forearm.role, rig.bones[forearm.parent].name) == ("full", "joint", "upper_arm")
     assert [(m.skinned, m.vertices > 0) for m in rig.meshes] == [(True, True)]
+    # What each one says when printed: what it is, not where it lies in memory.
+    assert repr(forearm) == f'<bonescope.Bone {forearm.index} "forearm": joint, parent {forearm.parent}, mode full>'
+    assert repr(rig.bones[0]).endswith(", parent None, mode full>")
+    clip = rig.clips[0]
+    keys = len(clip.key_times)
+    assert repr(clip) == f'<bonescope.Clip 0 "squash_stretch": 2.000 s from 0.0333 s, 30 fps, {keys} key times>'
+    mesh = rig.meshes[0]
+    assert repr(mesh) == f'<bonescope.Mesh "{mesh.name}": {mesh.vertices} vertices on bone {mesh.bone}, skinned, 0 morph targets>'
     maya = bonescope.load(MAYA)
     assert "segment-compensate" in {b.mode for b in maya.bones} and maya.unit == "metres" and maya.notes
 
@@ -210,10 +218,30 @@ def test_blender_reads_the_shear_bonescope_reads(tmp_path):
     assert "sheared bones agree" in run.stdout, run.stdout
 
 
-def test_the_readme_example_prints_what_the_readme_says(capsys, monkeypatch):
-    readme = Path(os.environ["BONESCOPE_README"])
-    block = readme.read_text().split("```python\n", 1)[1].split("```", 1)[0]  # the first: the Blender one needs bpy
-    monkeypatch.chdir(readme.parent)
-    exec(compile(block, str(readme), "exec"), {})
-    printed = capsys.readouterr().out.splitlines()
-    assert printed == ["{'forearm': 18.66, 'hand': 18.66, 'neck': 13.7, 'head': 12.73}", "neck → componentwise", "exact"]
+def test_the_version_is_the_wheels_and_the_command_lines():
+    from importlib.metadata import version
+
+    command_line = subprocess.run([BIN, "--version"], capture_output=True, text=True, check=True).stdout
+    assert bonescope.__version__ == version("bonescope")
+    assert command_line == f"bonescope {bonescope.__version__}\n"
+
+
+@pytest.mark.parametrize(
+    "readme, expected",
+    [
+        ("README.md", ["{'forearm': 18.66, 'hand': 18.66, 'neck': 13.7, 'head': 12.73}", "neck → componentwise", "exact"]),
+        (
+            "python/README.md",
+            ["forearm: 18.66°", "hand: 18.66°", "neck: 13.70°", "head: 12.73°"]
+            + ["forearm: 18.666° at 0.5539 s", "hand: 18.666° at 0.5539 s", "neck: 13.712° at 0.5720 s", "head: 12.734° at 0.5668 s"]
+            + ["forearm → blender-aligned"],
+        ),
+    ],
+)
+def test_the_readme_examples_print_what_they_say(readme, expected, capsys, monkeypatch):
+    root = Path(os.environ["BONESCOPE_README"]).parent
+    page = root / readme
+    block = page.read_text().split("```python\n", 1)[1].split("```", 1)[0]  # the first: the Blender one needs bpy
+    monkeypatch.chdir(root)
+    exec(compile(block, str(page), "exec"), {})
+    assert capsys.readouterr().out.splitlines() == expected

@@ -389,19 +389,14 @@ fn source_notes(rig: &Rig, singular: usize) -> Vec<String> {
 
 /// Writes `bytes` to `path` atomically: into a temporary file beside it, then renamed over it, so the path holds
 /// either its old content or all of the new one, never a half-written file. The file gets the permissions a new
-/// file would (a temporary file's are the owner's only).
+/// file would (a temporary file's are the owner's only). An error is the system's reason alone, for the caller to
+/// name `path` with: the temporary file is no name the user gave.
 pub fn save(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
     let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let mut builder = tempfile::Builder::new();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        // Narrowed by the umask, as `File::create` is.
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut file = builder.tempfile_in(folder)?;
-    file.write_all(bytes)?;
+    // Opened, and written, as a plain file rather than through tempfile's own, whose errors name the temporary file.
+    let mut file = tempfile::Builder::new().make_in(folder, |temporary| std::fs::File::create_new(temporary))?;
+    file.as_file_mut().write_all(bytes)?;
     file.as_file().sync_all()?;
     file.persist(path).map_err(|e| e.error)?;
     Ok(())

@@ -71,7 +71,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
     report.notes.extend(assumed);
     bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
     match args.format {
-        OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&report)?))?,
+        OutputFormat::Json => super::print_json(&report)?,
         OutputFormat::Table => super::print_out(render_table(args, &setup, &report, baked.glb.len()))?,
     }
     let worst = report.worst();

@@ -90,7 +90,7 @@ pub fn run(args: &DiffArgs) -> anyhow::Result<ExitCode> {
     let clips = if chosen.is_some() { Clips::Chosen } else { Clips::ByName };
     let diff = diff_files(&a, &b, clips, &args.map, args.rate, args.align)?;
     match args.format {
-        OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&diff)?))?,
+        OutputFormat::Json => super::print_json(&diff)?,
         OutputFormat::Table => super::print_out(render_table(&diff, [args.unit_a.is_some(), args.unit_b.is_some()]))?,
     }
     if let Some(apart) = diff.animations.iter().find(|a| a.samples == 0) {

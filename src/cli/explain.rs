@@ -55,7 +55,7 @@ pub fn run(args: &ExplainArgs) -> anyhow::Result<ExitCode> {
     let explained = explain(&evaluation, &before, question, &options);
     let report = Report::new(shown(&args.file), &evaluation, args.rate, &explained);
     match args.format {
-        OutputFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&report)?))?,
+        OutputFormat::Json => super::print_json(&report)?,
         OutputFormat::Table => {
             let shown = Shown { all: args.all, min_shear_deg: options.tolerances.min_shear_deg };
             super::print_out(render_table(&report, &rig, evaluation.modes(), shown))?;

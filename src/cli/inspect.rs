@@ -1,6 +1,5 @@
 //! `bonescope inspect`: every bone's matrices, decomposition and findings at chosen times.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -50,13 +49,7 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     let summary = setup.layers.summary(&rig, evaluation.clip);
     let report = LayeredInspectReport::new(shown(&args.file), &evaluation, setup.modes.label().to_owned(), samples);
     match args.format {
-        OutputFormat::Json => {
-            // Written as it is serialised: a rig of a million bones prints gigabytes, never held in memory at once.
-            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            serde_json::to_writer_pretty(&mut out, &report)?;
-            writeln!(out)?;
-            out.flush()?;
-        }
+        OutputFormat::Json => super::print_json(&report)?,
         OutputFormat::Table => super::print_out(render_table(&report, &summary))?,
     }
     Ok(ExitCode::SUCCESS)

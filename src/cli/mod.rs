@@ -125,6 +125,18 @@ fn print_out(text: impl std::fmt::Display) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Writes `value` to standard output as pretty JSON and a line end, as it is serialised (a rig of a million bones
+/// prints gigabytes, never held in memory whole). A failed write stays the I/O error it is, so that a closed pipe is
+/// known as one.
+fn print_json(value: &impl serde::Serialize) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    serde_json::to_writer_pretty(&mut out, value).map_err(std::io::Error::from)?;
+    writeln!(out)?;
+    out.flush()?;
+    Ok(())
+}
+
 /// Whether `error` is standard output's reader gone.
 fn closed_pipe(error: &anyhow::Error) -> bool {
     let kind = |e: &(dyn std::error::Error + 'static)| e.downcast_ref::<std::io::Error>().map(std::io::Error::kind);

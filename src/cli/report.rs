@@ -44,7 +44,7 @@ pub fn run(args: &ReportArgs) -> anyhow::Result<ExitCode> {
     let files = merge(files);
     match args.format {
         ReportFormat::Table => super::print_out(render_files(&files, &render_animation))?,
-        ReportFormat::Json => super::print_out(format_args!("{}\n", serde_json::to_string_pretty(&files)?))?,
+        ReportFormat::Json => super::print_json(&files)?,
         ReportFormat::Junit => super::print_out(format_args!("{}\n", junit(&files)))?,
     }
     for error in files.iter().filter_map(|f| f.error.as_deref()) {

@@ -55,6 +55,10 @@ pub struct LibraryArgs {
     pub progress: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: ScanFormat,
+    /// Report a folder named that holds no animation file as empty and go on, instead of failing with exit 2 (a job
+    /// pointed at the wrong folder fails unless this is given).
+    #[arg(long)]
+    pub allow_empty: bool,
 }
 
 #[derive(Debug, Args)]
@@ -163,12 +167,17 @@ pub(super) fn verdict(files: &[FileScan], fail_above: Option<f64>) -> ExitCode {
 }
 
 /// The files the arguments name ([`crate::library::collect`]); what could not be read on the way is reported on
-/// standard error, and the scan goes on.
+/// standard error, and the scan goes on. A folder named that gives no file is an error unless `--allow-empty`
+/// (checked before `--shard` splits the files: a shard may rightly get none).
 fn inputs(args: &LibraryArgs) -> anyhow::Result<Vec<PathBuf>> {
     let filter = Filter::new(&args.include, &args.exclude).map_err(anyhow::Error::msg)?;
     let inputs = collect(&args.files, &filter, &mut std::io::stdin().lock());
     for problem in &inputs.problems {
         eprintln!("warning: {}", printable(&format!("{}: {}", problem.path.display(), problem.message)));
+    }
+    if !(args.allow_empty || inputs.empty_folders.is_empty()) {
+        let folders: Vec<String> = inputs.empty_folders.iter().map(|f| f.display().to_string()).collect();
+        anyhow::bail!("no animation files under {}", folders.join(", "));
     }
     Ok(match args.shard {
         Some((part, parts)) => inputs.shard(part, parts),
@@ -235,7 +244,7 @@ fn report_files<T: serde::Serialize + Send>(
     progress.finish();
     written?;
     match format {
-        ScanFormat::Json => writeln!(out, "{}", serde_json::to_string_pretty(&files)?)?,
+        ScanFormat::Json => super::print_json(&files)?,
         ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
         ScanFormat::Junit => writeln!(out, "{}", junit(&files))?,
         ScanFormat::Jsonl => {}

@@ -14,6 +14,8 @@
 //! - `-` reads one path per line from standard input (each as above).
 //!
 //! Unreadable entries, symlink loops and names that match nothing are problems the scan reports, not reasons to stop.
+//! A folder named that gives no file is listed apart ([`Inputs::empty_folders`]): a scan pointed at the wrong folder
+//! would otherwise pass with an empty report.
 //! The files come out sorted and without duplicates, so reports do not depend on the order the file system or the
 //! threads deliver them in.
 
@@ -80,6 +82,8 @@ pub struct Found {
 pub struct Inputs {
     pub files: Vec<Found>,
     pub problems: Vec<InputProblem>,
+    /// The folders named (on the command line or in a list, not found by a glob) that gave no file to scan.
+    pub empty_folders: Vec<PathBuf>,
 }
 
 impl Inputs {
@@ -131,7 +135,11 @@ impl Inputs {
     /// One name: a folder, a file, or a glob.
     fn add(&mut self, name: &Path, filter: &Filter) {
         if name.is_dir() {
+            let before = self.files.len();
             self.walk(name, filter);
+            if self.files.len() == before {
+                self.empty_folders.push(name.to_owned());
+            }
         } else if name.exists() || !is_glob(name) {
             // A file as named; a missing one fails to load in the report, naming it.
             self.push_named(name);
@@ -352,6 +360,19 @@ mod tests {
         assert_eq!(names(&inputs, root), expected);
         assert_eq!(inputs.problems.len(), 1);
         assert_eq!(inputs.problems[0].message, "matches no file");
+    }
+
+    #[test]
+    fn named_folders_that_give_no_file_are_listed() {
+        let dir = library();
+        let root = dir.path();
+        std::fs::create_dir(root.join("empty")).unwrap();
+        // `mocap` has animations, none named `*.fbx`; a folder a glob finds is not named, nor listed.
+        let named = [root.join("mocap"), root.join("chars"), root.join("empty"), root.join("e*")];
+        let only_fbx = Filter::new(&["*.fbx".into()], &[]).unwrap();
+        let inputs = collect(&named, &only_fbx, &mut std::io::empty());
+        assert_eq!(inputs.empty_folders, [root.join("mocap"), root.join("empty")]);
+        assert_eq!(names(&inputs, root), ["chars/hero/run.fbx"]);
     }
 
     #[cfg(unix)]
