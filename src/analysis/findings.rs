@@ -39,6 +39,17 @@ impl Default for Tolerances {
     }
 }
 
+/// The colour a stretched bone is drawn in, sRGB: its shear on a ramp from pale (0.1° and below, barely visible) to
+/// the full colour (10° and more), logarithmic between, mixed byte by byte. The same in the app and the reports.
+pub fn shear_rgb(shear_deg: f64) -> [u8; 3] {
+    const PALE: [u8; 3] = [250, 200, 210];
+    let t = ((shear_deg.max(1e-12).log10() + 1.0) / 2.0).clamp(0.0, 1.0);
+    std::array::from_fn(|i| (f64::from(PALE[i]) + t * (f64::from(STRETCHED_RGB[i]) - f64::from(PALE[i]))).round() as u8)
+}
+
+/// The colour of a stretched bone, sRGB.
+pub const STRETCHED_RGB: [u8; 3] = [235, 64, 100];
+
 /// The verdicts on one matrix. `stretched` and `non_uniform` exclude each other.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct Findings {

@@ -10,13 +10,14 @@ pub mod report;
 mod request;
 mod sampled;
 mod scan;
+pub mod sketch;
 pub mod storage;
 mod stretch;
 mod variants;
 
 pub use bind::{BindCheck, BindGap, BindMismatch, BindTolerance, ClipFrame, check_bind};
 pub use clip_analysis::{BoneSummary, ClipAnalysis, ClipScan, Components, Curves, SAME_SHEAR_DEG};
-pub use findings::{Assessment, Findings, Tolerances};
+pub use findings::{Assessment, Findings, STRETCHED_RGB, Tolerances, shear_rgb};
 pub(crate) use peak::{around, gains};
 pub use request::{CurveRequest, Judged, ScanOptions};
 pub use sampled::{Sampled, sample};

@@ -168,6 +168,10 @@ pub struct AnimationScan {
     /// With `scan --explain`: each stretched bone's main cause and best fix (`crate::explain`), worst first.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub explained: Vec<ExplainedBone>,
+    /// Where a bone is stretched: the figure at the worst moment and the stretched bones' shear over the clip, for
+    /// a report to draw.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sketch: Option<super::sketch::Sketch>,
 }
 
 /// A stretched bone's explanation in brief: whose squash shears it most, and the cheapest fix.
@@ -211,6 +215,7 @@ impl AnimationScan {
             mirrored,
             degenerate,
             explained: Vec::new(),
+            sketch: None,
         }
     }
 }

@@ -21,7 +21,8 @@ use crate::eval::{Evaluation, Setup};
 use crate::explain::scan_clip;
 use crate::import;
 use crate::import::text::printable;
-use crate::library::{Case, Filter, collect, in_order, junit, junit_of};
+use crate::library::page::{self, Overview};
+use crate::library::{Case, Filter, Verdict, collect, in_order, junit, junit_of};
 use crate::model::{Choice, ModeChoice, Rig};
 
 /// What else `scan` and `storage` take for files.
@@ -124,6 +125,9 @@ pub enum ScanFormat {
     /// JUnit XML for CI test reporters: a suite per file, a case per clip, a failure per stretched bone, an error
     /// per file that does not load (the stretch scan only).
     Junit,
+    /// One self-contained HTML page: a sortable row per clip with a picture of its worst moment (the stretch scan
+    /// only; `report --format html` makes the same page from a library's JSON lines).
+    Html,
 }
 
 /// One clip of one file, as `bonescope storage` reports it.
@@ -149,20 +153,25 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<ExitCode> {
     }
     let report = |path: &Path| scan_file(path, args, &options);
     let (files, _) = report_files(&inputs(&args.library)?, &args.library, report, &render_animation, &junit)?;
+    if args.library.format == ScanFormat::Html {
+        super::print_out(page::html(&Overview::new(&files, args.fail_above), PAGE_TITLE))?;
+    }
     Ok(verdict(&files, args.fail_above))
 }
 
-/// The exit code of a stretch scan: 2 when a file did not load, else 1 when a stretched bone shears by more than
-/// `fail_above` degrees, else 0.
+/// The title of the HTML page of a scan.
+pub(super) const PAGE_TITLE: &str = "bonescope: shear in the library";
+
+/// The exit code of a stretch scan ([`Verdict`]).
 pub(super) fn verdict(files: &[FileScan], fail_above: Option<f64>) -> ExitCode {
-    let stretched = files.iter().flat_map(|f| &f.animations).flat_map(|a| &a.stretched);
-    let over = fail_above.is_some_and(|limit| stretched.map(|b| b.summary.worst_shear_deg).any(|shear| shear > limit));
-    if files.iter().any(|f| f.error.is_some()) {
-        ExitCode::from(2)
-    } else if over {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
+    ExitCode::from(Verdict::of(files, fail_above).exit_status())
+}
+
+/// Refuses `--format html` for a scan other than the stretch scan (`what`): the page shows stretched bones.
+fn only_stretch_pages(args: &LibraryArgs, what: &str) -> anyhow::Result<()> {
+    match args.format {
+        ScanFormat::Html => anyhow::bail!("--format html draws the stretch scan; {what} has tables, JSON and JUnit"),
+        _ => Ok(()),
     }
 }
 
@@ -247,7 +256,8 @@ fn report_files<T: serde::Serialize + Send>(
         ScanFormat::Json => super::print_json(&files)?,
         ScanFormat::Table => write!(out, "{}", render_files(&files, animation))?,
         ScanFormat::Junit => writeln!(out, "{}", junit(&files))?,
-        ScanFormat::Jsonl => {}
+        // The stretch scan writes its page itself; the others have none ([`only_stretch_pages`]).
+        ScanFormat::Jsonl | ScanFormat::Html => {}
     }
     if count < paths.len() {
         anyhow::bail!("interrupted: {count} of {} files scanned (their reports are above)", paths.len());
@@ -349,6 +359,7 @@ impl Loaded {
 
 /// `bonescope storage`.
 pub fn run_storage(args: &StorageArgs) -> anyhow::Result<ExitCode> {
+    only_stretch_pages(&args.library, "storage")?;
     if !(args.probe_distance > 0.0 && args.probe_distance.is_finite()) {
         anyhow::bail!("--probe-distance must be a positive number, got {}", args.probe_distance);
     }
@@ -405,6 +416,7 @@ fn error_rows(table: &mut Table, label: &str, runtime: &RuntimeError, probe_dist
 
 /// `--compare-inherit`: each file's clips [`diff_files`]-compared with themselves under the two sides' modes.
 fn run_comparison(args: &ScanArgs, sides: [ModeChoice; 2]) -> anyhow::Result<ExitCode> {
+    only_stretch_pages(&args.library, "--compare-inherit")?;
     let compare = |path: &Path| FileReport::new(shown(path), compare_animations(path, args, sides));
     let [a, b] = sides.map(|side| side.id());
     let render = |file: &str, diff: &AnimationDiff| {

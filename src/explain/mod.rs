@@ -29,6 +29,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::analysis::report::{AnimationInfo, AnimationScan, ExplainedBone};
+use crate::analysis::sketch::Sketch;
 use crate::analysis::{ClipAnalysis, CurveRequest, SAME_SHEAR_DEG, ScanOptions, Tolerances, analyze};
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
@@ -206,9 +207,10 @@ pub fn scan_clip(
         false => Vec::new(),
     };
     let inherit = evaluation.setup().modes.label().to_owned();
+    let sketch = Sketch::of(evaluation, &analysis.scan, &options.tolerances);
     let scanned = AnimationScan::new(evaluation.skeleton(), evaluation.clip, inherit, options.rate, analysis.scan);
     let explained = briefs.iter().map(|e| e.brief(evaluation.rig.unit)).collect();
-    Some(AnimationScan { explained, ..scanned })
+    Some(AnimationScan { explained, sketch, ..scanned })
 }
 
 /// Below this fraction of the rig's size a change is not visible: the exact bake's rounding.

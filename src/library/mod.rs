@@ -4,9 +4,12 @@
 mod inputs;
 mod junit;
 mod merged;
+pub mod page;
 mod pool;
+mod verdict;
 
 pub use inputs::{Filter, Found, InputProblem, Inputs, collect};
 pub use junit::{Case, junit, junit_of};
 pub use merged::{merge, read_json_lines};
 pub use pool::in_order;
+pub use verdict::Verdict;

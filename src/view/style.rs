@@ -2,7 +2,7 @@
 
 use egui::{Color32, Painter, Pos2, Shape, Stroke, Vec2};
 
-use crate::analysis::Findings;
+use crate::analysis::{Findings, STRETCHED_RGB, shear_rgb};
 
 /// A finding as people see it: a colour and an icon.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -18,23 +18,21 @@ impl Badge {
 
     pub fn color(self) -> Color32 {
         match self {
-            Badge::Stretched => Color32::from_rgb(235, 64, 100),
+            Badge::Stretched => Color32::from_rgb(STRETCHED_RGB[0], STRETCHED_RGB[1], STRETCHED_RGB[2]),
             Badge::NonUniform => Color32::from_rgb(240, 170, 40),
             Badge::Mirrored => Color32::from_rgb(70, 150, 240),
             Badge::Degenerate => Color32::from_rgb(150, 150, 160),
         }
     }
 
-    /// The colour of a finding of this severity: for a stretched bone, its shear angle on a ramp from pale (at or
-    /// below 0.1°, barely visible) to the full colour (10° and more), logarithmic in between; other findings have
-    /// one colour.
+    /// The colour of a finding of this severity: for a stretched bone, its shear angle's ([`shear_rgb`]); other
+    /// findings have one colour.
     pub fn color_for_shear(self, shear_deg: f64) -> Color32 {
         if self != Badge::Stretched {
             return self.color();
         }
-        let t = ((shear_deg.max(1e-12).log10() + 1.0) / 2.0).clamp(0.0, 1.0) as f32;
-        let pale = Color32::from_rgb(250, 200, 210);
-        pale.lerp_to_gamma(self.color(), t)
+        let [r, g, b] = shear_rgb(shear_deg);
+        Color32::from_rgb(r, g, b)
     }
 
     pub fn label(self) -> &'static str {
