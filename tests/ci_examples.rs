@@ -217,6 +217,7 @@ mod github {
         let env = |job: &Yaml| {
             let mut env = variables(&[&workflow["env"], &job["env"]]);
             env.push(("GITHUB_PATH".to_owned(), dir.join("github_path").display().to_string()));
+            env.push(("GITHUB_STEP_SUMMARY".to_owned(), dir.join("step_summary.md").display().to_string()));
             env
         };
         let shards: Vec<i64> = list(&scan["strategy"]["matrix"]["shard"]).iter().map(|s| s.as_i64().unwrap()).collect();
@@ -240,6 +241,18 @@ mod github {
         let verdict = last.expect("the report job runs a script");
         let stderr = String::from_utf8_lossy(&verdict.stderr);
         assert_reported(dir, shards.len(), verdict.status.code(), &stderr, &dir.join("bonescope.xml"));
+        // The page, uploaded whatever the verdict, and the job summary that points to it.
+        let page = std::fs::read_to_string(dir.join("bonescope-report.html")).unwrap();
+        assert!(
+            page.starts_with("<!DOCTYPE html>") && page.contains("class=\"refused\""),
+            "the page lists the broken file"
+        );
+        let upload = uses(report, "actions/upload-artifact");
+        assert!(upload.len() == 1 && runs_after_failure(&upload[0]["if"]), "{upload:?}");
+        assert_eq!(text(&upload[0]["with"]["path"]), "bonescope-report.html");
+        let summary = std::fs::read_to_string(dir.join("step_summary.md")).unwrap();
+        assert!(summary.starts_with("## bonescope: fail (exit 2): 1 file could not be read"), "{summary}");
+        assert!(summary.contains(text(&upload[0]["with"]["name"])), "the summary names the page's artifact");
     }
 }
 

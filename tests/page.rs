@@ -227,9 +227,10 @@ fn in_chromium_the_page_loads_cleanly_sorts_filters_and_looks_as_it_should() {
 const CHANNEL_TOLERANCE: u8 = 24;
 const CHANGED_SHARE: f64 = 0.005;
 
-/// `screenshot` against `tests/snapshots/NAME.png` (written where `UPDATE_SNAPSHOTS` is set, or where there is none).
+/// `screenshot` against `assets/readme/NAME.png`, the README's picture (written where `UPDATE_SNAPSHOTS` is set, or
+/// where there is none).
 fn looks_as_the_reference(screenshot: &Path, name: &str) {
-    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/snapshots/{name}.png"));
+    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("assets/readme/{name}.png"));
     if std::env::var_os("UPDATE_SNAPSHOTS").is_some() || !reference.exists() {
         std::fs::copy(screenshot, &reference).unwrap();
         eprintln!("wrote {}: look at it", reference.display());
