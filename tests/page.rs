@@ -168,6 +168,30 @@ fn the_markdown_summary_gives_the_verdict_the_worst_rows_and_the_page() {
     assert!(summary.ends_with("Every clip, with a picture of its worst moment: [report.html](report.html)\n"));
 }
 
+/// A report read back may come from anywhere: a sketch whose numbers make no figure (parents and the worst bone out
+/// of range, coordinates at the ends of their type, a frame of infinities, a curve of one point) still makes a page.
+#[test]
+fn a_page_of_nonsense_sketches_is_still_a_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let bone = r#"{"name":"b","index":0,"worst_shear_deg":3.0,"worst_shear_time":0.5,"worst_stretch_deg":1.0,
+        "flagged_samples":1,"first_flagged_time":0.5,"non_uniform_samples":0,"mirrored_samples":0,
+        "degenerate_samples":0}"#
+        .replace(char::is_whitespace, "");
+    let sketch = r#"{"time":0.5,"frame":[-1e308,0,1e308,1],"bones":[[7,2147483647,-2147483648,-5],[-9,0,0,4294967]],
+        "worst":99,"curves":[[4294967295],[]]}"#
+        .replace(char::is_whitespace, "");
+    let line = format!(
+        r#"{{"file":"odd<&>.glb","error":null,"animations":[{{"animation":null,"inherit":"declared","rate":60,"samples":1,"stretched":[{bone},{bone}],"non_uniform":[],"mirrored":[],"degenerate":[],"sketch":{sketch}}}]}}"#
+    );
+    let lines = dir.path().join("odd.jsonl");
+    std::fs::write(&lines, format!("{line}\n")).unwrap();
+    let out = bonescope(&["report", lines.to_str().unwrap(), "--format", "html"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page = String::from_utf8(out.stdout).unwrap();
+    assert!(page.contains("odd&lt;&amp;&gt;.glb") && !page.contains("odd<&>"), "names are escaped");
+    assert!(page.contains("<svg") && page.ends_with("</html>"));
+}
+
 /// Debian's Chromium, where installed (`.ci/run` installs it); `None`, saying the calling test is skipped, where not.
 fn chromium() -> Option<PathBuf> {
     let found = ["chromium", "chromium-browser"].iter().find_map(|name| {

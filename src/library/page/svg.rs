@@ -17,7 +17,8 @@ pub fn figure(sketch: &Sketch, worst: &str, size: u32) -> Markup {
     // The shorter side centred in the square.
     let offset = |length: f64| if side > 0.0 { ((steps - length / side * steps) / 2.0).round() as i32 } else { 0 };
     let (dx, dy) = (offset(x1 - x0), offset(y1 - y0));
-    let at = |bone: &[i32; 4]| (bone[1] + dx, STEPS - (bone[2] + dy));
+    // Saturating: a report read back may come from anywhere.
+    let at = |bone: &[i32; 4]| (bone[1].saturating_add(dx), STEPS.saturating_sub(bone[2].saturating_add(dy)));
     let margin = STEPS / 20;
     let view = format!("{} {} {} {}", -margin, -margin, STEPS + 2 * margin, STEPS + 2 * margin);
     let worst_at = sketch.bones.get(sketch.worst).map(at);
@@ -57,9 +58,9 @@ pub fn sparkline(curve: &[u32], width: u32, height: u32) -> Markup {
     html! {
         svg xmlns="http://www.w3.org/2000/svg" width=(width) height=(height) role="img" class="spark" {
             title { "shear over the clip, at most " (format!("{:.2}", f64::from(highest) * SHEAR_STEP_DEG)) "°" }
-            polyline points=(points.join(" ")) fill="none" stroke=(colour(highest as i32)) stroke-width="1.5" {}
+            polyline points=(points.join(" ")) fill="none" stroke=(colour(highest.try_into().unwrap_or(i32::MAX))) stroke-width="1.5" {}
             @if let Some((x, y)) = peak {
-                circle cx=(format!("{x:.1}")) cy=(format!("{y:.1}")) r="2.5" fill=(colour(highest as i32)) {}
+                circle cx=(format!("{x:.1}")) cy=(format!("{y:.1}")) r="2.5" fill=(colour(highest.try_into().unwrap_or(i32::MAX))) {}
             }
         }
     }
