@@ -96,6 +96,14 @@ fn the_page_shows_what_the_json_lines_hold_and_needs_nothing_else() {
         }
         for explained in &clip.explained {
             assert!(row.contains(&explained.line.replace('&', "&amp;")), "{}", explained.line);
+            // Both answers: as authored (the rig inherits fully: it already plays so), and the removal.
+            assert_eq!(explained.answers.len(), 2, "{:?}", explained.answers);
+            assert!(explained.answers[0].starts_with("to play it as authored in any engine: it already does"));
+            assert!(
+                explained.answers.iter().all(|a| row.contains(&a.replace('&', "&amp;"))),
+                "{:?}",
+                explained.answers
+            );
         }
     }
     let flagged: usize = clips.iter().map(|(_, c)| c.stretched.len()).sum();

@@ -191,6 +191,9 @@ pub struct ExplainedBone {
     pub fix_cost_fraction: Option<f64>,
     /// All of it in a line for people.
     pub line: String,
+    /// The two answers, a line each: how to play it as authored in any engine, and how to remove the shear.
+    #[serde(default)]
+    pub answers: Vec<String>,
 }
 
 impl AnimationScan {

@@ -49,6 +49,9 @@ pub struct Explanation {
     /// Changes that could not be measured, and why.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// Whether the clip already plays as authored in any engine: every bone inherits fully and no layer changes
+    /// it, so a glTF node holds each local transform and a bake changes nothing.
+    pub plays_as_authored: bool,
 }
 
 impl Explanation {
@@ -75,9 +78,18 @@ impl Explanation {
             return Vec::new();
         }
         let mut lines = Vec::new();
-        if let Some(bake) = self.as_authored() {
-            let change = if bake.cost.fraction < INVISIBLE { "no visible change".to_owned() } else { bake.moves(unit) };
-            lines.push(format!("to play it as authored in any engine: bake exact, {change}"));
+        match self.as_authored() {
+            Some(bake) => {
+                let change =
+                    if bake.cost.fraction < INVISIBLE { "no visible change".to_owned() } else { bake.moves(unit) };
+                lines.push(format!("to play it as authored in any engine: bake exact, {change}"));
+            }
+            None if self.plays_as_authored => lines.push(
+                "to play it as authored in any engine: it already does (every bone inherits fully, as glTF's nodes \
+                 do; the shear is in the clip)"
+                    .to_owned(),
+            ),
+            None => {}
         }
         let removal = match self.removal() {
             Some(fix) if fix.cost.fraction >= SMALL => format!("{} — no fix under 1 % of the rig", fix.summary(unit)),
@@ -100,6 +112,7 @@ impl Explanation {
             name: self.name.clone(),
             main_cause: self.causes.at.main_cause().map(|l| l.name.clone()),
             together: self.causes.at.together().iter().map(|l| l.name.clone()).collect(),
+            answers: self.answers(unit),
             best_fix: fix.map(|f| f.label.clone()),
             fix_removes: fix.map(|f| f.removes),
             fix_cost: fix.map(|f| f.cost.distance.max),
@@ -265,7 +278,8 @@ pub fn explain(
     let asked: Vec<(usize, f64)> = bones.iter().map(|&bone| (bone, at(bone))).collect();
     let causes = causes_each(evaluation, analysis, &asked, tolerances);
     // A bake that reproduces the clip leaves every shear where it was: no candidate for the best fix.
-    let bakes = question.costs == Costs::Every || !bakes_reproduce(evaluation);
+    let plays_as_authored = bakes_reproduce(evaluation);
+    let bakes = question.costs == Costs::Every || !plays_as_authored;
     let changes: Vec<Vec<Change>> = bones
         .iter()
         .zip(&causes)
@@ -319,7 +333,8 @@ pub fn explain(
         }
         rank(&mut fixes, tool);
         let worst_shear_deg = before.bones.get(bone).map_or(0.0, |b| b.worst_shear_deg);
-        Explanation { bone, name: skeleton.bone(bone).name.clone(), worst_shear_deg, causes, fixes, notes }
+        let name = skeleton.bone(bone).name.clone();
+        Explanation { bone, name, worst_shear_deg, causes, fixes, notes, plays_as_authored }
     });
     explained.collect()
 }

@@ -139,6 +139,12 @@ fn bone_block(clip: &AnimationScan, i: usize, bone: &BoneScanReport) -> Markup {
                 (bone_line(clip, bone))
                 @if let Some(explained) = clip.explained.iter().find(|e| e.name == bone.name) {
                     div .why { (explained.line) }
+                    @if !explained.answers.is_empty() {
+                        details .why {
+                            summary { "to play it as authored, to remove it" }
+                            @for answer in &explained.answers { div { (answer) } }
+                        }
+                    }
                 }
             }
         }
