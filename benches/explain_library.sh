@@ -5,14 +5,20 @@
 # The two commands run alternately, ROUNDS times each (default 9), so a machine whose load changes moves both; the
 # line printed gives the median wall time of each and the median of the per-round ratios, with their range.
 #
-# Usage, from anywhere: benches/explain_library.sh [ROUNDS]. The release build of the command line goes to
-# $CARGO_TARGET_DIR (default target/); BONESCOPE=path/to/bonescope measures that binary instead.
+# Usage, from anywhere: benches/explain_library.sh [ROUNDS] [FILE|FOLDER...]: the shared assets by default, or
+# what is named (paths from the repository's root), e.g. a generated rig the explanations were not tuned on:
+#   cargo run --release --locked --example write_generated_gltf -- target/generated
+#   benches/explain_library.sh 9 target/generated/generated_sixth_200x6000.glb
+# The release build of the command line goes to $CARGO_TARGET_DIR (default target/); BONESCOPE=path/to/bonescope
+# measures that binary instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 rounds=${1:-9}
 # shellcheck source=support/assets.sh
 source benches/support/assets.sh
+scanned=("${@:2}")
+[ ${#scanned[@]} -gt 0 ] || scanned=("$assets")
 if [ -z "${BONESCOPE:-}" ]; then
   cargo build --quiet --release --locked --no-default-features --bin bonescope
   BONESCOPE=$target/release/bonescope
@@ -22,7 +28,7 @@ fi
 seconds() {
   local start end
   start=$(date +%s.%N)
-  "$BONESCOPE" scan "$assets" --format jsonl "$@" >/dev/null 2>&1 || true
+  "$BONESCOPE" scan "${scanned[@]}" --format jsonl "$@" >/dev/null 2>&1 || true
   end=$(date +%s.%N)
   awk "BEGIN { print $end - $start }"
 }
@@ -32,8 +38,8 @@ median() {
 }
 
 # Some shared files are refused on purpose (scan then exits 2): the counts do not mind.
-files=$({ "$BONESCOPE" scan "$assets" --format jsonl 2>/dev/null || true; } | wc -l)
-explained=$({ "$BONESCOPE" scan "$assets" --explain --format jsonl 2>/dev/null || true; } | grep -c '"explained"' || true)
+files=$({ "$BONESCOPE" scan "${scanned[@]}" --format jsonl 2>/dev/null || true; } | wc -l)
+explained=$({ "$BONESCOPE" scan "${scanned[@]}" --explain --format jsonl 2>/dev/null || true; } | grep -c '"explained"' || true)
 plain=() explaining=() ratios=()
 for ((round = 0; round < rounds; round++)); do
   if ((round % 2 == 0)); then

@@ -39,6 +39,9 @@ pub enum Squashes {
     /// The fifth bone of every limb (the 19 chains off the spine): a production clip of squash-and-stretch limbs,
     /// the five bones below each squash flagged (95 in all).
     EveryLimb,
+    /// The sixth bone of every chain, the spine's too: a rig the explanation's speed was not tuned on, whose spine
+    /// squash shears the chains hanging below it as well.
+    SixthOfEveryChain,
 }
 
 impl Squashes {
@@ -46,6 +49,7 @@ impl Squashes {
         match self {
             Squashes::Sparse => bone % 25 == 24,
             Squashes::EveryLimb => bone >= CHAIN && bone % CHAIN == 4,
+            Squashes::SixthOfEveryChain => bone % CHAIN == 5,
         }
     }
 
@@ -54,6 +58,7 @@ impl Squashes {
         match self {
             Squashes::Sparse => "generated_200x6000",
             Squashes::EveryLimb => "generated_limbs_200x6000",
+            Squashes::SixthOfEveryChain => "generated_sixth_200x6000",
         }
     }
 }
