@@ -14,7 +14,7 @@ use pyo3::types::{PyDict, PyString};
 
 use bonescope_core::analysis::report::FileReport;
 use bonescope_core::analysis::{ScanOptions, Tolerances, sample};
-use bonescope_core::bake::{Engine, Request, Strategy};
+use bonescope_core::bake::{Engine, Plan, Strategy, bake_file, in_metres};
 use bonescope_core::diff::{Align, Clips, FileSide, chosen_clips, diff_files};
 use bonescope_core::eval::layers::RotationInterpolation;
 use bonescope_core::eval::{Evaluation, Layers, Setup};
@@ -611,14 +611,15 @@ fn parse_choice<T: Choice>(id: &str) -> PyResult<T> {
     })
 }
 
-/// Bakes `path` (any file bonescope reads) into a glTF binary at `out` that `engine`'s runtime plays as the source
-/// evaluates, and returns the report `bonescope bake --format json` prints (measured on the file read back).
-/// `engine`: `generic`, `blender`, `three`, `godot`, `unity` or `unreal`; `strategy` (`exact` or `trs`) overrides
-/// the engine's; `tolerance` is the fraction of the rig's size the keys may stray; `clip`, `modes` and `layers` as
-/// for `Rig.evaluate` (default every clip under the declared modes).
+/// Bakes `path` (any file bonescope reads) into a glTF binary at `out` (`.glb`) that `engine`'s runtime plays as the
+/// source evaluates, in metres, and returns the report `bonescope bake --format json` prints (measured on the file
+/// read back): the same bake as the command line's. `engine`: `generic`, `blender`, `three`, `godot`, `unity` or
+/// `unreal`; `strategy` (`exact` or `trs`) overrides the engine's; `tolerance` is the fraction of the rig's size the
+/// keys may stray; `clip`, `modes` and `layers` as for `Rig.evaluate` (default every clip under the declared modes);
+/// `unit` is the source's where its file states none (BVH), else the one its figure stands a person's height in.
 #[pyfunction]
 #[pyo3(signature = (path, out, engine = "generic", *, strategy = None, tolerance = 1e-4, clip = None, modes = None,
-    layers = None))]
+    layers = None, unit = None))]
 #[allow(clippy::too_many_arguments)]
 fn bake(
     py: Python<'_>,
@@ -630,32 +631,26 @@ fn bake(
     clip: Option<&Bound<'_, PyAny>>,
     modes: Option<&Bound<'_, PyAny>>,
     layers: Option<&Bound<'_, PyAny>>,
+    unit: Option<&str>,
 ) -> PyResult<Py<PyAny>> {
     let out = path_of(out)?;
     let engine = parse_choice::<Engine>(engine)?;
-    let strategy = strategy.map(parse_choice::<Strategy>).transpose()?.unwrap_or(engine.strategy());
-    if !(tolerance.is_finite() && tolerance >= 0.0) {
-        return Err(error(format!("tolerance must be a finite fraction ≥ 0, got {tolerance}")));
-    }
-    let source = load(py, path, None)?;
-    let setup = source.setup(py, clip, modes, layers)?;
-    let rig = &source.rig;
-    if rig.skeleton.is_empty() {
-        return Err(error(format!("{}: no nodes to bake", source.file)));
-    }
+    let plan = Plan { engine, strategy: strategy.map(parse_choice::<Strategy>).transpose()?, tolerance };
+    let unit = unit.map(parse_unit).transpose()?;
+    let Rig { rig, file } = load(py, path, None)?;
+    let (rig, assumed) = in_metres(rig, unit).map_err(|why| error(format!("unit: {why}")))?;
+    let source = Rig { rig, file };
+    // glTF is in metres: a source in another unit is measured in them.
+    let setup = Setup { unit: Some(Unit::METRE), ..source.setup(py, clip, modes, layers)? };
     let chosen = clip.is_some();
-    let report = py.detach(|| -> Result<_, String> {
-        let evaluation = Evaluation::of(rig, &setup).map_err(|e| e.to_string())?;
+    let written = py.detach(|| -> Result<_, String> {
+        let evaluation = Evaluation::of(&source.rig, &setup).map_err(|e| e.to_string())?;
         let only = chosen.then_some(evaluation.clip).flatten();
-        let request = Request::of(&evaluation, only, strategy, tolerance).for_engine(engine);
-        let baked = bonescope_core::bake::bake(&request);
-        let read_back = import::load_bytes(&out, &baked.glb)
-            .map_err(|e| format!("the baked glTF does not read back (a bug): {e}"))?;
-        let report = bonescope_core::bake::report(&request, &baked, &read_back);
-        bonescope_core::bake::save(&out, &baked.glb).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
-        Ok(report)
+        bake_file(&evaluation, &source.file, only, &plan, &out).map_err(|e| e.to_string())
     });
-    json_value(py, &report.map_err(error)?)
+    let mut report = written.map_err(error)?.report;
+    report.notes.extend(assumed.map(|note| format!("{note} (unit= to choose)")));
+    json_value(py, &report)
 }
 
 /// See what a skeletal animation really does to every bone: the polar decomposition of every bone's matrix over

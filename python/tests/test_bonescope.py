@@ -85,6 +85,21 @@ def test_bake_is_the_command_lines_and_writes_the_same_file(tmp_path):
     assert (tmp_path / "mine.glb").read_bytes() == (tmp_path / "theirs.glb").read_bytes()
 
 
+def test_a_bake_without_a_unit_is_the_command_lines_in_metres_and_what_it_refuses_it_refuses(tmp_path):
+    walk = ASSETS / "bvh" / "cmu_12_01_walk.bvh"
+    mine = bonescope.bake(walk, tmp_path / "mine.glb")
+    theirs = cli("bake", walk, "--out", tmp_path / "theirs.glb")
+    assert (tmp_path / "mine.glb").read_bytes() == (tmp_path / "theirs.glb").read_bytes()
+    # The unit guessed, said the same way but for how each face chooses another.
+    assert [n.replace("(unit= to choose)", "(--unit to choose)") for n in mine["notes"]] == theirs["notes"]
+    assert any("the file states no unit: read in" in n for n in mine["notes"])
+    assert {k: v for k, v in mine.items() if k != "notes"} == {k: v for k, v in theirs.items() if k != "notes"}
+    with pytest.raises(bonescope.Error) as refused:
+        bonescope.bake(STRETCHY, tmp_path / "x.usdc")
+    assert str(refused.value) == cli_error("bake", STRETCHY, "--out", tmp_path / "x.usdc")
+    assert not (tmp_path / "x.usdc").exists()
+
+
 def test_evaluate_is_inspect_at_each_time():
     rig = bonescope.load(STRETCHY)
     times = [0.0, 0.25, 0.55, 1.9]

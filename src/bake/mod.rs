@@ -23,6 +23,7 @@
 mod channels;
 mod document;
 mod engine;
+mod file;
 mod glb;
 mod keys;
 mod layout;
@@ -33,6 +34,7 @@ mod skins;
 mod times;
 
 pub use engine::Engine;
+pub use file::{BakeError, Plan, Written, bake_file, in_metres};
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
 

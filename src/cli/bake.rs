@@ -3,17 +3,16 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
 use clap::Args;
 
 use super::options::{Distance, choice, files_help, parse_distance};
 use super::setup::evaluation;
 use super::table::{Table, mesh_differences};
 use super::{EvalArgs, OutputFormat};
-use crate::bake::{self, BakeReport, Engine, Request, Strategy};
-use crate::eval::{Evaluation, Setup};
+use crate::bake::{self, BakeReport, Engine, Plan, Strategy, Written};
+use crate::eval::Setup;
 use crate::import;
-use crate::model::{Choice, Rig, Unit};
+use crate::model::{Choice, Unit};
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
@@ -21,7 +20,7 @@ pub struct BakeArgs {
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
-    /// Where to write the glTF binary (written whole or not at all).
+    /// Where to write the glTF binary, `.glb` (written whole or not at all).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
     /// The runtime the file is for: its strategy (trs for Unreal, exact elsewhere) and the rotation interpolation
@@ -48,52 +47,25 @@ pub struct BakeArgs {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<ExitCode> {
-    if !(args.tolerance.is_finite() && args.tolerance >= 0.0) {
-        bail!("--tolerance must be a finite fraction ≥ 0, got {}", args.tolerance);
-    }
     let rig = match &args.file {
         Some(path) => import::load(path)?,
         None => import::demo_rig(),
     };
-    if rig.skeleton.is_empty() {
-        bail!("{}: no nodes to bake", source_name(args));
-    }
-    let (rig, assumed) = with_unit(rig, args.unit)?;
+    let (rig, assumed) = bake::in_metres(rig, args.unit).map_err(|why| anyhow::anyhow!("--unit: {why}"))?;
     // glTF is in metres: a source in another unit is measured in them.
     let setup = Setup { unit: Some(Unit::METRE), ..args.eval.setup(&rig)? };
     let source = evaluation(&rig, &setup)?;
-    let (strategy, tolerance) = (args.strategy.unwrap_or(args.engine.strategy()), args.tolerance);
     let only = args.eval.anim.is_some().then_some(source.clip).flatten();
-    let request = Request::of(&source, only, strategy, tolerance).for_engine(args.engine);
-    let baked = bake::bake(&request);
-    let baked_rig = import::load_bytes(&args.out, &baked.glb).context("the baked glTF does not read back (a bug)")?;
-    let mut report = bake::report(&request, &baked, &baked_rig);
-    report.notes.extend(assumed);
-    bake::save(&args.out, &baked.glb).with_context(|| format!("cannot write {}", args.out.display()))?;
+    let plan = Plan { engine: args.engine, strategy: args.strategy, tolerance: args.tolerance };
+    let Written { mut report, bytes } = bake::bake_file(&source, &source_name(args), only, &plan, &args.out)?;
+    report.notes.extend(assumed.map(|note| format!("{note} (--unit to choose)")));
     match args.format {
         OutputFormat::Json => super::print_json(&report)?,
-        OutputFormat::Table => super::print_out(render_table(args, &setup, &report, baked.glb.len()))?,
+        OutputFormat::Table => super::print_out(render_table(args, &setup, &report, bytes))?,
     }
     let worst = report.worst();
     let over = args.fail_above.is_some_and(|limit| worst.max > limit.units(report.rig_size));
     Ok(if over { ExitCode::from(1) } else { ExitCode::SUCCESS })
-}
-
-/// `rig` in a unit: its file's, the one `given` (only where the file states none), else the one its figure stands a
-/// person's height in, with a note saying so.
-fn with_unit(rig: Rig, given: Option<Unit>) -> anyhow::Result<(Rig, Option<String>)> {
-    let mut rig = rig.given_unit(given).map_err(|why| anyhow::anyhow!("--unit: {why}"))?;
-    if rig.unit.is_some() {
-        return Ok((rig, None));
-    }
-    let size = Evaluation::declared(&rig, None).size(&[0.0]);
-    let unit = Unit::likeliest_for_figure(size).unwrap_or(Unit::METRE);
-    rig.unit = Some(unit);
-    let tall = Unit::readable(Some(unit), size);
-    let note = format!(
-        "the file states no unit: read in {unit}, where its figure stands {tall} across at rest (--unit to choose)"
-    );
-    Ok((rig, Some(note)))
 }
 
 /// The source file's name, or the demo rig's.
