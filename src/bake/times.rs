@@ -3,6 +3,9 @@
 //! tracks (a Hermite curve with equal tangents passes through the middle of its chord, so a midpoint alone would not
 //! show that it bends). [`super::refine`] adds what else lies between where the source needs it.
 
+use glam::{DMat3, DMat4};
+
+use crate::diff::PROBE_FRACTION;
 use crate::eval::Evaluation;
 use crate::model::{Clip, DEFAULT_FRAME_RATE, Interpolation, MAX_FRAMES, sample_times};
 
@@ -59,15 +62,19 @@ pub fn bake_times(side: &Evaluation) -> BakeTimes {
     times.dedup();
     steps.sort_by(f64::total_cmp);
     steps.dedup();
-    let times = spaced(times, &steps, &source_keys);
+    let times = spaced(times, &steps, &source_keys, |earlier, later| sharper(side, earlier, later));
     steps.retain(|s| times.binary_search_by(|t| t.total_cmp(s)).is_ok());
     BakeTimes { times, steps }
 }
 
 /// `times` (sorted) thinned to [`MIN_KEY_SPACING`]. Of two closer times the one that matters more stays: the clip's
 /// start and end and stepped keys (jumps, kept where they are; two such times both stay), then the source's keys
-/// (where a linear track kinks: a frame between would cut the corner), then frames; of two alike, the earlier.
-fn spaced(times: Vec<f64>, steps: &[f64], keys: &[f64]) -> Vec<f64> {
+/// (where a linear track kinks: a frame between would cut the corner), then frames. Of two keys, the one where the
+/// source bends more (`sharper(earlier, later)`: whether it is the later), else the earlier: a file that merges two
+/// clocks' samples into one track (at 37 and 37.5 a second, 0.39 ms apart where they meet) may turn at one of them
+/// and hold the other on the line between its neighbours; baking that one cuts the turn's corner (by up to its change
+/// of velocity times the 0.39 ms). Of two frames, the earlier.
+fn spaced(times: Vec<f64>, steps: &[f64], keys: &[f64], sharper: impl Fn(f64, f64) -> bool) -> Vec<f64> {
     let last = times.last().copied();
     let listed = |list: &[f64], t: f64| list.binary_search_by(|s| s.total_cmp(&t)).is_ok();
     let rank = |t: f64| match () {
@@ -82,6 +89,7 @@ fn spaced(times: Vec<f64>, steps: &[f64], keys: &[f64]) -> Vec<f64> {
         match spaced.last_mut() {
             Some(previous) if t - *previous < MIN_KEY_SPACING => match (rank(t), previous_rank) {
                 (Rank::Kept, Rank::Kept) => spaced.push(t),
+                (Rank::Key, Rank::Key) if sharper(*previous, t) => *previous = t,
                 (later, earlier) if later > earlier => *previous = t,
                 _ => {}
             },
@@ -89,6 +97,30 @@ fn spaced(times: Vec<f64>, steps: &[f64], keys: &[f64]) -> Vec<f64> {
         }
     }
     spaced
+}
+
+/// Whether `side` bends more at `later` than at `earlier`, two times closer than [`MIN_KEY_SPACING`]: how far each
+/// pose is from the middle of the poses half their distance before and after it (so that neither window reaches the
+/// other time), in model space ([`bend`]).
+fn sharper(side: &Evaluation, earlier: f64, later: f64) -> bool {
+    let half = 0.5 * (later - earlier);
+    let length = PROBE_FRACTION * side.size_of(&[earlier], &side.skeleton().character(), &[]);
+    bend(side, later, half, length) > bend(side, earlier, half, length)
+}
+
+/// How far `side`'s pose at `time` is from the middle of its poses `half` before and after: where every track is
+/// linear across `time` nothing; at a key where a linear track turns, `half` times half its change of velocity. Per
+/// bone, the distance bound of [`super::keys::BoneMetric`] (its origin's move, and its axes' times `length`); the
+/// largest over the bones.
+fn bend(side: &Evaluation, time: f64, half: f64, length: f64) -> f64 {
+    let [before, at, after] = [time - half, time, time + half].map(|t| side.pose_at(t).model.model);
+    let bones = at.iter().zip(before.iter().zip(&after));
+    let off = |(m, (a, b)): (&DMat4, (&DMat4, &DMat4))| {
+        let middle = (*a + *b) * 0.5 - *m;
+        let frobenius = DMat3::from_mat4(middle).to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt();
+        middle.w_axis.truncate().length() + frobenius * length
+    };
+    bones.map(off).fold(0.0, f64::max)
 }
 
 /// How much a baked time matters when two lie too close ([`spaced`]).
@@ -173,15 +205,42 @@ mod tests {
     }
 
     #[test]
+    fn of_two_keys_closer_than_the_spacing_the_turn_is_baked() {
+        // One bone moving along x, then along y, its track keyed at 0, 0.5, 0.5 + 0.3 ms and 1 s: the turn at one of
+        // the two close keys, the other on the line between its neighbours (two clocks' samples in one track).
+        let close = in_single_precision(0.5 + 3e-4);
+        let baked = |turn: f64| {
+            let mut rig = demo_rig();
+            let at = |t: f64| {
+                if t <= turn { Vec3::new(t as f32, 0.0, 0.0) } else { Vec3::new(turn as f32, (t - turn) as f32, 0.0) }
+            };
+            let times = [0.0, 0.5, close, 1.0];
+            let mut tracks = BoneTracks::new(0);
+            let values: Vec<Vec3> = times.iter().map(|&t| at(t)).collect();
+            tracks.translation = Some(Track::new(Arc::from(times.as_slice()), values, Interpolation::Linear).unwrap());
+            rig.clips = vec![Clip::new(0, None, vec![tracks], vec![]).with_frame_rate(2.0)];
+            bake_times(&Evaluation::declared(&rig, rig.clips.first())).times
+        };
+        assert_eq!(baked(close), [0.0, close, 1.0], "the later key turns");
+        assert_eq!(baked(0.5), [0.0, 0.5, 1.0], "the earlier key turns");
+    }
+
+    #[test]
     fn times_closer_than_a_hundredth_of_a_frame_are_thinned() {
         let close = 0.5 * MIN_KEY_SPACING;
         // Of two frames the earlier stays; a source key just after a frame takes its place, and so does a stepped
         // key; the start and end stay.
         let times = vec![0.0, close, 0.5, 0.5 + close, 1.0 - close, 1.0];
-        assert_eq!(spaced(times.clone(), &[], &[]), [0.0, 0.5, 1.0]);
-        assert_eq!(spaced(times.clone(), &[0.5 + close], &[]), [0.0, 0.5 + close, 1.0]);
-        assert_eq!(spaced(times.clone(), &[], &[0.5 + close]), [0.0, 0.5 + close, 1.0]);
-        assert_eq!(spaced(times, &[], &[0.5]), [0.0, 0.5, 1.0], "a key before a frame stays");
-        assert_eq!(spaced(vec![0.0, 0.25, 0.5], &[], &[]), [0.0, 0.25, 0.5], "frames apart stay");
+        let earlier = |_, _| false;
+        assert_eq!(spaced(times.clone(), &[], &[], earlier), [0.0, 0.5, 1.0]);
+        assert_eq!(spaced(times.clone(), &[0.5 + close], &[], earlier), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(times.clone(), &[], &[0.5 + close], earlier), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(times.clone(), &[], &[0.5], earlier), [0.0, 0.5, 1.0], "a key before a frame stays");
+        assert_eq!(spaced(vec![0.0, 0.25, 0.5], &[], &[], earlier), [0.0, 0.25, 0.5], "frames apart stay");
+        // Of two keys, the one where the source bends more; a frame never displaces a key.
+        let keys = [0.5, 0.5 + close];
+        assert_eq!(spaced(times.clone(), &[], &keys, earlier), [0.0, 0.5, 1.0]);
+        assert_eq!(spaced(times.clone(), &[], &keys, |_, _| true), [0.0, 0.5 + close, 1.0]);
+        assert_eq!(spaced(times, &[], &[0.5], |_, _| true), [0.0, 0.5, 1.0]);
     }
 }
