@@ -584,7 +584,9 @@ fn bake_names_the_path_it_cannot_write_with_the_systems_reason() {
     // Not the temporary file it writes first: the user never named that.
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing/baked.glb").display().to_string();
-    let folder = dir.path().display().to_string();
+    let folder = dir.path().join("folder.glb");
+    std::fs::create_dir(&folder).unwrap();
+    let folder = folder.display().to_string();
     for (out, reason) in
         [(&missing, "No such file or directory (os error 2)"), (&folder, "Is a directory (os error 21)")]
     {
@@ -592,7 +594,7 @@ fn bake_names_the_path_it_cannot_write_with_the_systems_reason() {
         assert_eq!(run.status.code(), Some(2), "{out}");
         assert_eq!(String::from_utf8_lossy(&run.stderr), format!("error: cannot write {out}: {reason}\n"));
     }
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no temporary file left");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left beside the folder");
 }
 
 #[test]
