@@ -604,4 +604,22 @@ fn a_take_that_starts_before_zero_is_written_from_zero_and_said_so() {
     let back = import::load(&out).unwrap_or_else(|e| panic!("{e}"));
     let span = back.clips[0].span();
     assert!(span.start >= 0.0 && span.length() > 333_000.0, "{span:?}");
+    // At 333,333 s a single-precision time is kept to 2^(18 − 23) s: keys move, and the bake says so rather than
+    // claim its tolerance.
+    assert!(notes.iter().any(|n| n.contains("glTF's single-precision key times are 3.125e-2 s apart")), "{notes:?}");
+    let (worst, tolerance) =
+        (report["animations"][0]["worst"]["max"].as_f64().unwrap(), report["tolerance"].as_f64().unwrap());
+    assert!(worst > tolerance, "{worst} within {tolerance}: the note would be wrong");
+    let table = bonescope(&[
+        "bake",
+        &asset("fbx-ufbx-corpus/maya_long_keyframes_7700_ascii.fbx").display().to_string(),
+        "--out",
+        &out.display().to_string(),
+    ]);
+    let shows = String::from_utf8_lossy(&table.stdout).lines().nth(1).unwrap_or_default().to_owned();
+    assert!(
+        shows.contains(&format!("shows the source within {worst:.3e} at "))
+            && shows.contains(&format!("past the {tolerance:.3e} asked")),
+        "{shows}"
+    );
 }

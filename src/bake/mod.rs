@@ -275,8 +275,27 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
             clip.name, -delay
         ));
     }
+    notes.extend(request.clips().iter().filter_map(coarse_times));
     notes.extend(source_notes(rig, dense.iter().map(|d| d.refined.stats.singular).sum()));
     Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }
+}
+
+/// Key times further apart than this, in seconds, where single precision holds them, are worth a note: a tenth of
+/// a millisecond, a 300th of a frame at 30 fps.
+const COARSE_TIME: f64 = 1e-4;
+
+/// A note where `clip` lasts so long that glTF's single-precision key times are coarse at its end: a time `t` is
+/// kept to `2^(⌊log₂ t⌋ − 23)` s, 1/64 s at 200,000 s, and keys move by that much.
+fn coarse_times(clip: &ClipToBake) -> Option<String> {
+    let end = clip.source.span().end;
+    let step = f64::from(f32::EPSILON) * 2f64.powf(end.abs().log2().floor());
+    (end.is_finite() && step > COARSE_TIME).then(|| {
+        format!(
+            "`{}` runs to {end:.0} s, where glTF's single-precision key times are {step:.3e} s apart: keys move that \
+             far, and the bake misses the source by as much as the clip moves in it",
+            clip.name
+        )
+    })
 }
 
 /// How many bytes of samples a bake keeps from the pass that learns what every sample teaches for the pass that
