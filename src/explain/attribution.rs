@@ -42,8 +42,8 @@ pub struct Attribution {
     pub stretched: bool,
     /// The root first, the explained bone last.
     pub chain: Vec<Link>,
-    /// The bone whose squash made uniform takes the most shear away, where one takes away more than rounding does
-    /// ([`contributes`]).
+    /// The bone whose squash made uniform takes the most shear away, where one takes away more than half the shear
+    /// tolerance (rounding moves a shear by far less).
     pub cause: Option<usize>,
     /// The fewest bones of the chain whose scales, all made uniform, leave the bone unflagged (empty when it is
     /// not flagged). Contributions need not add up, since scales compound and cancel; this set is what suffices.
