@@ -43,6 +43,8 @@ pub struct AnimationReport {
     pub meshes: Vec<MeshDifference>,
     /// The largest error anywhere (a probe or a vertex), model units.
     pub worst: Extreme,
+    /// Frames per second of the clip baked (its file's, or the rate its keys show), for times said with frames.
+    pub frame_rate: Option<f64>,
     /// Source bones the baked file lacks, and the reverse (none when the bake is sound).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub unmatched: Vec<String>,
@@ -137,6 +139,7 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
                 bones,
                 meshes,
                 worst: comparison.worst_distance(),
+                frame_rate: source.clip.map(|clip| clip.frame_rate()),
                 unmatched: unmatched_source.chain(unmatched_baked).collect(),
             }
         })

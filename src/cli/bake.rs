@@ -12,7 +12,7 @@ use super::{EvalArgs, OutputFormat};
 use crate::bake::{self, BakeReport, Engine, Plan, Strategy, Written};
 use crate::eval::Setup;
 use crate::import;
-use crate::model::{Choice, Unit};
+use crate::model::{At, Choice, Unit};
 
 #[derive(Debug, Args)]
 pub struct BakeArgs {
@@ -98,13 +98,13 @@ fn render_table(args: &BakeArgs, setup: &Setup, report: &BakeReport, bytes: usiz
     }
     for animation in &report.animations {
         out.push_str(&format!(
-            "\nanimation `{}`: {} samples, {} keys; worst {:.3e} ({}) at {:.4} s\n",
+            "\nanimation `{}`: {} samples, {} keys; worst {:.3e} ({}) at {}\n",
             animation.name,
             animation.samples,
             animation.keys,
             animation.worst.max,
             percent(animation.worst.max),
-            animation.worst.time
+            At { time: animation.worst.time, rate: animation.frame_rate }
         ));
         let mut bones = Table::new(&[
             ("bone", false),
