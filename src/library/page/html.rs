@@ -15,8 +15,11 @@ const FIGURE_PX: u32 = 120;
 const SPARK_WIDTH: u32 = 120;
 const SPARK_HEIGHT: u32 = 22;
 
-/// The page of `overview`, titled `title`.
+/// The page of `overview`, titled `title`. Where something is wrong (a stretched bone or a refused file), the page
+/// opens on those rows alone, the clean clips written hidden ("stretched only", one click away): what the lead came
+/// for is on top, and a library's clean thousand rows are not laid out before the page shows.
 pub fn html(overview: &Overview, title: &str) -> String {
+    let problems_only = overview.rows.iter().any(|row| row.worst_shear_deg().is_none_or(|worst| worst > 0.0));
     let page = html! {
         (DOCTYPE)
         html lang="en" {
@@ -31,7 +34,7 @@ pub fn html(overview: &Overview, title: &str) -> String {
                 p #summary .verdict[overview.verdict.exit_status() != 0] { (overview.summary()) }
                 div .controls {
                     label { "Filter " input #filter type="search" placeholder="file, clip or bone"; }
-                    label { input #stretched type="checkbox"; " stretched only" }
+                    label { input #stretched type="checkbox" checked[problems_only]; " stretched only" }
                     label { "Sort by "
                         select #sort {
                             option value="worst" { "worst shear (refused first)" }
@@ -51,7 +54,7 @@ pub fn html(overview: &Overview, title: &str) -> String {
                         th { "worst moment" }
                         th { "stretched bones" }
                     } }
-                    tbody { @for row in &overview.rows { (row_markup(row)) } }
+                    tbody { @for row in &overview.rows { (row_markup(row, problems_only)) } }
                 }
                 script { (PreEscaped(SCRIPT)) }
             }
@@ -60,7 +63,8 @@ pub fn html(overview: &Overview, title: &str) -> String {
     page.into_string()
 }
 
-fn row_markup(row: &Row) -> Markup {
+/// One row; a clean clip's hidden where the page opens on the problems alone (`problems_only`).
+fn row_markup(row: &Row, problems_only: bool) -> Markup {
     let worst = row.worst_shear_deg();
     let data_worst = worst.map_or_else(|| "Infinity".to_owned(), |w| w.to_string());
     match row.what {
@@ -73,7 +77,8 @@ fn row_markup(row: &Row) -> Markup {
             }
         },
         What::Clip(clip) => html! {
-            tr data-worst=(data_worst) data-file=(row.file) data-format=(row.format) data-search=(search_text(row, clip)) {
+            tr hidden[problems_only && worst == Some(0.0)] data-worst=(data_worst) data-file=(row.file)
+                data-format=(row.format) data-search=(search_text(row, clip)) {
                 td .num { (format!("{:.3}°", worst.unwrap_or(0.0))) }
                 td .file { (row.file) }
                 td { (clip_label(clip)) br; span .small { (clip_span(clip)) } }
@@ -228,7 +233,7 @@ const SCRIPT: &str = r#"
   }
   const asked = new URLSearchParams(location.hash.slice(1));
   filter.value = asked.get('filter') || '';
-  stretched.checked = asked.get('stretched') === '1';
+  if (asked.has('stretched')) stretched.checked = asked.get('stretched') === '1';
   order(asked.get('sort') || 'worst');
   apply();
   filter.addEventListener('input', apply);
