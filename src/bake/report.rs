@@ -7,7 +7,7 @@ use super::{Baked, BakedAnimation, Engine, Request, Strategy};
 use crate::diff::{Comparison, DEFAULT_RATE, Extreme, Measure, MeshDifference, Pairs, compare_each, comparison_times};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
-use crate::model::{Choice, Rig};
+use crate::model::{Choice, Rig, with_midpoints};
 
 /// How one bone was baked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -161,10 +161,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
 /// baked time and the midpoint between each two (where a sampled curve strays most from its chord), and the times
 /// `diff` compares at (both sides' keys and [`DEFAULT_RATE`] a second).
 fn checked_times(source: &Evaluation, result: &Evaluation, animation: &BakedAnimation) -> Vec<f64> {
-    let baked = &animation.times;
-    let midpoints = baked.windows(2).map(|w| 0.5 * (w[0] + w[1]));
-    let mut times: Vec<f64> =
-        baked.iter().copied().chain(midpoints).chain(comparison_times(source, result, DEFAULT_RATE)).collect();
+    let mut times = with_midpoints(&animation.times);
+    times.extend(comparison_times(source, result, DEFAULT_RATE));
     times.sort_by(f64::total_cmp);
     times.dedup();
     times

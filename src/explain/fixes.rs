@@ -156,12 +156,7 @@ impl Scale {
 
     /// The same size, at its times and the midpoints between them.
     fn with_midpoints(self) -> Self {
-        let mut times = Vec::with_capacity(2 * self.times.len());
-        for pair in self.times.windows(2) {
-            times.extend([pair[0], 0.5 * (pair[0] + pair[1])]);
-        }
-        times.extend(self.times.last());
-        Scale { times, ..self }
+        Scale { times: crate::model::with_midpoints(&self.times), ..self }
     }
 }
 

@@ -21,7 +21,7 @@ pub use inherit::{InheritMode, ModeChoice, Modes, UnknownInheritMode, UnknownMod
 pub(crate) use skeleton::named as named_skeleton;
 pub use skeleton::{Bone, NodeRole, ParentOrderError, Placement, Skeleton};
 pub use skin::{Mesh, MorphTarget, NodeBind, Skin, WEIGHT_SUM_TOLERANCE, normalized_weights};
-pub use timeline::{At, MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, Span, frames, sample_times};
+pub use timeline::{At, MAX_FRAMES, SAMPLES_PER_SPARSE_GAP, SampleTimes, Span, frames, sample_times, with_midpoints};
 pub use tool::Tool;
 pub use transform::{Transform, affine};
 pub(crate) use unit::significant;

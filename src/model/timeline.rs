@@ -96,6 +96,16 @@ pub fn frames(count: f64) -> String {
     if (count - whole).abs() < 1e-3 { format!("{}", whole + 0.0) } else { format!("{count:.1}") }
 }
 
+/// Sorted `times` with the midpoint between each two beside them: where something keyed at `times` strays most.
+pub fn with_midpoints(times: &[f64]) -> Vec<f64> {
+    let mut all = Vec::with_capacity(2 * times.len());
+    for pair in times.windows(2) {
+        all.extend([pair[0], 0.5 * (pair[0] + pair[1])]);
+    }
+    all.extend(times.last());
+    all
+}
+
 /// The sorted, distinct times to sample, and whether some frames were left out.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleTimes {
@@ -173,6 +183,13 @@ fn keep_anchors(anchors: Vec<f64>, mut others: Vec<f64>) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn midpoints_lie_between_the_times_in_order() {
+        assert_eq!(with_midpoints(&[0.0, 1.0, 3.0]), [0.0, 0.5, 1.0, 2.0, 3.0]);
+        assert_eq!(with_midpoints(&[2.0]), [2.0]);
+        assert!(with_midpoints(&[]).is_empty());
+    }
 
     #[test]
     fn spans_meet_shift_and_hold() {
