@@ -1367,7 +1367,7 @@ fn a_slider_dragged_over_many_frames_is_one_step() {
     settle(&mut harness);
     let weight = harness.state().session.doc.layers().bind_weight;
     assert!(weight < 0.9, "the slider moved: {weight}");
-    assert_eq!(harness.state().session.undo_label(), Some("bind weight on"));
+    assert_eq!(harness.state().session.undo_label(), Some(format!("bind weight {weight:.2}").as_str()));
     undo_key(&mut harness);
     assert_eq!(state_of(&harness), before, "one undo takes the whole drag back");
     assert_eq!(harness.state().session.undo_label(), None);
@@ -1440,4 +1440,209 @@ fn the_app_and_scan_report_one_worst_shear_stretch_and_time_on_every_shared_file
         }
     }
     assert!(compared >= 40, "the library has sheared bones to compare: {compared}");
+}
+
+// The new user's first minutes (issue 55): a tree that reads, controls that stay put, the small things.
+
+/// The left edge of the row named `name` in the skeleton list.
+fn row_left(harness: &Harness<'static, BonescopeApp>, name: &str) -> f32 {
+    in_pane(harness, "Skeleton", name).rect().left()
+}
+
+#[test]
+fn every_level_of_the_tree_steps_in_alike_and_names_hold_still_as_badges_come() {
+    let mut harness = laptop_demo();
+    let names = ["shoulder", "upper_arm", "forearm", "hand"];
+    let lefts = |harness: &Harness<'static, BonescopeApp>| names.map(|name| row_left(harness, name));
+    let at_start = lefts(&harness);
+    let steps: Vec<f32> = at_start.windows(2).map(|w| w[1] - w[0]).collect();
+    assert!(steps.iter().all(|s| *s > 4.0 && (s - steps[0]).abs() < 0.5), "one step a level: {steps:?}");
+    // At 0.5 s the forearm shears: its badge comes, and no name moves for it.
+    harness.state_mut().window.time = 0.5;
+    settle(&mut harness);
+    let forearm = bone(&harness, "forearm");
+    assert!(harness.state().analysis().unwrap().stretched_at(forearm, 15), "the forearm has a badge now");
+    assert_eq!(lefts(&harness), at_start);
+}
+
+#[test]
+fn a_click_on_a_rows_mode_selects_its_bone() {
+    let mut harness = laptop_demo();
+    let hand = in_pane(&harness, "Skeleton", "hand").rect();
+    let mode = harness.get_all_by_label("full").find(|n| (n.rect().center().y - hand.center().y).abs() < 2.0);
+    mode.expect("the hand's mode in its row").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().window.selection, vec![bone(&harness, "hand")]);
+}
+
+#[test]
+fn a_node_its_file_leaves_unnamed_reads_node_and_its_number() {
+    use bonescope::model::{Bone, Skeleton};
+    let mut rig = bonescope::import::demo_rig();
+    let mut bones = rig.skeleton.bones().to_vec();
+    let hand = bones.iter().position(|b| b.name == "hand").unwrap();
+    bones[hand].name = Bone::unnamed(bones[hand].node);
+    let node = bones[hand].node;
+    rig.skeleton = Skeleton::new(bones).unwrap();
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    settle(&mut harness);
+    in_pane(&harness, "Skeleton", &format!("(node {node})"));
+}
+
+#[test]
+fn a_barely_sheared_bone_says_how_little_not_zero() {
+    let mut harness = laptop_demo();
+    // Flag the least shear, and keep a thousandth of the clip: the forearm shears by a few hundredths of a degree.
+    let tolerances = &mut harness.state_mut().settings.tolerances;
+    (tolerances.min_anisotropy, tolerances.min_stretch_deg, tolerances.min_shear_deg) = (1e-9, 1e-9, 1e-9);
+    let layers = bonescope::eval::Layers { bind_weight: 0.001, ..Default::default() };
+    harness.state_mut().session.doc.set_layers(&layers).unwrap();
+    settle(&mut harness);
+    let forearm = bone(&harness, "forearm");
+    let summary = &harness.state().analysis().unwrap().scan.bones[forearm];
+    assert!(summary.stretched() && summary.worst_shear_deg < 0.05, "{}", summary.worst_shear_deg);
+    let badges: Vec<String> =
+        harness.query_all_by_role(Role::Label).filter_map(|n| n.value().filter(|v| v.starts_with("max "))).collect();
+    assert!(badges.iter().all(|b| b != "max 0.0°") && !badges.is_empty(), "{badges:?}");
+}
+
+#[test]
+fn a_drag_on_the_time_bar_lets_go_on_a_whole_frame() {
+    let mut harness = demo_app();
+    let bar = harness.get_by_label("time bar").rect();
+    let y = bar.center().y;
+    harness.drag_at(egui::pos2(bar.left() + 0.1 * bar.width(), y));
+    harness.run();
+    harness.hover_at(egui::pos2(bar.left() + 0.3 * bar.width(), y));
+    harness.run();
+    harness.drop_at(egui::pos2(bar.left() + 0.4337 * bar.width(), y));
+    settle(&mut harness);
+    let frame = harness.state().window.time * harness.state().session.doc.frame_rate();
+    assert!(frame > 1.0 && (frame - frame.round()).abs() < 1e-9, "frame {frame}");
+}
+
+#[test]
+fn undo_selects_the_bone_it_changes_back() {
+    let mut harness = laptop_demo();
+    in_pane(&harness, "Skeleton", "hand").click_secondary();
+    harness.run();
+    harness.get_by_label("Set mode of this bone").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "blender-aligned").click();
+    settle(&mut harness);
+    in_pane(&harness, "Skeleton", "shoulder").click();
+    settle(&mut harness);
+    undo_key(&mut harness);
+    assert_eq!(harness.state().window.selection, vec![bone(&harness, "hand")]);
+    // Edit → History lists the steps, the one undone among them.
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness.get_by_label("History").click();
+    harness.run();
+    harness.get_by_label("opened");
+    harness.get_by_label("hand to blender-aligned");
+}
+
+#[test]
+fn an_error_goes_when_another_file_opens() {
+    let mut harness = demo_app();
+    let dir = tempfile::tempdir().unwrap();
+    let broken = dir.path().join("broken.glb");
+    std::fs::write(&broken, b"glTF\x02\x00\x00\x00").unwrap();
+    harness.state_mut().open(&broken);
+    harness.run();
+    assert_eq!(harness.state().errors().len(), 1);
+    harness.state_mut().open(&asset("bvh/bvh_test2.bvh"));
+    settle(&mut harness);
+    assert_eq!(harness.state().errors(), vec![], "the broken file's error is of the document before");
+}
+
+/// Opens bonescope's own browser from the File menu's `item`.
+fn browse(harness: &mut Harness<'static, BonescopeApp>, item: &str) {
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label(item).click();
+    harness.run();
+}
+
+#[test]
+fn open_and_compare_browse_in_one_window_in_the_folder_left() {
+    let mut harness = demo_app();
+    harness.state_mut().window.dialogs.native = bonescope::app::NativeDialog::Unavailable;
+    browse(&mut harness, "Open…");
+    harness.get_by_label("Up").click();
+    harness.run();
+    let folder = harness.get_by_label("Path").value();
+    let place = harness.get_by_label("Open a file").rect().left_top();
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    browse(&mut harness, "Compare with…");
+    assert_eq!(harness.get_by_label("Path").value(), folder);
+    assert_eq!(harness.get_by_label("Compare with a file").rect().left_top(), place);
+}
+
+#[test]
+fn a_file_opens_on_the_clip_that_keys_the_most_channels() {
+    use bonescope::model::{BoneTracks, Clip};
+    let mut rig = bonescope::import::demo_rig();
+    let hand = rig.skeleton.find("hand").unwrap();
+    let eyes = rig.clips[1].tracks_of(hand).unwrap().clone();
+    let eyes = BoneTracks { translation: None, scale: None, ..eyes };
+    let mut stretch = rig.clips[0].clone();
+    stretch.index = 1;
+    rig.clips = vec![Clip::new(0, Some("eyes only".into()), vec![eyes], vec![]), stretch];
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    settle(&mut harness);
+    assert_eq!(harness.state().session.doc.clip().map(|c| c.label()).as_deref(), Some("stretch"));
+}
+
+#[test]
+fn the_top_bar_holds_still_for_a_comparison_and_a_file_without_a_skin() {
+    let mut harness = laptop_demo();
+    let places = |harness: &Harness<'static, BonescopeApp>| {
+        let combo = |label| harness.get_by_role_and_label(Role::ComboBox, label).rect();
+        [combo("Ghost"), combo("Skinning"), harness.get_by_label("Layers").rect()]
+    };
+    let before = places(&harness);
+    harness.state_mut().compare(&asset("bvh/cmu_12_01_walk.bvh"));
+    settle(&mut harness);
+    harness.get_by_label_contains("unit of");
+    assert_eq!(places(&harness), before, "the comparison's pickers have a place of their own");
+    harness.state_mut().open(&asset("bvh/bvh_test2.bvh"));
+    settle(&mut harness);
+    assert_eq!(places(&harness), before, "Skinning greyed, not gone");
+}
+
+#[test]
+fn the_time_unit_picker_holds_still_for_another_clips_length() {
+    let mut rig = bonescope::import::demo_rig();
+    rig.clips[1] = rig.clips[1].clone().with_span(bonescope::model::Span::new(0.0, 12.5));
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+    settle(&mut harness);
+    let picker = |harness: &Harness<'static, BonescopeApp>| harness.get_by_role_and_label(Role::ComboBox, "in").rect();
+    let before = picker(&harness);
+    harness.state_mut().session.doc.set_clip(Some(1)).unwrap();
+    settle(&mut harness);
+    harness.get_by_label_contains("of 12.5");
+    assert_eq!(picker(&harness), before);
+}
+
+#[test]
+fn a_small_window_plots_taller_than_a_strip() {
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1000.0, 700.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    settle(&mut harness);
+    harness.get_by_label("forearm").click();
+    settle(&mut harness);
+    let ctx = harness.ctx.clone();
+    let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
+    let height = memory().transform().frame().height();
+    assert!(height > 45.0, "the plot is {height} points tall");
 }

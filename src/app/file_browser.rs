@@ -76,7 +76,6 @@ pub struct FileBrowser {
 }
 
 impl FileBrowser {
-    /// A browser showing `folder`.
     /// A browser titled `title` (what the file is for), in `folder`.
     pub fn new(title: &'static str, folder: &Path) -> Self {
         let (folder_now, typed, entries, error) = (PathBuf::new(), String::new(), Vec::new(), None);
@@ -111,7 +110,9 @@ impl FileBrowser {
     pub fn ui(&mut self, ctx: &egui::Context, open: &mut bool) -> Option<PathBuf> {
         let mut chosen = None;
         let mut still_open = *open;
-        egui::Window::new(self.title).open(&mut still_open).collapsible(false).default_width(480.0).show(ctx, |ui| {
+        // One window whatever it is for: Open and Compare appear where the last one was left.
+        let window = egui::Window::new(self.title).id(egui::Id::unique("file-browser"));
+        window.open(&mut still_open).collapsible(false).default_width(480.0).show(ctx, |ui| {
             ui.horizontal(|ui| {
                 if ui.button("Up").on_hover_text("the parent folder").clicked()
                     && let Some(parent) = self.folder.parent().map(Path::to_owned)
@@ -166,11 +167,13 @@ pub struct Dialogs {
     pub native: NativeDialog,
     pending: Option<(Receiver<DialogOutcome>, Purpose)>,
     browser: Option<(FileBrowser, Purpose)>,
+    /// The folder the browser last showed: the next one, for either purpose, opens there.
+    browsed: Option<PathBuf>,
 }
 
 impl Default for Dialogs {
     fn default() -> Self {
-        Dialogs { native: NativeDialog::detect(), pending: None, browser: None }
+        Dialogs { native: NativeDialog::detect(), pending: None, browser: None, browsed: None }
     }
 }
 
@@ -191,6 +194,7 @@ impl Dialogs {
             Purpose::Open => "Open a file",
             Purpose::Compare => "Compare with a file",
         };
+        let folder = self.browsed.as_deref().filter(|f| f.is_dir()).unwrap_or(folder);
         self.browser = Some((FileBrowser::new(title, folder), purpose));
     }
 
@@ -214,6 +218,7 @@ impl Dialogs {
         let (browser, purpose) = self.browser.as_mut()?;
         let mut open = true;
         let chosen = browser.ui(ctx, &mut open).map(|path| (path, *purpose));
+        self.browsed = Some(browser.folder.clone());
         if !open {
             self.browser = None;
         }

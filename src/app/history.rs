@@ -65,6 +65,12 @@ impl History {
         self.states.get(self.current + 1).map(|s| s.label.as_str())
     }
 
+    /// Every step's label, oldest first (the first state's is empty: the document as opened), and which of them the
+    /// document is in (those after it were undone).
+    pub fn steps(&self) -> (Vec<&str>, usize) {
+        (self.states.iter().map(|s| s.label.as_str()).collect(), self.current)
+    }
+
     /// Takes `doc` back one step; on a state that no longer fits its rig (a reload lost the clip or bone it names),
     /// nothing changes and the error says why.
     pub fn undo(&mut self, doc: &mut Document) -> Result<(), SetupError> {

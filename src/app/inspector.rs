@@ -14,9 +14,11 @@ use crate::math::AffineParts;
 use crate::model::Choice;
 use crate::view::Badge;
 
-/// The panel: all it shows is the shared state's.
+/// The panel: the shared state's bone, and what its Why? section keeps between frames.
 #[derive(Default)]
-pub struct Inspector;
+pub struct Inspector {
+    why: why::Memory,
+}
 
 impl Panel for Inspector {
     fn pane(&self) -> Pane {
@@ -28,16 +30,16 @@ impl Panel for Inspector {
     }
 
     fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
-        let Some(bone) = why::shown(shared) else {
+        let Some(bone) = why::shown(shared, &mut self.why) else {
             ui.label(RichText::new("Select a bone in the viewport or the list.").weak());
             return;
         };
         why::pinned_line(ui, shared, bone);
-        bone_ui(ui, shared, bone);
+        bone_ui(ui, shared, &mut self.why, bone);
     }
 }
 
-fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+fn bone_ui(ui: &mut Ui, shared: &mut Shared, why: &mut why::Memory, bone: usize) {
     let reports =
         BoneReport::all(&shared.doc.rig.skeleton, shared.doc.modes(), &shared.frame.pose, &shared.settings.tolerances);
     let report = &reports[bone];
@@ -56,10 +58,10 @@ fn bone_ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
     ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
     ui.horizontal_wrapped(|ui| {
         copy_button(ui, shared, &reports);
-        why::header(ui, shared, bone);
+        why::header(ui, shared, why, bone);
     });
     egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-        why::ui(ui, shared, bone);
+        why::ui(ui, shared, why, bone);
         morph_weights(ui, shared, bone);
         let local = shared.frame.pose.local[bone].matrix();
         let tolerance = shared.settings.tolerances.min_anisotropy;

@@ -153,12 +153,14 @@ impl BonescopeApp {
 
     /// Undoes the last edit of what the document evaluates (Edit → Undo, Ctrl+Z).
     pub fn undo(&mut self) {
-        self.session.undo(&mut self.window.notifications);
+        let bones = self.session.undo(&mut self.window.notifications);
+        self.window.select_changed(&bones);
     }
 
     /// Redoes the last edit undone (Edit → Redo, Ctrl+Shift+Z, Ctrl+Y).
     pub fn redo(&mut self) {
-        self.session.redo(&mut self.window.notifications);
+        let bones = self.session.redo(&mut self.window.notifications);
+        self.window.select_changed(&bones);
     }
 
     /// Waits for the background work to finish (for tests and headless renders).

@@ -53,6 +53,11 @@ impl Notifications {
         self.items.retain(|n| !(n.error && n.topic.as_deref() == Some(topic)));
     }
 
+    /// Drops every error: another document opened.
+    pub fn clear_errors(&mut self) {
+        self.items.retain(|n| !n.error);
+    }
+
     /// Where they were drawn last frame.
     pub fn rect(&self) -> Option<egui::Rect> {
         self.area

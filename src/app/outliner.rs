@@ -27,6 +27,8 @@ pub struct Outliner {
 
 const ROW_HEIGHT: f32 = 20.0;
 const INDENT: f32 = 10.0;
+/// The fold toggle's slot ("+" and "−" differ in width; a leaf keeps the slot empty): names line up by level.
+const TOGGLE_WIDTH: f32 = 14.0;
 
 impl Panel for Outliner {
     fn pane(&self) -> Pane {
@@ -69,10 +71,11 @@ impl Panel for Outliner {
                 );
             }
         }
-        let badge_width = badge_column(shared, &rows);
+        let step = indent_step(rows.iter().map(|&b| depths[b]).max().unwrap_or(0), ui.available_width());
         list.show_rows(ui, ROW_HEIGHT, rows.len(), |ui, range| {
             for &bone in &rows[range] {
-                self.row(ui, shared, bone, if self.filter.is_empty() { depths[bone] } else { 0 }, badge_width);
+                let depth = if self.filter.is_empty() { depths[bone] } else { 0 };
+                self.row(ui, shared, bone, depth as f32 * step);
             }
         });
         // A bone picked in the list itself is in view already: the list stays where it is.
@@ -127,7 +130,6 @@ impl Outliner {
         let header = egui::CollapsingHeader::new(format!("Cameras, lights and helpers ({})", others.len()))
             .id_salt("outliner-others")
             .default_open(false);
-        let badge_width = badge_column(shared, &others.iter().map(|(_, b)| *b).collect::<Vec<_>>());
         header.show(ui, |ui| {
             let list = egui::ScrollArea::vertical().id_salt("outliner-others-list").max_height(ROW_HEIGHT * 8.0);
             list.show(ui, |ui| {
@@ -137,33 +139,33 @@ impl Outliner {
                         ui.label(RichText::new(format!("{}s", role.label())).weak().small());
                     }
                     for bone in bones {
-                        self.row(ui, shared, bone, 0, badge_width);
+                        self.row(ui, shared, bone, 0.0);
                     }
                 }
             });
         });
     }
 
-    fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, depth: usize, badge_width: f32) {
+    /// One bone's row, `indent` points in: the fold toggle, the badge, the name, the notes.
+    fn row(&mut self, ui: &mut egui::Ui, shared: &mut Shared, bone: usize, indent: f32) {
         let skeleton = &shared.doc.rig.skeleton;
         let has_children = (bone + 1..skeleton.len()).any(|c| skeleton.parent(c) == Some(bone));
-        let name = skeleton.bone(bone).name.clone();
+        let name = skeleton.bone(bone).shown_name().into_owned();
         let findings = shared.frame.primary.findings[bone];
-        let row_width = ui.available_width();
         ui.horizontal(|ui| {
             ui.set_height(ROW_HEIGHT);
-            ui.add_space(indent(depth, row_width));
+            ui.add_space(indent);
+            // The slot is there in every row, a leaf's empty: names line up level by level.
+            let (slot, _) = ui.allocate_exact_size(vec2(TOGGLE_WIDTH, ROW_HEIGHT), Sense::hover());
             if has_children {
                 let collapsed = self.collapsed.contains(&bone);
-                let toggle = ui.add(egui::Button::new(if collapsed { "+" } else { "−" }).small().frame(false));
+                let toggle = ui.put(slot, egui::Button::new(if collapsed { "+" } else { "−" }).small().frame(false));
                 if toggle.on_hover_text(format!("expand or collapse {name}")).clicked() && !self.collapsed.remove(&bone)
                 {
                     self.collapsed.insert(bone);
                 }
-            } else {
-                ui.add_space(14.0);
             }
-            badges(ui, &findings, badge_width);
+            badge(ui, &findings);
             let font = egui::TextStyle::Button.resolve(ui.style());
             let name_needs = text::text_width(ui, &name, &font) + 2.0 * ui.spacing().button_padding.x;
             let notes = Notes::of(shared, bone).fitted(ui, ui.available_width() - name_needs);
@@ -188,17 +190,17 @@ impl Outliner {
 /// Deep rows indent by at most this share of the list's width.
 const MAX_INDENT_SHARE: f32 = 0.25;
 
-/// Each level's indent is this share of the one above's: every level still steps in, and a hand's fingers under a
-/// HumanIK rig keep room for their names.
-const INDENT_DECAY: f32 = 0.85;
+/// The smallest step a level indents by, however deep the rig: a level must still read as one.
+const MIN_INDENT: f32 = 4.0;
 
-/// How far a row `depth` levels down indents in a list `width` wide: [`INDENT`] for the first level, a step smaller
-/// by [`INDENT_DECAY`] for each one below, the whole scaled down where the deepest would pass [`MAX_INDENT_SHARE`]
-/// of the width.
-fn indent(depth: usize, width: f32) -> f32 {
-    let deepest = INDENT / (1.0 - INDENT_DECAY);
-    let scale = (MAX_INDENT_SHARE * width / deepest).min(1.0);
-    scale * INDENT * (1.0 - INDENT_DECAY.powi(depth as i32)) / (1.0 - INDENT_DECAY)
+/// The indent of one level in a list `width` wide whose deepest row is `deepest` levels down: one step for every
+/// level (so a chain reads as a staircase), [`INDENT`] where there is room, smaller where the deepest row would pass
+/// [`MAX_INDENT_SHARE`] of the width.
+fn indent_step(deepest: usize, width: f32) -> f32 {
+    if deepest == 0 {
+        return INDENT;
+    }
+    (MAX_INDENT_SHARE * width / deepest as f32).clamp(MIN_INDENT, INDENT)
 }
 
 /// What a row says after the name: the difference from a compared file, the mode, the worst shear. Measured before
@@ -212,7 +214,7 @@ struct Notes {
 impl Notes {
     fn of(shared: &Shared, bone: usize) -> Notes {
         let worst = stretched_summary(shared, bone).map(|summary| {
-            RichText::new(format!("max {:.1}°", summary.worst_shear_deg))
+            RichText::new(format!("max {}°", short_degrees(summary.worst_shear_deg)))
                 .small()
                 .color(Badge::Stretched.color_for_shear(summary.worst_shear_deg))
         });
@@ -251,7 +253,12 @@ impl Notes {
             ui.label(difference).on_hover_text(difference_hint(shared, bone));
         }
         if let Some(mode) = self.mode {
-            ui.label(mode).on_hover_text(shared.doc.modes()[bone].description());
+            // Part of the row: a click on it selects the bone, as one on the name does.
+            let mode = ui.add(egui::Label::new(mode).sense(Sense::click()));
+            if mode.on_hover_text(shared.doc.modes()[bone].description()).clicked() {
+                let extend = ui.input(|i| i.modifiers.command || i.modifiers.shift);
+                shared.select(bone, extend);
+            }
         }
         if let (Some(worst), Some(summary)) = (self.worst, stretched_summary(shared, bone)) {
             let worst = ui.add(egui::Label::new(worst).sense(Sense::click())).on_hover_text(format!(
@@ -318,30 +325,28 @@ fn left_out(shared: &Shared, bone: usize) -> Option<LeftOut> {
     shared.doc.compared.as_ref().and_then(|compared| compared.left_out.get(bone).copied().flatten())
 }
 
-/// The icons of a bone's findings, painted in a fixed-width slot so names line up.
-fn badges(ui: &mut egui::Ui, findings: &Findings, width: f32) {
-    let (rect, response) = ui.allocate_exact_size(vec2(width, ROW_HEIGHT), Sense::hover());
-    let mut x = rect.left() + 6.0;
-    let mut names = Vec::new();
-    for badge in Badge::of(findings) {
-        badge.paint_icon(ui.painter(), egui::pos2(x, rect.center().y), 4.5);
-        names.push(badge.label());
-        x += BADGE_STEP;
-    }
-    if !names.is_empty() {
-        response.on_hover_text(names.join(", "));
+/// The icon of a bone's most serious finding (every finding named on hover), in a slot of its own that every row
+/// keeps: names stay where they are when findings come and go as the clip plays.
+fn badge(ui: &mut egui::Ui, findings: &Findings) {
+    let (rect, response) = ui.allocate_exact_size(vec2(BADGE_WIDTH, ROW_HEIGHT), Sense::hover());
+    if let Some(badge) = Badge::primary(findings) {
+        badge.paint_icon(ui.painter(), egui::pos2(rect.left() + 6.0, rect.center().y), 4.5);
+        response.on_hover_text(Badge::of(findings).map(Badge::label).collect::<Vec<_>>().join(", "));
     }
 }
 
-/// The width of the badges' column for the rows of `bones`: as wide as the most badges a row has, so that names
-/// line up and keep the room where nothing is found.
-fn badge_column(shared: &Shared, bones: &[usize]) -> f32 {
-    let most = bones.iter().map(|&b| Badge::of(&shared.frame.primary.findings[b]).count()).max().unwrap_or(0);
-    if most == 0 { 0.0 } else { 12.0 + BADGE_STEP * (most - 1) as f32 }
-}
+/// The badge's slot.
+const BADGE_WIDTH: f32 = 12.0;
 
-/// From one badge's centre to the next's.
-const BADGE_STEP: f32 = 11.0;
+/// An angle in degrees as the outliner's "max" note gives it: one decimal from 1° up, below that two significant
+/// digits (a bone flagged at 0.043° must not read "0.0°", as if nothing sheared).
+fn short_degrees(degrees: f64) -> String {
+    if !(degrees > 0.0 && degrees < 1.0) {
+        return format!("{degrees:.1}");
+    }
+    let decimals = (1 - degrees.log10().floor() as i32).clamp(1, 12) as usize;
+    format!("{degrees:.decimals$}")
+}
 
 /// The room an icon takes before its name in the legend.
 const ICON_WIDTH: f32 = 14.0;
@@ -389,15 +394,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_level_indents_further_in_smaller_steps_within_a_share_of_the_list() {
-        for width in [180.0, 270.0, 600.0] {
-            let indents: Vec<f32> = (0..12).map(|d| indent(d, width)).collect();
-            let steps: Vec<f32> = indents.windows(2).map(|w| w[1] - w[0]).collect();
-            assert_eq!(indents[0], 0.0);
-            assert!(steps.iter().all(|&s| s > 0.5), "{width}: every level steps in: {steps:?}");
-            assert!(steps.windows(2).all(|w| w[1] < w[0]), "{width}: smaller steps as depth grows: {steps:?}");
-            assert!(indents[11] <= MAX_INDENT_SHARE * width, "{width}: {indents:?}");
-        }
-        assert_eq!(indent(1, 600.0), INDENT, "room enough: the first step is whole");
+    fn every_level_indents_by_one_step_within_a_share_of_the_list() {
+        assert_eq!(indent_step(3, 600.0), INDENT, "room enough: the whole step");
+        assert_eq!(indent_step(0, 180.0), INDENT);
+        let step = indent_step(12, 270.0);
+        assert!(step < INDENT && 12.0 * step <= MAX_INDENT_SHARE * 270.0 + 1e-3, "{step}");
+        assert_eq!(indent_step(200, 270.0), MIN_INDENT, "a level still reads as one");
+    }
+
+    #[test]
+    fn a_small_worst_shear_keeps_its_digits() {
+        assert_eq!(short_degrees(24.26), "24.3");
+        assert_eq!(short_degrees(0.5), "0.50");
+        assert_eq!(short_degrees(0.0432), "0.043");
+        assert_eq!(short_degrees(0.000_012_3), "0.000012");
     }
 }

@@ -5,7 +5,6 @@ use super::document::Document;
 use super::frame::CurrentPose;
 use super::pane::{Pane, Place, Visibility};
 use super::settings::Settings;
-use super::why::Memory;
 use super::work::{Results, Work};
 
 /// At most this many bones are plotted at once (the most recently selected).
@@ -27,8 +26,6 @@ pub struct Shared<'a> {
     pub stretched: &'a [(f64, f64)],
     /// Where panels ask for more (an explanation, a bind check, a storage report).
     pub work: &'a mut Work,
-    /// What the Why? section keeps between frames (the fix last tried, the bone it stays with).
-    pub why: &'a mut Memory,
     /// Set by a panel that asks for the history's Undo (as Edit → Undo does).
     pub undo_asked: &'a mut bool,
 }

@@ -57,7 +57,8 @@ impl Session {
         let topic = path.display().to_string();
         match Document::load(path) {
             Ok(doc) => {
-                notes.resolved(&topic);
+                // What was said about the files before (one that failed, a comparison) is of another document.
+                notes.clear_errors();
                 self.watched.broken = None;
                 self.replace(doc);
                 notes.info_about(&topic, format!("opened {}", path.display()));
@@ -197,16 +198,35 @@ impl Session {
         self.history.redo_label()
     }
 
-    /// Undoes the last step; one that no longer fits the reloaded file is told and stays.
-    pub fn undo(&mut self, notes: &mut Notifications) {
-        if let Err(error) = self.history.undo(&mut self.doc) {
-            notes.error_about("undo", format!("cannot undo: {error}"));
-        }
+    /// Every step of the history by its label, and which one the document is in ([`History::steps`]).
+    pub fn steps(&self) -> (Vec<&str>, usize) {
+        self.history.steps()
     }
 
-    pub fn redo(&mut self, notes: &mut Notifications) {
-        if let Err(error) = self.history.redo(&mut self.doc) {
-            notes.error_about("redo", format!("cannot redo: {error}"));
+    /// Undoes the last step; one that no longer fits the reloaded file is told and stays. The bones it changed back
+    /// ([`crate::eval::Setup::changed_bones`]).
+    pub fn undo(&mut self, notes: &mut Notifications) -> Vec<usize> {
+        self.step(notes, "undo", History::undo)
+    }
+
+    /// Redoes the last step undone; the bones it changed.
+    pub fn redo(&mut self, notes: &mut Notifications) -> Vec<usize> {
+        self.step(notes, "redo", History::redo)
+    }
+
+    fn step(
+        &mut self,
+        notes: &mut Notifications,
+        name: &str,
+        step: fn(&mut History, &mut Document) -> Result<(), crate::eval::SetupError>,
+    ) -> Vec<usize> {
+        let before = self.doc.setup().clone();
+        match step(&mut self.history, &mut self.doc) {
+            Ok(()) => self.doc.setup().changed_bones(&before, &self.doc.rig.skeleton),
+            Err(error) => {
+                notes.error_about(name, format!("cannot {name}: {error}"));
+                Vec::new()
+            }
         }
     }
 }

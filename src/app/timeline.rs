@@ -87,8 +87,7 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     ui.separator();
     let unit = shared.settings.time_unit;
     time_field(ui, shared, unit, rate, span);
-    let ends = format!("from {} to {}", unit.format(span.start, rate), unit.format(span.end, rate));
-    ui.label(format!("of {}", unit.format_length(span.length(), rate))).on_hover_text(ends);
+    length_label(ui, shared, unit, rate, span);
     let label = ui.label("in");
     egui::ComboBox::from_id_salt("time-unit")
         .selected_text(unit.label())
@@ -107,6 +106,18 @@ fn controls(ui: &mut egui::Ui, shared: &mut Shared) {
     }
 }
 
+/// "of 2.0 s": the timeline's length, in a slot as wide as the longest any clip of the rig gives in any unit, so that
+/// the unit picker after it stays put whatever the clip or the unit.
+fn length_label(ui: &mut egui::Ui, shared: &Shared, unit: TimeUnit, rate: f64, span: Span) {
+    let font = egui::TextStyle::Body.resolve(ui.style());
+    let lengths = spans(shared, span).into_iter().map(|s| s.length());
+    let texts = lengths.flat_map(|length| TimeUnit::ALL.map(|u| format!("of {}", u.format_length(length, rate))));
+    let widest = texts.map(|text| text_width(ui, &text, &font)).fold(0.0, f32::max);
+    let ends = format!("from {} to {}", unit.format(span.start, rate), unit.format(span.end, rate));
+    let shown = ui.label(format!("of {}", unit.format_length(span.length(), rate))).on_hover_text(ends);
+    ui.add_space((widest - shown.rect.width()).max(0.0));
+}
+
 fn frame_button(ui: &mut egui::Ui, shared: &mut Shared, label: &str, key: &str, forward: bool, rate: f64, span: Span) {
     if ui.button(label).on_hover_text(key).clicked() {
         *shared.playing = false;
@@ -116,10 +127,11 @@ fn frame_button(ui: &mut egui::Ui, shared: &mut Shared, label: &str, key: &str, 
 
 /// The current time in the chosen unit, editable within the span: type a time, frame or tick (or drag to scrub).
 fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64, span: Span) {
+    let width = time_field_width(ui, unit, rate, &spans(shared, span));
     let field = egui::DragValue::new(shared.time)
         .range(span.start..=span.end)
         .speed(span.length().max(1e-3) / 500.0)
-        .min_size(vec2(time_field_width(ui, unit, rate, span), ui.spacing().interact_size.y))
+        .min_size(vec2(width, ui.spacing().interact_size.y))
         .custom_formatter(move |seconds, _| unit.format(seconds, rate))
         .custom_parser(move |text| unit.parse(text, rate));
     let response = ui.add(field).on_hover_text("type a time, a frame or a tick in the chosen unit");
@@ -129,13 +141,22 @@ fn time_field(ui: &mut egui::Ui, shared: &mut Shared, unit: TimeUnit, rate: f64,
     }
 }
 
-/// As wide as the time field's widest text, so the controls after it hold still while the clip plays: either end
-/// of the span half a frame farther from 0 (the most digits, and a frame's decimal).
-fn time_field_width(ui: &egui::Ui, unit: TimeUnit, rate: f64, span: Span) -> f32 {
+/// As wide as the time field's widest text, so the controls after it hold still while the clip plays and when
+/// another clip is chosen: either end of any of `spans` half a frame farther from 0 (the most digits, and a
+/// frame's decimal).
+fn time_field_width(ui: &egui::Ui, unit: TimeUnit, rate: f64, spans: &[Span]) -> f32 {
     let font = ui.style().drag_value_text_style.resolve(ui.style());
     let half_frame = 0.5 / rate;
-    let widest = [span.start, span.end].map(|t| text_width(ui, &unit.format(t + half_frame.copysign(t), rate), &font));
-    widest[0].max(widest[1]) + 2.0 * ui.spacing().button_padding.x
+    let ends = spans.iter().flat_map(|span| [span.start, span.end]);
+    let widest =
+        ends.map(|t| text_width(ui, &unit.format(t + half_frame.copysign(t), rate), &font)).fold(0.0, f32::max);
+    widest + 2.0 * ui.spacing().button_padding.x
+}
+
+/// The timeline's `span` now and the span of every clip of the rig: what the controls that show a time or a length
+/// keep room for.
+fn spans(shared: &Shared, span: Span) -> Vec<Span> {
+    shared.doc.rig.clips.iter().map(Clip::span).chain([span]).collect()
 }
 
 /// The timeline's frame rate: the clip's own (from its file), or one the user types; "file's rate" goes back.
@@ -195,6 +216,11 @@ fn time_bar(ui: &mut egui::Ui, shared: &mut Shared) {
     {
         *shared.playing = false;
         *shared.time = bar.span.clamp(unit.snap(bar.time(p.x), rate));
+    }
+    // A drag scrubs smoothly, and where it is let go (or clicked) is a whole frame, whatever the unit: a pose
+    // between frames is none the file has.
+    if response.clicked() || response.drag_stopped() {
+        *shared.time = bar.span.clamp(TimeUnit::Frames.snap(*shared.time, rate));
     }
     let painter = ui.painter_at(rect);
     let visuals = ui.visuals();

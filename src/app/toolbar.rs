@@ -37,6 +37,9 @@ pub struct Actions {
 pub struct Menus {
     pub undo: Option<String>,
     pub redo: Option<String>,
+    /// Every step of the history, oldest first, and the one the document is in.
+    pub history: Vec<String>,
+    pub current: usize,
     pub panels: Vec<(Pane, Visibility)>,
 }
 
@@ -60,6 +63,9 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut A
         ui.menu_button("View", |ui| view_menu(ui, shared, menus, actions));
         ui.separator();
         ui.label(RichText::new(shared.doc.title()).strong());
+        // A comparison's pickers have their place beside the file's name, so the toolbar below never moves for
+        // them.
+        unit_pickers(ui, shared.doc);
     });
     // On a narrow window the pickers wrap onto a second row rather than run off the edge.
     ui.horizontal_wrapped(|ui| {
@@ -68,12 +74,13 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut A
         mode_picker(ui, shared);
         ui.separator();
         ghost_picker(ui, shared);
-        unit_pickers(ui, shared.doc);
         ui.separator();
-        if !shared.doc.rig.skins.is_empty() {
-            skinning_picker(ui, shared);
-            ui.separator();
-        }
+        // Greyed, not gone, on a file without a skin: the controls after it stay where they are.
+        let skinned = !shared.doc.rig.skins.is_empty();
+        ui.add_enabled_ui(skinned, |ui| skinning_picker(ui, shared))
+            .response
+            .on_disabled_hover_text("no skinned mesh in the file");
+        ui.separator();
         if let Some((pane, visibility)) = menus.panels.iter().find(|(pane, _)| *pane == Pane::LAYERS) {
             let mut shown = shared.settings.shows(pane, *visibility);
             let hint = "blend, additive, crossfade, shake, targets, interpolation, bind pose, storage";
@@ -182,6 +189,21 @@ fn edit_menu(ui: &mut egui::Ui, menus: &Menus, actions: &mut Actions) {
         if ui.add_enabled(step.is_some(), button).clicked() {
             *asked = true;
         }
+    }
+    ui.menu_button("History", |ui| history_list(ui, menus));
+}
+
+/// The steps of the history, oldest first: the one the document is in marked, those undone greyed.
+fn history_list(ui: &mut egui::Ui, menus: &Menus) {
+    for (i, label) in menus.history.iter().enumerate() {
+        let text = if label.is_empty() { "opened".to_owned() } else { text::drawable(label) };
+        let text = match i.cmp(&menus.current) {
+            std::cmp::Ordering::Less => RichText::new(text),
+            std::cmp::Ordering::Equal => RichText::new(text).strong(),
+            std::cmp::Ordering::Greater => RichText::new(text).weak(),
+        };
+        let hint = if i > menus.current { "undone: Redo takes it again" } else { "a step of the history" };
+        ui.label(text).on_hover_text(hint);
     }
 }
 
@@ -308,11 +330,12 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .labelled_by(label.id);
 }
 
-/// Beside the ghost picker, for each file of the comparison that states no unit (a BVH), the unit it is in, and for
+/// Beside the document's name, for each file of the comparison that states no unit (a BVH), the unit it is in, and for
 /// the compared file the axis it stands along where it states none or lies down beside the document: the ghost, the
 /// dashed curves and the differences follow them.
 fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     let Some(compared) = doc.compared.clone() else { return };
+    ui.separator();
     if !compared.states_unit()
         && let Some(unit) = unit_picker(ui, &compared.title(), compared.rig.unit, &doc.title())
     {

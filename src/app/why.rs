@@ -53,9 +53,9 @@ struct Tried {
 
 /// The bone the Inspector shows: the selected one, or the bone in whose chain (in this section) the selected one was
 /// clicked, for as long as that one alone is selected (any other selection lets the section go).
-pub fn shown(shared: &mut Shared) -> Option<usize> {
+pub fn shown(shared: &Shared, memory: &mut Memory) -> Option<usize> {
     let selected = shared.inspected()?;
-    let (selection, pinned) = (&shared.selection, &mut shared.why.pinned);
+    let (selection, pinned) = (&shared.selection, &mut memory.pinned);
     *pinned = pinned.filter(|&(_, clicked)| selection.as_slice() == [clicked]);
     Some(pinned.map_or(selected, |(explained, _)| explained))
 }
@@ -74,12 +74,12 @@ pub fn pinned_line(ui: &mut Ui, shared: &mut Shared, bone: usize) {
 
 /// The section's header for `bone`, in the row of the Inspector's buttons (it takes no room of its own): a toggle
 /// when the whole-clip analysis flags the bone, a note otherwise.
-pub fn header(ui: &mut Ui, shared: &Shared, bone: usize) {
+pub fn header(ui: &mut Ui, shared: &Shared, memory: &Memory, bone: usize) {
     match flagged(shared, bone) {
         None => {
             ui.label(RichText::new("Why? once the clip is analysed").weak());
         }
-        Some(false) if standing(shared, bone).is_some() => {
+        Some(false) if standing(shared, memory, bone).is_some() => {
             ui.label(RichText::new("not sheared now").weak());
         }
         Some(false) => {
@@ -102,8 +102,8 @@ pub fn header(ui: &mut Ui, shared: &Shared, bone: usize) {
 
 /// The section's body, while its header is open: the explanation, computed off the UI thread; first, the fix tried
 /// on the bone while it stands, with Undo.
-pub fn ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
-    if let Some(line) = standing(shared, bone) {
+pub fn ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, bone: usize) {
+    if let Some(line) = standing(shared, memory, bone) {
         ui.horizontal_wrapped(|ui| {
             ui.label(RichText::new(line).strong());
             if ui.link("Undo").on_hover_text("take the fix back (Edit → Undo)").clicked() {
@@ -114,10 +114,10 @@ pub fn ui(ui: &mut Ui, shared: &mut Shared, bone: usize) {
     if flagged(shared, bone) != Some(true) {
         return;
     }
-    collapsing(ui.ctx()).show_body_unindented(ui, |ui| ui.indent("why-body", |ui| body(ui, shared, bone)));
+    collapsing(ui.ctx()).show_body_unindented(ui, |ui| ui.indent("why-body", |ui| body(ui, shared, memory, bone)));
 }
 
-fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
+fn body(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, bone: usize) {
     // The flag above may be the previous state's: explain once the analysis of this one is there.
     if shared.results.progress.is_some() {
         spinner(ui, "waiting for the whole-clip analysis…");
@@ -125,15 +125,15 @@ fn body(ui: &mut Ui, shared: &mut Shared, bone: usize) {
     }
     let options = ScanOptions { rate: shared.doc.analysis_rate(), tolerances: shared.settings.tolerances };
     match shared.work.explanation(shared.doc, bone, options) {
-        Some((explained, true)) => explanation_ui(ui, shared, &explained),
-        Some((first, false)) => first_answer_ui(ui, shared, &first),
+        Some((explained, true)) => explanation_ui(ui, shared, memory, &explained),
+        Some((first, false)) => first_answer_ui(ui, shared, memory, &first),
         None => spinner(ui, &format!("explaining {}…", shared.doc.rig.skeleton.bone(bone).name)),
     }
 }
 
 /// The line of the fix tried on `bone`, while the document evaluates what it made.
-fn standing(shared: &Shared, bone: usize) -> Option<String> {
-    let tried = shared.why.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
+fn standing(shared: &Shared, memory: &Memory, bone: usize) -> Option<String> {
+    let tried = memory.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
     Some(tried.line.clone())
 }
 
@@ -156,20 +156,20 @@ fn spinner(ui: &mut Ui, text: &str) {
 
 /// The explanation with its best fix alone, while every fix is ranked: the headline (the cause and that fix), the
 /// chain and the causes over the clip.
-fn first_answer_ui(ui: &mut Ui, shared: &mut Shared, first: &Explanation) {
+fn first_answer_ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, first: &Explanation) {
     ui.label(drawable(&first.headline(shared.doc.rig.unit)));
     if first.causes.stretched_samples == 0 {
         return;
     }
     ui.add_space(4.0);
-    chain(ui, shared, first);
+    chain(ui, shared, memory, first);
     ui.add_space(4.0);
     spans(ui, shared, first);
     ui.add_space(4.0);
     spinner(ui, "ranking every fix…");
 }
 
-fn explanation_ui(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+fn explanation_ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Explanation) {
     ui.label(drawable(&explained.headline(shared.doc.rig.unit)));
     if explained.causes.stretched_samples == 0 {
         return;
@@ -178,11 +178,11 @@ fn explanation_ui(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
         ui.label(RichText::new(drawable(&answer)).small());
     }
     ui.add_space(4.0);
-    chain(ui, shared, explained);
+    chain(ui, shared, memory, explained);
     ui.add_space(4.0);
     spans(ui, shared, explained);
     ui.add_space(4.0);
-    fixes(ui, shared, explained);
+    fixes(ui, shared, memory, explained);
     for note in &explained.notes {
         ui.label(RichText::new(drawable(&format!("note: {note}"))).small().weak());
     }
@@ -208,7 +208,7 @@ impl Columns {
 
 /// The chain at the worst time, root first: each bone's name (a click selects it, the section staying), a bar as long as the share of
 /// the shear its squash causes, the contribution in degrees, and the scale where it is unequal.
-fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+fn chain(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Explanation) {
     let at = &explained.causes.at;
     ui.horizontal_wrapped(|ui| {
         let hint = "each bone's contribution: the shear minus what is left with its scale made uniform (all else as \
@@ -224,7 +224,8 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     let columns = Columns::of(ui);
     let tolerance = shared.settings.tolerances.min_anisotropy;
     for link in &at.chain {
-        link_row(ui, shared, explained.bone, link, at.shear_deg, Some(link.bone) == main, &columns);
+        let pinned = &mut memory.pinned;
+        link_row(ui, shared, pinned, explained.bone, link, at.shear_deg, Some(link.bone) == main, &columns);
         if link.anisotropy > tolerance {
             ui.horizontal(|ui| {
                 ui.add_space(ui.spacing().indent);
@@ -245,10 +246,12 @@ fn chain(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     }
 }
 
-/// One bone of `explained`'s chain; a click on its name selects it, the section staying with `explained`.
+/// One bone of `explained`'s chain; a click on its name selects it, the section staying with `explained` (`pinned`).
+#[expect(clippy::too_many_arguments)]
 fn link_row(
     ui: &mut Ui,
     shared: &mut Shared,
+    pinned: &mut Option<(usize, usize)>,
     explained: usize,
     link: &Link,
     shear: f64,
@@ -261,7 +264,7 @@ fn link_row(
         let room = columns.name - name.rect.width();
         if name.clicked() {
             shared.select(link.bone, false);
-            shared.why.pinned = Some((explained, link.bone)).filter(|_| link.bone != explained);
+            *pinned = Some((explained, link.bone)).filter(|_| link.bone != explained);
         }
         ui.add_space(room.max(0.0));
         let hint = link_hint(link, shear);
@@ -330,7 +333,7 @@ fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
 
 /// The fixes, best first: each with what it leaves and what it moves, in columns; a Try button on those that are
 /// settings of the document.
-fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
+fn fixes(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Explanation) {
     // Those that change something: Blender's Fix Shear on a bone its parent does not shear is no fix.
     let shown: Vec<&Fix> = explained.shown_fixes(false, shared.settings.tolerances.min_shear_deg).collect();
     if shown.is_empty() {
@@ -339,7 +342,8 @@ fn fixes(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
     ui.label(RichText::new("Fixes, best first").strong());
     let unit = shared.doc.rig.unit;
     let columns = FixColumns::of(ui, &shown, unit);
-    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, |ui, fix| fix_row(ui, shared, fix, &columns, explained));
+    let row = |ui: &mut Ui, fix: &&Fix| fix_row(ui, shared, memory, fix, &columns, explained);
+    listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, row);
 }
 
 /// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
@@ -367,12 +371,19 @@ impl FixColumns {
 }
 
 /// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
-fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, explained: &Explanation) {
+fn fix_row(
+    ui: &mut Ui,
+    shared: &mut Shared,
+    memory: &mut Memory,
+    fix: &Fix,
+    columns: &FixColumns,
+    explained: &Explanation,
+) {
     let hint = fix_hint(fix, columns.unit, &shared.time_text(fix.cost.distance.time));
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
-            _ => try_button(ui, shared, fix, columns, explained),
+            _ => try_button(ui, shared, memory, fix, columns, explained),
         }
         ui.vertical(|ui| {
             // Rows as tall as their text, so that the label and its numbers read as one entry.
@@ -401,7 +412,14 @@ fn fix_row(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, ex
 }
 
 /// Try: the fix made, said in the section's place, and the timeline at the bone's worst time, where it shows.
-fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns, explained: &Explanation) {
+fn try_button(
+    ui: &mut Ui,
+    shared: &mut Shared,
+    memory: &mut Memory,
+    fix: &Fix,
+    columns: &FixColumns,
+    explained: &Explanation,
+) {
     let what = match fix.change {
         Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
         _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
@@ -412,7 +430,7 @@ fn try_button(ui: &mut Ui, shared: &mut Shared, fix: &Fix, columns: &FixColumns,
         go_to(shared, explained.causes.at.time);
         let setup = shared.doc.setup().clone();
         let line = tried_line(fix, explained, columns.unit, &shared.time_text(fix.cost.distance.time));
-        shared.why.tried = Some(Tried { bone: explained.bone, setup, line });
+        memory.tried = Some(Tried { bone: explained.bone, setup, line });
     }
 }
 

@@ -17,7 +17,6 @@ use super::settings::Settings;
 use super::timeline::{self, PlayClock};
 use super::toolbar::{self, Actions, Menus};
 use super::viewport::{CanvasFill, Viewport};
-use super::why;
 use super::work::{Wanted, Work};
 use super::{inspector, layers, outliner, plots};
 use crate::analysis::ClipAnalysis;
@@ -70,8 +69,6 @@ pub struct Window {
     size: egui::Vec2,
     pub notifications: Notifications,
     pub dialogs: Dialogs,
-    /// What the Why? section keeps between frames.
-    why: why::Memory,
 }
 
 impl Window {
@@ -90,7 +87,6 @@ impl Window {
             size: egui::Vec2::ZERO,
             notifications: Notifications::default(),
             dialogs: Dialogs::default(),
-            why: why::Memory::default(),
         };
         window.replaced(Replaced::Opened, doc);
         window
@@ -113,6 +109,14 @@ impl Window {
                     self.viewport.frame_all(doc);
                 }
             }
+        }
+    }
+
+    /// Selects the topmost of the bones an undo or redo changed (`bones`, parents first), so that the step shows;
+    /// a step of no bone in particular leaves the selection.
+    pub fn select_changed(&mut self, bones: &[usize]) {
+        if let Some(&top) = bones.first() {
+            self.selection = vec![top];
         }
     }
 
@@ -169,7 +173,9 @@ impl Window {
         }
         let panes = self.all_panels().iter().map(|p| (p.pane(), p.visibility())).collect();
         let [undo, redo] = [session.undo_label(), session.redo_label()].map(|label| label.map(str::to_owned));
-        let menus = Menus { undo, redo, panels: panes };
+        let (steps, current) = session.steps();
+        let history = steps.into_iter().map(str::to_owned).collect();
+        let menus = Menus { undo, redo, history, current, panels: panes };
         let doc = &mut session.doc;
         let frame = CurrentPose::evaluate(doc, self.time, settings.scene.skinning, &settings.tolerances);
         let results = work.results(doc);
@@ -185,7 +191,6 @@ impl Window {
             results: &results,
             stretched,
             work,
-            why: &mut self.why,
             undo_asked: &mut undo_asked,
         };
         if self.chrome == Chrome::ViewportOnly {
@@ -303,7 +308,7 @@ fn browsing_folder(doc: &Document, settings: &Settings) -> PathBuf {
 pub(super) fn panels() -> Vec<Box<dyn Panel>> {
     vec![
         Box::new(outliner::Outliner::default()),
-        Box::new(inspector::Inspector),
+        Box::new(inspector::Inspector::default()),
         Box::new(layers::LayersPanel::default()),
         Box::new(plots::Plots::default()),
     ]

@@ -76,6 +76,27 @@ impl Setup {
     }
 }
 
+impl Setup {
+    /// The bones whose evaluation this setup changes from `before` by name (a mode, a scale made uniform, a shake,
+    /// a target), parents first: where an undo shows its step. Empty for a change of the whole clip (another clip,
+    /// a blend) or of every bone.
+    pub fn changed_bones(&self, before: &Setup, skeleton: &Skeleton) -> Vec<usize> {
+        let (old, new) = (before.modes.resolve(skeleton), self.modes.resolve(skeleton));
+        let mut bones: Vec<usize> = (0..new.len()).filter(|&b| old.get(b) != new.get(b)).collect();
+        let (a, b) = (&before.layers, &self.layers);
+        bones.extend(a.uniform_scale.iter().filter(|x| !b.uniform_scale.contains(x)));
+        bones.extend(b.uniform_scale.iter().filter(|x| !a.uniform_scale.contains(x)));
+        if a.shake != b.shake {
+            bones.extend(a.shake.iter().chain(&b.shake).map(|s| s.bone));
+        }
+        bones.extend(a.targets.iter().filter(|t| !b.targets.contains(t)).map(|t| t.bone));
+        bones.extend(b.targets.iter().filter(|t| !a.targets.contains(t)).map(|t| t.bone));
+        bones.sort_unstable();
+        bones.dedup();
+        if bones.len() == skeleton.len() { Vec::new() } else { bones }
+    }
+}
+
 /// The modes `after` gives, as it differs from `before`: every bone's, one bone's, a subtree's, or a count.
 fn mode_change(before: &Modes, after: &Modes, skeleton: &Skeleton) -> String {
     let (old, new) = (before.resolve(skeleton), after.resolve(skeleton));
@@ -100,11 +121,22 @@ fn layer_changes(before: &Layers, after: &Layers, skeleton: &Skeleton) -> Vec<St
         _ if !same => parts.push(name.to_owned()),
         _ => {}
     };
-    toggled("bind weight", before.bind_weight < 1.0, after.bind_weight < 1.0, before.bind_weight == after.bind_weight);
+    // A weight is a slider's: its step says where it was left ("bind weight 0.50"), as a name never could.
+    let bind = format!("bind weight {:.2}", after.bind_weight);
+    toggled(&bind, false, false, before.bind_weight == after.bind_weight);
     let interpolation = before.interpolation == after.interpolation;
     toggled("interpolation", false, false, interpolation);
-    toggled("blend", before.blend.is_some(), after.blend.is_some(), before.blend == after.blend);
-    toggled("additive", before.additive.is_some(), after.additive.is_some(), before.additive == after.additive);
+    let blend = weight_alone(before.blend, after.blend, |b| &mut b.weight).map(|w| format!("blend weight {w:.2}"));
+    toggled(
+        blend.as_deref().unwrap_or("blend"),
+        before.blend.is_some(),
+        after.blend.is_some(),
+        before.blend == after.blend,
+    );
+    let additive =
+        weight_alone(before.additive, after.additive, |a| &mut a.weight).map(|w| format!("additive weight {w:.2}"));
+    let same = before.additive == after.additive;
+    toggled(additive.as_deref().unwrap_or("additive"), before.additive.is_some(), after.additive.is_some(), same);
     toggled("crossfade", before.crossfade.is_some(), after.crossfade.is_some(), before.crossfade == after.crossfade);
     toggled("shake", before.shake.is_some(), after.shake.is_some(), before.shake == after.shake);
     toggled("targets", !before.targets.is_empty(), !after.targets.is_empty(), before.targets == after.targets);
@@ -116,6 +148,18 @@ fn layer_changes(before: &Layers, after: &Layers, skeleton: &Skeleton) -> Vec<St
         parts.push(format!("{}'s scale as authored", name(bone)));
     }
     parts
+}
+
+/// The weight of a layer on before and after whose weight alone changed (a slider dragged); `None` otherwise.
+fn weight_alone<T: Copy + PartialEq>(
+    before: Option<T>,
+    after: Option<T>,
+    weight: fn(&mut T) -> &mut f64,
+) -> Option<f64> {
+    let (mut before, mut after) = (before?, after?);
+    let (was, is) = (*weight(&mut before), *weight(&mut after));
+    *weight(&mut before) = is;
+    (was != is && before == after).then_some(is)
 }
 
 impl<'a> Evaluation<'a> {
@@ -253,7 +297,14 @@ mod tests {
                 s.layers.bind_weight = 0.5;
                 s.clip = None;
             }),
-            "rest pose, bind weight on"
+            "rest pose, bind weight 0.50"
         );
+        let lighter = |s: &mut Setup| {
+            s.layers.blend = Some(Blend { weight: 0.25, ..blend });
+        };
+        let blended = Setup { layers: Layers { blend: Some(blend), ..Layers::default() }, ..before.clone() };
+        let mut after = blended.clone();
+        lighter(&mut after);
+        assert_eq!(after.change_from(&blended, &rig), "blend weight 0.25", "a slider's step names its value");
     }
 }

@@ -363,6 +363,14 @@ impl Clip {
         &self.tracks
     }
 
+    /// How many channels the clip keys: translations, rotations and scales of bones, and morph weights.
+    pub fn channels(&self) -> usize {
+        let bones = self.tracks.iter().map(|t| {
+            usize::from(t.translation.is_some()) + usize::from(t.rotation.is_some()) + usize::from(t.scale.is_some())
+        });
+        bones.sum::<usize>() + self.morph.iter().map(|m| m.weights.len()).sum::<usize>()
+    }
+
     /// The animated morph weights, by bone.
     pub fn morph(&self) -> &[MorphWeights] {
         &self.morph

@@ -47,17 +47,12 @@ pub struct Rig {
 }
 
 impl Rig {
-    /// The clip a viewer opens on: the first where it moves something, else the longest that does (a Mixamo FBX's
-    /// first take, `Take 001`, is empty beside its `mixamo.com`); `None` without clips.
+    /// The clip a viewer opens on: the one that keys the most channels, the first of those that key as many; `None`
+    /// without clips. facecap's eyes-only clip is not opened on beside its face's, nor a Mixamo FBX's empty
+    /// `Take 001` beside its `mixamo.com`.
     pub fn opening_clip(&self) -> Option<usize> {
-        let moving = |c: &&Clip| !c.tracks().is_empty();
-        let first = self.clips.first().filter(moving).map(|_| 0);
-        let longest = || {
-            // The first of equally long clips.
-            let keyed = self.clips.iter().enumerate().rev().filter(|(_, c)| moving(c));
-            keyed.max_by(|(_, a), (_, b)| a.span().length().total_cmp(&b.span().length())).map(|(i, _)| i)
-        };
-        first.or_else(longest).or((!self.clips.is_empty()).then_some(0))
+        // `max_by_key` takes the last of equals: from the end, that is the first.
+        self.clips.iter().enumerate().rev().max_by_key(|(_, clip)| clip.channels()).map(|(i, _)| i)
     }
 
     /// The clip named `name`, or with index `name` when it parses as a number.
@@ -230,17 +225,22 @@ mod tests {
     }
 
     #[test]
-    fn a_viewer_opens_on_the_first_clip_that_moves_something_else_the_longest() {
-        let moving = |index: usize, end: f64| {
+    fn a_viewer_opens_on_the_clip_that_keys_the_most_channels() {
+        let track = |end: f64, to: Vec3| {
             let times: Arc<[f64]> = vec![0.0, end].into();
-            let track = Track::new(times, vec![Vec3::ZERO, Vec3::X], Interpolation::Linear).unwrap();
-            Clip::new(index, None, vec![BoneTracks { translation: Some(track), ..BoneTracks::new(0) }], vec![])
+            Track::new(times, vec![Vec3::ZERO, to], Interpolation::Linear).unwrap()
+        };
+        let moving = |index: usize, bones: usize, end: f64| {
+            let tracks =
+                (0..bones).map(|b| BoneTracks { translation: Some(track(end, Vec3::X)), ..BoneTracks::new(b) });
+            Clip::new(index, None, tracks.collect(), vec![])
         };
         let empty = |index: usize| Clip::new(index, Some("Take 001".into()), vec![], vec![]);
         let rig = |clips: Vec<Clip>| Rig { clips, ..Rig::default() };
         assert_eq!(rig(vec![]).opening_clip(), None);
-        assert_eq!(rig(vec![moving(0, 1.0), moving(1, 5.0)]).opening_clip(), Some(0), "the first, where it moves");
-        assert_eq!(rig(vec![empty(0), moving(1, 1.0), moving(2, 19.8), moving(3, 19.8)]).opening_clip(), Some(2));
+        assert_eq!(rig(vec![moving(0, 1, 1.0), moving(1, 1, 5.0)]).opening_clip(), Some(0), "as many: the first");
+        assert_eq!(rig(vec![moving(0, 1, 1.0), moving(1, 3, 0.5)]).opening_clip(), Some(1), "the most channels");
+        assert_eq!(rig(vec![empty(0), moving(1, 1, 1.0)]).opening_clip(), Some(1), "an empty take is passed by");
         assert_eq!(rig(vec![empty(0), empty(1)]).opening_clip(), Some(0), "nothing moves: the first");
     }
 }

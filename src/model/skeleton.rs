@@ -24,6 +24,22 @@ impl Bone {
     pub fn joint(name: impl Into<String>, parent: Option<usize>, rest: Transform) -> Bone {
         Bone { name: name.into(), node: 0, parent, rest, inherit: InheritMode::Full, role: NodeRole::Joint }
     }
+
+    /// The name a reader gives node `node` of a file that names it not: `node7`, an identifier the command line's
+    /// options and `diff`'s pairing can use.
+    pub fn unnamed(node: usize) -> String {
+        format!("node{node}")
+    }
+
+    /// The name for people: a node its file leaves unnamed reads "(node 7)", so that it is not taken for a name the
+    /// file gave.
+    pub fn shown_name(&self) -> std::borrow::Cow<'_, str> {
+        if self.name.is_empty() || self.name == Bone::unnamed(self.node) {
+            format!("(node {})", self.node).into()
+        } else {
+            self.name.as_str().into()
+        }
+    }
 }
 
 /// What a node of the source scene is. Files carry more than the character: DCC exports keep their cameras (3ds Max

@@ -211,5 +211,5 @@ fn matrix(m: &ufbx::Matrix) -> glam::DMat4 {
 /// A node's name for people: its name, or `node<id>` when it has none.
 fn node_name(node: &ufbx::Node) -> String {
     let name: &str = &node.element.name;
-    if name.is_empty() { format!("node{}", node.element.typed_id) } else { name.to_owned() }
+    if name.is_empty() { crate::model::Bone::unnamed(node.element.typed_id as usize) } else { name.to_owned() }
 }

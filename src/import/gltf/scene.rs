@@ -40,7 +40,7 @@ pub(super) fn read(root: &Root, notes: &mut Vec<String>) -> Result<SceneBones> {
             role => role,
         };
         bones.push(Bone {
-            name: node.name.clone().unwrap_or_else(|| format!("node{index}")),
+            name: node.name.clone().unwrap_or_else(|| Bone::unnamed(index)),
             node: index,
             parent,
             rest: rest_transform(node, index)?,
