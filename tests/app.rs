@@ -767,7 +767,7 @@ fn bake(source: &std::path::Path, mode: InheritMode, strategy: bonescope::bake::
     let rig = bonescope::import::load(source).unwrap();
     let source = bonescope::eval::Evaluation::new(&rig, None, &vec![mode; rig.skeleton.len()]).unwrap();
     let request = bonescope::bake::Request::every_clip(&source, None, strategy, bonescope::bake::DEFAULT_TOLERANCE);
-    bonescope::bake::save(out, &bonescope::bake::bake(&request).glb).unwrap();
+    bonescope::bake::save(out, &bonescope::bake::bake(&request).bytes).unwrap();
 }
 
 /// Maya's mixed-inheritance file baked as the closest TRS under unscaled-parent, written to `folder`.

@@ -72,7 +72,7 @@ fn bake_all(strategy: Strategy, tolerance: f64) -> Vec<Baked> {
     jobs.into_par_iter()
         .map(|(source, mode)| {
             let baked = bake::bake(&request(source, mode, strategy, tolerance));
-            let rig = import::load_bytes(Path::new("baked.glb"), &baked.glb)
+            let rig = import::load_bytes(Path::new("baked.glb"), &baked.bytes)
                 .unwrap_or_else(|e| panic!("{source} ({}): the bake does not read back: {e}", label(mode)));
             Baked { source, mode, baked, rig }
         })
@@ -193,7 +193,7 @@ fn write_all(bakes: &[Baked], folder: &Path, tag: &str) -> Vec<PathBuf> {
         .map(|b| {
             let name = format!("{}_{}_{tag}.glb", b.source.replace('/', "_"), label(b.mode));
             let path = folder.join(name);
-            bake::save(&path, &b.baked.glb).unwrap();
+            bake::save(&path, &b.baked.bytes).unwrap();
             path
         })
         .collect()
@@ -251,10 +251,10 @@ fn a_mesh_without_faces_is_left_out_with_a_note_and_the_bake_validates() {
         assert!(baked.notes.contains(&note), "{}: {:?}", source.display(), baked.notes);
         let with_faces: Vec<&str> =
             rig.meshes.iter().filter(|m| !m.indices.is_empty()).map(|m| m.name.as_str()).collect();
-        let back = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+        let back = import::load_bytes(Path::new("baked.glb"), &baked.bytes).unwrap();
         assert_eq!(back.meshes.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(), with_faces);
         let path = folder.path().join(format!("{faceless}.glb"));
-        bake::save(&path, &baked.glb).unwrap();
+        bake::save(&path, &baked.bytes).unwrap();
         files.push(path);
     }
     for report in validate(&files) {
@@ -290,7 +290,7 @@ fn baked_skinned_vertices_equal_the_sources_in_export() {
     ] {
         let b = EVERY_SAMPLE.iter().find(|b| b.source == source && b.mode.is_none()).unwrap();
         let baked = folder.path().join(format!("{}.glb", source.replace('/', "_")));
-        bake::save(&baked, &b.baked.glb).unwrap();
+        bake::save(&baked, &b.baked.bytes).unwrap();
         let theirs = exported(&asset(source), time, folder.path());
         let ours = exported(&baked, time, folder.path());
         assert_eq!(ours.len(), theirs.len(), "{source}: vertex count");
@@ -309,7 +309,7 @@ fn the_baked_maya_file_gives_mayas_own_geometry() {
     let b = DEFAULT.iter().find(|b| b.source == maya && b.mode.is_none()).unwrap();
     let folder = tempfile::tempdir().unwrap();
     let baked = folder.path().join("maya.glb");
-    bake::save(&baked, &b.baked.glb).unwrap();
+    bake::save(&baked, &b.baked.bytes).unwrap();
     for frame in 0..8 {
         let reference: Vec<glam::DVec3> =
             obj_positions(&asset(&format!("fbx-ufbx-data/maya_mixed_inherit_mode_{frame}.obj")))
@@ -344,7 +344,7 @@ fn trs_reports_a_bound_of_what_diff_measures_and_never_more_than_the_local_trs()
     for (source, mode) in cases {
         let b = TRS.iter().find(|b| b.source == source && b.mode == mode).unwrap();
         let baked = folder.path().join("trs.glb");
-        bake::save(&baked, &b.baked.glb).unwrap();
+        bake::save(&baked, &b.baked.bytes).unwrap();
         let report = bake::report(&request(source, mode, Strategy::Trs, 0.0), &b.baked, &b.rig);
         let reported = report.worst().max;
         // Every sample is a key at the clip's frames (and its keys); the report checks them, the midpoints between
@@ -381,7 +381,7 @@ fn trs_reports_a_bound_of_what_diff_measures_and_never_more_than_the_local_trs()
 fn baked_as_declared(rig: &Rig) -> (Request<'_>, bake::Baked, Rig) {
     let request = Request::every_clip(&Evaluation::declared(rig, None), None, Strategy::Exact, bake::DEFAULT_TOLERANCE);
     let baked = bake::bake(&request);
-    let back = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+    let back = import::load_bytes(Path::new("baked.glb"), &baked.bytes).unwrap();
     (request, baked, back)
 }
 
@@ -580,7 +580,7 @@ fn brainstem_where_its_two_clocks_meet_bakes_within_the_bound_it_states() {
     rig.clips[0] = rig.clips[0].clone().with_span(Span::new(23.0, 24.5));
     let request = Request::of(&Evaluation::declared(&rig, None), None, Strategy::Exact, bake::DEFAULT_TOLERANCE);
     let baked = bake::bake(&request);
-    let back = import::load_bytes(Path::new("b.glb"), &baked.glb).unwrap();
+    let back = import::load_bytes(Path::new("b.glb"), &baked.bytes).unwrap();
     let source = &request.clips()[0].source;
     for rotation in [RotationInterpolation::Slerp, RotationInterpolation::Nlerp] {
         let played = Evaluation::declared(&back, back.clips.first()).played_with(rotation);

@@ -90,7 +90,7 @@ fn played_beyond_tolerance(
     let every = Request::every_clip(source, source.clip, engine.strategy(), bake::DEFAULT_TOLERANCE);
     let baked = bake::bake(&every.for_engine(engine));
     let glb = folder.join("baked.glb");
-    bake::save(&glb, &baked.glb).unwrap();
+    bake::save(&glb, &baked.bytes).unwrap();
     let name = format!("{file} for {}", engine.id());
     let played = played_by_blender(python, &glb, &times, folder);
     let worst = largest_distance(source, &times, &played, &name);

@@ -600,15 +600,13 @@ fn bake_names_the_path_it_cannot_write_with_the_systems_reason() {
 #[test]
 fn bake_refuses_an_output_it_does_not_write_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
-    for name in ["baked.usdc", "baked.gltf", "baked"] {
+    for name in ["baked.fbx", "baked.gltf", "baked"] {
         let out = dir.path().join(name).display().to_string();
         let run = bonescope(&["bake", &stretchy(), "--out", &out]);
         assert_eq!(run.status.code(), Some(2), "{out}");
         let stderr = String::from_utf8_lossy(&run.stderr);
-        assert!(
-            stderr.starts_with(&format!("error: {out}: bake writes a glTF binary, named `.glb` (got `")),
-            "{stderr}"
-        );
+        let expected = format!("error: {out}: bake writes a file named `.glb`, `.usda`, `.usdc` or `.usdz` (got `");
+        assert!(stderr.starts_with(&expected), "{stderr}");
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing written");

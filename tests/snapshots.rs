@@ -290,7 +290,7 @@ fn demo_compared_with_its_trs_bake() {
     let (trs, tolerance) = (bonescope::bake::Strategy::Trs, bonescope::bake::DEFAULT_TOLERANCE);
     let request = bonescope::bake::Request::every_clip(&source, None, trs, tolerance);
     let baked = folder.path().join("demo_trs.glb");
-    bonescope::bake::save(&baked, &bonescope::bake::bake(&request).glb).unwrap();
+    bonescope::bake::save(&baked, &bonescope::bake::bake(&request).bytes).unwrap();
     let mut doc = Document::demo();
     let compensate = bonescope::model::ModeChoice::Mode(InheritMode::SegmentCompensate);
     doc.set_mode(0, bonescope::app::ModeScope::All, compensate);

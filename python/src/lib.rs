@@ -611,8 +611,8 @@ fn parse_choice<T: Choice>(id: &str) -> PyResult<T> {
     })
 }
 
-/// Bakes `path` (any file bonescope reads) into a glTF binary at `out` (`.glb`) that `engine`'s runtime plays as the
-/// source evaluates, in metres, and returns the report `bonescope bake --format json` prints (measured on the file
+/// Bakes `path` (any file bonescope reads) into a file at `out` that `engine`'s runtime plays as the source evaluates
+/// (a glTF binary `.glb`, or a UsdSkel stage `.usda`, `.usdc` or `.usdz` of one clip), in metres, and returns the report `bonescope bake --format json` prints (measured on the file
 /// read back): the same bake as the command line's. `engine`: `generic`, `blender`, `three`, `godot`, `unity` or
 /// `unreal`; `strategy` (`exact` or `trs`) overrides the engine's; `tolerance` is the fraction of the rig's size the
 /// keys may stray; `clip`, `modes` and `layers` as for `Rig.evaluate` (default every clip under the declared modes);

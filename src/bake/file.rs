@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{BakeReport, Engine, Request, Strategy, bake, report, save};
+use super::{BakeReport, Engine, Output, Request, Strategy, bake_to, report, save};
 use crate::eval::Evaluation;
 use crate::import::{self, ImportError};
 use crate::model::{Clip, Rig, Unit};
@@ -21,14 +21,16 @@ pub struct Plan {
 /// Why a bake was not written.
 #[derive(Debug, thiserror::Error)]
 pub enum BakeError {
-    #[error("{}: bake writes a glTF binary, named `.glb` (got `{}`)", .0.display(), extension(.0))]
+    #[error("{}: bake writes a file named {} (got `{}`)", .0.display(), Output::EXTENSIONS, extension(.0))]
     Output(PathBuf),
     #[error("the tolerance must be a finite fraction ≥ 0, got {0}")]
     Tolerance(f64),
     #[error("{0}: no nodes to bake")]
     NoNodes(String),
-    #[error("the baked glTF does not read back (a bug): {0}")]
+    #[error("the baked file does not read back (a bug): {0}")]
     ReadBack(ImportError),
+    #[error("{}: {why} (a bug)", .path.display())]
+    Encode { path: PathBuf, why: String },
     /// The system's reason is said in the line, not chained: every face prints one line.
     #[error("cannot write {}: {why}", .path.display())]
     Write { path: PathBuf, why: std::io::Error },
@@ -62,7 +64,9 @@ pub struct Written {
 }
 
 /// Bakes `source` (every clip of its rig, or `only`), named `name` in errors, as `plan` asks, and writes it whole to
-/// `out` (or nothing): the output and the plan are checked before any work.
+/// `out` (or nothing), a file of the kind its extension names ([`Output::of`]): the output and the plan are checked
+/// before any work. A USD stage has one timeline: it gets `only`, else the clip `source` plays, and the report says
+/// which clips it leaves out.
 pub fn bake_file(
     source: &Evaluation,
     name: &str,
@@ -70,9 +74,7 @@ pub fn bake_file(
     plan: &Plan,
     out: &Path,
 ) -> Result<Written, BakeError> {
-    if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb")) {
-        return Err(BakeError::Output(out.to_owned()));
-    }
+    let output = Output::of(out).ok_or_else(|| BakeError::Output(out.to_owned()))?;
     if !(plan.tolerance.is_finite() && plan.tolerance >= 0.0) {
         return Err(BakeError::Tolerance(plan.tolerance));
     }
@@ -80,12 +82,25 @@ pub fn bake_file(
         return Err(BakeError::NoNodes(name.to_owned()));
     }
     let strategy = plan.strategy.unwrap_or(plan.engine.strategy());
+    let only = if output.one_clip() { only.or(source.clip) } else { only };
     let request = Request::of(source, only, strategy, plan.tolerance).for_engine(plan.engine);
-    let baked = bake(&request);
-    let read_back = import::load_bytes(out, &baked.glb).map_err(BakeError::ReadBack)?;
-    let report = report(&request, &baked, &read_back);
-    save(out, &baked.glb).map_err(|why| BakeError::Write { path: out.to_owned(), why })?;
-    Ok(Written { report, bytes: baked.glb.len() })
+    let baked = bake_to(&request, output).map_err(|why| BakeError::Encode { path: out.to_owned(), why })?;
+    let read_back = import::load_bytes(out, &baked.bytes).map_err(BakeError::ReadBack)?;
+    let mut report = report(&request, &baked, &read_back);
+    report.notes.extend(left_out(source.rig, only, output));
+    save(out, &baked.bytes).map_err(|why| BakeError::Write { path: out.to_owned(), why })?;
+    Ok(Written { report, bytes: baked.bytes.len() })
+}
+
+/// A note of the clips a file of `output`'s kind leaves out of `rig`'s, having baked `baked` alone.
+fn left_out(rig: &Rig, baked: Option<&Clip>, output: Output) -> Option<String> {
+    let baked = baked.filter(|_| output.one_clip() && rig.clips.len() > 1)?;
+    let others: Vec<String> = rig.clips.iter().filter(|c| c.index != baked.index).map(|c| c.label()).collect();
+    Some(format!(
+        "a USD stage plays one animation: baked `{}`, not {} (--anim names another)",
+        baked.label(),
+        others.iter().map(|o| format!("`{o}`")).collect::<Vec<_>>().join(", ")
+    ))
 }
 
 #[cfg(test)]
@@ -99,12 +114,13 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let plan = Plan { engine: Engine::default(), strategy: None, tolerance: 1e-4 };
         let usd = dir.path().join("demo.usdc");
-        let refused = bake_file(&source, "demo", None, &plan, &usd).unwrap_err();
+        let fbx = dir.path().join("demo.fbx");
+        let refused = bake_file(&source, "demo", None, &plan, &fbx).unwrap_err();
         assert_eq!(
             refused.to_string(),
-            format!("{}: bake writes a glTF binary, named `.glb` (got `.usdc`)", usd.display())
+            format!("{}: bake writes a file named `.glb`, `.usda`, `.usdc` or `.usdz` (got `.fbx`)", fbx.display())
         );
-        assert!(!usd.exists(), "nothing written");
+        assert!(!fbx.exists(), "nothing written");
         let bare = dir.path().join("demo");
         assert!(
             bake_file(&source, "demo", None, &plan, &bare).unwrap_err().to_string().ends_with("(got `no extension`)")

@@ -290,7 +290,7 @@ impl Writer {
 
 /// Per vertex: four joint indices (renumbered by `joint_map`) and four weights as glTF wants them (see the module's
 /// documentation).
-fn skin_attributes(mesh: &Mesh, joint_map: &[u16]) -> (Vec<u16>, Vec<f32>) {
+pub(super) fn skin_attributes(mesh: &Mesh, joint_map: &[u16]) -> (Vec<u16>, Vec<f32>) {
     let mut joints = Vec::with_capacity(mesh.joints.len() * 4);
     let mut weights = Vec::with_capacity(mesh.joints.len() * 4);
     for (indices, values) in mesh.joints.iter().zip(&mesh.weights) {

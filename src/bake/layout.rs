@@ -6,7 +6,7 @@ use glam::DQuat;
 
 use super::document::{GltfDocument, MeshGroup, Node};
 use super::nodes::{NodeSample, under_conversion};
-use super::skins::{skins, unique_name};
+use super::skins::{common_root, skins, unique_name};
 use crate::diff::HELPER_SUFFIX;
 use crate::math::decompose;
 use crate::model::{Mesh, Rig};
@@ -77,9 +77,8 @@ impl NodePlan {
         }
     }
 
-    /// The nodes, meshes and skins, with each node's default TRS from the rest pose (`rest`, one per bone); what a
-    /// user should know of them goes to `notes`.
-    pub fn document<'a>(&self, rig: &'a Rig, rest: &[NodeSample], notes: &mut Vec<String>) -> GltfDocument<'a> {
+    /// The nodes, meshes and skins, with each node's default TRS from the rest pose (`rest`, one per bone).
+    pub fn document<'a>(&self, rig: &'a Rig, rest: &[NodeSample]) -> GltfDocument<'a> {
         let mut document =
             GltfDocument { generator: format!("bonescope {}", env!("CARGO_PKG_VERSION")), ..GltfDocument::default() };
         for (bone, b) in rig.skeleton.bones().iter().enumerate() {
@@ -109,9 +108,15 @@ impl NodePlan {
         for node in &mut document.nodes {
             node.skin = node.mesh.and_then(|m| document.meshes[m].primitives[0].skin);
         }
-        conversion(self, rig, &mut document);
-        skins(rig, &self.bone_node, &mut document, notes);
+        document.skins = skins(rig, &self.bone_node);
         document
+    }
+
+    /// What glTF needs of `document` beyond its nodes: the source's unit and axes on a node above the roots, and one
+    /// root above every skin's joints; what a user should know of them goes to `notes`.
+    pub fn for_gltf(&self, rig: &Rig, document: &mut GltfDocument, notes: &mut Vec<String>) {
+        conversion(self, rig, document);
+        common_root(document, notes);
     }
 }
 

@@ -32,11 +32,13 @@ mod refine;
 pub mod report;
 mod skins;
 mod times;
+mod usd;
 
 pub use engine::Engine;
 pub use file::{BakeError, Plan, Written, bake_file, in_metres};
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
+pub use usd::{CUSTOM_DATA, Encoding, identifier};
 
 use keys::Metrics;
 use layout::NodePlan;
@@ -76,6 +78,36 @@ impl Choice for Strategy {
                 "one TRS node per bone, re-solved against its baked parent: for runtimes that cannot shear"
             }
         }
+    }
+}
+
+/// The file a bake writes: a glTF binary, or a UsdSkel scene in one of USD's encodings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Output {
+    #[default]
+    Glb,
+    Usd(Encoding),
+}
+
+impl Output {
+    /// The extensions a bake writes, for messages.
+    pub const EXTENSIONS: &'static str = "`.glb`, `.usda`, `.usdc` or `.usdz`";
+
+    /// The output a file named `path` asks for by its extension (in any case); `None` for any other.
+    pub fn of(path: &std::path::Path) -> Option<Output> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match extension.as_str() {
+            "glb" => Output::Glb,
+            "usda" => Output::Usd(Encoding::Text),
+            "usdc" | "usd" => Output::Usd(Encoding::Crate),
+            "usdz" => Output::Usd(Encoding::Package),
+            _ => return None,
+        })
+    }
+
+    /// Whether a file of this kind plays one clip (a USD stage has one timeline).
+    pub fn one_clip(self) -> bool {
+        matches!(self, Output::Usd(_))
     }
 }
 
@@ -217,8 +249,9 @@ pub struct BakedAnimation {
 /// The result of a bake.
 #[derive(Clone, Debug)]
 pub struct Baked {
-    /// The glTF binary.
-    pub glb: Vec<u8>,
+    pub output: Output,
+    /// The file's bytes: a glTF binary, or the USD layer or package asked for ([`bake_to`]).
+    pub bytes: Vec<u8>,
     /// Per source bone: whether it got a helper node.
     pub helpers: Vec<bool>,
     pub animations: Vec<BakedAnimation>,
@@ -231,11 +264,17 @@ pub struct Baked {
 
 /// Bakes `request` into a glTF binary.
 pub fn bake(request: &Request) -> Baked {
-    bake_keeping(request, HELD)
+    bake_keeping(request, Output::Glb, HELD).expect("a glTF binary is always encoded")
 }
 
-/// [`bake`], keeping up to `held` bytes of samples between passes ([`HELD`]).
-fn bake_keeping(request: &Request, held: usize) -> Baked {
+/// Bakes `request` into a file of `output`'s kind (of a USD stage, the first clip alone: its one timeline); `Err`
+/// where USD's writer fails.
+pub fn bake_to(request: &Request, output: Output) -> Result<Baked, String> {
+    bake_keeping(request, output, HELD)
+}
+
+/// [`bake_to`], keeping up to `held` bytes of samples between passes ([`HELD`]).
+fn bake_keeping(request: &Request, output: Output, held: usize) -> Result<Baked, String> {
     let (rig, strategy) = (request.rig(), request.strategy);
     let sources: Vec<&Evaluation> = request.clips().iter().map(|c| &c.source).collect();
     let base: Vec<BakeTimes> = sources.iter().map(|source| bake_times(source)).collect();
@@ -254,7 +293,7 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
         .collect();
     let layout = NodePlan::new(rig, &helpers);
     let mut notes = layout.notes.clone();
-    let mut document = layout.document(rig, &rest, &mut notes);
+    let mut document = layout.document(rig, &rest);
     let mut animations = Vec::new();
     for (clip, dense) in request.clips().iter().zip(&dense) {
         let times = &dense.refined.times;
@@ -268,7 +307,7 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
         animations.push(BakedAnimation { name: clip.name.clone(), times: times.clone(), keys });
         document.animations.push(animation);
     }
-    for clip in request.clips().iter().filter(|c| c.source.delay() != 0.0) {
+    for clip in request.clips().iter().filter(|c| c.source.delay() != 0.0 && output == Output::Glb) {
         let delay = clip.source.delay();
         notes.push(format!(
             "`{}` starts at {} s on its file's clock: written from 0 (glTF's clock starts there), {delay} s later",
@@ -277,8 +316,42 @@ fn bake_keeping(request: &Request, held: usize) -> Baked {
     }
     notes.extend(request.clips().iter().filter_map(coarse_times));
     notes.extend(source_notes(rig, dense.iter().map(|d| d.refined.stats.singular).sum()));
-    Baked { glb: glb::encode(&document), helpers, animations, rig_size: size, tolerance, notes }
+    let bytes = match output {
+        Output::Glb => {
+            layout.for_gltf(rig, &mut document, &mut notes);
+            glb::encode(&document)
+        }
+        Output::Usd(encoding) => usd::encode(&document, &placing(request), encoding, &mut notes)?,
+    };
+    Ok(Baked { output, bytes, helpers, animations, rig_size: size, tolerance, notes })
 }
+
+/// Where a USD bake's stage puts the scene: the rig's unit and up axis (a turn between other axes on the
+/// skeleton), and its first clip's rate and span on the clip's own clock.
+fn placing(request: &Request) -> usd::Placing {
+    let conversion = request.rig().skeleton.placement().conversion;
+    let scale = conversion.determinant().abs().cbrt();
+    let axes = conversion * glam::DMat4::from_scale(glam::DVec3::splat(1.0 / scale));
+    let alike = |turn: glam::DMat4| axes.abs_diff_eq(turn, 1e-9);
+    let (up, turn) = match [crate::model::UpAxis::Y, crate::model::UpAxis::Z].into_iter().find(|u| alike(u.to_y_up())) {
+        Some(up) => (up, glam::DMat4::IDENTITY),
+        None => (crate::model::UpAxis::Y, axes),
+    };
+    let source = &request.clips()[0].source;
+    let span = source.span();
+    let delay = source.delay();
+    usd::Placing {
+        meters_per_unit: if scale.is_finite() && scale > 0.0 { scale } else { 1.0 },
+        up,
+        turn,
+        codes_per_second: source.clip.map_or(DEFAULT_CODES_PER_SECOND, Clip::frame_rate),
+        delay,
+        span: (span.start - delay, span.end - delay),
+    }
+}
+
+/// A USD bake's time codes per second where there is no clip to take them from: USD's own default.
+const DEFAULT_CODES_PER_SECOND: f64 = 24.0;
 
 /// Key times further apart than this, in seconds, where single precision holds them, are worth a note: a tenth of
 /// a millisecond, a 300th of a frame at 30 fps.
@@ -438,9 +511,10 @@ mod tests {
         let source = Evaluation::new(&rig, rig.clips.first(), &modes).unwrap();
         for strategy in [Strategy::Exact, Strategy::Trs] {
             let request = Request::every_clip(&source, None, strategy, DEFAULT_TOLERANCE);
-            let kept = bake_keeping(&request, usize::MAX);
-            assert_eq!(bake_keeping(&request, 0).glb, kept.glb, "{strategy:?}");
-            assert_eq!(bake_keeping(&request, 1 << 20).glb, kept.glb, "{strategy:?}");
+            let bake = |held: usize| bake_keeping(&request, Output::Glb, held).unwrap().bytes;
+            let kept = bake(usize::MAX);
+            assert_eq!(bake(0), kept, "{strategy:?}");
+            assert_eq!(bake(1 << 20), kept, "{strategy:?}");
         }
     }
 

@@ -3,7 +3,7 @@
 //! sampled time ([`crate::diff::compare`]; the worse of the interpolations per bone), so the report measures the
 //! file that was written, as that runtime plays it, not the intentions behind it.
 
-use super::{Baked, BakedAnimation, Engine, Request, Strategy};
+use super::{Baked, BakedAnimation, Engine, Output, Request, Strategy};
 use crate::diff::{Comparison, DEFAULT_RATE, Extreme, Measure, MeshDifference, Pairs, compare_each, comparison_times};
 use crate::eval::Evaluation;
 use crate::eval::layers::RotationInterpolation;
@@ -113,6 +113,8 @@ pub fn report(request: &Request, baked: &Baked, baked_rig: &Rig) -> BakeReport {
         .map(|(k, animation)| {
             let source = &request.clips()[k].source;
             let result = Evaluation::declared(baked_rig, baked_rig.clips.get(k));
+            // A USD stage keeps the clip's own clock, where glTF's starts at 0 (a clip before it is delayed).
+            let result = if baked.output == Output::Glb { result } else { result.delayed(source.delay()) };
             // The report prints distances alone: the polar parts are not decomposed.
             let pairs = Pairs { measure: Measure::Distances, ..Pairs::by_name(source, &result) };
             let comparison =

@@ -1,13 +1,12 @@
-//! Skins as glTF requires them: only the joints the meshes use (FBX skins also list the mesh's own node, for
-//! vertices no cluster weights), and every skin's joints under one root node (the validator's `SKIN_NO_COMMON_ROOT`);
-//! where the joints lie under several roots, one new root node takes them all in.
+//! Skins as the baked files want them: only the joints the meshes use (FBX skins also list the mesh's own node, for
+//! vertices no cluster weights), and for glTF every skin's joints under one root node (the validator's
+//! `SKIN_NO_COMMON_ROOT`): where the joints lie under several roots, one new root node takes them all in.
 
 use super::document::{GltfDocument, Node, SkinOut};
 use crate::model::Rig;
 
-/// The skins of `rig` over the nodes `bone_node` gives each bone; adds a common root node to `document` where a skin
-/// needs one, saying so in `notes`.
-pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut GltfDocument, notes: &mut Vec<String>) {
+/// The skins of `rig` over the nodes `bone_node` gives each bone, each with only the joints its meshes use.
+pub fn skins(rig: &Rig, bone_node: &[usize]) -> Vec<SkinOut> {
     let mut skins = Vec::with_capacity(rig.skins.len());
     for (s, skin) in rig.skins.iter().enumerate() {
         let used = used_joints(rig, s, skin.joints.len());
@@ -22,8 +21,14 @@ pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut GltfDocument, notes:
         }
         skins.push(SkinOut { name: skin.name.clone(), joints, inverse_bind, joint_map });
     }
+    skins
+}
+
+/// Where some skin's joints lie under several root nodes (glTF wants one), a new root node above every root,
+/// said in `notes`.
+pub fn common_root(document: &mut GltfDocument, notes: &mut Vec<String>) {
     let roots = |joints: &[usize]| joints.iter().map(|&n| root_of(&document.nodes, n)).collect::<Vec<_>>();
-    let apart = skins.iter().any(|skin| roots(&skin.joints).windows(2).any(|w| w[0] != w[1]));
+    let apart = document.skins.iter().any(|skin| roots(&skin.joints).windows(2).any(|w| w[0] != w[1]));
     if apart {
         let name = unique_name(&document.nodes, "root");
         let wrapper = document.nodes.len();
@@ -33,7 +38,6 @@ pub fn skins(rig: &Rig, bone_node: &[usize], document: &mut GltfDocument, notes:
         document.nodes.push(Node { name: name.clone(), ..Node::identity(None) });
         notes.push(format!("a skin's joints lie under several root nodes; a new root `{name}` holds them all"));
     }
-    document.skins = skins;
 }
 
 /// Which joints of skin `s` some vertex of a mesh weights (a vertex with no positive weight falls back on joint 0).
@@ -109,7 +113,8 @@ mod tests {
         // Joints: root, arm, and the mesh's own node (a second root) that no vertex weights.
         let rig = rig(&[("root", None), ("arm", Some(0)), ("mesh", None)], vec![0, 1, 2], vec![[0.5, 0.5, 0.0, 0.0]]);
         let (mut doc, mut notes) = (document(&rig), Vec::new());
-        skins(&rig, &[0, 1, 2], &mut doc, &mut notes);
+        doc.skins = skins(&rig, &[0, 1, 2]);
+        common_root(&mut doc, &mut notes);
         assert_eq!(doc.skins[0].joints, [0, 1]);
         assert_eq!(doc.skins[0].joint_map, [0, 1, 0]);
         assert!(notes.is_empty() && doc.nodes.len() == 3, "no new root needed");
@@ -119,7 +124,8 @@ mod tests {
     fn joints_under_two_roots_get_a_common_one() {
         let rig = rig(&[("root", None), ("mesh", None)], vec![0, 1], vec![[0.5, 0.5, 0.0, 0.0]]);
         let (mut doc, mut notes) = (document(&rig), Vec::new());
-        skins(&rig, &[0, 1], &mut doc, &mut notes);
+        doc.skins = skins(&rig, &[0, 1]);
+        common_root(&mut doc, &mut notes);
         assert_eq!(doc.nodes.len(), 3);
         assert_eq!((doc.nodes[0].parent, doc.nodes[1].parent, doc.nodes[2].parent), (Some(2), Some(2), None));
         assert_eq!(doc.nodes[2].name, "root.1", "`root` is taken");

@@ -1,4 +1,5 @@
-//! `bonescope bake`: any scale inheritance baked into a plain glTF binary, with a report of how exact it is.
+//! `bonescope bake`: any scale inheritance baked into a plain glTF binary or a UsdSkel stage, with a report of how
+//! exact it is.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -20,7 +21,8 @@ pub struct BakeArgs {
     pub file: Option<PathBuf>,
     #[command(flatten)]
     pub eval: EvalArgs,
-    /// Where to write the glTF binary, `.glb` (written whole or not at all).
+    /// Where to write, by its extension: a glTF binary `.glb`, or a UsdSkel stage `.usda` (text), `.usdc` (binary) or
+    /// `.usdz` (package) of one clip (written whole or not at all).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
     /// The runtime the file is for: its strategy (trs for Unreal, exact elsewhere) and the rotation interpolation

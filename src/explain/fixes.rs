@@ -85,7 +85,7 @@ impl Change {
             Err(error) => return Some(Err(error.to_string())),
         };
         Some(
-            import::load_bytes(Path::new("baked.glb"), &baked.glb)
+            import::load_bytes(Path::new("baked.glb"), &baked.bytes)
                 .map_err(|e| format!("the bake does not read back: {e}")),
         )
     }

@@ -53,7 +53,10 @@ pub fn read(
     }
     let counts = int_array(at_start(mesh.face_vertex_counts_attr())?);
     let indices = int_array(at_start(mesh.face_vertex_indices_attr())?);
-    let name = path.name().unwrap_or("Mesh").to_owned();
+    let name = match super::skeleton::written_names(openusd::usd::SchemaBase::prim(&mesh), "name") {
+        Some(openusd::sdf::Value::String(name)) => name,
+        _ => path.name().unwrap_or("Mesh").to_owned(),
+    };
     let triangles = fans(&counts, &indices, positions.len());
     let mut read = Mesh { name: name.clone(), positions, indices: triangles, ..Mesh::default() };
     let api = SkelBindingAPI::get(stage, path.clone()).map_err(said)?;

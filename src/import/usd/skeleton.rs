@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::{DMat4, DQuat, Quat, Vec3};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::schemas::skel::{SkelAnimation, SkelBindingAPI, Skeleton};
-use openusd::sdf;
+use openusd::sdf::{self, Value};
 use openusd::usd::{Attribute, Prim, SchemaBase, SchemaKind, Stage, TimeCode};
 
 use super::samples::{Channel, Keys};
@@ -60,7 +60,12 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
     let skeleton = Skeleton::get(stage, path.clone()).map_err(said)?.ok_or("not a Skeleton")?;
     let joints = skeleton.joints().map_err(said)?;
     let parents = skeleton.joint_parent_indices().map_err(said)?;
-    let names = skeleton.joint_short_names().map_err(said)?;
+    let written = written_names(skeleton.prim(), "names");
+    let ours = matches!(&written, Some(Value::StringVec(names)) if names.len() == joints.len());
+    let names = match written {
+        Some(Value::StringVec(names)) if ours => names,
+        _ => skeleton.joint_short_names().map_err(said)?,
+    };
     let rest = rest_transforms(&skeleton, &joints, &parents)?;
     if let Some(j) = rest.iter().position(|m| !m.is_finite()) {
         return Err(format!("the rest transform of joint `{}` is not finite", joints[j]));
@@ -70,7 +75,9 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         return Err("its transform in the world is not finite".to_owned());
     }
     let name = path.name().unwrap_or("Skeleton").to_owned();
-    let mut bones = vec![Bone { node: first, ..Bone::joint(name, None, transform(&world)) }];
+    // A skeleton bonescope baked stands for no node of its source: its prim only holds the joints.
+    let role = if ours { NodeRole::Helper } else { NodeRole::Joint };
+    let mut bones = vec![Bone { node: first, role, ..Bone::joint(name, None, transform(&world)) }];
     for (j, joint) in joints.iter().enumerate() {
         let parent = match parents[j] {
             Some(p) if p < j => first + 1 + p,
@@ -118,6 +125,18 @@ fn not_affine_note(skeleton: &sdf::Path, attribute: &str, matrices: &[DMat4], jo
         joints.len(),
         names.join(", ")
     ))
+}
+
+/// What a bake of bonescope's wrote in `prim`'s `customData` under `key` (the name of a joint or mesh as baked,
+/// where USD's spelling of names lost it).
+pub fn written_names(prim: &Prim, key: &str) -> Option<Value> {
+    match prim.custom_data().ok()?? {
+        Value::Dictionary(mut custom) => match custom.remove(crate::bake::CUSTOM_DATA)? {
+            Value::Dictionary(mut ours) => ours.remove(key),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// A row-vector USD matrix as bonescope's column-vector one: the same sixteen numbers read by columns.
