@@ -5,7 +5,7 @@
 //! compensation).
 //!
 //! `cargo bench --locked --bench bake`; figures in BENCHMARKS.md (§8). `load` is `import::load` of the file; `bake`
-//! the whole bake (sampling, keys, the GLB bytes), `report` the bake read back and compared at every sampled time
+//! the whole bake (sampling, keys, the GLB bytes), `bake_usdc` the same written as a UsdSkel crate file, `report` the bake read back and compared at every sampled time
 //! (what `bonescope bake` prints), `diff` the source against the bake at its key times and 60 Hz (what `bonescope
 //! diff` does).
 
@@ -47,11 +47,14 @@ fn benches(c: &mut Criterion, name: &str, rig: &Rig, file: &Path, mode: Option<I
     group.bench_function("load", |b| b.iter(|| import::load(file).unwrap()));
     let request = request(rig, mode);
     let baked = bake::bake(&request);
-    let baked_rig = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+    let baked_rig = import::load_bytes(Path::new("baked.glb"), &baked.bytes).unwrap();
     group.bench_function("bake", |b| b.iter(|| bake::bake(&request)));
+    // The same bake written as a UsdSkel crate file: within 1.5× the glTF's time.
+    let usdc = bake::Output::Usd(bake::Encoding::Crate);
+    group.bench_function("bake_usdc", |b| b.iter(|| bake::bake_to(&request, usdc).unwrap()));
     group.bench_function("report", |b| {
         b.iter(|| {
-            let read = import::load_bytes(Path::new("baked.glb"), &baked.glb).unwrap();
+            let read = import::load_bytes(Path::new("baked.glb"), &baked.bytes).unwrap();
             bake::report(&request, &baked, &read)
         })
     });

@@ -501,11 +501,11 @@ fn a_bake_reports_a_bound_of_what_diff_finds_and_a_bake_of_a_bake_changes_nothin
         .flat_map(|&source| {
             let rig = &RIGS[source];
             let once = bake::bake(&request(source, None, Strategy::Exact, bake::DEFAULT_TOLERANCE));
-            let a = import::load_bytes(Path::new("a.glb"), &once.glb).unwrap();
+            let a = import::load_bytes(Path::new("a.glb"), &once.bytes).unwrap();
             let request_twice =
                 Request::every_clip(&Evaluation::declared(&a, None), None, Strategy::Exact, bake::DEFAULT_TOLERANCE);
             let twice = bake::bake(&request_twice);
-            let b = import::load_bytes(Path::new("b.glb"), &twice.glb).unwrap();
+            let b = import::load_bytes(Path::new("b.glb"), &twice.bytes).unwrap();
             let mut failures = Vec::new();
             let reported =
                 |request: &Request, baked: &bake::Baked, back: &Rig| bake::report(request, baked, back).worst().max;

@@ -113,7 +113,6 @@ mod tests {
         let source = Evaluation::declared(&rig, rig.clips.first());
         let dir = tempfile::tempdir().unwrap();
         let plan = Plan { engine: Engine::default(), strategy: None, tolerance: 1e-4 };
-        let usd = dir.path().join("demo.usdc");
         let fbx = dir.path().join("demo.fbx");
         let refused = bake_file(&source, "demo", None, &plan, &fbx).unwrap_err();
         assert_eq!(

@@ -115,31 +115,32 @@ impl NodePlan {
     /// What glTF needs of `document` beyond its nodes: the source's unit and axes on a node above the roots, and one
     /// root above every skin's joints; what a user should know of them goes to `notes`.
     pub fn for_gltf(&self, rig: &Rig, document: &mut GltfDocument, notes: &mut Vec<String>) {
-        conversion(self, rig, document);
+        self.converted(rig, document);
         common_root(document, notes);
     }
-}
 
-/// Where the source's space is converted (an FBX file in centimetres, or Z-up), a top node `conversion` carrying it
-/// above the roots [`under_conversion`] names: the baked bones keep the file's own numbers, and a reader that places
-/// conversion nodes outside the rig, as bonescope does, reads the scale factors the file's author set.
-fn conversion(layout: &NodePlan, rig: &Rig, document: &mut GltfDocument) {
-    // A bone's topmost node: its helper where it has one.
-    let top_node = |bone: usize| layout.helper_node[bone].unwrap_or(layout.bone_node[bone]);
-    let under: Vec<usize> = (under_conversion(&rig.skeleton).iter().enumerate())
-        .filter(|(_, under)| **under)
-        .map(|(bone, _)| top_node(bone))
-        .collect();
-    if under.is_empty() {
-        return;
+    /// The source's unit and axes on a node `conversion` above the roots that need it ([`under_conversion`]): the
+    /// baked bones keep the file's own numbers, and a reader that places conversion nodes outside the rig, as
+    /// bonescope does, reads the scale factors the file's author set. The node, where one was needed.
+    pub fn converted(&self, rig: &Rig, document: &mut GltfDocument) -> Option<usize> {
+        // A bone's topmost node: its helper where it has one.
+        let top_node = |bone: usize| self.helper_node[bone].unwrap_or(self.bone_node[bone]);
+        let under: Vec<usize> = (under_conversion(&rig.skeleton).iter().enumerate())
+            .filter(|(_, under)| **under)
+            .map(|(bone, _)| top_node(bone))
+            .collect();
+        if under.is_empty() {
+            return None;
+        }
+        let node = document.nodes.len();
+        for &root in &under {
+            document.nodes[root].parent = Some(node);
+        }
+        let parts = decompose(&rig.skeleton.placement().conversion);
+        let sample = NodeSample { rotation: parts.rotation, scale: parts.scale * parts.sign, ..NodeSample::IDENTITY };
+        document.nodes.push(node_with(&unique_name(&document.nodes, "conversion"), None, &sample));
+        Some(node)
     }
-    let node = document.nodes.len();
-    for &root in &under {
-        document.nodes[root].parent = Some(node);
-    }
-    let parts = decompose(&rig.skeleton.placement().conversion);
-    let sample = NodeSample { rotation: parts.rotation, scale: parts.scale * parts.sign, ..NodeSample::IDENTITY };
-    document.nodes.push(node_with(&unique_name(&document.nodes, "conversion"), None, &sample));
 }
 
 /// A node named `name` with the TRS of `sample` (its stretch is carried by the bone's own node, not here).

@@ -321,32 +321,22 @@ fn bake_keeping(request: &Request, output: Output, held: usize) -> Result<Baked,
             layout.for_gltf(rig, &mut document, &mut notes);
             glb::encode(&document)
         }
-        Output::Usd(encoding) => usd::encode(&document, &placing(request), encoding, &mut notes)?,
+        Output::Usd(encoding) => {
+            let conversion = layout.converted(rig, &mut document);
+            usd::encode(&document, &clock(request), conversion, encoding, &mut notes)?
+        }
     };
     Ok(Baked { output, bytes, helpers, animations, rig_size: size, tolerance, notes })
 }
 
-/// Where a USD bake's stage puts the scene: the rig's unit and up axis (a turn between other axes on the
-/// skeleton), and its first clip's rate and span on the clip's own clock.
-fn placing(request: &Request) -> usd::Placing {
-    let conversion = request.rig().skeleton.placement().conversion;
-    let scale = conversion.determinant().abs().cbrt();
-    let axes = conversion * glam::DMat4::from_scale(glam::DVec3::splat(1.0 / scale));
-    let alike = |turn: glam::DMat4| axes.abs_diff_eq(turn, 1e-9);
-    let (up, turn) = match [crate::model::UpAxis::Y, crate::model::UpAxis::Z].into_iter().find(|u| alike(u.to_y_up())) {
-        Some(up) => (up, glam::DMat4::IDENTITY),
-        None => (crate::model::UpAxis::Y, axes),
-    };
+/// A USD bake's clock: its first clip's rate and span, and how much later than its own clock it was baked.
+fn clock(request: &Request) -> usd::Clock {
     let source = &request.clips()[0].source;
     let span = source.span();
-    let delay = source.delay();
-    usd::Placing {
-        meters_per_unit: if scale.is_finite() && scale > 0.0 { scale } else { 1.0 },
-        up,
-        turn,
+    usd::Clock {
         codes_per_second: source.clip.map_or(DEFAULT_CODES_PER_SECOND, Clip::frame_rate),
-        delay,
-        span: (span.start - delay, span.end - delay),
+        delay: source.delay(),
+        span: (span.start, span.end),
     }
 }
 

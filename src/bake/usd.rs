@@ -15,8 +15,11 @@
 //! - names are identifiers (`[A-Za-z_][A-Za-z0-9_]*`), unique among siblings; each joint's and mesh's name as
 //!   baked is kept in `customData` (`bonescope = { names }` on the skeleton, `bonescope = { name }` on a mesh) for
 //!   bonescope's reader, so `diff` pairs the bones of the source and the bake by their own names;
-//! - the file's unit and up axis are stated (`metersPerUnit`, `upAxis`), the joints keeping the file's own numbers;
-//!   a turn between axes that is neither Y nor Z up stands on the skeleton prim's own transform.
+//! - the stage is stated in Y-up metres (`metersPerUnit`, `upAxis`): the source's own unit and axes stand on a joint
+//!   `conversion` above its roots where they differ, as in the glTF bake (whose nodes keep the file's numbers), and
+//!   the skeleton's `customData` names it (`bonescope = { placing }`) for bonescope's reader to place it outside the
+//!   rig. (Stated in the stage's metadata instead, they would also apply to roots that carry them themselves, as an
+//!   exporter's armature scaled 100 under a centimetre file does.)
 
 use std::collections::{HashMap, HashSet};
 use std::io::Cursor;
@@ -27,7 +30,7 @@ use openusd::sdf::{self, AbstractData, Path, Specifier, Value, Variability};
 
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property, SkinOut};
 use super::glb::skin_attributes;
-use crate::model::{Mesh, UpAxis};
+use crate::model::Mesh;
 
 /// Which of USD's three encodings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,19 +43,14 @@ pub enum Encoding {
     Package,
 }
 
-/// Where the scene lies on the stage's clock and in the world: the file's unit and axes (a turn that is neither
-/// axis left on the skeleton), and the clip's span and frame rate. A baked time `t` is at time code
+/// Where the scene lies on the stage's clock: the clip's span and frame rate. A baked time `t` is at time code
 /// `(t − delay) · codes_per_second`: the clip's own clock.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Placing {
-    pub meters_per_unit: f64,
-    pub up: UpAxis,
-    /// A rotation between axes beyond `up`'s (identity for Y- or Z-up files).
-    pub turn: DMat4,
+pub struct Clock {
     pub codes_per_second: f64,
     /// Seconds the baked clock runs behind the clip's own (a clip starting before 0 baked from 0).
     pub delay: f64,
-    /// The clip's start and end in seconds on its own clock.
+    /// The clip's start and end in seconds on the baked clock.
     pub span: (f64, f64),
 }
 
@@ -68,22 +66,25 @@ const ANIMATION: &str = "/Root/Skeleton/Animation";
 /// rounding of a time in double precision.
 const STEP_LEAD: f64 = 1e-6;
 
-/// `document` (its first animation) written as a UsdSkel layer in `encoding`; what a user should know of how goes
-/// to `notes`.
+/// `document` (its first animation) written as a UsdSkel layer in `encoding`, its node `conversion` (where it has
+/// one) carrying the source's unit and axes; what a user should know of how goes to `notes`.
 pub fn encode(
     document: &GltfDocument,
-    placing: &Placing,
+    clock: &Clock,
+    conversion: Option<usize>,
     encoding: Encoding,
     notes: &mut Vec<String>,
 ) -> Result<Vec<u8>, String> {
+    let (document, conversion) = &parents_first(document, conversion);
+    let conversion = *conversion;
     let mut layer = Layer::new();
-    layer.stage_metadata(placing);
+    layer.stage_metadata(clock);
     let joints = Joints::of(&document.nodes, notes);
     let binds = binds(document, notes);
-    layer.skeleton(document, &joints, &binds, placing);
+    layer.skeleton(document, &joints, &binds, conversion);
     let shapes = layer.meshes(document, &binds, notes);
     if let Some(animation) = document.animations.first() {
-        let rounding = layer.animation(document, animation, &joints, &shapes, placing);
+        let rounding = layer.animation(document, animation, &joints, &shapes, clock);
         if rounding > 0.0 {
             notes.push(format!(
                 "UsdSkel keeps animated scales in half precision: the scales written round by up to {rounding:.1e} \
@@ -93,6 +94,40 @@ pub fn encode(
         }
     }
     layer.write(encoding)
+}
+
+/// `document` with its nodes reordered so that each comes after its parent, as UsdSkel's joints must (a node put
+/// above the roots comes after them), every index into them renumbered, `conversion` too.
+fn parents_first<'a>(document: &GltfDocument<'a>, conversion: Option<usize>) -> (GltfDocument<'a>, Option<usize>) {
+    let nodes = &document.nodes;
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
+    for (n, node) in nodes.iter().enumerate() {
+        if let Some(p) = node.parent {
+            children[p].push(n);
+        }
+    }
+    // Depth first from the roots in their order, children in theirs: the order of the nodes wherever it already
+    // puts parents first.
+    let mut order = Vec::with_capacity(nodes.len());
+    let mut stack: Vec<usize> = (0..nodes.len()).rev().filter(|&n| nodes[n].parent.is_none()).collect();
+    while let Some(n) = stack.pop() {
+        order.push(n);
+        stack.extend(children[n].iter().rev());
+    }
+    let mut new_index = vec![0; nodes.len()];
+    for (i, &n) in order.iter().enumerate() {
+        new_index[n] = i;
+    }
+    let mut reordered = document.clone();
+    reordered.nodes =
+        order.iter().map(|&n| Node { parent: nodes[n].parent.map(|p| new_index[p]), ..nodes[n].clone() }).collect();
+    for skin in &mut reordered.skins {
+        skin.joints.iter_mut().for_each(|joint| *joint = new_index[*joint]);
+    }
+    for channel in reordered.animations.iter_mut().flat_map(|a| &mut a.channels) {
+        channel.node = new_index[channel.node];
+    }
+    (reordered, conversion.map(|n| new_index[n]))
 }
 
 /// The joints: each node's path (`A/B` is `B` under `A`), its name an identifier unique among its siblings.
@@ -208,18 +243,17 @@ impl Layer {
     }
 
     /// The stage's metadata: its default prim, unit, up axis and clock.
-    fn stage_metadata(&mut self, placing: &Placing) {
+    fn stage_metadata(&mut self, clock: &Clock) {
         let root = Path::abs_root();
-        let up = if placing.up == UpAxis::Z { "Z" } else { "Y" };
-        let (start, end) = placing.span;
+        let (start, end) = clock.span;
         let fields = [
             ("defaultPrim", Value::token("Root")),
-            ("metersPerUnit", Value::Double(placing.meters_per_unit)),
-            ("upAxis", Value::token(up)),
-            ("timeCodesPerSecond", Value::Double(placing.codes_per_second)),
-            ("framesPerSecond", Value::Double(placing.codes_per_second)),
-            ("startTimeCode", Value::Double(start * placing.codes_per_second)),
-            ("endTimeCode", Value::Double(end * placing.codes_per_second)),
+            ("metersPerUnit", Value::Double(1.0)),
+            ("upAxis", Value::token("Y")),
+            ("timeCodesPerSecond", Value::Double(clock.codes_per_second)),
+            ("framesPerSecond", Value::Double(clock.codes_per_second)),
+            ("startTimeCode", Value::Double(time_code(start, clock))),
+            ("endTimeCode", Value::Double(time_code(end, clock))),
             ("documentation", Value::String(format!("baked by bonescope {}", env!("CARGO_PKG_VERSION")))),
         ];
         for (field, value) in fields {
@@ -257,9 +291,9 @@ impl Layer {
         self.data.set_field(&Path::from(path), "apiSchemas", Value::TokenListOp(ops));
     }
 
-    /// The `SkelRoot` and its `Skeleton`: joints, rest and bind transforms, the nodes' own names, and the
-    /// animation bound to it.
-    fn skeleton(&mut self, document: &GltfDocument, joints: &Joints, binds: &[DMat4], placing: &Placing) {
+    /// The `SkelRoot` and its `Skeleton`: joints, rest and bind transforms, the nodes' own names (and which one is
+    /// the `conversion` of the source's unit and axes), and the animation bound to it.
+    fn skeleton(&mut self, document: &GltfDocument, joints: &Joints, binds: &[DMat4], conversion: Option<usize>) {
         self.prim(ROOT, "SkelRoot");
         self.prim(SKELETON, "Skeleton");
         let tokens = |paths: &[String]| Value::TokenVec(paths.iter().map(|p| p.as_str().into()).collect());
@@ -269,12 +303,9 @@ impl Layer {
         let bind: Vec<gf::Matrix4d> = binds.iter().map(usd_matrix).collect();
         self.attribute(SKELETON, "bindTransforms", "matrix4d[]", true, Value::Matrix4dVec(bind));
         let names: Vec<String> = document.nodes.iter().map(|n| n.name.clone()).collect();
-        self.custom_data(SKELETON, "names", Value::StringVec(names));
-        if placing.turn != DMat4::IDENTITY {
-            self.attribute(SKELETON, "xformOp:transform", "matrix4d", false, Value::Matrix4d(usd_matrix(&placing.turn)));
-            let order = Value::TokenVec(vec!["xformOp:transform".into()]);
-            self.attribute(SKELETON, "xformOpOrder", "token[]", true, order);
-        }
+        let mut ours = vec![("names", Value::StringVec(names))];
+        ours.extend(conversion.map(|node| ("placing", Value::IntVec(vec![node as i32]))));
+        self.custom_data(SKELETON, ours);
         if !document.animations.is_empty() {
             self.apply(SKELETON, "SkelBindingAPI");
             self.relationship(SKELETON, "skel:animationSource", &[ANIMATION]);
@@ -315,12 +346,12 @@ impl Layer {
             self.data.set_field(&at, "interpolation", Value::token("vertex"));
         }
         self.attribute(path, "subdivisionScheme", "token", true, Value::token("none"));
-        self.custom_data(path, "name", Value::String(mesh.name.clone()));
+        self.custom_data(path, vec![("name", Value::String(mesh.name.clone()))]);
     }
 
-    /// The prim at `path` given `customData = { bonescope = { key = value } }`.
-    fn custom_data(&mut self, path: &str, key: &str, value: Value) {
-        let ours = HashMap::from([(key.to_owned(), value)]);
+    /// The prim at `path` given `customData = { bonescope = { key = value, … } }`.
+    fn custom_data(&mut self, path: &str, ours: Vec<(&str, Value)>) {
+        let ours = ours.into_iter().map(|(key, value)| (key.to_owned(), value)).collect();
         let custom = HashMap::from([(CUSTOM_DATA.to_owned(), Value::Dictionary(ours))]);
         self.data.set_field(&Path::from(path), "customData", Value::Dictionary(custom));
     }
@@ -405,14 +436,14 @@ impl Layer {
         animation: &Animation,
         joints: &Joints,
         shapes: &Shapes,
-        placing: &Placing,
+        clock: &Clock,
     ) -> f64 {
         self.prim(ANIMATION, "SkelAnimation");
         let tokens = Value::token_vec(joints.paths.iter().map(String::as_str));
         self.attribute(ANIMATION, "joints", "token[]", true, tokens);
         let nodes = &document.nodes;
         let timeline = Timeline::of(&animation.channels);
-        let codes: Vec<f64> = timeline.times.iter().map(|&t| time_code(t, placing)).collect();
+        let codes: Vec<f64> = timeline.times.iter().map(|&t| time_code(t, clock)).collect();
         let mut channels: HashMap<(usize, Property), &Channel> = HashMap::new();
         for channel in &animation.channels {
             channels.insert((channel.node, channel.property), channel);
@@ -438,7 +469,8 @@ impl Layer {
                 let q = if q.dot(previous[n]) < 0.0 { -q } else { q };
                 previous[n] = q;
                 let scale = Vec3::from_slice(&s[n][3 * k..3 * k + 3]);
-                let (translation, half) = chain.add(n, node.parent, Vec3::from_slice(&t[n][3 * k..3 * k + 3]), q, scale);
+                let (translation, half) =
+                    chain.add(n, node.parent, Vec3::from_slice(&t[n][3 * k..3 * k + 3]), q, scale);
                 translations[k].push(gf::vec3f(translation.x, translation.y, translation.z));
                 rotations[k].push(gf::Quatf { w: q.w, x: q.x, y: q.y, z: q.z });
                 rounding = (0..3).fold(rounding, |r, i| r.max(relative_rounding(scale[i], half[i])));
@@ -466,12 +498,18 @@ impl Layer {
         rounding
     }
 
-    /// An attribute `name` of `prim` typed `kind`, sampled at the time codes `codes` with `values`.
+    /// An attribute `name` of `prim` typed `kind`, sampled at the time codes `codes` with `values`; one value
+    /// where they are all one: USD reads a value between two samples in the precision stored, and a half-precision
+    /// scale between two equal samples can read a half step off.
     fn samples(&mut self, prim: &str, name: &str, kind: &str, codes: &[f64], values: impl Iterator<Item = Value>) {
+        let samples: sdf::TimeSampleMap = codes.iter().copied().zip(values).collect();
+        if let Some((_, first)) = samples.first().filter(|(_, first)| samples.iter().all(|(_, v)| v == first)) {
+            self.attribute(prim, name, kind, false, first.clone());
+            return;
+        }
         let path = Path::from(prim).append_property(name).expect("a valid property name");
         sdf::AttributeSpecMut::new(&mut self.data, path.clone(), kind, Variability::Varying, false)
             .expect("a new attribute");
-        let samples: sdf::TimeSampleMap = codes.iter().copied().zip(values).collect();
         self.data.set_field(&path, "timeSamples", Value::TimeSamples(samples));
     }
 
@@ -563,9 +601,8 @@ impl HalfChain {
         let half = scale.to_array().map(gf::f16::from_f32);
         let rounded = glam::DVec3::from_array(half.map(|h| f64::from(h.to_f32())));
         let turn = glam::DMat3::from_quat(q.as_dquat());
-        let (above, above_played) = parent.map_or((glam::DMat3::IDENTITY, glam::DMat3::IDENTITY), |p| {
-            (self.baked[p], self.played[p])
-        });
+        let (above, above_played) =
+            parent.map_or((glam::DMat3::IDENTITY, glam::DMat3::IDENTITY), |p| (self.baked[p], self.played[p]));
         let t = match above_played.inverse() {
             inverse if inverse.is_finite() => (inverse * above * t.as_dvec3()).as_vec3(),
             // Under a scale that half precision rounds to nothing no translation can make up for it.
@@ -585,8 +622,8 @@ fn relative_rounding(value: f32, half: gf::f16) -> f64 {
 
 /// The time code of baked time `t`: on the 128th of a frame (where a bake's halvings of frames fall) that
 /// single-precision key times only missed.
-fn time_code(t: f64, placing: &Placing) -> f64 {
-    let code = (t - placing.delay) * placing.codes_per_second;
+fn time_code(t: f64, clock: &Clock) -> f64 {
+    let code = (t - clock.delay) * clock.codes_per_second;
     let snapped = (code * FRAME_PARTS).round() / FRAME_PARTS;
     if (code - snapped).abs() <= SNAP * (1.0 + snapped.abs()) { snapped } else { code }
 }
@@ -678,7 +715,8 @@ mod tests {
             let (written, half) = chain.add(n, parent, t, q, s);
             let rounded = Vec3::from_array(half.map(|h| h.to_f32()));
             assert!(s == Vec3::ONE || rounded != s, "the scale rounds");
-            let matrix = |t: Vec3, s: Vec3| DMat4::from_scale_rotation_translation(s.as_dvec3(), q.as_dquat(), t.as_dvec3());
+            let matrix =
+                |t: Vec3, s: Vec3| DMat4::from_scale_rotation_translation(s.as_dvec3(), q.as_dquat(), t.as_dvec3());
             let (b, p) = (matrix(t, s), matrix(written, rounded));
             baked.push(parent.map_or(b, |p| baked[p] * b));
             played.push(parent.map_or(p, |q| played[q] * p));
@@ -691,16 +729,9 @@ mod tests {
 
     #[test]
     fn time_codes_fall_on_frames_that_single_precision_only_missed() {
-        let placing = Placing {
-            meters_per_unit: 1.0,
-            up: UpAxis::Y,
-            turn: DMat4::IDENTITY,
-            codes_per_second: 30.0,
-            delay: 0.5,
-            span: (-0.5, 1.0),
-        };
-        assert_eq!(time_code(f64::from(17.0f32 / 30.0), &placing), 2.0, "(17/30 − 0.5) s at 30 codes a second");
-        assert_eq!(time_code(f64::from(0.5f32 + 1.0 / 60.0), &placing), 0.5, "a key halfway stays halfway");
-        assert_eq!(time_code(0.0, &placing), -15.0, "before the clip's own start: its own clock");
+        let clock = Clock { codes_per_second: 30.0, delay: 0.5, span: (0.0, 1.5) };
+        assert_eq!(time_code(f64::from(17.0f32 / 30.0), &clock), 2.0, "(17/30 − 0.5) s at 30 codes a second");
+        assert_eq!(time_code(f64::from(0.5f32 + 1.0 / 60.0), &clock), 0.5, "a key halfway stays halfway");
+        assert_eq!(time_code(0.0, &clock), -15.0, "before the clip's own start: its own clock");
     }
 }

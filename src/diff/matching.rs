@@ -135,11 +135,15 @@ impl<'s> Unmatched<'s> {
         let (helpers_a, helpers_b) = (helpers(&a.skeleton), helpers(&b.skeleton));
         let helpers = [&helpers_a, &helpers_b].iter().map(|h| h.iter().filter(|&&h| h).count()).sum();
         // A conversion node the other file holds as a bone of the same name (its format knows no joints, and a
-        // bake's node converted nothing there) is paired like any bone.
+        // bake's node converted nothing there) is paired like any bone, unless its own file holds that bone too (a
+        // USD bake's skeleton prim, named as the skeleton it baked).
         let (nodes_a, nodes_b) = (a.conversion_nodes(), b.conversion_nodes());
+        let bone_named = |rig: &Rig, nodes: &[bool], name: &str| {
+            rig.skeleton.bones().iter().zip(nodes).any(|(bone, &conversion)| !conversion && bone.name == name)
+        };
         let apart = |rig: &Rig, nodes: &[bool], other: &Rig, other_nodes: &[bool]| -> Vec<bool> {
-            let a_bone_there = |name: &str| other.skeleton.find(name).is_some_and(|i| !other_nodes[i]);
-            nodes.iter().zip(rig.skeleton.bones()).map(|(&c, bone)| c && !a_bone_there(&bone.name)).collect()
+            let paired = |name: &str| bone_named(other, other_nodes, name) && !bone_named(rig, nodes, name);
+            nodes.iter().zip(rig.skeleton.bones()).map(|(&c, bone)| c && !paired(&bone.name)).collect()
         };
         let (conversion_a, left_a) = split(&apart(a, &nodes_a, b, &nodes_b), &helpers_a);
         let (conversion_b, left_b) = split(&apart(b, &nodes_b, a, &nodes_a), &helpers_b);

@@ -53,7 +53,7 @@ pub fn read(
     }
     let counts = int_array(at_start(mesh.face_vertex_counts_attr())?);
     let indices = int_array(at_start(mesh.face_vertex_indices_attr())?);
-    let name = match super::skeleton::written_names(openusd::usd::SchemaBase::prim(&mesh), "name") {
+    let name = match super::skeleton::written(openusd::usd::SchemaBase::prim(&mesh), "name") {
         Some(openusd::sdf::Value::String(name)) => name,
         _ => path.name().unwrap_or("Mesh").to_owned(),
     };

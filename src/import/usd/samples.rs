@@ -376,6 +376,13 @@ impl<V: Stored> Columns<V> {
         codes.iter().map(|&code| read(code)).collect()
     }
 
+    /// Whether element `e`, the same in every sample, reads the same at every one of `reads`: a half-precision value
+    /// read between two samples of it can read a half step off ([`mix_half`]), as USD reads it.
+    fn reads_alike(&self, e: usize, reads: &[Read]) -> bool {
+        let held = reads.first().map(|&read| self.read(e, read));
+        self.precision != Precision::Half || reads.iter().all(|&read| self.read(e, read) == held.flatten())
+    }
+
     /// Element `e`'s value as `read` reads it; `None` for the identity.
     fn read(&self, e: usize, read: Read) -> Option<V> {
         let at = |sample: usize| {
@@ -411,7 +418,7 @@ impl<V: Stored> Columns<V> {
                     Ok(keys) => Ok(Keys::Moving(keys)),
                     Err(column) => made(&mut column.iter().map(|v| into(*v))),
                 },
-                None if all_fit && self.columns[e].is_none() => {
+                None if all_fit && self.columns[e].is_none() && self.reads_alike(e, &reads) => {
                     Ok(Keys::Held(self.read(e, reads[0]).map_or(identity, &into)))
                 }
                 None => made(&mut reads.iter().map(|&read| self.read(e, read).map_or(identity, &into))),

@@ -60,9 +60,13 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
     let skeleton = Skeleton::get(stage, path.clone()).map_err(said)?.ok_or("not a Skeleton")?;
     let joints = skeleton.joints().map_err(said)?;
     let parents = skeleton.joint_parent_indices().map_err(said)?;
-    let written = written_names(skeleton.prim(), "names");
-    let ours = matches!(&written, Some(Value::StringVec(names)) if names.len() == joints.len());
-    let names = match written {
+    let baked_names = written(skeleton.prim(), "names");
+    let placing = match written(skeleton.prim(), "placing") {
+        Some(Value::IntVec(joints)) => joints,
+        _ => Vec::new(),
+    };
+    let ours = matches!(&baked_names, Some(Value::StringVec(names)) if names.len() == joints.len());
+    let names = match baked_names {
         Some(Value::StringVec(names)) if ours => names,
         _ => skeleton.joint_short_names().map_err(said)?,
     };
@@ -86,7 +90,9 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
             None => first,
         };
         let bone = Bone::joint(names[j].clone(), Some(parent), transform(&rest[j]));
-        bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role: NodeRole::Joint, ..bone });
+        // The joint a bake put above the roots to carry its source's unit and axes only places them.
+        let role = if placing.contains(&(j as i32)) { NodeRole::Helper } else { NodeRole::Joint };
+        bones.push(Bone { node: first + 1 + j, inherit: InheritMode::Full, role, ..bone });
     }
     let (mut animation, weights) = animation(stage, &skeleton, &joints, first + 1, timing)?.unzip();
     if let Some(moving) = moving_node(stage, path, first, timing)? {
@@ -127,9 +133,9 @@ fn not_affine_note(skeleton: &sdf::Path, attribute: &str, matrices: &[DMat4], jo
     ))
 }
 
-/// What a bake of bonescope's wrote in `prim`'s `customData` under `key` (the name of a joint or mesh as baked,
-/// where USD's spelling of names lost it).
-pub fn written_names(prim: &Prim, key: &str) -> Option<Value> {
+/// What a bake of bonescope's wrote in `prim`'s `customData` under `key`: the names of joints or a mesh as baked,
+/// where USD's spelling of names lost them, and the joint that carries the source's unit and axes.
+pub fn written(prim: &Prim, key: &str) -> Option<Value> {
     match prim.custom_data().ok()?? {
         Value::Dictionary(mut custom) => match custom.remove(crate::bake::CUSTOM_DATA)? {
             Value::Dictionary(mut ours) => ours.remove(key),

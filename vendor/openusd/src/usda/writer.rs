@@ -796,22 +796,18 @@ impl<W: Write> Emitter<'_, W> {
     where
         F: FnMut(&mut String, &T) -> Result<()>,
     {
-        if items.len() == 1 {
-            let mut buf = String::new();
-            fmt_item(&mut buf, &items[0])?;
-            self.out.write_all(buf.as_bytes())?;
-        } else {
-            self.out.write_all(b"[")?;
-            for (i, item) in items.iter().enumerate() {
-                if i > 0 {
-                    self.out.write_all(b", ")?;
-                }
-                let mut buf = String::new();
-                fmt_item(&mut buf, item)?;
-                self.out.write_all(buf.as_bytes())?;
+        // bonescope: a list of one item in brackets too, as Pixar's USD writes it: its reader takes a bare item only
+        // in some list ops (references, not `apiSchemas`).
+        self.out.write_all(b"[")?;
+        for (i, item) in items.iter().enumerate() {
+            if i > 0 {
+                self.out.write_all(b", ")?;
             }
-            self.out.write_all(b"]")?;
+            let mut buf = String::new();
+            fmt_item(&mut buf, item)?;
+            self.out.write_all(buf.as_bytes())?;
         }
+        self.out.write_all(b"]")?;
         Ok(())
     }
 

@@ -21,6 +21,9 @@ use crate::{
 };
 
 use super::coding;
+
+/// bonescope: the fields that list a spec's children, as its crate file names them.
+const CHILDREN_FIELDS: [&str; 4] = ["primChildren", super::CRATE_PROPERTY_CHILDREN, "variantSetChildren", "variantChildren"];
 use super::layout::{
     version, Bootstrap, ListOpHeader, Section, Spec as FileSpec, Type, ValueRep, Version, SECTION_NAME_MAX_LENGTH,
 };
@@ -120,8 +123,14 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
                     } else {
                         name
                     };
+                    // bonescope: children lists are token vectors in Pixar's crate files, not token arrays: its
+                    // reader refuses a prim whose `primChildren` is not one.
+                    let children = CHILDREN_FIELDS.contains(&token.as_str());
                     let token_idx = self.tokens.intern(token);
-                    let rep = self.write_value(&value)?;
+                    let rep = match &value {
+                        Value::TokenVec(list) if children => self.write_children(list)?,
+                        _ => self.write_value(&value)?,
+                    };
                     let field_idx = self.fields.intern((token_idx, rep.0));
                     self.fieldsets.push(Some(field_idx));
                 }
@@ -786,6 +795,17 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
             self.write_pod(&q.w.to_bits())?;
         }
         Ok(rep_heap(ty, off, true))
+    }
+
+    /// A list of children (`primChildren` and the like): a `TokenVector`, the token indices after their count.
+    fn write_children(&mut self, v: &[tf::Token]) -> Result<ValueRep> {
+        let off = self.pos()?;
+        self.write_count(v.len() as u64)?;
+        for t in v {
+            let idx = self.tokens.intern(t.to_string());
+            self.write_pod(&idx)?;
+        }
+        Ok(rep_heap(Type::TokenVector, off, false))
     }
 
     fn write_token_vec(&mut self, ty: Type, v: &[tf::Token]) -> Result<ValueRep> {
