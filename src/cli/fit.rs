@@ -7,10 +7,11 @@ use std::process::ExitCode;
 
 use clap::Args;
 
-use super::options::{Distance, files_help, parse_distance};
+use super::options::{Distance, clip_index, files_help, parse_distance};
 use super::setup::evaluation;
 use super::table::{Table, shown};
-use super::{EvalArgs, OutputFormat};
+use super::{LayerArgs, OutputFormat};
+use crate::eval::Setup;
 use crate::fit::{DEFAULT_TOLERANCE, Fit, fit};
 use crate::import;
 use crate::model::{Choice, ModeChoice, Unit};
@@ -21,10 +22,12 @@ pub struct FitArgs {
     pub source: PathBuf,
     /// The runtime's pose dump of it (docs/pose-dump.md).
     pub dump: PathBuf,
-    /// The clip, layers and layers' options of the source (default: the clip named as the dump's, else the first);
-    /// --inherit is replaced by every mode in turn.
+    /// The source's animation, by name or index (default: the one named as the dump's, else the first).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub anim: Option<String>,
+    /// The runtime techniques the source plays through (its modes are every mode in turn).
     #[command(flatten)]
-    pub eval: EvalArgs,
+    pub layers: LayerArgs,
     /// The largest distance a fitting mode may leave: model units, or a percentage of the rig's size (default
     /// 0.01%).
     #[arg(long, value_name = "DISTANCE", value_parser = parse_distance)]
@@ -36,11 +39,13 @@ pub struct FitArgs {
 pub fn run(args: &FitArgs) -> anyhow::Result<ExitCode> {
     let source = import::load(&args.source)?;
     let dump = import::load(&args.dump)?;
-    let mut setup = args.eval.setup(&source)?;
     let named = dump.clips.first().and_then(|c| c.name.as_deref()).and_then(|name| source.find_clip(name));
-    if let (None, Some(clip)) = (&args.eval.anim, named) {
-        setup.clip = Some(clip.index);
-    }
+    let clip = match (&args.anim, named) {
+        (Some(name), _) => Some(clip_index(&source, "--anim", name)?),
+        (None, Some(clip)) => source.clips.iter().position(|c| std::ptr::eq(c, clip)),
+        (None, None) => Setup::declared(&source).clip,
+    };
+    let setup = Setup { clip, layers: args.layers.layers(&source)?, ..Setup::default() };
     let source_evaluation = evaluation(&source, &setup)?;
     let tolerance = |rig_size: f64| args.tolerance.map_or(DEFAULT_TOLERANCE * rig_size, |d| d.units(rig_size));
     let found = fit(&source_evaluation, &dump, tolerance)?;
