@@ -172,3 +172,22 @@ fn bad_csv_dumps_name_the_file_and_the_line() {
     let header = error("h.dump.csv", &good.replace("space=world", "space=model"));
     assert_eq!(header, "h.dump.csv: line 1: the space `model` is not one of world, local");
 }
+
+#[test]
+fn every_cut_and_flip_of_a_dump_reads_or_fails_without_panicking() {
+    let rig = demo_rig();
+    let (times, poses) = evaluated(&rig, InheritMode::Full);
+    for syntax in [Syntax::Json, Syntax::Csv] {
+        let bytes = written(&rig, syntax, DumpHeader::default(), &times[..3], &poses[..3]);
+        for cut in 0..bytes.len() {
+            let _ = load_bytes(Path::new("cut.dump"), &bytes[..cut]);
+        }
+        for (i, flip) in
+            (0..bytes.len()).step_by(7).zip([b'-', b'e', b',', b'"', b'9', b'\n', b'{', b'n'].iter().cycle())
+        {
+            let mut flipped = bytes.clone();
+            flipped[i] = *flip;
+            let _ = load_bytes(Path::new("flip.dump"), &flipped);
+        }
+    }
+}
