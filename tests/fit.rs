@@ -160,3 +160,19 @@ fn the_command_gates_on_the_fit_and_refuses_bad_dumps() {
     assert_eq!(error.lines().count(), 1, "{error}");
     assert!(error.contains("bad.dump.json: line 1: the space `sideways` is not one of world, local"), "{error}");
 }
+
+#[test]
+fn a_dump_in_centimetres_fits_its_source_in_metres() {
+    // A runtime that reads the file in centimetres puts the unit above the roots: S(100)·W for every bone.
+    let rig = load_asset("blender/stretchy_full.glb");
+    let (times, poses) = poses(&rig, InheritMode::Componentwise);
+    let centimetres = DMat4::from_scale(glam::DVec3::splat(100.0));
+    let scaled: Vec<Vec<DMat4>> = poses.iter().map(|pose| pose.iter().map(|m| centimetres * *m).collect()).collect();
+    let header = DumpHeader { unit: "cm".parse().ok(), ..DumpHeader::default() };
+    let mut writer = DumpWriter::new(Vec::new(), Syntax::Csv, header, &rig.skeleton).unwrap();
+    times.iter().zip(&scaled).for_each(|(&t, p)| writer.frame(t, p).unwrap());
+    let dump = load_bytes(Path::new("cm.dump.csv"), &writer.finish().unwrap()).unwrap();
+    let found = fitted(&rig, &dump);
+    assert!(found.fits.contains(&ModeChoice::Mode(InheritMode::Componentwise)), "{:?}", found.fits);
+    assert!((found.rig_size / 100.0 - 2.05).abs() < 0.01, "measured in the dump's unit: {}", found.rig_size);
+}

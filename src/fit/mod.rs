@@ -17,7 +17,7 @@
 use glam::{DMat3, DMat4, DVec3};
 
 use crate::diff::{BoneMatching, Extreme, PROBE_FRACTION, match_bones};
-use crate::eval::{Evaluation, HierarchyError, over_runs};
+use crate::eval::{Evaluation, HierarchyError, ModelPose, over_runs};
 use crate::math::{affine_inverse, decompose, shear_deg};
 use crate::model::{Choice, InheritMode, ModeChoice, Modes, Rig, Transform};
 
@@ -210,7 +210,8 @@ fn candidates<'a>(source: &Evaluation<'a>, dump: &Rig) -> Result<Vec<Candidate<'
 }
 
 /// Every pair's tally under every candidate of its own (`[candidate][pair]`; a [`Candidate::Same`]'s is empty), in
-/// parallel over runs of time.
+/// parallel over runs of time. The source is sampled once per time, by the first candidate (the layers are the
+/// same for all), and its local pose combined under each candidate's modes.
 fn tally(
     dump: &Evaluation,
     candidates: &[Candidate],
@@ -219,30 +220,29 @@ fn tally(
     probe: f64,
     tolerance: f64,
 ) -> Vec<Vec<Tally>> {
+    let Some(Candidate::Own(first)) = candidates.first() else { return Vec::new() };
     let runs = over_runs(times, |run| {
         let fresh = Tally { largest: Extreme { max: 0.0, time: run[0] }, first_over: None };
-        let mut tallies: Vec<Vec<Tally>> = candidates
-            .iter()
-            .map(|c| match c {
-                Candidate::Own(_) => vec![fresh; matching.pairs.len()],
-                Candidate::Same(_) => Vec::new(),
-            })
-            .collect();
-        let mut dump_evaluator = dump.evaluator();
-        let mut evaluators: Vec<_> = candidates
-            .iter()
-            .map(|c| match c {
-                Candidate::Own(evaluation) => Some(evaluation.evaluator()),
-                Candidate::Same(_) => None,
-            })
-            .collect();
+        let pairs = |c: &Candidate| match c {
+            Candidate::Own(_) => vec![fresh; matching.pairs.len()],
+            Candidate::Same(_) => Vec::new(),
+        };
+        let mut tallies: Vec<Vec<Tally>> = candidates.iter().map(pairs).collect();
+        let (mut dump_evaluator, mut sampler) = (dump.evaluator(), first.evaluator());
+        let mut other = ModelPose::default();
         for &time in run {
             let dumped = &dump_evaluator.evaluate(time).model.model;
-            for (evaluator, tallies) in evaluators.iter_mut().zip(&mut tallies) {
-                let Some(evaluator) = evaluator else { continue };
-                let model = &evaluator.evaluate(time).model.model;
+            sampler.evaluate(time);
+            for (c, (candidate, tallies)) in candidates.iter().zip(&mut tallies).enumerate() {
+                let Candidate::Own(evaluation) = candidate else { continue };
+                let model = if c == 0 {
+                    &sampler.pose.model
+                } else {
+                    sampler.model_under(&evaluation.hierarchy, &mut other);
+                    &other
+                };
                 for (tally, &(a, b)) in tallies.iter_mut().zip(&matching.pairs) {
-                    tally.add(distance(&model[a], &dumped[b], probe), time, tolerance);
+                    tally.add(distance(&model.model[a], &dumped[b], probe), time, tolerance);
                 }
             }
         }
