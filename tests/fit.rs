@@ -176,3 +176,28 @@ fn a_dump_in_centimetres_fits_its_source_in_metres() {
     assert!(found.fits.contains(&ModeChoice::Mode(InheritMode::Componentwise)), "{:?}", found.fits);
     assert!((found.rig_size / 100.0 - 2.05).abs() < 0.01, "measured in the dump's unit: {}", found.rig_size);
 }
+
+#[test]
+fn a_dump_is_a_file_like_any_other_for_inspect_scan_and_diff() {
+    let folder = tempfile::tempdir().unwrap();
+    let source = asset("blender/stretchy_full.glb");
+    let source = source.to_str().unwrap();
+    let dump = folder.path().join("stretchy.dump.json");
+    let written = bonescope(&["inspect", source, "--anim", "squash_stretch", "--format", "dump"]);
+    assert!(written.status.success());
+    std::fs::write(&dump, &written.stdout).unwrap();
+    let dump = dump.to_str().unwrap();
+    // At the dump's times (every frame, the source's keys among them) the two agree to single precision; the clip
+    // pairs by the name the dump gives it.
+    let diff = json(&bonescope(&["diff", source, dump, "--rate", "0", "--format", "json"]));
+    let animations = diff["animations"].as_array().unwrap();
+    assert_eq!(animations.len(), 1, "{diff}");
+    assert!(animations[0]["worst"]["max"].as_f64().unwrap() < 1e-5, "{}", animations[0]["worst"]);
+    // Read as a rig (full inheritance), the dump shears where the source does.
+    let scan = json(&bonescope(&["scan", dump, "--format", "json"]));
+    let stretched: Vec<&str> =
+        scan[0]["animations"][0]["stretched"].as_array().unwrap().iter().map(|b| b["name"].as_str().unwrap()).collect();
+    assert_eq!(stretched, ["forearm", "hand", "neck", "head"], "{scan}");
+    let inspect = json(&bonescope(&["inspect", dump, "--time", "1", "--format", "json"]));
+    assert_eq!(inspect["samples"][0]["bones"].as_array().unwrap().len(), 10, "{inspect}");
+}
