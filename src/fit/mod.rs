@@ -229,9 +229,11 @@ fn tally(
         };
         let mut tallies: Vec<Vec<Tally>> = candidates.iter().map(pairs).collect();
         let (mut dump_evaluator, mut sampler) = (dump.evaluator(), first.evaluator());
-        let mut other = ModelPose::default();
+        let (mut other, mut reaches) = (ModelPose::default(), Vec::with_capacity(matching.pairs.len()));
         for &time in run {
             let dumped = &dump_evaluator.evaluate(time).model.model;
+            reaches.clear();
+            reaches.extend(matching.pairs.iter().map(|&(_, b)| reach(&dumped[b], probe)));
             sampler.evaluate(time);
             for (c, (candidate, tallies)) in candidates.iter().zip(&mut tallies).enumerate() {
                 let Candidate::Own(evaluation) = candidate else { continue };
@@ -241,8 +243,8 @@ fn tally(
                     sampler.model_under(&evaluation.hierarchy, &mut other);
                     &other
                 };
-                for (tally, &(a, b)) in tallies.iter_mut().zip(&matching.pairs) {
-                    tally.add(distance(&model.model[a], &dumped[b], probe), time, tolerance);
+                for ((tally, &(a, b)), &reach) in tallies.iter_mut().zip(&matching.pairs).zip(&reaches) {
+                    tally.add(distance(&model.model[a], &dumped[b], reach), time, tolerance);
                 }
             }
         }
@@ -256,15 +258,18 @@ fn tally(
         .unwrap_or_default()
 }
 
-/// How far apart `w` (the source's) puts the dump's frame of `d`: the origins, and a point `probe` out along each
-/// of the dump's axes (scaled as `w` scales it, so that a scale difference shows).
-fn distance(w: &DMat4, d: &DMat4, probe: f64) -> f64 {
+/// How far a unit step along each of `d`'s axes must be taken to land `probe` out (`probe / |D·e_k|`; `probe` for
+/// an axis of no length): the same for every mode compared with the dump's bone at one time.
+fn reach(d: &DMat4, probe: f64) -> DVec3 {
+    let length = |k: usize| d.col(k).truncate().length();
+    DVec3::from_array([0, 1, 2].map(|k| if length(k) > 0.0 { probe / length(k) } else { probe }))
+}
+
+/// How far apart `w` (the source's) puts the dump's frame of `d`: the origins, and the point `reach` ([`reach`])
+/// out along each of the dump's axes (scaled as `w` scales it, so that a scale difference shows).
+fn distance(w: &DMat4, d: &DMat4, reach: DVec3) -> f64 {
     let origins = (w.w_axis - d.w_axis).truncate();
-    let axis = |k: usize| {
-        let length = d.col(k).truncate().length();
-        let reach = if length > 0.0 { probe / length } else { probe };
-        (origins + (w.col(k) - d.col(k)).truncate() * reach).length_squared()
-    };
+    let axis = |k: usize| (origins + (w.col(k) - d.col(k)).truncate() * reach[k]).length_squared();
     let largest = (0..3).map(axis).fold(origins.length_squared(), f64::max).sqrt();
     if largest.is_nan() { f64::INFINITY } else { largest }
 }
@@ -330,7 +335,7 @@ fn first_miss(
         bone: bone.name.clone(),
         time,
         closest: bone.closest,
-        distance: distance(&w, &d, probe),
+        distance: distance(&w, &d, reach(&d, probe)),
         residual,
         dump_shear_deg,
         closest_shear_deg,
