@@ -4,7 +4,7 @@
 //! (a clip, each bone's scale-inheritance mode, the layers of a game runtime's techniques, the skinning, the times
 //! a whole-clip pass visits) and evaluates poses: local transforms combined into model matrices with each bone's
 //! mode. On top of it: `analysis` decomposes every matrix (Shoemake's polar decomposition) and flags stretched,
-//! mirrored and degenerate bones; `explain` says whose scale shears a bone and which fix costs least; `diff`
+//! mirrored and degenerate bones; `fit` says which mode a runtime's pose dump implements; `explain` says whose scale shears a bone and which fix costs least; `diff`
 //! compares two evaluations; `bake` writes one as plain glTF; `library` scans folders of files; `cli` prints it all, and the `gui` feature adds the app (`app`, `view`, `render`).
 //!
 //! Load a file (here the built-in demo rig), scan a clip, and decompose a bone where it shears most:
@@ -38,6 +38,7 @@ pub mod diff;
 pub mod eval;
 pub mod explain;
 pub mod export;
+pub mod fit;
 pub mod import;
 pub mod library;
 pub mod math;

@@ -22,7 +22,7 @@ fn every_option_is_in_its_commands_synopsis() {
         .map(|page| std::fs::read_to_string(root.join("docs").join(page)).unwrap())
         .collect();
     let layer_table: Vec<&str> = pages.lines().filter(|line| line.starts_with("| `--")).collect();
-    let commands = ["inspect", "scan", "storage", "report", "export", "explain", "bake", "diff", "render"];
+    let commands = ["inspect", "scan", "storage", "report", "export", "explain", "bake", "diff", "fit", "render"];
     let mut missing = Vec::new();
     for command in commands {
         let synopsis = synopsis(&pages, command);

@@ -46,7 +46,7 @@ impl LocalChannels for CursorAt<'_, '_> {
     }
 
     fn stretch(&mut self) -> DQuat {
-        self.0.stretch()
+        self.0.stretch(self.1)
     }
 }
 

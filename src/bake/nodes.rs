@@ -20,16 +20,13 @@ use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::Strategy;
 use crate::eval::{Evaluation, Evaluator, over_runs_of};
-use crate::math::{AffineParts, decompose_near, stretch_nearest};
+use crate::math::{AffineParts, affine_inverse, decompose_near, frobenius, stretch_nearest};
 use crate::model::{Skeleton, affine};
 
 /// A stretch rotation matters when dropping it moves `U·K·Uᵀ` by more than this fraction of the largest factor: a
 /// few single-precision roundings. Less is the noise of a file's `f32` numbers (factors 1e-7 apart, whose frame
 /// turns at random), which a helper node, itself stored in `f32`, could not carry anyway.
 const STRETCH_MATTERS: f64 = 4.0 * f32::EPSILON as f64;
-
-/// A parent matrix counts as singular below this `|det|` relative to its size cubed.
-const SINGULAR: f64 = 1e-12;
 
 /// One bone's nodes at one time: the local matrix `T · Q · S · Vᵀ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -301,25 +298,6 @@ fn stretch_matters(parts: &AffineParts) -> bool {
     largest > STRETCH_MATTERS * parts.scale.abs().max_element()
 }
 
-/// The inverse of an affine matrix, or `None` when it is singular (or not finite).
-fn affine_inverse(m: &DMat4) -> Option<DMat4> {
-    let linear = DMat3::from_mat4(*m);
-    let size = frobenius(m);
-    let determinant = linear.determinant();
-    let regular = determinant.abs() > SINGULAR * size * size * size && determinant.is_finite();
-    if !regular {
-        return None;
-    }
-    let inverse = linear.inverse();
-    Some(affine(inverse, -(inverse * m.w_axis.truncate())))
-}
-
-/// The Frobenius norm of the 3×3 part: at least the largest factor by which the matrix scales a length.
-fn frobenius(m: &DMat4) -> f64 {
-    let linear = DMat3::from_mat4(*m);
-    (linear.x_axis.length_squared() + linear.y_axis.length_squared() + linear.z_axis.length_squared()).sqrt()
-}
-
 /// Makes a bone's nodes continuous over time ([`Follower`]), the whole series at once.
 #[cfg(test)]
 pub fn follow_frames(series: &mut Series) {
@@ -518,6 +496,5 @@ mod tests {
         let node = NodeSample::trs(&parts);
         assert!(node.scale.abs_diff_eq(DVec3::new(-1.5, -1.5, -1.0), 1e-12));
         assert_eq!((node.rotation, node.stretch), (parts.rotation, DQuat::IDENTITY));
-        assert_eq!(affine_inverse(&DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0))), None);
     }
 }

@@ -1,17 +1,36 @@
-//! `bonescope inspect`: every bone's matrices, decomposition and findings at chosen times.
+//! `bonescope inspect`: every bone's matrices, decomposition and findings at chosen times, or every bone's model
+//! matrix at every frame as a pose dump (`--format dump`, `dump-csv`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::options::files_help;
 use super::setup::evaluation;
 use super::table::{Table, shown, vector};
-use super::{EvalArgs, OutputFormat, ToleranceArgs};
+use super::{EvalArgs, ToleranceArgs};
 use crate::analysis::report::{AnimationInfo, BoneReport, LayeredInspectReport, SampleReport};
+use crate::eval::Evaluation;
+use crate::export::DumpWriter;
 use crate::import;
-use crate::model::{At, Choice};
+use crate::import::dump::{DumpHeader, Syntax};
+use crate::model::{At, Choice, UpAxis};
+
+/// What `inspect` writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum InspectFormat {
+    /// Aligned columns for people; flagged bones marked.
+    #[default]
+    Table,
+    /// One JSON document on standard output.
+    Json,
+    /// A pose dump (JSON, docs/pose-dump.md): every bone's model matrix at every frame (or at each --time), as a
+    /// runtime's dump would hold them; bonescope reads it back like any file.
+    Dump,
+    /// The same pose dump as CSV.
+    DumpCsv,
+}
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
@@ -19,11 +38,12 @@ pub struct InspectArgs {
     pub file: PathBuf,
     #[command(flatten)]
     pub eval: EvalArgs,
-    /// A time in seconds to evaluate (repeatable; default 0). Outside the clip the first or last key holds.
+    /// A time in seconds to evaluate (repeatable; default 0, for a dump every frame and key of the clip). Outside
+    /// the clip the first or last key holds.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub time: Vec<f64>,
     #[arg(long, value_enum, default_value_t)]
-    pub format: OutputFormat,
+    pub format: InspectFormat,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
 }
@@ -35,8 +55,18 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     if let Some(bad) = args.time.iter().find(|t| !t.is_finite()) {
         anyhow::bail!("--time must be a finite number of seconds, got {bad}");
     }
-    let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
     let evaluation = evaluation(&rig, &setup)?;
+    let dump = match args.format {
+        InspectFormat::Dump => Some(Syntax::Json),
+        InspectFormat::DumpCsv => Some(Syntax::Csv),
+        InspectFormat::Table | InspectFormat::Json => None,
+    };
+    if let Some(syntax) = dump {
+        let source = format!("bonescope {} (inherit: {})", env!("CARGO_PKG_VERSION"), setup.modes.label());
+        write_dump(&evaluation, &dump_times(&evaluation, &args.time), syntax, source)?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let times = if args.time.is_empty() { vec![0.0] } else { args.time.clone() };
     let modes = evaluation.modes();
     let mut evaluator = evaluation.evaluator();
     let samples = times
@@ -49,10 +79,38 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     let summary = setup.layers.summary(&rig, evaluation.clip);
     let report = LayeredInspectReport::new(shown(&args.file), &evaluation, setup.modes.label().to_owned(), samples);
     match args.format {
-        OutputFormat::Json => super::print_json(&report)?,
-        OutputFormat::Table => super::print_out(render_table(&report, &summary))?,
+        InspectFormat::Json => super::print_json(&report)?,
+        _ => super::print_out(render_table(&report, &summary))?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The times a dump holds: the ones asked for, sorted, else every frame and key of the clip at its frame rate.
+fn dump_times(evaluation: &Evaluation, asked: &[f64]) -> Vec<f64> {
+    if asked.is_empty() {
+        return evaluation.times(evaluation.clip.map_or(0.0, |clip| clip.frame_rate()));
+    }
+    let mut times = asked.to_vec();
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}
+
+/// Writes `evaluation` at `times` as a pose dump to standard output: world matrices, column-major, in the rig's
+/// unit and bonescope's Y-up space.
+fn write_dump(evaluation: &Evaluation, times: &[f64], syntax: Syntax, source: String) -> anyhow::Result<()> {
+    use std::io::Write;
+    let unit = evaluation.unit().or(evaluation.rig.unit);
+    let clip = evaluation.clip.and_then(|clip| clip.name.clone());
+    let header = DumpHeader { unit, up: Some(UpAxis::Y), clip, source: Some(source), ..DumpHeader::default() };
+    let out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut writer = DumpWriter::new(out, syntax, header, evaluation.skeleton())?;
+    let mut evaluator = evaluation.evaluator();
+    for &time in times {
+        writer.frame(time, &evaluator.evaluate(time).model.model)?;
+    }
+    writer.finish()?.flush()?;
+    Ok(())
 }
 
 fn render_table(layered: &LayeredInspectReport, layers_summary: &str) -> String {

@@ -1,16 +1,18 @@
 //! The command line: `inspect` prints exact numbers for chosen times, `scan` summarises whole clips (or compares two
 //! inheritance modes), `storage` measures the stretch-quaternion storage of whole clips, `export` writes the
 //! evaluated meshes of one time, `render` draws the viewport to PNG, `bake` writes any inheritance as plain glTF,
-//! `diff` compares two evaluations, `explain` says whose scale shears a bone and which fix costs least.
+//! `diff` compares two evaluations, `explain` says whose scale shears a bone and which fix costs least, `fit` says
+//! which mode a runtime's pose dump implements.
 //!
 //! Exit codes: 0 success; 1 `scan --fail-above` found a stretched bone, `render --reference` found a picture over
-//! its threshold, `bake --fail-above` or `diff --fail-above` a difference over its limit; 2 bad usage or a file that
+//! its threshold, `bake --fail-above` or `diff --fail-above` a difference over its limit, `fit` no mode that fits the dump; 2 bad usage or a file that
 //! cannot be loaded (after reporting every file that could).
 
 mod bake;
 mod diff;
 mod explain;
 mod export;
+mod fit;
 mod inspect;
 mod layers;
 mod options;
@@ -66,6 +68,9 @@ pub enum Command {
     Bake(bake::BakeArgs),
     /// Compare two evaluations (two files, or one under two sets of modes) over time, bone by bone.
     Diff(diff::DiffArgs),
+    /// Say which scale inheritance a runtime's pose dump implements: the source under every mode against the
+    /// dump, bone by bone (exit 1 when no mode fits).
+    Fit(fit::FitArgs),
     /// Render the viewport (or the whole window) to PNG without a display, optionally checked against a reference.
     #[cfg(feature = "gui")]
     Render(render::RenderArgs),
@@ -99,6 +104,7 @@ pub fn main() -> ExitCode {
         Some(Command::Explain(args)) => explain::run(&args),
         Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::Diff(args)) => diff::run(&args),
+        Some(Command::Fit(args)) => fit::run(&args),
         #[cfg(feature = "gui")]
         None => crate::app::run(cli.file).map(|()| ExitCode::SUCCESS).map_err(|e| anyhow::anyhow!("{e}")),
         #[cfg(not(feature = "gui"))]

@@ -64,7 +64,7 @@ impl Extreme {
         Extreme { max: floor, time }
     }
 
-    fn add(&mut self, value: f64, time: f64) {
+    pub(crate) fn add(&mut self, value: f64, time: f64) {
         // NaN (a degenerate matrix) counts as the largest difference there is.
         if value > self.max || (value.is_nan() && !self.max.is_nan()) {
             *self = Extreme { max: value, time };

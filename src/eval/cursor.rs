@@ -14,8 +14,8 @@ use crate::model::{BoneTracks, Clip, Interpolation, Skeleton, Track, Transform};
 pub struct BoneCursor<'a> {
     rest: Transform,
     tracks: Option<&'a BoneTracks>,
-    /// Where the translation, rotation and scale keys were found last.
-    hints: [usize; 3],
+    /// Where the translation, rotation, scale and stretch keys were found last.
+    hints: [usize; 4],
     /// The last rotation key interval and its slerp.
     slerp: (usize, Slerp),
 }
@@ -25,7 +25,7 @@ impl<'a> BoneCursor<'a> {
         BoneCursor {
             rest: skeleton.bone(bone).rest,
             tracks: clip.tracks_of(bone),
-            hints: [0; 3],
+            hints: [0; 4],
             slerp: (usize::MAX, Slerp::new(DQuat::IDENTITY, DQuat::IDENTITY)),
         }
     }
@@ -53,10 +53,12 @@ impl<'a> BoneCursor<'a> {
         }
     }
 
-    /// The stretch rotation of the local transform: the clip's where it sets one, else the rest's (clips do not
-    /// animate it).
-    pub fn stretch(&self) -> DQuat {
-        self.tracks.and_then(|t| t.stretch).unwrap_or(self.rest.stretch)
+    /// The stretch rotation of the local transform: the clip's where it sets one, else the rest's.
+    pub fn stretch(&mut self, time: f64) -> DQuat {
+        match self.tracks.and_then(|t| t.stretch.as_ref()) {
+            Some(track) => sample_track_near(track, time, &mut self.hints[3]),
+            None => self.rest.stretch,
+        }
     }
 
     /// Every channel.
@@ -65,7 +67,7 @@ impl<'a> BoneCursor<'a> {
             translation: self.translation(time),
             rotation: self.rotation(time),
             scale: self.scale(time),
-            stretch: self.stretch(),
+            stretch: self.stretch(time),
         }
     }
 

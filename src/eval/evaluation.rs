@@ -7,7 +7,7 @@ use glam::{DMat4, DVec3, DVec4};
 use super::hierarchy::HierarchyError;
 use super::layers::{Resampling, RotationInterpolation};
 use super::skinning::{Method as SkinningMethod, skin_meshes_with, skin_positions_with};
-use super::{Hierarchy, LayerStack, Pose, over_runs};
+use super::{Hierarchy, LayerStack, ModelPose, Pose, over_runs};
 use crate::model::{Clip, InheritMode, MAX_FRAMES, Modes, Rig, Skeleton, Span, Unit, sample_times};
 
 /// A clip of a rig (its rest pose for `None`) as one evaluation sees it.
@@ -299,6 +299,15 @@ impl<'e, 'a> Evaluator<'e, 'a> {
             scale_lengths(&mut self.pose.model.model, e.length_scale);
         }
         &self.pose
+    }
+
+    /// The local pose last evaluated combined under `hierarchy` (this rig's, other modes) into `out`, in this
+    /// evaluation's unit: one sampling shared by several sets of modes (what `fit` tries at each time).
+    pub fn model_under(&self, hierarchy: &Hierarchy, out: &mut ModelPose) {
+        hierarchy.evaluate(&self.pose.local, out);
+        if self.evaluation.length_scale != 1.0 {
+            scale_lengths(&mut out.model, self.evaluation.length_scale);
+        }
     }
 }
 

@@ -198,7 +198,7 @@ pub(crate) fn sample_clip_near(
     sample_clip_with(skeleton, clip, time, &Authored, pose, hints);
 }
 
-/// [`sample_clip`] with each track read by `sampler`, and with key hints (three per bone's tracks) when given.
+/// [`sample_clip`] with each track read by `sampler`, and with key hints (four per bone's tracks) when given.
 pub(crate) fn sample_clip_with(
     skeleton: &Skeleton,
     clip: &Clip,
@@ -209,14 +209,14 @@ pub(crate) fn sample_clip_with(
 ) {
     rest_pose_into(skeleton, pose);
     if let Some(hints) = &mut hints {
-        hints.resize(3 * clip.tracks().len(), 0);
+        hints.resize(4 * clip.tracks().len(), 0);
     }
     for (i, tracks) in clip.tracks().iter().enumerate() {
         let Some(local) = pose.get_mut(tracks.bone) else {
             continue;
         };
-        let mut fresh = [0; 3];
-        let hint = hints.as_deref_mut().map_or(&mut fresh[..], |h| &mut h[3 * i..3 * i + 3]);
+        let mut fresh = [0; 4];
+        let hint = hints.as_deref_mut().map_or(&mut fresh[..], |h| &mut h[4 * i..4 * i + 4]);
         if let Some(track) = &tracks.translation {
             local.translation = sampler.vector(track, time, &mut hint[0]);
         }
@@ -226,7 +226,9 @@ pub(crate) fn sample_clip_with(
         if let Some(track) = &tracks.scale {
             local.scale = sampler.vector(track, time, &mut hint[2]);
         }
-        local.stretch = tracks.stretch.unwrap_or(local.stretch);
+        if let Some(track) = &tracks.stretch {
+            local.stretch = sampler.rotation(track, time, &mut hint[3]);
+        }
     }
 }
 

@@ -15,11 +15,14 @@ pub enum Format {
     Bvh,
     /// OpenUSD (UsdSkel), text (`.usda`), binary (`.usdc`) or packaged (`.usdz`); `.usd` is either of the first two.
     Usd,
+    /// A runtime's evaluated matrices, JSON or CSV (`docs/pose-dump.md`); recognised by content, named
+    /// `.dump.json`/`.dump.csv` for folder scans.
+    PoseDump,
 }
 
 impl Format {
     /// Every format, in the order lists name them.
-    pub const ALL: [Format; 4] = [Format::Gltf, Format::Fbx, Format::Bvh, Format::Usd];
+    pub const ALL: [Format; 5] = [Format::Gltf, Format::Fbx, Format::Bvh, Format::Usd, Format::PoseDump];
 
     /// The name people know it by.
     pub fn name(self) -> &'static str {
@@ -28,6 +31,7 @@ impl Format {
             Format::Fbx => "FBX",
             Format::Bvh => "BVH",
             Format::Usd => "USD",
+            Format::PoseDump => "pose dump",
         }
     }
 
@@ -38,6 +42,7 @@ impl Format {
             Format::Fbx => &["fbx"],
             Format::Bvh => &["bvh"],
             Format::Usd => &["usd", "usda", "usdc", "usdz"],
+            Format::PoseDump => &["dump.json", "dump.csv"],
         }
     }
 
@@ -46,10 +51,12 @@ impl Format {
         Format::ALL.into_iter().flat_map(|format| format.extensions().iter().copied())
     }
 
-    /// The format whose extension `path` has (any case).
+    /// The format whose extension `path` has (any case; `walk.dump.json` has `dump.json`).
     pub fn named_by(path: &Path) -> Option<Format> {
-        let extension = path.extension()?.to_str()?;
-        Format::ALL.into_iter().find(|format| format.extensions().iter().any(|e| e.eq_ignore_ascii_case(extension)))
+        let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+        let named =
+            |e: &&str| name.len() > e.len() + 1 && name.ends_with(e) && name[..name.len() - e.len()].ends_with('.');
+        Format::ALL.into_iter().find(|format| format.extensions().iter().any(named))
     }
 
     /// Every format for people to read: its name, and its extensions where it has several
@@ -74,7 +81,14 @@ mod tests {
         assert_eq!(Format::named_by(Path::new("a/b.Bvh")), Some(Format::Bvh));
         assert_eq!(Format::named_by(Path::new("notes.txt")), None);
         assert_eq!(Format::named_by(Path::new("fbx")), None, "a name without an extension");
-        assert_eq!(Format::every_extension().count(), 8);
-        assert_eq!(Format::listed(), "glTF .gltf/.glb, FBX, BVH, USD .usd/.usda/.usdc/.usdz");
+        assert_eq!(Format::named_by(Path::new("three/Walk.Dump.JSON")), Some(Format::PoseDump));
+        assert_eq!(Format::named_by(Path::new("log.dump.csv")), Some(Format::PoseDump));
+        assert_eq!(Format::named_by(Path::new("report.json")), None, "JSON alone is no dump");
+        assert_eq!(Format::named_by(Path::new(".glb")), None, "a hidden file named only by its extension");
+        assert_eq!(Format::every_extension().count(), 10);
+        assert_eq!(
+            Format::listed(),
+            "glTF .gltf/.glb, FBX, BVH, USD .usd/.usda/.usdc/.usdz, pose dump .dump.json/.dump.csv"
+        );
     }
 }

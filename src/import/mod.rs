@@ -1,13 +1,14 @@
 //! Turning files into a [`Rig`]: one module per format and one [`load`] entry that picks the format by content.
 //!
 //! Formats: glTF 2.0 (`gltf`), FBX binary and ASCII through ufbx (`fbx`), BVH (`bvh`), OpenUSD's UsdSkel through
-//! the `openusd` crate (`usd`). Every reader turns any
+//! the `openusd` crate (`usd`), and a runtime's pose dump (`dump`, JSON or CSV). Every reader turns any
 //! problem into an [`ImportError`] naming the file and the place in it; none may panic or allocate much more than
 //! the file's size suggests, whatever the bytes (the fuzz targets in `fuzz/` and `examples/fuzz_import.rs` check).
 
 pub mod budget;
 mod bvh;
 mod demo;
+pub mod dump;
 mod failure;
 mod fbx;
 mod format;
@@ -136,14 +137,17 @@ const FBX_ASCII_LOOKAHEAD: usize = 64 * 1024;
 ///   in its first 64 KiB;
 /// - BVH: text whose first word is `HIERARCHY`;
 /// - USD: text that starts with `#usda`, the binary magic `PXR-USDC`, or a zip archive whose first entry is a USD
-///   layer (`.usdz`).
+///   layer (`.usdz`);
+/// - pose dump: CSV whose first line is `# bonescope-pose-dump`, or JSON naming `"bonescope-pose-dump"` in its first
+///   64 KiB (before glTF, which is any other JSON).
 pub fn detect(bytes: &[u8]) -> Option<Format> {
     if bytes.starts_with(b"#usda") || bytes.starts_with(b"PXR-USDC") || is_usdz(bytes) {
         return Some(Format::Usd);
     }
-    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let start = text.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(text.len());
-    let text = &text[start..];
+    let text = text_start(bytes);
+    if dump::detect(text).is_some() {
+        return Some(Format::PoseDump);
+    }
     if bytes.starts_with(b"glTF") || text.first() == Some(&b'{') {
         return Some(Format::Gltf);
     }
@@ -159,6 +163,13 @@ pub fn detect(bytes: &[u8]) -> Option<Format> {
         return Some(Format::Bvh);
     }
     None
+}
+
+/// `bytes` from their first character that is not blank (after a UTF-8 byte-order mark).
+fn text_start(bytes: &[u8]) -> &[u8] {
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let start = text.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(text.len());
+    &text[start..]
 }
 
 /// Whether `bytes` start a zip archive whose first entry is a USD layer: a `.usdz` package.
@@ -196,6 +207,12 @@ pub fn load_with(path: &Path, options: &Options) -> Result<Rig, ImportError> {
         Some(Format::Gltf) => return gltf::load_file(path, &file).and_then(|rig| finish(path, rig)),
         Some(Format::Fbx) => return fbx::load_file(path, file, &bytes, options).and_then(|rig| finish(path, rig)),
         Some(Format::Usd) => return usd::load(path, options).and_then(|rig| finish(path, rig)),
+        Some(Format::PoseDump) => {
+            // Streamed from the bytes already read on: a dump is never held whole besides its keys.
+            let size = file.metadata().map_or(0, |m| m.len());
+            let reader = std::io::BufReader::new(std::io::Cursor::new(&bytes).chain(&file));
+            return load_dump(path, reader, size, &bytes);
+        }
         _ => {}
     }
     let size = file.metadata().map_or(0, |m| usize::try_from(m.len()).unwrap_or(0));
@@ -228,8 +245,15 @@ pub fn load_bytes_as(format: Format, path: &Path, bytes: &[u8], options: &Option
         Format::Fbx => fbx::load(path, bytes, options),
         Format::Bvh => bvh::load(path, bytes),
         Format::Usd => usd::load_bytes(path, bytes, options),
+        Format::PoseDump => return load_dump(path, bytes, bytes.len() as u64, bytes),
     };
     rig.and_then(|rig| finish(path, rig))
+}
+
+/// Reads the pose dump of `size` bytes from `reader`, whose first bytes are `head` (CSV where they do not show JSON).
+fn load_dump(path: &Path, reader: impl std::io::BufRead, size: u64, head: &[u8]) -> Result<Rig, ImportError> {
+    let syntax = dump::detect(text_start(head)).unwrap_or(dump::Syntax::Csv);
+    dump::read(reader, size, syntax).map_err(|f| f.with_path(path)).and_then(|rig| finish(path, rig))
 }
 
 #[cfg(test)]
@@ -260,6 +284,8 @@ mod tests {
         usdz.truncate(30);
         usdz.extend(b"root.png\0");
         assert_eq!(detect(&usdz), None, "a zip of something else is no USD");
+        assert_eq!(detect(b"\n{\"format\": \"bonescope-pose-dump\", \"version\": 1"), Some(Format::PoseDump));
+        assert_eq!(detect(b"# bonescope-pose-dump 1 space=world\n"), Some(Format::PoseDump));
     }
 
     #[test]

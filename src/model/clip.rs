@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use glam::{DQuat, Quat, Vec3};
+use glam::{Quat, Vec3};
 
 use super::{Span, Transform};
 
@@ -251,9 +251,11 @@ pub struct BoneTracks {
     pub translation: Option<Track<Vec3>>,
     pub rotation: Option<Track<Quat>>,
     pub scale: Option<Track<Vec3>>,
-    /// The stretch rotation while the clip plays, where the clip sets it (a format whose animation gives a whole
-    /// local transform, as UsdSkel's translations, rotations and scales do: no stretch); the rest's where `None`.
-    pub stretch: Option<DQuat>,
+    /// The stretch rotation `U` of the local transform while the clip plays, where the clip sets it: a format whose
+    /// animation gives a whole local transform (UsdSkel's translations, rotations and scales: one identity key; a
+    /// pose dump's matrices, which may shear: one key per sample, its frame kept continuous so that it slerps);
+    /// the rest's where `None`. The scale track's factors apply in this frame.
+    pub stretch: Option<Track<Quat>>,
 }
 
 impl BoneTracks {
@@ -273,7 +275,9 @@ impl BoneTracks {
         if let Some(track) = &self.scale {
             held.scale = track.held()?.as_dvec3();
         }
-        held.stretch = self.stretch.unwrap_or(held.stretch);
+        if let Some(track) = &self.stretch {
+            held.stretch = track.held()?.as_dquat().normalize();
+        }
         Some(held)
     }
 
@@ -282,7 +286,8 @@ impl BoneTracks {
         let t = self.translation.iter().map(Track::times);
         let r = self.rotation.iter().map(Track::times);
         let s = self.scale.iter().map(Track::times);
-        t.chain(r).chain(s)
+        let u = self.stretch.iter().map(Track::times);
+        t.chain(r).chain(s).chain(u)
     }
 }
 

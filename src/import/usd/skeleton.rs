@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use glam::{DMat4, DQuat, Quat, Vec3};
+use glam::{DMat4, Quat, Vec3};
 use openusd::schemas::geom::{Imageable, Xformable};
 use openusd::schemas::skel::{SkelAnimation, SkelBindingAPI, Skeleton};
 use openusd::sdf::{self, Value};
@@ -249,13 +249,16 @@ fn animation(
     let translations = tracks(joint_keys(translated, Channel::vectors, &codes, Vec3::ZERO, n)?, &times)?;
     let rotations = tracks(joint_keys(rotated, Channel::rotations, &codes, Quat::IDENTITY, n)?, &times)?;
     let scales = tracks(joint_keys(scaled, Channel::vectors, &codes, Vec3::ONE, n)?, &times)?;
+    // UsdSkel's joint transforms are whole TRS: no stretch while the clip plays, one key at its start saying so.
+    let no_stretch =
+        times.get(..1).and_then(|first| Track::new(first.into(), [Quat::IDENTITY], Interpolation::Step).ok());
     let mut tracks = Vec::new();
     let joint_tracks = translations.into_iter().zip(rotations).zip(scales);
     for (joint, ((translation, rotation), scale)) in mapped.iter().zip(joint_tracks) {
         let Some(j) = joint.filter(|&j| j < joints.len()) else { continue };
         let mut bone = BoneTracks::new(first + j);
         (bone.translation, bone.rotation, bone.scale) = (Some(translation), Some(rotation), Some(scale));
-        bone.stretch = Some(DQuat::IDENTITY);
+        bone.stretch = no_stretch.clone();
         tracks.push(bone);
     }
     let weights = match shape_names.len() {
