@@ -10,7 +10,7 @@ use super::document::{Document, Ghost};
 use super::pane::{Pane, Place, Visibility};
 use super::panel::{Panel, Shared};
 use crate::model::Choice;
-use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, Triads, ViewKind, motion_bounds, paint};
+use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, Triads, ViewKind, motion_points, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
@@ -26,8 +26,8 @@ pub enum CanvasFill {
 
 #[derive(Default)]
 pub struct Viewport {
-    /// Bounds to frame once the canvas knows its shape (framing fits them to the aspect ratio).
-    framing: Option<Bounds>,
+    /// Points to frame once the canvas knows its shape (framing fits them to the aspect ratio).
+    framing: Option<Vec<glam::DVec3>>,
     /// Where the canvas was drawn last.
     rect: Option<egui::Rect>,
 }
@@ -42,13 +42,13 @@ impl Viewport {
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
-        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at);
+        self.framing = Some(motion_points(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at));
     }
 
     /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
     pub fn frame_now(&mut self, camera: &mut Camera, aspect: f64) {
-        if let Some(bounds) = self.framing.take() {
-            camera.frame(&bounds, aspect);
+        if let Some(points) = self.framing.take() {
+            camera.frame_points(&points, aspect);
         }
     }
 

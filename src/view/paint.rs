@@ -423,7 +423,7 @@ fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette,
     }
     if let Some(worst) = worst_skin_shear {
         line(at, &format!("skin shear (most now: {})", degrees(worst, scene.neutral_shear_deg)));
-        paint_shear_scale(painter, at + egui::vec2(10.0, 14.0), scene, palette);
+        paint_shear_scale(painter, at + egui::vec2(0.0, 14.0), scene, palette);
     }
 }
 
@@ -432,12 +432,13 @@ fn degrees(shear_deg: f64, neutral: f64) -> String {
     if shear_deg < neutral { "0°".to_owned() } else { format!("{}°", short_degrees(shear_deg)) }
 }
 
-/// The painted skin's colours from `left`: the neutral colour for no shear, then the ramp from 0.1° to 10° (each
-/// decade a third of it, as [`shear_rgb`] spreads it), labelled below.
+/// The painted skin's colours from `left`: a swatch of the neutral colour for no shear, then the ramp from 0.1° to
+/// 10° (each decade half of it, as [`shear_rgb`] spreads it), labelled below.
 fn paint_shear_scale(painter: &Painter, left: Pos2, scene: &Scene, palette: &Palette) {
     const WIDTH: f32 = 120.0;
-    let bar = Rect::from_min_size(left, egui::vec2(WIDTH, 8.0));
-    let neutral = Rect::from_min_size(left - egui::vec2(14.0, 0.0), egui::vec2(10.0, 8.0));
+    let neutral = Rect::from_min_size(left, egui::vec2(10.0, 8.0));
+    // Apart enough that the labels "0" and "0.1°" below them do not touch.
+    let bar = Rect::from_min_size(left + egui::vec2(30.0, 0.0), egui::vec2(WIDTH, 8.0));
     painter.rect_filled(neutral, 1.0, palette.mesh.to_opaque());
     let mut ramp = EguiMesh::default();
     for step in 0..=24 {

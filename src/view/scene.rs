@@ -370,31 +370,28 @@ pub fn typical_scale(rig: &Rig) -> f64 {
     scales.get(scales.len() / 2).copied().unwrap_or(1.0)
 }
 
-/// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
-/// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
-/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes; the bounds grow by the size of the axis triads and
-/// boxes drawn around the joints.
-pub fn motion_bounds(
+/// The points of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
+/// (model matrices), so a camera framed on them does not need to move while the clip plays. Only the joints that
+/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes.
+pub fn motion_points(
     rig: &Rig,
     clip: Option<&Clip>,
     span: Span,
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
-) -> Option<Bounds> {
+) -> Vec<DVec3> {
     let framed = rig.skeleton.figure();
     let mut morph = MorphPose::default();
-    let bounds = (0..samples.max(1))
-        .filter_map(|i| {
-            let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
-            let model = pose_at(time);
-            morph.evaluate(clip, time);
-            let meshes = skin_meshes(rig, &model, &morph);
-            let heads = model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
-            Bounds::of(heads.chain(meshes.into_iter().flatten()))
-        })
-        .reduce(Bounds::union)?;
-    let gizmo = DVec3::splat(gizmo_size(rig));
-    Some(Bounds { min: bounds.min - gizmo, max: bounds.max + gizmo })
+    let mut points = Vec::new();
+    for i in 0..samples.max(1) {
+        let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
+        let model = pose_at(time);
+        morph.evaluate(clip, time);
+        let meshes = skin_meshes(rig, &model, &morph);
+        points.extend(model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate()));
+        points.extend(meshes.into_iter().flatten().filter(|p| p.is_finite()));
+    }
+    points
 }
 
 /// The bounds of the rest pose's joints and meshes.
