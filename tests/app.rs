@@ -8,14 +8,21 @@ use bonescope::model::InheritMode;
 use common::{asset, settle};
 use egui::accesskit::Role;
 use egui_kittest::Harness;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 fn demo_app() -> Harness<'static, BonescopeApp> {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
-        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+        .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
     settle(&mut harness);
     harness
+}
+
+/// `app` without the first view its analysis would set ([`bonescope::app::Window::opening`]): for the tests that
+/// pick their own bone and time, as a user may before the analysis lands (the opening has tests of its own).
+fn unopened(mut app: BonescopeApp) -> BonescopeApp {
+    app.window.opening = false;
+    app
 }
 
 fn bone(harness: &Harness<'static, BonescopeApp>, name: &str) -> usize {
@@ -72,7 +79,7 @@ fn changing_every_bone_to_segment_compensate_removes_the_shear() {
 fn laptop_demo() -> Harness<'static, BonescopeApp> {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+        .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
     settle(&mut harness);
     harness
 }
@@ -96,7 +103,7 @@ fn the_plot_controls_and_the_top_bar_hold_still_whatever_is_chosen() {
     rig.clips[1].name = Some("a take named after its studio's whole folder path, as exporters do".into());
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), Document::new(None, rig))));
     settle(&mut harness);
     harness.get_by_label("forearm").click();
     settle(&mut harness);
@@ -271,7 +278,7 @@ fn layers_app(doc: Document) -> Harness<'static, BonescopeApp> {
     let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(settings, doc)));
     settle(&mut harness);
     harness
 }
@@ -341,7 +348,7 @@ fn a_ten_million_frame_take_opens_and_its_analysis_finishes() {
     let rig = bonescope::import::load(&path).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(Some(path), rig)));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), Document::new(Some(path), rig))));
     harness.get_by_label("pCube1").click();
     settle(&mut harness);
     assert!(harness.state().session.doc.clip().unwrap().span().length() > 333_000.0);
@@ -395,7 +402,7 @@ fn asset_app(path: &str) -> Harness<'static, BonescopeApp> {
     let doc = Document::load(&asset(path)).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), doc)));
     settle(&mut harness);
     harness
 }
@@ -555,7 +562,7 @@ fn playback_follows_the_wall_clock_when_frames_are_slow() {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))
         .with_step_dt(0.25)
-        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+        .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
     settle(&mut harness);
     harness.key_press(egui::Key::Space);
     harness.step();
@@ -592,7 +599,7 @@ fn selecting_a_bone_does_not_move_the_viewport() {
     let settings = Settings::default().showing(&bonescope::app::Pane::LAYERS, true);
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
-        .build_eframe(move |_cc| BonescopeApp::new(settings, Document::demo()));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(settings, Document::demo())));
     settle(&mut harness);
     let before = harness.get_by_label("viewport").rect();
     assert!(before.width() >= 0.4 * 1000.0, "the viewport keeps 40 % of the window: {before:?}");
@@ -863,7 +870,7 @@ fn laptop_app(path: &str, bone: &str, time: f64) -> Harness<'static, BonescopeAp
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
         .with_max_steps(12)
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(settings, doc)));
     harness.state_mut().window.time = time;
     harness.state_mut().window.selection = vec![index];
     settle(&mut harness);
@@ -976,7 +983,7 @@ fn frames_are_frames_everywhere_once_chosen() {
     let doc = Document::load(&asset("bvh/cmu_12_01_walk.bvh")).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(settings, doc)));
     settle(&mut harness);
     let rate = harness.state().session.doc.frame_rate();
     let frames = (harness.state().session.doc.span().length() * rate).round();
@@ -1059,7 +1066,7 @@ fn a_narrow_window_keeps_every_toolbar_control_with_a_long_take_name() {
     rig.clips[0].name = Some("Character1|Take 001|BaseLayer|walk_cycle_final_v12_approved_by_lead".to_owned());
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), doc)));
     settle(&mut harness);
     let layers = harness.get_by_label("Layers").rect();
     assert!(layers.right() <= 1000.0 && layers.bottom() <= 700.0, "{layers:?}");
@@ -1114,7 +1121,7 @@ fn a_z_up_bvh_compared_says_it_lies_down_and_stands_up_on_the_axis_picked() {
     let doc = Document::load(&asset("blender/stretchy_full.glb")).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), doc)));
     settle(&mut harness);
     harness.state_mut().compare(&asset("blender/stretchy_full.bvh"));
     settle(&mut harness);
@@ -1486,7 +1493,7 @@ fn a_node_its_file_leaves_unnamed_reads_node_and_its_number() {
     rig.skeleton = Skeleton::new(bones).unwrap();
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), Document::new(None, rig))));
     settle(&mut harness);
     in_pane(&harness, "Skeleton", &format!("(node {node})"));
 }
@@ -1595,7 +1602,7 @@ fn a_file_opens_on_the_clip_that_keys_the_most_channels() {
     rig.clips = vec![Clip::new(0, Some("eyes only".into()), vec![eyes], vec![]), stretch];
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), Document::new(None, rig))));
     settle(&mut harness);
     assert_eq!(harness.state().session.doc.clip().map(|c| c.label()).as_deref(), Some("stretch"));
 }
@@ -1623,7 +1630,7 @@ fn the_time_unit_picker_holds_still_for_another_clips_length() {
     rig.clips[1] = rig.clips[1].clone().with_span(bonescope::model::Span::new(0.0, 12.5));
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), Document::new(None, rig)));
+        .build_eframe(move |_cc| unopened(BonescopeApp::new(Settings::default(), Document::new(None, rig))));
     settle(&mut harness);
     let picker = |harness: &Harness<'static, BonescopeApp>| harness.get_by_role_and_label(Role::ComboBox, "in").rect();
     let before = picker(&harness);
@@ -1637,7 +1644,7 @@ fn the_time_unit_picker_holds_still_for_another_clips_length() {
 fn a_small_window_plots_taller_than_a_strip() {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
-        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+        .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
     settle(&mut harness);
     harness.get_by_label("forearm").click();
     settle(&mut harness);
@@ -1645,4 +1652,97 @@ fn a_small_window_plots_taller_than_a_strip() {
     let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
     let height = memory().transform().frame().height();
     assert!(height > 45.0, "the plot is {height} points tall");
+}
+
+#[test]
+fn a_file_that_shears_opens_on_its_worst_bone_at_its_worst_time_with_why() {
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    settle(&mut harness);
+    let worst = {
+        let scan = &harness.state().analysis().expect("analysed").scan;
+        let worst = scan.stretched_worst_first()[0];
+        (worst.index, worst.worst_shear_time)
+    };
+    assert_eq!(worst.0, bone(&harness, "forearm"));
+    assert_eq!(harness.state().window.selection, vec![worst.0]);
+    assert_eq!(harness.state().window.time, worst.1);
+    // Its shear is plotted, and the Why? section is open on its headline.
+    harness.get_by_label("forearm shear°");
+    settle(&mut harness);
+    harness.get_by_label_contains("forearm: upper_arm's scale");
+}
+
+#[test]
+fn a_file_without_shear_says_so_once_and_opens_at_its_start() {
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
+    harness.state_mut().open(&asset("bvh/cmu_12_01_walk.bvh"));
+    settle(&mut harness);
+    let app = harness.state();
+    let (start, bones) = (app.session.doc.span().start, app.session.doc.rig.skeleton.len());
+    assert!(app.window.selection.is_empty());
+    assert_eq!(app.window.time, start);
+    let clip = app.session.doc.clip().unwrap().label();
+    let said = format!("no bone shears in `{clip}`: 0 of {bones} bones");
+    assert_eq!(harness.get_all_by_label_contains(&said).count(), 1, "{said}");
+}
+
+#[test]
+fn f_frames_the_selected_bone_and_everything_below_it() {
+    use bonescope::view::{Camera, paint::projection};
+    let mut harness = laptop_demo();
+    in_pane(&harness, "Skeleton", "shoulder").click();
+    settle(&mut harness);
+    // Close up on the shoulder: the hand is far out of view.
+    let shoulder = bone(&harness, "shoulder");
+    let heads = |app: &BonescopeApp| -> Vec<glam::DVec3> {
+        let pose = app.session.doc.evaluation().pose_at(app.window.time);
+        pose.model.model.iter().map(|m| m.w_axis.truncate()).collect()
+    };
+    let target = heads(harness.state())[shoulder];
+    harness.state_mut().settings.camera = Camera { target, distance: 0.05, ..Camera::default() };
+    let canvas = harness.get_by_label("viewport").rect();
+    harness.hover_at(canvas.center());
+    harness.key_press(egui::Key::F);
+    settle(&mut harness);
+    let app = harness.state();
+    // The picture is the canvas less the caption's strip of three lines (file and clip, time, mode).
+    let picture = egui::Rect::from_min_max(canvas.min, egui::pos2(canvas.max.x, canvas.max.y - 3.0 * 17.0 - 8.0));
+    let projection = projection(&app.settings.camera, picture);
+    for (bone, head) in heads(app).into_iter().enumerate() {
+        let (at, _) = projection.project(head).unwrap();
+        let at = egui::pos2(at.x as f32, at.y as f32);
+        assert!(picture.contains(at), "bone {bone} at {at:?}, outside {picture:?}");
+    }
+}
+
+#[test]
+fn the_axes_picker_chooses_whose_triads_are_drawn() {
+    use bonescope::view::Triads;
+    let mut harness = laptop_demo();
+    assert_eq!(harness.state().settings.scene.triads, Triads::Stretched, "by default, where they help");
+    harness.get_by_role_and_label(Role::ComboBox, "Axes").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "all").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().settings.scene.triads, Triads::All);
+}
+
+#[test]
+fn the_shear_toggle_sits_beside_mesh_and_greys_without_one() {
+    let mut harness = laptop_demo();
+    let (mesh, shear) = (harness.get_by_label("Mesh").rect(), harness.get_by_label("Shear").rect());
+    assert!(shear.left() > mesh.right() && shear.left() - mesh.right() < 12.0, "{mesh:?} then {shear:?}");
+    assert!((shear.center().y - mesh.center().y).abs() < 1.0, "on one row");
+    assert!(harness.state().settings.scene.shear, "on by default");
+    harness.get_by_label("Shear").click();
+    settle(&mut harness);
+    assert!(!harness.state().settings.scene.shear);
+    harness.state_mut().open(&asset("bvh/cmu_12_01_walk.bvh"));
+    settle(&mut harness);
+    assert!(harness.get_by_label("Shear").accesskit_node().is_disabled(), "a mocap file has no mesh to paint");
+    assert_eq!(harness.get_by_label("Shear").rect(), shear, "greyed, not gone");
 }

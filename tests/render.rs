@@ -163,7 +163,7 @@ fn bad_requests_fail_with_a_message_that_names_the_problem() {
         (&["render", "--select", "elbow", "--out", arg(&out)], "no bone named `elbow`"),
         (&["render", "--size", "0x10", "--out", arg(&out)], "0×10"),
         (&["render", "--reference", "/no/such/reference.png"], "/no/such/reference.png"),
-        (&["render", "--show", "bones,shear", "--out", arg(&out)], "unknown item `shear`"),
+        (&["render", "--show", "bones,sheer", "--out", arg(&out)], "unknown item `sheer`"),
     ];
     for (args, expected) in cases {
         let output = bonescope(args);
@@ -185,7 +185,7 @@ fn the_readme_pictures_are_what_their_commands_render() {
         .lines()
         .filter(|line| line.starts_with("bonescope render ") && line.contains("--out assets/readme/"))
         .collect();
-    assert_eq!(commands.len(), 4, "docs/app.md shows four pictures' commands");
+    assert_eq!(commands.len(), 5, "docs/app.md shows five pictures' commands");
     let out = Path::new(env!("CARGO_TARGET_TMPDIR"));
     for command in commands {
         let mut args: Vec<String> = command.split_whitespace().skip(1).map(str::to_owned).collect();
@@ -287,13 +287,13 @@ fn gizmos_are_visible_at_the_opening_view() {
 }
 
 #[test]
-fn a_selected_bone_shows_its_axes_with_the_axes_toggle_off() {
+fn axes_on_the_selection_draw_the_selected_bones_triad() {
     // What the Why? section's chain relies on: picking an ancestor shows its scale in its triad. Pixels of the Y
-    // axis's green (80, 200, 90) count the triads of a bones-only render of the demo.
+    // axis's green (80, 200, 90) count the triads of a render of the demo's bones with `axes=selected`.
     let dir = TempDir::new().unwrap();
     let greens = |extra: &[&str]| {
         let out = path(&dir, &format!("{}.png", extra.len()));
-        let mut args = vec!["render", "--show", "bones", "--time", "0.5", "--out", arg(&out)];
+        let mut args = vec!["render", "--show", "bones,axes=selected", "--time", "0.5", "--out", arg(&out)];
         args.extend_from_slice(extra);
         succeeds(&bonescope(&args));
         let image = image::open(out).unwrap().to_rgba8();
@@ -301,6 +301,6 @@ fn a_selected_bone_shows_its_axes_with_the_axes_toggle_off() {
         image.pixels().filter(|p| near(p)).count()
     };
     let (none, selected) = (greens(&[]), greens(&["--select", "forearm"]));
-    assert!(none <= 2, "no triad without the toggle or a selection: {none} green pixels");
-    assert!(selected >= 10, "the selected forearm's triad: {selected} green pixels");
+    assert!(none <= 2, "no triad without a selection: {none} green pixels");
+    assert!(selected >= 10, "the selected forearm's chain's triads: {selected} green pixels");
 }

@@ -15,13 +15,20 @@ fn window(settings: Settings, doc: Document, time: f64, bone: Option<&str>) -> H
         .with_size(egui::vec2(1400.0, 900.0))
         .with_render_cursor(false)
         .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+        .build_eframe(move |_cc| chosen(BonescopeApp::new(settings, doc)));
     harness.state_mut().window.time = time;
     if let Some(bone) = bone {
         harness.get_by_label(bone).click();
     }
     settle_for_snapshot(&mut harness);
     harness
+}
+
+/// `app` for a picture whose bone and time the test chooses: without the first view its analysis would set
+/// ([`bonescope::app::Window::opening`]), which the `first_view` pictures show.
+fn chosen(mut app: BonescopeApp) -> BonescopeApp {
+    app.window.opening = false;
+    app
 }
 
 /// Lets the background analysis finish, then runs a fixed number of frames rather than `common::settle`'s `run()`:
@@ -231,7 +238,7 @@ fn laptop(
         .with_size(size)
         .with_render_cursor(false)
         .wgpu()
-        .build_eframe(move |_cc| BonescopeApp::new(settings, doc));
+        .build_eframe(move |_cc| chosen(BonescopeApp::new(settings, doc)));
     harness.state_mut().window.time = time;
     harness.state_mut().window.selection = vec![index];
     settle_for_snapshot(&mut harness);
@@ -302,4 +309,42 @@ fn demo_compared_with_its_trs_bake() {
     harness.get_by_label("ghost").click();
     settle_for_snapshot(&mut harness);
     harness.snapshot("demo_compared_with_its_trs_bake");
+}
+
+/// The first view of a file as it opens, nothing chosen: the worst bone selected at its worst time, its skin
+/// painted by shear, its shear plotted and the Why? section open; the figure filling the viewport.
+fn first_view(size: egui::Vec2, doc: Document) -> Harness<'static, BonescopeApp> {
+    let mut harness = Harness::builder()
+        .with_size(size)
+        .with_render_cursor(false)
+        .wgpu()
+        .build_eframe(move |_cc| BonescopeApp::new(Settings::default(), doc));
+    settle_for_snapshot(&mut harness);
+    // The Why? section explains off the UI thread once the bone is selected.
+    settle_for_snapshot(&mut harness);
+    harness
+}
+
+const LAPTOP: egui::Vec2 = egui::vec2(1280.0, 800.0);
+
+#[test]
+fn first_view_demo() {
+    first_view(LAPTOP, Document::demo()).snapshot("first_view_demo");
+}
+
+#[test]
+fn first_view_demo_small_window() {
+    first_view(egui::vec2(1000.0, 700.0), Document::demo()).snapshot("first_view_demo_1000x700");
+}
+
+#[test]
+fn first_view_blender_stretchy_full() {
+    first_view(LAPTOP, asset_document("blender/stretchy_full.glb")).snapshot("first_view_stretchy_full");
+}
+
+#[test]
+fn first_view_godot_mannequiny() {
+    let path = common::corpus("realworld/godot_mannequiny.glb");
+    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    first_view(LAPTOP, Document::new(Some(path), rig)).snapshot("first_view_godot_mannequiny");
 }

@@ -13,6 +13,7 @@ use super::panel::{Panel, Shared};
 use super::text;
 use crate::analysis::Findings;
 use crate::model::{Choice, ModeChoice, NodeRole};
+use crate::view::style::short_degrees;
 use crate::view::{Badge, Palette};
 
 #[derive(Default)]
@@ -338,16 +339,6 @@ fn badge(ui: &mut egui::Ui, findings: &Findings) {
 /// The badge's slot.
 const BADGE_WIDTH: f32 = 12.0;
 
-/// An angle in degrees as the outliner's "max" note gives it: one decimal from 1° up, below that two significant
-/// digits (a bone flagged at 0.043° must not read "0.0°", as if nothing sheared).
-fn short_degrees(degrees: f64) -> String {
-    if !(degrees > 0.0 && degrees < 1.0) {
-        return format!("{degrees:.1}");
-    }
-    let decimals = (1 - degrees.log10().floor() as i32).clamp(1, 12) as usize;
-    format!("{degrees:.decimals$}")
-}
-
 /// The room an icon takes before its name in the legend.
 const ICON_WIDTH: f32 = 14.0;
 
@@ -400,13 +391,5 @@ mod tests {
         let step = indent_step(12, 270.0);
         assert!(step < INDENT && 12.0 * step <= MAX_INDENT_SHARE * 270.0 + 1e-3, "{step}");
         assert_eq!(indent_step(200, 270.0), MIN_INDENT, "a level still reads as one");
-    }
-
-    #[test]
-    fn a_small_worst_shear_keeps_its_digits() {
-        assert_eq!(short_degrees(24.26), "24.3");
-        assert_eq!(short_degrees(0.5), "0.50");
-        assert_eq!(short_degrees(0.0432), "0.043");
-        assert_eq!(short_degrees(0.000_012_3), "0.000012");
     }
 }

@@ -28,11 +28,12 @@ type Channel = (&'static str, fn(&Components) -> f64);
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Component {
     Translation,
-    #[default]
     Rotation,
     Scale,
     Stretch,
     Sign,
+    /// What bonescope is for: a bone selected shows its shear over the clip first.
+    #[default]
     Shear,
 }
 

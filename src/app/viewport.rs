@@ -10,7 +10,7 @@ use super::document::{Document, Ghost};
 use super::pane::{Pane, Place, Visibility};
 use super::panel::{Panel, Shared};
 use crate::model::Choice;
-use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, ViewKind, motion_bounds, paint};
+use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, Triads, ViewKind, motion_points, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
@@ -26,8 +26,8 @@ pub enum CanvasFill {
 
 #[derive(Default)]
 pub struct Viewport {
-    /// Bounds to frame once the canvas knows its shape (framing fits them to the aspect ratio).
-    framing: Option<Bounds>,
+    /// Points to frame once the canvas knows its shape (framing fits them to the aspect ratio).
+    framing: Option<Vec<glam::DVec3>>,
     /// Where the canvas was drawn last.
     rect: Option<egui::Rect>,
 }
@@ -42,13 +42,13 @@ impl Viewport {
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
-        self.framing = motion_bounds(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at);
+        self.framing = Some(motion_points(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at));
     }
 
     /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
     pub fn frame_now(&mut self, camera: &mut Camera, aspect: f64) {
-        if let Some(bounds) = self.framing.take() {
-            camera.frame(&bounds, aspect);
+        if let Some(points) = self.framing.take() {
+            camera.frame_points(&points, aspect);
         }
     }
 
@@ -66,6 +66,7 @@ impl Viewport {
         };
         scene.caption = caption(shared);
         scene.selected = shared.selection.clone();
+        scene.neutral_shear_deg = shared.settings.tolerances.min_shear_deg;
         if shared.settings.scene.bind_pose {
             scene.bind_pose = Some(DrawnPose::bind(&rig, &scene.primary));
         }
@@ -128,19 +129,32 @@ fn navigate(ui: &Ui, response: &egui::Response, rect: egui::Rect, camera: &mut C
     }
 }
 
-/// Frames the selected bones with their children (a bone is its head and where its children start), at least a few
-/// gizmo sizes across so a single joint does not fill the picture; everything when nothing is selected.
+/// Frames the selected bones and everything drawn below them (every descendant's joint, and the tails of the last ones:
+/// `F` on the hips shows the whole figure), at least a few gizmo sizes across so a single joint does not fill the
+/// picture; everything when nothing is selected.
 fn frame_selection(scene: &Scene, selection: &[usize], camera: &mut Camera, aspect: f64) {
-    let skeleton = &scene.rig.skeleton;
-    let children = |bone: usize| (0..skeleton.len()).filter(move |&c| skeleton.parent(c) == Some(bone));
-    let points = selection.iter().flat_map(|&b| std::iter::once(b).chain(children(b))).map(|b| scene.primary.head(b));
-    let selected = Bounds::of(points).map(|b| {
+    let below: Vec<usize> = below(&scene.rig.skeleton, selection).into_iter().filter(|&b| scene.shows(b)).collect();
+    let heads = below.iter().map(|&b| scene.primary.head(b));
+    let tails = below.iter().filter_map(|&b| scene.tail(&scene.primary, b));
+    let selected = Bounds::of(heads.chain(tails)).map(|b| {
         let half = glam::DVec3::splat(scene.gizmo_size * 2.0);
         Bounds { min: b.min.min(b.center() - half), max: b.max.max(b.center() + half) }
     });
     if let Some(bounds) = selected.or_else(|| scene.bounds()) {
         camera.frame(&bounds, aspect);
     }
+}
+
+/// The bones of `selection` and all their descendants (parents come before children, so one pass finds them).
+fn below(skeleton: &crate::model::Skeleton, selection: &[usize]) -> Vec<usize> {
+    let mut inside = vec![false; skeleton.len()];
+    for &bone in selection.iter().filter(|&&b| b < skeleton.len()) {
+        inside[bone] = true;
+    }
+    for bone in 0..skeleton.len() {
+        inside[bone] |= skeleton.parent(bone).is_some_and(|p| inside[p]);
+    }
+    (0..skeleton.len()).filter(|&b| inside[b]).collect()
 }
 
 fn aspect(rect: egui::Rect) -> f64 {
@@ -158,11 +172,19 @@ fn toggles(ui: &mut Ui, shared: &mut Shared) {
         ui.selectable_value(&mut shared.settings.camera.view, view, view.label());
     }
     ui.separator();
+    let has_mesh = !shared.doc.rig.meshes.is_empty();
     let o = &mut shared.settings.scene;
     ui.toggle_value(&mut o.bones, "Bones");
-    ui.toggle_value(&mut o.axes, "Axes");
+    triads_picker(ui, &mut o.triads);
     ui.toggle_value(&mut o.boxes, "Boxes").on_hover_text("a unit box per bone: shear slants it");
     ui.toggle_value(&mut o.mesh, "Mesh");
+    // Greyed, not gone, where there is no mesh to paint: the toggles after it stay where they are.
+    ui.add_enabled_ui(has_mesh && o.mesh, |ui| {
+        ui.toggle_value(&mut o.shear, "Shear")
+            .on_hover_text("the mesh painted by the shear each vertex is skinned with (legend in degrees)")
+    })
+    .response
+    .on_disabled_hover_text("paints the mesh: no mesh shown");
     ui.toggle_value(&mut o.wireframe, "Wireframe");
     ui.toggle_value(&mut o.bind_pose, "Bind pose");
     ui.toggle_value(&mut o.helpers, "Helpers")
@@ -170,6 +192,21 @@ fn toggles(ui: &mut Ui, shared: &mut Shared) {
     ui.toggle_value(&mut o.names, "Names");
     ui.toggle_value(&mut o.grid, "Grid");
     ui.toggle_value(&mut o.legend, "Legend");
+}
+
+/// Whose axis triads are drawn.
+fn triads_picker(ui: &mut Ui, triads: &mut Triads) {
+    let label = ui.label("Axes");
+    egui::ComboBox::from_id_salt("triads")
+        .selected_text(triads.id())
+        .show_ui(ui, |ui| {
+            for &choice in Triads::ALL {
+                ui.selectable_value(triads, choice, choice.id()).on_hover_text(choice.description());
+            }
+        })
+        .response
+        .labelled_by(label.id)
+        .on_hover_text("whose axis triads are drawn, at the rig's size: a sheared frame loses its right angles");
 }
 
 impl Panel for Viewport {

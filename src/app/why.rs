@@ -142,6 +142,13 @@ fn flagged(shared: &Shared, bone: usize) -> Option<bool> {
     Some(shared.results.analysis.as_ref()?.scan.bones.get(bone).is_some_and(|b| b.stretched()))
 }
 
+/// Opens the section (a file opened on its worst bone shows why at once).
+pub fn open(ctx: &egui::Context) {
+    let mut state = collapsing(ctx);
+    state.set_open(true);
+    state.store(ctx);
+}
+
 /// Whether the section is open: one state for every bone, so that it stays open while the selection changes.
 fn collapsing(ctx: &egui::Context) -> CollapsingState {
     CollapsingState::load_with_default_open(ctx, egui::Id::unique("inspector-why"), false)

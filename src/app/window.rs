@@ -18,7 +18,7 @@ use super::timeline::{self, PlayClock};
 use super::toolbar::{self, Actions, Menus};
 use super::viewport::{CanvasFill, Viewport};
 use super::work::{Wanted, Work};
-use super::{inspector, layers, outliner, plots};
+use super::{inspector, layers, outliner, plots, why};
 use crate::analysis::ClipAnalysis;
 use crate::model::Span;
 
@@ -61,6 +61,9 @@ pub struct Window {
     span: Span,
     /// Selected bones; the last one is the inspected one.
     pub selection: Vec<usize>,
+    /// Whether the first view of a file opened is still to come from its whole-clip analysis ([`Window::open_on_the_problem`]).
+    /// Headless renders, which say what to show, turn it off.
+    pub opening: bool,
     viewport: Viewport,
     panels: Vec<Box<dyn Panel>>,
     spans: SpanCache,
@@ -80,6 +83,7 @@ impl Window {
             playing: false,
             span: Span::default(),
             selection: Vec::new(),
+            opening: false,
             viewport: Viewport::default(),
             panels: panels(),
             spans: SpanCache::default(),
@@ -97,6 +101,7 @@ impl Window {
     pub fn replaced(&mut self, how: Replaced, doc: &Document) {
         match how {
             Replaced::Opened => {
+                self.opening = true;
                 self.selection.clear();
                 self.span = doc.span();
                 self.time = self.span.start;
@@ -108,6 +113,33 @@ impl Window {
                 if !same_bones {
                     self.viewport.frame_all(doc);
                 }
+            }
+        }
+    }
+
+    /// The first view of a file opened, once its whole-clip analysis is there: where a bone shears, the worst one
+    /// selected (its shear plotted, the Why? section open) at its worst time; where none does, a line that says so,
+    /// the clip staying at its start. A bone or a time the user chose while the analysis ran stands.
+    fn open_on_the_problem(&mut self, ctx: &egui::Context, doc: &Document, work: &Work, settings: &Settings) {
+        if !self.opening {
+            return;
+        }
+        let Some(analysis) = work.analysis(&self.wanted(doc, settings)) else { return };
+        self.opening = false;
+        if !self.selection.is_empty() || self.time != self.span.start || self.playing {
+            return;
+        }
+        match analysis.scan.stretched_worst_first().first() {
+            Some(worst) => {
+                self.selection = vec![worst.index];
+                self.time = worst.worst_shear_time;
+                why::open(ctx);
+                ctx.request_repaint();
+            }
+            None => {
+                let clip = doc.clip().map_or_else(|| "the rest pose".to_owned(), |c| format!("`{}`", c.label()));
+                let bones = analysis.scan.bones.len();
+                self.notifications.info_about(&doc.title(), format!("no bone shears in {clip}: 0 of {bones} bones"));
             }
         }
     }
@@ -215,6 +247,10 @@ impl Window {
             });
         }
         actions.undo |= undo_asked;
+        // After the panels: a bone clicked in this very frame stands.
+        if self.chrome == Chrome::Window {
+            self.open_on_the_problem(&ctx, &session.doc, work, settings);
+        }
         self.notifications.ui(&ctx, self.viewport.rect().unwrap_or_else(|| ctx.content_rect()));
         let folder = browsing_folder(&session.doc, settings);
         if let Some((path, purpose)) = self.dialogs.ui(&ctx, &folder, &mut self.notifications) {

@@ -265,6 +265,8 @@ fn app(args: &RenderArgs) -> anyhow::Result<BonescopeApp> {
         app.settings.camera.distance = distance;
     }
     app.window.selection = selection;
+    // A render shows what its options say, not the bone a file would open on.
+    app.window.opening = false;
     app.window.chrome = if args.ui { Chrome::Window } else { Chrome::ViewportOnly };
     Ok(app)
 }

@@ -18,7 +18,7 @@
 use glam::{DMat3, DMat4, DQuat, DVec3};
 
 use super::MorphPose;
-use crate::math::decompose;
+use crate::math::{decompose, largest_column_cosine, shear_deg_of_cosine};
 use crate::model::{Choice, Mesh, Rig, Skin};
 
 /// Which skinning to use: the file's (per skin and vertex), or one of them everywhere (engines differ).
@@ -304,14 +304,8 @@ impl Skinner {
         each(&mut |v| any_dq |= method.dq_weight(mesh, v) > 0.0);
         let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
         each(&mut |v| {
-            // Weights as long as the joints (importers check): a shorter list skins the vertices it covers.
-            let Some(weights) = mesh.weights.get(v) else { return };
+            let Some(influences) = influences(mesh, v) else { return };
             let p = positions[v].as_dvec3();
-            let influences = mesh.joints[v]
-                .iter()
-                .zip(weights)
-                .filter(|(_, w)| **w != 0.0)
-                .map(|(&j, &w)| (usize::from(j), f64::from(w)));
             let dq = method.dq_weight(mesh, v);
             let linear = || influences.clone().map(|(j, w)| joints[j].transform_point3(p) * w).sum::<DVec3>();
             out[v] = match dq {
@@ -321,6 +315,13 @@ impl Skinner {
             };
         });
     }
+}
+
+/// The joints vertex `v` of `mesh` is weighted to, with their weights (zero weights skipped); `None` past the end of
+/// the weights (importers keep them as long as the joints: a shorter list skins the vertices it covers).
+fn influences(mesh: &Mesh, v: usize) -> Option<impl Iterator<Item = (usize, f64)> + Clone + '_> {
+    let weights = mesh.weights.get(v)?;
+    Some(mesh.joints[v].iter().zip(weights).filter(|(_, w)| **w != 0.0).map(|(&j, &w)| (usize::from(j), f64::from(w))))
 }
 
 /// The skin of `mesh` among `skins`, where it has one with a joint list per vertex.
@@ -345,30 +346,92 @@ impl RigidStretch {
     }
 }
 
-/// Kavan's blend of the rigid parts (signs aligned with the first influence, so the blend takes the short way) with
-/// the stretches blended linearly, applied to `p`.
+/// A blend of joints by dual quaternions: the unit rigid part (rotation and translation) and the blended stretch.
+struct DualBlend {
+    rotation: DQuat,
+    translation: DVec3,
+    stretch: DMat3,
+}
+
+impl DualBlend {
+    /// Kavan's blend of the rigid parts (signs aligned with the first influence, so the blend takes the short way)
+    /// with the stretches blended linearly; `None` for no weight.
+    fn of(joints: &[RigidStretch], influences: impl Iterator<Item = (usize, f64)>) -> Option<Self> {
+        let (mut real, mut dual, mut stretch) =
+            (DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DMat3::ZERO);
+        let (mut first, mut total): (Option<DQuat>, f64) = (None, 0.0);
+        for (j, w) in influences {
+            total += w;
+            let joint = &joints[j];
+            let reference = *first.get_or_insert(joint.real);
+            let w_signed = if reference.dot(joint.real) < 0.0 { -w } else { w };
+            real += joint.real * w_signed;
+            dual += joint.dual * w_signed;
+            stretch += joint.stretch * w;
+        }
+        let length = real.length();
+        if length == 0.0 || total == 0.0 {
+            return None;
+        }
+        // Unit dual quaternion, and the stretch over the weights' sum (stored weights may sum to 1 ± 1e-7).
+        let (real, dual) = (real / length, dual / length);
+        // t = 2 · dual · real*, the translation of a unit dual quaternion.
+        let t = dual * real.conjugate() * 2.0;
+        Some(DualBlend { rotation: real, translation: DVec3::new(t.x, t.y, t.z), stretch: stretch / total })
+    }
+
+    /// The linear part of the blend, `R · S`.
+    fn linear(&self) -> DMat3 {
+        DMat3::from_quat(self.rotation) * self.stretch
+    }
+}
+
+/// `p` skinned by the dual-quaternion blend of `influences` (left where it is for no weight).
 fn dual_quaternion(joints: &[RigidStretch], influences: impl Iterator<Item = (usize, f64)>, p: DVec3) -> DVec3 {
-    let (mut real, mut dual, mut stretch) =
-        (DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0), DMat3::ZERO);
-    let (mut first, mut total): (Option<DQuat>, f64) = (None, 0.0);
-    for (j, w) in influences {
-        total += w;
-        let joint = &joints[j];
-        let reference = *first.get_or_insert(joint.real);
-        let w_signed = if reference.dot(joint.real) < 0.0 { -w } else { w };
-        real += joint.real * w_signed;
-        dual += joint.dual * w_signed;
-        stretch += joint.stretch * w;
-    }
-    let length = real.length();
-    if length == 0.0 || total == 0.0 {
-        return p;
-    }
-    // Unit dual quaternion, and the stretch over the weights' sum (stored weights may sum to 1 ± 1e-7).
-    let (real, dual, stretch) = (real / length, dual / length, stretch / total);
-    // t = 2 · dual · real*, the translation of a unit dual quaternion.
-    let t = dual * real.conjugate() * 2.0;
-    real * (stretch * p) + DVec3::new(t.x, t.y, t.z)
+    DualBlend::of(joints, influences).map_or(p, |b| b.rotation * (b.stretch * p) + b.translation)
+}
+
+/// The shear each vertex of `mesh` is skinned with at the pose `model` (the model matrices of all bones), in
+/// degrees: the shear of the vertex's own skinning transform (what the skin really does to the mesh around it,
+/// through `method`'s blend), read in the bind frame of its heaviest joint. That frame makes a vertex weighted to one
+/// bone read exactly that bone's shear ([`crate::analysis::Assessment::shear_deg`]: the largest deviation from 90°
+/// between the columns); a vertex between bones reads the shear their blend gives it, which their weighted shears
+/// need not sum to (two turned bones blend into a squash). An unskinned mesh has its bone's shear throughout.
+/// Morph targets move the positions, not the transform: they change no vertex's shear.
+pub fn vertex_shears(mesh: &Mesh, skins: &[Skin], model: &[DMat4], method: Method) -> Vec<f64> {
+    let count = mesh.positions.len();
+    let Some(skin) = skin_of(mesh, skins) else {
+        return vec![column_shear_deg(&DMat3::from_mat4(model[mesh.bone])); count];
+    };
+    let mut joints = Vec::new();
+    joint_matrices(skin, model, &mut joints);
+    let any_dq = (0..count).any(|v| method.dq_weight(mesh, v) > 0.0);
+    let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
+    // Each joint's bind frame: the inverse of its inverse bind matrix's linear part.
+    let bind: Vec<DMat3> = skin.inverse_bind.iter().map(|m| DMat3::from_mat4(*m).inverse()).collect();
+    let shear = |v: usize| {
+        let influences = influences(mesh, v)?;
+        let (heaviest, _) = influences.clone().max_by(|a, b| a.1.total_cmp(&b.1))?;
+        let linear = || influences.clone().map(|(j, w)| DMat3::from_mat4(joints[j]) * w).sum::<DMat3>();
+        let dual = || DualBlend::of(&rigid, influences.clone()).map_or(DMat3::IDENTITY, |b| b.linear());
+        let skinning = match method.dq_weight(mesh, v) {
+            0.0 => linear(),
+            1.0 => dual(),
+            d => linear() * (1.0 - d) + dual() * d,
+        };
+        Some(column_shear_deg(&(skinning * bind[heaviest])))
+    };
+    (0..count).map(|v| shear(v).unwrap_or(0.0)).collect()
+}
+
+/// The largest deviation from 90° between two columns of `m`, in degrees.
+fn column_shear_deg(m: &DMat3) -> f64 {
+    shear_deg_of_cosine(largest_column_cosine(m))
+}
+
+/// [`vertex_shears`] of every mesh of the rig at the pose `model`, skinned by `method`.
+pub fn skin_shears(rig: &Rig, model: &[DMat4], method: Method) -> Vec<Vec<f64>> {
+    rig.meshes.iter().map(|mesh| vertex_shears(mesh, &rig.skins, model, method)).collect()
 }
 
 /// Every mesh of the rig morphed and skinned at the pose `model` (one vector of positions per mesh), as the file
@@ -542,6 +605,98 @@ mod tests {
         let expected = skinned(skin.clone(), &mesh, &model, Method::Linear) * 0.75
             + skinned(skin, &mesh, &model, Method::DualQuaternion) * 0.25;
         assert!(p.abs_diff_eq(expected, 1e-12), "{p:?} vs {expected:?}");
+    }
+
+    /// A bone sheared by 30°: its Y column leans 30° towards X (60° between them), scaled 1.5 along Z, turned and
+    /// moved; and its bind frame, turned 90° about Z at (0, 1, 0) (the inverse bind matrix is its inverse).
+    fn sheared_bone() -> (DMat4, DMat4) {
+        let (sin, cos) = 30f64.to_radians().sin_cos();
+        let shear = DMat4::from_cols(
+            glam::DVec4::X,
+            glam::DVec4::new(sin, cos, 0.0, 0.0),
+            glam::DVec4::new(0.0, 0.0, 1.5, 0.0),
+            glam::DVec4::new(0.3, 2.0, -1.0, 1.0),
+        );
+        let turn = DMat4::from_quat(DQuat::from_rotation_y(0.7));
+        let bind = DMat4::from_rotation_translation(DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2), DVec3::Y);
+        (turn * shear, bind.inverse())
+    }
+
+    /// The largest deviation from 90° between the columns of `m`, measured by hand: each pair's angle from its
+    /// cosine.
+    fn shear_by_angles(m: DMat3) -> f64 {
+        let columns = [m.x_axis, m.y_axis, m.z_axis];
+        let angle = |a: DVec3, b: DVec3| (a.dot(b) / (a.length() * b.length())).acos().to_degrees();
+        [(0, 1), (0, 2), (1, 2)]
+            .map(|(i, j)| (angle(columns[i], columns[j]) - 90.0).abs())
+            .into_iter()
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn a_vertex_bound_to_one_bone_has_that_bones_shear() {
+        // Bone 0 is the sheared bone, bone 1 only turned and moved. Vertices: one fully on each bone, one halfway.
+        let (sheared, inverse_bind) = sheared_bone();
+        let turned = DMat4::from_rotation_translation(DQuat::from_rotation_x(1.1), DVec3::new(1.0, 0.0, 0.0));
+        let skin = Skin { joints: vec![0, 1], inverse_bind: vec![inverse_bind, DMat4::IDENTITY], ..Skin::default() };
+        let mesh = Mesh {
+            skin: Some(0),
+            positions: vec![Vec3::ZERO; 3],
+            joints: vec![[0, 1, 0, 0]; 3],
+            weights: vec![[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.5, 0.5, 0.0, 0.0]],
+            ..Mesh::default()
+        };
+        let model = [sheared, turned];
+        let bone = crate::analysis::Assessment::of(&sheared, &crate::analysis::Tolerances::default()).shear_deg;
+        assert!((bone - 30.0).abs() < 1e-9, "the bone's own shear: {bone}");
+        for method in Method::ALL {
+            let shears = vertex_shears(&mesh, std::slice::from_ref(&skin), &model, *method);
+            assert!((shears[0] - bone).abs() < 1e-9, "{method:?}: {} vs the bone's {bone}", shears[0]);
+            assert!(shears[1].abs() < 1e-9, "{method:?}: a rigid bone gives none, {}", shears[1]);
+            assert!(shears[2] > 1.0, "{method:?}: halfway, some shear: {}", shears[2]);
+        }
+        // Unskinned, a mesh has its bone's shear everywhere.
+        let placed = Mesh { bone: 0, positions: vec![Vec3::X; 2], ..Mesh::default() };
+        let shears = vertex_shears(&placed, &[], &model, Method::AsFile);
+        assert!(shears.iter().all(|s| (s - bone).abs() < 1e-9), "{shears:?}");
+    }
+
+    #[test]
+    fn a_vertex_between_bones_has_the_shear_of_the_transform_that_skins_it() {
+        // The oracle: the vertex's skinning transform measured from positions alone. Four vertices with the same
+        // weights at p, p + x, p + y, p + z are skinned; their differences are the transform's columns (it is affine
+        // for fixed weights, linear blend or dual quaternion), read in the heaviest joint's bind frame.
+        let (sheared, inverse_bind) = sheared_bone();
+        let other = DMat4::from_scale_rotation_translation(
+            DVec3::new(1.0, 0.6, 1.2),
+            DQuat::from_rotation_x(0.8),
+            DVec3::new(0.0, 1.0, 0.5),
+        );
+        let skin = Skin { joints: vec![0, 1], inverse_bind: vec![inverse_bind, DMat4::IDENTITY], ..Skin::default() };
+        let p = Vec3::new(0.2, 0.9, -0.4);
+        let corners = [p, p + Vec3::X, p + Vec3::Y, p + Vec3::Z];
+        for (w0, w1, dq) in [(0.7, 0.3, 0.0), (0.3, 0.7, 1.0), (0.55, 0.45, 0.4)] {
+            let mesh = Mesh {
+                skin: Some(0),
+                positions: corners.to_vec(),
+                joints: vec![[0, 1, 0, 0]; 4],
+                weights: vec![[w0, w1, 0.0, 0.0]; 4],
+                dq_weights: vec![dq; 4],
+                ..Mesh::default()
+            };
+            let skins = std::slice::from_ref(&skin);
+            let model = [sheared, other];
+            let mut skinned = Vec::new();
+            skin_positions(&mesh, skins, &model, &MorphPose::default(), &mut skinned);
+            let columns = DMat3::from_cols(skinned[1] - skinned[0], skinned[2] - skinned[0], skinned[3] - skinned[0]);
+            let heaviest = if w0 > w1 { 0 } else { 1 };
+            let expected = shear_by_angles(columns * DMat3::from_mat4(skin.inverse_bind[heaviest]).inverse());
+            let shears = vertex_shears(&mesh, skins, &model, Method::AsFile);
+            assert!(expected > 1.0, "a shear to find: {expected}");
+            for shear in shears {
+                assert!((shear - expected).abs() < 1e-7, "weights {w0}/{w1}, dq {dq}: {shear} vs {expected}");
+            }
+        }
     }
 
     #[test]

@@ -122,15 +122,23 @@ impl Camera {
     /// corner of them is inside a viewport of this aspect ratio (width / height), with a margin: the whole box
     /// fills the picture along its tighter side, whatever the view direction.
     pub fn frame(&mut self, bounds: &Bounds, aspect: f64) {
+        self.frame_points(&bounds.corners(), aspect);
+    }
+
+    /// [`Camera::frame`] on the points themselves rather than their box: a figure over its motion (its joints and
+    /// skin at times through the clip) fills the picture, where the corners of its box, most of them far from any
+    /// part of it, would leave it small in the 3D view. Nothing happens for no finite point.
+    pub fn frame_points(&mut self, points: &[DVec3], aspect: f64) {
         const MARGIN: f64 = 1.15;
+        let Some(bounds) = Bounds::of(points.iter().copied()) else { return };
         self.target = bounds.center();
         let (back, up) = self.eye_direction();
         let right = up.cross(back).normalize();
         let up = back.cross(right);
         let tan_y = (FOV_Y * 0.5).tan();
         let tan_x = tan_y * aspect.max(1e-3);
-        let needed = bounds.corners().into_iter().map(|corner| {
-            let d = corner - self.target;
+        let needed = points.iter().filter(|p| p.is_finite()).map(|point| {
+            let d = *point - self.target;
             let (x, y) = (d.dot(right).abs() * MARGIN / tan_x, d.dot(up).abs() * MARGIN / tan_y);
             match self.view {
                 // The corner's depth in front of the eye, `distance − z`, must see it within the field of view.

@@ -10,7 +10,9 @@ use glam::{DMat3, DMat4, DVec2, DVec3};
 
 use super::camera::{Camera, Projection};
 use super::scene::{DrawnPose, Scene};
-use super::style::{Badge, Palette};
+use super::style::{Badge, Palette, short_degrees};
+use crate::analysis::shear_rgb;
+use crate::eval::skinning::skin_shears;
 
 /// Height of one caption line, in points.
 const CAPTION_LINE: f32 = 17.0;
@@ -44,11 +46,17 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         paint_sorted(&painter, triangles);
     }
     // The mesh is translucent and the bones are drawn over it (x-ray), so the skeleton is never hidden.
+    let shears = options.paints_shear().then(|| skin_shears(scene.rig, &scene.primary.model, options.skinning));
     if options.mesh {
         let mut triangles = Vec::new();
-        mesh_triangles(&mut triangles, &projection, scene, &scene.primary, palette.mesh, camera);
+        let color = |mesh: usize, vertex: usize| match &shears {
+            Some(shears) => skin_color(scene, palette, shears[mesh][vertex]),
+            None => palette.mesh,
+        };
+        mesh_triangles(&mut triangles, &projection, scene, &scene.primary, color, camera);
         paint_sorted(&painter, triangles);
     }
+    let chain = scene.selected_chains();
     // The ghost goes under the pose, so the pose's colour coding reads on top and the ghost shows where they part.
     if let Some(ghost) = &scene.ghost {
         let mut ghost_triangles = Vec::new();
@@ -60,9 +68,7 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         if options.boxes {
             paint_boxes(&painter, &projection, scene, ghost, |bone| faded(box_color(ghost, bone, palette)));
         }
-        if options.axes {
-            paint_axes(&painter, &projection, scene, ghost, |_| true, faded);
-        }
+        paint_axes(&painter, &projection, scene, ghost, |bone| scene.shows_triad(ghost, &chain, bone), faded);
     }
     if options.bones {
         let mut triangles = Vec::new();
@@ -76,18 +82,13 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         let drawn = &scene.primary;
         paint_boxes(&painter, &projection, scene, drawn, |bone| box_color(drawn, bone, palette));
     }
-    // The selection's axes always, as its name: a bone picked (in the Why? section's chain, say) shows its scale.
-    paint_axes(
-        &painter,
-        &projection,
-        scene,
-        &scene.primary,
-        |bone| options.axes || scene.selected.contains(&bone),
-        |c| c,
-    );
+    let primary = &scene.primary;
+    paint_axes(&painter, &projection, scene, primary, |bone| scene.shows_triad(primary, &chain, bone), |c| c);
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
-        paint_legend(&painter, rect, scene, palette);
+        let worst = shears.as_ref().filter(|_| !scene.rig.meshes.is_empty());
+        let worst = worst.map(|shears| shears.iter().flatten().copied().fold(0.0, f64::max));
+        paint_legend(&painter, rect, scene, palette, worst);
         paint_caption(&canvas, whole, &scene.caption, palette);
     }
 }
@@ -163,11 +164,11 @@ fn nice_step(x: f64) -> f64 {
     [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= x).unwrap_or(10.0 * power)
 }
 
-/// A screen-space triangle with its depth and colour.
+/// A screen-space triangle with its depth and its corners' colours.
 struct Triangle {
     points: [Pos2; 3],
     depth: f64,
-    color: Color32,
+    colors: [Color32; 3],
 }
 
 /// Flat shading: brighter where the face looks at the eye.
@@ -178,7 +179,13 @@ fn shade(color: Color32, normal: DVec3, toward_eye: DVec3) -> Color32 {
     Color32::from_rgba_unmultiplied(f(r), f(g), f(b), a)
 }
 
-fn push_triangle(out: &mut Vec<Triangle>, projection: &Projection, corners: [DVec3; 3], color: Color32, eye: DVec3) {
+fn push_triangle(
+    out: &mut Vec<Triangle>,
+    projection: &Projection,
+    corners: [DVec3; 3],
+    colors: [Color32; 3],
+    eye: DVec3,
+) {
     let projected = corners.map(|c| projection.project(c));
     let [Some(a), Some(b), Some(c)] = projected else { return };
     let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
@@ -187,7 +194,7 @@ fn push_triangle(out: &mut Vec<Triangle>, projection: &Projection, corners: [DVe
     out.push(Triangle {
         points: [pos(a.0), pos(b.0), pos(c.0)],
         depth: (a.1 + b.1 + c.1) / 3.0,
-        color: shade(color, normal, toward_eye),
+        colors: colors.map(|color| shade(color, normal, toward_eye)),
     });
 }
 
@@ -196,32 +203,48 @@ fn paint_sorted(painter: &Painter, mut triangles: Vec<Triangle>) {
     let mut mesh = EguiMesh::default();
     for t in triangles {
         let base = mesh.vertices.len() as u32;
-        for p in t.points {
-            mesh.colored_vertex(p, t.color);
+        for (p, color) in t.points.into_iter().zip(t.colors) {
+            mesh.colored_vertex(p, color);
         }
         mesh.add_triangle(base, base + 1, base + 2);
     }
     painter.add(Shape::mesh(mesh));
 }
 
+/// The meshes' triangles, each corner coloured by `color_of(mesh, vertex)`.
 fn mesh_triangles(
     out: &mut Vec<Triangle>,
     projection: &Projection,
     scene: &Scene,
     drawn: &DrawnPose,
-    color: Color32,
+    color_of: impl Fn(usize, usize) -> Color32,
     camera: &Camera,
 ) {
     let eye = camera.eye();
-    for (mesh, positions) in scene.rig.meshes.iter().zip(&drawn.meshes) {
+    for (index, (mesh, positions)) in scene.rig.meshes.iter().zip(&drawn.meshes).enumerate() {
         for tri in mesh.indices.chunks_exact(3) {
             let corner = |i: u32| positions.get(i as usize).copied();
             if let (Some(a), Some(b), Some(c)) = (corner(tri[0]), corner(tri[1]), corner(tri[2])) {
-                push_triangle(out, projection, [a, b, c], color, eye);
+                let colors = [tri[0], tri[1], tri[2]].map(|i| color_of(index, i as usize));
+                push_triangle(out, projection, [a, b, c], colors, eye);
             }
         }
     }
 }
+
+/// A skin vertex's colour for its shear: the mesh's own below [`Scene::neutral_shear_deg`], else the shear ramp
+/// of stretched bones ([`shear_rgb`]), as translucent as the mesh.
+fn skin_color(scene: &Scene, palette: &Palette, shear_deg: f64) -> Color32 {
+    if shear_deg < scene.neutral_shear_deg {
+        return palette.mesh;
+    }
+    let [r, g, b] = shear_rgb(shear_deg);
+    Color32::from_rgba_unmultiplied(r, g, b, SKIN_ALPHA)
+}
+
+/// How opaque the painted skin is: more than the plain mesh, so that its colours read, and still see-through, so
+/// that the bones inside show.
+const SKIN_ALPHA: u8 = 150;
 
 /// The colour of a bone: selection first, then its most serious finding.
 fn bone_color(scene: &Scene, drawn: &DrawnPose, bone: usize, palette: &Palette) -> Color32 {
@@ -258,8 +281,8 @@ fn bone_triangles(
         let color = tint.unwrap_or_else(|| bone_color(scene, drawn, bone, palette));
         for i in 0..4 {
             let (a, b) = (ring[i], ring[(i + 1) % 4]);
-            push_triangle(out, projection, [head, b, a], color, eye);
-            push_triangle(out, projection, [a, b, tail], color, eye);
+            push_triangle(out, projection, [head, b, a], [color; 3], eye);
+            push_triangle(out, projection, [a, b, tail], [color; 3], eye);
         }
     }
 }
@@ -335,7 +358,17 @@ fn paint_boxes(
     }
 }
 
-/// Axis triads of the shown bones `which` picks, from their gizmo axes ([`gizmo_axes`]).
+/// A bone's triad in model space: its gizmo axes ([`gizmo_axes`]) scaled as a whole so that the longest is the
+/// rig's gizmo length, whatever the bone's own scale (an `Empty` scaled 10 draws no lines across the view, a
+/// squashed bone no dot): the angles and proportions that show shear and non-uniform scale stay.
+fn triad_axes(scene: &Scene, projection: &Projection, model: &DMat4) -> DMat3 {
+    let axes = gizmo_axes(scene, projection, model);
+    let longest = [axes.x_axis, axes.y_axis, axes.z_axis].iter().map(|a| a.length()).fold(0.0, f64::max);
+    let rig_size = gizmo_unit(scene, projection, model.w_axis.truncate()) * scene.gizmo_size / scene.gizmo_unit;
+    if longest > 0.0 && longest.is_finite() { axes * (rig_size / longest) } else { axes }
+}
+
+/// Axis triads of the shown bones `which` picks ([`triad_axes`]).
 fn paint_axes(
     painter: &Painter,
     projection: &Projection,
@@ -347,7 +380,7 @@ fn paint_axes(
     let palette_axes = Palette::new(true).axes;
     for (_, model) in drawn.model.iter().enumerate().filter(|&(b, _)| scene.shows(b) && which(b)) {
         let origin = model.w_axis.truncate();
-        let axes = gizmo_axes(scene, projection, model);
+        let axes = triad_axes(scene, projection, model);
         for (axis, color) in [axes.x_axis, axes.y_axis, axes.z_axis].iter().zip(palette_axes) {
             line(painter, projection, origin, origin + *axis, Stroke::new(2.0, tint(color)));
         }
@@ -371,8 +404,9 @@ fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palet
     }
 }
 
-/// The meaning of the colours and icons, in the top-left corner.
-fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette) {
+/// The meaning of the colours and icons, in the top-left corner; with `worst_skin_shear` (the most any vertex
+/// shears now, in degrees) the painted skin's scale.
+fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette, worst_skin_shear: Option<f64>) {
     let mut at = rect.min + egui::vec2(14.0, 14.0);
     let line = |at: Pos2, text: &str| {
         painter.text(at + egui::vec2(10.0, 0.0), Align2::LEFT_CENTER, text, FontId::proportional(12.0), palette.text)
@@ -385,6 +419,47 @@ fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette)
     if scene.ghost.is_some() {
         painter.rect_filled(Rect::from_center_size(at, egui::vec2(9.0, 9.0)), 1.0, palette.ghost.to_opaque());
         line(at, &scene.ghost_label);
+        at.y += 17.0;
+    }
+    if let Some(worst) = worst_skin_shear {
+        line(at, &format!("skin shear (most now: {})", degrees(worst, scene.neutral_shear_deg)));
+        paint_shear_scale(painter, at + egui::vec2(0.0, 14.0), scene, palette);
+    }
+}
+
+/// A shear in degrees as the legend says it: two significant digits, 0 below the neutral shear.
+fn degrees(shear_deg: f64, neutral: f64) -> String {
+    if shear_deg < neutral { "0°".to_owned() } else { format!("{}°", short_degrees(shear_deg)) }
+}
+
+/// The painted skin's colours from `left`: a swatch of the neutral colour for no shear, then the ramp from 0.1° to
+/// 10° (each decade half of it, as [`shear_rgb`] spreads it), labelled below.
+fn paint_shear_scale(painter: &Painter, left: Pos2, scene: &Scene, palette: &Palette) {
+    const WIDTH: f32 = 120.0;
+    let neutral = Rect::from_min_size(left, egui::vec2(10.0, 8.0));
+    // Apart enough that the labels "0" and "0.1°" below them do not touch.
+    let bar = Rect::from_min_size(left + egui::vec2(30.0, 0.0), egui::vec2(WIDTH, 8.0));
+    painter.rect_filled(neutral, 1.0, palette.mesh.to_opaque());
+    let mut ramp = EguiMesh::default();
+    for step in 0..=24 {
+        let t = step as f32 / 24.0;
+        let color = skin_color(scene, palette, 10f64.powf(f64::from(t) * 2.0 - 1.0)).to_opaque();
+        ramp.colored_vertex(Pos2::new(bar.left() + t * WIDTH, bar.top()), color);
+        ramp.colored_vertex(Pos2::new(bar.left() + t * WIDTH, bar.bottom()), color);
+        if step > 0 {
+            let base = ramp.vertices.len() as u32 - 4;
+            ramp.add_triangle(base, base + 1, base + 2);
+            ramp.add_triangle(base + 1, base + 2, base + 3);
+        }
+    }
+    painter.add(Shape::mesh(ramp));
+    let label = |x: f32, text: &str| {
+        let at = Pos2::new(x, bar.bottom() + 2.0);
+        painter.text(at, Align2::CENTER_TOP, text, FontId::proportional(10.0), palette.text)
+    };
+    label(neutral.center().x, "0");
+    for (t, text) in [(0.0, "0.1°"), (0.5, "1°"), (1.0, "10°+")] {
+        label(bar.left() + t * WIDTH, text);
     }
 }
 
@@ -440,6 +515,27 @@ mod tests {
         let far = longest(DVec3::new(100.0, 50.0, 1.0));
         assert!((far[0] - MAX_GIZMO_STRETCH).abs() < 1e-12, "the longest axis capped: {far:?}");
         assert!((far[1] / far[0] - 0.5).abs() < 1e-12 && (far[2] / far[0] - 0.01).abs() < 1e-12, "proportions kept");
+    }
+
+    #[test]
+    fn a_triad_is_drawn_at_the_rigs_size_whatever_the_bones_scale() {
+        let rig = demo_rig();
+        let scene = Scene::new(&rig, DrawnPose::default(), SceneOptions::default());
+        let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
+        let at = DVec3::new(0.0, 1.5, 0.0);
+        let projection = projection(&Camera { distance: 2.0, target: at, ..Camera::default() }, rect);
+        let rig_size = gizmo_unit(&scene, &projection, at) * scene.gizmo_size / scene.gizmo_unit;
+        // An `Empty` scaled 10, a bone squashed to a hundredth, a stretched one: the longest axis is the rig's size,
+        // the others in proportion.
+        for scale in [DVec3::splat(10.0), DVec3::splat(0.01), DVec3::new(2.0, 1.0, 0.5)] {
+            let model = DMat4::from_scale_rotation_translation(scale, Default::default(), at);
+            let axes = triad_axes(&scene, &projection, &model);
+            let lengths = [axes.x_axis, axes.y_axis, axes.z_axis].map(|a| a.length() / rig_size);
+            let expected = (scale / scale.max_element()).to_array();
+            for (length, expected) in lengths.iter().zip(expected) {
+                assert!((length - expected).abs() < 1e-12, "scale {scale}: {lengths:?}");
+            }
+        }
     }
 
     #[test]

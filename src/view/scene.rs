@@ -8,7 +8,42 @@ use super::style::Badge;
 use crate::analysis::{Assessment, Findings, Tolerances};
 use crate::eval::skinning::skin_meshes_with;
 use crate::eval::{MorphPose, SkinningMethod, bind_model_matrices, skin_meshes};
-use crate::model::{Clip, NodeRole, Rig, Span};
+use crate::model::{Choice, Clip, NodeRole, Rig, Span};
+
+/// Which bones have their axis triads drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Triads {
+    None,
+    /// The selected bones and their chains (each up to its root).
+    Selected,
+    /// The selected bones' chains and every stretched bone: the frames that show something.
+    #[default]
+    Stretched,
+    All,
+}
+
+impl Choice for Triads {
+    const ALL: &'static [Triads] = &[Triads::None, Triads::Selected, Triads::Stretched, Triads::All];
+
+    fn id(self) -> &'static str {
+        match self {
+            Triads::None => "none",
+            Triads::Selected => "selected",
+            Triads::Stretched => "stretched",
+            Triads::All => "all",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            Triads::None => "no axis triads",
+            Triads::Selected => "the selected bones and their chains up to the root",
+            Triads::Stretched => "the selected bones' chains and every stretched bone",
+            Triads::All => "every bone",
+        }
+    }
+}
 
 /// What to show, as toggled in the viewport's toolbar (persisted with the settings).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -17,9 +52,11 @@ pub struct SceneOptions {
     pub grid: bool,
     pub bones: bool,
     pub mesh: bool,
+    /// The mesh painted by the shear of each vertex's skinning ([`crate::eval::skinning::vertex_shears`]).
+    pub shear: bool,
     pub wireframe: bool,
-    /// Each bone's axis triad from its model matrix columns (a sheared frame loses its right angles).
-    pub axes: bool,
+    /// Whose axis triads are drawn, from their model matrix columns (a sheared frame loses its right angles).
+    pub triads: Triads,
     /// A unit box per bone transformed by its model matrix (shear shows as a slanted parallelepiped).
     pub boxes: bool,
     pub names: bool,
@@ -37,8 +74,9 @@ impl Default for SceneOptions {
             grid: true,
             bones: true,
             mesh: true,
+            shear: true,
             wireframe: false,
-            axes: true,
+            triads: Triads::default(),
             boxes: false,
             names: false,
             bind_pose: false,
@@ -51,16 +89,16 @@ impl Default for SceneOptions {
 
 impl SceneOptions {
     /// The names `--show` takes, in toolbar order.
-    pub const NAMES: [&'static str; 10] =
-        ["bones", "axes", "boxes", "mesh", "wireframe", "bind-pose", "helpers", "names", "grid", "legend"];
+    pub const NAMES: [&'static str; 11] =
+        ["bones", "axes", "boxes", "mesh", "shear", "wireframe", "bind-pose", "helpers", "names", "grid", "legend"];
 
-    /// The switch called `name`.
+    /// The switch called `name`, but `axes`, which is a choice.
     fn switch(&mut self, name: &str) -> Option<&mut bool> {
         Some(match name {
             "bones" => &mut self.bones,
-            "axes" => &mut self.axes,
             "boxes" => &mut self.boxes,
             "mesh" => &mut self.mesh,
+            "shear" => &mut self.shear,
             "wireframe" => &mut self.wireframe,
             "bind-pose" => &mut self.bind_pose,
             "helpers" => &mut self.helpers,
@@ -72,6 +110,8 @@ impl SceneOptions {
     }
 
     /// Applies a comma-separated list: `bones,axes` shows exactly those; `+boxes,-grid` changes these defaults.
+    /// `axes` is every bone's triad, `-axes` none, `axes=stretched` a choice of [`Triads`]; `shear` paints the mesh,
+    /// so it shows the mesh too unless the list says `-mesh` after it.
     pub fn parse_list(list: &str) -> Result<Self, String> {
         let items: Vec<&str> = list.split(',').map(str::trim).filter(|s| !s.is_empty()).collect();
         let relative = items.iter().all(|s| s.starts_with(['+', '-']));
@@ -82,10 +122,27 @@ impl SceneOptions {
                 Some(("+", name)) => (true, name),
                 _ => (true, item),
             };
-            let known = Self::NAMES.join(", ");
-            *options.switch(name).ok_or_else(|| format!("unknown item `{name}` (known: {known})"))? = on;
+            options.set(name, on)?;
         }
         Ok(options)
+    }
+
+    /// Turns the item `name` of [`SceneOptions::parse_list`] on or off.
+    fn set(&mut self, name: &str, on: bool) -> Result<(), String> {
+        if let Some(choice) = name.strip_prefix("axes=") {
+            let known = Triads::ALL.iter().map(|t| t.id()).collect::<Vec<_>>().join(", ");
+            self.triads = Triads::from_id(choice).ok_or_else(|| format!("unknown axes `{choice}` (known: {known})"))?;
+            return Ok(());
+        }
+        match name {
+            "axes" => self.triads = if on { Triads::All } else { Triads::None },
+            "shear" if on => (self.shear, self.mesh) = (true, true),
+            _ => {
+                let known = Self::NAMES.join(", ");
+                *self.switch(name).ok_or_else(|| format!("unknown item `{name}` (known: {known})"))? = on;
+            }
+        }
+        Ok(())
     }
 
     fn none() -> Self {
@@ -93,8 +150,9 @@ impl SceneOptions {
             grid: false,
             bones: false,
             mesh: false,
+            shear: false,
             wireframe: false,
-            axes: false,
+            triads: Triads::None,
             boxes: false,
             names: false,
             bind_pose: false,
@@ -102,6 +160,11 @@ impl SceneOptions {
             legend: false,
             skinning: SkinningMethod::AsFile,
         }
+    }
+
+    /// Whether the mesh is drawn painted by shear.
+    pub fn paints_shear(&self) -> bool {
+        self.mesh && self.shear
     }
 }
 
@@ -181,6 +244,9 @@ pub struct Scene<'a> {
     /// so a centimetre rig under a 0.01 conversion gets triads of `gizmo_size`, while a bone scaled or sheared
     /// relative to the rest shows it in the lengths and angles of its axes.
     pub gizmo_unit: f64,
+    /// Below this shear, in degrees, a vertex is painted the mesh's own colour: the tolerance under which a bone is
+    /// not flagged as stretched ([`Tolerances::min_shear_deg`]).
+    pub neutral_shear_deg: f64,
     /// Each bone's first child of the figure (a helper below a joint, a camera's target, say, does not end its
     /// bone), found once: the tail of every bone is asked for each frame.
     first_child: Vec<Option<usize>>,
@@ -208,8 +274,34 @@ impl<'a> Scene<'a> {
             options,
             gizmo_size,
             gizmo_unit,
+            neutral_shear_deg: Tolerances::default().min_shear_deg,
             first_child,
         }
+    }
+
+    /// Whether `bone` has its axis triad drawn, as [`SceneOptions::triads`] chooses; `chain` marks the selected bones
+    /// and their ancestors ([`Scene::selected_chains`]).
+    pub fn shows_triad(&self, drawn: &DrawnPose, chain: &[bool], bone: usize) -> bool {
+        let in_chain = chain.get(bone).copied().unwrap_or(false);
+        match self.options.triads {
+            Triads::None => false,
+            Triads::Selected => in_chain,
+            Triads::Stretched => in_chain || drawn.findings.get(bone).is_some_and(|f| f.stretched),
+            Triads::All => true,
+        }
+    }
+
+    /// Per bone, whether it is selected or above a selected bone.
+    pub fn selected_chains(&self) -> Vec<bool> {
+        let mut chain = vec![false; self.rig.skeleton.len()];
+        for &selected in &self.selected {
+            let mut bone = Some(selected).filter(|&b| b < chain.len());
+            while let Some(b) = bone.filter(|&b| !chain[b]) {
+                chain[b] = true;
+                bone = self.rig.skeleton.parent(b);
+            }
+        }
+        chain
     }
 
     /// Whether `bone` is drawn: a bone of the figure, a helper when they are shown, or anything selected (picked in
@@ -278,31 +370,28 @@ pub fn typical_scale(rig: &Rig) -> f64 {
     scales.get(scales.len() / 2).copied().unwrap_or(1.0)
 }
 
-/// The bounds of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
-/// (model matrices), so a camera framed on it does not need to move while the clip plays. Only the bones that
-/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes; the bounds grow by the size of the axis triads and
-/// boxes drawn around the joints.
-pub fn motion_bounds(
+/// The points of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
+/// (model matrices), so a camera framed on them does not need to move while the clip plays. Only the joints that
+/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes.
+pub fn motion_points(
     rig: &Rig,
     clip: Option<&Clip>,
     span: Span,
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
-) -> Option<Bounds> {
+) -> Vec<DVec3> {
     let framed = rig.skeleton.figure();
     let mut morph = MorphPose::default();
-    let bounds = (0..samples.max(1))
-        .filter_map(|i| {
-            let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
-            let model = pose_at(time);
-            morph.evaluate(clip, time);
-            let meshes = skin_meshes(rig, &model, &morph);
-            let heads = model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate());
-            Bounds::of(heads.chain(meshes.into_iter().flatten()))
-        })
-        .reduce(Bounds::union)?;
-    let gizmo = DVec3::splat(gizmo_size(rig));
-    Some(Bounds { min: bounds.min - gizmo, max: bounds.max + gizmo })
+    let mut points = Vec::new();
+    for i in 0..samples.max(1) {
+        let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
+        let model = pose_at(time);
+        morph.evaluate(clip, time);
+        let meshes = skin_meshes(rig, &model, &morph);
+        points.extend(model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate()));
+        points.extend(meshes.into_iter().flatten().filter(|p| p.is_finite()));
+    }
+    points
 }
 
 /// The bounds of the rest pose's joints and meshes.
@@ -323,8 +412,15 @@ mod tests {
         let changed = SceneOptions::parse_list("+boxes,-grid").unwrap();
         assert_eq!(changed, SceneOptions { boxes: true, grid: false, ..SceneOptions::default() });
         assert_eq!(SceneOptions::parse_list("").unwrap(), SceneOptions::default());
-        let error = SceneOptions::parse_list("bones,shear").unwrap_err();
-        assert!(error.contains("`shear`") && error.contains("bind-pose"), "{error}");
+        let error = SceneOptions::parse_list("bones,sheer").unwrap_err();
+        assert!(error.contains("`sheer`") && error.contains("bind-pose"), "{error}");
+        // `shear` paints the mesh, so it shows it; the triads are a choice.
+        let painted = SceneOptions::parse_list("shear").unwrap();
+        assert_eq!(painted, SceneOptions { mesh: true, shear: true, ..SceneOptions::none() });
+        assert_eq!(SceneOptions::parse_list("+axes").unwrap().triads, Triads::All);
+        assert_eq!(SceneOptions::parse_list("-axes").unwrap().triads, Triads::None);
+        assert_eq!(SceneOptions::parse_list("bones,axes=selected").unwrap().triads, Triads::Selected);
+        assert!(SceneOptions::parse_list("axes=some").unwrap_err().contains("stretched"));
     }
 
     #[test]
@@ -359,6 +455,36 @@ mod tests {
             ..DrawnPose::default()
         };
         assert_eq!(DrawnPose::bind(&demo, &far).model, bind_model_matrices(&demo));
+    }
+
+    /// The names of the bones whose triads `scene` draws.
+    fn with_triads(scene: &Scene) -> Vec<String> {
+        let chain = scene.selected_chains();
+        let bones = scene.rig.skeleton.bones().iter().enumerate();
+        bones
+            .filter(|(b, _)| scene.shows_triad(&scene.primary, &chain, *b))
+            .map(|(_, bone)| bone.name.clone())
+            .collect()
+    }
+
+    #[test]
+    fn triads_go_to_the_selected_chain_and_the_stretched_bones() {
+        // The demo's chain: shoulder → upper_arm → forearm → hand; the upper arm stretched.
+        let rig = crate::import::demo_rig();
+        let find = |name: &str| rig.skeleton.find(name).unwrap();
+        let mut findings = vec![Findings::default(); rig.skeleton.len()];
+        findings[find("upper_arm")].stretched = true;
+        let mut scene = Scene::new(&rig, DrawnPose { findings, ..DrawnPose::default() }, SceneOptions::default());
+        assert_eq!(with_triads(&scene), ["upper_arm"], "nothing selected: the stretched bone alone");
+        scene.selected = vec![find("forearm")];
+        assert_eq!(with_triads(&scene), ["shoulder", "upper_arm", "forearm"], "and the chain up to the root");
+        scene.options.triads = Triads::Selected;
+        scene.selected = vec![find("shoulder")];
+        assert_eq!(with_triads(&scene), ["shoulder"]);
+        scene.options.triads = Triads::None;
+        assert!(with_triads(&scene).is_empty());
+        scene.options.triads = Triads::All;
+        assert_eq!(with_triads(&scene).len(), rig.skeleton.len());
     }
 
     #[test]

@@ -108,6 +108,16 @@ impl Badge {
     }
 }
 
+/// An angle in degrees as the outliner's "max" note and the skin's legend give it: one decimal from 1° up, below
+/// that two significant digits (a bone flagged at 0.043° must not read "0.0°", as if nothing sheared).
+pub fn short_degrees(degrees: f64) -> String {
+    if !(degrees > 0.0 && degrees < 1.0) {
+        return format!("{degrees:.1}");
+    }
+    let decimals = (1 - degrees.log10().floor() as i32).clamp(1, 12) as usize;
+    format!("{degrees:.decimals$}")
+}
+
 /// Colours of the viewport that do not depend on findings.
 #[derive(Clone, Copy, Debug)]
 pub struct Palette {
@@ -173,6 +183,14 @@ mod tests {
         };
         let (l1, l2) = (luminance(over), luminance([br, bg, bb]));
         (l1.max(l2) + 0.05) / (l1.min(l2) + 0.05)
+    }
+
+    #[test]
+    fn a_small_worst_shear_keeps_its_digits() {
+        assert_eq!(short_degrees(24.26), "24.3");
+        assert_eq!(short_degrees(0.5), "0.50");
+        assert_eq!(short_degrees(0.0432), "0.043");
+        assert_eq!(short_degrees(0.000_012_3), "0.000012");
     }
 
     #[test]
