@@ -315,7 +315,7 @@ fn bake_keeping(request: &Request, output: Output, held: usize) -> Result<Baked,
         ));
     }
     notes.extend(request.clips().iter().filter_map(coarse_times));
-    notes.extend(source_notes(rig, dense.iter().map(|d| d.refined.stats.singular).sum()));
+    notes.extend(source_notes(rig, output, dense.iter().map(|d| d.refined.stats.singular).sum()));
     let bytes = match output {
         Output::Glb => {
             layout.for_gltf(rig, &mut document, &mut notes);
@@ -446,12 +446,13 @@ impl Sampling<'_> {
     }
 }
 
-/// What the source has that glTF says differently.
-fn source_notes(rig: &Rig, singular: usize) -> Vec<String> {
+/// What the source has that the baked file (of `output`'s kind) says differently.
+fn source_notes(rig: &Rig, output: Output, singular: usize) -> Vec<String> {
     let mut notes = Vec::new();
     let dual: Vec<&str> =
         rig.meshes.iter().filter(|m| m.dq_weights.iter().any(|&w| w > 0.0)).map(|m| m.name.as_str()).collect();
-    if !dual.is_empty() {
+    // UsdSkel skins with dual quaternions too (its writer says where it cannot).
+    if !dual.is_empty() && output == Output::Glb {
         notes.push(format!(
             "skinned with dual quaternions in the file, linearly in glTF (see the vertex errors): {}",
             dual.join(", ")
@@ -459,7 +460,7 @@ fn source_notes(rig: &Rig, singular: usize) -> Vec<String> {
     }
     for skin in rig.skins.iter().filter(|s| s.node_bind.is_some()) {
         notes.push(format!(
-            "skin `{}` follows its mesh node's motion since the bind (Maya); glTF skins ignore the mesh node",
+            "skin `{}` follows its mesh node's motion since the bind (Maya); the baked skin does not",
             skin.name.as_deref().unwrap_or("unnamed")
         ));
     }

@@ -439,9 +439,10 @@ impl Layer {
         clock: &Clock,
     ) -> f64 {
         self.prim(ANIMATION, "SkelAnimation");
-        let tokens = Value::token_vec(joints.paths.iter().map(String::as_str));
-        self.attribute(ANIMATION, "joints", "token[]", true, tokens);
         let nodes = &document.nodes;
+        let animated = animated(nodes, &animation.channels);
+        let listed = joints.paths.iter().zip(&animated).filter(|(_, a)| **a).map(|(path, _)| path.as_str());
+        self.attribute(ANIMATION, "joints", "token[]", true, Value::token_vec(listed));
         let timeline = Timeline::of(&animation.channels);
         let codes: Vec<f64> = timeline.times.iter().map(|&t| time_code(t, clock)).collect();
         let mut channels: HashMap<(usize, Property), &Channel> = HashMap::new();
@@ -470,7 +471,10 @@ impl Layer {
                 previous[n] = q;
                 let scale = Vec3::from_slice(&s[n][3 * k..3 * k + 3]);
                 let (translation, half) =
-                    chain.add(n, node.parent, Vec3::from_slice(&t[n][3 * k..3 * k + 3]), q, scale);
+                    chain.add(n, node.parent, Vec3::from_slice(&t[n][3 * k..3 * k + 3]), q, scale, animated[n]);
+                if !animated[n] {
+                    continue;
+                }
                 translations[k].push(gf::vec3f(translation.x, translation.y, translation.z));
                 rotations[k].push(gf::Quatf { w: q.w, x: q.x, y: q.y, z: q.z });
                 rounding = (0..3).fold(rounding, |r, i| r.max(relative_rounding(scale[i], half[i])));
@@ -594,12 +598,24 @@ impl HalfChain {
         HalfChain { baked: Vec::with_capacity(joints), played: Vec::with_capacity(joints) }
     }
 
-    /// Joint `n` (under `parent`, added before it) with its baked translation, rotation and scale: the translation
-    /// and the half-precision scale to write.
-    fn add(&mut self, n: usize, parent: Option<usize>, t: Vec3, q: Quat, scale: Vec3) -> (Vec3, [gf::f16; 3]) {
+    /// Joint `n` (under `parent`, added before it) with its baked translation, rotation and scale, its scale
+    /// written in half precision where `animated` (else it rests, in double precision): the translation and the
+    /// half-precision scale to write.
+    fn add(
+        &mut self,
+        n: usize,
+        parent: Option<usize>,
+        t: Vec3,
+        q: Quat,
+        scale: Vec3,
+        animated: bool,
+    ) -> (Vec3, [gf::f16; 3]) {
         debug_assert_eq!(n, self.baked.len(), "joints in order");
         let half = scale.to_array().map(gf::f16::from_f32);
-        let rounded = glam::DVec3::from_array(half.map(|h| f64::from(h.to_f32())));
+        let rounded = match animated {
+            true => glam::DVec3::from_array(half.map(|h| f64::from(h.to_f32()))),
+            false => scale.as_dvec3(),
+        };
         let turn = glam::DMat3::from_quat(q.as_dquat());
         let (above, above_played) =
             parent.map_or((glam::DMat3::IDENTITY, glam::DMat3::IDENTITY), |p| (self.baked[p], self.played[p]));
@@ -618,6 +634,24 @@ impl HalfChain {
 fn relative_rounding(value: f32, half: gf::f16) -> f64 {
     let (value, half) = (f64::from(value), f64::from(half.to_f32()));
     if value == half { 0.0 } else { ((half - value) / value).abs() }
+}
+
+/// Which nodes the animation lists: those it keys, and every one below a node whose scale it keys (whose
+/// translation makes up for the rounding of that scale, [`HalfChain`]). The others hold their rest transforms, in
+/// double precision.
+fn animated(nodes: &[Node], channels: &[Channel]) -> Vec<bool> {
+    let (mut keyed, mut scaled) = (vec![false; nodes.len()], vec![false; nodes.len()]);
+    for channel in channels.iter().filter(|c| c.property != Property::Weights) {
+        keyed[channel.node] = true;
+        scaled[channel.node] |= channel.property == Property::Scale;
+    }
+    let mut below_scaled = vec![false; nodes.len()];
+    for (n, node) in nodes.iter().enumerate() {
+        let under = node.parent.is_some_and(|p| scaled[p] || below_scaled[p]);
+        below_scaled[n] = under;
+        keyed[n] |= under;
+    }
+    keyed
 }
 
 /// The time code of baked time `t`: on the 128th of a frame (where a bake's halvings of frames fall) that
@@ -712,7 +746,7 @@ mod tests {
         let mut chain = HalfChain::new(joints.len());
         let (mut baked, mut played): (Vec<DMat4>, Vec<DMat4>) = (Vec::new(), Vec::new());
         for (n, &(parent, t, q, s)) in joints.iter().enumerate() {
-            let (written, half) = chain.add(n, parent, t, q, s);
+            let (written, half) = chain.add(n, parent, t, q, s, true);
             let rounded = Vec3::from_array(half.map(|h| h.to_f32()));
             assert!(s == Vec3::ONE || rounded != s, "the scale rounds");
             let matrix =

@@ -55,6 +55,7 @@ pub fn read(
     let indices = int_array(at_start(mesh.face_vertex_indices_attr())?);
     let name = match super::skeleton::written(openusd::usd::SchemaBase::prim(&mesh), "name") {
         Some(openusd::sdf::Value::String(name)) => name,
+        Some(openusd::sdf::Value::Token(name)) => name.as_str().to_owned(),
         _ => path.name().unwrap_or("Mesh").to_owned(),
     };
     let triangles = fans(&counts, &indices, positions.len());

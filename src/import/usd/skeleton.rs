@@ -65,9 +65,15 @@ pub fn read(stage: &Stage, path: &sdf::Path, first: usize, timing: &Timing) -> R
         Some(Value::IntVec(joints)) => joints,
         _ => Vec::new(),
     };
-    let ours = matches!(&baked_names, Some(Value::StringVec(names)) if names.len() == joints.len());
+    // A text layer's reader reads a `string[]` in a dictionary as tokens.
+    let baked_names = match baked_names {
+        Some(Value::StringVec(names)) => Some(names),
+        Some(Value::TokenVec(names)) => Some(names.iter().map(|n| n.as_str().to_owned()).collect()),
+        _ => None,
+    };
+    let ours = baked_names.as_ref().is_some_and(|names| names.len() == joints.len());
     let names = match baked_names {
-        Some(Value::StringVec(names)) if ours => names,
+        Some(names) if ours => names,
         _ => skeleton.joint_short_names().map_err(said)?,
     };
     let rest = rest_transforms(&skeleton, &joints, &parents)?;
