@@ -414,6 +414,10 @@ fn the_memory_budget_refuses_with_its_figures_and_max_memory_sets_it() {
     assert!(run.output.status.success(), "{}", String::from_utf8_lossy(&run.output.stderr));
 }
 
+/// How many frames the app may take to settle: the demo's whole-clip analysis, run beside the frames, shows a spinner
+/// until it lands (about 20 frames here).
+const ANALYSED: u64 = 200;
+
 #[test]
 fn the_app_keeps_its_document_through_every_refused_file() {
     let dir = tempfile::tempdir().unwrap();
@@ -421,6 +425,7 @@ fn the_app_keeps_its_document_through_every_refused_file() {
     std::fs::write(&good, corpus::good_gltf()).unwrap();
     let mut harness = egui_kittest::Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
+        .with_max_steps(ANALYSED)
         .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
     harness.state_mut().open(&good);
     harness.run();
@@ -445,6 +450,7 @@ fn the_app_keeps_its_document_through_every_refused_file() {
     // notifications are shown).
     let mut harness = egui_kittest::Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
+        .with_max_steps(ANALYSED)
         .build_eframe(|_cc| BonescopeApp::new(Settings::default(), Document::demo()));
     let evil = corpus::all().into_iter().find(|c| c.name == "file_name").unwrap().write(dir.path());
     harness.state_mut().open(&evil);
