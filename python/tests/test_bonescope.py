@@ -95,9 +95,17 @@ def test_a_bake_without_a_unit_is_the_command_lines_in_metres_and_what_it_refuse
     assert any("the file states no unit: read in" in n for n in mine["notes"])
     assert {k: v for k, v in mine.items() if k != "notes"} == {k: v for k, v in theirs.items() if k != "notes"}
     with pytest.raises(bonescope.Error) as refused:
-        bonescope.bake(STRETCHY, tmp_path / "x.usdc")
-    assert str(refused.value) == cli_error("bake", STRETCHY, "--out", tmp_path / "x.usdc")
-    assert not (tmp_path / "x.usdc").exists()
+        bonescope.bake(STRETCHY, tmp_path / "x.fbx")
+    assert str(refused.value) == cli_error("bake", STRETCHY, "--out", tmp_path / "x.fbx")
+    assert not (tmp_path / "x.fbx").exists()
+
+
+def test_a_bake_to_usd_is_the_command_lines(tmp_path):
+    mine = bonescope.bake(STRETCHY, tmp_path / "mine.usdc")
+    theirs = cli("bake", STRETCHY, "--out", tmp_path / "theirs.usdc")
+    assert mine == theirs
+    assert (tmp_path / "mine.usdc").read_bytes() == (tmp_path / "theirs.usdc").read_bytes()
+    assert any("a USD stage plays one animation" in n for n in mine["notes"])
 
 
 def test_evaluate_is_inspect_at_each_time():

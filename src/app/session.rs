@@ -198,7 +198,7 @@ impl Session {
         self.history.redo_label()
     }
 
-    /// Every step of the history by its label, and which one the document is in ([`History::steps`]).
+    /// Every step of the history by its label, and which one the document is in.
     pub fn steps(&self) -> (Vec<&str>, usize) {
         self.history.steps()
     }

@@ -61,7 +61,7 @@ pub struct Window {
     span: Span,
     /// Selected bones; the last one is the inspected one.
     pub selection: Vec<usize>,
-    /// Whether the first view of a file opened is still to come from its whole-clip analysis ([`Window::open_on_the_problem`]).
+    /// Whether the first view of a file opened is still to come from its whole-clip analysis.
     /// Headless renders, which say what to show, turn it off.
     pub opening: bool,
     viewport: Viewport,

@@ -1,4 +1,4 @@
-//! Writing evaluated geometry for other tools to read: Wavefront OBJ, and pose dumps ([`dump`]).
+//! Writing evaluated geometry for other tools to read: Wavefront OBJ, and pose dumps (`dump`).
 //!
 //! Positions are written as evaluated (no axis or unit change: the caller chooses the space when loading), one
 //! `g` group per mesh, triangles as `f` lines with 1-based indices. Numbers use Rust's shortest round-trip

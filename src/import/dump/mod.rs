@@ -3,7 +3,7 @@
 //!
 //! A dump lists bones (names, parents by name) and, at increasing times, one 4×4 matrix per bone: world (model
 //! space) or local (`world = parent's world · local`), written column- or row-major, as JSON (`json`) or CSV
-//! (`csv`). Both are parsed into one [`Dump`], which is then made a [`Rig`] without meshes whose bones all inherit
+//! (`csv`). Both are parsed into one `Dump`, which is then made a [`Rig`] without meshes whose bones all inherit
 //! fully (a dump has no modes of its own): each bone's local matrix `L = W_parent⁻¹ · W` at each time, decomposed
 //! `L = T·R·U·S·Uᵀ` (`math::decompose`), is one key of its translation, rotation, scale and stretch tracks. The
 //! stretch `U` is kept per key because a runtime that composes otherwise than `full` (Unreal's `componentwise`, say)
