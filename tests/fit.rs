@@ -201,3 +201,22 @@ fn a_dump_is_a_file_like_any_other_for_inspect_scan_and_diff() {
     let inspect = json(&bonescope(&["inspect", dump, "--time", "1", "--format", "json"]));
     assert_eq!(inspect["samples"][0]["bones"].as_array().unwrap().len(), 10, "{inspect}");
 }
+
+#[test]
+fn the_readmes_dump_is_what_inspect_writes() {
+    // The README shows `fit` on a dump bonescope wrote of Blender's rig under `componentwise` (as Unreal composes):
+    // the committed file is what the command writes today.
+    let source = asset("blender/stretchy_full.glb").display().to_string();
+    let args = ["inspect", &source, "--anim", "squash_stretch", "--inherit", "componentwise", "--format", "dump"];
+    let run = bonescope(&args);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/dumps/stretchy_full_componentwise.dump.json");
+    let committed = std::fs::read_to_string(committed).unwrap();
+    let version = |text: &str| text.replacen(env!("CARGO_PKG_VERSION"), "VERSION", 1);
+    assert_eq!(
+        version(&String::from_utf8(run.stdout).unwrap()),
+        version(&committed),
+        "regenerate with: bonescope {}",
+        args.join(" ")
+    );
+}
