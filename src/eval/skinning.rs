@@ -379,11 +379,6 @@ impl DualBlend {
         let t = dual * real.conjugate() * 2.0;
         Some(DualBlend { rotation: real, translation: DVec3::new(t.x, t.y, t.z), stretch: stretch / total })
     }
-
-    /// The linear part of the blend, `R · S`.
-    fn linear(&self) -> DMat3 {
-        DMat3::from_quat(self.rotation) * self.stretch
-    }
 }
 
 /// `p` skinned by the dual-quaternion blend of `influences` (left where it is for no weight).
@@ -391,35 +386,23 @@ fn dual_quaternion(joints: &[RigidStretch], influences: impl Iterator<Item = (us
     DualBlend::of(joints, influences).map_or(p, |b| b.rotation * (b.stretch * p) + b.translation)
 }
 
-/// The shear each vertex of `mesh` is skinned with at the pose `model` (the model matrices of all bones), in
-/// degrees: the shear of the vertex's own skinning transform (what the skin really does to the mesh around it,
-/// through `method`'s blend), read in the bind frame of its heaviest joint. That frame makes a vertex weighted to one
-/// bone read exactly that bone's shear ([`crate::analysis::Assessment::shear_deg`]: the largest deviation from 90°
-/// between the columns); a vertex between bones reads the shear their blend gives it, which their weighted shears
-/// need not sum to (two turned bones blend into a squash). An unskinned mesh has its bone's shear throughout.
-/// Morph targets move the positions, not the transform: they change no vertex's shear.
-pub fn vertex_shears(mesh: &Mesh, skins: &[Skin], model: &[DMat4], method: Method) -> Vec<f64> {
+/// The shear each vertex of `mesh` carries at the pose `model` (the model matrices of all bones), in degrees: its
+/// joints' own shear ([`crate::analysis::Assessment::shear_deg`]: the largest deviation from 90° between the columns
+/// of the joint's model matrix), weighted as the vertex is. A vertex weighted to one bone reads exactly that bone's
+/// shear, and no vertex reads any where no bone shears: a linear blend of two differently turned joints is no
+/// rotation either, but that is the skinning's own squash, found wherever joints bend, not a scale's shear. An
+/// unskinned mesh has its bone's shear throughout; morph targets move the positions and change no vertex's shear.
+pub fn vertex_shears(mesh: &Mesh, skins: &[Skin], model: &[DMat4]) -> Vec<f64> {
     let count = mesh.positions.len();
+    let bone_shear = |bone: usize| model.get(bone).map_or(0.0, |m| column_shear_deg(&DMat3::from_mat4(*m)));
     let Some(skin) = skin_of(mesh, skins) else {
-        return vec![column_shear_deg(&DMat3::from_mat4(model[mesh.bone])); count];
+        return vec![bone_shear(mesh.bone); count];
     };
-    let mut joints = Vec::new();
-    joint_matrices(skin, model, &mut joints);
-    let any_dq = (0..count).any(|v| method.dq_weight(mesh, v) > 0.0);
-    let rigid: Vec<RigidStretch> = if any_dq { joints.iter().map(RigidStretch::of).collect() } else { Vec::new() };
-    // Each joint's bind frame: the inverse of its inverse bind matrix's linear part.
-    let bind: Vec<DMat3> = skin.inverse_bind.iter().map(|m| DMat3::from_mat4(*m).inverse()).collect();
+    let joints: Vec<f64> = skin.joints.iter().map(|&bone| bone_shear(bone)).collect();
     let shear = |v: usize| {
-        let influences = influences(mesh, v)?;
-        let (heaviest, _) = influences.clone().max_by(|a, b| a.1.total_cmp(&b.1))?;
-        let linear = || influences.clone().map(|(j, w)| DMat3::from_mat4(joints[j]) * w).sum::<DMat3>();
-        let dual = || DualBlend::of(&rigid, influences.clone()).map_or(DMat3::IDENTITY, |b| b.linear());
-        let skinning = match method.dq_weight(mesh, v) {
-            0.0 => linear(),
-            1.0 => dual(),
-            d => linear() * (1.0 - d) + dual() * d,
-        };
-        Some(column_shear_deg(&(skinning * bind[heaviest])))
+        let influences = influences(mesh, v)?.filter(|&(j, _)| j < joints.len());
+        let (sum, total) = influences.fold((0.0, 0.0), |(sum, total), (j, w)| (sum + w * joints[j], total + w));
+        (total > 0.0).then(|| sum / total)
     };
     (0..count).map(|v| shear(v).unwrap_or(0.0)).collect()
 }
@@ -429,9 +412,9 @@ fn column_shear_deg(m: &DMat3) -> f64 {
     shear_deg_of_cosine(largest_column_cosine(m))
 }
 
-/// [`vertex_shears`] of every mesh of the rig at the pose `model`, skinned by `method`.
-pub fn skin_shears(rig: &Rig, model: &[DMat4], method: Method) -> Vec<Vec<f64>> {
-    rig.meshes.iter().map(|mesh| vertex_shears(mesh, &rig.skins, model, method)).collect()
+/// [`vertex_shears`] of every mesh of the rig at the pose `model`.
+pub fn skin_shears(rig: &Rig, model: &[DMat4]) -> Vec<Vec<f64>> {
+    rig.meshes.iter().map(|mesh| vertex_shears(mesh, &rig.skins, model)).collect()
 }
 
 /// Every mesh of the rig morphed and skinned at the pose `model` (one vector of positions per mesh), as the file
@@ -649,54 +632,34 @@ mod tests {
         let model = [sheared, turned];
         let bone = crate::analysis::Assessment::of(&sheared, &crate::analysis::Tolerances::default()).shear_deg;
         assert!((bone - 30.0).abs() < 1e-9, "the bone's own shear: {bone}");
-        for method in Method::ALL {
-            let shears = vertex_shears(&mesh, std::slice::from_ref(&skin), &model, *method);
-            assert!((shears[0] - bone).abs() < 1e-9, "{method:?}: {} vs the bone's {bone}", shears[0]);
-            assert!(shears[1].abs() < 1e-9, "{method:?}: a rigid bone gives none, {}", shears[1]);
-            assert!(shears[2] > 1.0, "{method:?}: halfway, some shear: {}", shears[2]);
-        }
+        let shears = vertex_shears(&mesh, std::slice::from_ref(&skin), &model);
+        assert!((shears[0] - bone).abs() < 1e-9, "{} vs the bone's {bone}", shears[0]);
+        assert!(shears[1].abs() < 1e-9, "a rigid bone gives none, {}", shears[1]);
+        assert!((shears[2] - bone / 2.0).abs() < 1e-9, "halfway, half the sheared bone's: {}", shears[2]);
         // Unskinned, a mesh has its bone's shear everywhere.
         let placed = Mesh { bone: 0, positions: vec![Vec3::X; 2], ..Mesh::default() };
-        let shears = vertex_shears(&placed, &[], &model, Method::AsFile);
+        let shears = vertex_shears(&placed, &[], &model);
         assert!(shears.iter().all(|s| (s - bone).abs() < 1e-9), "{shears:?}");
     }
 
     #[test]
-    fn a_vertex_between_bones_has_the_shear_of_the_transform_that_skins_it() {
-        // The oracle: the vertex's skinning transform measured from positions alone. Four vertices with the same
-        // weights at p, p + x, p + y, p + z are skinned; their differences are the transform's columns (it is affine
-        // for fixed weights, linear blend or dual quaternion), read in the heaviest joint's bind frame.
-        let (sheared, inverse_bind) = sheared_bone();
-        let other = DMat4::from_scale_rotation_translation(
-            DVec3::new(1.0, 0.6, 1.2),
-            DQuat::from_rotation_x(0.8),
-            DVec3::new(0.0, 1.0, 0.5),
-        );
-        let skin = Skin { joints: vec![0, 1], inverse_bind: vec![inverse_bind, DMat4::IDENTITY], ..Skin::default() };
-        let p = Vec3::new(0.2, 0.9, -0.4);
-        let corners = [p, p + Vec3::X, p + Vec3::Y, p + Vec3::Z];
-        for (w0, w1, dq) in [(0.7, 0.3, 0.0), (0.3, 0.7, 1.0), (0.55, 0.45, 0.4)] {
-            let mesh = Mesh {
-                skin: Some(0),
-                positions: corners.to_vec(),
-                joints: vec![[0, 1, 0, 0]; 4],
-                weights: vec![[w0, w1, 0.0, 0.0]; 4],
-                dq_weights: vec![dq; 4],
-                ..Mesh::default()
-            };
-            let skins = std::slice::from_ref(&skin);
-            let model = [sheared, other];
-            let mut skinned = Vec::new();
-            skin_positions(&mesh, skins, &model, &MorphPose::default(), &mut skinned);
-            let columns = DMat3::from_cols(skinned[1] - skinned[0], skinned[2] - skinned[0], skinned[3] - skinned[0]);
-            let heaviest = if w0 > w1 { 0 } else { 1 };
-            let expected = shear_by_angles(columns * DMat3::from_mat4(skin.inverse_bind[heaviest]).inverse());
-            let shears = vertex_shears(&mesh, skins, &model, Method::AsFile);
-            assert!(expected > 1.0, "a shear to find: {expected}");
-            for shear in shears {
-                assert!((shear - expected).abs() < 1e-7, "weights {w0}/{w1}, dq {dq}: {shear} vs {expected}");
-            }
-        }
+    fn a_vertex_between_two_turned_bones_that_shear_not_reads_no_shear() {
+        // The blend of two joints turned about different axes squashes the skin between them (linear blending's
+        // own distortion, whose columns meet at other than 90°): no bone shears, so no vertex does.
+        let skin = Skin { joints: vec![0, 1], inverse_bind: vec![DMat4::IDENTITY; 2], ..Skin::default() };
+        let turned = DQuat::from_rotation_x(1.2) * DQuat::from_rotation_z(0.9);
+        let model = [DMat4::IDENTITY, DMat4::from_quat(turned)];
+        let mesh = Mesh {
+            skin: Some(0),
+            positions: vec![Vec3::new(0.2, 0.9, -0.4); 2],
+            joints: vec![[0, 1, 0, 0]; 2],
+            weights: vec![[0.5, 0.5, 0.0, 0.0], [0.3, 0.7, 0.0, 0.0]],
+            ..Mesh::default()
+        };
+        let blend = DMat3::from_mat4(model[0]) * 0.5 + DMat3::from_mat4(model[1]) * 0.5;
+        assert!(shear_by_angles(blend) > 1.0, "the blend itself is no rotation");
+        let shears = vertex_shears(&mesh, std::slice::from_ref(&skin), &model);
+        assert!(shears.iter().all(|s| s.abs() < 1e-12), "rounding alone: {shears:?}");
     }
 
     #[test]

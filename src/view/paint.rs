@@ -46,7 +46,7 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
         paint_sorted(&painter, triangles);
     }
     // The mesh is translucent and the bones are drawn over it (x-ray), so the skeleton is never hidden.
-    let shears = options.paints_shear().then(|| skin_shears(scene.rig, &scene.primary.model, options.skinning));
+    let shears = options.paints_shear().then(|| skin_shears(scene.rig, &scene.primary.model));
     if options.mesh {
         let mut triangles = Vec::new();
         let color = |mesh: usize, vertex: usize| match &shears {

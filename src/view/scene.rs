@@ -52,7 +52,7 @@ pub struct SceneOptions {
     pub grid: bool,
     pub bones: bool,
     pub mesh: bool,
-    /// The mesh painted by the shear of each vertex's skinning ([`crate::eval::skinning::vertex_shears`]).
+    /// The mesh painted by the shear each vertex's bones give it ([`crate::eval::skinning::vertex_shears`]).
     pub shear: bool,
     pub wireframe: bool,
     /// Whose axis triads are drawn, from their model matrix columns (a sheared frame loses its right angles).
