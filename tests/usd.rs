@@ -222,7 +222,7 @@ fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
         // A mesh is named as its prim, or as a bake's `customData` keeps its name (its prim the name as USD spells it).
         let name = &rig.meshes[mesh].name;
         assert!(
-            [name.clone(), bonescope::bake::identifier(name)].iter().any(|n| path.ends_with(&format!("/{n}"))),
+            [name.clone(), bonescope::diff::usd_identifier(name)].iter().any(|n| path.ends_with(&format!("/{n}"))),
             "{path}"
         );
         if path.starts_with("/GroundTruth") {

@@ -38,7 +38,7 @@ pub use engine::Engine;
 pub use file::{BakeError, Plan, Written, bake_file, in_metres};
 pub use report::{BakeReport, report};
 pub use times::{BakeTimes, bake_times};
-pub use usd::{CUSTOM_DATA, Encoding, identifier};
+pub use usd::{CUSTOM_DATA, Encoding};
 
 use keys::Metrics;
 use layout::NodePlan;

@@ -74,11 +74,15 @@ fn root_of(nodes: &[Node], mut node: usize) -> usize {
 
 /// `base`, or `base.1`, `base.2`, … whichever no node is called yet.
 pub(super) fn unique_name(nodes: &[Node], base: &str) -> String {
-    let taken = |name: &str| nodes.iter().any(|n| n.name == name);
+    unique(base, '.', |name| nodes.iter().any(|n| n.name == name))
+}
+
+/// `base`, or `base` with `1`, `2`, … after `separator`, whichever is not `taken`.
+pub(super) fn unique(base: &str, separator: char, taken: impl Fn(&str) -> bool) -> String {
     if !taken(base) {
         return base.to_owned();
     }
-    (1..).map(|k| format!("{base}.{k}")).find(|name| !taken(name)).unwrap_or_default()
+    (1..).map(|k| format!("{base}{separator}{k}")).find(|name| !taken(name)).unwrap_or_default()
 }
 
 #[cfg(test)]

@@ -30,6 +30,8 @@ use openusd::sdf::{self, AbstractData, Path, Specifier, Value, Variability};
 
 use super::document::{Animation, Channel, GltfDocument, Interpolation, Node, Property, SkinOut};
 use super::glb::skin_attributes;
+use super::skins::unique;
+use crate::diff::usd_identifier as identifier;
 use crate::model::Mesh;
 
 /// Which of USD's three encodings.
@@ -141,7 +143,7 @@ impl Joints {
         let (mut paths, mut renamed): (Vec<String>, Vec<String>) = Default::default();
         for node in nodes {
             let siblings = taken.entry(node.parent).or_default();
-            let name = unique(identifier(&node.name), siblings);
+            let name = unique_in(identifier(&node.name), siblings);
             if name != identifier(&node.name) {
                 renamed.push(format!("`{}` → `{name}`", node.name));
             }
@@ -159,22 +161,9 @@ impl Joints {
     }
 }
 
-/// `name` spelt as a USD identifier: every character but a letter, a digit or `_` made `_`, and `_` before a
-/// leading digit (or for no name at all).
-pub fn identifier(name: &str) -> String {
-    let spelt: String = name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
-    match spelt.chars().next() {
-        Some(c) if !c.is_ascii_digit() => spelt,
-        _ => format!("_{spelt}"),
-    }
-}
-
-/// `name`, or `name_1`, `name_2`, … whichever is not `taken`.
-fn unique(name: String, taken: &HashSet<String>) -> String {
-    if !taken.contains(&name) {
-        return name;
-    }
-    (1..).map(|k| format!("{name}_{k}")).find(|n| !taken.contains(n)).unwrap_or(name)
+/// `name`, or `name_1`, `name_2`, … whichever is not `taken` (a dot spells no identifier).
+fn unique_in(name: String, taken: &HashSet<String>) -> String {
+    unique(&name, '_', |n| taken.contains(n))
 }
 
 /// Each node's bind transform in the skeleton's space: the inverse of its inverse bind matrix in the first skin
@@ -320,7 +309,7 @@ impl Layer {
         let mut shapes = Vec::new();
         for (node, group) in document.nodes.iter().enumerate().filter_map(|(n, node)| Some((n, node.mesh?))) {
             for mesh in &document.meshes[group].primitives {
-                let name = unique(identifier(&mesh.name), &taken);
+                let name = unique_in(identifier(&mesh.name), &taken);
                 taken.insert(name.clone());
                 let path = format!("{ROOT}/{name}");
                 self.mesh(&path, mesh);
@@ -412,7 +401,7 @@ impl Layer {
         let mut taken = HashSet::new();
         let (mut names, mut targets) = (Vec::new(), Vec::new());
         for target in &mesh.morph_targets {
-            let name = unique(identifier(&target.name), &taken);
+            let name = unique_in(identifier(&target.name), &taken);
             taken.insert(name.clone());
             let shape = format!("{path}/{name}");
             self.prim(&shape, "BlendShape");

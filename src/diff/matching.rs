@@ -82,12 +82,20 @@ pub fn loose_name(name: &str) -> String {
     name.rsplit([':', '|']).next().unwrap_or(name).to_lowercase()
 }
 
-/// The loose name as a USD identifier spells it: every character but ASCII letters, digits and `_` made `_`, and
-/// `_` before a leading digit.
+/// The loose name as a USD identifier spells it ([`usd_identifier`]).
 pub fn usd_name(name: &str) -> String {
-    let loose = loose_name(name);
-    let spelled: String = loose.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
-    if spelled.starts_with(|c: char| c.is_ascii_digit()) { format!("_{spelled}") } else { spelled }
+    usd_identifier(&loose_name(name))
+}
+
+/// `name` spelt as a USD identifier (`[A-Za-z_][A-Za-z0-9_]*`): every character but an ASCII letter, a digit or `_`
+/// made `_`, and `_` before a leading digit (or for no name at all). USD exporters spell names so (Blender's
+/// `Bone.001` is `Bone_001`), and so does a bake to USD.
+pub fn usd_identifier(name: &str) -> String {
+    let spelt: String = name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+    match spelt.chars().next() {
+        Some(c) if !c.is_ascii_digit() => spelt,
+        _ => format!("_{spelt}"),
+    }
 }
 
 /// Pairs the bones of `a` and `b` by name (see the module's documentation).
