@@ -1,12 +1,13 @@
-"""Blender's glTF importer as a judge of `bonescope bake` (tests/blender.rs runs it).
+"""Blender's glTF and USD importers as judges of `bonescope bake` (tests/blender.rs runs it).
 
-blender's Python module: python play.py FILE.glb TIMES.json OUT.json
+blender's Python module: python play.py FILE.glb|FILE.usd[acz] TIMES.json OUT.json
 
-Imports FILE.glb into an empty scene as Blender's own importer does, plays it at each time of TIMES.json (seconds,
-frames of the scene's rate with subframes between), and writes per time the origin of every bone and of every other node not hung on a bone, and every
-skinned mesh's evaluated vertices in world space, turned back into glTF's axes (Blender is Z-up, glTF Y-up:
-glTF (x, y, z) = Blender (x, z, -y)). Origins and skinned vertices do not depend on the importer's choice of bone
-orientation.
+Imports FILE into an empty scene as Blender's own importer does, plays it at each time of TIMES.json (for glTF
+seconds, frames of the scene's rate with subframes between; for USD time codes, which Blender's USD importer makes
+its frames), and writes per time the origin of every bone and of every other node not hung on a bone, and every
+skinned mesh's evaluated vertices in world space, turned back into the file's Y-up axes (Blender is Z-up, glTF and
+bonescope's USD Y-up: (x, y, z) = Blender (x, z, -y)). Origins and skinned vertices do not depend on the importer's
+choice of bone orientation.
 """
 
 import json
@@ -21,16 +22,20 @@ def gltf_axes(v):
 
 
 def main():
-    glb, times_file, out = sys.argv[1:4]
+    path, times_file, out = sys.argv[1:4]
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.import_scene.gltf(filepath=glb)
+    usd = path.lower().endswith((".usd", ".usda", ".usdc", ".usdz"))
+    if usd:
+        bpy.ops.wm.usd_import(filepath=path)
+    else:
+        bpy.ops.import_scene.gltf(filepath=path)
     scene = bpy.context.scene
     fps = scene.render.fps / scene.render.fps_base
     with open(times_file) as f:
         times = json.load(f)
     played = []
     for time in times:
-        frame = time * fps
+        frame = time if usd else time * fps
         whole = math.floor(frame)
         scene.frame_set(whole, subframe=frame - whole)
         depsgraph = bpy.context.evaluated_depsgraph_get()
