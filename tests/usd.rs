@@ -2,6 +2,9 @@
 //! USD file equals what `usd-core`'s UsdSkel computes (`tests/usd/joint_transforms.py`) to 1e-6 of the model's size.
 
 mod common;
+#[path = "../benches/support/generated_gltf.rs"]
+#[allow(dead_code)]
+mod generated_gltf;
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -29,10 +32,10 @@ fn usd_files() -> Vec<PathBuf> {
     files
 }
 
-/// usd-core's evaluation of `file` (see `tests/usd/joint_transforms.py`).
-fn reference(python: &Path, file: &Path) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/joint_transforms.py");
-    let output = Command::new(python).arg(script).arg(file).output().expect("python runs");
+/// What `script` of `tests/usd/` prints of `file` at every `every`-th time code (and the last), run by usd-core.
+fn usd_core(python: &Path, script: &str, file: &Path, every: usize) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd").join(script);
+    let output = Command::new(python).arg(script).arg(file).arg(every.to_string()).output().expect("python runs");
     assert!(output.status.success(), "{}: {}", file.display(), String::from_utf8_lossy(&output.stderr));
     serde_json::from_slice(&output.stdout).expect("JSON")
 }
@@ -49,7 +52,7 @@ fn every_joint_is_where_usd_core_puts_it_at_every_time_code() {
     let mut compared = 0;
     for file in usd_files() {
         let rig = load_with(&file, &Options { space: Space::File }).unwrap_or_else(|e| panic!("{e}"));
-        compared += joints_as_usd_core(&python, &file, &rig);
+        compared += joints_as_usd_core(&python, &file, &rig, 1);
     }
     assert!(compared > 500, "{compared} skeleton poses compared");
 }
@@ -98,18 +101,18 @@ def Xform "Shot"
     )
     .unwrap();
     let rig = load_with(&file, &Options { space: Space::File }).unwrap();
-    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11, "every time code");
+    assert_eq!(joints_as_usd_core(&python, &file, &rig, 1), 11, "every time code");
     let text = std::fs::read_to_string(&file).unwrap();
     std::fs::write(&file, text.replace("prepend apiSchemas = [\"SkelBindingAPI\"]", "")).unwrap();
     let rig = load_with(&file, &Options { space: Space::File }).unwrap();
-    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11);
+    assert_eq!(joints_as_usd_core(&python, &file, &rig, 1), 11);
     assert!(rig.clips[0].tracks().iter().all(|t| t.bone == 0), "only the skeleton's node moves");
 }
 
-/// Compares every joint's world transform in `rig` (loaded from `file` in its own space) with usd-core's at every
-/// time code; how many skeleton poses were compared.
-fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig) -> usize {
-    let reference = reference(python, file);
+/// Compares every joint's world transform in `rig` (loaded from `file` in its own space) with usd-core's
+/// (`tests/usd/joint_transforms.py`) at every `every`-th time code; how many skeleton poses were compared.
+fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig, every: usize) -> usize {
+    let reference = usd_core(python, "joint_transforms.py", file, every);
     let rate = reference["time_codes_per_second"].as_f64().unwrap();
     let evaluation = Evaluation::declared(rig, rig.clips.first());
     // A time code `c` is at `c / rate` on the stage's clock; an attribute's default value holds from its start.
@@ -172,14 +175,6 @@ fn blenders_usd_export_shears_as_its_gltf_export_and_both_encodings_agree() {
     }
 }
 
-/// usd-core's world points of `file`'s meshes at every time code (see `tests/usd/world_points.py`).
-fn world_points(python: &Path, file: &Path) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/world_points.py");
-    let output = Command::new(python).arg(script).arg(file).output().expect("python runs");
-    assert!(output.status.success(), "{}: {}", file.display(), String::from_utf8_lossy(&output.stderr));
-    serde_json::from_slice(&output.stdout).expect("JSON")
-}
-
 #[test]
 fn skinned_and_blend_shaped_points_are_pixars_baked_ones() {
     // Pixar's own tests bake their skinning and blend shapes with `UsdSkel.BakeSkinning` into
@@ -201,16 +196,16 @@ fn skinned_and_blend_shaped_points_are_pixars_baked_ones() {
         pairs.push((file, out));
     }
     for (file, baked) in pairs {
-        let compared = points_as_baked(&python, &file, &baked);
+        let compared = points_as_baked(&python, &file, &baked, 1);
         assert!(compared > 1000, "{}: {compared} points compared", file.display());
     }
 }
 
-/// Compares every point bonescope deforms from `file` with usd-core's world points of `baked` at every time code, to
-/// 1e-5 of the model's size; how many were compared.
-fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
+/// Compares every point bonescope deforms from `file` with usd-core's world points of `baked`
+/// (`tests/usd/world_points.py`) at every `every`-th time code, to 1e-5 of the model's size; how many were compared.
+fn points_as_baked(python: &Path, file: &Path, baked: &Path, every: usize) -> usize {
     let rig = load_with(file, &Options { space: Space::File }).unwrap();
-    let baked = world_points(python, baked);
+    let baked = usd_core(python, "world_points.py", baked, every);
     let clip = rig.clips.first();
     let rate = clip.map(|c| c.frame_rate()).unwrap_or(24.0);
     let evaluation = Evaluation::declared(&rig, clip);
@@ -460,20 +455,28 @@ fn validation_errors(python: &Path, file: &Path) -> Vec<String> {
     errors.map(|e| format!("{}: {}", e["validator"].as_str().unwrap(), e["message"].as_str().unwrap())).collect()
 }
 
+/// At most about this many time codes of a file are compared with usd-core (every `n`-th, evenly over the clip, and
+/// the last): each is a whole pose of every joint, and of every point, as JSON.
+const COMPARED_CODES: f64 = 600.0;
+
 #[test]
 fn a_usd_bake_plays_in_usd_core_as_its_source_within_its_report() {
     // Each source baked to USD by the command line, its report measured on the file read back by bonescope. usd-core
     // puts every joint where bonescope reads it at every time code (1e-6 of the rig's size) and skins every point
     // as bonescope does (`UsdSkel.BakeSkinning`, 1e-5): so usd-core plays the source within the report's worst, plus
-    // that. Pixar's validators find nothing wrong in any of the three encodings.
+    // that. Pixar's validators find nothing wrong in any of the three encodings. The generated 200-bone rig's 6,001
+    // time codes are compared every tenth ([`COMPARED_CODES`]).
     let Some(python) = usd_python() else { return };
     let dir = tempfile::tempdir().unwrap();
+    let generated = dir.path().join("generated.glb");
+    std::fs::write(&generated, generated_gltf::glb(generated_gltf::Squashes::Sparse)).unwrap();
     let sources = [
         (common::asset("blender/stretchy_full.glb"), "usdc"),
         (common::asset("blender/stretchy_noinherit.fbx"), "usda"),
         (common::asset("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx"), "usdz"),
         (common::corpus("realworld/godot_mannequiny.glb"), "usdc"),
         (common::corpus("realworld/usdwg_BrainStem.usdz"), "usdc"),
+        (generated, "usdc"),
     ];
     for (k, (source, extension)) in sources.iter().enumerate() {
         let out = dir.path().join(format!("baked{k}.{extension}"));
@@ -484,17 +487,18 @@ fn a_usd_bake_plays_in_usd_core_as_its_source_within_its_report() {
         // UsdSkel's half-precision scales bound it: 2⁻¹¹ of a joint's reach, and the keys' tolerance.
         assert!(worst <= 1e-3 * size, "{source}: worst {worst} of a rig {size} across");
         let back = load_with(&out, &Options { space: Space::File }).unwrap_or_else(|e| panic!("{e}"));
-        assert!(joints_as_usd_core(&python, &out, &back) > 0, "{source}: poses compared");
-        // usd-core's skinned points of every vertex at every time code, as JSON: bounded (BrainStem's 34.9 s skin would
-        // be 77 million points); its joints are compared at every time code all the same.
-        let points: usize = back.meshes.iter().map(|m| m.positions.len()).sum();
         let codes = back.clips.first().map_or(1.0, |c| c.span().length() * c.frame_rate() + 1.0);
-        if points > 0 && points as f64 * codes <= 5e6 {
-            let skinned = dir.path().join(format!("skinned{k}.usda"));
+        let every = (codes / COMPARED_CODES).ceil().max(1.0) as usize;
+        assert!(joints_as_usd_core(&python, &out, &back, every) > 0, "{source}: poses compared");
+        // usd-core's skinned points of every vertex, as JSON: bounded (BrainStem's 34.9 s skin would be 38 million
+        // points even at every other time code); its joints are compared all the same.
+        let points: usize = back.meshes.iter().map(|m| m.positions.len()).sum();
+        if points > 0 && points as f64 * codes / every as f64 <= 5e6 {
+            let skinned = dir.path().join(format!("skinned{k}.usdc"));
             let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/bake_skinning.py");
             let status = Command::new(&python).arg(script).arg(&out).arg(&skinned).status().expect("python runs");
             assert!(status.success(), "usd-core baked the skinning of {source}'s bake");
-            assert!(points_as_baked(&python, &out, &skinned) > 0, "{source}: points compared");
+            assert!(points_as_baked(&python, &out, &skinned, every) > 0, "{source}: points compared");
         }
         let errors = validation_errors(&python, &out);
         assert!(errors.is_empty(), "{source}: {errors:#?}");

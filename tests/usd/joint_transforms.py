@@ -2,7 +2,8 @@
 at every time code of the stage (or the rest pose's time where none is authored), each joint's world transform as
 UsdSkel computes it (`SkeletonQuery.ComputeJointWorldTransforms`), printed as one JSON document.
 
-Usage: python joint_transforms.py FILE
+Usage: python joint_transforms.py FILE [EVERY]
+EVERY: only every EVERY-th time code from the start, and the last (default 1: all of them).
 Matrices are row-vector (translation in the last row), flattened row by row, as USD writes them.
 """
 import json
@@ -15,13 +16,13 @@ def flat(matrix):
     return [matrix[r][c] for r in range(4) for c in range(4)]
 
 
-def main(path):
+def main(path, every):
     stage = Usd.Stage.Open(path)
     cache = UsdSkel.Cache()
     skeletons = []
     if stage.HasAuthoredTimeCodeRange():
         start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
-        times = [start + i for i in range(int(round(end - start)) + 1)]
+        times = every_nth([start + i for i in range(int(round(end - start)) + 1)], every)
     else:
         times = [Usd.TimeCode.Default()]
     for prim in stage.Traverse():
@@ -48,5 +49,10 @@ def main(path):
     }))
 
 
+def every_nth(codes, every):
+    """Every `every`-th of `codes` from the first, and the last."""
+    return codes[::every] + ([codes[-1]] if (len(codes) - 1) % every else [])
+
+
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(sys.argv[1], int(sys.argv[2]) if len(sys.argv) > 2 else 1)

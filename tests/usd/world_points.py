@@ -3,18 +3,21 @@ baselines (`UsdSkel.BakeSkinning`'s output), the skinned points bonescope must r
 document: {"time_codes": [...], "meshes": [{"path": "/A/Mesh", "frames": [[[x, y, z], ...] per time code]}, ...]},
 the meshes in the stage's traversal order.
 
-Usage: python world_points.py FILE
+Usage: python world_points.py FILE [EVERY]
+EVERY: only every EVERY-th time code from the start, and the last (default 1: all of them).
 """
 import json
 import sys
 
 from pxr import Usd, UsdGeom
 
+from joint_transforms import every_nth
 
-def main(path):
+
+def main(path, every):
     stage = Usd.Stage.Open(path)
     start, end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
-    codes = [start + i for i in range(int(round(end - start)) + 1)]
+    codes = every_nth([start + i for i in range(int(round(end - start)) + 1)], every)
     meshes = []
     for prim in stage.Traverse():
         if not prim.IsA(UsdGeom.Mesh):
@@ -29,4 +32,4 @@ def main(path):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(sys.argv[1], int(sys.argv[2]) if len(sys.argv) > 2 else 1)
