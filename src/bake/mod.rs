@@ -323,7 +323,7 @@ fn bake_keeping(request: &Request, output: Output, held: usize) -> Result<Baked,
         }
         Output::Usd(encoding) => {
             let conversion = layout.converted(rig, &mut document);
-            usd::encode(&document, &clock(request), conversion, encoding, &mut notes)?
+            usd::encode(document, &clock(request), conversion, encoding, &mut notes)?
         }
     };
     Ok(Baked { output, bytes, helpers, animations, rig_size: size, tolerance, notes })

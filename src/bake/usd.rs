@@ -71,7 +71,7 @@ const STEP_LEAD: f64 = 1e-6;
 /// `document` (its first animation) written as a UsdSkel layer in `encoding`, its node `conversion` (where it has
 /// one) carrying the source's unit and axes; what a user should know of how goes to `notes`.
 pub fn encode(
-    document: &GltfDocument,
+    document: GltfDocument,
     clock: &Clock,
     conversion: Option<usize>,
     encoding: Encoding,
@@ -100,8 +100,8 @@ pub fn encode(
 
 /// `document` with its nodes reordered so that each comes after its parent, as UsdSkel's joints must (a node put
 /// above the roots comes after them), every index into them renumbered, `conversion` too.
-fn parents_first<'a>(document: &GltfDocument<'a>, conversion: Option<usize>) -> (GltfDocument<'a>, Option<usize>) {
-    let nodes = &document.nodes;
+fn parents_first(mut document: GltfDocument, conversion: Option<usize>) -> (GltfDocument, Option<usize>) {
+    let nodes = std::mem::take(&mut document.nodes);
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
     for (n, node) in nodes.iter().enumerate() {
         if let Some(p) = node.parent {
@@ -120,16 +120,15 @@ fn parents_first<'a>(document: &GltfDocument<'a>, conversion: Option<usize>) -> 
     for (i, &n) in order.iter().enumerate() {
         new_index[n] = i;
     }
-    let mut reordered = document.clone();
-    reordered.nodes =
+    document.nodes =
         order.iter().map(|&n| Node { parent: nodes[n].parent.map(|p| new_index[p]), ..nodes[n].clone() }).collect();
-    for skin in &mut reordered.skins {
+    for skin in &mut document.skins {
         skin.joints.iter_mut().for_each(|joint| *joint = new_index[*joint]);
     }
-    for channel in reordered.animations.iter_mut().flat_map(|a| &mut a.channels) {
+    for channel in document.animations.iter_mut().flat_map(|a| &mut a.channels) {
         channel.node = new_index[channel.node];
     }
-    (reordered, conversion.map(|n| new_index[n]))
+    (document, conversion.map(|n| new_index[n]))
 }
 
 /// The joints: each node's path (`A/B` is `B` under `A`), its name an identifier unique among its siblings.
@@ -439,28 +438,24 @@ impl Layer {
             channels.insert((channel.node, channel.property), channel);
         }
         let at = |node: usize, property: Property| channels.get(&(node, property)).map(|c| timeline.sampled(c));
-        let mut translations = vec![Vec::with_capacity(nodes.len()); codes.len()];
-        let mut rotations = vec![Vec::with_capacity(nodes.len()); codes.len()];
-        let mut scales = vec![Vec::with_capacity(nodes.len()); codes.len()];
-        let held = |values: Option<Vec<f32>>, rest: &[f32]| values.unwrap_or_else(|| rest.repeat(codes.len()));
-        let t: Vec<Vec<f32>> =
-            nodes.iter().enumerate().map(|(n, node)| held(at(n, Property::Translation), &node.translation)).collect();
-        let r: Vec<Vec<f32>> =
-            nodes.iter().enumerate().map(|(n, node)| held(at(n, Property::Rotation), &node.rotation)).collect();
-        let s: Vec<Vec<f32>> =
-            nodes.iter().enumerate().map(|(n, node)| held(at(n, Property::Scale), &node.scale)).collect();
+        // Each code's values of the joints listed, allocated whole: they are most of what the layer holds.
+        let count = animated.iter().filter(|&&a| a).count();
+        let (mut translations, mut rotations, mut scales) =
+            (per_code(codes.len(), count), per_code(codes.len(), count), per_code(codes.len(), count));
+        let sampled = |property| (0..nodes.len()).map(|n| at(n, property)).collect::<Vec<_>>();
+        let (t, r, s) = (sampled(Property::Translation), sampled(Property::Rotation), sampled(Property::Scale));
         let mut previous = vec![Quat::IDENTITY; nodes.len()];
         let mut rounding: f64 = 0.0;
         for k in 0..codes.len() {
             let mut chain = HalfChain::new(nodes.len());
             for (n, node) in nodes.iter().enumerate() {
-                let q = Quat::from_slice(&r[n][4 * k..4 * k + 4]);
+                let q = Quat::from_slice(at_code(&r[n], &node.rotation, k));
                 // Each sample on the side of the one before: USD slerps between them along the shorter arc.
                 let q = if q.dot(previous[n]) < 0.0 { -q } else { q };
                 previous[n] = q;
-                let scale = Vec3::from_slice(&s[n][3 * k..3 * k + 3]);
-                let (translation, half) =
-                    chain.add(n, node.parent, Vec3::from_slice(&t[n][3 * k..3 * k + 3]), q, scale, animated[n]);
+                let scale = Vec3::from_slice(at_code(&s[n], &node.scale, k));
+                let translation = Vec3::from_slice(at_code(&t[n], &node.translation, k));
+                let (translation, half) = chain.add(n, node.parent, translation, q, scale, animated[n]);
                 if !animated[n] {
                     continue;
                 }
@@ -641,6 +636,18 @@ fn animated(nodes: &[Node], channels: &[Channel]) -> Vec<bool> {
         keyed[n] |= under;
     }
     keyed
+}
+
+/// `codes` empty lists, each with room for `count` values.
+fn per_code<T>(codes: usize, count: usize) -> Vec<Vec<T>> {
+    (0..codes).map(|_| Vec::with_capacity(count)).collect()
+}
+
+/// The `k`-th value of a channel sampled at every time code (each as wide as `rest`), or `rest` where it is not
+/// keyed.
+fn at_code<'v>(sampled: &'v Option<Vec<f32>>, rest: &'v [f32], k: usize) -> &'v [f32] {
+    let width = rest.len();
+    sampled.as_ref().map_or(rest, |values| &values[width * k..width * (k + 1)])
 }
 
 /// The time code of baked time `t`: on the 128th of a frame (where a bake's halvings of frames fall) that

@@ -117,7 +117,8 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
             let fieldset_idx = self.fieldsets.len() as u32;
             if let Some(field_names) = data.list_fields(path) {
                 for name in field_names {
-                    let value = data.get_field(path, &name)?.into_owned();
+                    // bonescope: borrowed, not cloned (a layer's time samples are most of what it holds).
+                    let value = data.get_field(path, &name)?;
                     let token = if name == crate::sdf::ChildrenKey::PropertyChildren.as_str() {
                         super::CRATE_PROPERTY_CHILDREN.to_owned()
                     } else {
@@ -127,9 +128,9 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
                     // reader refuses a prim whose `primChildren` is not one.
                     let children = CHILDREN_FIELDS.contains(&token.as_str());
                     let token_idx = self.tokens.intern(token);
-                    let rep = match &value {
+                    let rep = match &*value {
                         Value::TokenVec(list) if children => self.write_children(list)?,
-                        _ => self.write_value(&value)?,
+                        value => self.write_value(value)?,
                     };
                     let field_idx = self.fields.intern((token_idx, rep.0));
                     self.fieldsets.push(Some(field_idx));
