@@ -115,7 +115,6 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
 pub struct Plots {
     /// The components plotted, in [`Component::ALL`]'s order: a click shows one, Ctrl- or Shift-click adds or removes.
     components: Vec<Component>,
-    pub show_ghost: bool,
     /// The curves, split into plots of one unit each (an angle in degrees and a unit axis never share an axis).
     cache: Option<(SeriesKey, Vec<Group>)>,
     /// Set by "Reset view": the next frame fits the plots to the whole clip again.
@@ -124,7 +123,7 @@ pub struct Plots {
 
 impl Default for Plots {
     fn default() -> Self {
-        Plots { components: vec![Component::default()], show_ghost: false, cache: None, reset: false }
+        Plots { components: vec![Component::default()], cache: None, reset: false }
     }
 }
 
@@ -245,7 +244,7 @@ impl Panel for Plots {
             components: self.components.clone(),
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
-            ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
+            ghost: shared.settings.plot_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
             compared: shared
                 .results
                 .compared_curves
@@ -299,7 +298,7 @@ impl Plots {
                 }
             }
             ui.separator();
-            ui.add_enabled(shared.doc.ghost.is_some(), egui::Checkbox::new(&mut self.show_ghost, "ghost"))
+            ui.add_enabled(shared.doc.ghost.is_some(), egui::Checkbox::new(&mut shared.settings.plot_ghost, "ghost"))
                 .on_disabled_hover_text("no ghost: choose one in the top bar");
             ui.separator();
             if ui.button("Reset view").on_hover_text("the whole clip again (or double-click a plot)").clicked() {

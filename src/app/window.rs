@@ -212,7 +212,7 @@ impl Window {
         let frame = CurrentPose::evaluate(doc, self.time, settings.scene.skinning, &settings.tolerances);
         let results = work.results(doc);
         let stretched = self.spans.get(results.analysis.as_ref(), self.selection.last().copied());
-        let mut undo_asked = false;
+        let (mut undo_asked, mut step_in_place) = (false, false);
         let mut shared = Shared {
             doc,
             settings,
@@ -224,6 +224,7 @@ impl Window {
             stretched,
             work,
             undo_asked: &mut undo_asked,
+            step_in_place: &mut step_in_place,
         };
         if self.chrome == Chrome::ViewportOnly {
             egui::CentralPanel::default()
@@ -247,6 +248,7 @@ impl Window {
             });
         }
         actions.undo |= undo_asked;
+        actions.step_in_place = step_in_place;
         // After the panels: a bone clicked in this very frame stands.
         if self.chrome == Chrome::Window {
             self.open_on_the_problem(&ctx, &session.doc, work, settings);
