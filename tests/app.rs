@@ -908,12 +908,13 @@ fn assert_nothing_cut(harness: &Harness<'static, BonescopeApp>) {
 fn at_a_laptops_size_every_number_and_name_is_whole() {
     let harness = laptop_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", "Left_Tip", 0.5);
     assert_nothing_cut(&harness);
-    // Both matrices whole, four columns each, within the Inspector.
+    // Both matrices whole, four columns each, within the Inspector's width (the column scrolls below them).
     let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
     let numbers = harness
         .query_all_by_role(Role::Label)
         .filter(|n| n.value().is_some_and(|l| l.trim().parse::<f64>().is_ok()))
-        .filter(|n| inspector.contains_rect(n.rect()))
+        .filter(|n| inspector.x_range().contains(n.rect().left()) && n.rect().right() <= inspector.right())
+        .filter(|n| inspector.y_range().contains(n.rect().top()))
         .count();
     assert!(numbers >= 2 * 16, "{numbers} numbers in the Inspector");
     let harness = laptop_app("fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx", "Character1_RightHandMiddle3", 0.0);
@@ -1673,7 +1674,7 @@ fn the_time_unit_picker_holds_still_for_another_clips_length() {
 }
 
 #[test]
-fn a_small_window_plots_taller_than_a_strip() {
+fn a_small_window_plots_taller_than_a_strip_under_a_top_bar_in_one_row() {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
         .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
@@ -1684,6 +1685,10 @@ fn a_small_window_plots_taller_than_a_strip() {
     let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
     let height = memory().transform().frame().height();
     assert!(height > 45.0, "the plot is {height} points tall");
+    // The top bar's controls in one row, the last as the first.
+    let row = |rect: egui::Rect| rect.center().y;
+    let first = row(harness.get_by_role_and_label(Role::ComboBox, "Animation").rect());
+    assert_eq!(row(harness.get_by_label("Layers").rect()), first, "the top bar does not wrap");
 }
 
 #[test]
@@ -1848,4 +1853,32 @@ fn a_mesh_that_does_not_decode_is_named_on_opening_and_in_the_layers_panel() {
     let layers = harness.state().pane_rect(&bonescope::app::Pane::LAYERS).unwrap();
     let listed = harness.query_all_by_label_contains(said).filter(|n| layers.contains(n.rect().center())).count();
     assert_eq!(listed, 1, "the Layers panel names the mesh too");
+}
+
+#[test]
+fn the_border_above_the_plots_is_grabbed_anywhere_in_its_gap_and_never_orbits_the_viewport() {
+    // egui grabs a panel's edge within 3 points either side of it: the border between the viewport and the plots
+    // is easier to grab, a press anywhere in its 8-point gap resizing and none orbiting the view or dragging a tab.
+    for offset in [-3.5, -2.0, 0.0, 2.0, 3.5] {
+        let mut harness = laptop_demo();
+        let viewport = harness.state().pane_rect(&bonescope::app::Pane::VIEWPORT).unwrap();
+        let plots = harness.state().pane_rect(&bonescope::app::Pane::named("Plots")).unwrap();
+        let camera = harness.state().settings.camera;
+        // The gap lies between the viewport's tile and the Plots tab's bar.
+        let gap = 8.0;
+        let start = egui::pos2(viewport.center().x, viewport.bottom() + 0.5 * gap + offset);
+        let end = start + egui::vec2(0.0, 40.0);
+        harness.hover_at(start);
+        harness.run();
+        harness.drag_at(start);
+        harness.run();
+        harness.hover_at(end);
+        harness.run();
+        harness.drop_at(end);
+        harness.run();
+        let after = harness.state().pane_rect(&bonescope::app::Pane::named("Plots")).unwrap();
+        // The drag counts from where egui sees it start, a few points on.
+        assert!(after.top() - plots.top() > 30.0, "{offset}: {} then {}", plots.top(), after.top());
+        assert_eq!(harness.state().settings.camera, camera, "{offset}: the view did not orbit");
+    }
 }

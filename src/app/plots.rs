@@ -138,9 +138,9 @@ struct Group {
 }
 
 impl Group {
-    /// The series split by unit: angles (names ending in `°`) apart from the rest, in their order.
+    /// The series split by unit: angles apart from the rest (a ghost's with its own), in their order.
     fn split(series: Vec<Series>) -> Vec<Group> {
-        let (degrees, other): (Vec<Series>, Vec<Series>) = series.into_iter().partition(|s| s.name.ends_with('°'));
+        let (degrees, other): (Vec<Series>, Vec<Series>) = series.into_iter().partition(|s| s.degrees);
         [degrees, other]
             .into_iter()
             .filter(|s| !s.is_empty())
@@ -205,6 +205,8 @@ struct Series {
     name: String,
     color: Color32,
     ghost: bool,
+    /// An angle in degrees (its channel's name ends in `°`), plotted apart from unit values.
+    degrees: bool,
     values: Vec<f64>,
 }
 
@@ -518,10 +520,12 @@ fn build_series(key: &SeriesKey, component: Component, skeleton: &crate::model::
                 (_, 1) => component.label().to_owned(),
                 _ => format!("{} {channel}", component.label()),
             };
+            let degrees = channel.ends_with('°');
             out.push(Series {
                 name: format!("{name} {channel}"),
                 color,
                 ghost: false,
+                degrees,
                 values: primary.iter().map(read).collect(),
             });
             if !ghost.is_empty() {
@@ -530,6 +534,7 @@ fn build_series(key: &SeriesKey, component: Component, skeleton: &crate::model::
                     name: format!("{name} {channel} ({})", if key.compared.is_some() { "compared" } else { "ghost" }),
                     color: color.gamma_multiply(0.5),
                     ghost: true,
+                    degrees,
                     values,
                 });
             }
@@ -577,7 +582,8 @@ mod tests {
     use super::*;
 
     fn series(name: &str) -> Series {
-        Series { name: name.to_owned(), color: Color32::WHITE, ghost: false, values: vec![0.0, 90.0] }
+        let degrees = name.ends_with('°');
+        Series { name: name.to_owned(), color: Color32::WHITE, ghost: false, degrees, values: vec![0.0, 90.0] }
     }
 
     #[test]
@@ -589,6 +595,9 @@ mod tests {
         // One unit: one plot.
         assert_eq!(Group::split(["hand x", "hand y"].map(series).into()).len(), 1);
         assert_eq!(Group::split(["hand X°", "hand Y°"].map(series).into()).len(), 1);
+        // The ghost's curve (the shear before a fix tried) dashed over the curve itself.
+        let ghost = Series { name: "hand shear° (ghost)".to_owned(), ghost: true, ..series("hand shear°") };
+        assert_eq!(Group::split(vec![series("hand shear°"), ghost]).len(), 1);
     }
 
     #[test]

@@ -235,8 +235,9 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mu
 }
 
 /// The width of the top bar's lists, in points: the animation's too, whatever its name's length (shortened to fit),
-/// so the controls after it never move.
-const PICKER_WIDTH: f32 = 170.0;
+/// so the controls after it never move; the ghost's longest choice ("cmu_12_01_walk.bvh") fits, and the bar does
+/// not wrap in a window 1000 points wide.
+const PICKER_WIDTH: f32 = 160.0;
 
 fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Animation");

@@ -241,6 +241,8 @@ impl Window {
                 let all = std::iter::once(&self.viewport as &dyn Panel).chain(self.panels.iter().map(|p| p.as_ref()));
                 let mut layout = take_layout(shared.settings, width, &all.collect::<Vec<_>>());
                 let style = ui.style().clone();
+                // The gaps between the tiles are their resize handles, edge to edge.
+                ui.style_mut().interaction.resize_grab_radius_side = super::layout::GRAB_RADIUS;
                 let mut panes =
                     Panes { shared: &mut shared, viewport: &mut self.viewport, panels: &mut self.panels, style };
                 layout.ui(&mut panes, ui);
