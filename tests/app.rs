@@ -908,12 +908,13 @@ fn assert_nothing_cut(harness: &Harness<'static, BonescopeApp>) {
 fn at_a_laptops_size_every_number_and_name_is_whole() {
     let harness = laptop_app("fbx-ufbx-data/maya_mixed_inherit_mode_7700_ascii.fbx", "Left_Tip", 0.5);
     assert_nothing_cut(&harness);
-    // Both matrices whole, four columns each, within the Inspector.
+    // Both matrices whole, four columns each, within the Inspector's width (the column scrolls below them).
     let inspector = harness.state().pane_rect(&bonescope::app::Pane::named("Inspector")).unwrap();
     let numbers = harness
         .query_all_by_role(Role::Label)
         .filter(|n| n.value().is_some_and(|l| l.trim().parse::<f64>().is_ok()))
-        .filter(|n| inspector.contains_rect(n.rect()))
+        .filter(|n| inspector.x_range().contains(n.rect().left()) && n.rect().right() <= inspector.right())
+        .filter(|n| inspector.y_range().contains(n.rect().top()))
         .count();
     assert!(numbers >= 2 * 16, "{numbers} numbers in the Inspector");
     let harness = laptop_app("fbx-ufbx-corpus/maya_human_ik_6100_binary.fbx", "Character1_RightHandMiddle3", 0.0);
@@ -1139,7 +1140,7 @@ fn a_z_up_bvh_compared_says_it_lies_down_and_stands_up_on_the_axis_picked() {
     harness.run();
     harness.get_by_label("Z").click();
     settle(&mut harness);
-    assert_eq!(harness.state().session.doc.compared.as_ref().unwrap().up, bonescope::model::UpAxis::Z);
+    assert_eq!(harness.state().session.doc.compared.as_ref().unwrap().stance.up, bonescope::model::UpAxis::Z);
     assert!(harness.query_by_label_contains("lies along").is_none(), "standing, nothing to say");
     // Standing, the ghost stands where the figure does: what is left is what a BVH cannot store (its scale).
     let (figure, ghost) = figure_and_ghost_heights(harness.state(), 0.0);
@@ -1227,7 +1228,39 @@ fn why_names_the_cause_selects_along_the_chain_and_tries_a_mode() {
     assert!(!app.analysis().unwrap().scan.bones[forearm].stretched(), "the analysis no longer flags the forearm");
     // The ghost shows the declared modes, as the clip was before.
     assert_eq!(app.session.doc.ghost, Some(Ghost::Modes(ModeChoice::Declared)));
-    harness.get_by_label("not sheared now");
+    harness.get_by_label_contains(&format!("tried: forearm to {mode}"));
+}
+
+#[test]
+fn after_a_try_the_fixes_stay_and_another_is_tried_in_its_place_one_undo_from_before() {
+    let mut harness = why_forearm();
+    let forearm = bone(&harness, "forearm");
+    let before = state_of(&harness);
+    in_inspector(&harness, "Try").click();
+    settle(&mut harness);
+    let first = harness.state().session.doc.modes()[forearm];
+    // The ranking stays, the fix tried marked with Undo in its Try button's place; the shear plot draws the curve
+    // before the fix dashed over the fixed one, without the ghost ticked by hand.
+    harness.get_by_label("Fixes, best first");
+    harness.get_by_label_contains(&format!("tried: forearm to {first}"));
+    in_inspector(&harness, "Undo");
+    in_pane(&harness, "Plots", "forearm shear° (ghost)");
+    assert!(harness.state().settings.plot_ghost);
+    // Noise is 0 in words as in the plots: no fix leaves "5.4e-6°".
+    let effects = harness.query_all_by_role(Role::Label).filter_map(|n| n.value()).filter(|v| v.contains("° left)"));
+    for effect in effects {
+        assert!(!effect.contains("e-"), "{effect}");
+    }
+    // Another fix tried takes the first one's place: one step of the history, and one undo from the clip as opened.
+    in_inspector(&harness, "Try").click();
+    settle(&mut harness);
+    let second = state_of(&harness);
+    assert_ne!(second, before);
+    assert_ne!(harness.state().session.doc.modes()[forearm], first, "the first fix taken back");
+    harness.get_by_label_contains("tried: ");
+    assert_eq!(harness.state().session.steps().0.len(), 2, "the clip as opened and the fix tried");
+    undo_key(&mut harness);
+    assert_eq!(state_of(&harness), before);
 }
 
 #[test]
@@ -1641,7 +1674,7 @@ fn the_time_unit_picker_holds_still_for_another_clips_length() {
 }
 
 #[test]
-fn a_small_window_plots_taller_than_a_strip() {
+fn a_small_window_plots_taller_than_a_strip_under_a_top_bar_in_one_row() {
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1000.0, 700.0))
         .build_eframe(|_cc| unopened(BonescopeApp::new(Settings::default(), Document::demo())));
@@ -1652,6 +1685,10 @@ fn a_small_window_plots_taller_than_a_strip() {
     let memory = || egui_plot::PlotMemory::load(&ctx, bonescope::app::plot_id(0)).expect("the plot is shown");
     let height = memory().transform().frame().height();
     assert!(height > 45.0, "the plot is {height} points tall");
+    // The top bar's controls in one row, the last as the first.
+    let row = |rect: egui::Rect| rect.center().y;
+    let first = row(harness.get_by_role_and_label(Role::ComboBox, "Animation").rect());
+    assert_eq!(row(harness.get_by_label("Layers").rect()), first, "the top bar does not wrap");
 }
 
 #[test]
@@ -1745,4 +1782,103 @@ fn the_shear_toggle_sits_beside_mesh_and_greys_without_one() {
     settle(&mut harness);
     assert!(harness.get_by_label("Shear").accesskit_node().is_disabled(), "a mocap file has no mesh to paint");
     assert_eq!(harness.get_by_label("Shear").rect(), shear, "greyed, not gone");
+}
+
+#[test]
+fn a_bvh_lying_along_z_opens_with_the_up_picker_and_stands_up_on_the_axis_picked() {
+    // Blender writes its BVH Z-up: in the view's Y-up space the rig lies on the floor. The document's file gets the
+    // picker and the line a compared file gets.
+    let mut harness = asset_app("blender/stretchy_full.bvh");
+    harness.get_by_label("lies along Z: the view stands along Y");
+    let height = |harness: &Harness<'static, BonescopeApp>| {
+        let pose = harness.state().session.doc.evaluation().pose_at(0.0);
+        let (ys, zs): (Vec<f64>, Vec<f64>) = pose.model.model.iter().map(|m| (m.w_axis.y, m.w_axis.z)).unzip();
+        let extent =
+            |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max) - v.iter().copied().fold(f64::MAX, f64::min);
+        (extent(&ys), extent(&zs))
+    };
+    let (y, z) = height(&harness);
+    assert!(z > 1.5 * y, "lying: {y} high, {z} long");
+    harness.get_by_role_and_label(Role::ComboBox, "up of stretchy_full.bvh").click();
+    harness.run();
+    harness.get_by_label("Z").click();
+    settle(&mut harness);
+    assert_eq!(harness.state().session.doc.stance.up, bonescope::model::UpAxis::Z);
+    assert!(harness.query_by_label_contains("lies along").is_none(), "standing, nothing to say");
+    let (y, z) = height(&harness);
+    assert!(y > 1.5 * z, "standing: {y} high, {z} deep");
+    // Standing is no edit of what is evaluated: nothing to undo, and the analysis is the stood rig's.
+    assert_eq!(harness.state().session.undo_label(), None);
+    assert!(harness.state().analysis().is_some());
+}
+
+/// A glTF of one node and one Draco-compressed mesh, `Tokyo`, whose stream is noise: it does not decode.
+fn undecodable_draco(folder: &std::path::Path) -> std::path::PathBuf {
+    use base64::Engine;
+    let noise: Vec<u8> = (0u32..64).map(|i| (i * 37 + 11) as u8).collect();
+    let data = base64::engine::general_purpose::STANDARD.encode(&noise);
+    let gltf = serde_json::json!({
+        "asset": { "version": "2.0" },
+        "extensionsUsed": ["KHR_draco_mesh_compression"],
+        "extensionsRequired": ["KHR_draco_mesh_compression"],
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "name": "city", "mesh": 0 }],
+        "meshes": [{ "name": "Tokyo", "primitives": [{
+            "attributes": { "POSITION": 0 },
+            "extensions": { "KHR_draco_mesh_compression": { "bufferView": 0, "attributes": { "POSITION": 0 } } }
+        }] }],
+        "accessors": [{ "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1] }],
+        "bufferViews": [{ "buffer": 0, "byteLength": noise.len() }],
+        "buffers": [{ "byteLength": noise.len(), "uri": format!("data:application/octet-stream;base64,{data}") }]
+    });
+    let path = folder.join("tokyo.gltf");
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn a_mesh_that_does_not_decode_is_named_on_opening_and_in_the_layers_panel() {
+    let folder = tempfile::tempdir().unwrap();
+    let path = undecodable_draco(folder.path());
+    let mut harness = demo_app();
+    harness.state_mut().open(&path);
+    settle(&mut harness);
+    // As `inspect` notes it: the mesh's name, where it is in the file, and why.
+    let said = "not drawn, their compressed geometry does not decode: Tokyo at meshes[0].primitives[0]";
+    harness.get_by_label_contains(said);
+    harness.state_mut().settings.show(&bonescope::app::Pane::LAYERS, true);
+    settle(&mut harness);
+    in_pane(&harness, "Layers", "Meshes not drawn");
+    let layers = harness.state().pane_rect(&bonescope::app::Pane::LAYERS).unwrap();
+    let listed = harness.query_all_by_label_contains(said).filter(|n| layers.contains(n.rect().center())).count();
+    assert_eq!(listed, 1, "the Layers panel names the mesh too");
+}
+
+#[test]
+fn the_border_above_the_plots_is_grabbed_anywhere_in_its_gap_and_never_orbits_the_viewport() {
+    // egui grabs a panel's edge within 3 points either side of it: the border between the viewport and the plots
+    // is easier to grab, a press anywhere in its 8-point gap resizing and none orbiting the view or dragging a tab.
+    for offset in [-3.5, -2.0, 0.0, 2.0, 3.5] {
+        let mut harness = laptop_demo();
+        let viewport = harness.state().pane_rect(&bonescope::app::Pane::VIEWPORT).unwrap();
+        let plots = harness.state().pane_rect(&bonescope::app::Pane::named("Plots")).unwrap();
+        let camera = harness.state().settings.camera;
+        // The gap lies between the viewport's tile and the Plots tab's bar.
+        let gap = 8.0;
+        let start = egui::pos2(viewport.center().x, viewport.bottom() + 0.5 * gap + offset);
+        let end = start + egui::vec2(0.0, 40.0);
+        harness.hover_at(start);
+        harness.run();
+        harness.drag_at(start);
+        harness.run();
+        harness.hover_at(end);
+        harness.run();
+        harness.drop_at(end);
+        harness.run();
+        let after = harness.state().pane_rect(&bonescope::app::Pane::named("Plots")).unwrap();
+        // The drag counts from where egui sees it start, a few points on.
+        assert!(after.top() - plots.top() > 30.0, "{offset}: {} then {}", plots.top(), after.top());
+        assert_eq!(harness.state().settings.camera, camera, "{offset}: the view did not orbit");
+    }
 }

@@ -326,25 +326,53 @@ fn first_view(size: egui::Vec2, doc: Document) -> Harness<'static, BonescopeApp>
 }
 
 const LAPTOP: egui::Vec2 = egui::vec2(1280.0, 800.0);
+const SMALL: egui::Vec2 = egui::vec2(1000.0, 700.0);
 
-#[test]
-fn first_view_demo() {
-    first_view(LAPTOP, Document::demo()).snapshot("first_view_demo");
+/// The first view of `doc` in a laptop's window and a small one, as `first_view_NAME.png` and
+/// `first_view_NAME_1000x700.png`.
+fn first_views(name: &str, doc: impl Fn() -> Document) {
+    let mut results = egui_kittest::SnapshotResults::new();
+    for (size, suffix) in [(LAPTOP, ""), (SMALL, "_1000x700")] {
+        let mut harness = first_view(size, doc());
+        harness.snapshot(format!("first_view_{name}{suffix}"));
+        results.extend_harness(&mut harness);
+    }
+    results.unwrap();
+}
+
+/// A file of the shared corpus (`../shared/corpus/FOLDER/NAME`) as a document.
+fn corpus_file(path: &str) -> Document {
+    let path = common::corpus(path);
+    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    Document::new(Some(path), rig)
 }
 
 #[test]
-fn first_view_demo_small_window() {
-    first_view(egui::vec2(1000.0, 700.0), Document::demo()).snapshot("first_view_demo_1000x700");
+fn first_view_demo() {
+    first_views("demo", Document::demo);
 }
 
 #[test]
 fn first_view_blender_stretchy_full() {
-    first_view(LAPTOP, asset_document("blender/stretchy_full.glb")).snapshot("first_view_stretchy_full");
+    first_views("stretchy_full", || asset_document("blender/stretchy_full.glb"));
 }
 
 #[test]
 fn first_view_godot_mannequiny() {
-    let path = common::corpus("realworld/godot_mannequiny.glb");
-    let rig = bonescope::import::load(&path).unwrap_or_else(|e| panic!("{e}"));
-    first_view(LAPTOP, Document::new(Some(path), rig)).snapshot("first_view_godot_mannequiny");
+    first_views("godot_mannequiny", || corpus_file("realworld/godot_mannequiny.glb"));
+}
+
+#[test]
+fn first_view_maya_human_ik() {
+    first_views("maya_human_ik", || corpus_document("maya_human_ik_7400_binary.fbx"));
+}
+
+#[test]
+fn first_view_robot_expressive_usd() {
+    first_views("robot_expressive_usdc", || corpus_file("blender-io/RobotExpressive.usdc"));
+}
+
+#[test]
+fn first_view_cmu_walk() {
+    first_views("cmu_walk", || asset_document("bvh/cmu_12_01_walk.bvh"));
 }

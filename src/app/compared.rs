@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::identity::RigId;
+use super::stance::Stance;
 use crate::analysis::{Assessment, Tolerances};
 use crate::diff::{match_bones, match_clips, match_meshes, standing_apart};
 use crate::eval::layers::RotationInterpolation;
@@ -27,11 +28,9 @@ pub struct Compared {
     pub rig_id: RigId,
     /// Whether the file states its unit.
     states_unit: bool,
-    /// The axis the file is read as standing along (Y: as it says).
-    pub up: UpAxis,
-    /// The axes the document and this file stand along as they play (the document's opening clip and its partner),
-    /// where they differ ([`standing_apart`]).
-    pub apart: Option<[UpAxis; 2]>,
+    /// The axis the file is read as standing along, and the axes the document and this file stand along as they
+    /// play (the document's opening clip and its partner), where they differ ([`standing_apart`]).
+    pub stance: Stance,
     /// The unit the file is measured in: the document's, or the one the user gave the document where its file
     /// states none.
     document_unit: Option<Unit>,
@@ -113,8 +112,8 @@ impl Compared {
         let (rig, rig_id, played) = (Arc::new(rig), RigId::fresh(), RotationInterpolation::default());
         let opening = document.opening_clip();
         let apart = standing_apart((document, opening), (&rig, opening.and_then(|o| clips[o])));
-        let up = UpAxis::Y;
-        Compared { path, rig, rig_id, states_unit, up, apart, document_unit, bones, left_out, meshes, clips, played }
+        let stance = Stance { up: UpAxis::Y, apart };
+        Compared { path, rig, rig_id, states_unit, stance, document_unit, bones, left_out, meshes, clips, played }
     }
 
     /// The same file paired with another document rig (the document was reloaded), keeping the units given and
@@ -122,18 +121,20 @@ impl Compared {
     pub fn repaired(&self, document: &Rig) -> Self {
         let repaired = Compared::pair(self.path.clone(), (*self.rig).clone(), document);
         let document_unit = document.unit.or(self.document_unit);
-        Compared { states_unit: self.states_unit, up: self.up, document_unit, played: self.played, ..repaired }
+        let stance = Stance { up: self.stance.up, ..repaired.stance };
+        Compared { states_unit: self.states_unit, stance, document_unit, played: self.played, ..repaired }
     }
 
     /// The file read again after it changed on disk, paired with `document`, keeping the units and the up axis the
     /// user gave and how it is played.
     pub fn reloaded(&self, document: &Rig) -> Result<Self, ImportError> {
-        let mut rig = import::load(&self.path)?.stood_up(self.up);
+        let mut rig = import::load(&self.path)?.stood_up(self.stance.up);
         if rig.unit.is_none() && !self.states_unit {
             rig.unit = self.rig.unit;
         }
         let fresh = Compared::pair(self.path.clone(), rig, document);
-        Ok(Compared { document_unit: self.document_unit, played: self.played, up: self.up, ..fresh })
+        let stance = Stance { up: self.stance.up, ..fresh.stance };
+        Ok(Compared { document_unit: self.document_unit, played: self.played, stance, ..fresh })
     }
 
     /// Whether the file states its unit (else the user gives it one).
@@ -150,11 +151,11 @@ impl Compared {
 
     /// The same file read as standing along `up` beside `document`: another rig to compare.
     pub fn given_up(&self, up: UpAxis, document: &Rig) -> Self {
-        let rig = (*self.rig).clone().restood(self.up, up);
+        let rig = (*self.rig).clone().restood(self.stance.up, up);
         let opening = document.opening_clip();
         let apart =
             standing_apart((document, opening), (&rig, opening.and_then(|o| self.clips.get(o).copied().flatten())));
-        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), up, apart, ..self.clone() }
+        Compared { rig: Arc::new(rig), rig_id: RigId::fresh(), stance: Stance { up, apart }, ..self.clone() }
     }
 
     /// The same measured in `unit`, the document's where its file states none.

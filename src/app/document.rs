@@ -6,10 +6,11 @@ use std::sync::Arc;
 
 use super::compared::Compared;
 use super::identity::RigId;
+use super::stance::Stance;
 use crate::analysis::ScanOptions;
 use crate::eval::{Evaluation, LayerStack, Layers, Setup, SetupError};
 use crate::import::{self, ImportError};
-use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton, Span};
+use crate::model::{Choice, Clip, DEFAULT_FRAME_RATE, InheritMode, ModeChoice, Modes, Rig, Skeleton, Span, UpAxis};
 
 /// A second pose drawn translucent over the first and plotted dashed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,6 +62,9 @@ pub struct Document {
     pub frame_rate_override: Option<f64>,
     /// A second file compared with this one.
     pub compared: Option<Arc<Compared>>,
+    /// The axis the file is read as standing along, and where it lies down in the view's Y-up space as it plays
+    /// (the view's axis and its own).
+    pub stance: Stance,
 }
 
 impl Document {
@@ -79,6 +83,8 @@ impl Document {
     pub fn new(path: Option<PathBuf>, rig: Rig) -> Self {
         let setup = Setup::declared(&rig);
         let modes = rig.skeleton.declared_modes();
+        let lies = crate::diff::standing(&rig, rig.opening_clip()).filter(|&up| up != UpAxis::Y);
+        let stance = Stance { up: UpAxis::Y, apart: lies.map(|up| [UpAxis::Y, up]) };
         Document {
             path,
             rig: Arc::new(rig),
@@ -89,14 +95,16 @@ impl Document {
             ghost: None,
             frame_rate_override: None,
             compared: None,
+            stance,
         }
     }
 
-    /// The same file re-read (after it changed on disk), keeping clip, modes, ghost and layers where they still
-    /// fit. Layers naming clips or bones the new file lacks are dropped rather than kept half-valid: the error says
-    /// why, for the user.
+    /// The same file re-read (after it changed on disk), keeping clip, modes, ghost, layers and the axis it was
+    /// stood along where they still fit. Layers naming clips or bones the new file lacks are dropped rather than
+    /// kept half-valid: the error says why, for the user.
     pub fn reloaded(&self, rig: Rig) -> (Self, Option<SetupError>) {
-        let mut doc = Document::new(self.path.clone(), rig);
+        let mut doc = Document::new(self.path.clone(), rig.stood_up(self.stance.up));
+        doc.stance.up = self.stance.up;
         doc.frame_rate_override = self.frame_rate_override;
         doc.compared = self.compared.as_ref().map(|c| Arc::new(c.repaired(&doc.rig)));
         doc.ghost = self.ghost.filter(|ghost| *ghost != Ghost::Compared || doc.compared.is_some());
@@ -111,6 +119,15 @@ impl Document {
         let _ = doc.set_setup(kept);
         let dropped = doc.set_layers(&self.setup.layers).err();
         (doc, dropped)
+    }
+
+    /// The same file read as standing along `up` (a BVH lying down in the view), keeping what is evaluated: another
+    /// rig, the same bones.
+    pub fn stood_up(&self, up: UpAxis) -> Self {
+        let as_read = (*self.rig).clone().restood(self.stance.up, UpAxis::Y);
+        let turned = Document { stance: Stance { up, ..self.stance }, ..self.clone() };
+        // The same bones, clips and layers: nothing is dropped.
+        turned.reloaded(as_read).0
     }
 
     /// What is evaluated.

@@ -7,7 +7,7 @@ use glam::DMat4;
 
 use super::pane::{Pane, Place};
 use super::panel::{Panel, Shared};
-use super::text::compact;
+use super::text::{compact, precise};
 use super::why;
 use crate::analysis::report::{BoneReport, LayeredInspectReport, SampleReport};
 use crate::math::AffineParts;
@@ -55,7 +55,8 @@ fn bone_ui(ui: &mut Ui, shared: &mut Shared, why: &mut why::Memory, bone: usize)
     let color = badges.first().map_or(ui.visuals().text_color(), |b| b.color());
     let explanation = badges.iter().map(|b| b.explanation()).collect::<Vec<_>>().join("; ");
     ui.label(RichText::new(text).color(color).strong()).on_hover_text(explanation);
-    ui.label(format!("shear {:.4}°   stretch angle {:.4}°", assessment.shear_deg, assessment.stretch_deg));
+    let (shear, stretch) = (compact(assessment.shear_deg), compact(assessment.stretch_deg));
+    ui.label(format!("shear {shear}°   stretch angle {stretch}°"));
     ui.horizontal_wrapped(|ui| {
         copy_button(ui, shared, &reports);
         why::header(ui, shared, why, bone);
@@ -158,7 +159,7 @@ const COLUMN_GAP: f32 = 6.0;
 /// change), the exact value on hover.
 fn numbers(ui: &mut Ui, values: &[f64]) {
     for &value in values {
-        let text = RichText::new(format!("{:>7}", compact(value + 0.0))).monospace();
-        ui.label(text).on_hover_text(format!("{value}"));
+        let text = RichText::new(format!("{:>7}", compact(value))).monospace();
+        ui.label(text).on_hover_text(precise(value));
     }
 }

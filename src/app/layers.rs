@@ -1,5 +1,6 @@
 //! The Layers panel: the runtime techniques layered on the clip (bind weight, interpolation, blend, additive,
-//! crossfade, shake, uniform scale, targets), the bind pose check and the stretch-quaternion storage report.
+//! crossfade, shake, uniform scale, targets), the bind pose check and the stretch-quaternion storage report; first,
+//! the file's meshes that are not drawn, and why.
 //!
 //! A technique's section starts open when its layer is on. Edits go to a copy of the document's layers; the
 //! document takes the copy at the end of the frame (it checks every clip and bone index, so a bad combination is
@@ -43,6 +44,7 @@ impl Panel for LayersPanel {
     fn ui(&mut self, ui: &mut Ui, shared: &mut Shared) {
         let mut layers = shared.doc.layers().clone();
         egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+            not_drawn_section(ui, &shared.doc.rig);
             bind_section(ui, shared, &mut layers);
             interpolation_section(ui, shared, &mut layers);
             blend_section(ui, shared, &mut layers);
@@ -411,6 +413,21 @@ fn vector(ui: &mut Ui, label: &str, v: &mut DVec3) {
         let label = ui.label(label);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
             ui.add(DragValue::new(c).speed(0.01)).labelled_by(label.id);
+        }
+    });
+}
+
+/// The file's meshes that are not drawn, and why, as `inspect` notes them: a figure of bones alone says what it
+/// lacks. Nothing on a file whose every mesh is drawn.
+fn not_drawn_section(ui: &mut Ui, rig: &Rig) {
+    let notes: Vec<&str> = rig.meshes_not_drawn().collect();
+    if notes.is_empty() {
+        return;
+    }
+    let title = RichText::new("Meshes not drawn").color(Badge::NonUniform.color());
+    CollapsingHeader::new(title).default_open(true).show(ui, |ui| {
+        for note in notes {
+            ui.add(egui::Label::new(note).wrap());
         }
     });
 }

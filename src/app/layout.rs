@@ -90,6 +90,11 @@ pub struct Panes<'p, 's> {
     pub style: std::sync::Arc<egui::Style>,
 }
 
+/// How far either side of the gap between two panels a press grabs it to resize them: more than egui's 3 points
+/// either side of a panel's edge, whose neighbours (the viewport's orbit, a tab's drag) would take a press 4 points
+/// away.
+pub const GRAB_RADIUS: f32 = 4.0;
+
 /// Space around a panel's contents (the viewport fills its tile).
 const PANEL_MARGIN: i8 = 6;
 
@@ -123,8 +128,19 @@ impl egui_tiles::Behavior<Pane> for Panes<'_, '_> {
         120.0
     }
 
+    /// The whole gap resizes ([`GRAB_RADIUS`] either side of its middle), and no panel's contents (the viewport's
+    /// orbit, a tab's drag) reach into it.
     fn gap_width(&self, _style: &egui::Style) -> f32 {
-        3.0
+        2.0 * GRAB_RADIUS
+    }
+
+    /// A thin line down the middle of the gap, as egui draws a panel's edge, brighter while grabbed.
+    fn resize_stroke(&self, style: &egui::Style, state: egui_tiles::ResizeState) -> egui::Stroke {
+        match state {
+            egui_tiles::ResizeState::Idle => style.visuals.widgets.noninteractive.bg_stroke,
+            egui_tiles::ResizeState::Hovering => style.visuals.widgets.hovered.fg_stroke,
+            egui_tiles::ResizeState::Dragging => style.visuals.widgets.active.fg_stroke,
+        }
     }
 }
 

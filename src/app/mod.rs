@@ -24,6 +24,7 @@ mod plots;
 mod reduce;
 mod session;
 mod settings;
+mod stance;
 mod text;
 mod ticks;
 mod timeline;
@@ -111,8 +112,11 @@ impl BonescopeApp {
         let replaced = self.session.poll(&mut self.window.notifications);
         self.replaced(replaced);
         let actions = self.window.ui(ui, &mut self.session, &mut self.work, &mut self.settings);
+        let in_place = actions.step_in_place;
         self.apply(actions, ui.ctx());
-        if !ui.ctx().input(|i| i.pointer.any_down()) {
+        if in_place {
+            self.session.record_in_place();
+        } else if !ui.ctx().input(|i| i.pointer.any_down()) {
             self.session.record();
         }
     }

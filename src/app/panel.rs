@@ -28,6 +28,9 @@ pub struct Shared<'a> {
     pub work: &'a mut Work,
     /// Set by a panel that asks for the history's Undo (as Edit → Undo does).
     pub undo_asked: &'a mut bool,
+    /// Set by a panel whose edit this frame takes the place of the history's current step (a fix tried instead of
+    /// the one tried), rather than adding one.
+    pub step_in_place: &'a mut bool,
 }
 
 impl Shared<'_> {

@@ -115,7 +115,6 @@ fn axis_angle(q: Quat) -> (f64, [f64; 3]) {
 pub struct Plots {
     /// The components plotted, in [`Component::ALL`]'s order: a click shows one, Ctrl- or Shift-click adds or removes.
     components: Vec<Component>,
-    pub show_ghost: bool,
     /// The curves, split into plots of one unit each (an angle in degrees and a unit axis never share an axis).
     cache: Option<(SeriesKey, Vec<Group>)>,
     /// Set by "Reset view": the next frame fits the plots to the whole clip again.
@@ -124,7 +123,7 @@ pub struct Plots {
 
 impl Default for Plots {
     fn default() -> Self {
-        Plots { components: vec![Component::default()], show_ghost: false, cache: None, reset: false }
+        Plots { components: vec![Component::default()], cache: None, reset: false }
     }
 }
 
@@ -139,9 +138,9 @@ struct Group {
 }
 
 impl Group {
-    /// The series split by unit: angles (names ending in `°`) apart from the rest, in their order.
+    /// The series split by unit: angles apart from the rest (a ghost's with its own), in their order.
     fn split(series: Vec<Series>) -> Vec<Group> {
-        let (degrees, other): (Vec<Series>, Vec<Series>) = series.into_iter().partition(|s| s.name.ends_with('°'));
+        let (degrees, other): (Vec<Series>, Vec<Series>) = series.into_iter().partition(|s| s.degrees);
         [degrees, other]
             .into_iter()
             .filter(|s| !s.is_empty())
@@ -206,6 +205,8 @@ struct Series {
     name: String,
     color: Color32,
     ghost: bool,
+    /// An angle in degrees (its channel's name ends in `°`), plotted apart from unit values.
+    degrees: bool,
     values: Vec<f64>,
 }
 
@@ -245,7 +246,7 @@ impl Panel for Plots {
             components: self.components.clone(),
             format: shared.settings.rotation_format,
             model_space: shared.settings.plot_model_space,
-            ghost: self.show_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
+            ghost: shared.settings.plot_ghost && shared.doc.ghost.is_some() && shared.settings.plot_model_space,
             compared: shared
                 .results
                 .compared_curves
@@ -299,7 +300,7 @@ impl Plots {
                 }
             }
             ui.separator();
-            ui.add_enabled(shared.doc.ghost.is_some(), egui::Checkbox::new(&mut self.show_ghost, "ghost"))
+            ui.add_enabled(shared.doc.ghost.is_some(), egui::Checkbox::new(&mut shared.settings.plot_ghost, "ghost"))
                 .on_disabled_hover_text("no ghost: choose one in the top bar");
             ui.separator();
             if ui.button("Reset view").on_hover_text("the whole clip again (or double-click a plot)").clicked() {
@@ -519,10 +520,12 @@ fn build_series(key: &SeriesKey, component: Component, skeleton: &crate::model::
                 (_, 1) => component.label().to_owned(),
                 _ => format!("{} {channel}", component.label()),
             };
+            let degrees = channel.ends_with('°');
             out.push(Series {
                 name: format!("{name} {channel}"),
                 color,
                 ghost: false,
+                degrees,
                 values: primary.iter().map(read).collect(),
             });
             if !ghost.is_empty() {
@@ -531,6 +534,7 @@ fn build_series(key: &SeriesKey, component: Component, skeleton: &crate::model::
                     name: format!("{name} {channel} ({})", if key.compared.is_some() { "compared" } else { "ghost" }),
                     color: color.gamma_multiply(0.5),
                     ghost: true,
+                    degrees,
                     values,
                 });
             }
@@ -578,7 +582,8 @@ mod tests {
     use super::*;
 
     fn series(name: &str) -> Series {
-        Series { name: name.to_owned(), color: Color32::WHITE, ghost: false, values: vec![0.0, 90.0] }
+        let degrees = name.ends_with('°');
+        Series { name: name.to_owned(), color: Color32::WHITE, ghost: false, degrees, values: vec![0.0, 90.0] }
     }
 
     #[test]
@@ -590,6 +595,9 @@ mod tests {
         // One unit: one plot.
         assert_eq!(Group::split(["hand x", "hand y"].map(series).into()).len(), 1);
         assert_eq!(Group::split(["hand X°", "hand Y°"].map(series).into()).len(), 1);
+        // The ghost's curve (the shear before a fix tried) dashed over the curve itself.
+        let ghost = Series { name: "hand shear° (ghost)".to_owned(), ghost: true, ..series("hand shear°") };
+        assert_eq!(Group::split(vec![series("hand shear°"), ghost]).len(), 1);
     }
 
     #[test]

@@ -60,8 +60,11 @@ impl Session {
                 // What was said about the files before (one that failed, a comparison) is of another document.
                 notes.clear_errors();
                 self.watched.broken = None;
-                self.replace(doc);
                 notes.info_about(&topic, format!("opened {}", path.display()));
+                for not_drawn in doc.rig.meshes_not_drawn() {
+                    notes.info_about(&topic, not_drawn.to_owned());
+                }
+                self.replace(doc);
                 Some(Replaced::Opened)
             }
             Err(error) => {
@@ -188,6 +191,12 @@ impl Session {
     /// not in the middle of a gesture).
     pub fn record(&mut self) {
         self.history.record(&self.doc);
+    }
+
+    /// Takes what the document evaluates now in place of the history's current step (a fix tried instead of the
+    /// one tried).
+    pub fn record_in_place(&mut self) {
+        self.history.record_in_place(&self.doc);
     }
 
     pub fn undo_label(&self) -> Option<&str> {

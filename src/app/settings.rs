@@ -102,6 +102,8 @@ pub struct Settings {
     pub rotation_format: RotationFormat,
     /// Plot model-space components (else local).
     pub plot_model_space: bool,
+    /// Plot the ghost's curves, dashed (a fix tried turns it on: its ghost is the clip before the fix).
+    pub plot_ghost: bool,
     /// The panels shown or hidden in the View menu (the others as they start).
     pub shown: BTreeMap<Pane, bool>,
     /// Bones farther than this percentage of the rig's size from their partner in a compared file are badged.
@@ -123,6 +125,7 @@ impl Default for Settings {
             looping: true,
             rotation_format: RotationFormat::Quaternion,
             plot_model_space: true,
+            plot_ghost: false,
             shown: BTreeMap::new(),
             compare_threshold_percent: 0.01,
             layout: None,

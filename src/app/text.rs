@@ -17,18 +17,25 @@ pub fn clip_choice(clip: &Clip) -> String {
     format!("{} ({:.2} s)", clip.label(), clip.span().length())
 }
 
-/// Below this a value is shown as 0: floating-point noise of a matrix, not a measurement.
-const NOISE: f64 = 1e-9;
+/// Below this a value is shown as 0, as the plots draw it: floating-point noise (a matrix's 5e-17, a fixed bone's
+/// 6e-6° of shear left by single-precision keys), not a measurement.
+const NOISE: f64 = 1e-5;
 
-/// `x` in at most 7 characters (8 for a negative exponent of two digits) with four or five significant digits: 4
-/// decimals below 10, one fewer per digit before the point, scientific notation from 100000 up and for values below
-/// 0.001 (so 3e-5 is not shown as 0.0000).
+/// `x` as every number the app shows is taken: 0 where it is noise (never −0), else itself.
+pub fn denoised(x: f64) -> f64 {
+    if x.abs() < NOISE { 0.0 } else { x }
+}
+
+/// `x` in at most 7 characters with four or five significant digits: 4 decimals below 10, one fewer per digit
+/// before the point, scientific notation from 100000 up and below 0.001 (so 3e-5 is not shown as 0.0000); noise
+/// is 0 ([`denoised`]).
 pub fn compact(x: f64) -> String {
-    let size = x.abs();
     if !x.is_finite() {
         return "—".to_owned();
     }
-    if size < NOISE {
+    let x = denoised(x);
+    let size = x.abs();
+    if size == 0.0 {
         return "0".to_owned();
     }
     if !(1e-3..1e5).contains(&size) {
@@ -39,6 +46,22 @@ pub fn compact(x: f64) -> String {
     let text = format!("{x:.decimals$}");
     // 9.99996 rounds to "10.0000": one decimal too many for the width.
     if text.trim_start_matches('-').len() > 6 && decimals > 0 { format!("{x:.0$}", decimals - 1) } else { text }
+}
+
+/// `x` with every digit that is not noise, for a hover that gives the exact value: ten significant digits at most
+/// (a double's seventeen say nothing its source, at best single precision, knew), trailing zeros dropped; noise
+/// is 0 ([`denoised`]).
+pub fn precise(x: f64) -> String {
+    if !x.is_finite() {
+        return "—".to_owned();
+    }
+    let x = denoised(x);
+    if x == 0.0 {
+        return "0".to_owned();
+    }
+    let decimals = (9 - x.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
 }
 
 /// `text` with characters taken from its middle and replaced by "…" until `fits` says it fits; the whole text when
@@ -119,13 +142,32 @@ mod tests {
             (12345.67, "12346"),
             (123456.7, "1.2e5"),
             (3e-5, "3.0e-5"),
-            (-4.77e-9, "-4.8e-9"),
+            (-4.77e-9, "0"),
+            (6.4e-6, "0"),
             (9.99996, "10.000"),
             (f64::NAN, "—"),
         ];
         for (x, shown) in cases {
             assert_eq!(compact(x), shown, "{x}");
             assert!(compact(x).chars().count() <= 7);
+        }
+    }
+
+    #[test]
+    fn exact_values_keep_ten_digits_and_lose_their_noise() {
+        let cases = [
+            (5.060290082411953e-17, "0"),
+            (-5.4e-6, "0"),
+            (std::f64::consts::FRAC_1_SQRT_2, "0.7071067812"),
+            (-123.4567, "-123.4567"),
+            (1.0, "1"),
+            (18.666049, "18.666049"),
+            (123456789.123, "123456789.1"),
+            (3e-5, "0.00003"),
+            (f64::INFINITY, "—"),
+        ];
+        for (x, shown) in cases {
+            assert_eq!(precise(x), shown, "{x}");
         }
     }
 

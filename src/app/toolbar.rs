@@ -10,6 +10,7 @@ use super::compared::Compared;
 use super::document::{Document, Ghost, ModeScope};
 use super::pane::{Pane, Visibility};
 use super::panel::Shared;
+use super::stance::Stance;
 use super::text;
 use crate::analysis::Tolerances;
 use crate::eval::SkinningMethod;
@@ -30,6 +31,9 @@ pub struct Actions {
     pub frame_all: bool,
     pub undo: bool,
     pub redo: bool,
+    /// The document's edit this frame takes the place of the history's current step (a fix tried instead of the
+    /// one tried): an undo goes back to the state before both.
+    pub step_in_place: bool,
 }
 
 /// What the menus list that the panels' shared state does not hold: the steps the Edit menu undoes and redoes, and
@@ -63,8 +67,9 @@ pub fn ui(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mut A
         ui.menu_button("View", |ui| view_menu(ui, shared, menus, actions));
         ui.separator();
         ui.label(RichText::new(shared.doc.title()).strong());
-        // A comparison's pickers have their place beside the file's name, so the toolbar below never moves for
-        // them.
+        // The pickers of a file's unit and axis have their place beside its name, so the toolbar below never moves
+        // for them.
+        up_of_document(ui, shared.doc, actions);
         unit_pickers(ui, shared.doc);
     });
     // On a narrow window the pickers wrap onto a second row rather than run off the edge.
@@ -230,8 +235,9 @@ fn view_menu(ui: &mut egui::Ui, shared: &mut Shared, menus: &Menus, actions: &mu
 }
 
 /// The width of the top bar's lists, in points: the animation's too, whatever its name's length (shortened to fit),
-/// so the controls after it never move.
-const PICKER_WIDTH: f32 = 170.0;
+/// so the controls after it never move; the ghost's longest choice ("cmu_12_01_walk.bvh") fits, and the bar does
+/// not wrap in a window 1000 points wide.
+const PICKER_WIDTH: f32 = 160.0;
 
 fn clip_picker(ui: &mut egui::Ui, shared: &mut Shared) {
     let label = ui.label("Animation");
@@ -330,6 +336,18 @@ fn ghost_picker(ui: &mut egui::Ui, shared: &mut Shared) {
         .labelled_by(label.id);
 }
 
+/// Beside the document's name, where its file states no axes (a BVH) or lies down in the view, the axis it stands
+/// along; standing it up frames it again.
+fn up_of_document(ui: &mut egui::Ui, doc: &mut Document, actions: &mut Actions) {
+    // A file that states no unit (a BVH) states no axes either.
+    if doc.stance.pickable(doc.rig.unit.is_some())
+        && let Some(up) = up_picker(ui, &doc.title(), doc.stance, "the view")
+    {
+        *doc = doc.stood_up(up);
+        actions.frame_all = true;
+    }
+}
+
 /// Beside the document's name, for each file of the comparison that states no unit (a BVH), the unit it is in, and for
 /// the compared file the axis it stands along where it states none or lies down beside the document: the ghost, the
 /// dashed curves and the differences follow them.
@@ -341,8 +359,8 @@ fn unit_pickers(ui: &mut egui::Ui, doc: &mut Document) {
     {
         replace(doc, compared.given_unit(unit));
     }
-    if (!compared.states_unit() || compared.apart.is_some() || compared.up != UpAxis::Y)
-        && let Some(up) = up_picker(ui, &compared, &doc.title())
+    if compared.stance.pickable(compared.states_unit())
+        && let Some(up) = up_picker(ui, &compared.title(), compared.stance, &doc.title())
     {
         replace(doc, compared.given_up(up, &doc.rig));
     }
@@ -385,14 +403,13 @@ fn unit_picker(ui: &mut egui::Ui, file: &str, unit: Option<Unit>, other: &str) -
     picked.filter(|_| picked != unit)
 }
 
-/// A picker of the axis `compared` stands along, saying where it lies down beside the document; the axis picked, if
-/// another.
-fn up_picker(ui: &mut egui::Ui, compared: &Compared, document: &str) -> Option<UpAxis> {
-    let file = compared.title();
+/// A picker of the axis `file` stands along (its `stance`), saying where it lies down beside `beside`; the axis
+/// picked, if another.
+fn up_picker(ui: &mut egui::Ui, file: &str, stance: Stance, beside: &str) -> Option<UpAxis> {
     let label = ui.label(format!("up of {file}"));
-    let mut picked = compared.up;
-    egui::ComboBox::from_id_salt(("up", &file))
-        .selected_text(compared.up.id().to_uppercase())
+    let mut picked = stance.up;
+    egui::ComboBox::from_id_salt(("up", file))
+        .selected_text(stance.up.id().to_uppercase())
         .show_ui(ui, |ui| {
             for &up in UpAxis::ALL {
                 ui.selectable_value(&mut picked, up, up.id().to_uppercase()).on_hover_text(up.description());
@@ -401,13 +418,13 @@ fn up_picker(ui: &mut egui::Ui, compared: &Compared, document: &str) -> Option<U
         .response
         .labelled_by(label.id)
         .on_hover_text(format!("the axis {file}'s skeleton stands along, where the file does not say (BVH)"));
-    if let Some([ours, theirs]) = compared.apart {
+    if let Some([ours, theirs]) = stance.apart {
         let text =
-            format!("lies along {}: {document} stands along {}", theirs.id().to_uppercase(), ours.id().to_uppercase());
+            format!("lies along {}: {beside} stands along {}", theirs.id().to_uppercase(), ours.id().to_uppercase());
         ui.label(RichText::new(text).color(Badge::NonUniform.color()))
             .on_hover_text("every difference would measure the turn: pick the axis the file stands along");
     }
-    (picked != compared.up).then_some(picked)
+    (picked != stance.up).then_some(picked)
 }
 
 /// The document compared with `compared` instead.

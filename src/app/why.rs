@@ -5,17 +5,20 @@
 //!
 //! A fix that is a setting of the document can be tried on it (one step of the history: Edit → Undo takes it back,
 //! the ghost with it): a mode goes to the bone's own mode, a uniform scale to the layers.
-//! The ghost then shows the clip as it was, beside the fixed pose.
+//! The ghost then shows the clip as it was, beside the fixed pose, and the plots its curves dashed. While the fix
+//! stands the section keeps the ranking it was chosen from (the bone no longer shears, so there would be nothing
+//! to explain): the fix tried is marked with Undo beside it, and another is tried in its place.
 
 use egui::collapsing_header::{CollapsingState, paint_default_icon};
 use egui::{
     Align, Align2, Button, CollapsingHeader, Color32, Layout, Rect, RichText, Sense, Stroke, StrokeKind, TextStyle, Ui,
 };
 use egui::{pos2, vec2};
+use std::sync::Arc;
 
 use super::document::{Ghost, ModeScope};
 use super::panel::Shared;
-use super::text::{compact, drawable, name_label, text_width};
+use super::text::{compact, denoised, drawable, name_label, text_width};
 use crate::analysis::ScanOptions;
 use crate::eval::Setup;
 use crate::explain::{Change, Explanation, Fix, Link, Measured};
@@ -30,9 +33,6 @@ const SHOWN_SPANS: usize = 6;
 /// The bar of a bone whose squash counters the shear (a negative contribution): a colour no finding uses.
 const COUNTERS: Color32 = Color32::from_rgb(60, 175, 160);
 
-/// Below this a shear left by a fix is floating-point noise, not a measurement.
-const NOISE_DEG: f64 = 1e-9;
-
 /// What the section keeps between frames.
 #[derive(Default)]
 pub struct Memory {
@@ -43,11 +43,15 @@ pub struct Memory {
     pinned: Option<(usize, usize)>,
 }
 
-/// A fix tried on a bone from this section: what was evaluated after it (while the document still evaluates that,
-/// it stands) and the line that says what it did.
+/// A fix tried on a bone from this section: what was evaluated before it and after it (while the document still
+/// evaluates that, it stands), the ranking it was chosen from, and the line that says what it did.
 struct Tried {
     bone: usize,
+    change: Change,
+    /// Another fix is tried in this one's place on what was evaluated before.
+    before: Setup,
     setup: Setup,
+    explained: Arc<Explanation>,
     line: String,
 }
 
@@ -79,13 +83,10 @@ pub fn header(ui: &mut Ui, shared: &Shared, memory: &Memory, bone: usize) {
         None => {
             ui.label(RichText::new("Why? once the clip is analysed").weak());
         }
-        Some(false) if standing(shared, memory, bone).is_some() => {
-            ui.label(RichText::new("not sheared now").weak());
-        }
-        Some(false) => {
+        Some(false) if standing(shared, memory, bone).is_none() => {
             ui.label(RichText::new("not sheared: nothing to explain").weak());
         }
-        Some(true) => {
+        Some(_) => {
             let mut state = collapsing(ui.ctx());
             ui.horizontal(|ui| {
                 ui.spacing_mut().item_spacing.x = 0.0;
@@ -100,16 +101,15 @@ pub fn header(ui: &mut Ui, shared: &Shared, memory: &Memory, bone: usize) {
     }
 }
 
-/// The section's body, while its header is open: the explanation, computed off the UI thread; first, the fix tried
-/// on the bone while it stands, with Undo.
+/// The section's body, while its header is open: the explanation, computed off the UI thread; while a fix tried on
+/// the bone stands, the line that says what it did over the ranking it was chosen from.
 pub fn ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, bone: usize) {
-    if let Some(line) = standing(shared, memory, bone) {
-        ui.horizontal_wrapped(|ui| {
-            ui.label(RichText::new(line).strong());
-            if ui.link("Undo").on_hover_text("take the fix back (Edit → Undo)").clicked() {
-                *shared.undo_asked = true;
-            }
-        });
+    if let Some(tried) = standing(shared, memory, bone) {
+        ui.label(RichText::new(&tried.line).strong());
+        let explained = tried.explained.clone();
+        collapsing(ui.ctx())
+            .show_body_unindented(ui, |ui| ui.indent("why-body", |ui| explanation_ui(ui, shared, memory, &explained)));
+        return;
     }
     if flagged(shared, bone) != Some(true) {
         return;
@@ -131,10 +131,9 @@ fn body(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, bone: usize) {
     }
 }
 
-/// The line of the fix tried on `bone`, while the document evaluates what it made.
-fn standing(shared: &Shared, memory: &Memory, bone: usize) -> Option<String> {
-    let tried = memory.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())?;
-    Some(tried.line.clone())
+/// The fix tried on `bone`, while the document evaluates what it made.
+fn standing<'a>(shared: &Shared, memory: &'a Memory, bone: usize) -> Option<&'a Tried> {
+    memory.tried.as_ref().filter(|t| t.bone == bone && t.setup == *shared.doc.setup())
 }
 
 /// Whether the whole-clip analysis flags `bone` anywhere in the clip; `None` before the first analysis.
@@ -176,7 +175,7 @@ fn first_answer_ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, first:
     spinner(ui, "ranking every fix…");
 }
 
-fn explanation_ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Explanation) {
+fn explanation_ui(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Arc<Explanation>) {
     ui.label(drawable(&explained.headline(shared.doc.rig.unit)));
     if explained.causes.stretched_samples == 0 {
         return;
@@ -276,7 +275,7 @@ fn link_row(
         ui.add_space(room.max(0.0));
         let hint = link_hint(link, shear);
         bar(ui, columns.bar, link.contribution_deg, shear, main).on_hover_text(&hint);
-        let number = RichText::new(format!("{:>7}°", compact(link.contribution_deg + 0.0))).monospace();
+        let number = RichText::new(format!("{:>7}°", compact(link.contribution_deg))).monospace();
         ui.label(number).on_hover_text(&hint);
         if main {
             let mark = RichText::new("main").strong().color(Badge::Stretched.color());
@@ -312,7 +311,7 @@ fn link_hint(link: &Link, shear: f64) -> String {
     if let Some(turn) = link.turn_deg {
         text.push_str(&format!("; its axes turned {}° from the bone's", compact(turn)));
     }
-    let (left, shear, causes) = (compact(link.shear_left_deg), compact(shear), compact(link.contribution_deg + 0.0));
+    let (left, shear, causes) = (compact(link.shear_left_deg), compact(shear), compact(link.contribution_deg));
     text.push_str(&format!("\nmade uniform, {left}° of the {shear}° shear is left: it causes {causes}°"));
     if link.contribution_deg < 0.0 {
         text.push_str("\nnegative: its scale counters the others' (made uniform, the shear grows)");
@@ -340,7 +339,7 @@ fn spans(ui: &mut Ui, shared: &mut Shared, explained: &Explanation) {
 
 /// The fixes, best first: each with what it leaves and what it moves, in columns; a Try button on those that are
 /// settings of the document.
-fn fixes(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Explanation) {
+fn fixes(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Arc<Explanation>) {
     // Those that change something: Blender's Fix Shear on a bone its parent does not shear is no fix.
     let shown: Vec<&Fix> = explained.shown_fixes(false, shared.settings.tolerances.min_shear_deg).collect();
     if shown.is_empty() {
@@ -353,7 +352,7 @@ fn fixes(ui: &mut Ui, shared: &mut Shared, memory: &mut Memory, explained: &Expl
     listed(ui, "why-more-fixes", &shown, SHOWN_FIXES, row);
 }
 
-/// The widths of a fix's rows: the Try button, and the widest effect and distance among the fixes (so that the
+/// The widths of a fix's rows: the Try button (or Undo, in its place while its fix stands), and the widest effect and distance among the fixes (so that the
 /// numbers of every fix line up).
 struct FixColumns {
     button: f32,
@@ -369,7 +368,8 @@ impl FixColumns {
             fixes.iter().map(|fix| text_width(ui, &text(fix), &body)).fold(0.0, f32::max)
         };
         FixColumns {
-            button: text_width(ui, "Try", &TextStyle::Button.resolve(ui.style())) + 2.0 * ui.spacing().button_padding.x,
+            button: text_width(ui, "Undo", &TextStyle::Button.resolve(ui.style()))
+                + 2.0 * ui.spacing().button_padding.x,
             effect: widest(&effect),
             distance: widest(&|fix| distance(fix, unit)),
             unit,
@@ -377,27 +377,31 @@ impl FixColumns {
     }
 }
 
-/// One fix: the Try button (or, for a bake, where to make it), then its label over its numbers.
+/// One fix: the Try button (Undo while it is the fix tried; for a bake, where to make it), then its label over its
+/// numbers.
 fn fix_row(
     ui: &mut Ui,
     shared: &mut Shared,
     memory: &mut Memory,
     fix: &Fix,
     columns: &FixColumns,
-    explained: &Explanation,
+    explained: &Arc<Explanation>,
 ) {
     let hint = fix_hint(fix, columns.unit, &shared.time_text(fix.cost.distance.time));
+    let tried = memory.tried.as_ref().is_some_and(|t| t.change == fix.change && t.setup == *shared.doc.setup());
     ui.with_layout(Layout::left_to_right(Align::Min), |ui| {
         match fix.change {
             Change::Bake { strategy } => bake_slot(ui, strategy, columns.button),
+            _ if tried => undo_button(ui, shared, columns.button),
             _ => try_button(ui, shared, memory, fix, columns, explained),
         }
         ui.vertical(|ui| {
             // Rows as tall as their text, so that the label and its numbers read as one entry.
             ui.spacing_mut().interact_size.y = 0.0;
             ui.spacing_mut().item_spacing.y = 1.0;
-            let label = RichText::new(drawable(&fix.label));
-            let label = if fix.removes { label.strong() } else { label };
+            let label = drawable(&fix.label);
+            let label = RichText::new(if tried { format!("tried: {label}") } else { label });
+            let label = if fix.removes || tried { label.strong() } else { label };
             ui.add(egui::Label::new(label).truncate()).on_hover_text(&hint);
             ui.horizontal_wrapped(|ui| {
                 let effect = RichText::new(effect(fix));
@@ -418,26 +422,45 @@ fn fix_row(
     });
 }
 
-/// Try: the fix made, said in the section's place, and the timeline at the bone's worst time, where it shows.
+/// Try: the fix made (in place of the one tried, while that stands: one step of the history, not two), said in the
+/// section's place, and the timeline at the bone's worst time, where it shows.
 fn try_button(
     ui: &mut Ui,
     shared: &mut Shared,
     memory: &mut Memory,
     fix: &Fix,
     columns: &FixColumns,
-    explained: &Explanation,
+    explained: &Arc<Explanation>,
 ) {
     let what = match fix.change {
         Change::UniformScale { .. } => "adds the uniform scale to the layers (remove it in the Layers panel)",
         _ => "sets the bone's mode (set it back from the skeleton's menu, or Declared in the toolbar)",
     };
     let hint = format!("{what}; the ghost then shows the clip as it was");
-    if ui.add(Button::new("Try").small().min_size(vec2(columns.button, 0.0))).on_hover_text(hint).clicked() {
-        try_fix(shared, fix.change);
-        go_to(shared, explained.causes.at.time);
-        let setup = shared.doc.setup().clone();
-        let line = tried_line(fix, explained, columns.unit, &shared.time_text(fix.cost.distance.time));
-        memory.tried = Some(Tried { bone: explained.bone, setup, line });
+    if !ui.add(Button::new("Try").small().min_size(vec2(columns.button, 0.0))).on_hover_text(hint).clicked() {
+        return;
+    }
+    let standing = memory.tried.take().filter(|t| t.setup == *shared.doc.setup());
+    let before = match standing {
+        Some(tried) if shared.doc.set_setup(tried.before.clone()).is_ok() => {
+            *shared.step_in_place = true;
+            tried.before
+        }
+        _ => shared.doc.setup().clone(),
+    };
+    try_fix(shared, fix.change);
+    go_to(shared, explained.causes.at.time);
+    let setup = shared.doc.setup().clone();
+    let line = tried_line(fix, explained, columns.unit, &shared.time_text(fix.cost.distance.time));
+    let explained = explained.clone();
+    memory.tried = Some(Tried { bone: explained.bone, change: fix.change, before, setup, explained, line });
+}
+
+/// Undo, in the Try button's place while its fix stands: the fix taken back (Edit → Undo).
+fn undo_button(ui: &mut Ui, shared: &mut Shared, width: f32) {
+    let button = Button::selectable(true, "Undo").small().min_size(vec2(width, 0.0));
+    if ui.add(button).on_hover_text("take the fix back (Edit → Undo)").clicked() {
+        *shared.undo_asked = true;
     }
 }
 
@@ -479,7 +502,7 @@ fn slot(ui: &mut Ui, text: RichText, width: f32) -> egui::Response {
 /// What a fix leaves of the shear: "removes", "removes (0.04° left)" (within the tolerances), "leaves 38.078°".
 fn effect(fix: &Fix) -> String {
     let left = compact(fix.shear_left_deg);
-    match (fix.removes, fix.shear_left_deg < NOISE_DEG) {
+    match (fix.removes, denoised(fix.shear_left_deg) == 0.0) {
         (true, true) => "removes".to_owned(),
         (true, false) => format!("removes ({left}° left)"),
         (false, _) => format!("leaves {left}°"),
@@ -521,7 +544,8 @@ fn fix_hint(fix: &Fix, unit: Option<Unit>, when: &str) -> String {
 
 /// Applies a fix to the document, as `explain` applies it, and shows the clip as it was as the ghost: the modes as
 /// they were (declared for a document as opened; declared too where they were mixed) for a mode, the clip without
-/// its layers for a uniform scale (the declared modes' ghost would be the fixed pose itself).
+/// its layers for a uniform scale (the declared modes' ghost would be the fixed pose itself); the plots draw the
+/// ghost's curves, dashed over the fixed ones.
 fn try_fix(shared: &mut Shared, change: Change) {
     let doc = &mut *shared.doc;
     let ghost = match change {
@@ -532,6 +556,7 @@ fn try_fix(shared: &mut Shared, change: Change) {
     let fixed = change.apply(doc.setup(), &doc.rig.skeleton);
     if fixed.is_ok_and(|setup| doc.set_setup(setup).is_ok()) {
         doc.ghost = Some(ghost);
+        shared.settings.plot_ghost = true;
     }
 }
 

@@ -212,7 +212,7 @@ impl Window {
         let frame = CurrentPose::evaluate(doc, self.time, settings.scene.skinning, &settings.tolerances);
         let results = work.results(doc);
         let stretched = self.spans.get(results.analysis.as_ref(), self.selection.last().copied());
-        let mut undo_asked = false;
+        let (mut undo_asked, mut step_in_place) = (false, false);
         let mut shared = Shared {
             doc,
             settings,
@@ -224,6 +224,7 @@ impl Window {
             stretched,
             work,
             undo_asked: &mut undo_asked,
+            step_in_place: &mut step_in_place,
         };
         if self.chrome == Chrome::ViewportOnly {
             egui::CentralPanel::default()
@@ -240,6 +241,8 @@ impl Window {
                 let all = std::iter::once(&self.viewport as &dyn Panel).chain(self.panels.iter().map(|p| p.as_ref()));
                 let mut layout = take_layout(shared.settings, width, &all.collect::<Vec<_>>());
                 let style = ui.style().clone();
+                // The gaps between the tiles are their resize handles, edge to edge.
+                ui.style_mut().interaction.resize_grab_radius_side = super::layout::GRAB_RADIUS;
                 let mut panes =
                     Panes { shared: &mut shared, viewport: &mut self.viewport, panels: &mut self.panels, style };
                 layout.ui(&mut panes, ui);
@@ -247,6 +250,7 @@ impl Window {
             });
         }
         actions.undo |= undo_asked;
+        actions.step_in_place = step_in_place;
         // After the panels: a bone clicked in this very frame stands.
         if self.chrome == Chrome::Window {
             self.open_on_the_problem(&ctx, &session.doc, work, settings);

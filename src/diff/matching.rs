@@ -263,19 +263,22 @@ pub fn match_clips(a: &[Clip], b: &[Clip]) -> (Vec<(usize, usize)>, Vec<usize>, 
 
 /// The axes two rigs stand along, `[A's, B's]`, where they differ: one file's skeleton lies down beside the
 /// other's (a Z-up BVH beside its Y-up glTF), and every distance between them would measure the turn, not the
-/// motion. Each figure is looked at as it plays, at the start of its clip compared (its rest pose for `None`): a
-/// rest pose may lie otherwise than every frame (Blender's FBX rests its bones as they were edited, along Z).
-/// `None` where they agree or either figure stands along neither Y nor Z clearly.
+/// motion. Each figure is looked at as it plays ([`standing`]). `None` where they agree or either figure stands
+/// along neither Y nor Z clearly.
 pub fn standing_apart((a, clip_a): (&Rig, Option<usize>), (b, clip_b): (&Rig, Option<usize>)) -> Option<[UpAxis; 2]> {
-    let standing = |rig: &Rig, clip: Option<usize>| {
-        let figure = rig.skeleton.figure();
-        let playing = Evaluation::declared(rig, clip.and_then(|c| rig.clips.get(c)));
-        let model = playing.pose_at(playing.span().start).model.model;
-        let heads = model.into_iter().enumerate().filter(|&(i, _)| figure[i]);
-        UpAxis::standing(heads.map(|(_, m)| m.w_axis.truncate()))
-    };
     let (a, b) = (standing(a, clip_a)?, standing(b, clip_b)?);
     (a != b).then_some([a, b])
+}
+
+/// The axis a rig's figure stands along as it plays, at the start of `clip` (its rest pose for `None`): a rest pose
+/// may lie otherwise than every frame (Blender's FBX rests its bones as they were edited, along Z). `None` where it
+/// stands along neither Y nor Z clearly.
+pub fn standing(rig: &Rig, clip: Option<usize>) -> Option<UpAxis> {
+    let figure = rig.skeleton.figure();
+    let playing = Evaluation::declared(rig, clip.and_then(|c| rig.clips.get(c)));
+    let model = playing.pose_at(playing.span().start).model.model;
+    let heads = model.into_iter().enumerate().filter(|&(i, _)| figure[i]);
+    UpAxis::standing(heads.map(|(_, m)| m.w_axis.truncate()))
 }
 
 #[cfg(test)]

@@ -31,7 +31,7 @@ mod report;
 
 pub use matching::{
     BoneMatching, HELPER_SUFFIX, helpers, loose_name, match_bones, match_bones_mapped, match_clips, match_meshes,
-    standing_apart, usd_identifier,
+    standing, standing_apart, usd_identifier,
 };
 pub use report::{Align, AnimationDiff, Clips, FileDiff, FileSide, MissingClip, chosen_clips, diff_files};
 

@@ -30,6 +30,10 @@ pub use unit::{Unit, UnknownUnit};
 /// How a rig's notes say the up axis it was given.
 const UP_NOTE: &str = "axes: given as up along ";
 
+/// How a rig's notes start that name meshes of the file left out, and why (their data not in the file, their
+/// compression not decoding): what the app says on opening the file, beside `inspect`'s every note.
+pub const NOT_DRAWN_NOTE: &str = "not drawn, ";
+
 /// Everything bonescope knows about one file.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Rig {
@@ -101,6 +105,11 @@ impl Rig {
             }
         }
         weighted
+    }
+
+    /// The notes that name meshes of the file left out, and why ([`NOT_DRAWN_NOTE`]).
+    pub fn meshes_not_drawn(&self) -> impl Iterator<Item = &str> {
+        self.notes.iter().map(String::as_str).filter(|n| n.starts_with(NOT_DRAWN_NOTE))
     }
 
     /// For each bone, whether it is a conversion node: one at the top of the hierarchy (a root, or below conversion

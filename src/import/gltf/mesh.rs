@@ -9,7 +9,7 @@ use super::accessor::Accessors;
 use super::scene::SceneBones;
 use super::schema::{self, DataType, Root};
 use super::{Failure, Result};
-use crate::model::{Mesh, MorphTarget, Skeleton, Skin};
+use crate::model::{Mesh, MorphTarget, NOT_DRAWN_NOTE, Skeleton, Skin};
 
 /// How far the last row of an inverse bind matrix, stored in single precision, may be from `0, 0, 0, 1`.
 const AFFINE_TOLERANCE: f64 = 1e-6;
@@ -157,16 +157,16 @@ fn read_primitive(
         return Ok(None);
     }
     let place = format!("meshes[{}].primitives[{p}]", shown.mesh_index);
+    let base = mesh.name.as_deref().unwrap_or(&scene.skeleton.bone(bone).name);
+    let name = if mesh.primitives.len() == 1 { base.to_owned() } else { format!("{base}[{p}]") };
     if let Some(buffer) = unsupplied_buffer(primitive, accessors) {
-        tally.unsupplied.push(format!("{place} (buffers[{}])", buffer.0));
+        tally.unsupplied.push(format!("{name} at {place} (buffers[{}])", buffer.0));
         return Ok(None);
     }
     if let Err(failure) = decompress(primitive, accessors, &place) {
-        tally.undecoded.push(format!("{}: {}", failure.place.unwrap_or_default(), failure.message));
+        tally.undecoded.push(format!("{name} at {}: {}", failure.place.unwrap_or_default(), failure.message));
         return Ok(None);
     }
-    let base = mesh.name.as_deref().unwrap_or(&scene.skeleton.bone(bone).name);
-    let name = if mesh.primitives.len() == 1 { base.to_owned() } else { format!("{base}[{p}]") };
     let mut read = Mesh { name, bone, ..Mesh::default() };
     read.positions = positions(primitive, accessors, &place)?;
     if shown.skin.is_some() && quantized_positions(root, primitive) {
@@ -268,12 +268,13 @@ impl Tally {
         }
         if !self.unsupplied.is_empty() {
             notes.push(format!(
-                "not drawn, their data lies in buffers without a uri (to be supplied by an application): {}",
+                "{NOT_DRAWN_NOTE}their data lies in buffers without a uri (to be supplied by an application): {}",
                 self.unsupplied.join(", ")
             ));
         }
         if !self.undecoded.is_empty() {
-            notes.push(format!("not drawn, their compressed geometry does not decode: {}", self.undecoded.join("; ")));
+            let undecoded = self.undecoded.join("; ");
+            notes.push(format!("{NOT_DRAWN_NOTE}their compressed geometry does not decode: {undecoded}"));
         }
     }
 }
