@@ -77,7 +77,7 @@ impl Notifications {
         self.items.push(Notification { text, error, topic, count, shown_at: None });
     }
 
-    /// Shows the messages in the lower left corner of `within` (the viewport).
+    /// Shows the messages in the lower left corner of `within` (a part of the viewport), as wide as it.
     pub fn ui(&mut self, ctx: &egui::Context, within: Rect) {
         let now = ctx.input(|i| i.time);
         let hovered =
@@ -91,7 +91,7 @@ impl Notifications {
             self.area = None;
             return;
         }
-        let width = (within.width() * (1.0 - CAPTION_SIDE) - 2.0 * MARGIN).clamp(MIN_WIDTH, MAX_WIDTH);
+        let width = (within.width() - 2.0 * MARGIN).clamp(MIN_WIDTH, MAX_WIDTH);
         let mut dismissed = None;
         let hidden = self.items.len().saturating_sub(MAX_SHOWN);
         let response = egui::Area::new(egui::Id::unique("notifications"))
@@ -123,8 +123,8 @@ impl Notifications {
 const MARGIN: f32 = 10.0;
 /// The share of the viewport's width, at its right, left to the caption (file, clip, time, modes).
 pub const CAPTION_SIDE: f32 = 0.4;
-/// The width of the stack: as wide as the viewport allows beside the caption, up to a readable line.
-const MIN_WIDTH: f32 = 220.0;
+/// The width of the stack: as wide as its place allows, up to a readable line.
+const MIN_WIDTH: f32 = 130.0;
 const MAX_WIDTH: f32 = 480.0;
 
 impl Notification {

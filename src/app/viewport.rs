@@ -10,7 +10,7 @@ use super::document::{Document, Ghost};
 use super::pane::{Pane, Place, Visibility};
 use super::panel::{Panel, Shared};
 use crate::model::Choice;
-use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, Triads, ViewKind, motion_points, paint};
+use crate::view::{Bounds, Camera, DrawnPose, Palette, Scene, Triads, ViewKind, ground, motion, paint};
 
 /// Poses sampled to find the bounds of a clip's motion.
 const MOTION_SAMPLES: usize = 24;
@@ -28,21 +28,29 @@ pub enum CanvasFill {
 pub struct Viewport {
     /// Points to frame once the canvas knows its shape (framing fits them to the aspect ratio).
     framing: Option<Vec<glam::DVec3>>,
-    /// Where the canvas was drawn last.
-    rect: Option<egui::Rect>,
+    /// The figure the camera follows over the ground, where the clip travels.
+    follow: Option<Follow>,
+    /// Where messages stack, at the lower left of it (see [`Viewport::messages_rect`]).
+    messages: Option<egui::Rect>,
 }
 
 impl Viewport {
-    /// Where the canvas was drawn in the last frame (messages go in its corner).
-    pub fn rect(&self) -> Option<egui::Rect> {
-        self.rect
+    /// Where messages stack, in their lower left corner and as wide: the legend's column, which the figure is
+    /// framed beside, so that a message on opening covers none of it; without the legend the canvas's left, clear
+    /// of the caption at its right.
+    pub fn messages_rect(&self) -> Option<egui::Rect> {
+        self.messages
     }
 
-    /// Frames the whole motion of the current clip (through its layers), at the canvas's next frame.
+    /// Frames the figure in every posture of the current clip (through its layers), at the canvas's next frame;
+    /// where the clip travels, the camera follows the figure from then on (see [`motion`]).
     pub fn frame_all(&mut self, doc: &Document) {
         let evaluation = doc.evaluation();
         let pose_at = |time| evaluation.pose_at(time).model.model;
-        self.framing = Some(motion_points(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at));
+        let motion = motion(&doc.rig, doc.clip(), doc.span(), MOTION_SAMPLES, pose_at);
+        self.framing = Some(motion.points);
+        // The points stand their anchor above the origin: the first frame moves the camera to where it is.
+        self.follow = motion.anchor.map(|bone| Follow { bone, at: glam::DVec3::ZERO });
     }
 
     /// Applies a pending [`Viewport::frame_all`] now, for a canvas of this aspect ratio.
@@ -55,7 +63,6 @@ impl Viewport {
     /// The picture alone, filling the space left: what headless renders of the viewport show.
     pub fn canvas(&mut self, ui: &mut Ui, shared: &mut Shared, background: CanvasFill) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
-        self.rect = Some(rect);
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "viewport"));
         let rig = shared.doc.rig.clone();
         let mut scene = Scene::new(&rig, shared.frame.primary.clone(), shared.settings.scene);
@@ -71,7 +78,14 @@ impl Viewport {
             scene.bind_pose = Some(DrawnPose::bind(&rig, &scene.primary));
         }
         let picture = paint::picture_rect(rect, &scene);
+        self.messages = Some(
+            paint::legend_rect(rect, &scene)
+                .unwrap_or_else(|| rect.with_max_x(rect.max.x - rect.width() * super::notifications::CAPTION_SIDE)),
+        );
         self.frame_now(&mut shared.settings.camera, aspect(picture));
+        if let Some(follow) = &mut self.follow {
+            follow.step(&scene.primary, &mut shared.settings.camera);
+        }
         navigate(ui, &response, picture, &mut shared.settings.camera);
         if response.clicked()
             && let Some(at) = response.interact_pointer_pos()
@@ -92,6 +106,22 @@ impl Viewport {
             palette.background = egui::Color32::TRANSPARENT;
         }
         paint::paint(ui.painter(), rect, camera, &scene, &palette);
+    }
+}
+
+/// A camera that keeps a travelling figure where it was framed: it moves over the ground as its anchor bone does
+/// (a pan or an orbit stays as the user left it, relative to the figure).
+struct Follow {
+    bone: usize,
+    /// Where over the ground the anchor was when the camera last moved with it.
+    at: glam::DVec3,
+}
+
+impl Follow {
+    fn step(&mut self, pose: &DrawnPose, camera: &mut Camera) {
+        let Some(head) = pose.model.get(self.bone).map(|m| ground(m.w_axis.truncate())) else { return };
+        camera.target += head - self.at;
+        self.at = head;
     }
 }
 

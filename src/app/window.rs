@@ -255,7 +255,7 @@ impl Window {
         if self.chrome == Chrome::Window {
             self.open_on_the_problem(&ctx, &session.doc, work, settings);
         }
-        self.notifications.ui(&ctx, self.viewport.rect().unwrap_or_else(|| ctx.content_rect()));
+        self.notifications.ui(&ctx, self.viewport.messages_rect().unwrap_or_else(|| ctx.content_rect()));
         let folder = browsing_folder(&session.doc, settings);
         if let Some((path, purpose)) = self.dialogs.ui(&ctx, &folder, &mut self.notifications) {
             match purpose {

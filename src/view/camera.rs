@@ -127,28 +127,66 @@ impl Camera {
 
     /// [`Camera::frame`] on the points themselves rather than their box: a figure over its motion (its joints and
     /// skin at times through the clip) fills the picture, where the corners of its box, most of them far from any
-    /// part of it, would leave it small in the 3D view. Nothing happens for no finite point.
+    /// part of it, would leave it small in the 3D view. The points are centred on the picture, not their box's
+    /// centre (in perspective the near side looks larger, and a figure's raised arms put its middle above its
+    /// box's): a few steps move the target until the margins either side match. Nothing happens for no finite
+    /// point.
     pub fn frame_points(&mut self, points: &[DVec3], aspect: f64) {
-        const MARGIN: f64 = 1.15;
+        let points: Vec<DVec3> = points.iter().copied().filter(|p| p.is_finite()).collect();
         let Some(bounds) = Bounds::of(points.iter().copied()) else { return };
         self.target = bounds.center();
-        let (back, up) = self.eye_direction();
-        let right = up.cross(back).normalize();
-        let up = back.cross(right);
+        let (_, right, up) = self.basis();
+        for _ in 0..4 {
+            self.distance = self.fitting_distance(&points, aspect);
+            let middle = self.middle_on_screen(&points);
+            self.target += (right * middle.x + up * middle.y) * self.distance;
+        }
+        self.distance = self.fitting_distance(&points, aspect);
+    }
+
+    /// The distance (or, in a 2D view, the zoom) at which every point is in a picture of this aspect ratio, with
+    /// a margin, the target staying where it is.
+    fn fitting_distance(&self, points: &[DVec3], aspect: f64) -> f64 {
+        const MARGIN: f64 = 1.15;
+        let (back, right, up) = self.basis();
         let tan_y = (FOV_Y * 0.5).tan();
         let tan_x = tan_y * aspect.max(1e-3);
-        let needed = points.iter().filter(|p| p.is_finite()).map(|point| {
+        let needed = points.iter().map(|point| {
             let d = *point - self.target;
             let (x, y) = (d.dot(right).abs() * MARGIN / tan_x, d.dot(up).abs() * MARGIN / tan_y);
             match self.view {
-                // The corner's depth in front of the eye, `distance − z`, must see it within the field of view.
+                // The point's depth in front of the eye, `distance − z`, must see it within the field of view.
                 ViewKind::Persp => d.dot(back) + x.max(y),
                 // 2D views show `distance·tan(fov/2)` either side of the target.
                 _ => x.max(y),
             }
         });
         // At least a centimetre in view, so a single point still frames.
-        self.distance = needed.fold(0.01 * MARGIN / tan_y, f64::max);
+        needed.fold(0.01 * MARGIN / tan_y, f64::max)
+    }
+
+    /// The middle of the points' extent on screen (right, up), as a share of the distance: where the target
+    /// should move, in distances, to have them centred.
+    fn middle_on_screen(&self, points: &[DVec3]) -> DVec2 {
+        let (back, right, up) = self.basis();
+        let on_screen = points.iter().map(|point| {
+            let d = *point - self.target;
+            // Perspective divides by the depth in front of the eye; a 2D view by the distance alone.
+            let depth = match self.view {
+                ViewKind::Persp => (self.distance - d.dot(back)).max(1e-9),
+                _ => self.distance,
+            };
+            DVec2::new(d.dot(right), d.dot(up)) / depth
+        });
+        let (min, max) = on_screen.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        (min + max) * 0.5
+    }
+
+    /// Direction from the target to the eye, the screen's right and its up.
+    fn basis(&self) -> (DVec3, DVec3, DVec3) {
+        let (back, up) = self.eye_direction();
+        let right = up.cross(back).normalize();
+        (back, right, back.cross(right))
     }
 
     /// Direction from the target to the eye, and up.
@@ -308,6 +346,26 @@ mod tests {
             assert!(filled > tight, "{view:?}: the box fills only {filled} of the picture");
         }
         assert!(Bounds::of([DVec3::NAN]).is_none());
+    }
+
+    #[test]
+    fn framed_points_are_centred_on_the_picture() {
+        // A figure with its arms out high (a T) seen from above: its box's centre is below its middle on screen.
+        let figure = [DVec3::ZERO, DVec3::new(0.0, 1.8, 0.0), DVec3::new(-0.9, 1.5, 0.0), DVec3::new(0.9, 1.5, 0.0)];
+        for view in ViewKind::ALL {
+            let mut camera = Camera { view, yaw: 0.6, pitch: 0.35, ..Camera::default() };
+            camera.frame_points(&figure, 2.0);
+            let p = projection(&camera);
+            let screen: Vec<DVec2> = figure.iter().map(|c| p.project(*c).unwrap().0).collect();
+            let (min, max) =
+                screen.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), s| (lo.min(*s), hi.max(*s)));
+            let margins = [min.x, 200.0 - max.x, min.y, 100.0 - max.y];
+            assert!(
+                (margins[0] - margins[1]).abs() < 0.5 && (margins[2] - margins[3]).abs() < 0.5,
+                "{view:?}: {margins:?}"
+            );
+            assert!(margins.iter().all(|m| *m >= 0.0), "{view:?}: {margins:?}");
+        }
     }
 
     #[test]

@@ -7,5 +7,5 @@ pub mod scene;
 pub mod style;
 
 pub use camera::{Bounds, Camera, Projection, ViewKind};
-pub use scene::{DrawnPose, Scene, SceneOptions, Triads, motion_points, rest_bounds};
+pub use scene::{DrawnPose, Motion, Scene, SceneOptions, Triads, ground, motion, rest_bounds};
 pub use style::{Badge, Palette};

@@ -17,9 +17,14 @@ use crate::eval::skinning::skin_shears;
 /// Height of one caption line, in points.
 const CAPTION_LINE: f32 = 17.0;
 
+/// Width of the legend's column at the canvas's left, in points: its longest line with a margin; wider with the
+/// ghost's entry or the painted skin's scale ("skin shear (most now: 18.7°)", the ramp's last label).
+const LEGEND_WIDTH: f32 = 150.0;
+const WIDE_LEGEND_WIDTH: f32 = 200.0;
+
 /// Where the model is drawn inside a canvas `rect`: all of it, less a strip at the bottom for the caption when it
-/// is shown, so the caption never covers the model. Framing and picking use the same rectangle.
-pub fn picture_rect(rect: Rect, scene: &Scene) -> Rect {
+/// is shown, so the caption never covers the model.
+pub fn drawing_rect(rect: Rect, scene: &Scene) -> Rect {
     if !scene.options.legend || scene.caption.is_empty() {
         return rect;
     }
@@ -27,13 +32,32 @@ pub fn picture_rect(rect: Rect, scene: &Scene) -> Rect {
     Rect::from_min_max(rect.min, Pos2::new(rect.max.x, (rect.max.y - strip).max(rect.min.y + rect.height() * 0.5)))
 }
 
-/// Paints `scene` into `rect` as seen by `camera` (the model in [`picture_rect`], the caption below it).
+/// The column at the canvas's left that holds the legend (and, in the app, the messages at its foot), when the
+/// legend is shown; at most half the canvas wide.
+pub fn legend_rect(rect: Rect, scene: &Scene) -> Option<Rect> {
+    let wide = scene.ghost.is_some() || shows_skin_scale(scene);
+    let right = (rect.min.x + if wide { WIDE_LEGEND_WIDTH } else { LEGEND_WIDTH }).min(rect.center().x);
+    scene.options.legend.then(|| Rect::from_min_max(rect.min, Pos2::new(right, rect.max.y)))
+}
+
+/// What the camera projects onto: the [`drawing_rect`] less the legend's column, so a framed figure stands
+/// beside the legend, never under it (the grid still runs on under the legend). Framing and picking use the same
+/// rectangle.
+pub fn picture_rect(rect: Rect, scene: &Scene) -> Rect {
+    let drawn = drawing_rect(rect, scene);
+    match legend_rect(rect, scene) {
+        Some(legend) => Rect::from_min_max(Pos2::new(legend.max.x, drawn.min.y), drawn.max),
+        None => drawn,
+    }
+}
+
+/// Paints `scene` into `rect` as seen by `camera` (the model in [`drawing_rect`], projected onto [`picture_rect`],
+/// the legend in its column, the caption below).
 pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, palette: &Palette) {
     painter.rect_filled(rect, 0.0, palette.background);
     let (canvas, whole) = (painter.with_clip_rect(rect), rect);
-    let rect = picture_rect(rect, scene);
-    let projection = projection(camera, rect);
-    let painter = painter.with_clip_rect(rect);
+    let projection = projection(camera, picture_rect(rect, scene));
+    let painter = painter.with_clip_rect(drawing_rect(rect, scene));
     let options = &scene.options;
     if options.grid {
         paint_grid(&painter, &projection, scene, palette);
@@ -86,9 +110,11 @@ pub fn paint(painter: &Painter, rect: Rect, camera: &Camera, scene: &Scene, pale
     paint_axes(&painter, &projection, scene, primary, |bone| scene.shows_triad(primary, &chain, bone), |c| c);
     paint_joints(&painter, &projection, scene, palette);
     if options.legend {
-        let worst = shears.as_ref().filter(|_| !scene.rig.meshes.is_empty());
+        let worst = shears.as_ref().filter(|_| shows_skin_scale(scene));
         let worst = worst.map(|shears| shears.iter().flatten().copied().fold(0.0, f64::max));
-        paint_legend(&painter, rect, scene, palette, worst);
+        if let Some(legend) = legend_rect(whole, scene) {
+            paint_legend(&canvas, legend, scene, palette, worst);
+        }
         paint_caption(&canvas, whole, &scene.caption, palette);
     }
 }
@@ -404,27 +430,37 @@ fn paint_joints(painter: &Painter, projection: &Projection, scene: &Scene, palet
     }
 }
 
-/// The meaning of the colours and icons, in the top-left corner; with `worst_skin_shear` (the most any vertex
-/// shears now, in degrees) the painted skin's scale.
+/// The meaning of the colours and icons, at the top of the legend's column `rect`; with `worst_skin_shear` (the
+/// most any vertex shears now, in degrees) the painted skin's scale.
 fn paint_legend(painter: &Painter, rect: Rect, scene: &Scene, palette: &Palette, worst_skin_shear: Option<f64>) {
     let mut at = rect.min + egui::vec2(14.0, 14.0);
-    let line = |at: Pos2, text: &str| {
-        painter.text(at + egui::vec2(10.0, 0.0), Align2::LEFT_CENTER, text, FontId::proportional(12.0), palette.text)
+    // Each entry beside its icon at `at`, wrapped within the column (a compared file's name can be long); the next
+    // one goes below it.
+    let entry = |at: &mut Pos2, text: &str| {
+        let font = FontId::proportional(12.0);
+        let galley = painter.layout(text.to_owned(), font, palette.text, (rect.right() - at.x - 14.0).max(40.0));
+        let height = galley.size().y;
+        painter.galley(*at + egui::vec2(10.0, -7.0), galley, palette.text);
+        at.y += (height + 3.0).max(17.0);
     };
     for badge in Badge::ALL {
         badge.paint_icon(painter, at, 5.0);
-        line(at, badge.label());
-        at.y += 17.0;
+        entry(&mut at, badge.label());
     }
     if scene.ghost.is_some() {
         painter.rect_filled(Rect::from_center_size(at, egui::vec2(9.0, 9.0)), 1.0, palette.ghost.to_opaque());
-        line(at, &scene.ghost_label);
-        at.y += 17.0;
+        entry(&mut at, &scene.ghost_label);
     }
     if let Some(worst) = worst_skin_shear {
-        line(at, &format!("skin shear (most now: {})", degrees(worst, scene.neutral_shear_deg)));
-        paint_shear_scale(painter, at + egui::vec2(0.0, 14.0), scene, palette);
+        let top = at;
+        entry(&mut at, &format!("skin shear (most now: {})", degrees(worst, scene.neutral_shear_deg)));
+        paint_shear_scale(painter, Pos2::new(top.x, at.y - 3.0), scene, palette);
     }
+}
+
+/// Whether the legend has the painted skin's scale: where there is a skin painted by shear.
+fn shows_skin_scale(scene: &Scene) -> bool {
+    scene.options.paints_shear() && !scene.rig.meshes.is_empty()
 }
 
 /// A shear in degrees as the legend says it: two significant digits, 0 below the neutral shear.
@@ -539,14 +575,20 @@ mod tests {
     }
 
     #[test]
-    fn the_caption_has_its_own_strip_below_the_model() {
+    fn the_caption_has_its_own_strip_below_the_model_and_the_legend_its_column() {
         let rig = demo_rig();
         let mut scene = Scene::new(&rig, DrawnPose::default(), SceneOptions::default());
         let rect = Rect::from_min_max(Pos2::ZERO, Pos2::new(400.0, 300.0));
-        assert_eq!(picture_rect(rect, &scene), rect, "no caption, the whole canvas");
+        assert_eq!(drawing_rect(rect, &scene), rect, "no caption, the whole canvas");
         scene.caption = vec!["demo rig · stretch".into(), "0.500 s".into(), "mode: full".into()];
-        assert_eq!(picture_rect(rect, &scene).max.y, 300.0 - 3.0 * CAPTION_LINE - 8.0);
+        assert_eq!(drawing_rect(rect, &scene).max.y, 300.0 - 3.0 * CAPTION_LINE - 8.0);
+        // The camera projects beside the legend's column, so a framed figure is never under the legend.
+        let legend = legend_rect(rect, &scene).unwrap();
+        let picture = picture_rect(rect, &scene);
+        assert_eq!((legend.min, legend.max.y), (rect.min, rect.max.y));
+        assert_eq!((picture.min.x, picture.max), (legend.max.x, drawing_rect(rect, &scene).max));
         scene.options.legend = false;
-        assert_eq!(picture_rect(rect, &scene), rect, "captions hidden with the legend");
+        assert_eq!(picture_rect(rect, &scene), rect, "captions hidden with the legend, and its column");
+        assert_eq!(legend_rect(rect, &scene), None);
     }
 }

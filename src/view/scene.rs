@@ -370,28 +370,81 @@ pub fn typical_scale(rig: &Rig) -> f64 {
     scales.get(scales.len() / 2).copied().unwrap_or(1.0)
 }
 
-/// The points of the whole motion: the pose sampled at `samples` evenly spaced times over `span` by `pose_at`
-/// (model matrices), so a camera framed on them does not need to move while the clip plays. Only the joints that
-/// matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)), and the skinned meshes.
-pub fn motion_points(
+/// What the viewport frames of a clip: the figure in every posture it takes, and the bone it travels with.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// The figure's joints (those its anchor carries, where it travels) and skinned meshes at times through the
+    /// clip, each pose moved over the ground so that its `anchor` stands above the origin: a walk is framed as one
+    /// figure-sized box of its postures, not as its whole path (where the figure would be a speck at one end).
+    pub points: Vec<DVec3>,
+    /// The bone whose course over the ground the figure travels along (the hips of a walk), where it travels more
+    /// than a quarter of its size; `None` for a clip played in place, whose points are where they are.
+    pub anchor: Option<usize>,
+}
+
+/// The motion of the clip: the pose sampled at `samples` evenly spaced times over `span` by `pose_at` (model
+/// matrices). Only the joints that matter count (the figure's, [`Skeleton::figure`](crate::model::Skeleton::figure)),
+/// and the skinned meshes. A camera framed on the points and following the anchor over the ground need not zoom
+/// while the clip plays.
+pub fn motion(
     rig: &Rig,
     clip: Option<&Clip>,
     span: Span,
     samples: usize,
     mut pose_at: impl FnMut(f64) -> Vec<DMat4>,
-) -> Vec<DVec3> {
+) -> Motion {
     let framed = rig.skeleton.figure();
     let mut morph = MorphPose::default();
+    let poses: Vec<(Vec<DVec3>, Vec<DVec3>)> = (0..samples.max(1))
+        .map(|i| {
+            let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
+            let model = pose_at(time);
+            morph.evaluate(clip, time);
+            let meshes = skin_meshes(rig, &model, &morph).into_iter().flatten().filter(|p| p.is_finite()).collect();
+            (model.iter().map(|m| m.w_axis.truncate()).collect(), meshes)
+        })
+        .collect();
+    let anchor = travelling_bone(rig, poses.iter().map(|(joints, _)| joints.as_slice()));
+    // A travelling figure is what its anchor carries: a reference node left at the origin is not framed.
+    let framed: Vec<bool> = (0..rig.skeleton.len())
+        .map(|bone| framed[bone] && anchor.is_none_or(|a| rig.skeleton.is_in_subtree(bone, a)))
+        .collect();
     let mut points = Vec::new();
-    for i in 0..samples.max(1) {
-        let time = span.start + span.length() * i as f64 / (samples.max(2) - 1) as f64;
-        let model = pose_at(time);
-        morph.evaluate(clip, time);
-        let meshes = skin_meshes(rig, &model, &morph);
-        points.extend(model.iter().zip(framed).filter(|(_, f)| **f).map(|(m, _)| m.w_axis.truncate()));
-        points.extend(meshes.into_iter().flatten().filter(|p| p.is_finite()));
+    for (joints, meshes) in poses {
+        let offset = anchor.map_or(DVec3::ZERO, |bone| ground(joints[bone]));
+        points.extend(joints.iter().zip(&framed).filter(|(_, f)| **f).map(|(p, _)| *p - offset));
+        points.extend(meshes.iter().map(|p| *p - offset));
     }
-    points
+    Motion { points, anchor }
+}
+
+/// Where a point is over the ground (Y is up in the view).
+pub fn ground(p: DVec3) -> DVec3 {
+    DVec3::new(p.x, 0.0, p.z)
+}
+
+/// The bone the figure travels with over these poses (each the heads of every bone): the topmost bone carrying at
+/// least half of the figure whose course over the ground spans more than a quarter of the figure's size (a
+/// reference node that stays at the origin while the hips walk away is passed over; a waving hand carries too
+/// little of the figure to count). `None` when the figure stays in place.
+fn travelling_bone<'a>(rig: &Rig, poses: impl Iterator<Item = &'a [DVec3]> + Clone) -> Option<usize> {
+    let skeleton = &rig.skeleton;
+    let figure = skeleton.figure();
+    // Figure bones at and below each bone (parents come before children, so one backwards pass counts them).
+    let mut carried: Vec<usize> = figure.iter().map(|&f| usize::from(f)).collect();
+    for bone in (0..skeleton.len()).rev() {
+        if let Some(parent) = skeleton.parent(bone) {
+            carried[parent] += carried[bone];
+        }
+    }
+    let whole = figure.iter().filter(|f| **f).count();
+    let posture = |joints: &[DVec3]| {
+        Bounds::of(joints.iter().zip(figure).filter(|(_, f)| **f).map(|(p, _)| *p)).map_or(0.0, |b| b.radius() * 2.0)
+    };
+    let size = poses.clone().map(posture).fold(0.0, f64::max);
+    let course =
+        |bone: usize| Bounds::of(poses.clone().map(|joints| ground(joints[bone]))).map_or(0.0, |b| b.radius() * 2.0);
+    (0..skeleton.len()).find(|&bone| figure[bone] && carried[bone] * 2 >= whole && course(bone) > size * 0.25)
 }
 
 /// The bounds of the rest pose's joints and meshes.
@@ -423,22 +476,52 @@ mod tests {
         assert!(SceneOptions::parse_list("axes=some").unwrap_err().contains("stretched"));
     }
 
+    /// A joint `y` above its parent at rest.
+    fn joint(name: &str, parent: Option<usize>, y: f64) -> crate::model::Bone {
+        let rest = crate::model::Transform::from_trs(DVec3::new(0.0, y, 0.0), glam::DQuat::IDENTITY, DVec3::ONE);
+        crate::model::Bone::joint(name, parent, rest)
+    }
+
+    /// A rig of these joints, no mesh.
+    fn skeleton_rig(joints: Vec<crate::model::Bone>) -> Rig {
+        Rig { skeleton: crate::model::Skeleton::new(joints).unwrap(), ..Rig::default() }
+    }
+
+    #[test]
+    fn a_walk_is_framed_as_its_postures_and_followed_along_its_hips() {
+        // A reference node staying at the origin, the hips walking 4 along X over 2 s, a knee and a head on them.
+        let rig = skeleton_rig(vec![
+            joint("reference", None, 0.0),
+            joint("hips", Some(0), 1.0),
+            joint("knee", Some(1), -0.5),
+            joint("head", Some(1), 0.7),
+        ]);
+        let span = Span { start: 0.0, end: 2.0 };
+        let walking = |speed: f64| {
+            move |t: f64| {
+                let hips = DMat4::from_translation(DVec3::new(speed * t, 1.0, 0.0));
+                vec![
+                    DMat4::IDENTITY,
+                    hips,
+                    hips * DMat4::from_translation(-0.5 * DVec3::Y),
+                    hips * DMat4::from_translation(0.7 * DVec3::Y),
+                ]
+            }
+        };
+        let walk = motion(&rig, None, span, 5, walking(2.0));
+        assert_eq!(walk.anchor, Some(1), "the hips, not the reference node that stays behind");
+        let framed = Bounds::of(walk.points.iter().copied()).unwrap();
+        assert!(framed.min.x >= -1e-12 && framed.max.x <= 1e-12, "one figure's width, not the path: {framed:?}");
+        // Swaying in place, a few centimetres: framed where it is, not followed.
+        let sway = motion(&rig, None, span, 5, walking(0.05));
+        assert_eq!(sway.anchor, None);
+        assert!(Bounds::of(sway.points.iter().copied()).unwrap().max.x > 0.09);
+    }
+
     #[test]
     fn a_rig_without_skins_has_its_rest_pose_drawn_where_the_pose_stands() {
-        use crate::model::{Bone, InheritMode, Skeleton, Transform};
         // Mocap: hips at the origin at rest, a knee 0.5 below. The take has the hips at (5, 1, 2), turned.
-        let bone = |name: &str, parent: Option<usize>, y: f64| Bone {
-            name: name.into(),
-            node: 0,
-            parent,
-            rest: Transform::from_trs(DVec3::new(0.0, y, 0.0), glam::DQuat::IDENTITY, DVec3::ONE),
-            inherit: InheritMode::Full,
-            role: NodeRole::Joint,
-        };
-        let rig = Rig {
-            skeleton: Skeleton::new(vec![bone("hips", None, 0.0), bone("knee", Some(0), -0.5)]).unwrap(),
-            ..Rig::default()
-        };
+        let rig = skeleton_rig(vec![joint("hips", None, 0.0), joint("knee", Some(0), -0.5)]);
         let hips = DMat4::from_rotation_translation(glam::DQuat::from_rotation_y(1.0), DVec3::new(5.0, 1.0, 2.0));
         let pose = DrawnPose {
             model: vec![hips, hips * DMat4::from_translation(DVec3::new(0.0, -0.5, 0.0))],
