@@ -8,7 +8,7 @@
 //
 // three.js is found in `node_modules` of the folder THREE_DIR names (default: the current one). CLIP is the
 // animation's name (default: the first). Matrices are column-major (`elements`), Y up, in metres for glTF and in
-// the FBX file's own unit for FBX (FBXLoader does not convert it).
+// the FBX file's own unit and axes for FBX (FBXLoader converts neither).
 
 import { readFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
@@ -59,8 +59,8 @@ action.clampWhenFinished = true;
 action.play();
 
 const out = [];
-// glTF is in metres, Y up; FBXLoader keeps the file's unit (`UnitScaleFactor`: centimetres in one), and its axes
-// unless the file says otherwise.
+// glTF is in metres, Y up. FBXLoader keeps the file's unit and its axes, whatever its `UpAxis` says: Y up is right
+// for Maya's and Blender's files (a Z-up file's dump must say `"up": "z"`).
 const header = { format: 'bonescope-pose-dump', version: 1, space: 'world', order: 'column-major',
   unit: fbx ? gltf.unit : 'm', up: 'y', clip: clip.name,
   source: `three.js r${THREE.REVISION} ${fbx ? 'FBXLoader' : 'GLTFLoader'} + AnimationMixer` };
@@ -81,10 +81,10 @@ async function loadGltf(buffer) {
   return new Promise((done, fail) => new GLTFLoader().parse(buffer, '', done, fail));
 }
 
-// FBXLoader's group as GLTFLoader's result, with the file's unit (centimetres times `UnitScaleFactor`, in metres).
+// FBXLoader's group as GLTFLoader's result, with the file's unit in metres.
 async function loadFbx(buffer) {
   const { FBXLoader } = await import(pathToFileURL(join(loaders, 'FBXLoader.js')));
   const scene = new FBXLoader().parse(buffer, '');
-  const factor = /UnitScaleFactor", *"double", *"Number", *"",([-0-9.eE+]+)/.exec(new TextDecoder().decode(buffer));
-  return { scene, animations: scene.animations, unit: factor ? Number(factor[1]) / 100 : 0.01 };
+  // FBXLoader keeps the file's `UnitScaleFactor` (centimetres per unit) without applying it.
+  return { scene, animations: scene.animations, unit: (scene.userData.unitScaleFactor ?? 1) / 100 };
 }
