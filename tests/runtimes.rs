@@ -1,14 +1,16 @@
 //! Real runtimes as pose-dump writers, and what `fit` finds they do with each bone's inheritance:
 //! `examples/dump_threejs.mjs` (three.js: GLTFLoader or FBXLoader + AnimationMixer), `examples/dump_babylonjs.mjs`
-//! (Babylon.js: NullEngine + its glTF loader) and `examples/dump_blender.py` (Blender's glTF and FBX importers).
+//! (Babylon.js: NullEngine + its glTF loader), `examples/dump_blender.py` (Blender's glTF and FBX importers) and
+//! `examples/dump_godot.gd` (Godot 3.2's glTF importer + AnimationPlayer).
 //!
-//! - On glTF every runtime plays `full` on every bone (all compose full matrices, shear kept).
+//! - On glTF every runtime plays `full` on every bone (all compose full matrices, shear kept). Blender and Godot
+//!   play cubic-spline keys as other curves, so a cubic-spline rig is judged through its bake there.
 //! - On FBX each importer's handling of the declared inherit types is a finding, asserted bone by bone.
 //! - `bake --for ENGINE` of an FBX, played by that engine, fits `declared`: the bake fixes what the runtime breaks.
 //!
 //! The node runtimes run where `node` and the pinned package (`npm ci` in `tests/threejs`, `tests/babylonjs`) are
-//! there, Blender where `BONESCOPE_BLENDER_PYTHON` names a Python with its module; each is skipped with a message
-//! otherwise.
+//! there, Blender where `BONESCOPE_BLENDER_PYTHON` names a Python with its module, Godot where `godot3` and
+//! `xvfb-run` are installed; each is skipped with a message otherwise.
 
 mod common;
 
