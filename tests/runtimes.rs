@@ -200,6 +200,22 @@ fn three_js_fbx_loader_plays_segment_compensation_as_full() {
     }
 }
 
+/// three.js FBXLoader (r170) on Blender's FBX: no mode fits, and not for inheritance. Blender's exporter simplifies
+/// each Euler curve on its own, and FBXLoader's `interpolateRotations` walks the X curve's keys and reads the Y and
+/// Z curves at the same indices: `upper_arm`'s rotation track keeps 2 keys of 61, and it is the first bone no mode
+/// fits (17 cm off on its way), its parents fitting every mode. Its bake, glTF, plays as declared (below).
+#[test]
+fn three_js_fbx_loader_misreads_blenders_euler_curves() {
+    let Some(three) = Runtime::three() else { return };
+    let (out, source, clip) =
+        (tempfile::tempdir().unwrap(), asset("blender/stretchy_full.fbx"), "Stretchy|squash_stretch");
+    let report = fit(&source, &three.dump(&source, Some(clip), out.path()), Some(clip));
+    assert!(fits(&report).is_empty(), "{report}");
+    assert_eq!(report["miss"]["bone"], "upper_arm", "{report}");
+    let any = |name: &str| report["bones"].as_array().unwrap().iter().any(|b| b["name"] == name && b["any"] == true);
+    assert!(["hips", "spine", "chest"].into_iter().all(any), "{report}");
+}
+
 /// The bakes for three.js, played by its GLTFLoader: the Maya file's segment compensation, which FBXLoader drops,
 /// comes out as the source evaluates it.
 #[test]
