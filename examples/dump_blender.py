@@ -53,10 +53,20 @@ def armatures_playing(clip):
     return playing, playing[0].animation_data.action
 
 
+def curves(action):
+    """The F-curves of `action`: in its layers' channel bags (Blender 4.4's slotted actions; 5.0 has no other way),
+    else in its own list."""
+    if getattr(action, "layers", None):
+        bags = [bag for layer in action.layers for strip in layer.strips for bag in strip.channelbags]
+        return [curve for bag in bags for curve in bag.fcurves]
+    return list(action.fcurves)
+
+
 def key_frames(action):
-    """Every frame that holds a key of `action`, in order: sampled there only, the dump does not depend on how
-    Blender interpolates between keys (its quaternions component by component)."""
-    return sorted({key.co.x for curve in action.fcurves for key in curve.keyframe_points})
+    """Every frame that holds a key of `action`, in order. Sampled there, the dump depends less on how Blender
+    interpolates between keys (quaternions component by component; glTF's cubic splines with handles of its own),
+    though a channel keyed at other frames than the rest is still interpolated at theirs."""
+    return sorted({key.co.x for curve in curves(action) for key in curve.keyframe_points})
 
 
 def bones_of(armatures, gltf):
