@@ -5,7 +5,7 @@
 //! cargo run --release --example fuzz_import -- bvh 10       # format (gltf, fbx, bvh, usd), minutes [, seed [, skip]]
 //! ```
 //!
-//! Seeds: every file of that format under `../shared/assets`. Each input is a seed with 1–8 mutations: byte
+//! Seeds: every file of that format under `../shared/assets` (and the pose dumps of `assets/dumps`). Each input is a seed with 1–8 mutations: byte
 //! flips, inserted or deleted bytes, a 32-bit field set to an extreme value, a number in the text replaced by an
 //! absurd one, a range duplicated or spliced in from another seed, a truncation. A panic or an input slower than
 //! 5 s is written to `fuzz/artifacts/`, and a watchdog thread writes out an input still running after 20 s (a
@@ -89,10 +89,13 @@ fn parse_format(format: &str) -> Format {
     found.unwrap_or_else(|| panic!("unknown format `{format}` ({names})"))
 }
 
+/// The seeds of `format`: its small files among the shared assets and the repository's own (the pose dumps bonescope
+/// writes).
 fn seeds(format: Format) -> Vec<(PathBuf, Vec<u8>)> {
     let mut files = Vec::new();
-    for folder in std::fs::read_dir(shared_assets::root()).expect("../shared/assets") {
-        let folder = folder.unwrap().path();
+    let shared = std::fs::read_dir(shared_assets::root()).expect("../shared/assets").map(|f| f.unwrap().path());
+    let own = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/dumps");
+    for folder in shared.chain([own]) {
         if !folder.is_dir() {
             continue;
         }
