@@ -32,18 +32,37 @@ fn usd_files() -> Vec<PathBuf> {
     files
 }
 
-/// What `script` of `tests/usd/` prints of `file` at every `every`-th time code (and the last), run by usd-core.
-fn usd_core(python: &Path, script: &str, file: &Path, every: usize) -> Value {
+/// What `script` of `tests/usd/` finds of `file`, run by usd-core: the JSON it prints, and the numbers it writes
+/// beside it (64-bit little-endian floats: every pose of a long clip, which as JSON would be hundreds of megabytes),
+/// read `width` at a time.
+fn usd_core(python: &Path, script: &str, file: &Path, width: usize) -> (Value, Numbers) {
+    let numbers = tempfile::NamedTempFile::new().unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd").join(script);
-    let output = Command::new(python).arg(script).arg(file).arg(every.to_string()).output().expect("python runs");
+    let output = Command::new(python).arg(script).arg(file).arg(numbers.path()).output().expect("python runs");
     assert!(output.status.success(), "{}: {}", file.display(), String::from_utf8_lossy(&output.stderr));
-    serde_json::from_slice(&output.stdout).expect("JSON")
+    let reader = std::io::BufReader::new(std::fs::File::open(numbers.path()).unwrap());
+    (serde_json::from_slice(&output.stdout).expect("JSON"), Numbers { reader, width })
+}
+
+/// Numbers a usd-core script wrote, read in groups of `width` (a matrix's 16, a point's 3).
+struct Numbers {
+    reader: std::io::BufReader<std::fs::File>,
+    width: usize,
+}
+
+impl Iterator for Numbers {
+    type Item = Vec<f64>;
+
+    fn next(&mut self) -> Option<Vec<f64>> {
+        let mut bytes = vec![0u8; 8 * self.width];
+        self.reader.read_exact(&mut bytes).ok()?;
+        Some(bytes.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect())
+    }
 }
 
 /// A row-vector USD matrix, flattened by rows, as a column-vector one.
-fn matrix(value: &Value) -> DMat4 {
-    let numbers: Vec<f64> = value.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    DMat4::from_cols_slice(&numbers)
+fn matrix(numbers: &[f64]) -> DMat4 {
+    DMat4::from_cols_slice(numbers)
 }
 
 #[test]
@@ -52,7 +71,7 @@ fn every_joint_is_where_usd_core_puts_it_at_every_time_code() {
     let mut compared = 0;
     for file in usd_files() {
         let rig = load_with(&file, &Options { space: Space::File }).unwrap_or_else(|e| panic!("{e}"));
-        compared += joints_as_usd_core(&python, &file, &rig, 1);
+        compared += joints_as_usd_core(&python, &file, &rig);
     }
     assert!(compared > 500, "{compared} skeleton poses compared");
 }
@@ -101,18 +120,18 @@ def Xform "Shot"
     )
     .unwrap();
     let rig = load_with(&file, &Options { space: Space::File }).unwrap();
-    assert_eq!(joints_as_usd_core(&python, &file, &rig, 1), 11, "every time code");
+    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11, "every time code");
     let text = std::fs::read_to_string(&file).unwrap();
     std::fs::write(&file, text.replace("prepend apiSchemas = [\"SkelBindingAPI\"]", "")).unwrap();
     let rig = load_with(&file, &Options { space: Space::File }).unwrap();
-    assert_eq!(joints_as_usd_core(&python, &file, &rig, 1), 11);
+    assert_eq!(joints_as_usd_core(&python, &file, &rig), 11);
     assert!(rig.clips[0].tracks().iter().all(|t| t.bone == 0), "only the skeleton's node moves");
 }
 
 /// Compares every joint's world transform in `rig` (loaded from `file` in its own space) with usd-core's
-/// (`tests/usd/joint_transforms.py`) at every `every`-th time code; how many skeleton poses were compared.
-fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig, every: usize) -> usize {
-    let reference = usd_core(python, "joint_transforms.py", file, every);
+/// (`tests/usd/joint_transforms.py`) at every time code; how many skeleton poses were compared.
+fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig) -> usize {
+    let (reference, mut matrices) = usd_core(python, "joint_transforms.py", file, 16);
     let rate = reference["time_codes_per_second"].as_f64().unwrap();
     let evaluation = Evaluation::declared(rig, rig.clips.first());
     // A time code `c` is at `c / rate` on the stage's clock; an attribute's default value holds from its start.
@@ -129,11 +148,11 @@ fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig, every: usize) -> us
     for skeleton in reference["skeletons"].as_array().unwrap() {
         let joints = skeleton["joints"].as_array().unwrap().len();
         assert_eq!(rig.skeleton.bone(bone).name, skeleton["path"].as_str().unwrap().rsplit('/').next().unwrap());
-        for sample in skeleton["samples"].as_array().unwrap() {
-            let time = sample["time_code"].as_f64().map_or(start, |code| code / rate);
+        for code in skeleton["time_codes"].as_array().unwrap() {
+            let time = code.as_f64().map_or(start, |code| code / rate);
             let pose = evaluation.pose_at(time).model.model;
-            for (j, world) in sample["world"].as_array().unwrap().iter().enumerate() {
-                let (ours, theirs) = (pose[bone + 1 + j], matrix(world));
+            for j in 0..joints {
+                let (ours, theirs) = (pose[bone + 1 + j], matrix(&matrices.next().expect("a matrix per joint")));
                 let apart = (ours - theirs).to_cols_array().iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 assert!(
                     apart <= tolerance,
@@ -196,16 +215,16 @@ fn skinned_and_blend_shaped_points_are_pixars_baked_ones() {
         pairs.push((file, out));
     }
     for (file, baked) in pairs {
-        let compared = points_as_baked(&python, &file, &baked, 1);
+        let compared = points_as_baked(&python, &file, &baked);
         assert!(compared > 1000, "{}: {compared} points compared", file.display());
     }
 }
 
 /// Compares every point bonescope deforms from `file` with usd-core's world points of `baked`
-/// (`tests/usd/world_points.py`) at every `every`-th time code, to 1e-5 of the model's size; how many were compared.
-fn points_as_baked(python: &Path, file: &Path, baked: &Path, every: usize) -> usize {
+/// (`tests/usd/world_points.py`) at every time code, to 1e-5 of the model's size; how many were compared.
+fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
     let rig = load_with(file, &Options { space: Space::File }).unwrap();
-    let baked = usd_core(python, "world_points.py", baked, every);
+    let (baked, mut points) = usd_core(python, "world_points.py", baked, 3);
     let clip = rig.clips.first();
     let rate = clip.map(|c| c.frame_rate()).unwrap_or(24.0);
     let evaluation = Evaluation::declared(&rig, clip);
@@ -220,17 +239,18 @@ fn points_as_baked(python: &Path, file: &Path, baked: &Path, every: usize) -> us
             [name.clone(), bonescope::diff::usd_identifier(name)].iter().any(|n| path.ends_with(&format!("/{n}"))),
             "{path}"
         );
-        if path.starts_with("/GroundTruth") {
-            continue;
-        }
-        for (k, frame) in baked_mesh["frames"].as_array().unwrap().iter().enumerate() {
-            let code = baked["time_codes"][k].as_f64().unwrap();
+        let count = baked_mesh["points"].as_u64().unwrap() as usize;
+        for code in baked["time_codes"].as_array().unwrap() {
+            let code = code.as_f64().unwrap();
+            let theirs: Vec<Vec<f64>> = points.by_ref().take(count).collect();
+            if path.starts_with("/GroundTruth") {
+                continue;
+            }
             let pose = evaluation.pose_at(code / rate);
             let mut ours = Vec::new();
             evaluation.skin(&pose, mesh, &mut ours);
-            for (v, point) in frame.as_array().unwrap().iter().enumerate() {
-                let theirs: Vec<f64> = point.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
-                let apart = (ours[v] - glam::DVec3::from_slice(&theirs)).length();
+            for (v, theirs) in theirs.iter().enumerate() {
+                let apart = (ours[v] - glam::DVec3::from_slice(theirs)).length();
                 assert!(
                     apart <= 1e-5 * size,
                     "{}: {path} vertex {v} at code {code}: {apart} apart ({size})",
@@ -455,17 +475,13 @@ fn validation_errors(python: &Path, file: &Path) -> Vec<String> {
     errors.map(|e| format!("{}: {}", e["validator"].as_str().unwrap(), e["message"].as_str().unwrap())).collect()
 }
 
-/// At most about this many time codes of a file are compared with usd-core (every `n`-th, evenly over the clip, and
-/// the last): each is a whole pose of every joint, and of every point, as JSON.
-const COMPARED_CODES: f64 = 600.0;
-
 #[test]
 fn a_usd_bake_plays_in_usd_core_as_its_source_within_its_report() {
     // Each source baked to USD by the command line, its report measured on the file read back by bonescope. usd-core
     // puts every joint where bonescope reads it at every time code (1e-6 of the rig's size) and skins every point
     // as bonescope does (`UsdSkel.BakeSkinning`, 1e-5): so usd-core plays the source within the report's worst, plus
-    // that. Pixar's validators find nothing wrong in any of the three encodings. The generated 200-bone rig's 6,001
-    // time codes are compared every tenth ([`COMPARED_CODES`]).
+    // that. Pixar's validators find nothing wrong in any of the three encodings. The generated 200-bone rig too, at
+    // each of its 6,001 time codes.
     let Some(python) = usd_python() else { return };
     let dir = tempfile::tempdir().unwrap();
     let generated = dir.path().join("generated.glb");
@@ -487,18 +503,17 @@ fn a_usd_bake_plays_in_usd_core_as_its_source_within_its_report() {
         // UsdSkel's half-precision scales bound it: 2⁻¹¹ of a joint's reach, and the keys' tolerance.
         assert!(worst <= 1e-3 * size, "{source}: worst {worst} of a rig {size} across");
         let back = load_with(&out, &Options { space: Space::File }).unwrap_or_else(|e| panic!("{e}"));
-        let codes = back.clips.first().map_or(1.0, |c| c.span().length() * c.frame_rate() + 1.0);
-        let every = (codes / COMPARED_CODES).ceil().max(1.0) as usize;
-        assert!(joints_as_usd_core(&python, &out, &back, every) > 0, "{source}: poses compared");
-        // usd-core's skinned points of every vertex, as JSON: bounded (BrainStem's 34.9 s skin would be 38 million
-        // points even at every other time code); its joints are compared all the same.
+        assert!(joints_as_usd_core(&python, &out, &back) > 0, "{source}: poses compared");
+        // usd-core's skinned points of every vertex at every time code: bounded (BrainStem's 34.9 s skin would be 77
+        // million points, and its baked stage gigabytes); its joints are compared all the same.
         let points: usize = back.meshes.iter().map(|m| m.positions.len()).sum();
-        if points > 0 && points as f64 * codes / every as f64 <= 5e6 {
+        let codes = back.clips.first().map_or(1.0, |c| c.span().length() * c.frame_rate() + 1.0);
+        if points > 0 && points as f64 * codes <= 5e6 {
             let skinned = dir.path().join(format!("skinned{k}.usdc"));
             let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/usd/bake_skinning.py");
             let status = Command::new(&python).arg(script).arg(&out).arg(&skinned).status().expect("python runs");
             assert!(status.success(), "usd-core baked the skinning of {source}'s bake");
-            assert!(points_as_baked(&python, &out, &skinned, every) > 0, "{source}: points compared");
+            assert!(points_as_baked(&python, &out, &skinned) > 0, "{source}: points compared");
         }
         let errors = validation_errors(&python, &out);
         assert!(errors.is_empty(), "{source}: {errors:#?}");
