@@ -602,18 +602,23 @@ impl<'p> Differences<'p> {
     }
 
     fn add(&mut self, a: &mut Side, b: &mut Side, probe_length: f64, time: f64) {
-        let (model_a, model_b) = (&a.posing.pose().model.model, &b.posing.pose().model.model);
         for difference in &mut self.bones {
-            let (wa, wb) = (&model_a[difference.a], &model_b[difference.b]);
+            let turn = b.frames.get(difference.b).map(|&turn| DMat4::from_quat(turn));
+            // A's probe points are found once per time, for every side compared with it.
+            let offsets_a = match turn {
+                None => *a.probe_offsets(difference.a, probe_length),
+                Some(_) => [DVec3::ZERO; 3],
+            };
+            let (wa, wb) = (&a.posing.pose().model.model[difference.a], &b.posing.pose().model.model[difference.b]);
             difference.position.add((wa.w_axis - wb.w_axis).truncate().length(), time);
-            let probe = match b.frames.get(difference.b).map(|&turn| DMat4::from_quat(turn)) {
+            let probe = match turn {
                 // Each seen from the other's frame, so that either file may be A.
                 Some(turn) => probe_distance(wa, &(*wb * turn), probe_length).max(probe_distance(
                     wb,
                     &(*wa * turn.inverse()),
                     probe_length,
                 )),
-                None => probe_distance(wa, wb, probe_length),
+                None => probe_distance_along(wa, &offsets_a, wb, probe_length),
             };
             difference.probe.add(probe, time);
             self.largest = self.largest.max(probe);
@@ -759,6 +764,11 @@ struct Side<'e, 'a> {
     skinners: Vec<Option<Skinner>>,
     skinned: Vec<Vec<DVec3>>,
     fresh: Vec<bool>,
+    /// Per bone, its probe points' offsets ([`probe_offsets`]) and the evaluation they were found at: A's are read
+    /// by every side compared with it.
+    probes: Vec<([DVec3; 3], u64)>,
+    /// How many times the side was evaluated.
+    evaluations: u64,
 }
 
 /// How a side's poses are found.
@@ -809,7 +819,8 @@ impl<'e, 'a> Side<'e, 'a> {
         let skinned = vec![Vec::new(); skinners.len()];
         let fresh = vec![false; skinners.len()];
         let length_scales = plan.evaluation.length_scales();
-        Side { posing, plan, parts: Vec::new(), length_scales, frames: &[], skinners, skinned, fresh }
+        let (parts, probes) = (Vec::new(), Vec::new());
+        Side { posing, plan, parts, length_scales, frames: &[], skinners, skinned, fresh, probes, evaluations: 0 }
     }
 
     /// The same side with its frames read in its partner's through `frames` ([`frame_turns`]).
@@ -861,6 +872,18 @@ impl<'e, 'a> Side<'e, 'a> {
             }
         }
         self.fresh.fill(false);
+        self.evaluations += 1;
+    }
+
+    /// Bone `bone`'s probe offsets ([`probe_offsets`]) at the time evaluated, found once.
+    fn probe_offsets(&mut self, bone: usize, probe_length: f64) -> &[DVec3; 3] {
+        let model = &self.posing.pose().model.model;
+        self.probes.resize(model.len(), ([DVec3::ZERO; 3], u64::MAX));
+        let (offsets, found_at) = &mut self.probes[bone];
+        if *found_at != self.evaluations {
+            (*offsets, *found_at) = (probe_offsets(&model[bone], probe_length), self.evaluations);
+        }
+        offsets
     }
 
     /// Skins mesh `mesh` (its vertices the plan compares) at the time evaluated, once.
@@ -913,11 +936,23 @@ pub fn model_curves(evaluation: &Evaluation, bones: &[usize], times: &[f64]) -> 
 /// origin for an axis of no length, or of no finite one). How far a point a tenth of the rig out along the bone
 /// moved, whatever scale either frame carries: a scale differs in the scale ratio and in the skin.
 fn probe_distance(wa: &DMat4, wb: &DMat4, probe_length: f64) -> f64 {
+    probe_distance_along(wa, &probe_offsets(wa, probe_length), wb, probe_length)
+}
+
+/// [`probe_distance`], A's probe points given as their offsets from its origin ([`probe_offsets`]): found once per
+/// time for all the sides compared with A.
+fn probe_distance_along(wa: &DMat4, offsets_a: &[DVec3; 3], wb: &DMat4, probe_length: f64) -> f64 {
     let origins = (wa.w_axis - wb.w_axis).truncate();
-    let along = |w: &DMat4, axis: usize| w.col(axis).truncate().normalize_or_zero() * probe_length;
+    let offsets_b = probe_offsets(wb, probe_length);
     // Compared squared, the root of the largest being the largest root.
-    let axes = (0..3).map(|axis| (origins + along(wa, axis) - along(wb, axis)).length_squared());
+    let axes = (0..3).map(|axis| (origins + offsets_a[axis] - offsets_b[axis]).length_squared());
     axes.fold(origins.length_squared(), f64::max).sqrt()
+}
+
+/// The offsets of a frame's probe points from its origin: `ℓ·c/|c|` of each axis's column `c` (none for an axis of
+/// no length, or of no finite one).
+fn probe_offsets(w: &DMat4, probe_length: f64) -> [DVec3; 3] {
+    std::array::from_fn(|axis| w.col(axis).truncate().normalize_or_zero() * probe_length)
 }
 
 /// The largest ratio between corresponding stretch factors, sorted (≥ 1; infinite where one is zero and the other

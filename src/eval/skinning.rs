@@ -97,7 +97,7 @@ fn joint_matrix(skin: &Skin, model: &[DMat4], moved: Option<DMat4>, j: usize) ->
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reach {
     /// Per joint some vertex is weighted to (a skin's joint index, or the mesh's bone for an unskinned mesh), the
-    /// points that bound those vertices' distances ([`Hull`]).
+    /// points that bound those vertices' distances ([`Hull`]), through the joint's inverse bind where skinned.
     joints: Vec<(usize, Hull)>,
     /// The largest `Σ|w_j|` of a vertex (1 unskinned).
     weight: f64,
@@ -139,8 +139,11 @@ impl Reach {
             }
             weight = weight.max(sum);
         }
-        let joints = hulls.into_iter().enumerate().filter_map(|(j, hull)| Some((j, hull.closed()?)));
-        Some(Reach { joints: joints.collect(), weight, skin: Some(skin) })
+        // Each joint's points carried through its inverse bind once: `(J − J′)·p = (W − W′)·(IBM·p)`.
+        let inverse_bind = &skins[skin].inverse_bind;
+        let closed = hulls.into_iter().enumerate().filter_map(|(j, hull)| Some((j, hull.closed()?)));
+        let joints = closed.map(|(j, hull)| Some((j, hull.mapped(inverse_bind.get(j)?)))).collect::<Option<_>>()?;
+        Some(Reach { joints, weight, skin: Some(skin) })
     }
 
     /// The most any of the vertices lies apart under the poses whose model matrices (of every bone) are `a` and `b`.
@@ -149,16 +152,18 @@ impl Reach {
         let moved = skin.map(|skin| (moved_since_bind(skin, a), moved_since_bind(skin, b)));
         let joints = self.joints.iter().map(|(joint, hull)| {
             let difference = match (skin, moved) {
-                // (A − B)·I: one product, and none where the joint does not move (a variant's joints above it).
+                // A − B, nothing where the joint does not move (a variant's joints above it).
                 (Some(skin), Some((None, None))) => {
                     let bone = skin.joints[*joint];
                     if a[bone] == b[bone] {
                         return 0.0;
                     }
-                    (a[bone] - b[bone]) * skin.inverse_bind[*joint]
+                    a[bone] - b[bone]
                 }
                 (Some(skin), Some((moved_a, moved_b))) => {
-                    joint_matrix(skin, a, moved_a, *joint) - joint_matrix(skin, b, moved_b, *joint)
+                    let bone = skin.joints[*joint];
+                    let posed = |model: &[DMat4], moved: Option<DMat4>| moved.map_or(model[bone], |m| m * model[bone]);
+                    posed(a, moved_a) - posed(b, moved_b)
                 }
                 _ => a[*joint] - b[*joint],
             };
@@ -198,6 +203,14 @@ impl Hull {
             (self.points, self.count) = (box_corners((self.low, self.high)), self.points.len());
         }
         (self.count > 0).then_some(self)
+    }
+
+    /// The hull of the points carried by `m` (an affine map keeps a point inside the hull of the others' images).
+    fn mapped(mut self, m: &DMat4) -> Self {
+        for p in &mut self.points[..self.count] {
+            *p = m.transform_point3(*p);
+        }
+        self
     }
 
     /// How far `difference` (`J − J′`) moves the farthest point.
