@@ -132,6 +132,35 @@ const VARIANTS: usize = 32;
 /// (measured in BENCHMARKS.md, §11).
 const BOUND_TIMES: usize = 512;
 
+/// Costs closer than this fraction of the rig's size are alike: the same motion measured through other rounding
+/// (fixes that move the same bones the same way, evaluated along other paths, cost the same but for the last bits).
+const SAME_COST: f64 = 1e-9;
+
+/// Costs in steps of [`SAME_COST`] of the rig's size: fixes whose costs fall in one step rank alike, in the order
+/// they are found for the bone (ties in a stable sort), not by their rounding.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CostSteps {
+    unit: f64,
+}
+
+impl CostSteps {
+    /// For a rig of size `rig_size` (the source's: every cost is in its units).
+    pub fn of(rig_size: f64) -> Self {
+        CostSteps { unit: (SAME_COST * rig_size).max(f64::MIN_POSITIVE) }
+    }
+
+    /// The step a cost of `distance` falls in.
+    pub fn step(self, distance: f64) -> f64 {
+        (distance / self.unit).round()
+    }
+
+    /// A distance just past every cost of step `step` (beyond the rounding of a division at the step's edge): one
+    /// that moves further is in a later step.
+    pub fn past(self, step: f64) -> f64 {
+        (step + 0.5 + 1e-6) * self.unit
+    }
+}
+
 /// How large the character is over a clip: the times an evaluation and its changes are compared at (its own
 /// comparison times, [`comparison_times`]), and its size over them ([`Evaluation::size`]). Measuring it is a whole
 /// evaluation of the clip, so one measured for an evaluation serves every explanation of it ([`super::Question`]).
@@ -177,6 +206,8 @@ pub(super) struct Baseline<'e, 'a> {
     /// The rig's bind pose, found when a change first needs it (a Blender mode rests bones in it): every change of
     /// the rig is evaluated from it.
     bind_pose: OnceLock<Vec<Transform>>,
+    /// What costs rank alike, for the source's size.
+    pub steps: CostSteps,
 }
 
 impl<'e, 'a> Baseline<'e, 'a> {
@@ -191,7 +222,8 @@ impl<'e, 'a> Baseline<'e, 'a> {
         debug_assert_eq!(scale.times, comparison_times(source, source, options.rate), "the source's scale");
         let analysis_times = source.times(options.rate);
         let own_pairs = Pairs::by_name(source, source);
-        Baseline { source, before, options, scale, analysis_times, own_pairs, bind_pose: OnceLock::new() }
+        let steps = CostSteps::of(scale.size);
+        Baseline { source, before, options, scale, analysis_times, own_pairs, bind_pose: OnceLock::new(), steps }
     }
 
     /// The cost `comparison` (of the source against a change of it) shows: the largest distance of any mesh's
@@ -732,12 +764,13 @@ impl Fix {
     }
 }
 
-/// Ranks fixes: those that remove the shear first, the modes of `tool` (the file's own) before the others, by cost;
-/// then the others the same way by the shear they leave (to [`SAME_SHEAR_DEG`]), then cost.
-pub(super) fn rank(fixes: &mut [Fix], tool: Option<Tool>) {
+/// Ranks fixes: those that remove the shear first, the modes of `tool` (the file's own) before the others, by cost
+/// (in `steps`: alike costs in their order); then the others the same way by the shear they leave (to
+/// [`SAME_SHEAR_DEG`]), then cost.
+pub(super) fn rank(fixes: &mut [Fix], tool: Option<Tool>, steps: CostSteps) {
     let key = |f: &Fix| {
         let left = if f.removes { 0.0 } else { (f.shear_left_deg / SAME_SHEAR_DEG).round() };
-        (!f.removes, is_other_mode(f.change, tool), left, f.cost.distance.max)
+        (!f.removes, is_other_mode(f.change, tool), left, steps.step(f.cost.distance.max))
     };
     fixes.sort_by(|a, b| {
         let (ka, kb) = (key(a), key(b));
@@ -795,10 +828,40 @@ mod tests {
         };
         let shear: f64 = 29.069865920889978;
         let (below, above) = (shear.next_down(), shear.next_up());
-        let mut fixes = vec![fix(1, below, 3e-6), fix(2, above, 0.0), fix(3, shear, 3e-14), fix(4, 20.0, 0.5)];
-        rank(&mut fixes, None);
+        let mut fixes = vec![fix(1, below, 3e-6), fix(2, above, 0.0), fix(3, shear, 3e-8), fix(4, 20.0, 0.5)];
+        rank(&mut fixes, None, CostSteps::of(1.0));
         let order: Vec<usize> = fixes.iter().map(|f| f.change.changed_below().unwrap()).collect();
         assert_eq!(order, [4, 2, 3, 1], "less shear left first, then the same shear by cost");
+    }
+
+    #[test]
+    fn fixes_that_move_alike_but_for_rounding_rank_in_their_order() {
+        // Three removals of a rig of size 2: the second and third move 0.168 but for their last bits (an ulp below
+        // and 1e-10 above, both within a billionth of the rig), the first 0.1 % more. The two alike keep their order,
+        // whichever rounds lower; one cheaper by more than a step comes first; a step's edges are a step apart.
+        let fix = |bone: usize, moved: f64| Fix {
+            change: Change::Mode { bone, mode: InheritMode::SegmentCompensate },
+            label: String::new(),
+            shear_left_deg: 0.0,
+            removes: true,
+            elsewhere: Vec::new(),
+            cost: Cost {
+                distance: Extreme { max: moved, time: 0.0 },
+                fraction: moved / 2.0,
+                measured: Measured::Bones,
+            },
+        };
+        let moved: f64 = 0.168;
+        let steps = CostSteps::of(2.0);
+        let mut fixes = vec![fix(1, moved * 1.001), fix(2, moved + 1e-10), fix(3, moved.next_down())];
+        rank(&mut fixes, None, steps);
+        let order: Vec<usize> = fixes.iter().map(|f| f.change.changed_below().unwrap()).collect();
+        assert_eq!(order, [2, 3, 1], "alike costs in their order, then the dearer one");
+        let mut fixes = vec![fix(1, moved), fix(2, moved - 4e-9)];
+        rank(&mut fixes, None, steps);
+        assert_eq!(fixes[0].change.changed_below(), Some(2), "2e-9 of the rig cheaper is cheaper");
+        let step = steps.step(moved);
+        assert!(steps.step(steps.past(step)) == step + 1.0 && steps.step(steps.past(step - 1.0)) == step);
     }
 
     #[test]

@@ -34,7 +34,7 @@ use crate::analysis::{ClipAnalysis, CurveRequest, SAME_SHEAR_DEG, ScanOptions, T
 use crate::bake::Strategy;
 use crate::eval::{Evaluation, Layers};
 use crate::model::{Tool, Unit, significant};
-use fixes::{Applied, Asked, Baseline, bakes_reproduce, candidates, rank};
+use fixes::{Applied, Asked, Baseline, CostSteps, bakes_reproduce, candidates, rank};
 
 /// One bone explained over a clip.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -302,8 +302,11 @@ pub fn explain(
             known.make(&baseline, &bakes);
             let open = open_changes(&baseline, &bones, &changes, tool);
             known.bound(&baseline, &open.iter().flatten().map(|&(_, change)| change).collect::<Vec<_>>());
-            let mut searches: Vec<Removal> =
-                bones.iter().zip(&open).map(|(&bone, open)| Removal::new(bone, open, &known.bounds)).collect();
+            let mut searches: Vec<Removal> = bones
+                .iter()
+                .zip(&open)
+                .map(|(&bone, open)| Removal::new(bone, open, &known.bounds, baseline.steps))
+                .collect();
             remove(&baseline, &mut searches, &mut known);
             // Where no change removes the shear, the best is among every change made.
             let unremoved: Vec<usize> = (0..bones.len()).filter(|&i| searches[i].best.is_none()).collect();
@@ -314,6 +317,7 @@ pub fn explain(
         }
     }
     let Known { applied, costs, .. } = known;
+    let steps = baseline.steps;
     let skeleton = evaluation.skeleton();
     let scanned = (before, tolerances.min_shear_deg);
     let explained = bones.iter().zip(causes).zip(changes).map(|((&bone, causes), changes)| {
@@ -331,7 +335,7 @@ pub fn explain(
                 (None, _) | (Some(Ok(_)), None) => {}
             }
         }
-        rank(&mut fixes, tool);
+        rank(&mut fixes, tool, steps);
         let worst_shear_deg = before.bones.get(bone).map_or(0.0, |b| b.worst_shear_deg);
         let name = skeleton.bone(bone).name.clone();
         Explanation { bone, name, worst_shear_deg, causes, fixes, notes, plays_as_authored }
@@ -414,10 +418,11 @@ fn open_changes(
     each
 }
 
-/// One bone's search for the cheapest of its open changes ([`open_changes`]) that leaves it unflagged (ties: the
-/// first in its changes), making and costing as few changes as it takes. They are tried in the order of their cost's
-/// lower bound ([`Baseline::cost_bound`]: a bake's once it is made, any other's from its setup), until the next
-/// bound exceeds the cheapest cost found (a bound never exceeds its cost).
+/// One bone's search for the cheapest of its open changes ([`open_changes`]) that leaves it unflagged (costs alike,
+/// in one [`CostSteps`] step: the first in its changes), making and costing as few changes as it takes. They are
+/// tried in the order of their cost's lower bound ([`Baseline::cost_bound`]: a bake's once it is made, any other's
+/// from its setup), until the next bound lies in a later step than the cheapest cost found (a bound never exceeds its
+/// cost); one whose bound lies in the cheapest's step ranks after it where it comes after it, and is passed over.
 /// What it finds depends on what each change is alone, whoever made or costed it, so the searches of every bone go on
 /// side by side ([`remove`]), each needing one change made or costed at a time.
 struct Removal {
@@ -460,18 +465,29 @@ impl Need {
 
 impl Removal {
     /// The search of `bone` through `changes`, given their lower bounds (a change without one is no contender).
-    fn new(bone: usize, changes: &[(usize, Change)], bounds: &HashMap<Change, Option<f64>>) -> Self {
+    /// Bounds in one step ([`CostSteps`]) are tried in the bone's order: of changes that move alike, the first.
+    fn new(bone: usize, changes: &[(usize, Change)], bounds: &HashMap<Change, Option<f64>>, steps: CostSteps) -> Self {
         let bounded = changes.iter().filter_map(|&(place, change)| Some((bounds[&change]?, place, change)));
         let mut order: Vec<(f64, usize, Change)> = bounded.collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order.sort_by(|a, b| steps.step(a.0).total_cmp(&steps.step(b.0)).then(a.1.cmp(&b.1)));
         Removal { bone, order, next: 0, looked: false, given_up: false, best: None }
     }
 
     /// Goes on as far as what is `known` settles; what it needs next, or `None` once the search is over.
     fn advance(&mut self, baseline: &Baseline, known: &Known) -> Option<Need> {
+        let steps = baseline.steps;
         while let Some(&(bound, place, change)) = self.order.get(self.next) {
-            if self.best.is_some_and(|(cost, ..)| bound > cost) {
-                break;
+            if let Some((cost, first, _)) = self.best {
+                // A change costs at least its bound: in a later step it costs more, in the same one it ranks after
+                // the cheapest where it comes after it.
+                let (step, cheapest) = (steps.step(bound), steps.step(cost));
+                if step > cheapest {
+                    break;
+                }
+                if step == cheapest && place > first {
+                    (self.next, self.looked, self.given_up) = (self.next + 1, false, false);
+                    continue;
+                }
             }
             match self.look(baseline, known, place, change) {
                 Ok(Some(cost)) => self.best = Some((cost, place, change)),
@@ -494,10 +510,18 @@ impl Removal {
         if self.given_up || (first_look && baseline.leaves_flagged(change, self.bone)) {
             return Ok(None);
         }
+        let steps = baseline.steps;
         let cheaper = |cost: f64| {
-            self.best.is_none_or(|(cheapest, first, _)| cost < cheapest || (cost == cheapest && place < first))
+            self.best.is_none_or(|(cheapest, first, _)| {
+                let (step, cheapest) = (steps.step(cost), steps.step(cheapest));
+                step < cheapest || (step == cheapest && place < first)
+            })
         };
-        let limit = self.best.map_or(f64::INFINITY, |(cost, ..)| cost);
+        // The furthest it may move and still rank first: within the cheapest's step where it comes before it, else
+        // in an earlier step.
+        let limit = self.best.map_or(f64::INFINITY, |(cost, first, _)| {
+            steps.past(steps.step(cost) - if place < first { 0.0 } else { 1.0 })
+        });
         match (made, known.costs.get(&change)) {
             (Some(Err(_)), _) | (_, Some(Err(_))) => Ok(None),
             (_, Some(Ok(cost))) if !cheaper(cost.distance.max) => Ok(None),
@@ -560,8 +584,8 @@ fn remove(baseline: &Baseline, searches: &mut [Removal], known: &mut Known) {
 }
 
 /// Costs enough of `contenders` (made) into `known` for the cheapest to be among them, exactly: lower bounds of every
-/// cost first ([`Baseline::cost_bound`]), then exact costs in the order of their bounds until the next bound exceeds
-/// the cheapest exact cost found (ties included, so the ranking's order among equal costs is kept).
+/// cost first ([`Baseline::cost_bound`]), then exact costs in the order of their bounds until the next bound lies in a
+/// later step than the cheapest exact cost found (costs alike included, so the ranking's order among them is kept).
 fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
     let made: Vec<Change> =
         contenders.iter().copied().filter(|change| matches!(known.applied.get(change), Some(Ok(_)))).collect();
@@ -569,9 +593,10 @@ fn cheapest(baseline: &Baseline, contenders: &[Change], known: &mut Known) {
     let mut bounds: Vec<(f64, Change)> =
         made.into_iter().zip(bounds).filter_map(|(change, bound)| Some((bound?, change))).collect();
     bounds.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut cheapest = f64::INFINITY;
+    let (steps, mut cheapest) = (baseline.steps, f64::INFINITY);
     for (bound, change) in bounds {
-        if bound > cheapest {
+        // Costs alike rank in the bone's order: every one in the cheapest's step is costed.
+        if steps.step(bound) > steps.step(cheapest) {
             break;
         }
         let Some(Ok(made)) = known.applied.get(&change) else { continue };
