@@ -154,10 +154,10 @@ impl CostSteps {
         (distance / self.unit).round()
     }
 
-    /// A distance just past every cost of step `step` (beyond the rounding of a division at the step's edge): one
-    /// that moves further is in a later step.
+    /// A distance just past every cost of step `step` (its edge moved out by far more than the rounding of the
+    /// division and the product at it, a few parts in 1e16 at any step): one that moves further is in a later step.
     pub fn past(self, step: f64) -> f64 {
-        (step + 0.5 + 1e-6) * self.unit
+        (step + 0.5) * self.unit * (1.0 + 1e-12)
     }
 }
 
