@@ -639,7 +639,7 @@ impl<'p> Differences<'p> {
             }
             a.skin(difference.a);
             b.skin(difference.b);
-            let (va, vb) = (&a.skinned[difference.a], &b.skinned[difference.b]);
+            let (va, vb) = (&a.skinned[difference.a].0, &b.skinned[difference.b].0);
             let mut largest: f64 = 0.0;
             let means = self.measure != Measure::Largest;
             let mut add = |p: &DVec3, q: &DVec3| {
@@ -759,15 +759,14 @@ struct Side<'e, 'a> {
     length_scales: Vec<f64>,
     /// Per bone, the turn that reads its frame in its partner's ([`frame_turns`]); empty where read as it is.
     frames: &'e [DQuat],
-    /// Per mesh, what skins the vertices the plan compares (`None` for a mesh not compared), where they are, and
-    /// whether they are skinned at the time evaluated.
+    /// Per mesh, what skins the vertices the plan compares (`None` for a mesh not compared), and where they are,
+    /// with the evaluation they were skinned at.
     skinners: Vec<Option<Skinner>>,
-    skinned: Vec<Vec<DVec3>>,
-    fresh: Vec<bool>,
+    skinned: Vec<(Vec<DVec3>, u64)>,
     /// Per bone, its probe points' offsets ([`probe_offsets`]) and the evaluation they were found at: A's are read
     /// by every side compared with it.
     probes: Vec<([DVec3; 3], u64)>,
-    /// How many times the side was evaluated.
+    /// How many times the side was evaluated: what is found once per time is marked with it.
     evaluations: u64,
 }
 
@@ -816,11 +815,10 @@ impl<'e, 'a> Side<'e, 'a> {
         for (mesh, vertices) in &plan.meshes {
             skinners[*mesh] = Some(Skinner::new(&rig.meshes[*mesh], &rig.skins, vertices.clone()));
         }
-        let skinned = vec![Vec::new(); skinners.len()];
-        let fresh = vec![false; skinners.len()];
+        let skinned = vec![(Vec::new(), u64::MAX); skinners.len()];
         let length_scales = plan.evaluation.length_scales();
         let (parts, probes) = (Vec::new(), Vec::new());
-        Side { posing, plan, parts, length_scales, frames: &[], skinners, skinned, fresh, probes, evaluations: 0 }
+        Side { posing, plan, parts, length_scales, frames: &[], skinners, skinned, probes, evaluations: 0 }
     }
 
     /// The same side with its frames read in its partner's through `frames` ([`frame_turns`]).
@@ -871,7 +869,6 @@ impl<'e, 'a> Side<'e, 'a> {
                 }
             }
         }
-        self.fresh.fill(false);
         self.evaluations += 1;
     }
 
@@ -888,13 +885,14 @@ impl<'e, 'a> Side<'e, 'a> {
 
     /// Skins mesh `mesh` (its vertices the plan compares) at the time evaluated, once.
     fn skin(&mut self, mesh: usize) {
-        if std::mem::replace(&mut self.fresh[mesh], true) {
+        let (skinned, skinned_at) = &mut self.skinned[mesh];
+        if std::mem::replace(skinned_at, self.evaluations) == self.evaluations {
             return;
         }
         let Some(skinner) = &mut self.skinners[mesh] else { return };
         let (evaluation, pose) = (self.plan.evaluation, self.posing.pose());
         let (rig, posed) = (evaluation.rig, (&pose.model.model[..], &pose.morph));
-        skinner.skin(&rig.meshes[mesh], &rig.skins, posed, evaluation.skinning, &mut self.skinned[mesh]);
+        skinner.skin(&rig.meshes[mesh], &rig.skins, posed, evaluation.skinning, skinned);
     }
 }
 
