@@ -165,6 +165,7 @@ fn joints_as_usd_core(python: &Path, file: &Path, rig: &Rig) -> usize {
         }
         bone += 1 + joints;
     }
+    assert!(matrices.next().is_none(), "{}: usd-core wrote matrices for no joint", file.display());
     compared
 }
 
@@ -243,12 +244,14 @@ fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
         for code in baked["time_codes"].as_array().unwrap() {
             let code = code.as_f64().unwrap();
             let theirs: Vec<Vec<f64>> = points.by_ref().take(count).collect();
+            assert_eq!(theirs.len(), count, "{path} at code {code}: usd-core's points end early");
             if path.starts_with("/GroundTruth") {
                 continue;
             }
             let pose = evaluation.pose_at(code / rate);
             let mut ours = Vec::new();
             evaluation.skin(&pose, mesh, &mut ours);
+            assert_eq!(ours.len(), count, "{}: {path}: bonescope's vertices and usd-core's points", file.display());
             for (v, theirs) in theirs.iter().enumerate() {
                 let apart = (ours[v] - glam::DVec3::from_slice(theirs)).length();
                 assert!(
@@ -260,6 +263,7 @@ fn points_as_baked(python: &Path, file: &Path, baked: &Path) -> usize {
             }
         }
     }
+    assert!(points.next().is_none(), "{}: usd-core wrote points for no mesh", file.display());
     compared
 }
 
